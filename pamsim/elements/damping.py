@@ -1,0 +1,65 @@
+"""Viscous damping force F_damp(v) [N], opposing the motion when positive.
+
+Every law here is zero at v = 0, which the stick/slip logic relies on.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable, Mapping
+
+
+@dataclass(frozen=True)
+class PaperDamping:
+    """Literal reading of paper eq. (8): ``D1 v + D2 v |v|`` (MODEL_NOTES sec. 3).
+
+    With the paper's D1 < 0 this adds energy below |v| = -D1/D2; the work
+    balance in the results reports it.
+    """
+
+    D1_N_s_per_m: float
+    D2_N_s2_per_m2: float
+    name: str = "paper"
+
+    @classmethod
+    def from_parameters(cls, p: Mapping[str, float]) -> "PaperDamping":
+        return cls(p["D1_N_s_per_m"], p["D2_N_s2_per_m2"])
+
+    def force_N(self, v_m_s):
+        return (self.D1_N_s_per_m + self.D2_N_s2_per_m2 * abs(v_m_s)) * v_m_s
+
+
+@dataclass(frozen=True)
+class LinearDamping:
+    """``c v`` with ``c = |D1|``: a dissipative alternative to the paper reading."""
+
+    c_N_s_per_m: float
+    name: str = "linear"
+
+    @classmethod
+    def from_parameters(cls, p: Mapping[str, float]) -> "LinearDamping":
+        return cls(abs(p["D1_N_s_per_m"]))
+
+    def force_N(self, v_m_s):
+        return self.c_N_s_per_m * v_m_s
+
+
+@dataclass(frozen=True)
+class NoDamping:
+    """No viscous damping."""
+
+    name: str = "none"
+
+    @classmethod
+    def from_parameters(cls, p: Mapping[str, float]) -> "NoDamping":
+        return cls()
+
+    def force_N(self, v_m_s):
+        return 0.0 * v_m_s
+
+
+DAMPING_MODELS: dict[str, Callable[[Mapping[str, float]], object]] = {
+    "paper": PaperDamping.from_parameters,
+    "linear": LinearDamping.from_parameters,
+    "none": NoDamping.from_parameters,
+}

@@ -1,0 +1,96 @@
+"""Where the muscle's pressure comes from: a valve feeding the chamber, or a
+prescribed pressure.
+
+A source owns its own states (none for a prescribed pressure; chamber
+pressure and air mass for the valve) and reports the gauge pressure the
+mechanics see.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from .chamber import MuscleChamber
+from .valve import ProportionalValve33
+
+
+@dataclass(frozen=True)
+class ValveChamberSource:
+    """A proportional 3/3 valve between a supply and the muscle chamber.
+
+    States: absolute chamber pressure [Pa] and air mass [kg].
+    ``supply_gauge_Pa(t)`` and ``command(t)`` (in [-1, 1]) are signals.
+    """
+
+    valve: ProportionalValve33
+    chamber: MuscleChamber
+    supply_gauge_Pa: Callable
+    command: Callable
+    T_supply_K: float
+    p_atm_Pa: float
+    name: str = "valve"
+    state_names: tuple[str, ...] = ("p_abs_Pa", "air_mass_kg")
+
+    def initial_state(self, x_m: float, p_gauge_Pa: float = 0.0) -> list[float]:
+        p = self.p_atm_Pa + p_gauge_Pa
+        return [p, self.chamber.air_mass_kg(p, self.chamber.volume_m3(x_m), self.T_supply_K)]
+
+    def pressure_gauge_Pa(self, t_s, s):
+        return s[0] - self.p_atm_Pa
+
+    def inflow_kg_s(self, t_s, s, x_m):
+        """Valve mass flow into the chamber [kg/s] and the chamber gas temperature [K]."""
+        p, m = s[0], s[1]
+        V = self.chamber.volume_m3(x_m)
+        T_gas = self.chamber.gas_temperature_K(p, V, m)
+        mdot = self.valve.inflow_kg_s(self.command(t_s), p, T_gas, self.supply_gauge_Pa(t_s) + self.p_atm_Pa,
+                                      self.T_supply_K, self.p_atm_Pa)
+        return mdot, T_gas
+
+    def derivatives(self, t_s, s, x_m, v_m_s) -> tuple[float, float]:
+        p = s[0]
+        mdot, T_gas = self.inflow_kg_s(t_s, s, x_m)
+        mdot = float(mdot)
+        T_in = self.T_supply_K if mdot >= 0.0 else T_gas
+        V = self.chamber.volume_m3(x_m)
+        dV = self.chamber.dvolume_dx_m2(x_m) * v_m_s
+        return self.chamber.pressure_rate_Pa_s(p, V, dV, mdot, T_in), mdot
+
+    @property
+    def breakpoints(self) -> tuple[float, ...]:
+        return tuple(getattr(self.supply_gauge_Pa, "breakpoints", ())) + tuple(getattr(self.command, "breakpoints", ()))
+
+    def outputs(self, t_s, S, x_m) -> dict[str, np.ndarray]:
+        mdot, T_gas = self.inflow_kg_s(t_s, S, x_m)
+        return {"air_mass_kg": S[1], "valve_mass_flow_kg_s": np.asarray(mdot, dtype=float),
+                "valve_command": np.asarray(self.command(t_s), dtype=float) + 0.0 * t_s,
+                "supply_gauge_Pa": np.asarray(self.supply_gauge_Pa(t_s), dtype=float) + 0.0 * t_s,
+                "gas_temperature_K": T_gas}
+
+
+@dataclass(frozen=True)
+class PrescribedPressure:
+    """Gauge pressure imposed as a signal ``p_gauge_Pa(t)``: step, ramp, lag or measured trace."""
+
+    p_gauge_Pa: Callable
+    name: str = "prescribed"
+    state_names: tuple[str, ...] = ()
+
+    def initial_state(self, x_m: float, p_gauge_Pa: float = 0.0) -> list[float]:
+        return []
+
+    def pressure_gauge_Pa(self, t_s, s):
+        return self.p_gauge_Pa(t_s)
+
+    def derivatives(self, t_s, s, x_m, v_m_s) -> tuple[()]:
+        return ()
+
+    @property
+    def breakpoints(self) -> tuple[float, ...]:
+        return tuple(getattr(self.p_gauge_Pa, "breakpoints", ()))
+
+    def outputs(self, t_s, S, x_m) -> dict[str, np.ndarray]:
+        return {}

@@ -1,0 +1,36 @@
+"""End stops: a lower stop at x = 0 and an upper stop at the braid-lock contraction.
+
+Both are rigid unilateral contacts with a coefficient of restitution (0 by
+default: perfectly inelastic).  They are handled as hybrid modes of the
+simulator, so the contraction never passes them; the contact force is
+reported in the results.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Mapping
+
+from ..parameters import braid_geometry
+
+
+@dataclass(frozen=True)
+class EndStops:
+    """Lower and upper stop positions [m] and restitution [-]."""
+
+    x_low_m: float
+    x_high_m: float
+    restitution: float
+    min_rebound_speed_m_s: float = 1e-3
+
+    @classmethod
+    def from_parameters(cls, p: Mapping[str, float]) -> "EndStops":
+        b, _ = braid_geometry(p)
+        # Braid lock at 54.7 deg (cos^2 = 1/3): L_lock = b / sqrt(3), MODEL_NOTES sec. 5.
+        return cls(0.0, p["L0_m"] - b / math.sqrt(3.0), p["stop_restitution"])
+
+    def rebound_speed_m_s(self, impact_speed_m_s: float) -> float:
+        """Speed after an impact; below ``min_rebound_speed_m_s`` the load stays on the stop."""
+        rebound = self.restitution * abs(impact_speed_m_s)
+        return rebound if rebound > self.min_rebound_speed_m_s else 0.0

@@ -1,0 +1,71 @@
+"""ISO 6358 valve with a laminar branch near a pressure ratio of 1, and the
+proportional 3/3 valve built on it.
+
+Not in the paper (MODEL_NOTES sec. 6).  The subsonic ISO 6358 law has an
+infinite slope at p_down/p_up -> 1; above ``laminar_ratio`` it is replaced by a
+straight line to zero flow at ratio 1, as Simscape's ISO 6358 block does.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Mapping
+
+
+@dataclass(frozen=True)
+class Iso6358Orifice:
+    """Sonic conductance C [m^3/(s Pa)], critical ratio b [-], laminar ratio [-], reference state."""
+
+    C_m3_per_s_Pa: float
+    b: float
+    laminar_ratio: float
+    rho0_kg_m3: float
+    T0_K: float
+
+    @classmethod
+    def from_parameters(cls, p: Mapping[str, float]) -> "Iso6358Orifice":
+        return cls(p["valve_C_m3_per_s_Pa"], p["valve_b"], p["valve_laminar_ratio"],
+                   p["rho0_kg_m3"], p["T0_K"])
+
+    def mass_flow_kg_s(self, p_a_Pa, p_b_Pa, T_a_K, T_b_K):
+        """Signed mass flow [kg/s] from side a to side b (absolute pressures, temperatures).
+
+        Written without branches so that one code path serves floats (in the
+        right-hand side, where numpy calls on scalars would dominate the cost)
+        and arrays (when a trace is post-processed).
+        """
+        forward = p_a_Pa >= p_b_Pa
+        p_up = _max(p_a_Pa, p_b_Pa)
+        p_down = _min(p_a_Pa, p_b_Pa)
+        T_up = T_b_K + (T_a_K - T_b_K) * forward
+        ratio = p_down / p_up
+        # Below b the flow is choked (s = 0); above laminar_ratio the subsonic law is frozen
+        # and scaled linearly to zero at ratio 1.
+        s = _max(_min(ratio, self.laminar_ratio) - self.b, 0.0) / (1.0 - self.b)
+        laminar_scale = _min(1.0, (1.0 - ratio) / (1.0 - self.laminar_ratio))
+        flow = (self.C_m3_per_s_Pa * self.rho0_kg_m3 * p_up * (self.T0_K / T_up) ** 0.5
+                * (1.0 - s * s) ** 0.5 * laminar_scale)
+        return flow * (2 * forward - 1)
+
+
+def _min(a, b):
+    return 0.5 * (a + b - abs(a - b))
+
+
+def _max(a, b):
+    return 0.5 * (a + b + abs(a - b))
+
+
+@dataclass(frozen=True)
+class ProportionalValve33:
+    """3/3 proportional valve: command u in [-1, 1] scales the conductance
+    to supply (u > 0) or to exhaust (u < 0); u = 0 closes it."""
+
+    orifice: Iso6358Orifice
+
+    def inflow_kg_s(self, u, p_chamber_Pa, T_chamber_K, p_supply_Pa, T_supply_K, p_exhaust_Pa):
+        """Mass flow into the chamber [kg/s] (absolute pressures)."""
+        u_supply = _min(_max(u, 0.0), 1.0)
+        u_exhaust = _min(_max(-u, 0.0), 1.0)
+        return (u_supply * self.orifice.mass_flow_kg_s(p_supply_Pa, p_chamber_Pa, T_supply_K, T_chamber_K)
+                + u_exhaust * self.orifice.mass_flow_kg_s(p_exhaust_Pa, p_chamber_Pa, T_supply_K, T_chamber_K))

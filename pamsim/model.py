@@ -1,0 +1,136 @@
+"""The muscle model: the elements composed into one hybrid ODE.
+
+State vector ``y``::
+
+    [x_m, v_m_s, *source states, W_muscle_J, E_friction_J, E_damping_J, W_external_J]
+
+The last four are work integrals used for the energy balance.  The equation
+of motion (paper eq. (12), MODEL_NOTES sec. 4), x > 0 contracting::
+
+    m x'' = F_static(x, p) - F_damp(v) - F_c(x, p) sgn(v) - m g + F_ext(t)
+
+The friction direction is not a sign function but a discrete mode
+(:class:`Mode`); in the rest modes x and v are frozen and only the pressure
+source evolves.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import IntEnum
+
+import numpy as np
+
+from .elements.load import HangingLoad
+from .elements.stops import EndStops
+
+
+class Mode(IntEnum):
+    """Friction / contact mode of the load."""
+
+    SLIP_DOWN = -1
+    STICK = 0
+    SLIP_UP = 1
+    STOP_LOW = 2
+    STOP_HIGH = 3
+
+    @property
+    def is_slip(self) -> bool:
+        return self in (Mode.SLIP_UP, Mode.SLIP_DOWN)
+
+    @property
+    def label(self) -> str:
+        return self.name.lower()
+
+
+N_WORK = 4
+WORK_NAMES = ("W_muscle_J", "E_friction_J", "E_damping_J", "W_external_J")
+
+
+@dataclass(frozen=True)
+class FitRange:
+    """Range on which the static polynomial was fitted [m, Pa]."""
+
+    x_min_m: float
+    x_max_m: float
+    p_max_gauge_Pa: float
+
+
+@dataclass(frozen=True)
+class MuscleModel:
+    """The composed model.  Every element is swappable."""
+
+    static_force: object
+    friction: object
+    damping: object
+    load: HangingLoad
+    stops: EndStops
+    source: object
+    fit_range: FitRange
+
+    @property
+    def n_source(self) -> int:
+        return len(self.source.state_names)
+
+    @property
+    def state_names(self) -> tuple[str, ...]:
+        return ("x_m", "v_m_s") + tuple(self.source.state_names) + WORK_NAMES
+
+    def initial_state(self, x0_m: float = 0.0) -> np.ndarray:
+        return np.array([x0_m, 0.0] + self.source.initial_state(x0_m) + [0.0] * N_WORK)
+
+    @property
+    def breakpoints(self) -> tuple[float, ...]:
+        return tuple(self.source.breakpoints) + tuple(self.load.breakpoints)
+
+    def rest_forces(self, t: float, y) -> tuple[float, float]:
+        """Net force at zero velocity (static - weight + external) and the Coulomb level [N]."""
+        x = y[0]
+        p = self.source.pressure_gauge_Pa(t, y[2:2 + self.n_source])
+        net = self.static_force.force_N(x, p) - self.load.weight_N + self.load.external_N(t)
+        return float(net), float(self.friction.level_N(x, p, self.load.mass_kg))
+
+    def rhs(self, t: float, y, mode: Mode) -> np.ndarray:
+        x, v = y[0], y[1]
+        ns = self.n_source
+        s = y[2:2 + ns]
+        p = self.source.pressure_gauge_Pa(t, s)
+        if mode == Mode.SLIP_UP or mode == Mode.SLIP_DOWN:
+            F_s = self.static_force.force_N(x, p)
+            F_c = self.friction.level_N(x, p, self.load.mass_kg)
+            F_d = self.damping.force_N(v)
+            F_e = self.load.external_N(t)
+            a = (F_s - F_d - mode * F_c - self.load.weight_N + F_e) / self.load.mass_kg
+            out = [v, a, *self.source.derivatives(t, s, x, v), F_s * v, F_c * abs(v), F_d * v, F_e * v]
+        else:
+            out = [0.0, 0.0, *self.source.derivatives(t, s, x, 0.0), 0.0, 0.0, 0.0, 0.0]
+        return np.array(out, dtype=float)
+
+    def breakdown(self, t, Y, modes) -> dict[str, np.ndarray]:
+        """Force components [N] along x (positive contracts) and source outputs for a trace.
+
+        ``Y`` has one column per time.  In a rest mode the friction and stop
+        reactions are whatever holds the load still.
+        """
+        x, v = Y[0], Y[1]
+        S = Y[2:2 + self.n_source]
+        p = np.asarray(self.source.pressure_gauge_Pa(t, S), dtype=float) + 0.0 * t
+        F_s = np.asarray(self.static_force.force_N(x, p), dtype=float)
+        F_c = np.asarray(self.friction.level_N(x, p, self.load.mass_kg), dtype=float) + 0.0 * t
+        F_e = np.asarray(self.load.external_N(t), dtype=float) + 0.0 * t
+        F_g = np.full_like(t, -self.load.weight_N)
+        net = F_s + F_g + F_e
+        slip = np.abs(modes) == 1
+        stick = modes == Mode.STICK
+        low = modes == Mode.STOP_LOW
+        high = modes == Mode.STOP_HIGH
+        friction = np.where(slip, -modes * F_c, 0.0)
+        # Held still: friction takes what it can, the stop the rest (pressing into it).
+        held_by_friction = stick | (low & (net > 0)) | (high & (net < 0))
+        friction = np.where(held_by_friction, -net, friction)
+        stop = np.where((low & (net <= 0)) | (high & (net >= 0)), -net, 0.0)
+        damping = np.where(slip, -np.asarray(self.damping.force_N(v), dtype=float), 0.0)
+        out = {"p_gauge_Pa": p, "F_static_N": F_s, "F_friction_N": friction, "F_damping_N": damping,
+               "F_gravity_N": F_g, "F_external_N": F_e, "F_stop_N": stop, "F_coulomb_level_N": F_c}
+        out.update(self.source.outputs(t, S, x))
+        return out

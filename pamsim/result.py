@@ -1,0 +1,166 @@
+"""Simulation results: arrays with units in their names, summaries, balances, CSV."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from .atomic import atomic_path
+from .model import N_WORK, Mode
+
+if TYPE_CHECKING:
+    from .model import MuscleModel
+
+CSV_LEADING_COLUMNS = ("t_s", "x_m", "v_m_s", "p_gauge_Pa")
+REST_SPEED_M_S = 1e-4
+"""A load in a slip mode slower than this, with the net force inside the friction band, counts as at rest."""
+
+
+@dataclass(frozen=True)
+class TransitionEvent:
+    """A mode change: when, why, from and to which mode, at which contraction."""
+
+    t_s: float
+    kind: str
+    from_mode: str
+    to_mode: str
+    x_m: float
+
+
+@dataclass
+class Result:
+    """Trace of one simulation, sampled at the output rate.
+
+    Attributes are numpy arrays named with their unit: ``t_s``, ``x_m``,
+    ``v_m_s``, ``p_gauge_Pa``, ``mode`` (:class:`~pamsim.model.Mode` values),
+    and ``signals``, a dict holding the force components (``F_static_N``,
+    ``F_friction_N``, ``F_damping_N``, ``F_gravity_N``, ``F_external_N``,
+    ``F_stop_N``, ``F_coulomb_level_N``), the work integrals and, for a valve
+    source, ``air_mass_kg``, ``valve_mass_flow_kg_s``, ``valve_command``,
+    ``supply_gauge_Pa`` and ``gas_temperature_K``.
+    """
+
+    name: str
+    t_s: np.ndarray
+    x_m: np.ndarray
+    v_m_s: np.ndarray
+    p_gauge_Pa: np.ndarray
+    mode: np.ndarray
+    signals: dict[str, np.ndarray]
+    transitions: list[TransitionEvent]
+    stats: dict
+    wall_time_s: float
+    mass_kg: float
+    g_m_s2: float
+    impact_loss_J: float
+    final_rest_forces_N: tuple[float, float]
+    fit_range_violations: list[str] = field(default_factory=list)
+    model: "MuscleModel | None" = field(default=None, repr=False)
+
+    @classmethod
+    def from_trace(cls, model: "MuscleModel", name, t, Y, modes, transitions, impact_losses, stats, wall_time_s):
+        sig = model.breakdown(t, Y, modes)
+        for i, key in enumerate(model.state_names[-N_WORK:]):
+            sig[key] = Y[-N_WORK + i]
+        loss_t = np.array([a for a, _ in impact_losses])
+        loss_J = np.array([b for _, b in impact_losses])
+        cum = np.concatenate([[0.0], np.cumsum(loss_J)])
+        sig["E_impacts_J"] = cum[np.searchsorted(loss_t, t, side="right")]
+        p = sig.pop("p_gauge_Pa")
+        fr = model.fit_range
+        violations = []
+        if Y[0].min() < fr.x_min_m:
+            violations.append(f"contraction down to {Y[0].min() * 1e3:.2f} mm, below the fitted {fr.x_min_m * 1e3:.2f} mm")
+        if Y[0].max() > fr.x_max_m:
+            violations.append(f"contraction up to {Y[0].max() * 1e3:.2f} mm, above the fitted {fr.x_max_m * 1e3:.1f} mm")
+        if p.max() > fr.p_max_gauge_Pa:
+            violations.append(f"pressure up to {p.max() / 1e5:.3f} bar, above the fitted {fr.p_max_gauge_Pa / 1e5:.2f} bar")
+        final = model.rest_forces(float(t[-1]), Y[:, -1])
+        wall_time_s = wall_time_s  # the breakdown above is part of the run's cost
+        return cls(name, t, Y[0].copy(), Y[1].copy(), p, modes, sig, transitions, stats, wall_time_s,
+                   model.load.mass_kg, model.load.g_m_s2, float(loss_J.sum()), final, violations, model)
+
+    # ------------------------------------------------------------------ queries
+    @property
+    def final_mode(self) -> Mode:
+        return Mode(int(self.mode[-1]))
+
+    @property
+    def at_rest_at_end(self) -> bool:
+        """Held (stick or on a stop), or slower than ``REST_SPEED_M_S`` inside the friction band."""
+        if not self.final_mode.is_slip:
+            return True
+        net, level = self.final_rest_forces_N
+        return abs(self.v_m_s[-1]) < REST_SPEED_M_S and abs(net) <= level + 1e-3
+
+    @property
+    def out_of_fit_range(self) -> bool:
+        return bool(self.fit_range_violations)
+
+    def energy_balance(self) -> dict[str, float]:
+        """Work of the muscle and external force against the energy the load gained and lost [J].
+
+        ``residual_J`` = work in - (kinetic + potential gain + friction + damping + impacts);
+        ``relative`` divides it by the largest term.
+        """
+        s = self.signals
+        d_ke = 0.5 * self.mass_kg * (self.v_m_s[-1] ** 2 - self.v_m_s[0] ** 2)
+        d_pe = self.mass_kg * self.g_m_s2 * (self.x_m[-1] - self.x_m[0])
+        terms = {"W_muscle_J": float(s["W_muscle_J"][-1]), "W_external_J": float(s["W_external_J"][-1]),
+                 "dKE_J": float(d_ke), "dPE_J": float(d_pe), "E_friction_J": float(s["E_friction_J"][-1]),
+                 "E_damping_J": float(s["E_damping_J"][-1]), "E_impacts_J": float(s["E_impacts_J"][-1])}
+        residual = (terms["W_muscle_J"] + terms["W_external_J"] - terms["dKE_J"] - terms["dPE_J"]
+                    - terms["E_friction_J"] - terms["E_damping_J"] - terms["E_impacts_J"])
+        scale = max(abs(v) for v in terms.values()) or 1.0
+        return {**terms, "residual_J": float(residual), "relative": float(abs(residual) / scale)}
+
+    def summary(self) -> dict:
+        """The figures ``pamsim run`` writes to its JSON file."""
+        s = {
+            "scenario": self.name,
+            "final_contraction_m": float(self.x_m[-1]),
+            "peak_contraction_m": float(self.x_m.max()),
+            "final_velocity_m_s": float(self.v_m_s[-1]),
+            "final_pressure_gauge_Pa": float(self.p_gauge_Pa[-1]),
+            "peak_pressure_gauge_Pa": float(self.p_gauge_Pa.max()),
+            "final_mode": self.final_mode.label,
+            "at_rest_at_end": bool(self.at_rest_at_end),
+            "final_net_force_N": float(self.final_rest_forces_N[0]),
+            "final_coulomb_level_N": float(self.final_rest_forces_N[1]),
+            "events": int(self.stats["events"]),
+            "rhs_evaluations": int(self.stats["rhs_evaluations"]),
+            "segments": int(self.stats["segments"]),
+            "wall_time_s": float(self.wall_time_s),
+            "out_of_fit_range": self.out_of_fit_range,
+            "fit_range_violations": list(self.fit_range_violations),
+            "energy_balance": self.energy_balance(),
+        }
+        return s
+
+    # ------------------------------------------------------------------ output
+    def columns(self) -> dict[str, np.ndarray]:
+        cols = {"t_s": self.t_s, "x_m": self.x_m, "v_m_s": self.v_m_s, "p_gauge_Pa": self.p_gauge_Pa,
+                "mode": self.mode}
+        cols.update(self.signals)
+        return cols
+
+    def to_csv(self, path) -> None:
+        """Write the trace; the first columns are ``t_s,x_m,v_m_s,p_gauge_Pa``. Atomic."""
+        cols = self.columns()
+        data = np.column_stack([np.asarray(v, dtype=float) for v in cols.values()])
+        with atomic_path(path) as tmp:
+            np.savetxt(tmp, data, delimiter=",", header=",".join(cols), comments="", fmt="%.10g")
+
+    def to_json(self, path) -> None:
+        """Write :meth:`summary` as JSON. Atomic."""
+        with atomic_path(path) as tmp:
+            tmp.write_text(json.dumps(self.summary(), indent=2) + "\n")
+
+    def plot(self, path=None, **kwargs):
+        """Plot contraction, pressure and forces (see :func:`pamsim.plotting.plot_result`)."""
+        from .plotting import plot_result
+
+        return plot_result(self, path, **kwargs)

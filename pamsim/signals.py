@@ -1,0 +1,130 @@
+"""Time signals that drive a simulation: valve command, supply or prescribed
+pressure, external force.
+
+Every signal is evaluated with ``signal(t)`` for a float or an array of times,
+and lists its ``breakpoints``: the times at which it jumps or kinks, where the
+simulator restarts the integrator instead of letting the error control stumble
+over a discontinuity.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Constant:
+    """A constant value."""
+
+    value: float
+
+    def __call__(self, t):
+        return self.value + 0.0 * t
+
+    @property
+    def breakpoints(self) -> tuple[float, ...]:
+        return ()
+
+    @property
+    def final_value(self) -> float:
+        return self.value
+
+
+@dataclass(frozen=True)
+class Step:
+    """``initial`` before ``time_s``, ``final`` from then on."""
+
+    time_s: float
+    initial: float
+    final: float
+
+    def __call__(self, t):
+        if np.ndim(t) == 0:
+            return self.final if t >= self.time_s else self.initial
+        return np.where(np.asarray(t) >= self.time_s, self.final, self.initial)
+
+    @property
+    def breakpoints(self) -> tuple[float, ...]:
+        return (self.time_s,)
+
+    @property
+    def final_value(self) -> float:
+        return self.final
+
+
+@dataclass(frozen=True)
+class Ramp:
+    """Linear from ``initial`` at ``start_s`` to ``final`` at ``end_s``."""
+
+    start_s: float
+    end_s: float
+    initial: float
+    final: float
+
+    def __call__(self, t):
+        return np.interp(t, (self.start_s, self.end_s), (self.initial, self.final)) if np.ndim(t) else (
+            float(np.interp(t, (self.start_s, self.end_s), (self.initial, self.final))))
+
+    @property
+    def breakpoints(self) -> tuple[float, ...]:
+        return (self.start_s, self.end_s)
+
+    @property
+    def final_value(self) -> float:
+        return self.final
+
+
+@dataclass(frozen=True)
+class FirstOrderLag:
+    """A step from ``initial`` to ``final`` at ``time_s`` through a first-order lag ``tau_s``."""
+
+    time_s: float
+    initial: float
+    final: float
+    tau_s: float
+
+    def __call__(self, t):
+        if np.ndim(t) == 0:
+            if t < self.time_s:
+                return self.initial
+            return self.final + (self.initial - self.final) * math.exp(-(t - self.time_s) / self.tau_s)
+        t = np.asarray(t, dtype=float)
+        lag = self.final + (self.initial - self.final) * np.exp(-np.maximum(t - self.time_s, 0.0) / self.tau_s)
+        return np.where(t >= self.time_s, lag, self.initial)
+
+    @property
+    def breakpoints(self) -> tuple[float, ...]:
+        return (self.time_s,)
+
+    @property
+    def final_value(self) -> float:
+        return self.final
+
+
+@dataclass(frozen=True)
+class Trace:
+    """A measured signal, linearly interpolated, held constant outside its span."""
+
+    t_s: np.ndarray = field(repr=False)
+    values: np.ndarray = field(repr=False)
+    source: str = ""
+
+    def __call__(self, t):
+        if np.ndim(t) == 0:
+            return float(np.interp(t, self.t_s, self.values))
+        return np.interp(t, self.t_s, self.values)
+
+    @property
+    def breakpoints(self) -> tuple[float, ...]:
+        return ()
+
+    @property
+    def final_value(self) -> float:
+        return float(self.values[-1])
+
+    @property
+    def max_value(self) -> float:
+        return float(np.max(self.values))
