@@ -1,0 +1,18 @@
+"""pamsim: dynamic simulation of McKibben pneumatic artificial muscles.
+
+    import pamsim
+    result = pamsim.simulate(pamsim.load_scenario("scenarios/acra2012_fig4.toml"))
+    result.plot("fig4.png")
+"""
+
+from .api import simulate
+from .model import Mode, MuscleModel
+from .parameters import PARAMETER_SETS, ParameterSet, get_parameter_set
+from .result import Result
+from .scenario import Scenario, ScenarioError, load_scenario
+from .simulator import SolverFailure, SolverOptions, simulate_model
+
+__all__ = ["simulate", "load_scenario", "Scenario", "ScenarioError", "Result", "Mode", "MuscleModel",
+           "PARAMETER_SETS", "ParameterSet", "get_parameter_set", "SolverFailure", "SolverOptions",
+           "simulate_model"]
+__version__ = "0.1.0"

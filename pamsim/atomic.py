@@ -25,3 +25,23 @@ def atomic_path(path: str | os.PathLike):
         with contextlib.suppress(FileNotFoundError):
             os.unlink(tmp)
         raise
+
+
+@contextlib.contextmanager
+def atomic_outputs(directory: str | os.PathLike, names: list[str]):
+    """Yield ``{name: temporary path}`` for a set of files that appear together or not at all.
+
+    The files are written into a hidden staging folder inside ``directory``
+    and moved into place only when the block succeeds.
+    """
+    import shutil
+
+    directory = Path(directory)
+    directory.mkdir(parents=True, exist_ok=True)
+    stage = Path(tempfile.mkdtemp(prefix=".pamsim-", dir=directory))
+    try:
+        yield {name: stage / name for name in names}
+        for name in names:
+            os.replace(stage / name, directory / name)
+    finally:
+        shutil.rmtree(stage, ignore_errors=True)

@@ -21,12 +21,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from .model import N_WORK, Mode, MuscleModel
+from .errors import SolverFailure
+from .model import Mode, MuscleModel
 from .result import Result, TransitionEvent
-
-
-class SolverFailure(RuntimeError):
-    """The integrator failed or the event logic exceeded its bounds."""
 
 
 @dataclass(frozen=True)
@@ -206,4 +203,4 @@ def _transition(model: MuscleModel, kind: str, t: float, y: np.ndarray, mode: Mo
     return _rest_mode(model, t, y, Mode.STOP_LOW if low else Mode.STOP_HIGH, opts.stick_margin_N)
 
 
-__all__ = ["SolverFailure", "SolverOptions", "simulate_model", "initial_mode", "N_WORK"]
+__all__ = ["SolverFailure", "SolverOptions", "simulate_model", "initial_mode"]

@@ -1,0 +1,21 @@
+"""Simulation backends selectable with ``pamsim run --backend``.
+
+Each maps a :class:`~pamsim.scenario.Scenario` to a :class:`~pamsim.result.Result`.
+Backends that need optional machinery (a C compiler for the FMU) are
+imported only when chosen.
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import Callable
+
+# name -> "module:function"
+BACKENDS: dict[str, str] = {
+    "python": "pamsim.api:simulate",
+}
+
+
+def get_backend(name: str) -> Callable:
+    module, func = BACKENDS[name].split(":")
+    return getattr(importlib.import_module(module), func)

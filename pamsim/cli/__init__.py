@@ -1,0 +1,57 @@
+"""The ``pamsim`` command line: a thin layer over the Python API.
+
+Each subcommand lives in its own module with a ``register(subparsers)``
+function; user mistakes exit with code 2 and a one-line message, solver
+failures with code 3.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+from ..errors import InputError, SolverFailure
+
+COMMANDS = (
+    "pamsim.cli.run",
+    "pamsim.cli.static",
+)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="pamsim", description="McKibben muscle simulator")
+    parser.add_argument("--version", action="version", version="pamsim " + __import__("pamsim").__version__)
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    for name in COMMANDS:
+        importlib.import_module(name).register(sub)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return int(args.func(args) or 0)
+    except InputError as exc:
+        print(f"pamsim: error: {exc}", file=sys.stderr)
+        return 2
+    except SolverFailure as exc:
+        print(f"pamsim: solver failure: {exc}", file=sys.stderr)
+        return 3
+    except KeyboardInterrupt:
+        print("pamsim: interrupted", file=sys.stderr)
+        return 130
+
+
+def finite_float(text: str) -> float:
+    """argparse type: a finite number."""
+    import math
+
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a finite number")
+    return value

@@ -1,0 +1,400 @@
+"""Scenarios: a TOML file (or a dict) that names a parameter set, overrides,
+the element choices, the load, the pressure source, the duration and the
+solver settings.  The schema is documented in ``docs/scenarios.md``.
+
+Every mistake raises :class:`ScenarioError` naming the file, the key and the
+offending value; the CLI turns it into a one-line message and exit code 2.
+"""
+
+from __future__ import annotations
+
+import copy
+import difflib
+import math
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Mapping
+
+import numpy as np
+
+from .constants import PA_PER_BAR
+from .errors import InputError
+from .elements.chamber import MuscleChamber
+from .elements.damping import DAMPING_MODELS
+from .elements.friction import FRICTION_MODELS
+from .elements.load import HangingLoad
+from .elements.pressure_source import PrescribedPressure, ValveChamberSource
+from .elements.static_force import STATIC_FORCE_MODELS
+from .elements.stops import EndStops
+from .elements.valve import Iso6358Orifice, ProportionalValve33
+from .model import FitRange, MuscleModel
+from .parameters import PARAMETER_SETS, ParameterSet
+from .signals import Constant, FirstOrderLag, Ramp, Step, Trace
+from .simulator import SolverOptions
+
+
+# Schema: section -> {key: (type, required)}; a nested dict is a sub-table.
+_SIGNAL_KEYS = {"kind", "time_s", "start_s", "end_s", "tau_s", "file", "time_column", "value_column"}
+_SCHEMA: dict[str, dict[str, Any]] = {
+    "": {"name": str, "description": str, "model": dict, "parameters": dict, "load": dict, "pressure": dict,
+         "simulation": dict, "solver": dict},
+    "model": {"parameter_set": str, "static_force": str, "friction": str, "damping": str},
+    "load": {"weight_N": float, "mass_kg": float, "external_force": dict},
+    "pressure": {"source": str, "supply_gauge_bar": float, "supply_gauge_Pa": float, "valve_open_time_s": float,
+                 "command": dict, "prescribed": dict, "initial_gauge_bar": float},
+    "simulation": {"duration_s": float, "sample_rate_Hz": float, "initial_contraction_m": float},
+    "solver": {"method": str, "rtol": float, "max_events": int, "max_step_s": float},
+}
+_METHODS = ("LSODA", "RK45", "DOP853", "Radau", "BDF", "RK23")
+
+
+class ScenarioError(InputError):
+    """A scenario that cannot be run; the message names file, key and value."""
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """A validated scenario.  Build one with :func:`load_scenario` or :meth:`from_dict`.
+
+    ``spec`` is the validated dict (the TOML content); ``parameters`` the
+    parameter set with the scenario's overrides applied.
+    """
+
+    name: str
+    spec: Mapping[str, Any] = field(repr=False)
+    parameters: ParameterSet = field(repr=False)
+    duration_s: float
+    solver: SolverOptions
+    base_dir: Path = field(default=Path("."), repr=False)
+    origin: str = "<dict>"
+
+    # ------------------------------------------------------------ construction
+    @classmethod
+    def from_dict(cls, spec: Mapping[str, Any], name: str | None = None, base_dir: str | Path = ".",
+                  origin: str = "<dict>") -> "Scenario":
+        """Validate ``spec`` (the same structure as a TOML file) and return a Scenario."""
+        v = _Validator(origin, Path(base_dir))
+        spec = copy.deepcopy(dict(spec))
+        v.check_table("", spec)
+        for section in ("model", "load", "pressure", "simulation", "solver"):
+            if section in spec:
+                v.check_table(section, spec[section])
+        for section in ("load", "pressure", "simulation"):
+            if section not in spec:
+                raise ScenarioError(f"{origin}: missing section [{section}]")
+        model = spec.setdefault("model", {})
+        set_name = model.setdefault("parameter_set", "shadow_6x300_acra2012")
+        if set_name not in PARAMETER_SETS:
+            v.fail("model.parameter_set", set_name, "unknown parameter set", choices=PARAMETER_SETS)
+        for key, registry, default in (("static_force", STATIC_FORCE_MODELS, "acra2012_polynomial"),
+                                       ("friction", FRICTION_MODELS, "load_dependent"),
+                                       ("damping", DAMPING_MODELS, "paper")):
+            choice = model.setdefault(key, default)
+            if choice not in registry:
+                v.fail(f"model.{key}", choice, "unknown choice", choices=registry)
+        params = PARAMETER_SETS[set_name]
+        overrides = spec.get("parameters", {})
+        for key, value in overrides.items():
+            if key not in params:
+                v.fail(f"parameters.{key}", value, "unknown parameter", choices=params)
+            v.number(f"parameters.{key}", value)
+        params = params.with_overrides(overrides, source=f"override in {origin}")
+        sim = spec["simulation"]
+        duration = v.positive("simulation.duration_s", v.required(sim, "simulation", "duration_s"))
+        sample_rate = v.positive("simulation.sample_rate_Hz", sim.get("sample_rate_Hz", 1000.0))
+        x0 = v.number("simulation.initial_contraction_m", sim.get("initial_contraction_m", 0.0))
+        solver = spec.get("solver", {})
+        method = solver.get("method", "LSODA")
+        if method not in _METHODS:
+            v.fail("solver.method", method, "unknown method", choices=_METHODS)
+        rtol = v.number("solver.rtol", solver.get("rtol", 1e-6))
+        if not 1e-13 <= rtol <= 1e-2:
+            v.fail("solver.rtol", rtol, "must lie in [1e-13, 1e-2]")
+        max_events = solver.get("max_events", 20000)
+        if max_events < 1:
+            v.fail("solver.max_events", max_events, "must be at least 1")
+        max_step = v.positive("solver.max_step_s", solver.get("max_step_s", math.inf))
+        opts = SolverOptions(method=method, rtol=rtol, sample_rate_Hz=sample_rate, max_events=int(max_events),
+                             max_step_s=max_step)
+        scenario = cls(name or spec.get("name") or "scenario", spec, params, duration, opts, Path(base_dir), origin)
+        scenario._check_load(v)
+        scenario._build_source(v)  # validates the pressure section and any trace file
+        stops = EndStops.from_parameters(params)
+        if not stops.x_low_m <= x0 <= stops.x_high_m:
+            v.fail("simulation.initial_contraction_m", x0, f"must lie between the stops, 0 and {stops.x_high_m:.4f} m")
+        return scenario
+
+    def with_changes(self, changes: Mapping[str, Mapping[str, Any]], name: str | None = None) -> "Scenario":
+        """A new scenario with some keys of some sections replaced (for sweeps and scripts)."""
+        spec = copy.deepcopy(dict(self.spec))
+        for section, values in changes.items():
+            spec.setdefault(section, {}).update(values)
+        for exclusive in (("weight_N", "mass_kg"), ("supply_gauge_bar", "supply_gauge_Pa")):
+            for section in ("load", "pressure"):
+                table = changes.get(section, {})
+                if any(k in table for k in exclusive):
+                    for k in exclusive:
+                        if k not in table:
+                            spec[section].pop(k, None)
+        return Scenario.from_dict(spec, name or self.name, self.base_dir, self.origin)
+
+    # ------------------------------------------------------------ model build
+    @property
+    def mass_kg(self) -> float:
+        load = self.spec["load"]
+        return load["mass_kg"] if "mass_kg" in load else load["weight_N"] / self.parameters["g_m_s2"]
+
+    @property
+    def final_pressure_gauge_Pa(self) -> float:
+        """Supply pressure of the valve, or the final prescribed pressure [Pa gauge]."""
+        return self._final_pressure_Pa()
+
+    def _final_pressure_Pa(self) -> float:
+        src = self._build_source(_Validator(self.origin, self.base_dir))
+        if isinstance(src, ValveChamberSource):
+            return float(src.supply_gauge_Pa.final_value)
+        return float(src.p_gauge_Pa.final_value)
+
+    def _check_load(self, v: "_Validator") -> None:
+        load = self.spec["load"]
+        if ("weight_N" in load) == ("mass_kg" in load):
+            raise ScenarioError(f"{self.origin}: [load] needs exactly one of weight_N or mass_kg")
+        key = "weight_N" if "weight_N" in load else "mass_kg"
+        value = v.number(f"load.{key}", load[key])
+        if value <= 0:
+            v.fail(f"load.{key}", value, "must be positive")
+
+    def _build_source(self, v: "_Validator"):
+        pr = self.spec["pressure"]
+        p = self.parameters
+        source = v.required(pr, "pressure", "source")
+        rating = p["rated_pressure_gauge_Pa"]
+        if source == "valve":
+            v.allowed("pressure", pr, {"source", "supply_gauge_bar", "supply_gauge_Pa", "valve_open_time_s",
+                                       "command", "initial_gauge_bar"})
+            if ("supply_gauge_bar" in pr) == ("supply_gauge_Pa" in pr):
+                raise ScenarioError(f"{self.origin}: [pressure] needs exactly one of supply_gauge_bar or supply_gauge_Pa")
+            key = "supply_gauge_bar" if "supply_gauge_bar" in pr else "supply_gauge_Pa"
+            supply = v.number(f"pressure.{key}", pr[key]) * (PA_PER_BAR if key.endswith("bar") else 1.0)
+            if supply < 0:
+                v.fail(f"pressure.{key}", pr[key], "must not be negative")
+            if supply > rating:
+                v.fail(f"pressure.{key}", pr[key], f"exceeds the muscle's rating of {rating / PA_PER_BAR:g} bar "
+                       f"(parameter rated_pressure_gauge_Pa: {self.parameters.entries['rated_pressure_gauge_Pa'].source})")
+            if ("command" in pr) == ("valve_open_time_s" in pr):
+                raise ScenarioError(f"{self.origin}: [pressure] needs exactly one of valve_open_time_s or [pressure.command]")
+            if "command" in pr:
+                command = _signal(v, "pressure.command", pr["command"], "", 1.0, self.base_dir)
+                lo, hi = _signal_range(command)
+                if lo < -1 or hi > 1:
+                    v.fail("pressure.command", f"{lo:g}..{hi:g}", "valve command must stay within [-1, 1]")
+            else:
+                t_open = v.number("pressure.valve_open_time_s", pr["valve_open_time_s"])
+                if t_open < 0:
+                    v.fail("pressure.valve_open_time_s", t_open, "must not be negative")
+                command = Step(t_open, 0.0, 1.0)
+            return ValveChamberSource(ProportionalValve33(Iso6358Orifice.from_parameters(p)),
+                                      MuscleChamber.from_parameters(p), Constant(supply), command,
+                                      p["T_supply_K"], p["p_atm_Pa"])
+        if source == "prescribed":
+            v.allowed("pressure", pr, {"source", "prescribed"})
+            sig = _signal(v, "pressure.prescribed", v.required(pr, "pressure", "prescribed"), "_gauge_bar",
+                          PA_PER_BAR, self.base_dir, alt_suffix=("_gauge_Pa", 1.0))
+            lo, hi = _signal_range(sig)
+            if hi > rating:
+                v.fail("pressure.prescribed", f"{hi / PA_PER_BAR:g} bar", f"exceeds the muscle's rating of {rating / PA_PER_BAR:g} bar")
+            if lo < -p["p_atm_Pa"]:
+                v.fail("pressure.prescribed", f"{lo / PA_PER_BAR:g} bar", "is below vacuum")
+            return PrescribedPressure(sig)
+        v.fail("pressure.source", source, "unknown source", choices=("valve", "prescribed"))
+
+    def build_model(self) -> MuscleModel:
+        """Compose the elements this scenario names into a :class:`MuscleModel`."""
+        p = self.parameters
+        m = self.spec["model"]
+        v = _Validator(self.origin, self.base_dir)
+        ext = self.spec["load"].get("external_force")
+        ext_sig = _signal(v, "load.external_force", ext, "_N", 1.0, self.base_dir) if ext else None
+        return MuscleModel(
+            static_force=STATIC_FORCE_MODELS[m["static_force"]](p),
+            friction=FRICTION_MODELS[m["friction"]](p),
+            damping=DAMPING_MODELS[m["damping"]](p),
+            load=HangingLoad(self.mass_kg, p["g_m_s2"], ext_sig),
+            stops=EndStops.from_parameters(p),
+            source=self._build_source(v),
+            fit_range=FitRange(p["fit_x_min_m"], p["fit_x_max_m"], p["fit_p_max_Pa"]),
+        )
+
+    @property
+    def initial_contraction_m(self) -> float:
+        return float(self.spec["simulation"].get("initial_contraction_m", 0.0))
+
+
+def load_scenario(path: str | Path) -> Scenario:
+    """Read and validate a scenario TOML file."""
+    path = Path(path)
+    if not path.is_file():
+        raise ScenarioError(f"{path}: no such scenario file")
+    try:
+        spec = tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as exc:
+        raise ScenarioError(f"{path}: not valid TOML: {exc}") from None
+    except UnicodeDecodeError:
+        raise ScenarioError(f"{path}: not a text file") from None
+    return Scenario.from_dict(spec, name=spec.get("name") or path.stem, base_dir=path.parent, origin=str(path))
+
+
+# ---------------------------------------------------------------- validation
+class _Validator:
+    def __init__(self, origin: str, base_dir: Path):
+        self.origin = origin
+        self.base_dir = base_dir
+
+    def fail(self, key: str, value: Any, why: str, choices=None):
+        msg = f"{self.origin}: {key} = {value!r}: {why}"
+        if choices is not None:
+            close = difflib.get_close_matches(str(value), [str(c) for c in choices], n=1)
+            msg += f" (did you mean {close[0]!r}?)" if close else f" (choose from {', '.join(map(str, choices))})"
+        raise ScenarioError(msg)
+
+    def check_table(self, section: str, table: Any):
+        where = f"[{section}]" if section else "the top level"
+        if not isinstance(table, dict):
+            raise ScenarioError(f"{self.origin}: {section} = {table!r}: must be a table")
+        schema = _SCHEMA[section]
+        for key, value in table.items():
+            full = f"{section}.{key}" if section else key
+            if key not in schema:
+                close = difflib.get_close_matches(key, list(schema), n=1)
+                hint = f" (did you mean {close[0]!r}?)" if close else f" (known keys in {where}: {', '.join(schema)})"
+                raise ScenarioError(f"{self.origin}: unknown key {full!r} in {where}{hint}")
+            self.type_of(full, value, schema[key])
+
+    def allowed(self, section: str, table: Mapping, keys: set[str]):
+        for key in table:
+            if key not in keys:
+                close = difflib.get_close_matches(key, sorted(keys), n=1)
+                hint = f" (did you mean {close[0]!r}?)" if close else ""
+                raise ScenarioError(f"{self.origin}: key {section}.{key} does not apply to "
+                                    f"source = {table.get('source')!r}{hint}")
+
+    def type_of(self, key: str, value: Any, expected: type):
+        ok = {float: isinstance(value, (int, float)) and not isinstance(value, bool),
+              int: isinstance(value, int) and not isinstance(value, bool),
+              str: isinstance(value, str), dict: isinstance(value, dict)}[expected]
+        if not ok:
+            names = {float: "a number", int: "an integer", str: "a string", dict: "a table"}
+            self.fail(key, value, f"must be {names[expected]}, not {type(value).__name__}")
+        if expected is float and not math.isfinite(value):
+            self.fail(key, value, "must be a finite number")
+
+    def number(self, key: str, value: Any) -> float:
+        self.type_of(key, value, float)
+        return float(value)
+
+    def positive(self, key: str, value: Any) -> float:
+        value = self.number(key, value) if value != math.inf else value
+        if not value > 0:
+            self.fail(key, value, "must be positive")
+        return value
+
+    def required(self, table: Mapping, section: str, key: str):
+        if key not in table:
+            raise ScenarioError(f"{self.origin}: missing key {section}.{key}")
+        return table[key]
+
+
+def _signal(v: _Validator, where: str, spec: Any, suffix: str, scale: float, base_dir: Path,
+            alt_suffix: tuple[str, float] | None = None):
+    """Build a signal from a table ``{kind = ..., ...}``; values are named ``initial<suffix>``, ``final<suffix>``."""
+    if not isinstance(spec, dict):
+        v.fail(where, spec, "must be a table with a 'kind'")
+    kinds = ("constant", "step", "ramp", "lag", "trace")
+    kind = v.required(spec, where, "kind")
+    if kind not in kinds:
+        v.fail(f"{where}.kind", kind, "unknown signal kind", choices=kinds)
+    suffixes = [(suffix, scale)] + ([alt_suffix] if alt_suffix else [])
+    value_keys = {f"{n}{s}" for n in ("initial", "final", "value") for s, _ in suffixes}
+    allowed = {"kind", "time_s", "start_s", "end_s", "tau_s", "initial", "final", "value"} if kind != "trace" else \
+        {"kind", "file", "time_column", "value_column"}
+    for key, value in spec.items():
+        base = key if key in _SIGNAL_KEYS else next((key[: -len(s)] for s, _ in suffixes if s and key.endswith(s)), key)
+        if key not in _SIGNAL_KEYS and key not in value_keys or base not in allowed:
+            known = sorted((allowed & _SIGNAL_KEYS) | {k for k in value_keys if k.split("_")[0] in allowed})
+            close = difflib.get_close_matches(key, known, n=1)
+            hint = f" (did you mean {close[0]!r}?)" if close else f" (known: {', '.join(known)})"
+            raise ScenarioError(f"{v.origin}: unknown key {where}.{key} for kind = {kind!r}{hint}")
+
+    def val(name: str, default: float | None = None) -> float:
+        for s, k in suffixes:
+            if f"{name}{s}" in spec:
+                return v.number(f"{where}.{name}{s}", spec[f"{name}{s}"]) * k
+        if default is None:
+            raise ScenarioError(f"{v.origin}: missing key {where}.{name}{suffixes[0][0]}")
+        return default
+
+    def t(name: str) -> float:
+        value = v.number(f"{where}.{name}", v.required(spec, where, name))
+        if value < 0:
+            v.fail(f"{where}.{name}", value, "must not be negative")
+        return value
+
+    if kind == "constant":
+        return Constant(val("value"))
+    if kind == "step":
+        return Step(t("time_s"), val("initial", 0.0), val("final"))
+    if kind == "ramp":
+        start, end = t("start_s"), t("end_s")
+        if end <= start:
+            v.fail(f"{where}.end_s", end, f"must be after start_s = {start}")
+        return Ramp(start, end, val("initial", 0.0), val("final"))
+    if kind == "lag":
+        tau = t("tau_s")
+        if tau <= 0:
+            v.fail(f"{where}.tau_s", tau, "must be positive")
+        return FirstOrderLag(t("time_s"), val("initial", 0.0), val("final"), tau)
+    return _trace(v, where, spec, suffixes, base_dir)
+
+
+def _trace(v: _Validator, where: str, spec: Mapping, suffixes, base_dir: Path) -> Trace:
+    name = spec["file"]
+    if not isinstance(name, str):
+        v.fail(f"{where}.file", name, "must be a string (a CSV path)")
+    path = (base_dir / name) if not Path(name).is_absolute() else Path(name)
+    if not path.is_file():
+        v.fail(f"{where}.file", name, f"trace file not found at {path}")
+    time_col = spec.get("time_column", "t_s")
+    try:
+        with open(path) as fh:
+            header = fh.readline().strip().split(",")
+        data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+    except (ValueError, OSError) as exc:
+        v.fail(f"{where}.file", name, f"cannot read as CSV with a header row: {exc}")
+    value_cols = [spec["value_column"]] if "value_column" in spec else [c for c in header if c != time_col]
+    if time_col not in header:
+        v.fail(f"{where}.time_column", time_col, f"no such column in {name} (columns: {', '.join(header)})")
+    col = next((c for c in value_cols if c in header), None)
+    unit = next((k for s, k in suffixes if col and col.endswith(s)), None)
+    if col is None or unit is None:
+        want = " or ".join(f"a column ending in {s}" for s, _ in suffixes)
+        v.fail(f"{where}.value_column", spec.get("value_column", col), f"{name} needs {want}")
+    t = data[:, header.index(time_col)]
+    y = data[:, header.index(col)] * unit
+    if len(t) < 2:
+        v.fail(f"{where}.file", name, "a trace needs at least two rows")
+    if not (np.all(np.isfinite(t)) and np.all(np.isfinite(y))):
+        row = int(np.flatnonzero(~(np.isfinite(t) & np.isfinite(y)))[0]) + 2
+        v.fail(f"{where}.file", name, f"non-finite value on line {row}")
+    bad = np.flatnonzero(np.diff(t) <= 0)
+    if bad.size:
+        v.fail(f"{where}.file", name, f"time must increase strictly; line {int(bad[0]) + 3} has t = {t[bad[0] + 1]:g} "
+               f"after {t[bad[0]]:g}")
+    return Trace(t, y, str(path))
+
+
+def _signal_range(sig) -> tuple[float, float]:
+    if isinstance(sig, Trace):
+        return float(sig.values.min()), float(sig.values.max())
+    vals = [getattr(sig, a) for a in ("value", "initial", "final") if hasattr(sig, a)]
+    return min(vals), max(vals)

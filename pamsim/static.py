@@ -1,0 +1,71 @@
+"""Static analysis: the equilibrium contraction under a load, the friction band
+around it, and the force capability (largest load held above the lower stop).
+"""
+
+from __future__ import annotations
+
+from typing import Mapping
+
+import numpy as np
+from scipy.optimize import brentq
+
+from .elements.stops import EndStops
+
+
+def equilibrium_contraction_m(static_force, p_gauge_Pa: float, load_N: float, x_max_m: float,
+                              n_grid: int = 400) -> float:
+    """Smallest contraction x in [0, x_max_m] where F_static(x, p) = load with F falling through it.
+
+    Returns 0 when the muscle cannot lift the load off the lower stop, and
+    ``x_max_m`` when it still pulls harder than the load there.
+    """
+    x = np.linspace(0.0, x_max_m, n_grid)
+    excess = static_force.force_N(x, p_gauge_Pa) - load_N
+    if excess[0] <= 0.0:
+        return 0.0
+    falls = np.flatnonzero((excess[:-1] > 0.0) & (excess[1:] <= 0.0))
+    if falls.size == 0:
+        return float(x_max_m)
+    i = int(falls[0])
+    return float(brentq(lambda xx: static_force.force_N(xx, p_gauge_Pa) - load_N, x[i], x[i + 1], xtol=1e-12))
+
+
+def max_load_N(static_force, p_gauge_Pa: float, x_max_m: float, n_grid: int = 400) -> float:
+    """Force capability: the largest static force over the contraction range, at least that at x = 0."""
+    x = np.linspace(0.0, x_max_m, n_grid)
+    return float(np.max(static_force.force_N(x, p_gauge_Pa)))
+
+
+def friction_band_m(static_force, friction, p_gauge_Pa: float, mass_kg: float, g_m_s2: float,
+                    x_max_m: float) -> tuple[float, float]:
+    """Contractions ``(x_lo, x_hi)`` between which a load at rest stays stuck.
+
+    With F_static falling in x, the band runs from where F_static = W + F_c to
+    where F_static = W - F_c.
+    """
+    W = mass_kg * g_m_s2
+
+    def edge(sign: float) -> float:
+        x = np.linspace(0.0, x_max_m, 400)
+        g = static_force.force_N(x, p_gauge_Pa) - W - sign * friction.level_N(x, p_gauge_Pa, mass_kg)
+        if g[0] <= 0:
+            return 0.0
+        i = np.flatnonzero((g[:-1] > 0) & (g[1:] <= 0))
+        if i.size == 0:
+            return float(x_max_m)
+        k = int(i[0])
+        return float(brentq(lambda xx: static_force.force_N(xx, p_gauge_Pa) - W
+                            - sign * friction.level_N(xx, p_gauge_Pa, mass_kg), x[k], x[k + 1], xtol=1e-12))
+
+    return edge(+1.0), edge(-1.0)
+
+
+def static_report(params: Mapping[str, float], static_force, p_gauge_Pa: float, load_N: float) -> dict:
+    """The figures ``pamsim static`` prints."""
+    x_hi = EndStops.from_parameters(params).x_high_m
+    x_eq = equilibrium_contraction_m(static_force, p_gauge_Pa, load_N, x_hi)
+    return {"pressure_gauge_Pa": p_gauge_Pa, "load_N": load_N, "equilibrium_contraction_m": x_eq,
+            "max_load_N": max_load_N(static_force, p_gauge_Pa, x_hi), "lifts_load": x_eq > 0.0,
+            "upper_stop_m": x_hi,
+            "within_fit_range": bool(params["fit_x_min_m"] <= x_eq <= params["fit_x_max_m"]
+                                     and p_gauge_Pa <= params["fit_p_max_Pa"])}
