@@ -85,26 +85,41 @@ class MuscleModel:
 
     def rest_forces(self, t: float, y) -> tuple[float, float]:
         """Net force at zero velocity (static - weight + external) and the Coulomb level [N]."""
+        return self.rest_forces_with_inputs(y, self.source.inputs(t), self.load.external_N(t))
+
+    def rest_forces_with_inputs(self, y, source_inputs, F_ext_N) -> tuple[float, float]:
         x = y[0]
-        p = self.source.pressure_gauge_Pa(t, y[2:2 + self.n_source])
-        net = self.static_force.force_N(x, p) - self.load.weight_N + self.load.external_N(t)
+        p = self.source.pressure_gauge_Pa(y[2:2 + self.n_source], source_inputs)
+        net = self.static_force.force_N(x, p) - self.load.weight_N + F_ext_N
         return float(net), float(self.friction.level_N(x, p, self.load.mass_kg))
 
     def rhs(self, t: float, y, mode: Mode) -> np.ndarray:
-        x, v = y[0], y[1]
-        ns = self.n_source
-        s = y[2:2 + ns]
-        p = self.source.pressure_gauge_Pa(t, s)
+        """Time derivative of ``y`` in ``mode``, with the inputs taken from the signals."""
         if mode == Mode.SLIP_UP or mode == Mode.SLIP_DOWN:
-            F_s = self.static_force.force_N(x, p)
-            F_c = self.friction.level_N(x, p, self.load.mass_kg)
-            F_d = self.damping.force_N(v)
-            F_e = self.load.external_N(t)
-            a = (F_s - F_d - mode * F_c - self.load.weight_N + F_e) / self.load.mass_kg
-            out = [v, a, *self.source.derivatives(t, s, x, v), F_s * v, F_c * abs(v), F_d * v, F_e * v]
-        else:
-            out = [0.0, 0.0, *self.source.derivatives(t, s, x, 0.0), 0.0, 0.0, 0.0, 0.0]
-        return np.array(out, dtype=float)
+            return self.slip_rhs(y, float(mode), self.source.inputs(t), self.load.external_N(t))
+        return self.held_rhs(y, self.source.inputs(t))
+
+    def slip_rhs(self, y, friction_direction: float, source_inputs, F_ext_N) -> np.ndarray:
+        """Derivatives of a moving load with explicit inputs.
+
+        The Coulomb level is applied as ``-friction_direction * F_c``: +1 or -1
+        for sliding up or down, 0 to drop it, or a smooth ``tanh(v / v_s)`` for
+        a regularised model (used by linearisation).
+        """
+        x, v = y[0], y[1]
+        s = y[2:2 + self.n_source]
+        p = self.source.pressure_gauge_Pa(s, source_inputs)
+        F_s = self.static_force.force_N(x, p)
+        F_c = self.friction.level_N(x, p, self.load.mass_kg)
+        F_d = self.damping.force_N(v)
+        a = (F_s - F_d - friction_direction * F_c - self.load.weight_N + F_ext_N) / self.load.mass_kg
+        return np.array([v, a, *self.source.derivatives(s, x, v, source_inputs),
+                         F_s * v, F_c * abs(v), F_d * v, F_ext_N * v], dtype=float)
+
+    def held_rhs(self, y, source_inputs) -> np.ndarray:
+        """Derivatives of a load held still (stuck or on a stop): only the source evolves."""
+        s = y[2:2 + self.n_source]
+        return np.array([0.0, 0.0, *self.source.derivatives(s, y[0], 0.0, source_inputs), 0.0, 0.0, 0.0, 0.0])
 
     def breakdown(self, t, Y, modes) -> dict[str, np.ndarray]:
         """Force components [N] along x (positive contracts) and source outputs for a trace.
@@ -114,7 +129,7 @@ class MuscleModel:
         """
         x, v = Y[0], Y[1]
         S = Y[2:2 + self.n_source]
-        p = np.asarray(self.source.pressure_gauge_Pa(t, S), dtype=float) + 0.0 * t
+        p = np.asarray(self.source.pressure_gauge_Pa(S, self.source.inputs(t)), dtype=float) + 0.0 * t
         F_s = np.asarray(self.static_force.force_N(x, p), dtype=float)
         F_c = np.asarray(self.friction.level_N(x, p, self.load.mass_kg), dtype=float) + 0.0 * t
         F_e = np.asarray(self.load.external_N(t), dtype=float) + 0.0 * t

@@ -38,21 +38,26 @@ class ValveChamberSource:
         p = self.p_atm_Pa + p_gauge_Pa
         return [p, self.chamber.air_mass_kg(p, self.chamber.volume_m3(x_m), self.T_supply_K)]
 
-    def pressure_gauge_Pa(self, t_s, s):
+    def inputs(self, t_s) -> tuple:
+        """The source's inputs at time t: (valve command [-], supply gauge pressure [Pa])."""
+        return self.command(t_s), self.supply_gauge_Pa(t_s)
+
+    def pressure_gauge_Pa(self, s, inputs):
         return s[0] - self.p_atm_Pa
 
-    def inflow_kg_s(self, t_s, s, x_m):
+    def inflow_kg_s(self, s, x_m, inputs):
         """Valve mass flow into the chamber [kg/s] and the chamber gas temperature [K]."""
         p, m = s[0], s[1]
+        u, supply_gauge_Pa = inputs
         V = self.chamber.volume_m3(x_m)
         T_gas = self.chamber.gas_temperature_K(p, V, m)
-        mdot = self.valve.inflow_kg_s(self.command(t_s), p, T_gas, self.supply_gauge_Pa(t_s) + self.p_atm_Pa,
-                                      self.T_supply_K, self.p_atm_Pa)
+        mdot = self.valve.inflow_kg_s(u, p, T_gas, supply_gauge_Pa + self.p_atm_Pa, self.T_supply_K, self.p_atm_Pa)
         return mdot, T_gas
 
-    def derivatives(self, t_s, s, x_m, v_m_s) -> tuple[float, float]:
+    def derivatives(self, s, x_m, v_m_s, inputs) -> tuple[float, float]:
+        """(dp/dt [Pa/s], dm/dt [kg/s]) of the chamber."""
         p = s[0]
-        mdot, T_gas = self.inflow_kg_s(t_s, s, x_m)
+        mdot, T_gas = self.inflow_kg_s(s, x_m, inputs)
         mdot = float(mdot)
         T_in = self.T_supply_K if mdot >= 0.0 else T_gas
         V = self.chamber.volume_m3(x_m)
@@ -64,10 +69,11 @@ class ValveChamberSource:
         return tuple(getattr(self.supply_gauge_Pa, "breakpoints", ())) + tuple(getattr(self.command, "breakpoints", ()))
 
     def outputs(self, t_s, S, x_m) -> dict[str, np.ndarray]:
-        mdot, T_gas = self.inflow_kg_s(t_s, S, x_m)
+        inputs = self.inputs(t_s)
+        mdot, T_gas = self.inflow_kg_s(S, x_m, inputs)
         return {"air_mass_kg": S[1], "valve_mass_flow_kg_s": np.asarray(mdot, dtype=float),
-                "valve_command": np.asarray(self.command(t_s), dtype=float) + 0.0 * t_s,
-                "supply_gauge_Pa": np.asarray(self.supply_gauge_Pa(t_s), dtype=float) + 0.0 * t_s,
+                "valve_command": np.asarray(inputs[0], dtype=float) + 0.0 * t_s,
+                "supply_gauge_Pa": np.asarray(inputs[1], dtype=float) + 0.0 * t_s,
                 "gas_temperature_K": T_gas}
 
 
@@ -82,10 +88,14 @@ class PrescribedPressure:
     def initial_state(self, x_m: float, p_gauge_Pa: float = 0.0) -> list[float]:
         return []
 
-    def pressure_gauge_Pa(self, t_s, s):
-        return self.p_gauge_Pa(t_s)
+    def inputs(self, t_s) -> tuple:
+        """The source's input at time t: (gauge pressure [Pa],)."""
+        return (self.p_gauge_Pa(t_s),)
 
-    def derivatives(self, t_s, s, x_m, v_m_s) -> tuple[()]:
+    def pressure_gauge_Pa(self, s, inputs):
+        return inputs[0]
+
+    def derivatives(self, s, x_m, v_m_s, inputs) -> tuple[()]:
         return ()
 
     @property
