@@ -22,7 +22,7 @@ from .constants import PA_PER_BAR
 from .errors import InputError
 from .elements.chamber import MuscleChamber
 from .elements.damping import DAMPING_MODELS
-from .elements.friction import FRICTION_MODELS
+from .elements.friction import FRICTION_MODELS, NEGATIVE_LEVEL_CHOICES
 from .elements.load import HangingLoad
 from .elements.pressure_source import PrescribedPressure, ValveChamberSource
 from .elements.static_force import STATIC_FORCE_MODELS
@@ -39,7 +39,8 @@ _SIGNAL_KEYS = {"kind", "time_s", "start_s", "end_s", "tau_s", "file", "time_col
 _SCHEMA: dict[str, dict[str, Any]] = {
     "": {"name": str, "description": str, "model": dict, "parameters": dict, "load": dict, "pressure": dict,
          "simulation": dict, "solver": dict},
-    "model": {"parameter_set": str, "static_force": str, "friction": str, "damping": str},
+    "model": {"parameter_set": str, "static_force": str, "friction": str, "damping": str,
+              "friction_negative_level": str},
     "load": {"weight_N": float, "mass_kg": float, "external_force": dict},
     "pressure": {"source": str, "supply_gauge_bar": float, "supply_gauge_Pa": float, "valve_open_time_s": float,
                  "command": dict, "prescribed": dict, "initial_gauge_bar": float},
@@ -93,6 +94,9 @@ class Scenario:
             choice = model.setdefault(key, default)
             if choice not in registry:
                 v.fail(f"model.{key}", choice, "unknown choice", choices=registry)
+        negative = model.setdefault("friction_negative_level", "clamp")
+        if negative not in NEGATIVE_LEVEL_CHOICES:
+            v.fail("model.friction_negative_level", negative, "unknown choice", choices=NEGATIVE_LEVEL_CHOICES)
         params = PARAMETER_SETS[set_name]
         overrides = spec.get("parameters", {})
         for key, value in overrides.items():
@@ -218,7 +222,8 @@ class Scenario:
         ext_sig = _signal(v, "load.external_force", ext, "_N", 1.0, self.base_dir) if ext else None
         return MuscleModel(
             static_force=STATIC_FORCE_MODELS[m["static_force"]](p),
-            friction=FRICTION_MODELS[m["friction"]](p),
+            friction=(FRICTION_MODELS[m["friction"]](p, m["friction_negative_level"]) if m["friction"] == "load_dependent"
+                      else FRICTION_MODELS[m["friction"]](p)),
             damping=DAMPING_MODELS[m["damping"]](p),
             load=HangingLoad(self.mass_kg, p["g_m_s2"], ext_sig),
             stops=EndStops.from_parameters(p),

@@ -11,28 +11,37 @@ from typing import Callable, Mapping
 
 from ..constants import PA_PER_BAR
 
+NEGATIVE_LEVEL_CHOICES = ("clamp", "abs")
+
 
 @dataclass(frozen=True)
 class LoadDependentCoulomb:
     """Paper eq. (5)-(7): ``(P + phi)(N2 x^2 + N1 x + N0)`` with ``phi = -m``, P in bar, m in kg.
 
     For heavy loads at low pressure ``P - m`` is negative, which would make the
-    friction push the motion; pamsim clamps the level at zero (docs/model.md).
+    friction push the motion.  ``negative_level`` decides (a pamsim choice,
+    docs/model.md): ``"clamp"`` (default) sets the level to zero there,
+    ``"abs"`` uses its magnitude.
     """
 
     N2_N_per_bar_m2: float
     N1_N_per_bar_m: float
     N0_N_per_bar: float
     phi_bar_per_kg: float
+    negative_level: str = "clamp"
     name: str = "load_dependent"
 
     @classmethod
-    def from_parameters(cls, p: Mapping[str, float]) -> "LoadDependentCoulomb":
-        return cls(p["N2_N_per_bar_m2"], p["N1_N_per_bar_m"], p["N0_N_per_bar"], p["phi_bar_per_kg"])
+    def from_parameters(cls, p: Mapping[str, float], negative_level: str = "clamp") -> "LoadDependentCoulomb":
+        if negative_level not in NEGATIVE_LEVEL_CHOICES:
+            raise ValueError(f"negative_level must be one of {NEGATIVE_LEVEL_CHOICES}, not {negative_level!r}")
+        return cls(p["N2_N_per_bar_m2"], p["N1_N_per_bar_m"], p["N0_N_per_bar"], p["phi_bar_per_kg"], negative_level)
 
     def level_N(self, x_m, p_gauge_Pa, mass_kg):
         level = ((p_gauge_Pa / PA_PER_BAR - self.phi_bar_per_kg * mass_kg)
                  * ((self.N2_N_per_bar_m2 * x_m + self.N1_N_per_bar_m) * x_m + self.N0_N_per_bar))
+        if self.negative_level == "abs":
+            return abs(level)
         return 0.5 * (level + abs(level))  # max(level, 0) for floats and arrays alike
 
 

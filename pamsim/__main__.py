@@ -1,0 +1,7 @@
+"""``python -m pamsim`` is the ``pamsim`` command."""
+
+import sys
+
+from .cli import main
+
+sys.exit(main())

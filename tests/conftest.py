@@ -1,0 +1,29 @@
+"""Shared fixtures: the paper scenarios, simulated once per session."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+import pamsim
+
+ROOT = Path(__file__).resolve().parents[1]
+SCENARIOS = ROOT / "scenarios"
+PAPER_SCENARIOS = {  # name: (supply bar, weight N), from the issue / paper Figs 3-6
+    "acra2012_fig3": (4.0, 22.74),
+    "acra2012_fig4": (3.6, 22.74),
+    "acra2012_fig5": (3.6, 12.74),
+    "acra2012_fig6a": (2.8, 12.74),
+    "acra2012_fig6b": (2.0, 22.74),
+}
+
+
+@pytest.fixture(scope="session")
+def paper_results():
+    """{name: (scenario, result)} for the five paper scenarios with their file defaults."""
+    out = {}
+    for name in PAPER_SCENARIOS:
+        sc = pamsim.load_scenario(SCENARIOS / f"{name}.toml")
+        out[name] = (sc, pamsim.simulate(sc))
+    return out
