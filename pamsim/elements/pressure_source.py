@@ -45,11 +45,10 @@ class ValveChamberSource:
     def pressure_gauge_Pa(self, s, inputs):
         return s[0] - self.p_atm_Pa
 
-    def inflow_kg_s(self, s, x_m, inputs):
-        """Valve mass flow into the chamber [kg/s] and the chamber gas temperature [K]."""
+    def inflow_kg_s(self, s, V, inputs):
+        """Valve mass flow into the chamber [kg/s] and the chamber gas temperature [K] at volume V [m^3]."""
         p, m = s[0], s[1]
         u, supply_gauge_Pa = inputs
-        V = self.chamber.volume_m3(x_m)
         T_gas = self.chamber.gas_temperature_K(p, V, m)
         mdot = self.valve.inflow_kg_s(u, p, T_gas, supply_gauge_Pa + self.p_atm_Pa, self.T_supply_K, self.p_atm_Pa)
         return mdot, T_gas
@@ -57,10 +56,10 @@ class ValveChamberSource:
     def derivatives(self, s, x_m, v_m_s, inputs) -> tuple[float, float]:
         """(dp/dt [Pa/s], dm/dt [kg/s]) of the chamber."""
         p = s[0]
-        mdot, T_gas = self.inflow_kg_s(s, x_m, inputs)
+        V = self.chamber.volume_m3(x_m)
+        mdot, T_gas = self.inflow_kg_s(s, V, inputs)
         mdot = float(mdot)
         T_in = self.T_supply_K if mdot >= 0.0 else T_gas
-        V = self.chamber.volume_m3(x_m)
         dV = self.chamber.dvolume_dx_m2(x_m) * v_m_s
         return self.chamber.pressure_rate_Pa_s(p, V, dV, mdot, T_in), mdot
 
@@ -70,7 +69,7 @@ class ValveChamberSource:
 
     def outputs(self, t_s, S, x_m) -> dict[str, np.ndarray]:
         inputs = self.inputs(t_s)
-        mdot, T_gas = self.inflow_kg_s(S, x_m, inputs)
+        mdot, T_gas = self.inflow_kg_s(S, self.chamber.volume_m3(x_m), inputs)
         return {"air_mass_kg": S[1], "valve_mass_flow_kg_s": np.asarray(mdot, dtype=float),
                 "valve_command": np.asarray(inputs[0], dtype=float) + 0.0 * t_s,
                 "supply_gauge_Pa": np.asarray(inputs[1], dtype=float) + 0.0 * t_s,

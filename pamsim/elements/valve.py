@@ -64,8 +64,12 @@ class ProportionalValve33:
     orifice: Iso6358Orifice
 
     def inflow_kg_s(self, u, p_chamber_Pa, T_chamber_K, p_supply_Pa, T_supply_K, p_exhaust_Pa):
-        """Mass flow into the chamber [kg/s] (absolute pressures)."""
-        u_supply = _min(_max(u, 0.0), 1.0)
-        u_exhaust = _min(_max(-u, 0.0), 1.0)
-        return (u_supply * self.orifice.mass_flow_kg_s(p_supply_Pa, p_chamber_Pa, T_supply_K, T_chamber_K)
-                + u_exhaust * self.orifice.mass_flow_kg_s(p_exhaust_Pa, p_chamber_Pa, T_supply_K, T_chamber_K))
+        """Mass flow into the chamber [kg/s] (absolute pressures).
+
+        Only one path is open at a time, so the orifice is evaluated once,
+        against the supply for u >= 0 and against the exhaust for u < 0.
+        """
+        to_supply = u >= 0.0
+        p_port = p_exhaust_Pa + (p_supply_Pa - p_exhaust_Pa) * to_supply
+        opening = _min(abs(u), 1.0)
+        return opening * self.orifice.mass_flow_kg_s(p_port, p_chamber_Pa, T_supply_K, T_chamber_K)

@@ -1,0 +1,32 @@
+"""``pamsim params``: the parameter set with units and provenance."""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+from ..errors import InputError
+from ..parameters import PARAMETER_SETS
+
+
+def register(sub) -> None:
+    p = sub.add_parser("params", help="list a parameter set with units and provenance")
+    p.add_argument("--set", default="shadow_6x300_acra2012", help="parameter set name")
+    p.add_argument("--json", action="store_true", help="print JSON")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    if args.set not in PARAMETER_SETS:
+        raise InputError(f"--set = {args.set!r}: unknown parameter set (choose from {', '.join(PARAMETER_SETS)})")
+    ps = PARAMETER_SETS[args.set]
+    rows = ps.table()
+    if args.json:
+        print(json.dumps({"name": ps.name, "citation": ps.citation,
+                          "parameters": [dict(zip(("name", "value", "unit", "source", "description"), r))
+                                         for r in rows]}, indent=2))
+        return 0
+    print(f"{ps.name}: {ps.citation}")
+    for name, value, unit, source, _ in rows:
+        print(f"  {name:26s} {value:>12.6g} {unit:12s} {source}")
+    return 0
