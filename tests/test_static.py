@@ -72,3 +72,12 @@ def test_static_report_keys():
     r = static_report(P, POLY, 3.6e5, 22.74)
     assert {"equilibrium_contraction_m", "max_load_N"} <= set(r)
     assert r["lifts_load"] and r["within_fit_range"]
+
+
+def test_docs_parameter_table_is_current():
+    from pathlib import Path
+
+    from pamsim.cli.params import markdown_table
+
+    doc = (Path(__file__).resolve().parents[1] / "docs" / "model.md").read_text()
+    assert markdown_table(P) in doc

@@ -13,6 +13,7 @@ def register(sub) -> None:
     p = sub.add_parser("params", help="list a parameter set with units and provenance")
     p.add_argument("--set", default="shadow_6x300_acra2012", help="parameter set name")
     p.add_argument("--json", action="store_true", help="print JSON")
+    p.add_argument("--markdown", action="store_true", help="print a Markdown table (as in docs/model.md)")
     p.set_defaults(func=run)
 
 
@@ -26,7 +27,17 @@ def run(args: argparse.Namespace) -> int:
                           "parameters": [dict(zip(("name", "value", "unit", "source", "description"), r))
                                          for r in rows]}, indent=2))
         return 0
+    if args.markdown:
+        print(markdown_table(ps))
+        return 0
     print(f"{ps.name}: {ps.citation}")
     for name, value, unit, source, _ in rows:
         print(f"  {name:26s} {value:>12.6g} {unit:12s} {source}")
     return 0
+
+
+def markdown_table(ps) -> str:
+    """The parameter table of ``docs/model.md``; a test keeps the two identical."""
+    lines = ["| name | value | unit | source | meaning |", "| --- | --- | --- | --- | --- |"]
+    lines += [f"| `{n}` | {v:.6g} | {u} | {s} | {d} |" for n, v, u, s, d in ps.table()]
+    return "\n".join(lines)
