@@ -11,12 +11,28 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import ClassVar
 
 import numpy as np
 
 
+class _Signal:
+    """Breakpoints are the values of the fields named in ``_break_fields``."""
+
+    _break_fields: ClassVar[tuple[str, ...]] = ()
+
+    @property
+    def breakpoints(self) -> tuple[float, ...]:
+        return tuple(getattr(self, f) for f in self._break_fields)
+
+    @property
+    def final_value(self) -> float:
+        return self.final
+
+
+
 @dataclass(frozen=True)
-class Constant:
+class Constant(_Signal):
     """A constant value."""
 
     value: float
@@ -24,9 +40,6 @@ class Constant:
     def __call__(self, t):
         return self.value + 0.0 * t
 
-    @property
-    def breakpoints(self) -> tuple[float, ...]:
-        return ()
 
     @property
     def final_value(self) -> float:
@@ -34,57 +47,48 @@ class Constant:
 
 
 @dataclass(frozen=True)
-class Step:
+class Step(_Signal):
     """``initial`` before ``time_s``, ``final`` from then on."""
 
     time_s: float
     initial: float
     final: float
+    _break_fields: ClassVar[tuple[str, ...]] = ("time_s",)
 
     def __call__(self, t):
         if np.ndim(t) == 0:
             return self.final if t >= self.time_s else self.initial
         return np.where(np.asarray(t) >= self.time_s, self.final, self.initial)
 
-    @property
-    def breakpoints(self) -> tuple[float, ...]:
-        return (self.time_s,)
 
-    @property
-    def final_value(self) -> float:
-        return self.final
 
 
 @dataclass(frozen=True)
-class Ramp:
+class Ramp(_Signal):
     """Linear from ``initial`` at ``start_s`` to ``final`` at ``end_s``."""
 
     start_s: float
     end_s: float
     initial: float
     final: float
+    _break_fields: ClassVar[tuple[str, ...]] = ("start_s", "end_s")
 
     def __call__(self, t):
         return np.interp(t, (self.start_s, self.end_s), (self.initial, self.final)) if np.ndim(t) else (
             float(np.interp(t, (self.start_s, self.end_s), (self.initial, self.final))))
 
-    @property
-    def breakpoints(self) -> tuple[float, ...]:
-        return (self.start_s, self.end_s)
 
-    @property
-    def final_value(self) -> float:
-        return self.final
 
 
 @dataclass(frozen=True)
-class FirstOrderLag:
+class FirstOrderLag(_Signal):
     """A step from ``initial`` to ``final`` at ``time_s`` through a first-order lag ``tau_s``."""
 
     time_s: float
     initial: float
     final: float
     tau_s: float
+    _break_fields: ClassVar[tuple[str, ...]] = ("time_s",)
 
     def __call__(self, t):
         if np.ndim(t) == 0:
@@ -95,17 +99,11 @@ class FirstOrderLag:
         lag = self.final + (self.initial - self.final) * np.exp(-np.maximum(t - self.time_s, 0.0) / self.tau_s)
         return np.where(t >= self.time_s, lag, self.initial)
 
-    @property
-    def breakpoints(self) -> tuple[float, ...]:
-        return (self.time_s,)
 
-    @property
-    def final_value(self) -> float:
-        return self.final
 
 
 @dataclass(frozen=True)
-class Trace:
+class Trace(_Signal):
     """A measured signal, linearly interpolated, held constant outside its span."""
 
     t_s: np.ndarray = field(repr=False)
@@ -117,9 +115,6 @@ class Trace:
             return float(np.interp(t, self.t_s, self.values))
         return np.interp(t, self.t_s, self.values)
 
-    @property
-    def breakpoints(self) -> tuple[float, ...]:
-        return ()
 
     @property
     def final_value(self) -> float:

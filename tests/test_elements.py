@@ -156,3 +156,9 @@ def test_signals():
     lag = FirstOrderLag(1.0, 0.0, 1.0, 0.5)
     assert lag(1.5) == pytest.approx(1 - math.exp(-1)) and lag(0.5) == 0.0
     assert lag(np.array([1.5]))[0] == pytest.approx(1 - math.exp(-1))
+
+
+def test_signal_breakpoints_and_final_values():
+    assert Step(1.0, 0.0, 2.0).breakpoints == (1.0,) and Step(1.0, 0.0, 2.0).final_value == 2.0
+    assert Ramp(0.5, 1.5, 0.0, 3.0).breakpoints == (0.5, 1.5) and Ramp(0.5, 1.5, 0.0, 3.0).final_value == 3.0
+    assert FirstOrderLag(1.0, 0.0, 4.0, 0.1).final_value == 4.0
