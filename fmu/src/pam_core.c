@@ -1,0 +1,533 @@
+/* pamsim muscle model core; see pam_core.h.  Every equation mirrors a
+ * pamsim element (names given at each function) so the two can be compared. */
+#include "pam_core.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+#define PA_PER_BAR 1.0e5
+#define PI 3.14159265358979323846
+/* Event indicators are shifted by these so that a new mode starts strictly
+ * inside its region (v = 0 after a release is not an event) and the event
+ * test after root location has the same margin on either side of the root. */
+#define V_TOL_M_S 1e-9
+#define X_TOL_M 1e-9
+#define MIN_REBOUND_M_S 1e-3 /* pamsim.elements.stops.EndStops.min_rebound_speed_m_s */
+#define MAX_ZERO_LENGTH_EVENTS 50 /* pamsim.simulator: "made no progress" */
+#define MAX_STEPS_PER_CALL 10000000L
+
+enum { X = 0, V = 1, P = 2, M = 3 };
+
+void pam_logf(PamCore *c, int level, const char *fmt, ...) {
+    char buf[512];
+    va_list ap;
+    if (!c->log) return;
+    va_start(ap, fmt);
+    vsnprintf(buf, sizeof buf, fmt, ap);
+    va_end(ap);
+    c->log(c->log_env, level, buf);
+}
+
+void pam_reset(PamCore *c) {
+    int k;
+    for (k = 0; k < PAM_NVARS; k++) {
+        if (PAM_VARS[k].kind == 'r') c->r[PAM_VARS[k].index] = PAM_VARS[k].start;
+        else c->i[PAM_VARS[k].index] = (int32_t)PAM_VARS[k].start;
+    }
+    c->time_s = 0.0;
+    c->mode = PAM_STICK;
+    c->inputs_changed = 0;
+    c->h_s = 1e-4;
+    c->n_steps = c->n_rhs = c->n_events = 0;
+}
+
+/* ------------------------------------------------------------ elements */
+
+/* pamsim.parameters.braid_geometry */
+static void braid_geometry(const double *r, double *b, double *n) {
+    double theta = r[R_braid_angle_rest_deg] * PI / 180.0;
+    *b = r[R_L0_m] / cos(theta);
+    *n = *b * sin(theta) / (PI * r[R_D0_m]);
+}
+
+/* elements.chamber.MuscleChamber.volume_m3 / dvolume_dx_m2 */
+static double volume_m3(const PamCore *c, double x) {
+    double L = c->r[R_L0_m] - x, b = c->braid_b_m, n = c->braid_turns;
+    return L * (b * b - L * L) / (4.0 * PI * n * n) + c->r[R_dead_volume_m3];
+}
+
+static double dvolume_dx_m2(const PamCore *c, double x) {
+    double L = c->r[R_L0_m] - x, b = c->braid_b_m, n = c->braid_turns;
+    return -(b * b - 3.0 * L * L) / (4.0 * PI * n * n);
+}
+
+static double pressure_gauge_Pa(const PamCore *c, const double *y) {
+    if (c->i[I_pressure_source] == 1) return c->r[R_prescribed_pressure_gauge_Pa];
+    return y[P] - c->r[R_p_atm_Pa];
+}
+
+/* elements.static_force.Acra2012Polynomial */
+static double static_force_N(const double *r, double x, double p_gauge) {
+    double p_bar = p_gauge / PA_PER_BAR;
+    return ((r[R_K1_N_per_bar_m2] * x + r[R_K2_N_per_bar_m]) * x + r[R_C1_N_per_bar]) * p_bar
+           + (r[R_S1_N_per_m2] * x + r[R_S2_N_per_m]) * x + r[R_S3_N];
+}
+
+/* elements.friction: load-dependent (clamped at zero), constant, none */
+static double coulomb_level_N(const PamCore *c, double x, double p_gauge) {
+    const double *r = c->r;
+    double level;
+    switch (c->i[I_friction_model]) {
+    case 0:
+        level = (p_gauge / PA_PER_BAR - r[R_phi_bar_per_kg] * r[R_load_mass_kg])
+                * ((r[R_N2_N_per_bar_m2] * x + r[R_N1_N_per_bar_m]) * x + r[R_N0_N_per_bar]);
+        return level > 0.0 ? level : 0.0;
+    case 1: return r[R_coulomb_constant_N];
+    default: return 0.0;
+    }
+}
+
+/* elements.damping: paper D1 v + D2 v|v|, linear |D1| v, none */
+static double damping_force_N(const PamCore *c, double v) {
+    switch (c->i[I_damping_model]) {
+    case 0: return (c->r[R_D1_N_s_per_m] + c->r[R_D2_N_s2_per_m2] * fabs(v)) * v;
+    case 1: return fabs(c->r[R_D1_N_s_per_m]) * v;
+    default: return 0.0;
+    }
+}
+
+/* elements.valve.Iso6358Orifice.mass_flow_kg_s: signed flow from side a to side b */
+static double orifice_flow_kg_s(const double *r, double pa, double pb, double Ta, double Tb) {
+    int forward = pa >= pb;
+    double p_up = forward ? pa : pb, p_down = forward ? pb : pa, T_up = forward ? Ta : Tb;
+    double ratio = p_down / p_up, lam = r[R_valve_laminar_ratio], b = r[R_valve_b];
+    double s = fmax(fmin(ratio, lam) - b, 0.0) / (1.0 - b);
+    double laminar_scale = fmin(1.0, (1.0 - ratio) / (1.0 - lam));
+    double flow = r[R_valve_C_m3_per_s_Pa] * r[R_rho0_kg_m3] * p_up * sqrt(r[R_T0_K] / T_up)
+                  * sqrt(1.0 - s * s) * laminar_scale;
+    return forward ? flow : -flow;
+}
+
+/* elements.pressure_source.ValveChamberSource.derivatives */
+static void chamber_derivatives(const PamCore *c, const double *y, double v, double *dp, double *dm) {
+    const double *r = c->r;
+    double p = y[P], m = y[M], u = r[R_valve_command];
+    double Vol = volume_m3(c, y[X]);
+    double T_gas = p * Vol / (m * r[R_R_J_per_kg_K]);
+    double T_sup = r[R_T_supply_K];
+    double u_s = fmin(fmax(u, 0.0), 1.0), u_e = fmin(fmax(-u, 0.0), 1.0);
+    double mdot = 0.0, T_in, dV;
+    if (u_s > 0.0)
+        mdot += u_s * orifice_flow_kg_s(r, r[R_supply_pressure_gauge_Pa] + r[R_p_atm_Pa], p, T_sup, T_gas);
+    if (u_e > 0.0) mdot += u_e * orifice_flow_kg_s(r, r[R_p_atm_Pa], p, T_sup, T_gas);
+    T_in = mdot >= 0.0 ? T_sup : T_gas;
+    dV = dvolume_dx_m2(c, y[X]) * v;
+    *dp = r[R_polytropic_index] * (r[R_R_J_per_kg_K] * T_in * mdot - p * dV) / Vol;
+    *dm = mdot;
+}
+
+/* MuscleModel.rest_forces: net force at zero velocity and the Coulomb level [N] */
+static void rest_forces(const PamCore *c, const double *y, double *net, double *level) {
+    double p = pressure_gauge_Pa(c, y);
+    *net = static_force_N(c->r, y[X], p) - c->r[R_load_mass_kg] * c->r[R_g_m_s2] + c->r[R_external_force_N];
+    *level = coulomb_level_N(c, y[X], p);
+}
+
+/* MuscleModel.slip_rhs / held_rhs */
+static void rhs(PamCore *c, int mode, const double *y, double *dy) {
+    const double *r = c->r;
+    int slip = mode == PAM_SLIP_UP || mode == PAM_SLIP_DOWN;
+    double v = slip ? y[V] : 0.0;
+    c->n_rhs++;
+    if (slip) {
+        double p = pressure_gauge_Pa(c, y), m = r[R_load_mass_kg];
+        double F = static_force_N(r, y[X], p) - damping_force_N(c, v) - (double)mode * coulomb_level_N(c, y[X], p)
+                   - m * r[R_g_m_s2] + r[R_external_force_N];
+        dy[X] = v;
+        dy[V] = F / m;
+    } else {
+        dy[X] = 0.0;
+        dy[V] = 0.0;
+    }
+    if (c->i[I_pressure_source] == 0) chamber_derivatives(c, y, v, &dy[P], &dy[M]);
+    else dy[P] = dy[M] = 0.0;
+}
+
+/* Positive inside the current mode; a sign change is an event (simulator._Events). */
+static void indicators(const PamCore *c, int mode, const double *y, double *z) {
+    double net, level, eps = c->r[R_release_margin_N];
+    switch (mode) {
+    case PAM_SLIP_UP: z[0] = y[V] + V_TOL_M_S; z[1] = c->x_high_m + X_TOL_M - y[X]; return;
+    case PAM_SLIP_DOWN: z[0] = V_TOL_M_S - y[V]; z[1] = y[X] - c->x_low_m + X_TOL_M; return;
+    default: break;
+    }
+    rest_forces(c, y, &net, &level);
+    z[0] = mode == PAM_STOP_HIGH ? 1.0 : level + eps - net;
+    z[1] = mode == PAM_STOP_LOW ? 1.0 : level + eps + net;
+}
+
+/* simulator._rest_mode: slip if the net force beats friction by stick_margin_N, else held */
+static int rest_mode(const PamCore *c, const double *y, int where) {
+    double net, level, margin = c->r[R_stick_margin_N];
+    rest_forces(c, y, &net, &level);
+    if (where != PAM_STOP_HIGH && net - level > margin) return PAM_SLIP_UP;
+    if (where != PAM_STOP_LOW && -net - level > margin) return PAM_SLIP_DOWN;
+    return where;
+}
+
+static void get_states(const PamCore *c, double *y) {
+    int k;
+    for (k = 0; k < PAM_NX; k++) y[k] = c->r[PAM_STATE_R[k]];
+}
+
+static void put_states(PamCore *c, const double *y) {
+    int k;
+    for (k = 0; k < PAM_NX; k++) c->r[PAM_STATE_R[k]] = y[k];
+}
+
+/* ------------------------------------------------------------ checks */
+
+int pam_check_value(PamCore *c, unsigned vr, double value) {
+    const PamVarInfo *info;
+    if (vr < 1 || vr > PAM_NVARS) return 0;
+    info = &PAM_VARS[vr - 1];
+    if (!isfinite(value)) {
+        pam_logf(c, PAM_LOG_ERROR, "%s = %g: must be a finite number", info->name, value);
+        return -1;
+    }
+    if (vr == VR_load_mass_kg && !(value > 0.0)) {
+        pam_logf(c, PAM_LOG_ERROR, "load_mass_kg = %g: the hanging mass must be positive", value);
+        return -1;
+    }
+    if ((vr == VR_supply_pressure_gauge_Pa || vr == VR_prescribed_pressure_gauge_Pa)
+        && value > c->r[R_rated_pressure_gauge_Pa]) {
+        pam_logf(c, PAM_LOG_ERROR, "%s = %g Pa: exceeds the muscle's rating rated_pressure_gauge_Pa = %g Pa",
+                 info->name, value, c->r[R_rated_pressure_gauge_Pa]);
+        return -1;
+    }
+    if (vr == VR_supply_pressure_gauge_Pa && value < 0.0) {
+        pam_logf(c, PAM_LOG_ERROR, "supply_pressure_gauge_Pa = %g Pa: must not be negative", value);
+        return -1;
+    }
+    if (vr == VR_prescribed_pressure_gauge_Pa && value < -c->r[R_p_atm_Pa]) {
+        pam_logf(c, PAM_LOG_ERROR, "prescribed_pressure_gauge_Pa = %g Pa: below vacuum", value);
+        return -1;
+    }
+    if (vr == VR_valve_command && (value < -1.0 || value > 1.0)) {
+        pam_logf(c, PAM_LOG_ERROR, "valve_command = %g: must lie in [-1, 1]", value);
+        return -1;
+    }
+    return 0;
+}
+
+static int require(PamCore *c, int ok, const char *what) {
+    if (!ok) pam_logf(c, PAM_LOG_ERROR, "invalid parameters: %s", what);
+    return ok ? 0 : -1;
+}
+
+int pam_check_parameters(PamCore *c) {
+    const double *r = c->r;
+    int bad = 0, k;
+    double b, n, x_high;
+    for (k = 0; k < PAM_NVARS; k++)
+        if (PAM_VARS[k].kind == 'r' && PAM_VARS[k].causality <= PAM_INPUT && !isfinite(r[PAM_VARS[k].index])) {
+            pam_logf(c, PAM_LOG_ERROR, "invalid parameters: %s is not finite", PAM_VARS[k].name);
+            bad = -1;
+        }
+    if (bad) return -1;
+    bad |= require(c, r[R_L0_m] > 0.0, "L0_m must be positive");
+    bad |= require(c, r[R_D0_m] > 0.0, "D0_m must be positive");
+    bad |= require(c, r[R_braid_angle_rest_deg] > 0.0 && r[R_braid_angle_rest_deg] < 54.7356,
+                   "braid_angle_rest_deg must lie in (0, 54.7356) (below the braid lock angle)");
+    bad |= require(c, r[R_dead_volume_m3] >= 0.0, "dead_volume_m3 must not be negative");
+    bad |= require(c, r[R_valve_C_m3_per_s_Pa] >= 0.0, "valve_C_m3_per_s_Pa must not be negative");
+    bad |= require(c, r[R_valve_b] >= 0.0 && r[R_valve_b] < r[R_valve_laminar_ratio] && r[R_valve_laminar_ratio] < 1.0,
+                   "need 0 <= valve_b < valve_laminar_ratio < 1");
+    bad |= require(c, r[R_rho0_kg_m3] > 0.0 && r[R_T0_K] > 0.0 && r[R_T_supply_K] > 0.0 && r[R_R_J_per_kg_K] > 0.0,
+                   "rho0_kg_m3, T0_K, T_supply_K and R_J_per_kg_K must be positive");
+    bad |= require(c, r[R_polytropic_index] >= 1.0, "polytropic_index must be at least 1");
+    bad |= require(c, r[R_p_atm_Pa] > 0.0, "p_atm_Pa must be positive");
+    bad |= require(c, r[R_g_m_s2] > 0.0, "g_m_s2 must be positive");
+    bad |= require(c, r[R_rated_pressure_gauge_Pa] > 0.0, "rated_pressure_gauge_Pa must be positive");
+    bad |= require(c, r[R_stop_restitution] >= 0.0 && r[R_stop_restitution] <= 1.0,
+                   "stop_restitution must lie in [0, 1]");
+    bad |= require(c, r[R_coulomb_constant_N] >= 0.0, "coulomb_constant_N must not be negative");
+    bad |= require(c, r[R_stick_margin_N] >= 0.0 && r[R_release_margin_N] > r[R_stick_margin_N],
+                   "need 0 <= stick_margin_N < release_margin_N");
+    bad |= require(c, r[R_cs_relative_tolerance] > 0.0 && r[R_cs_relative_tolerance] <= 1e-2,
+                   "cs_relative_tolerance must lie in (0, 1e-2]");
+    bad |= require(c, r[R_cs_max_step_s] > 0.0, "cs_max_step_s must be positive");
+    bad |= require(c, c->i[I_friction_model] >= 0 && c->i[I_friction_model] <= 2, "friction_model must be 0, 1 or 2");
+    bad |= require(c, c->i[I_damping_model] >= 0 && c->i[I_damping_model] <= 2, "damping_model must be 0, 1 or 2");
+    bad |= require(c, c->i[I_pressure_source] == 0 || c->i[I_pressure_source] == 1, "pressure_source must be 0 or 1");
+    for (k = 0; k < PAM_NVARS; k++)
+        if (PAM_VARS[k].causality == PAM_INPUT && pam_check_value(c, (unsigned)k + 1, r[PAM_VARS[k].index])) bad = 1;
+    if (bad) return -1;
+    braid_geometry(r, &b, &n);
+    x_high = r[R_L0_m] - b / sqrt(3.0);
+    return require(c, r[R_initial_contraction_m] >= 0.0 && r[R_initial_contraction_m] <= x_high,
+                   "initial_contraction_m must lie between the stops (0 and the braid-lock contraction)");
+}
+
+/* ------------------------------------------------------------ state and outputs */
+
+void pam_initialize(PamCore *c) {
+    double y[PAM_NX], b, n;
+    braid_geometry(c->r, &b, &n);
+    c->braid_b_m = b;
+    c->braid_turns = n;
+    c->x_low_m = 0.0;
+    c->x_high_m = c->r[R_L0_m] - b / sqrt(3.0); /* braid lock at 54.7 deg, elements.stops */
+    y[X] = c->r[R_initial_contraction_m];
+    y[V] = 0.0;
+    y[P] = c->r[R_p_atm_Pa];
+    y[M] = y[P] * volume_m3(c, y[X]) / (c->r[R_R_J_per_kg_K] * c->r[R_T_supply_K]);
+    put_states(c, y);
+    /* simulator.initial_mode */
+    c->mode = rest_mode(c, y, y[X] <= c->x_low_m ? PAM_STOP_LOW : y[X] >= c->x_high_m ? PAM_STOP_HIGH : PAM_STICK);
+    c->inputs_changed = 0;
+    pam_evaluate(c);
+}
+
+void pam_evaluate(PamCore *c) {
+    double y[PAM_NX], dy[PAM_NX], z[PAM_NZ], net, level, friction;
+    int k, mode = c->mode;
+    get_states(c, y);
+    rhs(c, mode, y, dy);
+    for (k = 0; k < PAM_NX; k++) c->r[PAM_DERIV_R[k]] = dy[k];
+    indicators(c, mode, y, z);
+    c->r[R_event_indicator_1] = z[0];
+    c->r[R_event_indicator_2] = z[1];
+    rest_forces(c, y, &net, &level);
+    /* MuscleModel.breakdown: sliding -> -mode F_c; held -> friction takes what it can, the stop the rest */
+    if (mode == PAM_SLIP_UP || mode == PAM_SLIP_DOWN) friction = -(double)mode * level;
+    else if (mode == PAM_STICK || (mode == PAM_STOP_LOW && net > 0.0) || (mode == PAM_STOP_HIGH && net < 0.0))
+        friction = -net;
+    else friction = 0.0;
+    c->r[R_pressure_gauge_Pa] = pressure_gauge_Pa(c, y);
+    c->r[R_muscle_force_N] = static_force_N(c->r, y[X], c->r[R_pressure_gauge_Pa]);
+    c->r[R_friction_force_N] = friction;
+    c->i[I_friction_mode] = mode;
+}
+
+/* ------------------------------------------------------------ events */
+
+/* simulator._transition, decided from the state instead of from the event's name */
+static int transition(PamCore *c, double *y) {
+    int mode = c->mode;
+    if (mode == PAM_SLIP_UP || mode == PAM_SLIP_DOWN) {
+        int up = mode == PAM_SLIP_UP;
+        if (up ? y[X] >= c->x_high_m : y[X] <= c->x_low_m) {
+            double rebound = c->r[R_stop_restitution] * fabs(y[V]);
+            y[X] = up ? c->x_high_m : c->x_low_m;
+            if (rebound > MIN_REBOUND_M_S) {
+                y[V] = up ? -rebound : rebound;
+                c->mode = up ? PAM_SLIP_DOWN : PAM_SLIP_UP;
+            } else {
+                y[V] = 0.0;
+                c->mode = rest_mode(c, y, up ? PAM_STOP_HIGH : PAM_STOP_LOW);
+            }
+            return 1;
+        }
+        if (up ? y[V] <= 0.0 : y[V] >= 0.0) {
+            y[V] = 0.0;
+            c->mode = rest_mode(c, y, PAM_STICK);
+            return 1;
+        }
+        return 0;
+    }
+    c->mode = rest_mode(c, y, mode);
+    return 0;
+}
+
+int pam_event_update(PamCore *c) {
+    double y[PAM_NX];
+    int old = c->mode, jumped;
+    get_states(c, y);
+    jumped = transition(c, y);
+    if (jumped || c->mode != old) c->n_events++;
+    put_states(c, y);
+    c->inputs_changed = 0;
+    pam_evaluate(c);
+    return jumped;
+}
+
+/* ------------------------------------------------------------ Dormand-Prince 5(4) */
+
+static const double DP_C[7] = {0.0, 1.0 / 5, 3.0 / 10, 4.0 / 5, 8.0 / 9, 1.0, 1.0};
+static const double DP_A[7][6] = {
+    {0},
+    {1.0 / 5},
+    {3.0 / 40, 9.0 / 40},
+    {44.0 / 45, -56.0 / 15, 32.0 / 9},
+    {19372.0 / 6561, -25360.0 / 2187, 64448.0 / 6561, -212.0 / 729},
+    {9017.0 / 3168, -355.0 / 33, 46732.0 / 5247, 49.0 / 176, -5103.0 / 18656},
+    {35.0 / 384, 0.0, 500.0 / 1113, 125.0 / 192, -2187.0 / 6784, 11.0 / 84}};
+static const double DP_E[7] = {-71.0 / 57600, 0.0, 71.0 / 16695, -71.0 / 1920, 17253.0 / 339200, -22.0 / 525, 1.0 / 40};
+/* Shampine's 4th-order continuous extension (as scipy's RK45): y(t + th h) = y + h sum_i k_i sum_j P[i][j] th^(j+1) */
+static const double DP_P[7][4] = {
+    {1.0, -8048581381.0 / 2820520608, 8663915743.0 / 2820520608, -12715105075.0 / 11282082432},
+    {0.0, 0.0, 0.0, 0.0},
+    {0.0, 131558114200.0 / 32700410799, -68118460800.0 / 10900136933, 87487479700.0 / 32700410799},
+    {0.0, -1754552775.0 / 470086768, 14199869525.0 / 1410260304, -10690763975.0 / 1880347072},
+    {0.0, 127303824393.0 / 49829197408, -318862633887.0 / 49829197408, 701980252875.0 / 199316789632},
+    {0.0, -282668133.0 / 205662961, 2019193451.0 / 616988883, -1453857185.0 / 822651844},
+    {0.0, 40617522.0 / 29380423, -110615467.0 / 29380423, 69997945.0 / 29380423}};
+
+typedef struct {
+    double k[7][PAM_NX];
+} DpStages;
+
+/* One trial step; returns the scaled RMS error norm. k[0] must hold f(y0). */
+static double dp_step(PamCore *c, const double *y0, double h, DpStages *s, double *y1) {
+    double yt[PAM_NX], err = 0.0, rtol = c->r[R_cs_relative_tolerance];
+    int st, j, n;
+    for (st = 1; st < 7; st++) {
+        for (n = 0; n < PAM_NX; n++) {
+            double acc = 0.0;
+            for (j = 0; j < st; j++) acc += DP_A[st][j] * s->k[j][n];
+            yt[n] = y0[n] + h * acc;
+        }
+        rhs(c, c->mode, yt, s->k[st]);
+    }
+    for (n = 0; n < PAM_NX; n++) {
+        double e = 0.0, sc;
+        y1[n] = yt[n]; /* stage 7 is evaluated at the 5th-order solution (FSAL) */
+        for (st = 0; st < 7; st++) e += DP_E[st] * s->k[st][n];
+        sc = rtol * PAM_NOMINAL[n] + rtol * fmax(fabs(y0[n]), fabs(y1[n]));
+        err += (h * e / sc) * (h * e / sc);
+    }
+    return sqrt(err / PAM_NX);
+}
+
+static void dp_dense(const DpStages *s, const double *y0, double h, double th, double *y) {
+    double pw[4] = {th, th * th, th * th * th, th * th * th * th};
+    int n, st, j;
+    for (n = 0; n < PAM_NX; n++) {
+        double acc = 0.0;
+        for (st = 0; st < 7; st++) {
+            double q = 0.0;
+            for (j = 0; j < 4; j++) q += DP_P[st][j] * pw[j];
+            acc += s->k[st][n] * q;
+        }
+        y[n] = y0[n] + h * acc;
+    }
+}
+
+static double min_indicator(const PamCore *c, const double *y) {
+    double z[PAM_NZ];
+    indicators(c, c->mode, y, z);
+    return fmin(z[0], z[1]);
+}
+
+int pam_do_step(PamCore *c, double t_end) {
+    double y[PAM_NX], y1[PAM_NX], t = c->time_s, h_max = c->r[R_cs_max_step_s];
+    DpStages s;
+    long steps = 0;
+    int zero_length = 0;
+    get_states(c, y);
+    if (c->inputs_changed && c->mode != PAM_SLIP_UP && c->mode != PAM_SLIP_DOWN) {
+        /* simulator: a held load is re-checked where its inputs jump */
+        int old = c->mode;
+        c->mode = rest_mode(c, y, c->mode);
+        if (c->mode != old) c->n_events++;
+    }
+    c->inputs_changed = 0;
+    rhs(c, c->mode, y, s.k[0]);
+    /* A remainder below the time resolution (left by an event located just before t_end) is not a step. */
+    while (t_end - t > 1e-13 * fmax(1.0, fabs(t_end))) {
+        double h = fmin(fmin(c->h_s, h_max), t_end - t), err, factor;
+        int last = h >= t_end - t;
+        if (++steps > MAX_STEPS_PER_CALL) {
+            pam_logf(c, PAM_LOG_ERROR, "more than %ld internal steps between t = %.9g s and %.9g s", MAX_STEPS_PER_CALL,
+                     c->time_s, t_end);
+            return -1;
+        }
+        if (h < 1e-14 * fmax(1.0, fabs(t))) {
+            pam_logf(c, PAM_LOG_ERROR, "step size underflow at t = %.9g s", t);
+            return -1;
+        }
+        err = dp_step(c, y, h, &s, y1);
+        if (!(err <= 1.0)) {
+            c->h_s = h * (isfinite(err) ? fmax(0.2, 0.9 * pow(err, -0.2)) : 0.1);
+            continue;
+        }
+        factor = err == 0.0 ? 10.0 : fmin(10.0, fmax(0.2, 0.9 * pow(err, -0.2)));
+        c->n_steps++;
+        if (min_indicator(c, y1) <= 0.0) {
+            /* Locate the first crossing on the dense output; keep the far side so that the event test holds. */
+            double lo = 0.0, hi = 1.0, ye[PAM_NX];
+            int it;
+            for (it = 0; it < 100 && (hi - lo) * h > 1e-15 * fmax(1.0, fabs(t)); it++) {
+                double mid = 0.5 * (lo + hi);
+                dp_dense(&s, y, h, mid, ye);
+                if (min_indicator(c, ye) <= 0.0) hi = mid;
+                else lo = mid;
+            }
+            if (hi < 1.0) dp_dense(&s, y, h, hi, ye);
+            else memcpy(ye, y1, sizeof ye);
+            t = hi < 1.0 ? t + hi * h : (last ? t_end : t + h);
+            memcpy(y, ye, sizeof y);
+            put_states(c, y);
+            {
+                int old = c->mode, jumped = transition(c, y);
+                if (!jumped && c->mode == old) {
+                    if (++zero_length > MAX_ZERO_LENGTH_EVENTS) {
+                        pam_logf(c, PAM_LOG_ERROR, "event switching made no progress at t = %.9g s", t);
+                        return -1;
+                    }
+                } else {
+                    zero_length = 0;
+                    c->n_events++;
+                }
+            }
+            c->h_s = fmax(h * hi, 1e-6);
+            rhs(c, c->mode, y, s.k[0]);
+            continue;
+        }
+        t = last ? t_end : t + h;
+        memcpy(y, y1, sizeof y);
+        memcpy(s.k[0], s.k[6], sizeof s.k[0]);
+        if (!last || factor < 1.0) c->h_s = h * factor;
+    }
+    c->time_s = t_end;
+    put_states(c, y);
+    pam_evaluate(c);
+    return 0;
+}
+
+/* ------------------------------------------------------------ directional derivatives */
+
+static double *value_ptr(PamCore *c, unsigned vr) {
+    if (vr < 1 || vr > PAM_NVARS || PAM_VARS[vr - 1].kind != 'r') return 0;
+    return &c->r[PAM_VARS[vr - 1].index];
+}
+
+int pam_directional_derivative(PamCore *c, const unsigned *unknowns, int n_unknowns, const unsigned *knowns,
+                               int n_knowns, const double *seed, double *sensitivity) {
+    double saved[PAM_NR], up[PAM_NR], eps = 0.0;
+    int k, u;
+    for (k = 0; k < n_knowns; k++)
+        if (!value_ptr(c, knowns[k])) return -1;
+    for (u = 0; u < n_unknowns; u++)
+        if (!value_ptr(c, unknowns[u])) return -1;
+    memcpy(saved, c->r, sizeof saved);
+    for (k = 0; k < n_knowns; k++) eps = fmax(eps, fabs(*value_ptr(c, knowns[k])) / (fabs(seed[k]) + 1e-300));
+    /* A relative step suits states of very different scales (m and Pa). */
+    eps = 1e-6 * (eps > 0.0 ? eps : 1.0);
+    for (k = 0; k < n_knowns; k++) *value_ptr(c, knowns[k]) += eps * seed[k];
+    pam_evaluate(c);
+    memcpy(up, c->r, sizeof up);
+    memcpy(c->r, saved, sizeof saved);
+    for (k = 0; k < n_knowns; k++) *value_ptr(c, knowns[k]) -= eps * seed[k];
+    pam_evaluate(c);
+    for (u = 0; u < n_unknowns; u++) {
+        int idx = PAM_VARS[unknowns[u] - 1].index;
+        sensitivity[u] = (up[idx] - c->r[idx]) / (2.0 * eps);
+    }
+    memcpy(c->r, saved, sizeof saved);
+    pam_evaluate(c);
+    return 0;
+}

@@ -1,0 +1,10 @@
+"""Export the muscle model as an FMU (FMI 2.0 and 3.0, Model Exchange and
+Co-Simulation) and run scenarios through it.
+
+``build()`` compiles the C model in ``fmu/`` (see ``docs/fmu.md``);
+``simulate_fmu()`` runs a :class:`~pamsim.scenario.Scenario` through fmpy.
+"""
+
+from .build import build
+
+__all__ = ["build"]

@@ -1,0 +1,79 @@
+"""Compile the FMU with the system C compiler and pack it.
+
+``build(output_path, fmi_version)`` writes the generated sources, the model
+description and a shared library in the platform folder the standard names
+(``binaries/linux64`` for FMI 2.0, ``binaries/x86_64-linux`` for FMI 3.0 on
+Linux), so ``fmpy compile`` can rebuild the same archive elsewhere.
+"""
+
+from __future__ import annotations
+
+import os
+import platform
+import shutil
+import subprocess
+import sys
+import tempfile
+import zipfile
+from pathlib import Path
+
+from ..errors import InputError
+from .generate import MODEL_IDENTIFIER, WRAPPERS, model_description, write_sources
+
+FMI_VERSIONS = (2, 3)
+
+
+def platform_folder(fmi_version: int) -> str:
+    """The binaries/ sub-folder of this machine for ``fmi_version``."""
+    machine = platform.machine().lower()
+    arch = {"amd64": "x86_64", "x86_64": "x86_64", "arm64": "aarch64", "aarch64": "aarch64"}.get(machine, machine)
+    system = {"linux": "linux", "darwin": "darwin", "win32": "windows"}[sys.platform if sys.platform != "cygwin" else "win32"]
+    if fmi_version == 2:
+        bits = "64" if sys.maxsize > 2**32 else "32"
+        return {"linux": f"linux{bits}", "darwin": f"darwin{bits}", "windows": f"win{bits}"}[system]
+    return f"{arch}-{system}"
+
+
+def shared_library_suffix() -> str:
+    return {"darwin": ".dylib", "win32": ".dll"}.get(sys.platform, ".so")
+
+
+def default_output(fmi_version: int) -> Path:
+    return Path(f"{MODEL_IDENTIFIER}_fmi{fmi_version}.fmu")
+
+
+def build(output_path: str | os.PathLike | None = None, fmi_version: int = 2) -> Path:
+    """Generate, compile and zip the FMU; return the path of the ``.fmu`` file.
+
+    Raises :class:`~pamsim.errors.InputError` for an unknown FMI version, a
+    missing C compiler or a failed compilation (with the compiler's message).
+    """
+    if fmi_version not in FMI_VERSIONS:
+        raise InputError(f"FMI version must be 2 or 3, not {fmi_version!r}")
+    out = Path(output_path) if output_path else default_output(fmi_version)
+    if out.suffix != ".fmu":
+        raise InputError(f"{out}: the FMU file name must end in .fmu")
+    compiler = os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc")
+    if not compiler:
+        raise InputError("no C compiler found (install gcc, or set CC)")
+    with tempfile.TemporaryDirectory(prefix="pamsim-fmu-") as tmp:
+        root = Path(tmp)
+        src = root / "sources"
+        write_sources(src, fmi_version)
+        (root / "modelDescription.xml").write_text(model_description(fmi_version))
+        bin_dir = root / "binaries" / platform_folder(fmi_version)
+        bin_dir.mkdir(parents=True)
+        lib = bin_dir / (MODEL_IDENTIFIER + shared_library_suffix())
+        cmd = [compiler, "-shared", "-fPIC", "-O2", "-std=c99", "-Wall", "-I", str(src),
+               str(src / "pam_core.c"), str(src / WRAPPERS[fmi_version]), "-o", str(lib), "-lm"]
+        proc = subprocess.run(cmd, capture_output=True, text=True)
+        if proc.returncode != 0:
+            raise InputError(f"compiling the FMU failed ({' '.join(cmd[:2])} ...): {proc.stderr.strip()}")
+        out.parent.mkdir(parents=True, exist_ok=True)
+        partial = out.with_name(f".{out.name}.tmp")
+        with zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED) as zf:
+            for path in sorted(root.rglob("*")):
+                if path.is_file():
+                    zf.write(path, path.relative_to(root).as_posix())
+        os.replace(partial, out)
+    return out
