@@ -1,0 +1,140 @@
+"""``pamsim linearize SCENARIO``: a linear model of the muscle at an operating point.
+
+Without an option the operating point is the scenario's load at rest with the
+valve open and the chamber at the supply pressure; ``--contraction-mm X`` holds
+X with the valve closed; ``--at-time T`` takes the state of the scenario's
+simulation at T.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+
+from ..atomic import atomic_outputs
+from ..control.linear import VALVE_SLOPES, linearize
+from ..control.operating_point import held_equilibrium, open_valve_equilibrium, trajectory_point
+from ..control.system import FRICTION_KINDS, FrictionTreatment
+from ..scenario import load_scenario
+from . import finite_float
+
+
+def register(sub) -> None:
+    p = sub.add_parser("linearize", help="linear model at an operating point (python-control)",
+                       description="Linearise the muscle about an operating point of a scenario (valve source); "
+                                   "print A, B, C, D, poles, the mechanical mode and DC gains; write a Bode plot "
+                                   "and a pole-zero map into DIR.")
+    p.add_argument("scenario", help="scenario TOML file (valve source)")
+    where = p.add_mutually_exclusive_group()
+    where.add_argument("--at-time", type=finite_float, metavar="T", help="state of the simulation at T [s]")
+    where.add_argument("--contraction-mm", type=finite_float, metavar="X",
+                       help="hold contraction X [mm] with the valve closed")
+    p.add_argument("--friction", choices=FRICTION_KINDS, default="dropped",
+                   help="Coulomb friction: dropped (default), regularised, or sliding (moving load only)")
+    p.add_argument("--friction-velocity-mm-s", type=finite_float, default=1.0,
+                   help="velocity scale of the regularised friction [mm/s] (default 1)")
+    p.add_argument("--valve-slope", choices=VALVE_SLOPES, default="mean",
+                   help="valve slope at command 0: mean of fill and vent (default), fill, vent")
+    p.add_argument("--json", action="store_true", help="print JSON")
+    p.add_argument("-o", "--output", default="out", help="directory for the PNG plots (default: out)")
+    p.set_defaults(func=run)
+
+
+def _matrix(a) -> list[list[float]]:
+    return [[float(v) for v in row] for row in np.atleast_2d(a)]
+
+
+def _complex(z: complex) -> list[float]:
+    return [float(z.real), float(z.imag)]
+
+
+def report(lin) -> dict:
+    """The JSON-safe figures of a :class:`~pamsim.control.linear.LinearModel`."""
+    sys = lin.sys
+    mode = lin.mechanical_mode()
+    dc, integ = {}, {}
+    for inp in sys.input_labels:
+        for out in sys.output_labels:
+            g0, k_int = lin.gain_at_zero(inp, out)
+            dc[f"{inp}->{out}"] = g0  # None: infinite (a free integrator in the channel)
+            if g0 is None:
+                integ[f"{inp}->{out}"] = k_int
+    omega = lin.frequency_grid_rad_s(60)
+    return {
+        "A": _matrix(sys.A), "B": _matrix(sys.B), "C": _matrix(sys.C), "D": _matrix(sys.D),
+        "states": list(sys.state_labels), "inputs": list(sys.input_labels), "outputs": list(sys.output_labels),
+        "poles": [_complex(z) for z in sys.poles()],
+        "natural_frequency_Hz": mode.natural_frequency_Hz,
+        "damping_ratio": mode.damping_ratio,
+        "mechanical_poles": [_complex(z) for z in mode.poles],
+        "dc_gain": dc,
+        "integrator_gain_per_s": integ,
+        "bode_valve_to_contraction": lin.bode("valve_command", "contraction_m", omega),
+        "operating_point": lin.op.as_dict(),
+        "residual_f_x0_u0": [float(v) for v in lin.residual],
+        "friction": lin.friction.describe(),
+        "valve_slope": lin.valve_slope,
+        "dropped_states": list(lin.dropped_states),
+    }
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..control.plots import bode_figure, pole_zero_figure
+
+    scenario = load_scenario(args.scenario)
+    model = scenario.build_model()
+    supply = scenario.final_pressure_gauge_Pa
+    if args.at_time is not None:
+        op = trajectory_point(scenario, args.at_time)
+    elif args.contraction_mm is not None:
+        op = held_equilibrium(model, args.contraction_mm * 1e-3, supply)
+    else:
+        op = open_valve_equilibrium(model, supply)
+    friction = FrictionTreatment(args.friction, args.friction_velocity_mm_s * 1e-3)
+    lin = linearize(model, op, friction, args.valve_slope)
+    rep = report(lin)
+    stem = f"{scenario.name}_linear"
+    names = [f"{stem}_bode.png", f"{stem}_pzmap.png"]
+    with atomic_outputs(args.output, names) as tmp:
+        bode_figure(lin).savefig(tmp[names[0]], format="png", dpi=110)
+        pole_zero_figure(lin).savefig(tmp[names[1]], format="png", dpi=110)
+    if args.json:
+        print(json.dumps(rep, indent=2))
+        return 0
+    _print_text(lin, rep)
+    print(f"wrote {', '.join(str(Path(args.output) / n) for n in names)}")
+    return 0
+
+
+def _print_text(lin, rep: dict) -> None:
+    np.set_printoptions(precision=6, linewidth=140)
+    print(f"operating point: {lin.op.description}")
+    print(f"friction: {rep['friction']}; valve slope at command 0: {lin.valve_slope}")
+    if lin.dropped_states:
+        print(f"dropped (unobservable, decoupled): {', '.join(lin.dropped_states)}")
+    print(f"states:  {', '.join(rep['states'])}")
+    print(f"inputs:  {', '.join(rep['inputs'])}")
+    print(f"outputs: {', '.join(rep['outputs'])}")
+    for key in ("A", "B", "C", "D"):
+        print(f"{key} =\n{np.array(rep[key])}")
+    print("poles [1/s]: " + ", ".join(f"{re:.6g}{im:+.6g}j" for re, im in rep["poles"]))
+    print(f"mechanical mode: natural frequency {rep['natural_frequency_Hz']:.4g} Hz, "
+          f"damping ratio {rep['damping_ratio']:.4g}")
+    g0 = rep["dc_gain"]["valve_command->contraction_m"]
+    if g0 is None:
+        k = rep["integrator_gain_per_s"]["valve_command->contraction_m"]
+        print(f"DC gain valve_command -> contraction: infinite (the closed valve integrates the command); "
+              f"integrator gain {k * 1e3:.4g} mm/s per unit command")
+    else:
+        print(f"DC gain valve_command -> contraction: {g0 * 1e3:.4g} mm per unit command")
+    for key, value in rep["dc_gain"].items():
+        if key.endswith("contraction_m") and not key.startswith("valve_command"):
+            print(f"DC gain {key}: " + ("infinite" if value is None else f"{value:.6g} m per SI unit"))
+    if np.max(np.abs(lin.residual)) > 0 and lin.op.kind == "trajectory":
+        print("note: not an equilibrium; f(x0, u0) = " + ", ".join(f"{v:.4g}" for v in lin.residual))
+    if not all(math.isfinite(v) for v in (rep["natural_frequency_Hz"], rep["damping_ratio"])):
+        print("note: no oscillatory mechanical mode found")

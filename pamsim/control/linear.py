@@ -1,0 +1,238 @@
+"""Linearisation of the muscle model about an operating point.
+
+The Jacobians are central differences of :class:`~pamsim.control.system.MusclePlant`
+(the model's own right-hand side) with one Richardson extrapolation step, the
+step of each variable scaled by its typical magnitude (``STATE_SCALES``).
+python-control's own ``linearize`` uses a forward difference with one
+absolute step of 1e-6 for every variable, which is 1e-11 of a pressure in Pa
+and 10 % of an air mass in kg; hence this module.
+
+Two non-smooth points are handled explicitly:
+
+* Coulomb friction, by the :class:`~pamsim.control.system.FrictionTreatment`.
+* The valve command at 0, where the 3/3 valve switches from the exhaust
+  orifice to the supply orifice: the flow is continuous but its slope jumps
+  from the venting to the filling conductance.  ``valve_slope`` picks
+  ``mean`` (the central difference: the average of the two slopes, which is
+  also the describing-function gain of the kink for a symmetric command),
+  ``fill`` or ``vent`` (one-sided).  At a saturated command (|u| = 1) the
+  one-sided difference into the valve's range is used.
+
+Near a pressure ratio of 1 (chamber at supply pressure with the valve open)
+the valve's own laminar branch makes the flow linear in the pressure drop, so
+the pressure has a finite time constant instead of the infinite slope of the
+ISO 6358 subsonic law; the Jacobian simply differentiates that branch.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import control as ct
+import numpy as np
+
+from ..errors import InputError
+from ..model import MuscleModel
+from .operating_point import OperatingPoint
+from .system import INPUT_SCALES, INPUTS, OUTPUTS, STATE_SCALES, STATES, FrictionTreatment, MusclePlant
+
+VALVE_SLOPES = ("mean", "fill", "vent")
+RELATIVE_STEP = 1e-4
+"""Finite-difference step as a fraction of each variable's typical magnitude."""
+
+
+def _derivative(f, z0: np.ndarray, i: int, h: float, side: int) -> np.ndarray:
+    """d f / d z_i at z0 by a Richardson-extrapolated difference: central (side 0) or one-sided (+1/-1)."""
+    def diff(step):
+        zp, zm = z0.copy(), z0.copy()
+        if side == 0:
+            zp[i] += step
+            zm[i] -= step
+            return (f(zp) - f(zm)) / (2.0 * step)
+        zp[i] += side * step
+        return (f(zp) - f(zm)) / (side * step)
+
+    d1, d2 = diff(h), diff(0.5 * h)
+    # Central: error ~ h^2, so (4 d(h/2) - d(h)) / 3; one-sided: error ~ h, so 2 d(h/2) - d(h).
+    return (4.0 * d2 - d1) / 3.0 if side == 0 else 2.0 * d2 - d1
+
+
+def jacobians(plant: MusclePlant, op: OperatingPoint, friction: FrictionTreatment,
+              valve_slope: str = "mean") -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """A, B, C, D of the four-state model at ``op`` (see the module notes on the kinks)."""
+    if valve_slope not in VALVE_SLOPES:
+        raise InputError(f"valve slope {valve_slope!r}: choose from {', '.join(VALVE_SLOPES)}")
+    x0 = np.asarray(op.states, dtype=float)
+    u0 = np.asarray(op.inputs, dtype=float)
+    nx, nu = len(STATES), len(INPUTS)
+
+    def fx(x):
+        return np.concatenate([plant.rhs(x, u0, friction), plant.output(x, u0, friction)])
+
+    def fu(u):
+        return np.concatenate([plant.rhs(x0, u, friction), plant.output(x0, u, friction)])
+
+    J_x = np.column_stack([_derivative(fx, x0, i, RELATIVE_STEP * _state_step_scale(i, friction), 0)
+                           for i in range(nx)])
+    J_u = np.column_stack([_derivative(fu, u0, j, RELATIVE_STEP * INPUT_SCALES[j], _input_side(j, u0[j], valve_slope))
+                           for j in range(nu)])
+    return J_x[:nx], J_u[:nx], J_x[nx:], J_u[nx:]
+
+
+def _state_step_scale(i: int, friction: FrictionTreatment) -> float:
+    # A regularised friction varies on the velocity scale v_s, which may be far below 0.1 m/s.
+    if STATES[i] == "v_m_s" and friction.kind == "regularised":
+        return min(STATE_SCALES[i], friction.velocity_scale_m_s)
+    return STATE_SCALES[i]
+
+
+def _input_side(j: int, value: float, valve_slope: str) -> int:
+    if INPUTS[j] != "valve_command":
+        return 0
+    if value >= 1.0:
+        return -1
+    if value <= -1.0:
+        return 1
+    if value == 0.0:
+        return {"mean": 0, "fill": 1, "vent": -1}[valve_slope]
+    return 0
+
+
+@dataclass(frozen=True)
+class MechanicalMode:
+    """The pole pair of the load's motion: natural frequency [rad/s], damping ratio, poles."""
+
+    omega_n_rad_s: float
+    damping_ratio: float
+    poles: tuple[complex, complex]
+
+    @property
+    def natural_frequency_Hz(self) -> float:
+        return self.omega_n_rad_s / (2.0 * math.pi)
+
+
+@dataclass(frozen=True)
+class LinearModel:
+    """A linearisation: the state-space system, where it was taken and how.
+
+    ``sys`` keeps the state, input and output names of
+    :mod:`pamsim.control.system`; ``dropped_states`` lists states removed
+    because nothing depends on them (see :func:`linearize`).
+    """
+
+    sys: ct.StateSpace
+    op: OperatingPoint
+    friction: FrictionTreatment
+    valve_slope: str
+    residual: np.ndarray
+    dropped_states: tuple[str, ...]
+
+    def mechanical_mode(self) -> MechanicalMode:
+        """The two poles with the largest participation of the velocity state.
+
+        Participation factors ``|w_k v_k|`` (left and right eigenvectors with
+        ``w^T v = 1``) pick the load's pole pair even when the regularised
+        friction makes it overdamped (two real poles).
+        """
+        A = self.sys.A
+        lam, right = np.linalg.eig(A)
+        left = np.linalg.inv(right)
+        k_v = list(self.sys.state_labels).index("v_m_s")
+        participation = np.abs(left[:, k_v] * right[k_v, :])
+        i, j = np.argsort(participation)[-2:]
+        p1, p2 = complex(lam[i]), complex(lam[j])
+        prod = (p1 * p2).real
+        omega = math.sqrt(abs(prod))
+        zeta = -(p1 + p2).real / (2.0 * omega) if omega > 0 else math.nan
+        return MechanicalMode(omega, zeta, tuple(sorted((p1, p2), key=lambda p: p.imag)))
+
+    def gain_at_zero(self, input_name: str = "valve_command",
+                     output_name: str = "contraction_m") -> tuple[float | None, float]:
+        """(DC gain, integrator gain) of one channel.
+
+        If the channel contains a free integrator (the closed valve integrates
+        the command into air mass) the DC gain is infinite and returned as
+        None; the integrator gain ``lim_{s->0} s G(s)`` is then the steady
+        rate of the output per unit input.  Both come from ``G`` evaluated at
+        two small real ``s`` and extrapolated (``G(s) = K_i / s + G_0 + O(s)``).
+        """
+        g = self.sys[output_name, input_name]
+        scale = max(self.mechanical_mode().omega_n_rad_s, 1.0)
+        eps = 1e-7 * scale
+        a = eps * float(np.real(g(eps)))
+        b = 2.0 * eps * float(np.real(g(2.0 * eps)))
+        k_int = 2.0 * a - b
+        g0 = (b - a) / eps
+        # A free integrator shows as k_int well above what the O(eps) remainder of G0 could leave there.
+        if abs(k_int) > 1e-6 * (abs(g0) * scale + abs(k_int)) and abs(k_int) > 0.0:
+            return None, k_int
+        return g0, 0.0
+
+    def bode(self, input_name: str, output_name: str, omega_rad_s: np.ndarray) -> dict[str, list[float]]:
+        """Bode data of one channel: frequency [Hz], magnitude [output unit per input unit], phase [deg]."""
+        resp = ct.frequency_response(self.sys[output_name, input_name], omega_rad_s)
+        return {"frequency_Hz": [float(w / (2 * math.pi)) for w in omega_rad_s],
+                "magnitude": [float(m) for m in np.atleast_1d(np.squeeze(resp.magnitude))],
+                "phase_deg": [float(np.degrees(ph)) for ph in np.atleast_1d(np.squeeze(resp.phase))]}
+
+    def frequency_grid_rad_s(self, n: int = 200) -> np.ndarray:
+        """Logarithmic grid two decades either side of the mechanical mode."""
+        w = self.mechanical_mode().omega_n_rad_s or 1.0
+        return np.logspace(math.log10(w) - 2.0, math.log10(w) + 2.0, n)
+
+
+def linearize(model: MuscleModel, op: OperatingPoint, friction: FrictionTreatment | None = None,
+              valve_slope: str = "mean", drop_unobservable_air_mass: bool = True) -> LinearModel:
+    """Linearise ``model`` about ``op``.
+
+    Parameters
+    ----------
+    model : MuscleModel
+        A model with a valve source.
+    op : OperatingPoint
+        From :mod:`pamsim.control.operating_point`.
+    friction : FrictionTreatment, optional
+        Default ``dropped``.  ``sliding`` needs a moving load (its direction
+        is taken from the sign of the velocity at ``op``).
+    valve_slope : {"mean", "fill", "vent"}
+        Slope of the valve at command 0 (see the module notes).
+    drop_unobservable_air_mass : bool
+        The air mass feeds back only through the gas temperature of venting
+        air; where its column of A and C is zero (closed or filling valve, or
+        the chamber at supply pressure) it is an unobservable integrator and
+        is dropped, which leaves every transfer function unchanged.
+
+    Returns
+    -------
+    LinearModel
+        With ``sys`` a :class:`control.StateSpace` named like the nonlinear system.
+
+    Raises
+    ------
+    InputError
+        For ``sliding`` at a load at rest, or an unknown choice.
+    """
+    friction = friction or FrictionTreatment("dropped")
+    v0 = float(op.states[1])
+    if friction.kind == "sliding":
+        if v0 == 0.0:
+            raise InputError("friction 'sliding' needs a moving load; at rest Coulomb friction has no "
+                             "linearisation (use 'dropped' or 'regularised')")
+        friction = FrictionTreatment("sliding", friction.velocity_scale_m_s, math.copysign(1.0, v0))
+    plant = MusclePlant(model)
+    A, B, C, D = jacobians(plant, op, friction, valve_slope)
+    residual = plant.rhs(op.states, op.inputs, friction)
+    keep = list(range(len(STATES)))
+    k_m = STATES.index("air_mass_kg")
+    dropped: tuple[str, ...] = ()
+    if drop_unobservable_air_mass:
+        # Compare in scaled variables so that kg and Pa columns are commensurable.
+        scaled_A = A * np.asarray(STATE_SCALES)[None, :] / np.asarray(STATE_SCALES)[:, None]
+        others = [k for k in keep if k != k_m]
+        coupling = np.max(np.abs(np.delete(scaled_A[:, k_m], k_m))) + np.max(np.abs(C[:, k_m])) * STATE_SCALES[k_m]
+        if coupling <= 1e-9 * np.max(np.abs(scaled_A[np.ix_(others, others)])):
+            keep, dropped = others, ("air_mass_kg",)
+    sys = ct.ss(A[np.ix_(keep, keep)], B[keep], C[:, keep], D, states=[STATES[k] for k in keep],
+                inputs=list(INPUTS), outputs=list(OUTPUTS), name="muscle_linear")
+    return LinearModel(sys, op, friction, valve_slope, residual, dropped)

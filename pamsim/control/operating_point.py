@@ -1,0 +1,159 @@
+"""Operating points of the muscle for linearisation.
+
+Three kinds:
+
+``open_valve``
+    Valve fully open to a supply pressure, the chamber at supply pressure,
+    the load at rest where ``F_static(x, p_supply) = W - F_ext``.  The valve
+    flow is in its laminar branch (pressure ratio 1).
+``held_pressure``
+    A target contraction held with the valve closed (command 0): the chamber
+    holds the pressure where ``F_static(x, p) = W - F_ext``.  A 3/3 valve
+    cannot fill and vent at once, so no balance of inflow and outflow exists;
+    a closed valve at the holding pressure is its only equilibrium away from
+    the supply pressure.
+``trajectory``
+    The state of a scenario's hybrid simulation at a given time, with the
+    inputs at that time.  It need not be an equilibrium; the residual
+    ``f(x0, u0)`` is reported.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import brentq
+
+from ..constants import PA_PER_BAR
+from ..errors import InputError
+from ..model import Mode, MuscleModel
+from ..static import equilibrium_contraction_m, max_load_N
+from .system import MusclePlant
+
+
+@dataclass(frozen=True)
+class OperatingPoint:
+    """States ``(x_m, v_m_s, p_abs_Pa, air_mass_kg)`` and inputs ``(valve_command, supply_gauge_Pa, F_ext_N)``.
+
+    ``mode`` is the hybrid mode of the load there (stick for an equilibrium).
+    """
+
+    states: np.ndarray
+    inputs: np.ndarray
+    kind: str
+    mode: Mode
+    description: str
+
+    def as_dict(self) -> dict:
+        return {"kind": self.kind, "mode": self.mode.label, "description": self.description,
+                "states": [float(v) for v in self.states], "inputs": [float(v) for v in self.inputs]}
+
+
+def _load_N(model: MuscleModel, F_ext_N: float) -> float:
+    """Force the muscle must supply at rest: the weight less any helping external force [N]."""
+    return model.load.weight_N - F_ext_N
+
+
+def _rest_states(model: MuscleModel, x_m: float, p_gauge_Pa: float) -> np.ndarray:
+    return np.array([x_m, 0.0, *model.source.initial_state(x_m, p_gauge_Pa)], dtype=float)
+
+
+def open_valve_equilibrium(model: MuscleModel, supply_gauge_Pa: float, F_ext_N: float = 0.0) -> OperatingPoint:
+    """The load at rest with the valve fully open and the chamber at supply pressure.
+
+    Raises
+    ------
+    InputError
+        If the load exceeds the muscle's force capability at that pressure (it
+        stays on the lower stop) or the muscle still out-pulls it at the upper
+        stop (no free equilibrium).
+    """
+    MusclePlant(model)  # checks the source type
+    load = _load_N(model, F_ext_N)
+    x_high = model.stops.x_high_m
+    x_eq = equilibrium_contraction_m(model.static_force, supply_gauge_Pa, load, x_high)
+    bar = supply_gauge_Pa / PA_PER_BAR
+    if x_eq <= model.stops.x_low_m:
+        cap = max_load_N(model.static_force, supply_gauge_Pa, x_high)
+        raise InputError(f"a load of {load:.2f} N is beyond the muscle's force capability at {bar:g} bar "
+                         f"({cap:.2f} N): it rests on the lower stop, no equilibrium to linearise about")
+    if x_eq >= x_high:
+        raise InputError(f"at {bar:g} bar the muscle out-pulls {load:.2f} N up to its upper stop "
+                         f"({x_high * 1e3:.1f} mm): no free equilibrium to linearise about")
+    return OperatingPoint(_rest_states(model, x_eq, supply_gauge_Pa), np.array([1.0, supply_gauge_Pa, F_ext_N]),
+                          "open_valve", Mode.STICK,
+                          f"valve open, chamber at the {bar:g} bar supply, load {load:.2f} N at rest at "
+                          f"{x_eq * 1e3:.3f} mm")
+
+
+def contraction_range_m(model: MuscleModel) -> tuple[float, float]:
+    """Contractions at which a held equilibrium is accepted: above the lower stop, within the fitted range."""
+    return model.stops.x_low_m, min(model.stops.x_high_m, model.fit_range.x_max_m)
+
+
+def holding_pressure_Pa(model: MuscleModel, x_m: float, load_N: float, p_max_gauge_Pa: float) -> float:
+    """Gauge pressure [Pa] in [0, p_max_gauge_Pa] at which ``F_static(x, p) = load_N``.
+
+    Raises
+    ------
+    InputError
+        If the load needs more than ``p_max_gauge_Pa`` there, or the muscle's
+        elastic force alone already exceeds it (it would need a vacuum).
+    """
+    F = model.static_force.force_N
+    lo, hi = F(x_m, 0.0) - load_N, F(x_m, p_max_gauge_Pa) - load_N
+    if hi < 0.0:
+        raise InputError(f"holding {load_N:.2f} N at {x_m * 1e3:g} mm needs more than the "
+                         f"{p_max_gauge_Pa / PA_PER_BAR:g} bar supply (the muscle can hold {F(x_m, p_max_gauge_Pa):.2f} N "
+                         "there): the load is beyond its force capability at this contraction")
+    if lo > 0.0:
+        raise InputError(f"at {x_m * 1e3:g} mm the unpressurised muscle already pulls {F(x_m, 0.0):.2f} N, "
+                         f"more than the {load_N:.2f} N load: it cannot be held there at a gauge pressure >= 0")
+    return float(brentq(lambda p: F(x_m, p) - load_N, 0.0, p_max_gauge_Pa, xtol=1e-9))
+
+
+def held_equilibrium(model: MuscleModel, x_m: float, supply_gauge_Pa: float, F_ext_N: float = 0.0) -> OperatingPoint:
+    """The load held at contraction ``x_m`` by a closed valve and the pressure that balances it.
+
+    Raises
+    ------
+    InputError
+        If ``x_m`` is outside :func:`contraction_range_m` or the holding
+        pressure is not between atmospheric and the supply pressure.
+    """
+    MusclePlant(model)
+    lo, hi = contraction_range_m(model)
+    if not lo < x_m < hi:
+        raise InputError(f"contraction {x_m * 1e3:g} mm is outside the model's range ({lo * 1e3:g} mm, "
+                         f"{hi * 1e3:g} mm): above the lower stop and within the static polynomial's fitted range")
+    p = holding_pressure_Pa(model, x_m, _load_N(model, F_ext_N), supply_gauge_Pa)
+    return OperatingPoint(_rest_states(model, x_m, p), np.array([0.0, supply_gauge_Pa, F_ext_N]),
+                          "held_pressure", Mode.STICK,
+                          f"valve closed, chamber holding {p / PA_PER_BAR:.4f} bar, load "
+                          f"{_load_N(model, F_ext_N):.2f} N at rest at {x_m * 1e3:g} mm")
+
+
+def trajectory_point(scenario, time_s: float) -> OperatingPoint:
+    """The state of ``scenario``'s hybrid simulation at ``time_s`` and the inputs then.
+
+    Raises
+    ------
+    InputError
+        If ``time_s`` is not in (0, duration].
+    """
+    from ..api import simulate
+
+    if not 0.0 < time_s <= scenario.duration_s:
+        raise InputError(f"--at-time {time_s:g} s: must lie in (0, {scenario.duration_s:g}] s, the scenario's duration")
+    model = scenario.build_model()
+    MusclePlant(model)
+    result = simulate(scenario.with_changes({"simulation": {"duration_s": float(time_s)}}))
+    p_abs = result.p_gauge_Pa[-1] + model.source.p_atm_Pa
+    states = np.array([result.x_m[-1], result.v_m_s[-1], p_abs, result.signals["air_mass_kg"][-1]], dtype=float)
+    command, supply = model.source.inputs(float(time_s))
+    mode = result.final_mode
+    return OperatingPoint(states, np.array([command, supply, model.load.external_N(float(time_s))], dtype=float),
+                          "trajectory", mode,
+                          f"state of the simulation at t = {time_s:g} s ({mode.label}): x = {states[0] * 1e3:.3f} mm, "
+                          f"v = {states[1] * 1e3:.3f} mm/s, p = {(p_abs - model.source.p_atm_Pa) / PA_PER_BAR:.4f} bar")
