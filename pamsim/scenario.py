@@ -38,7 +38,7 @@ from .simulator import SolverOptions
 _SIGNAL_KEYS = {"kind", "time_s", "start_s", "end_s", "tau_s", "file", "time_column", "value_column"}
 _SCHEMA: dict[str, dict[str, Any]] = {
     "": {"name": str, "description": str, "model": dict, "parameters": dict, "load": dict, "pressure": dict,
-         "simulation": dict, "solver": dict},
+         "simulation": dict, "solver": dict, "controller": dict},
     "model": {"parameter_set": str, "static_force": str, "friction": str, "damping": str,
               "friction_negative_level": str},
     "load": {"weight_N": float, "mass_kg": float, "external_force": dict},

@@ -17,6 +17,7 @@ COMMANDS = (
     "pamsim.cli.run",
     "pamsim.cli.static",
     "pamsim.cli.linearize",
+    "pamsim.cli.control_example",
     "pamsim.cli.params",
 )
 

@@ -59,3 +59,31 @@ def pole_zero_figure(lin: LinearModel) -> Figure:
     ax.set_title(f"f_n = {mode.natural_frequency_Hz:.3g} Hz, zeta = {mode.damping_ratio:.3g}"
                  + ("" if math.isfinite(mode.damping_ratio) else ""))
     return fig
+
+
+def closed_loop_figure(run) -> Figure:
+    """Contraction against reference and linear prediction, pressure, and valve command of a closed-loop run."""
+    res = run.result
+    fig = Figure(figsize=(9, 8.5), constrained_layout=True)
+    ax_x, ax_p, ax_u = fig.subplots(3, 1, sharex=True)
+    ax_x.plot(res.t_s, res.signals["reference_m"] * 1e3, "k--", lw=1, label="reference")
+    ax_x.plot(run.linear_t_s, run.linear_x_m * 1e3, color="C1", lw=1, label="linear loop (design model)")
+    ax_x.plot(res.t_s, res.x_m * 1e3, color="C0", label="hybrid model")
+    held = res.mode == 0
+    if held.any():
+        ax_x.plot(res.t_s[held], res.x_m[held] * 1e3, ".", ms=1.5, color="k", label="stuck (friction)")
+    ax_x.set_ylabel("contraction [mm]")
+    ax_x.legend(loc="lower right", fontsize=8)
+    ax_p.plot(res.t_s, res.p_gauge_Pa / 1e5, color="C3", label="chamber")
+    ax_p.plot(res.t_s, res.signals["feedforward_gauge_Pa"] / 1e5, ":", color="k", label="holding pressure (feedforward)")
+    ax_p.set_ylabel("gauge pressure [bar]")
+    ax_p.legend(loc="lower right", fontsize=8)
+    ax_u.plot(res.t_s, res.signals["valve_command"], color="C2")
+    ax_u.set_ylabel("valve command [-]")
+    ax_u.set_xlabel("time [s]")
+    for ax in (ax_x, ax_p, ax_u):
+        ax.grid(alpha=0.3)
+    m = run.metrics
+    fig.suptitle(f"{res.name}: rise {m['rise_time_s'] * 1e3:.0f} ms, overshoot {m['overshoot_percent']:.1f} %, "
+                 f"settling {m['settling_time_s'] * 1e3:.0f} ms, steady-state error {m['steady_state_error_mm']:.3f} mm")
+    return fig

@@ -1,0 +1,372 @@
+"""A position controller designed on the linear model and run on the hybrid model.
+
+Design (``docs/control.md``): LQR with integral action on the linearisation
+at a held operating point (valve closed), states contraction, velocity and
+chamber pressure plus the integral of the position error; the reference
+enters through the holding pressure of the target (static feedforward).  The
+velocity is estimated from the position by a first-order filter, so the
+controller needs a position and a pressure sensor only.
+
+On the nonlinear model the controller runs as part of the pressure source
+(:class:`ClosedLoopValveSource`): its states (error integral, position filter)
+sit beside the chamber states, and the valve command it computes is clipped to
+[-1, 1].  So :func:`~pamsim.simulator.simulate_model` integrates the loop with
+its unchanged stick/slip event logic.  The controller is continuous-time (an
+analogue of a controller sampled much faster than the 4 Hz mechanical mode).
+
+Non-linear parts of the law:
+
+* valve saturation with back-calculation anti-windup of the integral;
+* a deadband on the integrated error: inside it the integral stops, which
+  keeps Coulomb friction from driving a stick-slip limit cycle (the integral
+  would otherwise ramp the pressure of a stuck load until it jumps past the
+  target, and back).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+from typing import Any, Mapping
+
+import control as ct
+import numpy as np
+
+from ..atomic import atomic_outputs
+from ..constants import PA_PER_BAR
+from ..elements.pressure_source import ValveChamberSource
+from ..errors import InputError
+from ..model import MuscleModel
+from ..result import Result
+from ..scenario import Scenario, load_scenario
+from ..signals import Step
+from ..simulator import simulate_model
+from .linear import LinearModel, linearize
+from .operating_point import held_equilibrium, holding_pressure_Pa
+from .system import FrictionTreatment, MusclePlant
+
+# [controller] keys: name -> (default or None if required, unit factor to SI)
+_CONTROLLER_KEYS: dict[str, tuple[Any, float]] = {
+    "kind": ("lqr_integral", 1.0),
+    "target_contraction_mm": (None, 1e-3),
+    "step_time_s": (None, 1.0),
+    "design_contraction_mm": (None, 1e-3),
+    "max_position_error_mm": (None, 1e-3),
+    "max_velocity_mm_s": (None, 1e-3),
+    "max_pressure_error_bar": (None, PA_PER_BAR),
+    "max_integral_mm_s": (None, 1e-3),
+    "max_command": (1.0, 1.0),
+    "velocity_filter_time_s": (None, 1.0),
+    "integrator_deadband_mm": (0.0, 1e-3),
+    "antiwindup_time_s": (None, 1.0),
+    "spec": ({}, 1.0),
+}
+_SPEC_KEYS = ("rise_time_max_s", "overshoot_max_percent", "settling_time_max_s", "settling_band_mm",
+              "steady_state_error_max_mm")
+
+
+@dataclass(frozen=True)
+class ControllerConfig:
+    """The ``[controller]`` table of a scenario, in SI units (see ``docs/control.md``)."""
+
+    target_contraction_m: float
+    step_time_s: float
+    design_contraction_m: float
+    max_position_error_m: float
+    max_velocity_m_s: float
+    max_pressure_error_Pa: float
+    max_integral_m_s: float
+    max_command: float
+    velocity_filter_time_s: float
+    integrator_deadband_m: float
+    antiwindup_time_s: float
+    spec: Mapping[str, float]
+
+    @classmethod
+    def from_scenario(cls, scenario: Scenario) -> "ControllerConfig":
+        """Read and validate ``[controller]``.
+
+        Raises
+        ------
+        InputError
+            Naming the file and key for a missing, unknown or non-positive entry.
+        """
+        where = scenario.origin
+        table = scenario.spec.get("controller")
+        if not isinstance(table, dict):
+            raise InputError(f"{where}: missing table [controller] (see docs/control.md)")
+        for key in table:
+            if key not in _CONTROLLER_KEYS:
+                raise InputError(f"{where}: unknown key controller.{key} (known: {', '.join(_CONTROLLER_KEYS)})")
+        if table.get("kind", "lqr_integral") != "lqr_integral":
+            raise InputError(f"{where}: controller.kind = {table['kind']!r}: only 'lqr_integral' is implemented")
+        values = {}
+        for key, (default, factor) in _CONTROLLER_KEYS.items():
+            if key in ("kind", "spec"):
+                continue
+            if key not in table and default is None:
+                raise InputError(f"{where}: missing key controller.{key}")
+            raw = table.get(key, default)
+            if isinstance(raw, bool) or not isinstance(raw, (int, float)) or not math.isfinite(raw):
+                raise InputError(f"{where}: controller.{key} = {raw!r}: must be a finite number")
+            if raw < 0 or (raw == 0 and key != "integrator_deadband_mm"):
+                raise InputError(f"{where}: controller.{key} = {raw!r}: must be positive")
+            name = key.replace("_mm_s", "_m_s").replace("_mm", "_m").replace("_bar", "_Pa")
+            values[name] = float(raw) * factor
+        spec = table.get("spec", {})
+        if not isinstance(spec, dict) or any(k not in _SPEC_KEYS for k in spec):
+            raise InputError(f"{where}: controller.spec must be a table with keys from {', '.join(_SPEC_KEYS)}")
+        for key, raw in spec.items():
+            if isinstance(raw, bool) or not isinstance(raw, (int, float)) or raw <= 0:
+                raise InputError(f"{where}: controller.spec.{key} = {raw!r}: must be a positive number")
+        if not 0.0 < values["step_time_s"] < scenario.duration_s:
+            raise InputError(f"{where}: controller.step_time_s = {values['step_time_s']:g}: must lie inside the "
+                             f"simulation (0, {scenario.duration_s:g}) s")
+        return cls(spec={k: float(v) for k, v in spec.items()}, **values)
+
+
+@dataclass(frozen=True)
+class LqrDesign:
+    """Gains ``K = [K_x, K_v, K_p, K_z]`` of ``u = -K [x - r, v, p - p_ff(r), z]`` with ``z' = x - r``.
+
+    ``linear`` is the plant linearisation it was designed on, ``closed_loop_poles``
+    the poles of the linear loop with the state feedback (ideal velocity).
+    """
+
+    K: np.ndarray
+    linear: LinearModel
+    closed_loop_poles: np.ndarray
+    model: MuscleModel
+
+
+def design_lqr(model: MuscleModel, config: ControllerConfig, supply_gauge_Pa: float) -> LqrDesign:
+    """LQR with integral action on the held-pressure linearisation at the design contraction.
+
+    Bryson's rule sets the weights: each state and the command are divided by
+    their largest acceptable value.  Coulomb friction is dropped from the
+    design model (no linearisation at rest); the valve slope at command 0 is
+    the mean of filling and venting.
+    """
+    op = held_equilibrium(model, config.design_contraction_m, supply_gauge_Pa)
+    lin = linearize(model, op, FrictionTreatment("dropped"), "mean")
+    plant = lin.sys[["contraction_m", "p_gauge_Pa"], "valve_command"]
+    labels = list(lin.sys.state_labels)
+    if labels != ["x_m", "v_m_s", "p_abs_Pa"]:
+        raise InputError(f"the design model has states {labels}; expected x_m, v_m_s, p_abs_Pa")
+    A, B = plant.A, plant.B
+    # Augment with z' = x - r (r = 0 in deviation variables).
+    A_aug = np.block([[A, np.zeros((3, 1))], [np.array([[1.0, 0.0, 0.0, 0.0]])]])
+    B_aug = np.vstack([B, [[0.0]]])
+    Q = np.diag([config.max_position_error_m ** -2, config.max_velocity_m_s ** -2,
+                 config.max_pressure_error_Pa ** -2, config.max_integral_m_s ** -2])
+    R = np.array([[config.max_command ** -2]])
+    K, _, poles = ct.lqr(A_aug, B_aug, Q, R)
+    return LqrDesign(np.asarray(K, dtype=float).ravel(), lin, np.asarray(poles), model)
+
+
+@dataclass(frozen=True)
+class ClosedLoopValveSource:
+    """A :class:`ValveChamberSource` whose command comes from the position controller.
+
+    States: chamber pressure [Pa], air mass [kg], error integral ``z`` [m s]
+    and the position filter ``x_f`` [m] of the velocity estimate
+    ``(x - x_f) / tau``.  Inputs at time t: reference [m], feedforward
+    holding pressure [Pa gauge], supply pressure [Pa gauge].
+    """
+
+    plant: ValveChamberSource
+    K: tuple[float, float, float, float]
+    reference_m: Step
+    feedforward_gauge_Pa: Step
+    velocity_filter_time_s: float
+    deadband_m: float
+    antiwindup_time_s: float
+    name: str = "closed_loop_valve"
+    state_names: tuple[str, ...] = ("p_abs_Pa", "air_mass_kg", "z_error_integral_m_s", "x_filter_m")
+
+    @property
+    def p_atm_Pa(self) -> float:
+        return self.plant.p_atm_Pa
+
+    def initial_state(self, x_m: float, p_gauge_Pa: float | None = None) -> list[float]:
+        """At rest at ``x_m`` with the chamber at the feedforward (holding) pressure of the initial reference."""
+        p = self.feedforward_gauge_Pa(0.0) if p_gauge_Pa is None else p_gauge_Pa
+        return self.plant.initial_state(x_m, p) + [0.0, x_m]
+
+    def inputs(self, t_s) -> tuple:
+        return self.reference_m(t_s), self.feedforward_gauge_Pa(t_s), self.plant.supply_gauge_Pa(t_s)
+
+    def pressure_gauge_Pa(self, s, inputs):
+        return s[0] - self.p_atm_Pa
+
+    def command(self, s, x_m, inputs):
+        """(clipped, unclipped) valve command for source states ``s`` at contraction ``x_m``."""
+        r, p_ff, _ = inputs
+        Kx, Kv, Kp, Kz = self.K
+        v_hat = (x_m - s[3]) / self.velocity_filter_time_s
+        raw = -(Kx * (x_m - r) + Kv * v_hat + Kp * (s[0] - self.p_atm_Pa - p_ff) + Kz * s[2])
+        return np.clip(raw, -1.0, 1.0), raw
+
+    def derivatives(self, s, x_m, v_m_s, inputs) -> tuple[float, ...]:
+        u, raw = self.command(s, x_m, inputs)
+        dp, dm = self.plant.derivatives(s[:2], x_m, v_m_s, (float(u), inputs[2]))
+        e = x_m - inputs[0]
+        dead = math.copysign(max(abs(e) - self.deadband_m, 0.0), e)
+        # Back-calculation: while the valve saturates, bleed the integral so that the
+        # unclipped command returns to the limit within antiwindup_time_s.
+        dz = dead + (raw - u) / (self.K[3] * self.antiwindup_time_s)
+        return dp, dm, dz, (x_m - s[3]) / self.velocity_filter_time_s
+
+    @property
+    def breakpoints(self) -> tuple[float, ...]:
+        return self.reference_m.breakpoints + tuple(getattr(self.plant.supply_gauge_Pa, "breakpoints", ()))
+
+    def outputs(self, t_s, S, x_m) -> dict[str, np.ndarray]:
+        inputs = self.inputs(t_s)
+        u, _ = self.command(S, x_m, inputs)
+        mdot, T_gas = self.plant.inflow_kg_s(S[:2], x_m, (u, inputs[2]))
+        zero = 0.0 * np.asarray(t_s, dtype=float)
+        return {"air_mass_kg": S[1], "valve_mass_flow_kg_s": np.asarray(mdot, dtype=float) + zero,
+                "valve_command": np.asarray(u, dtype=float) + zero, "supply_gauge_Pa": inputs[2] + zero,
+                "gas_temperature_K": T_gas, "reference_m": np.asarray(inputs[0], dtype=float) + zero,
+                "feedforward_gauge_Pa": np.asarray(inputs[1], dtype=float) + zero,
+                "z_error_integral_m_s": S[2], "velocity_estimate_m_s": (x_m - S[3]) / self.velocity_filter_time_s}
+
+
+def closed_loop_model(scenario: Scenario, config: ControllerConfig, design: LqrDesign) -> MuscleModel:
+    """The scenario's model with its valve driven by the controller."""
+    model = scenario.build_model()
+    MusclePlant(model)  # a valve source is required
+    supply = scenario.final_pressure_gauge_Pa
+    x0 = scenario.initial_contraction_m
+    W = model.load.weight_N
+    p0 = holding_pressure_Pa(model, x0, W, supply) if x0 > 0 else 0.0
+    held_equilibrium(model, config.target_contraction_m, supply)  # validates the target
+    p1 = holding_pressure_Pa(model, config.target_contraction_m, W, supply)
+    source = ClosedLoopValveSource(model.source, tuple(float(k) for k in design.K),
+                                   Step(config.step_time_s, x0, config.target_contraction_m),
+                                   Step(config.step_time_s, p0, p1), config.velocity_filter_time_s,
+                                   config.integrator_deadband_m, config.antiwindup_time_s)
+    return dataclasses.replace(model, source=source)
+
+
+def step_metrics(t_s: np.ndarray, x_m: np.ndarray, step_time_s: float, x0_m: float, x1_m: float,
+                 settling_band_m: float, tail_s: float = 0.3) -> dict[str, float]:
+    """Rise time (10-90 %), overshoot [% of the step], settling time into ``settling_band_m``,
+    steady-state error (mean over the last ``tail_s``) and the peak-to-peak motion in that tail.
+
+    Times are measured from the step.  A response that never rises or
+    settles gets ``inf``.
+    """
+    after = t_s >= step_time_s
+    t, x = t_s[after] - step_time_s, x_m[after]
+    dx = x1_m - x0_m
+    frac = (x - x0_m) / dx
+    t10 = t[np.argmax(frac >= 0.1)] if np.any(frac >= 0.1) else math.inf
+    t90 = t[np.argmax(frac >= 0.9)] if np.any(frac >= 0.9) else math.inf
+    outside = np.flatnonzero(np.abs(x - x1_m) > settling_band_m)
+    if outside.size == 0:
+        settle = 0.0
+    elif outside[-1] == len(t) - 1:
+        settle = math.inf
+    else:
+        settle = float(t[outside[-1] + 1])
+    tail = t >= t[-1] - tail_s
+    return {"rise_time_s": float(t90 - t10), "overshoot_percent": float(max(0.0, np.max(frac) - 1.0) * 100.0),
+            "settling_time_s": settle, "steady_state_error_mm": float(abs(np.mean(x[tail]) - x1_m) * 1e3),
+            "tail_peak_to_peak_mm": float(np.ptp(x[tail]) * 1e3)}
+
+
+def linear_step_prediction(design: LqrDesign, config: ControllerConfig, x0_m: float,
+                           duration_s: float) -> tuple[np.ndarray, np.ndarray]:
+    """Contraction [m] of the linear loop (no saturation, deadband or friction) for the same step.
+
+    The controller, with its velocity filter, is built as a python-control
+    system and closed around the plant linearisation by signal name.
+    """
+    lin = design.linear
+    model_plant = lin.sys[["contraction_m", "p_gauge_Pa"], :]
+    Kx, Kv, Kp, Kz = design.K
+    tau = config.velocity_filter_time_s
+    # Holding-pressure slope dp_ff/dr at the design point, for the reference feedforward.
+    h = 1e-5
+    supply = float(lin.op.inputs[1])
+    model = design.model
+    load = model.load.weight_N - float(lin.op.inputs[2])
+    g_ff = (holding_pressure_Pa(model, config.design_contraction_m + h, load, supply)
+            - holding_pressure_Pa(model, config.design_contraction_m - h, load, supply)) / (2 * h)
+    # Controller states z (error integral), x_f (filter); inputs contraction, pressure, reference.
+    ctrl = ct.ss([[0.0, 0.0], [0.0, -1.0 / tau]],
+                 [[1.0, 0.0, -1.0], [1.0 / tau, 0.0, 0.0]],
+                 [[-Kz, Kv / tau]],
+                 [[-(Kx + Kv / tau), -Kp, Kx + Kp * g_ff]],
+                 states=["z_error_integral_m_s", "x_filter_m"], inputs=["contraction_m", "p_gauge_Pa", "r_m"],
+                 outputs=["valve_command"], name="lqr")
+    loop = ct.interconnect([model_plant, ctrl], inplist=["r_m", "supply_gauge_Pa", "F_ext_N"],
+                           outlist=["contraction_m", "valve_command"], inputs=["r_m", "supply_gauge_Pa", "F_ext_N"],
+                           outputs=["contraction_m", "valve_command"], name="linear_loop")
+    t = np.linspace(0.0, duration_s, 2001)
+    resp = ct.forced_response(loop[:, "r_m"], t, np.full_like(t, config.target_contraction_m - x0_m))
+    return t, x0_m + resp.outputs[0]
+
+
+@dataclass
+class ClosedLoopRun:
+    """A closed-loop run: the hybrid result, the design, the metrics and the spec check."""
+
+    result: Result
+    design: LqrDesign
+    config: ControllerConfig
+    metrics: dict[str, float]
+    linear_t_s: np.ndarray
+    linear_x_m: np.ndarray
+    linear_metrics: dict[str, float]
+
+    def failures(self) -> list[str]:
+        """The spec items this run misses (empty when it meets its specification)."""
+        m, s = self.metrics, self.config.spec
+        checks = (("rise_time_max_s", m["rise_time_s"], "rise time {:.3f} s > {:.3f} s"),
+                  ("overshoot_max_percent", m["overshoot_percent"], "overshoot {:.2f} % > {:.2f} %"),
+                  ("settling_time_max_s", m["settling_time_s"], "settling time {:.3f} s > {:.3f} s"),
+                  ("steady_state_error_max_mm", m["steady_state_error_mm"], "steady-state error {:.3f} mm > {:.3f} mm"))
+        return [msg.format(value, s[key]) for key, value, msg in checks if key in s and not value <= s[key]]
+
+    def summary(self) -> dict:
+        return {"scenario": self.result.name, "gains_K": [float(k) for k in self.design.K],
+                "gain_order": ["x_m", "v_m_s", "p_gauge_Pa", "z_error_integral_m_s"],
+                "design_poles": [[float(p.real), float(p.imag)] for p in self.design.closed_loop_poles],
+                "metrics": self.metrics, "linear_prediction_metrics": self.linear_metrics,
+                "spec": dict(self.config.spec), "meets_spec": not self.failures(), "failures": self.failures(),
+                "events": int(self.result.stats["events"]), "wall_time_s": float(self.result.wall_time_s)}
+
+
+def run_closed_loop(scenario: Scenario | str, overrides: Mapping[str, Any] | None = None) -> ClosedLoopRun:
+    """Design the controller of ``scenario`` and run it on the hybrid model.
+
+    Parameters
+    ----------
+    scenario : Scenario or path
+        A scenario with a valve source and a ``[controller]`` table.
+    overrides : mapping, optional
+        Replacement ``[controller]`` keys (e.g. ``{"integrator_deadband_mm": 0}``
+        to see the friction limit cycle).
+    """
+    if not isinstance(scenario, Scenario):
+        scenario = load_scenario(scenario)
+    if overrides:
+        spec = dict(scenario.spec)
+        spec["controller"] = {**spec.get("controller", {}), **overrides}
+        scenario = Scenario.from_dict(spec, scenario.name, scenario.base_dir, scenario.origin)
+    config = ControllerConfig.from_scenario(scenario)
+    model = scenario.build_model()
+    design = design_lqr(model, config, scenario.final_pressure_gauge_Pa)
+    cl_model = closed_loop_model(scenario, config, design)
+    result = simulate_model(cl_model, scenario.duration_s, scenario.solver, x0_m=scenario.initial_contraction_m,
+                            name=scenario.name)
+    x0 = scenario.initial_contraction_m
+    band = config.spec.get("settling_band_mm", 0.5) * 1e-3
+    metrics = step_metrics(result.t_s, result.x_m, config.step_time_s, x0, config.target_contraction_m, band)
+    t_lin, x_lin = linear_step_prediction(design, config, x0, scenario.duration_s - config.step_time_s)
+    lin_metrics = step_metrics(t_lin, x_lin, 0.0, x0, config.target_contraction_m, band)
+    return ClosedLoopRun(result, design, config, metrics, t_lin + config.step_time_s, x_lin, lin_metrics)
