@@ -356,7 +356,8 @@ int pam_event_update(PamCore *c) {
 
 /* ------------------------------------------------------------ Dormand-Prince 5(4) */
 
-static const double DP_C[7] = {0.0, 1.0 / 5, 3.0 / 10, 4.0 / 5, 8.0 / 9, 1.0, 1.0};
+/* Inputs are held over a communication step, so the right-hand side does not depend on time
+ * and the nodes c_i of the tableau are not needed. */
 static const double DP_A[7][6] = {
     {0},
     {1.0 / 5},
