@@ -13,6 +13,8 @@ from typing import Callable
 # name -> "module:function"
 BACKENDS: dict[str, str] = {
     "python": "pamsim.api:simulate",
+    "fmu-cs": "pamsim.fmu.runner:simulate_cs",
+    "fmu-me": "pamsim.fmu.runner:simulate_me",
 }
 
 

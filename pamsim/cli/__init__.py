@@ -16,6 +16,7 @@ from ..errors import InputError, SolverFailure
 COMMANDS = (
     "pamsim.cli.run",
     "pamsim.cli.static",
+    "pamsim.cli.fmu",
     "pamsim.cli.linearize",
     "pamsim.cli.control_example",
     "pamsim.cli.params",
