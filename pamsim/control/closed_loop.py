@@ -225,7 +225,7 @@ class ClosedLoopValveSource:
     def outputs(self, t_s, S, x_m) -> dict[str, np.ndarray]:
         inputs = self.inputs(t_s)
         u, _ = self.command(S, x_m, inputs)
-        mdot, T_gas = self.plant.inflow_kg_s(S[:2], x_m, (u, inputs[2]))
+        mdot, T_gas = self.plant.inflow_kg_s(S[:2], self.plant.chamber.volume_m3(x_m), (u, inputs[2]))
         zero = 0.0 * np.asarray(t_s, dtype=float)
         return {"air_mass_kg": S[1], "valve_mass_flow_kg_s": np.asarray(mdot, dtype=float) + zero,
                 "valve_command": np.asarray(u, dtype=float) + zero, "supply_gauge_Pa": inputs[2] + zero,
