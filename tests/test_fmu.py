@@ -1,0 +1,487 @@
+"""The FMU (FMI 2.0 and 3.0, Model Exchange and Co-Simulation) against the Python simulator.
+
+Each FMU is built once per session from the current sources.  The reference
+is ``pamsim.simulate`` (solve_ivp, LSODA) on the same scenario: the two
+implementations share no code, so agreement checks the C equations, the
+event logic and both FMI wrappers.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import re
+import subprocess
+import sys
+import time
+import xml.etree.ElementTree as ET
+import zipfile
+
+import numpy as np
+import pytest
+
+import pamsim
+from conftest import PAPER_SCENARIOS, SCENARIOS
+from pamsim.fmu import build
+from pamsim.fmu.generate import c_header, token
+from pamsim.fmu.runner import ScenarioInputs, run_cs, run_me, start_values
+from pamsim.fmu.variables import VARIABLES, value_reference
+from pamsim.parameters import get_parameter_set
+
+MAX_DIFF_M = 0.2e-3
+FINAL_DIFF_M = 0.05e-3
+
+
+@pytest.fixture(scope="session")
+def fmus(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("fmu")
+    return {v: build(folder / f"pamsim_muscle_fmi{v}.fmu", v) for v in (2, 3)}
+
+
+@pytest.fixture(scope="session")
+def traces(fmus, paper_results):
+    """{(scenario, interface, version): trace} for the five paper scenarios."""
+    out = {}
+    for name, (sc, _) in paper_results.items():
+        for v in (2, 3):
+            out[name, "cs", v] = run_cs(sc, v, fmu_path=fmus[v])
+            out[name, "me", v] = run_me(sc, v, fmu_path=fmus[v])
+    return out
+
+
+def _diff(trace, result):
+    assert np.allclose(trace["t_s"], result.t_s, atol=1e-9)
+    return np.abs(trace["contraction_m"] - result.x_m)
+
+
+# ------------------------------------------------------------------ the archive
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_validate_fmu_reports_no_problems(fmus, version):
+    from fmpy.validation import validate_fmu
+
+    assert validate_fmu(str(fmus[version])) == []
+
+
+@pytest.mark.parametrize("version,platform", [(2, "binaries/linux64/"), (3, "binaries/x86_64-linux/")])
+def test_archive_layout(fmus, version, platform):
+    names = zipfile.ZipFile(fmus[version]).namelist()
+    assert f"{platform}pamsim_muscle.so" in names
+    for src in ("sources/pam_core.c", "sources/pam_core.h", "sources/pam_variables.h", "sources/buildDescription.xml",
+                f"sources/fmi{version}_wrapper.c", f"sources/fmi{version}Functions.h", "sources/FMI_HEADERS_LICENSE.txt"):
+        assert src in names
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_model_description_and_header_come_from_the_table(fmus, version):
+    xml = zipfile.ZipFile(fmus[version]).read("modelDescription.xml").decode()
+    root = ET.fromstring(xml)
+    tag = "ScalarVariable" if version == 2 else "*"
+    declared = {e.get("name"): e for e in root.find("ModelVariables").findall(tag)}
+    params = get_parameter_set("shadow_6x300_acra2012")
+    for name, p in params.entries.items():
+        e = declared[name]
+        real = e.find("Real") if version == 2 else e
+        assert float(real.get("start")) == p.value
+        assert real.get("unit") == p.unit
+        assert p.description in e.get("description")
+        assert e.get("causality") == "parameter"
+    for name in ("valve_command", "supply_pressure_gauge_Pa", "load_mass_kg", "external_force_N",
+                 "prescribed_pressure_gauge_Pa"):
+        assert declared[name].get("causality") == "input"
+    for name in ("contraction_m", "velocity_m_s", "pressure_gauge_Pa", "muscle_force_N", "friction_force_N",
+                 "friction_mode"):
+        assert declared[name].get("causality") == "output"
+    # The C header's value references are the XML's.
+    header = zipfile.ZipFile(fmus[version]).read("sources/pam_variables.h").decode()
+    assert header == c_header(version)
+    for v in VARIABLES:
+        vr = int(re.search(rf"#define VR_{re.escape(v.c_name)} (\d+)u", header).group(1))
+        assert vr == int(declared[v.name].get("valueReference")) == value_reference(v.name)
+    key = "guid" if version == 2 else "instantiationToken"
+    assert root.get(key) == token(version) and token(version) in header
+
+
+def test_token_is_deterministic_and_differs_between_versions(fmus, tmp_path):
+    again = build(tmp_path / "again.fmu", 2)
+    read = lambda p: ET.fromstring(zipfile.ZipFile(p).read("modelDescription.xml")).get("guid")  # noqa: E731
+    assert read(again) == read(fmus[2]) == token(2)
+    assert token(2) != token(3)
+
+
+# ------------------------------------------------------------------ against the Python simulator
+
+
+@pytest.mark.parametrize("version", [2, 3])
+@pytest.mark.parametrize("interface", ["cs", "me"])
+@pytest.mark.parametrize("name", sorted(PAPER_SCENARIOS))
+def test_paper_scenarios_match_python_simulator(traces, paper_results, name, interface, version):
+    d = _diff(traces[name, interface, version], paper_results[name][1])
+    assert d.max() <= MAX_DIFF_M, f"max contraction difference {d.max() * 1e3:.4f} mm"
+    assert d[-1] <= FINAL_DIFF_M, f"final contraction difference {d[-1] * 1e3:.4f} mm"
+
+
+@pytest.mark.parametrize("name", sorted(PAPER_SCENARIOS))
+def test_friction_modes_match_python_simulator(traces, paper_results, name):
+    ref = paper_results[name][1]
+    for key in ("cs", "me"):
+        modes = traces[name, key, 2]["friction_mode"]
+        # Mode switches may land one sample apart; everything else must agree.
+        assert np.mean(modes == ref.mode) > 0.995
+        assert modes[-1] == ref.mode[-1]
+
+
+@pytest.mark.parametrize("name", sorted(PAPER_SCENARIOS))
+def test_model_exchange_and_co_simulation_agree(traces, name):
+    for v in (2, 3):
+        cs, me = traces[name, "cs", v], traces[name, "me", v]
+        assert np.max(np.abs(cs["contraction_m"] - me["contraction_m"])) <= 0.05e-3
+        assert np.max(np.abs(cs["pressure_gauge_Pa"] - me["pressure_gauge_Pa"])) <= 100.0
+    # Both versions run the same core.
+    assert np.array_equal(traces[name, "cs", 2]["contraction_m"], traces[name, "cs", 3]["contraction_m"])
+
+
+def test_stick_resets_velocity_to_zero(traces):
+    for (name, interface, v), tr in traces.items():
+        held = tr["friction_mode"] != 1
+        held &= tr["friction_mode"] != -1
+        assert np.all(tr["velocity_m_s"][held] == 0.0), (name, interface, v)
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_random_non_uniform_communication_steps(fmus, paper_results, version):
+    sc, ref = paper_results["acra2012_fig4"]
+    rng = np.random.default_rng(4)
+    steps = rng.uniform(1e-5, 0.07, 400)
+    steps[::7] = 1e-11  # tiny steps, some of which land next to events
+    times = np.concatenate([[0.0], np.cumsum(steps)])
+    times = np.append(times[times < sc.duration_s], sc.duration_s)
+    t0 = time.perf_counter()
+    tr = run_cs(sc, version, communication_times=times, fmu_path=fmus[version])
+    assert time.perf_counter() - t0 < 20.0
+    assert np.array_equal(tr["t_s"], times)
+    x_ref = np.interp(times, ref.t_s, ref.x_m)
+    assert np.max(np.abs(tr["contraction_m"] - x_ref)) <= MAX_DIFF_M
+    assert abs(tr["contraction_m"][-1] - ref.x_m[-1]) <= FINAL_DIFF_M
+
+
+# ------------------------------------------------------------------ other importers
+
+
+def _inputs_and_starts(name):
+    sc = pamsim.load_scenario(SCENARIOS / f"{name}.toml")
+    return sc, ScenarioInputs(sc), start_values(sc)
+
+
+def test_libcosim_matches_fmpy(fmus, traces):
+    pytest.importorskip("libcosimpy", reason="libcosimpy (test extra) is not installed")
+    from libcosimpy.CosimExecution import CosimExecution
+    from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
+    from libcosimpy.CosimManipulator import CosimManipulator
+    from libcosimpy.CosimObserver import CosimObserver
+    from libcosimpy.CosimSlave import CosimLocalSlave
+
+    log_output_level(CosimLogLevel.ERROR)
+    sc, inputs, starts = _inputs_and_starts("acra2012_fig4")
+    ex = CosimExecution.from_step_size(step_size=1_000_000)  # nanoseconds
+    slave = ex.add_local_slave(CosimLocalSlave(fmu_path=str(fmus[2]), instance_name="muscle"))
+    manipulator = CosimManipulator.create_override()
+    ex.add_manipulator(manipulator)
+    observer = CosimObserver.create_last_value()
+    ex.add_observer(observer)
+    for k, v in starts.items():
+        (ex.real_initial_value if isinstance(v, float) else ex.integer_initial_value)(slave, value_reference(k), v)
+    names = list(inputs(0.0))
+    for k, v in inputs(0.0).items():
+        ex.real_initial_value(slave, value_reference(k), v)
+    x = []
+    for k in range(8000):
+        u = inputs(k * 1e-3)
+        manipulator.slave_real_values(slave, [value_reference(n) for n in names], [u[n] for n in names])
+        assert ex.step()
+        x.append(observer.last_real_values(slave, [value_reference("contraction_m")])[0])
+    fmpy_x = traces["acra2012_fig4", "cs", 2]["contraction_m"][1:]
+    assert np.max(np.abs(np.array(x) - fmpy_x)) <= 1e-9
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_ecos_matches_fmpy(fmus, traces, version):
+    pytest.importorskip("ecospy", reason="ecospy (test extra) is not installed")
+    from ecospy import EcosSimulation, EcosSimulationStructure
+
+    sc, inputs, starts = _inputs_and_starts("acra2012_fig6a")
+    structure = EcosSimulationStructure()
+    structure.add_model("muscle", str(fmus[version]))
+    init = {f"muscle::{k}": v for k, v in starts.items()}
+    init.update({f"muscle::{k}": v for k, v in inputs(0.0).items()})
+    structure.add_parameter_set("init", init)
+    sim = EcosSimulation(structure=structure, step_size=1e-3)
+    sim.init(parameter_set="init")
+    x = [sim.get_real("muscle::contraction_m")]
+    for k in range(8000):
+        for n, v in inputs(k * 1e-3).items():
+            sim.set_real(f"muscle::{n}", v)
+        sim.step()
+        x.append(sim.get_real("muscle::contraction_m"))
+    sim.terminate()
+    sim.free()
+    assert np.max(np.abs(np.array(x) - traces["acra2012_fig6a", "cs", version]["contraction_m"])) <= 1e-9
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_fmu_without_binaries_rebuilds_with_fmpy_compile(fmus, paper_results, tmp_path, version):
+    import shutil
+
+    if not shutil.which("cmake"):
+        pytest.skip("fmpy compile needs cmake (the test extra installs it from PyPI)")
+    stripped = tmp_path / f"stripped{version}.fmu"
+    with zipfile.ZipFile(fmus[version]) as src, zipfile.ZipFile(stripped, "w") as dst:
+        for item in src.infolist():
+            if not item.filename.startswith("binaries/"):
+                dst.writestr(item, src.read(item))
+    proc = subprocess.run([sys.executable, "-m", "fmpy", "compile", str(stripped)], capture_output=True, text=True,
+                          timeout=300)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert any(n.startswith("binaries/") and n.endswith(".so") for n in zipfile.ZipFile(stripped).namelist())
+    sc, ref = paper_results["acra2012_fig5"]
+    rebuilt = run_cs(sc, version, fmu_path=stripped)
+    original = run_cs(sc, version, fmu_path=fmus[version])
+    assert np.max(np.abs(rebuilt["contraction_m"] - original["contraction_m"])) <= 1e-9
+    assert np.max(_diff(rebuilt, ref)) <= MAX_DIFF_M
+
+
+# ------------------------------------------------------------------ FMI protocol
+
+
+def _instance(fmus, version, interface="cs"):
+    from fmpy import extract, read_model_description
+    from fmpy.fmi2 import FMU2Model, FMU2Slave
+    from fmpy.fmi3 import FMU3Model, FMU3Slave
+
+    md = read_model_description(fmus[version])
+    cls = {(2, "cs"): FMU2Slave, (2, "me"): FMU2Model, (3, "cs"): FMU3Slave, (3, "me"): FMU3Model}[version, interface]
+    fmu = cls(guid=md.guid if version == 2 else md.instantiationToken, unzipDirectory=extract(fmus[version]),
+              modelIdentifier="pamsim_muscle", instanceName="muscle")
+    fmu.instantiate()
+    return fmu
+
+
+class _Api:
+    """Version-neutral calls on an fmpy instance."""
+
+    def __init__(self, fmu, version):
+        self.fmu, self.v = fmu, version
+
+    def set(self, name, value):
+        f = self.fmu.setReal if self.v == 2 else self.fmu.setFloat64
+        f([value_reference(name)], [value])
+
+    def get(self, *names):
+        f = self.fmu.getReal if self.v == 2 else self.fmu.getFloat64
+        return f([value_reference(n) for n in names])
+
+    def mode(self):
+        return (self.fmu.getInteger if self.v == 2 else self.fmu.getInt32)([value_reference("friction_mode")])[0]
+
+    def init(self):
+        if self.v == 2:
+            self.fmu.setupExperiment(startTime=0.0)
+        self.fmu.enterInitializationMode()
+        self.fmu.exitInitializationMode()
+
+    def step(self, t, h):
+        self.fmu.doStep(currentCommunicationPoint=t, communicationStepSize=h)
+
+
+def _error_status(call):
+    from fmpy.fmi1 import FMICallException
+
+    with pytest.raises(FMICallException) as info:
+        call()
+    return info.value.status
+
+
+@pytest.mark.parametrize("version", [2, 3])
+@pytest.mark.parametrize("name,value,message", [
+    ("load_mass_kg", -1.0, "hanging mass must be positive"),
+    ("load_mass_kg", float("nan"), "must be a finite number"),
+    ("supply_pressure_gauge_Pa", 5.0e5, "exceeds the muscle's rating"),
+    ("valve_command", 2.0, "must lie in [-1, 1]"),
+    ("L0_m", float("inf"), "must be a finite number"),
+])
+def test_bad_inputs_return_error_status_with_message(fmus, version, name, value, message, capfd):
+    fmu = _instance(fmus, version)
+    api = _Api(fmu, version)
+    assert _error_status(lambda: api.set(name, value)) == 3  # fmi2Error / fmi3Error
+    assert message in capfd.readouterr().out
+    # The value was rejected: the instance still initialises and steps.
+    api.init()
+    api.step(0.0, 0.01)
+    fmu.terminate()
+    fmu.freeInstance()
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_invalid_parameters_fail_initialisation(fmus, version, capfd):
+    fmu = _instance(fmus, version)
+    api = _Api(fmu, version)
+    api.set("L0_m", -0.3)
+    if version == 2:
+        fmu.setupExperiment(startTime=0.0)
+    fmu.enterInitializationMode()
+    assert _error_status(fmu.exitInitializationMode) == 3
+    assert "L0_m must be positive" in capfd.readouterr().out
+    fmu.freeInstance()
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_calls_out_of_state_machine_order_are_errors(fmus, version, capfd):
+    fmu = _instance(fmus, version)
+    api = _Api(fmu, version)
+    assert _error_status(lambda: api.step(0.0, 0.1)) == 3  # before initialisation
+    assert _error_status(fmu.exitInitializationMode) == 3  # not in initialisation mode
+    api.init()
+    assert _error_status(lambda: api.set("L0_m", 0.2)) == 3  # a fixed parameter after initialisation
+    assert _error_status(lambda: api.set("contraction_m", 0.01)) == 3  # an output
+    assert "not allowed in the current state" in capfd.readouterr().out
+    fmu.terminate()
+    assert _error_status(lambda: api.step(0.0, 0.1)) == 3  # after termination
+    fmu.freeInstance()
+
+
+def _start_fig4(api):
+    sc, inputs, starts = _inputs_and_starts("acra2012_fig4")
+    for k, v in starts.items():
+        if isinstance(v, float):
+            api.set(k, v)
+    for k, v in inputs(1.0).items():
+        api.set(k, v)
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_fmu_state_get_set_and_serialise_repeat_a_step(fmus, version):
+    fmu = _instance(fmus, version)
+    api = _Api(fmu, version)
+    _start_fig4(api)
+    api.init()
+    api.step(0.0, 0.3)
+    get, put = (fmu.getFMUstate, fmu.setFMUstate) if version == 2 else (fmu.getFMUState, fmu.setFMUState)
+    ser, deser = (fmu.serializeFMUstate, fmu.deSerializeFMUstate) if version == 2 else \
+        (fmu.serializeFMUState, fmu.deserializeFMUState)
+    state = get()
+    blob = ser(state)
+    api.step(0.3, 0.4)
+    first = api.get("contraction_m", "velocity_m_s", "pressure_gauge_Pa")
+    assert first[0] > 0.0  # the load moved during the repeated step
+    put(state)
+    api.step(0.3, 0.4)
+    assert api.get("contraction_m", "velocity_m_s", "pressure_gauge_Pa") == first
+    put(deser(blob))
+    api.step(0.3, 0.4)
+    assert api.get("contraction_m", "velocity_m_s", "pressure_gauge_Pa") == first
+    fmu.terminate()
+    fmu.freeInstance()
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_directional_derivative_matches_python_model(fmus, version):
+    fmu = _instance(fmus, version)
+    api = _Api(fmu, version)
+    _start_fig4(api)
+    api.init()
+    api.step(0.0, 0.25)
+    mode = api.mode()
+    assert mode in (1, -1)  # sliding: the acceleration depends on x and p
+    x, v, p, m = api.get("contraction_m", "velocity_m_s", "chamber_pressure_abs_Pa", "air_mass_kg")
+    unknown, known = [value_reference("der(velocity_m_s)")], [value_reference("contraction_m")]
+    dd = fmu.getDirectionalDerivative(unknown, known, [1.0])[0]
+    sc = pamsim.load_scenario(SCENARIOS / "acra2012_fig4.toml")
+    model = sc.build_model()
+    inputs = model.source.inputs(2.0)
+    acc = lambda xx: model.slip_rhs(np.array([xx, v, p, m, 0, 0, 0, 0]), float(mode), inputs, 0.0)[1]  # noqa: E731
+    h = 1e-6
+    expected = (acc(x + h) - acc(x - h)) / (2 * h)
+    assert dd == pytest.approx(expected, rel=1e-4)
+    fmu.terminate()
+    fmu.freeInstance()
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_model_exchange_events_protocol(fmus, version):
+    """Drive the ME interface by hand: every event leaves all indicators strictly positive
+    (no chattering) and stopping resets the velocity with valuesOfContinuousStatesChanged."""
+    fmu = _instance(fmus, version, "me")
+    api = _Api(fmu, version)
+    _start_fig4(api)
+    api.init()
+
+    def update():
+        # fmpy returns (update needed, terminate, nominals changed, values changed, time defined, next time)
+        r = fmu.newDiscreteStates() if version == 2 else fmu.updateDiscreteStates()
+        return r[3], r[0]
+
+    update()
+    fmu.enterContinuousTimeMode()
+    x, dx, z = np.zeros(4), np.zeros(4), np.zeros(2)
+
+    def ptr(a):
+        return a.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
+
+    get_x = lambda: fmu.getContinuousStates(ptr(x), 4)  # noqa: E731
+    get_dx = (lambda: fmu.getDerivatives(ptr(dx), 4)) if version == 2 else \
+        (lambda: fmu.getContinuousStateDerivatives(ptr(dx), 4))
+    get_z = lambda: fmu.getEventIndicators(ptr(z), 2)  # noqa: E731
+    get_x()
+    get_z()
+    t, h, events, stops = 0.0, 1e-4, 0, 0
+    while t < 2.0 and stops == 0:
+        get_dx()
+        z_old = z.copy()
+        x += h * dx
+        t += h
+        fmu.setTime(t)
+        fmu.setContinuousStates(ptr(x), 4)
+        get_z()
+        if np.any((z_old > 0) & (z <= 0)):
+            mode_before = api.mode()
+            fmu.enterEventMode()
+            changed, again = update()
+            assert not again
+            events += 1
+            if mode_before == 1 and api.mode() in (0, -1):
+                assert changed  # the velocity was reset
+                get_x()
+                assert x[1] == 0.0
+                stops += 1
+            fmu.enterContinuousTimeMode()
+            get_x()
+            get_z()
+            assert np.all(z > 0), "an event left an indicator at or below zero (would chatter)"
+    assert events >= 2 and stops == 1  # released from the lower stop, then stopped at the top of the swing
+    fmu.terminate()
+    fmu.freeInstance()
+
+
+# ------------------------------------------------------------------ command line
+
+
+def test_cli_build_and_run_with_fmu_backends(tmp_path):
+    def pamsim_cli(*args):
+        return subprocess.run([sys.executable, "-m", "pamsim", *map(str, args)], capture_output=True, text=True,
+                              timeout=300)
+
+    out = pamsim_cli("fmu", "build", "-o", tmp_path / "m.fmu", "--fmi", "3")
+    assert out.returncode == 0 and (tmp_path / "m.fmu").is_file(), out.stderr
+    bad = pamsim_cli("fmu", "build", "--fmi", "4")
+    assert bad.returncode == 2 and bad.stderr.count("\n") == 1 and "must be 2 or 3" in bad.stderr
+    scenario = SCENARIOS / "acra2012_fig6b.toml"
+    csvs = {}
+    for backend in ("python", "fmu-cs", "fmu-me"):
+        r = pamsim_cli("run", scenario, "-o", tmp_path / backend, "--backend", backend, "--no-plot")
+        assert r.returncode == 0, r.stderr
+        with open(tmp_path / backend / "acra2012_fig6b.csv") as fh:
+            header = fh.readline()
+        csvs[backend] = (header, np.loadtxt(tmp_path / backend / "acra2012_fig6b.csv", delimiter=",", skiprows=1))
+    for backend in ("fmu-cs", "fmu-me"):
+        assert csvs[backend][0] == csvs["python"][0]
+        assert np.max(np.abs(csvs[backend][1][:, 1] - csvs["python"][1][:, 1])) <= MAX_DIFF_M
