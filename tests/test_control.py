@@ -204,6 +204,67 @@ def test_A_matches_central_difference(fig4):
         assert np.max(err / ref) < 1e-6, name
 
 
+def test_A_matches_fmu_directional_derivatives(fig4):
+    """Cross-check against the FMU (C model, docs/fmu.md): its directional derivatives at a sliding
+    state it reached itself, against this linearisation of the Python model there, to 1e-4."""
+    fmpy = pytest.importorskip("fmpy")
+    import os
+    import shutil
+
+    if not (os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc")):
+        pytest.skip("no C compiler to build the FMU")
+    from fmpy.fmi2 import FMU2Slave
+
+    from pamsim.control import OperatingPoint
+    from pamsim.fmu.runner import ScenarioInputs, cached_fmu, start_values
+    from pamsim.fmu.variables import value_reference
+
+    sc, model = fig4
+    path = cached_fmu(2)
+    md = fmpy.read_model_description(path)
+    unzipped = fmpy.extract(path)
+    fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzipped, modelIdentifier=md.coSimulation.modelIdentifier,
+                    instanceName="control_check")
+    names = ["contraction_m", "velocity_m_s", "chamber_pressure_abs_Pa", "air_mass_kg"]
+    inputs = ScenarioInputs(sc)
+
+    def set_values(values):
+        reals = {value_reference(k): v for k, v in values.items() if isinstance(v, float)}
+        ints = {value_reference(k): v for k, v in values.items() if not isinstance(v, float)}
+        fmu.setReal(list(reals), list(reals.values()))
+        if ints:
+            fmu.setInteger(list(ints), list(ints.values()))
+
+    try:
+        fmu.instantiate()
+        fmu.setupExperiment(startTime=0.0, stopTime=2.0)
+        set_values(start_values(sc))
+        set_values(inputs(0.0))
+        fmu.enterInitializationMode()
+        fmu.exitInitializationMode()
+        fmu.doStep(0.0, 1.0)  # the valve opens at 1 s
+        set_values(inputs(1.0))
+        fmu.doStep(1.0, 0.3)
+        states = np.array(fmu.getReal([value_reference(n) for n in names]))
+        mode = fmu.getInteger([value_reference("friction_mode")])[0]
+        ders = [value_reference(f"der({n})") for n in names]
+        A_fmu = np.column_stack([fmu.getDirectionalDerivative(ders, [value_reference(n)], [1.0]) for n in names])
+        fmu.terminate()
+    finally:
+        fmu.freeInstance()
+        shutil.rmtree(unzipped, ignore_errors=True)
+    assert mode in (1, -1) and states[1] != 0.0  # sliding, so the Coulomb term has a derivative
+    u, supply = model.source.inputs(1.3)
+    op = OperatingPoint(states, np.array([u, supply, 0.0]), "fmu", pamsim.Mode(mode), "FMU state at 1.3 s")
+    lin = linearize(model, op, FrictionTreatment("sliding"), drop_unobservable_air_mass=False)
+    assert lin.friction.direction == mode
+    s = np.array([1e-2, 1e-1, 1e5, 1e-5])
+    S = s[None, :] / s[:, None]
+    ref = np.max(np.abs(A_fmu) * S, axis=1, keepdims=True)
+    ref[ref == 0.0] = 1.0
+    assert np.max(np.abs(lin.sys.A - A_fmu) * S / ref) < 1e-4
+
+
 def test_sliding_friction_needs_motion(fig4):
     sc, model = fig4
     op = held_equilibrium(model, 0.030, sc.final_pressure_gauge_Pa)
