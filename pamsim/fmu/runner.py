@@ -137,7 +137,9 @@ def run_cs(scenario: Scenario, fmi_version: int = 2, communication_times: Sequen
             rows.append(get_real(out_vrs))
             modes.append(get_int(mode_vr)[0])
             if k + 1 < len(times):
-                _set(fmu, fmi_version, inputs(t))
+                # Inputs are held over a step; the midpoint value is the second-order choice for
+                # smooth signals, and jumps fall on communication points.
+                _set(fmu, fmi_version, inputs(0.5 * (t + times[k + 1])))
                 fmu.doStep(currentCommunicationPoint=t, communicationStepSize=times[k + 1] - t)
         fmu.terminate()
     except Exception as exc:  # fmpy raises a bare Exception carrying the FMI status
@@ -164,10 +166,11 @@ def run_me(scenario: Scenario, fmi_version: int = 2, fmu_path: Path | None = Non
     inputs = ScenarioInputs(scenario)
     dt = 1.0 / scenario.solver.sample_rate_Hz
     grid = np.linspace(0.0, scenario.duration_s, int(round(scenario.duration_s / dt)) + 1)
-    t_in = [0.0]
-    for b in inputs.breakpoints:
-        t_in += [b, b]
-    t_in.append(scenario.duration_s)
+    # fmpy interpolates inputs linearly: sample smooth signals on the output grid and
+    # duplicate the jump times (fmpy's convention for a discontinuity).
+    bps = np.array(inputs.breakpoints)
+    smooth = [t for t in grid if not np.any(np.abs(bps - t) < 1e-9)]
+    t_in = sorted(smooth + 2 * list(bps))
     vals = []
     for j, t in enumerate(t_in):
         # At a duplicated time point the first row holds the value before the jump.
