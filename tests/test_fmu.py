@@ -546,3 +546,37 @@ def test_other_element_choices_match_python_simulator(fmus, case, interface):
     # value, so the CS output lags by half a step (the lag rises at up to 10 bar/s).
     held = interface == "cs" and sc.spec["pressure"]["source"] == "prescribed"
     assert np.max(np.abs(tr["pressure_gauge_Pa"] - ref.p_gauge_Pa)) <= (1000.0 if held else 50.0)
+
+
+# ------------------------------------------------------------------ docs
+
+DOCS = SCENARIOS.parent / "docs" / "fmu.md"
+
+
+def test_docs_variable_table_is_the_generated_one():
+    from pamsim.fmu.generate import markdown_table
+
+    text = DOCS.read_text()
+    start = text.index("<!-- BEGIN GENERATED VARIABLE TABLE -->\n") + len("<!-- BEGIN GENERATED VARIABLE TABLE -->\n")
+    end = text.index("<!-- END GENERATED VARIABLE TABLE -->")
+    assert text[start:end] == markdown_table()
+
+
+def test_docs_import_snippets_run_and_match_python(fmus, paper_results, tmp_path):
+    import shutil
+
+    for module in ("libcosimpy", "ecospy"):
+        pytest.importorskip(module, reason=f"{module} (test extra) is not installed")
+
+    for v in (2, 3):
+        shutil.copy(fmus[v], tmp_path / f"pamsim_muscle_fmi{v}.fmu")
+    blocks = re.findall(r"```python\n(.*?)```", DOCS.read_text(), flags=re.S)
+    assert len(blocks) == 3  # fmpy, libcosim, Ecos
+    expected = f"{paper_results['acra2012_fig4'][1].x_m[-1] * 1e3:.2f}"
+    printed = []
+    for code in blocks:
+        r = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True, timeout=300)
+        assert r.returncode == 0, r.stderr[-2000:]
+        printed += re.findall(r"final contraction (\S+) mm", r.stdout)
+    assert len(printed) == 5  # fmpy ME and CS, libcosim, Ecos FMI 2.0 and 3.0
+    assert set(printed) == {expected}

@@ -212,3 +212,14 @@ def write_sources(dest: Path, fmi_version: int) -> list[str]:
     (dest / "pam_variables.h").write_text(c_header(fmi_version))
     (dest / "buildDescription.xml").write_text(build_description(fmi_version))
     return names + ["pam_variables.h", "buildDescription.xml"]
+
+
+def markdown_table() -> str:
+    """The variable table for ``docs/fmu.md`` (a test checks the docs carry this exact text)."""
+    rows = ["| name | causality | type | unit | start | description |", "|---|---|---|---|---|---|"]
+    for v in VARIABLES:
+        kind = "Real / Float64" if v.kind == "real" else "Integer / Int32"
+        start = "" if v.start is None else f"{v.start:g}" if isinstance(v.start, float) else str(v.start)
+        desc = v.description.replace("|", "\\|")
+        rows.append(f"| `{v.name}` | {v.causality} | {kind} | {v.unit or ''} | {start} | {desc} |")
+    return "\n".join(rows) + "\n"
