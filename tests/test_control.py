@@ -46,12 +46,12 @@ def test_nlsys_names_and_rhs_are_the_models(fig4):
     u = np.array([0.4, 3.6e5, 1.5])
     y = np.concatenate([x, np.zeros(4)])
     expected = model.slip_rhs(y, 1.0, (0.4, 3.6e5), 1.5)[:4]
-    np.testing.assert_array_equal(sys_nl._rhs(0.0, x, u), expected)
+    np.testing.assert_array_equal(sys_nl.dynamics(0.0, x, u), expected)
     # Muscle force = static - damping - friction, from the elements directly.
     p = 3.0e5 - model.source.p_atm_Pa
     F = (model.static_force.force_N(0.03, p) - model.damping.force_N(0.01)
          - model.friction.level_N(0.03, p, model.load.mass_kg))
-    out = sys_nl._out(0.0, x, u)
+    out = sys_nl.output(0.0, x, u)
     assert out[0] == 0.03 and out[1] == pytest.approx(p)
     assert out[2] == pytest.approx(F, rel=1e-12, abs=1e-12)
 

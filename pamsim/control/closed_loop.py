@@ -33,7 +33,6 @@ from typing import Any, Mapping
 import control as ct
 import numpy as np
 
-from ..atomic import atomic_outputs
 from ..constants import PA_PER_BAR
 from ..elements.pressure_source import ValveChamberSource
 from ..errors import InputError

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq
 
+from ..api import simulate
 from ..constants import PA_PER_BAR
 from ..errors import InputError
 from ..model import Mode, MuscleModel
@@ -142,8 +143,6 @@ def trajectory_point(scenario, time_s: float) -> OperatingPoint:
     InputError
         If ``time_s`` is not in (0, duration].
     """
-    from ..api import simulate
-
     if not 0.0 < time_s <= scenario.duration_s:
         raise InputError(f"--at-time {time_s:g} s: must lie in (0, {scenario.duration_s:g}] s, the scenario's duration")
     model = scenario.build_model()

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from matplotlib.figure import Figure
 
@@ -56,8 +54,7 @@ def pole_zero_figure(lin: LinearModel) -> Figure:
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     mode = lin.mechanical_mode()
-    ax.set_title(f"f_n = {mode.natural_frequency_Hz:.3g} Hz, zeta = {mode.damping_ratio:.3g}"
-                 + ("" if math.isfinite(mode.damping_ratio) else ""))
+    ax.set_title(f"f_n = {mode.natural_frequency_Hz:.3g} Hz, zeta = {mode.damping_ratio:.3g}")
     return fig
 
 
