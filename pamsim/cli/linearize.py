@@ -52,6 +52,11 @@ def _complex(z: complex) -> list[float]:
     return [float(z.real), float(z.imag)]
 
 
+def _number(value: float) -> float | None:
+    """JSON has no NaN or infinity: a mode without a finite figure is reported as null."""
+    return float(value) if math.isfinite(value) else None
+
+
 def report(lin) -> dict:
     """The JSON-safe figures of a :class:`~pamsim.control.linear.LinearModel`."""
     sys = lin.sys
@@ -68,8 +73,8 @@ def report(lin) -> dict:
         "A": _matrix(sys.A), "B": _matrix(sys.B), "C": _matrix(sys.C), "D": _matrix(sys.D),
         "states": list(sys.state_labels), "inputs": list(sys.input_labels), "outputs": list(sys.output_labels),
         "poles": [_complex(z) for z in sys.poles()],
-        "natural_frequency_Hz": mode.natural_frequency_Hz,
-        "damping_ratio": mode.damping_ratio,
+        "natural_frequency_Hz": _number(mode.natural_frequency_Hz),
+        "damping_ratio": _number(mode.damping_ratio),
         "mechanical_poles": [_complex(z) for z in mode.poles],
         "dc_gain": dc,
         "integrator_gain_per_s": integ,
@@ -122,8 +127,9 @@ def _print_text(lin, rep: dict) -> None:
     for key in ("A", "B", "C", "D"):
         print(f"{key} =\n{np.array(rep[key])}")
     print("poles [1/s]: " + ", ".join(f"{re:.6g}{im:+.6g}j" for re, im in rep["poles"]))
-    print(f"mechanical mode: natural frequency {rep['natural_frequency_Hz']:.4g} Hz, "
-          f"damping ratio {rep['damping_ratio']:.4g}")
+    mode = lin.mechanical_mode()
+    print(f"mechanical mode: natural frequency {mode.natural_frequency_Hz:.4g} Hz, "
+          f"damping ratio {mode.damping_ratio:.4g}")
     g0 = rep["dc_gain"]["valve_command->contraction_m"]
     if g0 is None:
         k = rep["integrator_gain_per_s"]["valve_command->contraction_m"]
@@ -136,5 +142,3 @@ def _print_text(lin, rep: dict) -> None:
             print(f"DC gain {key}: " + ("infinite" if value is None else f"{value:.6g} m per SI unit"))
     if np.max(np.abs(lin.residual)) > 0 and lin.op.kind == "trajectory":
         print("note: not an equilibrium; f(x0, u0) = " + ", ".join(f"{v:.4g}" for v in lin.residual))
-    if not all(math.isfinite(v) for v in (rep["natural_frequency_Hz"], rep["damping_ratio"])):
-        print("note: no oscillatory mechanical mode found")

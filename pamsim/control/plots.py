@@ -40,10 +40,16 @@ def pole_zero_figure(lin: LinearModel) -> Figure:
     fig = Figure(figsize=(6.5, 5.5), constrained_layout=True)
     ax = fig.subplots()
     poles = lin.sys.poles()
-    zeros = lin.sys["contraction_m", "valve_command"].zeros()
+    channel = lin.sys["contraction_m", "valve_command"]
+    # A channel the operating point switches off (saturated valve) has no zeros to show.
+    zeros = channel.zeros() if np.any(channel.B) else np.array([])
+    zeros = zeros[np.isfinite(zeros)]
     ax.plot(poles.real, poles.imag, "x", ms=9, mew=2, label="poles")
     if zeros.size:
         ax.plot(zeros.real, zeros.imag, "o", mfc="none", ms=9, label="zeros valve -> contraction")
+    reals = np.concatenate([poles.real, zeros.real, [0.0]])
+    span = max(np.max(np.abs(reals)), 1.0)
+    ax.set_xlim(min(reals.min(), -0.1 * span) * 1.5, max(reals.max(), 0.1 * span) * 1.5)
     ax.axhline(0, color="k", lw=0.5)
     ax.axvline(0, color="k", lw=0.5)
     # Pressure poles can sit a decade beyond the mechanical pair; symlog keeps both readable.
