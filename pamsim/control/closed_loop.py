@@ -241,8 +241,8 @@ def closed_loop_model(scenario: Scenario, config: ControllerConfig, design: LqrD
     x0 = scenario.initial_contraction_m
     W = model.load.weight_N
     p0 = holding_pressure_Pa(model, x0, W, supply) if x0 > 0 else 0.0
-    held_equilibrium(model, config.target_contraction_m, supply)  # validates the target
-    p1 = holding_pressure_Pa(model, config.target_contraction_m, W, supply)
+    target = held_equilibrium(model, config.target_contraction_m, supply)  # also validates the target
+    p1 = float(target.states[2]) - model.source.p_atm_Pa
     source = ClosedLoopValveSource(model.source, tuple(float(k) for k in design.K),
                                    Step(config.step_time_s, x0, config.target_contraction_m),
                                    Step(config.step_time_s, p0, p1), config.velocity_filter_time_s,
