@@ -6,5 +6,6 @@ Co-Simulation) and run scenarios through it.
 """
 
 from .build import build
+from .runner import simulate_fmu
 
-__all__ = ["build"]
+__all__ = ["build", "simulate_fmu"]

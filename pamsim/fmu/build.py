@@ -27,7 +27,7 @@ def platform_folder(fmi_version: int) -> str:
     """The binaries/ sub-folder of this machine for ``fmi_version``."""
     machine = platform.machine().lower()
     arch = {"amd64": "x86_64", "x86_64": "x86_64", "arm64": "aarch64", "aarch64": "aarch64"}.get(machine, machine)
-    system = {"linux": "linux", "darwin": "darwin", "win32": "windows"}[sys.platform if sys.platform != "cygwin" else "win32"]
+    system = {"linux": "linux", "darwin": "darwin", "win32": "windows", "cygwin": "windows"}[sys.platform]
     if fmi_version == 2:
         bits = "64" if sys.maxsize > 2**32 else "32"
         return {"linux": f"linux{bits}", "darwin": f"darwin{bits}", "windows": f"win{bits}"}[system]
@@ -70,7 +70,7 @@ def build(output_path: str | os.PathLike | None = None, fmi_version: int = 2) ->
         if proc.returncode != 0:
             raise InputError(f"compiling the FMU failed ({' '.join(cmd[:2])} ...): {proc.stderr.strip()}")
         out.parent.mkdir(parents=True, exist_ok=True)
-        partial = out.with_name(f".{out.name}.tmp")
+        partial = out.with_name(f".{out.name}.{os.getpid()}.tmp")  # concurrent builds of one cache entry
         with zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED) as zf:
             for path in sorted(root.rglob("*")):
                 if path.is_file():

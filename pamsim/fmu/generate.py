@@ -177,7 +177,9 @@ def c_header(fmi_version: int) -> str:
     out += [f"#define I_{v.c_name} {i}" for i, v in enumerate(ints)]
     out += [f"#define VR_{v.c_name} {value_reference(v.name)}u" for v in VARIABLES]
     out += ["", "typedef enum { PAM_PARAMETER, PAM_INPUT, PAM_OUTPUT, PAM_LOCAL } PamCausality;",
-            "typedef struct { const char *name; char kind; int index; PamCausality causality; double start; } PamVarInfo;",
+            "typedef struct {",
+            "    const char *name; char kind; int index; PamCausality causality; double start;",
+            "} PamVarInfo;",
             "", "/* Indexed by value reference - 1. */", "static const PamVarInfo PAM_VARS[PAM_NVARS] = {"]
     ri = ii = 0
     for v in VARIABLES:

@@ -16,6 +16,7 @@ are not itemised (the FMU does not report its events).
 from __future__ import annotations
 
 import math
+import shutil
 import tempfile
 import time
 from pathlib import Path
@@ -91,7 +92,8 @@ def _instantiate(fmu_path: Path, fmi_version: int, interface: str):
 
     md = read_model_description(fmu_path)
     unzipdir = extract(fmu_path)
-    cls = {(2, "cs"): FMU2Slave, (2, "me"): FMU2Model, (3, "cs"): FMU3Slave, (3, "me"): FMU3Model}[(fmi_version, interface)]
+    classes = {(2, "cs"): FMU2Slave, (2, "me"): FMU2Model, (3, "cs"): FMU3Slave, (3, "me"): FMU3Model}
+    cls = classes[fmi_version, interface]
     ident = md.coSimulation.modelIdentifier if interface == "cs" else md.modelExchange.modelIdentifier
     fmu = cls(guid=md.guid if fmi_version == 2 else md.instantiationToken, unzipDirectory=unzipdir,
               modelIdentifier=ident, instanceName="muscle")
@@ -113,8 +115,10 @@ def run_cs(scenario: Scenario, fmi_version: int = 2, communication_times: Sequen
     sample grid).  Every input jump is added as a communication point.  Returns named arrays."""
     fmu_path = fmu_path or cached_fmu(fmi_version)
     inputs = ScenarioInputs(scenario)
-    grid = np.asarray(communication_times if communication_times is not None else
-                      np.linspace(0.0, scenario.duration_s, int(round(scenario.duration_s * scenario.solver.sample_rate_Hz)) + 1))
+    if communication_times is None:
+        n = int(round(scenario.duration_s * scenario.solver.sample_rate_Hz))
+        communication_times = np.linspace(0.0, scenario.duration_s, n + 1)
+    grid = np.asarray(communication_times, dtype=float)
     times = np.union1d(grid, inputs.breakpoints)
     md, fmu, unzipdir = _instantiate(fmu_path, fmi_version, "cs")
     out_vrs = [value_reference(n) for n in OUTPUTS]
@@ -146,8 +150,6 @@ def run_cs(scenario: Scenario, fmi_version: int = 2, communication_times: Sequen
         raise SolverFailure(f"FMU co-simulation failed: {exc}") from None
     finally:
         fmu.freeInstance()
-        import shutil
-
         shutil.rmtree(unzipdir, ignore_errors=True)
     data = np.array(rows)
     keep = np.isin(times, grid)
@@ -191,7 +193,8 @@ def run_me(scenario: Scenario, fmi_version: int = 2, fmu_path: Path | None = Non
     # fmpy records both sides of an event; keep the last sample at each time (after the event).
     last = np.r_[t[1:] != t[:-1], True]
     idx = np.flatnonzero(last)
-    on_grid = idx[np.isin(np.round(t[idx] / dt), np.round(grid / dt)) & (np.abs(t[idx] / dt - np.round(t[idx] / dt)) < 1e-6)]
+    ticks = t[idx] / dt
+    on_grid = idx[np.abs(ticks - np.round(ticks)) < 1e-6]
     out = {name: np.asarray(res[name][on_grid], dtype=float) for name in OUTPUTS}
     out["t_s"] = np.asarray(t[on_grid], dtype=float)
     out["friction_mode"] = np.asarray(res["friction_mode"][on_grid], dtype=int)
