@@ -186,10 +186,17 @@ fmi3Status fmi3Reset(fmi3Instance instance) {
     return fmi3OK;
 }
 
-/* Outputs of the initialization mode follow the parameters set so far. */
+/* Outputs of the initialization mode follow the parameters set so far; invalid ones are
+ * reported once, by ExitInitializationMode, not at every read. */
 static void refresh(Instance *in) {
-    if (in->state == S_INIT && pam_check_parameters(&in->core) == 0) pam_initialize(&in->core);
-    else if (in->state & (S_EVENT | S_CONT)) pam_evaluate(&in->core);
+    PamLogFn log = in->core.log;
+    int valid;
+    if (in->state == S_INIT) {
+        in->core.log = 0;
+        valid = pam_check_parameters(&in->core) == 0;
+        in->core.log = log;
+        if (valid) pam_initialize(&in->core);
+    } else if (in->state & (S_EVENT | S_CONT)) pam_evaluate(&in->core);
 }
 
 static int check_vr(Instance *in, const char *function, fmi3ValueReference vr, char kind) {
