@@ -19,10 +19,13 @@ from __future__ import annotations
 from dataclasses import dataclass
 from enum import IntEnum
 
+import math
+
 import numpy as np
 
 from .elements.load import HangingLoad
 from .elements.stops import EndStops
+from .signals import max_step_hint_s
 
 
 class Mode(IntEnum):
@@ -83,11 +86,18 @@ class MuscleModel:
     def breakpoints(self) -> tuple[float, ...]:
         return tuple(self.source.breakpoints) + tuple(self.load.breakpoints)
 
+    @property
+    def max_input_step_s(self) -> float:
+        """Longest step over which every input is monotonic (a measured trace's sample spacing)."""
+        return min(getattr(self.source, "max_input_step_s", math.inf),
+                   max_step_hint_s(self.load.external_force_N))
+
     def rest_forces(self, t: float, y) -> tuple[float, float]:
         """Net force at zero velocity (static - weight + external) and the Coulomb level [N]."""
         return self.rest_forces_with_inputs(y, self.source.inputs(t), self.load.external_N(t))
 
     def rest_forces_with_inputs(self, y, source_inputs, F_ext_N) -> tuple[float, float]:
+        y = y.tolist()  # Python floats: scalar arithmetic on numpy scalars is several times slower
         x = y[0]
         p = self.source.pressure_gauge_Pa(y[2:2 + self.n_source], source_inputs)
         net = self.static_force.force_N(x, p) - self.load.weight_N + F_ext_N
@@ -106,6 +116,7 @@ class MuscleModel:
         for sliding up or down, 0 to drop it, or a smooth ``tanh(v / v_s)`` for
         a regularised model (used by linearisation).
         """
+        y = y.tolist()  # Python floats: scalar arithmetic on numpy scalars is several times slower
         x, v = y[0], y[1]
         s = y[2:2 + self.n_source]
         p = self.source.pressure_gauge_Pa(s, source_inputs)
@@ -118,6 +129,7 @@ class MuscleModel:
 
     def held_rhs(self, y, source_inputs) -> np.ndarray:
         """Derivatives of a load held still (stuck or on a stop): only the source evolves."""
+        y = y.tolist()
         s = y[2:2 + self.n_source]
         return np.array([0.0, 0.0, *self.source.derivatives(s, y[0], 0.0, source_inputs), 0.0, 0.0, 0.0, 0.0])
 

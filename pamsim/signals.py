@@ -17,9 +17,15 @@ import numpy as np
 
 
 class _Signal:
-    """Breakpoints are the values of the fields named in ``_break_fields``."""
+    """Breakpoints are the values of the fields named in ``_break_fields``.
+
+    ``max_step_s`` is the longest step over which the signal is monotonic: a
+    held load's release is only sure to be seen if the integrator does not
+    step over a rise and fall of its inputs.
+    """
 
     _break_fields: ClassVar[tuple[str, ...]] = ()
+    max_step_s: ClassVar[float] = math.inf
 
     @property
     def breakpoints(self) -> tuple[float, ...]:
@@ -56,7 +62,7 @@ class Step(_Signal):
     _break_fields: ClassVar[tuple[str, ...]] = ("time_s",)
 
     def __call__(self, t):
-        if np.ndim(t) == 0:
+        if isinstance(t, float):  # numpy float64 is a float; np.ndim costs more than the signal
             return self.final if t >= self.time_s else self.initial
         return np.where(np.asarray(t) >= self.time_s, self.final, self.initial)
 
@@ -74,8 +80,9 @@ class Ramp(_Signal):
     _break_fields: ClassVar[tuple[str, ...]] = ("start_s", "end_s")
 
     def __call__(self, t):
-        return np.interp(t, (self.start_s, self.end_s), (self.initial, self.final)) if np.ndim(t) else (
-            float(np.interp(t, (self.start_s, self.end_s), (self.initial, self.final))))
+        if isinstance(t, float):
+            return float(np.interp(t, (self.start_s, self.end_s), (self.initial, self.final)))
+        return np.interp(t, (self.start_s, self.end_s), (self.initial, self.final))
 
 
 
@@ -91,7 +98,7 @@ class FirstOrderLag(_Signal):
     _break_fields: ClassVar[tuple[str, ...]] = ("time_s",)
 
     def __call__(self, t):
-        if np.ndim(t) == 0:
+        if isinstance(t, float):  # numpy float64 is a float; np.ndim costs more than the signal
             if t < self.time_s:
                 return self.initial
             return self.final + (self.initial - self.final) * math.exp(-(t - self.time_s) / self.tau_s)
@@ -111,7 +118,7 @@ class Trace(_Signal):
     source: str = ""
 
     def __call__(self, t):
-        if np.ndim(t) == 0:
+        if isinstance(t, float):  # numpy float64 is a float; np.ndim costs more than the signal
             return float(np.interp(t, self.t_s, self.values))
         return np.interp(t, self.t_s, self.values)
 
@@ -121,5 +128,14 @@ class Trace(_Signal):
         return float(self.values[-1])
 
     @property
+    def max_step_s(self) -> float:
+        return float(np.min(np.diff(self.t_s)))
+
+    @property
     def max_value(self) -> float:
         return float(np.max(self.values))
+
+
+def max_step_hint_s(*signals) -> float:
+    """The smallest ``max_step_s`` of some signals (callables without one count as smooth)."""
+    return min((getattr(sig, "max_step_s", math.inf) for sig in signals if sig is not None), default=math.inf)

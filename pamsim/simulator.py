@@ -32,6 +32,12 @@ class SolverOptions:
 
     ``rtol`` is relative; absolute tolerances are ``rtol`` times a typical
     scale of each state (10 mm, 0.1 m/s, 1 bar, 10 mg of air, 0.1 J).
+    ``held_max_step_s`` caps the step while the load is held.  There the
+    states may be constant and the integrator may take one step to the next
+    input breakpoint; a release is still found if the inputs are monotonic
+    between breakpoints (steps, ramps, lags) and, for a measured trace, the
+    step is capped at its sample spacing automatically.  Set this only for
+    inputs that are neither (a custom callable that rises and falls).
     """
 
     method: str = "LSODA"
@@ -39,6 +45,7 @@ class SolverOptions:
     sample_rate_Hz: float = 1000.0
     max_events: int = 20000
     max_step_s: float = math.inf
+    held_max_step_s: float = math.inf
     stick_margin_N: float = 1e-7
     release_margin_N: float = 2e-7
 
@@ -59,6 +66,7 @@ class _Events:
     def __init__(self, model: MuscleModel, opts: SolverOptions):
         stops = model.stops
         eps = opts.release_margin_N
+        self.t_left = math.inf  # inputs are read at min(t, t_left): the left limit at a segment's end
 
         def velocity_zero(t, y):
             return y[1]
@@ -70,11 +78,11 @@ class _Events:
             return y[0] - stops.x_high_m
 
         def release_up(t, y):
-            net, level = model.rest_forces(t, y)
+            net, level = model.rest_forces(min(t, self.t_left), y)
             return net - level - eps
 
         def release_down(t, y):
-            net, level = model.rest_forces(t, y)
+            net, level = model.rest_forces(min(t, self.t_left), y)
             return -net - level - eps
 
         self.by_mode = {
@@ -119,6 +127,7 @@ def simulate_model(model: MuscleModel, duration_s: float, options: SolverOptions
     breaks = sorted({b for b in model.breakpoints if 0.0 < b < duration_s} | {duration_s})
     events = _Events(model, opts)
     m = model.load.mass_kg
+    held_max_step = min(opts.held_max_step_s, model.max_input_step_s)
 
     t = 0.0
     y = model.initial_state(x0_m)
@@ -139,9 +148,13 @@ def simulate_model(model: MuscleModel, duration_s: float, options: SolverOptions
             t_eval = np.append(t_eval, t_break)
         named = events.by_mode[mode]
         seg_mode = mode
-        sol = solve_ivp(lambda tt, yy: model.rhs(tt, yy, seg_mode), (t, t_break), y, method=opts.method,
-                        t_eval=t_eval, events=[f for _, f in named], rtol=opts.rtol, atol=atol,
-                        max_step=opts.max_step_s)
+        # An input that jumps at t_break belongs to the next segment: this one sees its left limit,
+        # so a jump cannot hide a crossing that happened before it.
+        t_left = events.t_left = float(np.nextafter(t_break, -math.inf))
+        max_step = opts.max_step_s if mode.is_slip else min(opts.max_step_s, held_max_step)
+        sol = solve_ivp(lambda tt, yy: model.rhs(tt if tt < t_left else t_left, yy, seg_mode), (t, t_break), y,
+                        method=opts.method, t_eval=t_eval, events=[f for _, f in named], rtol=opts.rtol,
+                        atol=atol, max_step=max_step)
         nfev += sol.nfev
         n_segments += 1
         if sol.status == -1:

@@ -502,8 +502,6 @@ source = "prescribed"
 prescribed = { kind = "lag", time_s = 0.5, initial_gauge_bar = 0.0, final_gauge_bar = 3.0, tau_s = 0.3 }
 [simulation]
 duration_s = 6.0
-[solver]
-max_step_s = 0.005  # see the note at the test: solve_ivp needs it to see releases while stuck
 """,
     "valve_vent_no_friction": """
 [model]
@@ -528,11 +526,6 @@ duration_s = 5.0
 def test_other_element_choices_match_python_simulator(fmus, case, interface):
     """Constant friction, linear damping, a prescribed lagged pressure, an external force
     step, venting through the valve and a rebounding stop.
-
-    While the load is stuck under a prescribed pressure the Python model has no
-    moving state, so solve_ivp steps straight to the next input breakpoint and
-    tests the release condition only there (after the jump); ``max_step_s``
-    makes it look in between.  The FMU locates that release without help.
     """
     import tomllib
 

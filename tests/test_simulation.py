@@ -233,3 +233,35 @@ def test_csv_columns(paper_results, tmp_path):
     data = np.loadtxt(tmp_path / "r.csv", delimiter=",", skiprows=1)
     assert data.shape == (8001, len(header))
     assert np.allclose(data[:, 1], res.x_m, rtol=1e-9, atol=1e-12)
+
+
+def test_held_load_releases_between_breakpoints():
+    """Stuck under a rising prescribed pressure, with the next input breakpoint (an external
+    force step) seconds away: the release must be found when the margin crosses zero, not
+    skipped because the jump at the breakpoint undoes it.  The release time is checked
+    against a root of the margin computed here from the lag formula."""
+    from scipy.optimize import brentq
+
+    sc = pamsim.Scenario.from_dict({
+        "model": {"friction": "constant", "damping": "linear"},
+        "load": {"weight_N": 12.74, "external_force": {"kind": "step", "time_s": 4.0, "final_N": -3.0}},
+        "pressure": {"source": "prescribed", "prescribed": {"kind": "lag", "time_s": 0.5, "final_gauge_bar": 3.0,
+                                                             "tau_s": 0.3}},
+        "simulation": {"duration_s": 6.0},
+    })
+    res = pamsim.simulate(sc)
+    model = sc.build_model()
+    sticks = [e for e in res.transitions if e.to_mode == "stick"]
+    assert sticks
+    checked = 0
+    for stick in sticks:
+        def margin(t, x=stick.x_m):
+            p = 3.0e5 * (1.0 - np.exp(-(t - 0.5) / 0.3))
+            return model.static_force.force_N(x, p) - 12.74 - 2.5 - sc.solver.release_margin_N
+
+        if stick.t_s < 3.99 and margin(3.99) > 0:  # the pressure alone frees it before the force step
+            release = next(e for e in res.transitions if e.t_s > stick.t_s)
+            assert release.kind == "release_up"
+            assert release.t_s == pytest.approx(brentq(margin, stick.t_s, 3.99), abs=1e-6)
+            checked += 1
+    assert checked >= 3

@@ -13,6 +13,7 @@ from typing import Callable
 
 import numpy as np
 
+from ..signals import max_step_hint_s
 from .chamber import MuscleChamber
 from .valve import ProportionalValve33
 
@@ -67,6 +68,10 @@ class ValveChamberSource:
     def breakpoints(self) -> tuple[float, ...]:
         return tuple(getattr(self.supply_gauge_Pa, "breakpoints", ())) + tuple(getattr(self.command, "breakpoints", ()))
 
+    @property
+    def max_input_step_s(self) -> float:
+        return max_step_hint_s(self.supply_gauge_Pa, self.command)
+
     def outputs(self, t_s, S, x_m) -> dict[str, np.ndarray]:
         inputs = self.inputs(t_s)
         mdot, T_gas = self.inflow_kg_s(S, self.chamber.volume_m3(x_m), inputs)
@@ -100,6 +105,10 @@ class PrescribedPressure:
     @property
     def breakpoints(self) -> tuple[float, ...]:
         return tuple(getattr(self.p_gauge_Pa, "breakpoints", ()))
+
+    @property
+    def max_input_step_s(self) -> float:
+        return max_step_hint_s(self.p_gauge_Pa)
 
     def outputs(self, t_s, S, x_m) -> dict[str, np.ndarray]:
         return {}
