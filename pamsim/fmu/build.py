@@ -18,7 +18,7 @@ import zipfile
 from pathlib import Path
 
 from ..errors import InputError
-from .generate import MODEL_IDENTIFIER, WRAPPERS, model_description, write_sources
+from .generate import MODEL_IDENTIFIER, compiled_sources, model_description, write_sources
 
 FMI_VERSIONS = (2, 3)
 
@@ -65,7 +65,7 @@ def build(output_path: str | os.PathLike | None = None, fmi_version: int = 2) ->
         bin_dir.mkdir(parents=True)
         lib = bin_dir / (MODEL_IDENTIFIER + shared_library_suffix())
         cmd = [compiler, "-shared", "-fPIC", "-O2", "-std=c99", "-Wall", "-I", str(src),
-               str(src / "pam_core.c"), str(src / WRAPPERS[fmi_version]), "-o", str(lib), "-lm"]
+               *(str(src / name) for name in compiled_sources(fmi_version)), "-o", str(lib), "-lm"]
         proc = subprocess.run(cmd, capture_output=True, text=True)
         if proc.returncode != 0:
             raise InputError(f"compiling the FMU failed ({' '.join(cmd[:2])} ...): {proc.stderr.strip()}")

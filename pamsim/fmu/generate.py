@@ -18,12 +18,17 @@ from .variables import BY_NAME, EVENT_INDICATORS, STATES, VARIABLES, value_refer
 MODEL_NAME = "pamsim_muscle"
 MODEL_IDENTIFIER = "pamsim_muscle"
 C_DIR = Path(__file__).resolve().parents[2] / "fmu"
-CORE_SOURCES = ("pam_core.c", "pam_core.h")
+CORE_SOURCES = ("pam_core.c", "pam_core.h", "fmi_shell.c", "fmi_shell.h")
 WRAPPERS = {2: "fmi2_wrapper.c", 3: "fmi3_wrapper.c"}
 HEADERS = {2: ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h"),
            3: ("fmi3Functions.h", "fmi3FunctionTypes.h", "fmi3PlatformTypes.h")}
 DESCRIPTION = ("McKibben muscle lifting a hanging load (ACRA 2012 model, pamsim): static force polynomial, "
                "load-dependent Coulomb friction with stick/slip, damping, ISO 6358 valve and chamber, end stops")
+
+
+def compiled_sources(fmi_version: int) -> tuple[str, ...]:
+    """The C files the FMU's binary is compiled from (as listed in the XML and by ``build``)."""
+    return tuple(n for n in CORE_SOURCES if n.endswith(".c")) + (WRAPPERS[fmi_version],)
 
 
 def c_source_dir() -> Path:
@@ -71,7 +76,7 @@ def _attrs(**kw) -> str:
 
 def _fmi2() -> str:
     tok = token(2)
-    src_files = "".join(f'\n      <File name="{n}"/>' for n in ("pam_core.c", WRAPPERS[2]))
+    src_files = "".join(f'\n      <File name="{n}"/>' for n in compiled_sources(2))
     lines = ['<?xml version="1.0" encoding="UTF-8"?>',
              f'<fmiModelDescription fmiVersion="2.0"{_attrs(modelName=MODEL_NAME, guid=tok, description=DESCRIPTION)}'
              ' generationTool="pamsim.fmu" variableNamingConvention="flat" numberOfEventIndicators="2">',
@@ -155,7 +160,7 @@ def _fmi3() -> str:
 
 
 def build_description(fmi_version: int) -> str:
-    files = "".join(f'\n      <SourceFile name="{n}"/>' for n in ("pam_core.c", WRAPPERS[fmi_version]))
+    files = "".join(f'\n      <SourceFile name="{n}"/>' for n in compiled_sources(fmi_version))
     return ('<?xml version="1.0" encoding="UTF-8"?>\n'
             '<fmiBuildDescription fmiVersion="3.0">\n'
             f'  <BuildConfiguration modelIdentifier="{MODEL_IDENTIFIER}">\n'

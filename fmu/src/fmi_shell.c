@@ -1,0 +1,370 @@
+/* The FMI logic that FMI 2.0 and 3.0 share; see fmi_shell.h. */
+#include "fmi_shell.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const char *level_category[] = {"logStatusOK", "logStatusWarning", "logStatusError"};
+
+void *fmu_instantiate(size_t size, const FmuFlavour *flavour, const char *name, int is_cs, int logging_on,
+                      PamLogFn log) {
+    FmuInstance *in = (FmuInstance *)calloc(1, size);
+    if (!in) return NULL;
+    in->name = (char *)malloc(strlen(name) + 1);
+    if (in->name) strcpy(in->name, name);
+    in->flavour = flavour;
+    in->is_cs = is_cs;
+    in->logging_on = logging_on;
+    pam_reset(&in->core);
+    in->core.log = log;
+    in->core.log_env = in;
+    in->state = FMU_INSTANTIATED;
+    return in;
+}
+
+void fmu_free(FmuInstance *in) {
+    if (!in) return;
+    free(in->name);
+    free(in);
+}
+
+const char *fmu_log_category(const FmuInstance *in, int level) {
+    return in->logging_on || level != PAM_LOG_INFO ? level_category[level] : NULL;
+}
+
+int fmu_allowed(FmuInstance *in, const char *function, int states) {
+    if (!in) return 0;
+    if (in->state & states) return 1;
+    pam_logf(&in->core, PAM_LOG_ERROR, "%s: not allowed in the current state (%s state machine)", function,
+             in->flavour->standard);
+    return 0;
+}
+
+int fmu_refuse(FmuInstance *in, const char *function, const char *reason) {
+    if (in) pam_logf(&in->core, PAM_LOG_ERROR, "%s: %s", function, reason);
+    return -1;
+}
+
+/* Moves to `to` if `function` is allowed in `from`. */
+static int transition(FmuInstance *in, const char *function, int from, int to) {
+    if (!fmu_allowed(in, function, from)) return -1;
+    in->state = to;
+    return 0;
+}
+
+int fmu_set_debug_logging(FmuInstance *in, const char *function, int logging_on) {
+    if (!fmu_allowed(in, function, FMU_ANY)) return -1;
+    in->logging_on = logging_on;
+    return 0;
+}
+
+int fmu_setup_experiment(FmuInstance *in, const char *function, int tolerance_defined, double tolerance,
+                         double start_time) {
+    if (!fmu_allowed(in, function, FMU_INSTANTIATED)) return -1;
+    in->core.time_s = start_time;
+    /* The importer's tolerance tightens the co-simulation integrator, never loosens the default. */
+    if (tolerance_defined && tolerance > 0.0 && tolerance < in->core.r[R_cs_relative_tolerance])
+        in->core.r[R_cs_relative_tolerance] = tolerance;
+    return 0;
+}
+
+int fmu_enter_initialization_mode(FmuInstance *in, const char *function) {
+    return transition(in, function, FMU_INSTANTIATED, FMU_INIT);
+}
+
+int fmu_exit_initialization_mode(FmuInstance *in, const char *function) {
+    if (!fmu_allowed(in, function, FMU_INIT)) return -1;
+    if (pam_check_parameters(&in->core)) {
+        in->state = FMU_ERROR;
+        return -1;
+    }
+    pam_initialize(&in->core);
+    in->state = in->is_cs ? FMU_STEP : FMU_EVENT;
+    return 0;
+}
+
+int fmu_enter_event_mode(FmuInstance *in, const char *function) {
+    if (!fmu_allowed(in, function, FMU_EVENT | FMU_CONT) || in->is_cs) return -1;
+    in->state = FMU_EVENT;
+    return 0;
+}
+
+int fmu_enter_continuous_time_mode(FmuInstance *in, const char *function) {
+    return transition(in, function, FMU_EVENT, FMU_CONT);
+}
+
+int fmu_terminate(FmuInstance *in, const char *function) {
+    return transition(in, function, FMU_EVENT | FMU_CONT | FMU_STEP, FMU_TERMINATED);
+}
+
+int fmu_reset(FmuInstance *in, const char *function) {
+    if (!fmu_allowed(in, function, FMU_ANY)) return -1;
+    pam_reset(&in->core);
+    in->state = FMU_INSTANTIATED;
+    return 0;
+}
+
+/* ------------------------------------------------------------ variables */
+
+/* Outputs of the initialization mode follow the parameters set so far; invalid ones are
+ * reported once, by ExitInitializationMode, not at every read. */
+static void refresh(FmuInstance *in, int evaluate_in) {
+    PamLogFn log = in->core.log;
+    int valid;
+    if (in->state == FMU_INIT) {
+        in->core.log = 0;
+        valid = pam_check_parameters(&in->core) == 0;
+        in->core.log = log;
+        if (valid) pam_initialize(&in->core);
+    }
+    if (in->state & evaluate_in) pam_evaluate(&in->core);
+}
+
+static int check_vr(FmuInstance *in, const char *function, unsigned vr, char kind) {
+    if (vr < 1 || vr > PAM_NVARS || PAM_VARS[vr - 1].kind != kind) {
+        pam_logf(&in->core, PAM_LOG_ERROR, "%s: no %s variable with value reference %u", function,
+                 kind == 'r' ? in->flavour->real_type : in->flavour->integer_type, vr);
+        return 0;
+    }
+    return 1;
+}
+
+/* Parameters before the end of initialisation, inputs at any time before termination. */
+static int settable(FmuInstance *in, const char *function, unsigned vr) {
+    PamCausality cz = PAM_VARS[vr - 1].causality;
+    if (cz == PAM_INPUT && (in->state & (FMU_INSTANTIATED | FMU_INIT | FMU_EVENT | FMU_CONT | FMU_STEP))) return 1;
+    if (cz == PAM_PARAMETER && (in->state & (FMU_INSTANTIATED | FMU_INIT))) return 1;
+    pam_logf(&in->core, PAM_LOG_ERROR, "%s: %s cannot be set %s", function, PAM_VARS[vr - 1].name,
+             cz == PAM_PARAMETER ? "after initialization (fixed parameter)" : "(not a parameter or input)");
+    return 0;
+}
+
+int fmu_get_reals(FmuInstance *in, const char *function, const unsigned vr[], size_t nvr, double values[],
+                  size_t n_values) {
+    size_t k;
+    if (!fmu_allowed(in, function, FMU_RUNNING) || n_values != nvr) return -1;
+    refresh(in, FMU_EVENT | FMU_CONT);
+    for (k = 0; k < nvr; k++) {
+        if (vr[k] == 0 && in->flavour->time_is_vr0) {
+            values[k] = in->core.time_s;
+            continue;
+        }
+        if (!check_vr(in, function, vr[k], 'r')) return -1;
+        values[k] = in->core.r[PAM_VARS[vr[k] - 1].index];
+    }
+    return 0;
+}
+
+int fmu_get_integers(FmuInstance *in, const char *function, const unsigned vr[], size_t nvr, int32_t values[],
+                     size_t n_values) {
+    size_t k;
+    if (!fmu_allowed(in, function, FMU_RUNNING) || n_values != nvr) return -1;
+    refresh(in, FMU_EVENT | FMU_CONT);
+    for (k = 0; k < nvr; k++) {
+        if (!check_vr(in, function, vr[k], 'i')) return -1;
+        values[k] = in->core.i[PAM_VARS[vr[k] - 1].index];
+    }
+    return 0;
+}
+
+int fmu_set_reals(FmuInstance *in, const char *function, const unsigned vr[], size_t nvr, const double values[],
+                  size_t n_values) {
+    size_t k;
+    if (!fmu_allowed(in, function, FMU_INSTANTIATED | FMU_INIT | FMU_EVENT | FMU_CONT | FMU_STEP) || n_values != nvr)
+        return -1;
+    for (k = 0; k < nvr; k++) {
+        double *dst;
+        if (!check_vr(in, function, vr[k], 'r') || !settable(in, function, vr[k])) return -1;
+        if (pam_check_value(&in->core, vr[k], values[k])) return -1;
+        dst = &in->core.r[PAM_VARS[vr[k] - 1].index];
+        if (*dst != values[k]) in->core.inputs_changed = 1;
+        *dst = values[k];
+    }
+    return 0;
+}
+
+int fmu_set_integers(FmuInstance *in, const char *function, const unsigned vr[], size_t nvr, const int32_t values[],
+                     size_t n_values) {
+    size_t k;
+    if (!fmu_allowed(in, function, FMU_INSTANTIATED | FMU_INIT) || n_values != nvr) return -1;
+    for (k = 0; k < nvr; k++) {
+        if (!check_vr(in, function, vr[k], 'i') || !settable(in, function, vr[k])) return -1;
+        in->core.i[PAM_VARS[vr[k] - 1].index] = values[k];
+    }
+    return 0;
+}
+
+int fmu_no_such_type(FmuInstance *in, const char *function, int states, size_t nvr, const char *what) {
+    if (!fmu_allowed(in, function, states)) return -1;
+    if (nvr == 0) return 0;
+    pam_logf(&in->core, PAM_LOG_ERROR, "%s: %s", function, what);
+    return -1;
+}
+
+/* ------------------------------------------------------------ FMU state */
+
+typedef struct {
+    PamCore core;
+    int state;
+} Snapshot;
+
+/* The serialized form is the snapshot behind the token of this build. */
+#define SERIAL_SIZE (sizeof(PAM_TOKEN) + sizeof(Snapshot))
+
+/* A state the caller had from before is reused, as the standards allow; calloc so that the
+ * padding a serialized state carries is not uninitialised memory. */
+static Snapshot *snapshot_for(void **s) {
+    return *s ? (Snapshot *)*s : (Snapshot *)calloc(1, sizeof(Snapshot));
+}
+
+int fmu_get_fmu_state(FmuInstance *in, const char *function, void **s) {
+    Snapshot *copy;
+    if (!fmu_allowed(in, function, FMU_ANY)) return -1;
+    copy = snapshot_for(s);
+    if (!copy) return -1;
+    copy->core = in->core;
+    copy->state = in->state;
+    *s = copy;
+    return 0;
+}
+
+int fmu_set_fmu_state(FmuInstance *in, const char *function, const void *s) {
+    PamLogFn log;
+    void *log_env;
+    if (!fmu_allowed(in, function, FMU_ANY) || !s) return -1;
+    /* The logger belongs to this instance, not to the one the state was taken from. */
+    log = in->core.log;
+    log_env = in->core.log_env;
+    in->core = ((const Snapshot *)s)->core;
+    in->state = ((const Snapshot *)s)->state;
+    in->core.log = log;
+    in->core.log_env = log_env;
+    return 0;
+}
+
+int fmu_free_fmu_state(FmuInstance *in, const char *function, void **s) {
+    if (!fmu_allowed(in, function, FMU_ANY)) return -1;
+    if (s && *s) {
+        free(*s);
+        *s = NULL;
+    }
+    return 0;
+}
+
+int fmu_serialized_fmu_state_size(FmuInstance *in, const char *function, size_t *size) {
+    if (!fmu_allowed(in, function, FMU_ANY)) return -1;
+    *size = SERIAL_SIZE;
+    return 0;
+}
+
+int fmu_serialize_fmu_state(FmuInstance *in, const char *function, const void *s, void *bytes, size_t size) {
+    if (!fmu_allowed(in, function, FMU_ANY) || !s || size < SERIAL_SIZE) return -1;
+    memcpy(bytes, PAM_TOKEN, sizeof(PAM_TOKEN));
+    memcpy((char *)bytes + sizeof(PAM_TOKEN), s, sizeof(Snapshot));
+    return 0;
+}
+
+int fmu_deserialize_fmu_state(FmuInstance *in, const char *function, const void *bytes, size_t size, void **s) {
+    Snapshot *copy;
+    if (!fmu_allowed(in, function, FMU_ANY)) return -1;
+    if (size != SERIAL_SIZE || memcmp(bytes, PAM_TOKEN, sizeof(PAM_TOKEN)) != 0) {
+        pam_logf(&in->core, PAM_LOG_ERROR, "%s: the bytes are not a state of this FMU build", function);
+        return -1;
+    }
+    copy = snapshot_for(s);
+    if (!copy) return -1;
+    memcpy(copy, (const char *)bytes + sizeof(PAM_TOKEN), sizeof(Snapshot));
+    *s = copy;
+    return 0;
+}
+
+int fmu_directional_derivative(FmuInstance *in, const char *function, const unsigned unknowns[], size_t n_unknowns,
+                               const unsigned knowns[], size_t n_knowns, const double seed[], size_t n_seed,
+                               double sensitivity[], size_t n_sensitivity) {
+    if (!fmu_allowed(in, function, FMU_INIT | FMU_EVENT | FMU_CONT | FMU_STEP | FMU_TERMINATED)) return -1;
+    if (n_seed != n_knowns || n_sensitivity != n_unknowns
+        || pam_directional_derivative(&in->core, unknowns, (int)n_unknowns, knowns, (int)n_knowns, seed,
+                                      sensitivity)) {
+        pam_logf(&in->core, PAM_LOG_ERROR, "%s: only %s can be differentiated", function, in->flavour->differentiable);
+        return -1;
+    }
+    return 0;
+}
+
+/* ------------------------------------------------------------ Model Exchange */
+
+int fmu_update_discrete_states(FmuInstance *in, const char *function, int *states_changed) {
+    if (!fmu_allowed(in, function, FMU_EVENT)) return -1;
+    *states_changed = pam_event_update(&in->core);
+    return 0;
+}
+
+int fmu_completed_integrator_step(FmuInstance *in, const char *function) {
+    return fmu_allowed(in, function, FMU_CONT) ? 0 : -1;
+}
+
+int fmu_set_time(FmuInstance *in, const char *function, double time) {
+    if (!fmu_allowed(in, function, FMU_EVENT | FMU_CONT)) return -1;
+    in->core.time_s = time;
+    return 0;
+}
+
+int fmu_set_continuous_states(FmuInstance *in, const char *function, const double x[], size_t nx) {
+    size_t k;
+    if (!fmu_allowed(in, function, FMU_CONT) || nx != PAM_NX) return -1;
+    for (k = 0; k < nx; k++) {
+        if (!isfinite(x[k])) {
+            pam_logf(&in->core, PAM_LOG_ERROR, "%s: state %u is not finite", function, (unsigned)k);
+            return -1;
+        }
+        in->core.r[PAM_STATE_R[k]] = x[k];
+    }
+    return 0;
+}
+
+/* Copies n reals from the r[] indices `from` after bringing them up to date. */
+static int get_vector(FmuInstance *in, const char *function, const int from[], double out[], size_t n, size_t n_expected,
+                      int evaluate_in) {
+    size_t k;
+    if (!fmu_allowed(in, function, FMU_INIT | FMU_EVENT | FMU_CONT | FMU_TERMINATED) || n != n_expected) return -1;
+    refresh(in, evaluate_in);
+    for (k = 0; k < n; k++) out[k] = in->core.r[from[k]];
+    return 0;
+}
+
+int fmu_get_continuous_states(FmuInstance *in, const char *function, double x[], size_t nx) {
+    return get_vector(in, function, PAM_STATE_R, x, nx, PAM_NX, in ? in->flavour->states_evaluate_in : 0);
+}
+
+int fmu_get_derivatives(FmuInstance *in, const char *function, double dx[], size_t nx) {
+    return get_vector(in, function, PAM_DERIV_R, dx, nx, PAM_NX, in ? in->flavour->derivatives_evaluate_in : 0);
+}
+
+int fmu_get_event_indicators(FmuInstance *in, const char *function, double z[], size_t nz) {
+    static const int indicators[PAM_NZ] = {R_event_indicator_1, R_event_indicator_2};
+    return get_vector(in, function, indicators, z, nz, PAM_NZ, in ? in->flavour->derivatives_evaluate_in : 0);
+}
+
+int fmu_get_nominals(FmuInstance *in, const char *function, double nominals[], size_t nx) {
+    size_t k;
+    if (!fmu_allowed(in, function, FMU_ANY) || nx != PAM_NX) return -1;
+    for (k = 0; k < nx; k++) nominals[k] = PAM_NOMINAL[k];
+    return 0;
+}
+
+/* ------------------------------------------------------------ Co-Simulation */
+
+int fmu_do_step(FmuInstance *in, const char *function, double current_time, double step_size) {
+    if (!fmu_allowed(in, function, FMU_STEP) || !in->is_cs) return FMU_STEP_REFUSED;
+    if (!(step_size >= 0.0) || !isfinite(current_time)) {
+        pam_logf(&in->core, PAM_LOG_ERROR, "%s: invalid step size %g", function, step_size);
+        return FMU_STEP_REJECTED;
+    }
+    in->core.time_s = current_time;
+    if (pam_do_step(&in->core, current_time + step_size)) {
+        in->state = FMU_ERROR;
+        return FMU_STEP_FAILED;
+    }
+    return 0;
+}
