@@ -140,11 +140,17 @@ static int settable(FmuInstance *in, const char *function, unsigned vr) {
     return 0;
 }
 
+/* Values may be read from the end of instantiation, and are then up to date. */
+static int begin_read(FmuInstance *in, const char *function, size_t nvr, size_t n_values) {
+    if (!fmu_allowed(in, function, FMU_RUNNING) || n_values != nvr) return -1;
+    refresh(in, FMU_EVENT | FMU_CONT);
+    return 0;
+}
+
 int fmu_get_reals(FmuInstance *in, const char *function, const unsigned vr[], size_t nvr, double values[],
                   size_t n_values) {
     size_t k;
-    if (!fmu_allowed(in, function, FMU_RUNNING) || n_values != nvr) return -1;
-    refresh(in, FMU_EVENT | FMU_CONT);
+    if (begin_read(in, function, nvr, n_values)) return -1;
     for (k = 0; k < nvr; k++) {
         if (vr[k] == 0 && in->flavour->time_is_vr0) {
             values[k] = in->core.time_s;
@@ -159,8 +165,7 @@ int fmu_get_reals(FmuInstance *in, const char *function, const unsigned vr[], si
 int fmu_get_integers(FmuInstance *in, const char *function, const unsigned vr[], size_t nvr, int32_t values[],
                      size_t n_values) {
     size_t k;
-    if (!fmu_allowed(in, function, FMU_RUNNING) || n_values != nvr) return -1;
-    refresh(in, FMU_EVENT | FMU_CONT);
+    if (begin_read(in, function, nvr, n_values)) return -1;
     for (k = 0; k < nvr; k++) {
         if (!check_vr(in, function, vr[k], 'i')) return -1;
         values[k] = in->core.i[PAM_VARS[vr[k] - 1].index];

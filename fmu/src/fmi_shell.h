@@ -3,8 +3,8 @@
  * Both wrappers keep their instance as a struct whose first member is an FmuInstance, so a
  * component / instance pointer can be passed here as it is.  Every function takes the name of
  * the FMI function it serves (for error messages) and returns 0 on success and a negative
- * number on error (already logged where the standard expects a message); the wrappers only
- * translate arguments and status codes.
+ * number on error, logged wherever the wrappers logged it before they shared this code (a
+ * wrong array length, for one, is not); the wrappers only translate arguments and status codes.
  */
 #ifndef FMI_SHELL_H
 #define FMI_SHELL_H
