@@ -16,7 +16,8 @@ static const FmuFlavour FMI3 = {.standard = "FMI 3.0",
                                 .differentiable = "Float64 scalars",
                                 .time_is_vr0 = 1,
                                 .states_evaluate_in = FMU_EVENT | FMU_CONT,
-                                .derivatives_evaluate_in = FMU_EVENT | FMU_CONT};
+                                /* As FMI 2: a read after Terminate or during initialization sees the current values. */
+                                .derivatives_evaluate_in = FMU_INIT | FMU_EVENT | FMU_CONT | FMU_TERMINATED};
 
 #define FMU(instance) ((FmuInstance *)(instance))
 #define STATUS(rc) ((rc) ? fmi3Error : fmi3OK)

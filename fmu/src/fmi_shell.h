@@ -37,8 +37,7 @@ typedef struct {
     const char *differentiable; /* what GetDirectionalDerivative accepts, in its error */
     int time_is_vr0;            /* FMI 3.0 declares time as value reference 0 */
     /* The states in which reading the continuous states, or their derivatives and the event
-     * indicators, re-evaluates the model.  The wrappers were written apart and differ here
-     * (FMI 2.0 also in initialization and terminated mode); kept so that no result changes. */
+     * indicators, re-evaluates the model (derivatives: the same in both standards). */
     int states_evaluate_in;
     int derivatives_evaluate_in;
 } FmuFlavour;
