@@ -17,7 +17,7 @@ from .variables import BY_NAME, EVENT_INDICATORS, STATES, VARIABLES, value_refer
 
 MODEL_NAME = "pamsim_muscle"
 MODEL_IDENTIFIER = "pamsim_muscle"
-C_DIR = Path(__file__).resolve().parents[2] / "fmu"
+C_DIR = Path(__file__).resolve().parents[2] / "fmu"  # the source tree; an installed wheel has pamsim.fmu.csrc
 CORE_SOURCES = ("pam_core.c", "pam_core.h", "fmi_shell.c", "fmi_shell.h")
 WRAPPERS = {2: "fmi2_wrapper.c", 3: "fmi3_wrapper.c"}
 HEADERS = {2: ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h"),
@@ -32,11 +32,15 @@ def compiled_sources(fmi_version: int) -> tuple[str, ...]:
 
 
 def c_source_dir() -> Path:
-    if not (C_DIR / "src" / "pam_core.c").is_file():
-        from ..errors import InputError
+    """The folder holding ``src/`` and ``include/`` of the C model."""
+    if (C_DIR / "src" / "pam_core.c").is_file():
+        return C_DIR
+    installed = Path(__file__).resolve().with_name("csrc")  # where the wheel puts fmu/ (pyproject.toml)
+    if (installed / "src" / "pam_core.c").is_file():
+        return installed
+    from ..errors import InputError
 
-        raise InputError(f"the FMU's C sources are not at {C_DIR / 'src'} (pamsim must be run from its source tree)")
-    return C_DIR
+    raise InputError(f"the FMU's C sources are neither at {C_DIR / 'src'} nor in the installed package")
 
 
 def table_text() -> str:
