@@ -17,6 +17,7 @@ from ..errors import InputError, SolverFailure
 COMMANDS = (
     "pamsim.cli.run",
     "pamsim.cli.static",
+    "pamsim.cli.sweep",
     "pamsim.cli.fmu",
     "pamsim.cli.linearize",
     "pamsim.cli.control_example",

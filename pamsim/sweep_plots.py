@@ -1,0 +1,188 @@
+"""Figures of a sweep, as matplotlib ``Figure`` objects (no pyplot global state).
+
+Each ``*_figure`` function returns a Figure; :func:`write_figures` saves them
+as PNG to the paths it is given (the caller stages them atomically).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING, Mapping
+
+import numpy as np
+from matplotlib.colors import TwoSlopeNorm
+from matplotlib.figure import Figure
+
+from .constants import PA_PER_BAR
+
+if TYPE_CHECKING:
+    from .sweep import SweepResult
+
+_DPI = 110
+
+
+def write_figures(result: "SweepResult", paths: Mapping[str, object]) -> None:
+    """Save the four sweep figures to ``paths`` (keys are the names in ``pamsim.sweep.FIGURES``)."""
+    makers = {"error_heatmap.png": error_heatmap_figure, "steady_state_vs_pressure.png": steady_state_figure,
+              "time_responses.png": time_responses_figure, "frequency_vs_load.png": frequency_figure}
+    for name, path in paths.items():
+        makers[name](result).savefig(path, format="png", dpi=_DPI)
+
+
+def _grid_pressure(row: Mapping) -> float:
+    """Row position on the pressure axis: the nominal step when measured data give it, else the case pressure."""
+    p = row["pressure_step_bar"]
+    return p if math.isfinite(p) else row["pressure_bar"]
+
+
+def _empty(fig: Figure, text: str) -> Figure:
+    ax = fig.subplots()
+    ax.text(0.5, 0.5, text, ha="center", va="center", transform=ax.transAxes)
+    ax.set_axis_off()
+    return fig
+
+
+def error_heatmap_figure(result: "SweepResult") -> Figure:
+    """Contraction error (model minus measured, mm) over pressure x load, one panel per quantity."""
+    rows = [r for r in result.rows if math.isfinite(r["measured_contraction_m"])]
+    fig = Figure(figsize=(13, 6), constrained_layout=True)
+    if not rows:
+        return _empty(fig, "no measured data to compare with")
+    pressures = sorted({_grid_pressure(r) for r in rows})
+    weights = sorted({r["weight_N"] for r in rows})
+    first = result.spec.friction_models[0]
+    panels = [("equilibrium_error_m", "static equilibrium - measured"),
+              ("error_m", f"simulated final ({first} friction) - measured")]
+    grids = []
+    for col, _ in panels:
+        g = np.full((len(pressures), len(weights)), np.nan)
+        for r in rows:
+            g[pressures.index(_grid_pressure(r)), weights.index(r["weight_N"])] = r[col] * 1e3
+        grids.append(g)
+    limit = max(float(np.nanmax(np.abs(g))) for g in grids) if any(np.isfinite(g).any() for g in grids) else 1.0
+    norm = TwoSlopeNorm(vcenter=0.0, vmin=-limit, vmax=limit)
+    axes = fig.subplots(1, 2, sharey=True)
+    for ax, g, (col, title) in zip(axes, grids, panels):
+        im = ax.imshow(g, origin="lower", cmap="RdBu_r", norm=norm, aspect="auto")
+        ax.set_facecolor("0.85")  # missing tests show grey
+        for i, p in enumerate(pressures):
+            for j, w in enumerate(weights):
+                if not math.isfinite(g[i, j]):
+                    ax.text(j, i, "no data", ha="center", va="center", fontsize=7, color="0.4")
+                    continue
+                row = next(r for r in rows if _grid_pressure(r) == p and r["weight_N"] == w)
+                ax.text(j, i, f"{g[i, j]:+.1f}", ha="center", va="center", fontsize=8,
+                        color="white" if abs(g[i, j]) > 0.6 * limit else "black",
+                        fontweight="bold" if row["within_capability"] else "normal")
+                if not row["within_capability"]:
+                    ax.add_patch(_hatch(j, i))
+        ax.set_xticks(range(len(weights)), [f"{w:g}" for w in weights])
+        ax.set_yticks(range(len(pressures)), [f"{p:g}" for p in pressures])
+        ax.set_xlabel("hanging weight [N]")
+        ax.set_title(title, fontsize=10)
+    axes[0].set_ylabel("pressure step [bar]")
+    fig.colorbar(im, ax=axes, label="contraction error [mm]", shrink=0.9)
+    thr = result.spec.capability_min_equilibrium_m * 1e3
+    fig.suptitle(f"{result.spec.name}: contraction error; hatched = beyond force capability "
+                 f"(static equilibrium < {thr:g} mm), bold = within")
+    return fig
+
+
+def _hatch(j: int, i: int):
+    from matplotlib.patches import Rectangle
+
+    return Rectangle((j - 0.5, i - 0.5), 1, 1, fill=False, hatch="///", edgecolor="0.5", lw=0)
+
+
+def steady_state_figure(result: "SweepResult") -> Figure:
+    """Measured against modelled steady-state contraction versus pressure, one colour per load."""
+    fig = Figure(figsize=(13, 6), constrained_layout=True)
+    rows = result.rows
+    if not rows:
+        return _empty(fig, "no cases")
+    first = result.spec.friction_models[0]
+    axes = fig.subplots(1, 2, sharey=True)
+    panels = [("equilibrium_contraction_m", "static equilibrium (paper polynomial)"),
+              ("final_contraction_m", f"simulated final contraction ({first} friction, 8 s run)")]
+    weights = sorted({r["weight_N"] for r in rows})
+    for ax, (col, title) in zip(axes, panels):
+        for k, w in enumerate(weights):
+            rs = sorted((r for r in rows if r["weight_N"] == w), key=lambda r: r["pressure_bar"])
+            p = np.array([r["pressure_bar"] for r in rs])
+            colour = f"C{k % 10}"
+            meas = np.array([r["measured_contraction_m"] for r in rs]) * 1e3
+            if np.isfinite(meas).any():
+                ax.plot(p, meas, "o", color=colour, ms=6, mfc="none", mew=1.5)
+            ax.plot(p, np.array([r[col] for r in rs], dtype=float) * 1e3, "-", color=colour, lw=1.8,
+                    label=f"{w:g} N")
+        ax.set_xlabel("pressure [bar] (measured stable pressure)")
+        ax.set_title(title, fontsize=10)
+        ax.grid(alpha=0.3)
+    axes[0].set_ylabel("steady-state contraction [mm]")
+    axes[0].plot([], [], "ko", mfc="none", label="measured (Table 2)")
+    axes[0].plot([], [], "k-", label="model")
+    axes[0].legend(fontsize=8, loc="upper left", ncol=2)
+    fig.suptitle(f"{result.spec.name}: steady-state contraction, measured (circles) and modelled (lines)")
+    return fig
+
+
+def time_responses_figure(result: "SweepResult") -> Figure:
+    """Contraction against time for each response scenario, one line style per friction model."""
+    names = list(result.responses)
+    fig = Figure(figsize=(13, 3.2 * max(1, math.ceil(len(names) / 2))), constrained_layout=True)
+    if not names:
+        return _empty(fig, "no [time_responses] in the sweep file")
+    ncols = 2 if len(names) > 1 else 1
+    nrows = math.ceil(len(names) / ncols)
+    axes = np.atleast_1d(fig.subplots(nrows, ncols, squeeze=False).ravel())
+    styles = ["-", "--", ":", "-."]
+    for ax, name in zip(axes, names):
+        runs = result.responses[name]
+        for k, (f, out) in enumerate(runs.items()):
+            if out.get("error"):
+                ax.text(0.5, 0.2 + 0.1 * k, f"{f}: failed", transform=ax.transAxes, color="red")
+                continue
+            ax.plot(out["t_s"], out["x_m"] * 1e3, styles[k % len(styles)], color=f"C{k}", lw=1.6,
+                    label=f"{f} friction")
+        pax = ax.twinx()
+        first = next((o for o in runs.values() if not o.get("error")), None)
+        if first is not None:
+            pax.plot(first["t_s"], first["p_gauge_Pa"] / PA_PER_BAR, color="0.6", lw=0.8)
+        pax.set_ylabel("pressure [bar]", color="0.5", fontsize=8)
+        pax.tick_params(axis="y", colors="0.5", labelsize=8)
+        ax.set_title(name, fontsize=10)
+        ax.set_ylabel("contraction [mm]")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8, loc="lower right")
+    for ax in axes[len(names):]:
+        ax.set_axis_off()
+    for ax in axes[max(0, len(names) - ncols):len(names)]:
+        ax.set_xlabel("time [s]")
+    fig.suptitle("Time responses: load-dependent against constant friction (grey: muscle pressure, right axis)")
+    return fig
+
+
+def frequency_figure(result: "SweepResult") -> Figure:
+    """Estimated oscillation frequency against load for each friction model."""
+    fig = Figure(figsize=(8, 5.5), constrained_layout=True)
+    rows = result.frequency_rows
+    if not rows:
+        return _empty(fig, "no [frequency] study in the sweep file")
+    ax = fig.subplots()
+    w = np.array([r["weight_N"] for r in rows])
+    for k, f in enumerate(result.spec.friction_models):
+        freq = np.array([r[f"{f}_frequency_Hz"] for r in rows], dtype=float)
+        n = [r[f"{f}_n_half_cycles"] for r in rows]
+        ax.plot(w, freq, "o-" if k == 0 else "s--", color=f"C{k}", ms=7, mfc="none" if k else None,
+                label=f"{f} friction")
+        for wi, fi, ni in zip(w, freq, n):
+            if math.isfinite(fi):
+                ax.annotate(f"n={ni}", (wi, fi), textcoords="offset points", xytext=(6, 6 if k == 0 else -12),
+                            fontsize=7, color=f"C{k}")
+    ax.set_xlabel("hanging weight [N]")
+    ax.set_ylabel("oscillation frequency [Hz]")
+    ax.grid(alpha=0.3)
+    ax.legend()
+    fig.suptitle(f"Oscillation frequency at {result.spec.frequency.pressure_bar:g} bar "
+                 "(n = half-cycles seen after the pressure settled)", fontsize=11)
+    return fig
