@@ -164,11 +164,16 @@ def sweep_from_dict(spec: Mapping[str, Any], base_dir: str | Path = ".", origin:
                        _typed(origin, "description", spec.get("description", ""), str), origin, base, cases,
                        frictions, threshold_mm * 1e-3, frequency, responses)
     # Build every scenario once so a bad value (a pressure above the rating...) fails before the run.
-    for case in cases:
-        result.case_scenario(case, frictions[0])
-    if frequency is not None:
-        for w in frequency.weights_N:
-            result.frequency_scenario(w, frictions[0])
+    try:
+        for case in cases:
+            result.case_scenario(case, frictions[0])
+        if frequency is not None:
+            for w in frequency.weights_N:
+                result.frequency_scenario(w, frictions[0])
+    except SweepError:
+        raise
+    except InputError as exc:  # a ScenarioError names the base file; say which sweep produced the value
+        raise SweepError(f"{origin}: a case does not make a valid scenario: {exc}") from None
     return result
 
 
