@@ -32,7 +32,8 @@ def plot_result(result: "Result", path=None, title: str | None = None, compare: 
         ax_x.plot(other.t_s, other.x_m * 1e3, "--", label=other.name)
     held = result.mode == 0
     if held.any():
-        ax_x.plot(t[held], result.x_m[held] * 1e3, ".", ms=1.5, color="k", label="stuck (friction)")
+        ax_x.fill_between(t, 0, 1, where=held, transform=ax_x.get_xaxis_transform(), color="0.85", lw=0,
+                          label="stuck (friction)")
     ax_x.set_ylabel("contraction x [mm]")
     ax_x.legend(loc="lower right", fontsize=8)
     ax_x.grid(alpha=0.3)
