@@ -38,7 +38,7 @@ class Oscillation:
     ----------
     frequency_Hz : float
         Damped oscillation frequency, ``1 / (2 * mean half-period)``; NaN with
-        fewer than two turning points.
+        fewer half-periods than asked for.
     damping_ratio : float
         Equivalent viscous damping ratio from the mean logarithmic decrement of
         successive swings; NaN with fewer than three turning points.
@@ -54,8 +54,8 @@ class Oscillation:
     turning_times_s: tuple[float, ...]
 
 
-def estimate_oscillation(t_s, x, t_start_s: float | None = None,
-                         hysteresis: float | None = None) -> Oscillation:
+def estimate_oscillation(t_s, x, t_start_s: float | None = None, hysteresis: float | None = None,
+                         min_half_cycles: int = 2) -> Oscillation:
     """Estimate frequency and damping of ``x(t)`` after ``t_start_s``.
 
     Parameters
@@ -70,6 +70,9 @@ def estimate_oscillation(t_s, x, t_start_s: float | None = None,
     hysteresis : float, optional
         Reversal that confirms a turning point.  Default: ``HYSTERESIS_FRACTION``
         of the range of ``x`` after ``t_start_s``, at least ``MIN_HYSTERESIS_M``.
+    min_half_cycles : int
+        Fewest half-periods that give a frequency (default 2: one lone swing that
+        ends in a stick is too easily shaped by the still-changing input).
 
     Returns
     -------
@@ -91,7 +94,7 @@ def estimate_oscillation(t_s, x, t_start_s: float | None = None,
     idx = _turning_indices(y, hysteresis)
     times = np.array([_refine_time(t, y, i) for i in idx])
     n_half = max(len(idx) - 1, 0)
-    frequency = 1.0 / (2.0 * float(np.mean(np.diff(times)))) if n_half >= 1 else math.nan
+    frequency = 1.0 / (2.0 * float(np.mean(np.diff(times)))) if n_half >= max(min_half_cycles, 1) else math.nan
     damping = math.nan
     if len(idx) >= 3:
         swings = np.abs(np.diff(y[idx]))

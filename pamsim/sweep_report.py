@@ -80,7 +80,7 @@ def write_report(result: "SweepResult") -> str:
         out += [f"## Oscillation frequency against load at {study.pressure_bar:g} bar", "",
                 f"Pressure source for this study: `{_inline(source)}`. Frequency and damping ratio are estimated "
                 "from the turning points of the contraction after the pressure has settled "
-                "(`pamsim.oscillation`); n = number of half-cycles seen, n/a = too few turning points.", "",
+                "(`pamsim.oscillation`); n = number of half-cycles seen, n/a = fewer than two half-cycles.", "",
                 "| weight [N] | " + " | ".join(f"{f} f [Hz] | {f} zeta | {f} n" for f in models) + " |",
                 "|---|" + "---|---|---|" * len(models)]
         for r in result.frequency_rows:
