@@ -143,7 +143,8 @@ def sweep_from_dict(spec: Mapping[str, Any], base_dir: str | Path = ".", origin:
     _check_keys(origin, "the top level", "", spec, _TOP_KEYS)
     base_name = _required(origin, spec, "base_scenario", str)
     base = load_scenario(_resolve(base_dir, base_name))
-    frictions = tuple(spec.get("friction_models", [base.spec["model"]["friction"]]))
+    frictions = tuple(_typed(origin, "friction_models", spec.get("friction_models", [base.spec["model"]["friction"]]),
+                             list))
     if not frictions:
         raise SweepError(f"{origin}: friction_models = []: name at least one friction model")
     for f in frictions:

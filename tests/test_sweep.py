@@ -246,6 +246,8 @@ BAD_FILES = {
     "unknown key": ('frictions = ["constant"]\n[axes]\npressure_bar = [3.6]\nweight_N = [12.74]\n', "frictions"),
     "unknown friction": ('friction_models = ["viscous"]\n[axes]\npressure_bar = [3.6]\nweight_N = [12.74]\n',
                          "viscous"),
+    "friction not a list": ('friction_models = "constant"\n[axes]\npressure_bar = [3.6]\nweight_N = [12.74]\n',
+                            "must be a list"),
     "no cases": ('name = "x"\n', "exactly one of"),
     "over rating": ('[axes]\npressure_bar = [9.0]\nweight_N = [12.74]\n', "rating"),
 }
