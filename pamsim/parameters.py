@@ -38,6 +38,10 @@ class ParameterSet(Mapping[str, float]):
         self.citation = citation
         self.entries: Mapping[str, Parameter] = MappingProxyType(dict(entries))
 
+    def __reduce__(self):
+        # A read-only mapping proxy does not pickle; a plain dict rebuilds it (process pools).
+        return ParameterSet, (self.name, self.citation, dict(self.entries))
+
     def __getitem__(self, key: str) -> float:
         return self.entries[key].value
 

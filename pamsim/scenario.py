@@ -130,17 +130,25 @@ class Scenario:
         return scenario
 
     def with_changes(self, changes: Mapping[str, Mapping[str, Any]], name: str | None = None) -> "Scenario":
-        """A new scenario with some keys of some sections replaced (for sweeps and scripts)."""
+        """A new scenario with some keys of some sections replaced (for sweeps and scripts).
+
+        Keys are merged into each section, except that a change of
+        ``pressure.source`` replaces the whole ``[pressure]`` table (the keys of
+        one source mean nothing to the other), and naming one of a pair of
+        alternatives (``weight_N``/``mass_kg``, ``supply_gauge_bar``/``supply_gauge_Pa``)
+        drops the other.
+        """
         spec = copy.deepcopy(dict(self.spec))
         for section, values in changes.items():
-            spec.setdefault(section, {}).update(values)
-        for exclusive in (("weight_N", "mass_kg"), ("supply_gauge_bar", "supply_gauge_Pa")):
-            for section in ("load", "pressure"):
-                table = changes.get(section, {})
-                if any(k in table for k in exclusive):
-                    for k in exclusive:
-                        if k not in table:
-                            spec[section].pop(k, None)
+            old = spec.get(section, {})
+            if section == "pressure" and "source" in values and values["source"] != old.get("source"):
+                old = {}
+            spec[section] = {**old, **copy.deepcopy(dict(values))}
+            for pair in (("weight_N", "mass_kg"), ("supply_gauge_bar", "supply_gauge_Pa")):
+                given = [k for k in pair if k in values]
+                for k in pair:
+                    if given and k not in given:
+                        spec[section].pop(k, None)
         return Scenario.from_dict(spec, name or self.name, self.base_dir, self.origin)
 
     # ------------------------------------------------------------ model build

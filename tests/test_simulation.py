@@ -265,3 +265,17 @@ def test_held_load_releases_between_breakpoints():
             assert release.t_s == pytest.approx(brentq(margin, stick.t_s, 3.99), abs=1e-6)
             checked += 1
     assert checked >= 3
+
+
+def test_with_changes_can_switch_the_pressure_source_and_scenarios_pickle(paper_results):
+    import pickle
+
+    sc, _ = paper_results["acra2012_fig4"]
+    presc = sc.with_changes({"pressure": {"source": "prescribed",
+                                          "prescribed": {"kind": "step", "time_s": 1.0, "final_gauge_bar": 3.6}}})
+    assert presc.spec["pressure"] == {"source": "prescribed",
+                                      "prescribed": {"kind": "step", "time_s": 1.0, "final_gauge_bar": 3.6}}
+    heavier = sc.with_changes({"load": {"mass_kg": 3.0}})
+    assert "weight_N" not in heavier.spec["load"] and heavier.mass_kg == 3.0
+    clone = pickle.loads(pickle.dumps(presc))
+    assert np.array_equal(pamsim.simulate(clone).x_m, pamsim.simulate(presc).x_m)
