@@ -244,17 +244,22 @@ class Scenario:
         return float(self.spec["simulation"].get("initial_contraction_m", 0.0))
 
 
+def read_toml(path: Path, kind: str, error: type[InputError] = InputError) -> dict:
+    """Parse a TOML file, turning every way it can be unreadable into ``error`` naming the file."""
+    if not path.is_file():
+        raise error(f"{path}: no such {kind} file")
+    try:
+        return tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as exc:
+        raise error(f"{path}: not valid TOML: {exc}") from None
+    except (UnicodeDecodeError, OSError) as exc:
+        raise error(f"{path}: cannot read it as text: {exc}") from None
+
+
 def load_scenario(path: str | Path) -> Scenario:
     """Read and validate a scenario TOML file."""
     path = Path(path)
-    if not path.is_file():
-        raise ScenarioError(f"{path}: no such scenario file")
-    try:
-        spec = tomllib.loads(path.read_text())
-    except tomllib.TOMLDecodeError as exc:
-        raise ScenarioError(f"{path}: not valid TOML: {exc}") from None
-    except UnicodeDecodeError:
-        raise ScenarioError(f"{path}: not a text file") from None
+    spec = read_toml(path, "scenario", ScenarioError)
     return Scenario.from_dict(spec, name=spec.get("name") or path.stem, base_dir=path.parent, origin=str(path))
 
 

@@ -12,22 +12,27 @@ from scipy.optimize import brentq
 from .elements.stops import EndStops
 
 
-def equilibrium_contraction_m(static_force, p_gauge_Pa: float, load_N: float, x_max_m: float,
-                              n_grid: int = 400) -> float:
+def _first_fall_through_zero(excess, x_max_m: float, n_grid: int = 400) -> float:
+    """Smallest x in [0, x_max_m] where ``excess(x)`` falls through zero: 0 if it starts at or
+    below zero, ``x_max_m`` if it never falls."""
+    x = np.linspace(0.0, x_max_m, n_grid)
+    g = excess(x)
+    if g[0] <= 0.0:
+        return 0.0
+    falls = np.flatnonzero((g[:-1] > 0.0) & (g[1:] <= 0.0))
+    if falls.size == 0:
+        return float(x_max_m)
+    i = int(falls[0])
+    return float(brentq(excess, x[i], x[i + 1], xtol=1e-12))
+
+
+def equilibrium_contraction_m(static_force, p_gauge_Pa: float, load_N: float, x_max_m: float) -> float:
     """Smallest contraction x in [0, x_max_m] where F_static(x, p) = load with F falling through it.
 
     Returns 0 when the muscle cannot lift the load off the lower stop, and
     ``x_max_m`` when it still pulls harder than the load there.
     """
-    x = np.linspace(0.0, x_max_m, n_grid)
-    excess = static_force.force_N(x, p_gauge_Pa) - load_N
-    if excess[0] <= 0.0:
-        return 0.0
-    falls = np.flatnonzero((excess[:-1] > 0.0) & (excess[1:] <= 0.0))
-    if falls.size == 0:
-        return float(x_max_m)
-    i = int(falls[0])
-    return float(brentq(lambda xx: static_force.force_N(xx, p_gauge_Pa) - load_N, x[i], x[i + 1], xtol=1e-12))
+    return _first_fall_through_zero(lambda x: static_force.force_N(x, p_gauge_Pa) - load_N, x_max_m)
 
 
 def max_load_N(static_force, p_gauge_Pa: float, x_max_m: float, n_grid: int = 400) -> float:
@@ -46,16 +51,8 @@ def friction_band_m(static_force, friction, p_gauge_Pa: float, mass_kg: float, g
     W = mass_kg * g_m_s2
 
     def edge(sign: float) -> float:
-        x = np.linspace(0.0, x_max_m, 400)
-        g = static_force.force_N(x, p_gauge_Pa) - W - sign * friction.level_N(x, p_gauge_Pa, mass_kg)
-        if g[0] <= 0:
-            return 0.0
-        i = np.flatnonzero((g[:-1] > 0) & (g[1:] <= 0))
-        if i.size == 0:
-            return float(x_max_m)
-        k = int(i[0])
-        return float(brentq(lambda xx: static_force.force_N(xx, p_gauge_Pa) - W
-                            - sign * friction.level_N(xx, p_gauge_Pa, mass_kg), x[k], x[k + 1], xtol=1e-12))
+        return _first_fall_through_zero(lambda x: static_force.force_N(x, p_gauge_Pa) - W
+                                        - sign * friction.level_N(x, p_gauge_Pa, mass_kg), x_max_m)
 
     return edge(+1.0), edge(-1.0)
 

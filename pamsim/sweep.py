@@ -19,7 +19,6 @@ import difflib
 import math
 import sys
 import time
-import tomllib
 from concurrent.futures import Executor, as_completed
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -34,7 +33,7 @@ from .elements.static_force import STATIC_FORCE_MODELS
 from .elements.stops import EndStops
 from .errors import InputError
 from .oscillation import estimate_oscillation
-from .scenario import Scenario, load_scenario
+from .scenario import Scenario, load_scenario, read_toml
 from .static import friction_band_m, static_report
 
 SETTLED_FRACTION = 0.05
@@ -125,14 +124,7 @@ def load_sweep(path: str | Path) -> SweepSpec:
         before anything runs.
     """
     path = Path(path)
-    if not path.is_file():
-        raise SweepError(f"{path}: no such sweep file")
-    try:
-        spec = tomllib.loads(path.read_text())
-    except tomllib.TOMLDecodeError as exc:
-        raise SweepError(f"{path}: not valid TOML: {exc}") from None
-    except UnicodeDecodeError:
-        raise SweepError(f"{path}: not a text file") from None
+    spec = read_toml(path, "sweep", SweepError)
     return sweep_from_dict(spec, base_dir=path.parent, origin=str(path), default_name=path.stem)
 
 
