@@ -104,6 +104,8 @@ class Scenario:
                 v.fail(f"parameters.{key}", value, "unknown parameter", choices=params)
             v.number(f"parameters.{key}", value)
         params = params.with_overrides(overrides, source=f"override in {origin}")
+        for key, value, why in params.violations():
+            v.fail(f"parameters.{key}", value, why)
         sim = spec["simulation"]
         duration = v.positive("simulation.duration_s", v.required(sim, "simulation", "duration_s"))
         sample_rate = v.positive("simulation.sample_rate_Hz", sim.get("sample_rate_Hz", 1000.0))
