@@ -9,6 +9,7 @@ event logic and both FMI wrappers.
 from __future__ import annotations
 
 import ctypes
+import math
 import re
 import subprocess
 import sys
@@ -24,7 +25,7 @@ from conftest import PAPER_SCENARIOS, SCENARIOS
 from pamsim.fmu import build
 from pamsim.fmu.generate import c_header, token
 from pamsim.fmu.runner import ScenarioInputs, run_cs, run_me, start_values
-from pamsim.fmu.variables import VARIABLES, value_reference
+from pamsim.fmu.variables import BY_NAME, VARIABLES, value_reference
 from pamsim.parameters import get_parameter_set
 
 MAX_DIFF_M = 0.2e-3
@@ -321,17 +322,126 @@ def test_bad_inputs_return_error_status_with_message(fmus, version, name, value,
     fmu.freeInstance()
 
 
-@pytest.mark.parametrize("version", [2, 3])
-def test_invalid_parameters_fail_initialisation(fmus, version, capfd):
-    fmu = _instance(fmus, version)
+@pytest.fixture(scope="session")
+def unzipped(fmus):
+    from fmpy import extract
+
+    return {v: extract(fmus[v]) for v in (2, 3)}
+
+
+def _initialise_with(unzipped, version, values):
+    """Instantiate (CS), set ``values`` and initialise; returns the status of exitInitializationMode
+    (0 OK, 3 error).  The FMU logs to stdout."""
+    from fmpy.fmi1 import FMICallException
+    from fmpy.fmi2 import FMU2Slave
+    from fmpy.fmi3 import FMU3Slave
+
+    cls = FMU2Slave if version == 2 else FMU3Slave
+    fmu = cls(guid=token(version), unzipDirectory=unzipped[version], modelIdentifier="pamsim_muscle",
+              instanceName="check")
+    fmu.instantiate()
     api = _Api(fmu, version)
-    api.set("L0_m", -0.3)
-    if version == 2:
-        fmu.setupExperiment(startTime=0.0)
-    fmu.enterInitializationMode()
-    assert _error_status(fmu.exitInitializationMode) == 3
-    assert "L0_m must be positive" in capfd.readouterr().out
-    fmu.freeInstance()
+    try:
+        for name, value in values.items():
+            if BY_NAME[name].kind == "integer":
+                (fmu.setInteger if version == 2 else fmu.setInt32)([value_reference(name)], [int(value)])
+            else:
+                api.set(name, float(value))
+        if version == 2:
+            fmu.setupExperiment(startTime=0.0)
+        fmu.enterInitializationMode()
+        try:
+            fmu.exitInitializationMode()
+            status = 0
+            fmu.terminate()
+        except FMICallException as exc:
+            status = exc.status
+    finally:
+        fmu.freeInstance()
+    return status
+
+
+def _python_reason(name, value):
+    """Why ``pamsim.Scenario.from_dict`` refuses ``parameters.name = value`` (it must refuse)."""
+    spec = {"load": {"weight_N": 22.74}, "pressure": {"source": "valve", "supply_gauge_bar": 3.6,
+                                                      "valve_open_time_s": 1.0},
+            "simulation": {"duration_s": 1.0}, "parameters": {name: value}}
+    with pytest.raises(pamsim.ScenarioError, match=rf"parameters\.{name} = ") as info:
+        pamsim.Scenario.from_dict(spec)
+    return str(info.value).split(f"parameters.{name} = {value!r}: ", 1)[1]
+
+
+@pytest.mark.parametrize("version", [2, 3])
+@pytest.mark.parametrize("name,value", [
+    ("D0_m", 0.0),
+    ("L0_m", -0.3),
+    ("braid_angle_rest_deg", 60.0),
+    ("valve_b", 0.9995),  # inside its own range [0, 1), above valve_laminar_ratio
+    ("polytropic_index", 0.5),
+    ("stop_restitution", 1.5),
+    ("dead_volume_m3", -1e-6),
+    ("valve_laminar_ratio", 1.0),
+    ("fit_x_min_m", 0.08),  # above fit_x_max_m
+])
+def test_out_of_range_parameters_are_refused_by_fmu_and_scenario_alike(unzipped, version, name, value, capfd):
+    why = _python_reason(name, value)
+    capfd.readouterr()
+    status = _initialise_with(unzipped, version, {name: value})
+    log = capfd.readouterr().out
+    assert status == 3, log  # fmi2Error / fmi3Error at exit from initialisation
+    assert f"invalid parameters: {name} = {value:g}: {why}" in log
+
+
+@pytest.mark.parametrize("version", [2, 3])
+@pytest.mark.parametrize("values,message", [
+    ({"friction_model": -1}, "friction_model = -1: must lie in [0, 2]"),
+    ({"pressure_source": 2}, "pressure_source = 2: must lie in [0, 1]"),
+    ({"release_margin_N": 1e-7}, "release_margin_N = 1e-07: must be above stick_margin_N = 1e-07"),
+    ({"cs_relative_tolerance": 0.1}, "cs_relative_tolerance = 0.1: must lie in (0, 0.01]"),
+    ({"initial_contraction_m": 0.12}, "initial_contraction_m = 0.12: must lie between the stops, 0 and 0.1157 m"),
+    ({"initial_contraction_m": -1e-3}, "initial_contraction_m = -0.001: must lie between the stops"),
+])
+def test_invalid_fmu_parameters_fail_initialisation(unzipped, version, values, message, capfd):
+    capfd.readouterr()
+    status = _initialise_with(unzipped, version, values)
+    log = capfd.readouterr().out
+    assert status == 3 and message in log, log
+
+
+def _header_bounds(version):
+    """{name: (lower, upper, lower_open, upper_open)} parsed from the generated PAM_VARS[]."""
+    num = lambda t: {"HUGE_VAL": math.inf, "-HUGE_VAL": -math.inf}.get(t) or float(t)  # noqa: E731
+    rows = re.findall(r'^    \{"([^"]+)", \'[ri]\', \d+, \w+, [^,]+, ([^,]+), ([^,]+), ([01]), ([01])\},$',
+                      c_header(version), flags=re.M)
+    assert len(rows) == len(VARIABLES)
+    return {n: (num(lo), num(hi), lo_open == "1", hi_open == "1") for n, lo, hi, lo_open, hi_open in rows}
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_generated_bounds_are_the_parameter_bounds(fmus, unzipped, version, capfd):
+    """The C header carries every Parameter's range, and the compiled check agrees with
+    ParameterSet.violations at each finite bound and just beyond it."""
+    assert zipfile.ZipFile(fmus[version]).read("sources/pam_variables.h").decode() == c_header(version)
+    bounds = _header_bounds(version)
+    params = get_parameter_set("shadow_6x300_acra2012")
+    for name, p in params.entries.items():
+        assert bounds[name] == (p.lower, p.upper, p.lower_open, p.upper_open), name
+    for v in VARIABLES:
+        if v.choices:
+            assert bounds[v.name] == (0, len(v.choices) - 1, False, False)
+    assert sum(math.isfinite(b) for n in params for b in bounds[n][:2]) >= 20
+    checked = 0
+    for name, p in params.entries.items():
+        for bound, step in ((p.lower, -1), (p.upper, 1)):
+            if not math.isfinite(bound):
+                continue
+            for value in (bound, bound + step * max(1e-9, 1e-6 * abs(bound))):
+                python_ok = not params.with_overrides({name: value}).violations()
+                status = _initialise_with(unzipped, version, {name: value})
+                log = capfd.readouterr().out
+                assert (status == 0) == python_ok, f"{name} = {value!r}: {log}"
+                checked += 1
+    assert checked >= 40
 
 
 @pytest.mark.parametrize("version", [2, 3])

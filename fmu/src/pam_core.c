@@ -222,53 +222,69 @@ int pam_check_value(PamCore *c, unsigned vr, double value) {
     return 0;
 }
 
-static int require(PamCore *c, int ok, const char *what) {
-    if (!ok) pam_logf(c, PAM_LOG_ERROR, "invalid parameters: %s", what);
-    return ok ? 0 : -1;
+/* pamsim.parameters.Parameter.violation: 1 and the reason in `why` if `value` is outside the
+ * generated range of `info`, else 0. */
+static int range_violation(const PamVarInfo *info, double value, char *why, size_t size) {
+    int low_bad = info->lower_open ? value <= info->lower : value < info->lower;
+    int high_bad = info->upper_open ? value >= info->upper : value > info->upper;
+    if (!low_bad && !high_bad) return 0;
+    if (isinf(info->upper)) snprintf(why, size, "must be %s %g", info->lower_open ? ">" : ">=", info->lower);
+    else if (isinf(info->lower)) snprintf(why, size, "must be %s %g", info->upper_open ? "<" : "<=", info->upper);
+    else
+        snprintf(why, size, "must lie in %c%g, %g%c", info->lower_open ? '(' : '[', info->lower, info->upper,
+                 info->upper_open ? ')' : ']');
+    return 1;
 }
 
 int pam_check_parameters(PamCore *c) {
     const double *r = c->r;
     int bad = 0, k;
     double b, n, x_high;
+    char why[160];
     for (k = 0; k < PAM_NVARS; k++)
         if (PAM_VARS[k].kind == 'r' && PAM_VARS[k].causality <= PAM_INPUT && !isfinite(r[PAM_VARS[k].index])) {
             pam_logf(c, PAM_LOG_ERROR, "invalid parameters: %s is not finite", PAM_VARS[k].name);
             bad = -1;
         }
     if (bad) return -1;
-    bad |= require(c, r[R_L0_m] > 0.0, "L0_m must be positive");
-    bad |= require(c, r[R_D0_m] > 0.0, "D0_m must be positive");
-    bad |= require(c, r[R_braid_angle_rest_deg] > 0.0 && r[R_braid_angle_rest_deg] < 54.7356,
-                   "braid_angle_rest_deg must lie in (0, 54.7356) (below the braid lock angle)");
-    bad |= require(c, r[R_dead_volume_m3] >= 0.0, "dead_volume_m3 must not be negative");
-    bad |= require(c, r[R_valve_C_m3_per_s_Pa] >= 0.0, "valve_C_m3_per_s_Pa must not be negative");
-    bad |= require(c, r[R_valve_b] >= 0.0 && r[R_valve_b] < r[R_valve_laminar_ratio] && r[R_valve_laminar_ratio] < 1.0,
-                   "need 0 <= valve_b < valve_laminar_ratio < 1");
-    bad |= require(c, r[R_rho0_kg_m3] > 0.0 && r[R_T0_K] > 0.0 && r[R_T_supply_K] > 0.0 && r[R_R_J_per_kg_K] > 0.0,
-                   "rho0_kg_m3, T0_K, T_supply_K and R_J_per_kg_K must be positive");
-    bad |= require(c, r[R_polytropic_index] >= 1.0, "polytropic_index must be at least 1");
-    bad |= require(c, r[R_p_atm_Pa] > 0.0, "p_atm_Pa must be positive");
-    bad |= require(c, r[R_g_m_s2] > 0.0, "g_m_s2 must be positive");
-    bad |= require(c, r[R_rated_pressure_gauge_Pa] > 0.0, "rated_pressure_gauge_Pa must be positive");
-    bad |= require(c, r[R_stop_restitution] >= 0.0 && r[R_stop_restitution] <= 1.0,
-                   "stop_restitution must lie in [0, 1]");
-    bad |= require(c, r[R_coulomb_constant_N] >= 0.0, "coulomb_constant_N must not be negative");
-    bad |= require(c, r[R_stick_margin_N] >= 0.0 && r[R_release_margin_N] > r[R_stick_margin_N],
-                   "need 0 <= stick_margin_N < release_margin_N");
-    bad |= require(c, r[R_cs_relative_tolerance] > 0.0 && r[R_cs_relative_tolerance] <= 1e-2,
-                   "cs_relative_tolerance must lie in (0, 1e-2]");
-    bad |= require(c, r[R_cs_max_step_s] > 0.0, "cs_max_step_s must be positive");
-    bad |= require(c, c->i[I_friction_model] >= 0 && c->i[I_friction_model] <= 2, "friction_model must be 0, 1 or 2");
-    bad |= require(c, c->i[I_damping_model] >= 0 && c->i[I_damping_model] <= 2, "damping_model must be 0, 1 or 2");
-    bad |= require(c, c->i[I_pressure_source] == 0 || c->i[I_pressure_source] == 1, "pressure_source must be 0 or 1");
+    /* Each parameter's own range, generated from pamsim/fmu/variables.py (the Python Parameter bounds). */
+    for (k = 0; k < PAM_NVARS; k++) {
+        const PamVarInfo *info = &PAM_VARS[k];
+        double value = info->kind == 'r' ? r[info->index] : (double)c->i[info->index];
+        if (info->causality == PAM_PARAMETER && range_violation(info, value, why, sizeof why)) {
+            pam_logf(c, PAM_LOG_ERROR, "invalid parameters: %s = %g: %s", info->name, value, why);
+            bad = -1;
+        }
+    }
+    if (bad) return -1;
+    /* Checks between parameters (ParameterSet.violations) and of the FMU's own parameters. */
+    if (!(r[R_valve_b] < r[R_valve_laminar_ratio])) {
+        pam_logf(c, PAM_LOG_ERROR, "invalid parameters: valve_b = %g: must be below valve_laminar_ratio = %g",
+                 r[R_valve_b], r[R_valve_laminar_ratio]);
+        bad = -1;
+    }
+    if (!(r[R_fit_x_min_m] < r[R_fit_x_max_m])) {
+        pam_logf(c, PAM_LOG_ERROR, "invalid parameters: fit_x_min_m = %g: must be below fit_x_max_m = %g",
+                 r[R_fit_x_min_m], r[R_fit_x_max_m]);
+        bad = -1;
+    }
+    if (!(r[R_release_margin_N] > r[R_stick_margin_N])) {
+        pam_logf(c, PAM_LOG_ERROR, "invalid parameters: release_margin_N = %g: must be above stick_margin_N = %g",
+                 r[R_release_margin_N], r[R_stick_margin_N]);
+        bad = -1;
+    }
     for (k = 0; k < PAM_NVARS; k++)
-        if (PAM_VARS[k].causality == PAM_INPUT && pam_check_value(c, (unsigned)k + 1, r[PAM_VARS[k].index])) bad = 1;
+        if (PAM_VARS[k].causality == PAM_INPUT && pam_check_value(c, (unsigned)k + 1, r[PAM_VARS[k].index])) bad = -1;
     if (bad) return -1;
     braid_geometry(r, &b, &n);
     x_high = r[R_L0_m] - b / sqrt(3.0);
-    return require(c, r[R_initial_contraction_m] >= 0.0 && r[R_initial_contraction_m] <= x_high,
-                   "initial_contraction_m must lie between the stops (0 and the braid-lock contraction)");
+    if (!(r[R_initial_contraction_m] >= 0.0 && r[R_initial_contraction_m] <= x_high)) {
+        pam_logf(c, PAM_LOG_ERROR,
+                 "invalid parameters: initial_contraction_m = %g: must lie between the stops, 0 and %.4f m "
+                 "(the braid-lock contraction)", r[R_initial_contraction_m], x_high);
+        return -1;
+    }
+    return 0;
 }
 
 /* ------------------------------------------------------------ state and outputs */

@@ -14,6 +14,7 @@ FMI 3.0.
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass
 
@@ -36,7 +37,10 @@ class Variable:
 
     ``kind`` is ``"real"`` or ``"integer"``; ``derivative_of`` names the state
     a derivative belongs to; ``nominal`` sets the state scale the importer's
-    error control uses.
+    error control uses.  ``lower``/``upper`` (``*_open``: bound excluded) is
+    the range a parameter must lie in, as :class:`pamsim.parameters.Parameter`;
+    the C parameter check loops over these bounds (``PAM_VARS[]`` in
+    ``pam_variables.h``).  An integer choice's range is ``[0, len(choices) - 1]``.
     """
 
     name: str
@@ -49,6 +53,11 @@ class Variable:
     initial: str | None = None
     derivative_of: str | None = None
     nominal: float | None = None
+    lower: float = -math.inf
+    upper: float = math.inf
+    lower_open: bool = False
+    upper_open: bool = False
+    choices: tuple[str, ...] | None = None
 
     @property
     def c_name(self) -> str:
@@ -60,31 +69,37 @@ def _choices(values: tuple[str, ...]) -> str:
     return ", ".join(f"{i} = {v}" for i, v in enumerate(values))
 
 
+def _choice(name: str, description: str, choices: tuple[str, ...]) -> Variable:
+    """An integer parameter choosing one of ``choices`` (0 = the first, the default)."""
+    return Variable(name, "integer", "parameter", "fixed", description.format(_choices(choices)), None, 0, "exact",
+                    lower=0, upper=len(choices) - 1, choices=choices)
+
+
 def _table() -> tuple[Variable, ...]:
     params = get_parameter_set(PARAMETER_SET)
     solver = SolverOptions()
     rows = [Variable(name, "real", "parameter", "fixed", f"{p.description} [{p.unit}] (source: {p.source})",
-                     p.unit, p.value, "exact")
+                     p.unit, p.value, "exact", lower=p.lower, upper=p.upper, lower_open=p.lower_open,
+                     upper_open=p.upper_open)
             for name, p in params.entries.items()]
     rows += [
-        Variable("friction_model", "integer", "parameter", "fixed",
-                 f"Coulomb friction law: {_choices(FRICTION_CHOICES)}", None, 0, "exact"),
-        Variable("damping_model", "integer", "parameter", "fixed",
-                 f"viscous damping law: {_choices(DAMPING_CHOICES)}", None, 0, "exact"),
-        Variable("pressure_source", "integer", "parameter", "fixed",
-                 f"pressure source: {_choices(SOURCE_CHOICES)} (input prescribed_pressure_gauge_Pa)", None, 0, "exact"),
+        _choice("friction_model", "Coulomb friction law: {}", FRICTION_CHOICES),
+        _choice("damping_model", "viscous damping law: {}", DAMPING_CHOICES),
+        _choice("pressure_source", "pressure source: {} (input prescribed_pressure_gauge_Pa)", SOURCE_CHOICES),
         Variable("initial_contraction_m", "real", "parameter", "fixed",
                  "contraction at t = 0, load at rest, chamber at ambient pressure [m]", "m", 0.0, "exact"),
         Variable("stick_margin_N", "real", "parameter", "fixed",
                  "a stopping load is held when the net force exceeds friction by no more than this [N]",
-                 "N", solver.stick_margin_N, "exact"),
+                 "N", solver.stick_margin_N, "exact", lower=0.0),
         Variable("release_margin_N", "real", "parameter", "fixed",
                  "a held load is released when the net force exceeds friction by this [N] (> stick_margin_N)",
-                 "N", solver.release_margin_N, "exact"),
+                 "N", solver.release_margin_N, "exact", lower=0.0, lower_open=True),
         Variable("cs_relative_tolerance", "real", "parameter", "fixed",
-                 "relative tolerance of the co-simulation integrator (Dormand-Prince 5(4)) [1]", "1", 1e-8, "exact"),
+                 "relative tolerance of the co-simulation integrator (Dormand-Prince 5(4)) [1]", "1", 1e-8, "exact",
+                 lower=0.0, upper=1e-2, lower_open=True),
         Variable("cs_max_step_s", "real", "parameter", "fixed",
-                 "largest internal step of the co-simulation integrator [s]", "s", 0.01, "exact"),
+                 "largest internal step of the co-simulation integrator [s]", "s", 0.01, "exact",
+                 lower=0.0, lower_open=True),
         # Inputs.
         Variable("valve_command", "real", "input", "continuous",
                  "proportional 3/3 valve: 1 open to supply, 0 closed, -1 open to exhaust [1]", "1", 0.0),
