@@ -1,25 +1,52 @@
-"""Atomic file output: write to a temporary file beside the target, then rename.
+"""Atomic file output: write to temporary files beside the targets, then rename.
 
 A run that fails part-way leaves neither a partial file nor a stale temporary.
+A folder that cannot be written to is a user mistake (:class:`OutputError`),
+found before any work is done when the caller checks it first with
+:func:`ensure_output_dir`.
 """
 
 from __future__ import annotations
 
 import contextlib
 import os
+import shutil
 import tempfile
 from pathlib import Path
+
+from .errors import InputError
+
+_UMASK = os.umask(0)
+os.umask(_UMASK)
+
+
+class OutputError(InputError):
+    """An output folder or file that cannot be written."""
+
+
+def ensure_output_dir(directory: str | os.PathLike) -> Path:
+    """Create ``directory`` if needed and check that files can be created in it."""
+    directory = Path(directory)
+    try:
+        directory.mkdir(parents=True, exist_ok=True)
+        fd, probe = tempfile.mkstemp(prefix=".pamsim-probe-", dir=directory)
+        os.close(fd)
+        os.unlink(probe)
+    except OSError as exc:
+        raise OutputError(f"{directory}: cannot write output there: {exc.strerror or exc}") from None
+    return directory
 
 
 @contextlib.contextmanager
 def atomic_path(path: str | os.PathLike):
     """Yield a temporary path; on success it is renamed to ``path``, on error removed."""
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
+    ensure_output_dir(path.parent)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     os.close(fd)
     try:
         yield Path(tmp)
+        os.chmod(tmp, 0o666 & ~_UMASK)  # mkstemp makes it private; the result is an ordinary file
         os.replace(tmp, path)
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
@@ -32,16 +59,22 @@ def atomic_outputs(directory: str | os.PathLike, names: list[str]):
     """Yield ``{name: temporary path}`` for a set of files that appear together or not at all.
 
     The files are written into a hidden staging folder inside ``directory``
-    and moved into place only when the block succeeds.
+    and moved into place only when the block succeeds; if a move fails, the
+    files already moved are removed again.
     """
-    import shutil
-
-    directory = Path(directory)
-    directory.mkdir(parents=True, exist_ok=True)
+    directory = ensure_output_dir(directory)
     stage = Path(tempfile.mkdtemp(prefix=".pamsim-", dir=directory))
     try:
         yield {name: stage / name for name in names}
-        for name in names:
-            os.replace(stage / name, directory / name)
+        moved = []
+        try:
+            for name in names:
+                os.replace(stage / name, directory / name)
+                moved.append(directory / name)
+        except OSError as exc:
+            for path in moved:
+                with contextlib.suppress(OSError):
+                    path.unlink()
+            raise OutputError(f"{directory / name}: cannot write it: {exc.strerror or exc}") from None
     finally:
         shutil.rmtree(stage, ignore_errors=True)

@@ -79,8 +79,10 @@ class MuscleModel:
     def state_names(self) -> tuple[str, ...]:
         return ("x_m", "v_m_s") + tuple(self.source.state_names) + WORK_NAMES
 
-    def initial_state(self, x0_m: float = 0.0) -> np.ndarray:
-        return np.array([x0_m, 0.0] + self.source.initial_state(x0_m) + [0.0] * N_WORK)
+    def initial_state(self, x0_m: float = 0.0, p0_gauge_Pa: float | None = None) -> np.ndarray:
+        """At rest at ``x0_m``; the source's own initial pressure unless ``p0_gauge_Pa`` is given."""
+        source = self.source.initial_state(x0_m) if p0_gauge_Pa is None else self.source.initial_state(x0_m, p0_gauge_Pa)
+        return np.array([x0_m, 0.0] + source + [0.0] * N_WORK)
 
     @property
     def breakpoints(self) -> tuple[float, ...]:

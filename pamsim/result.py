@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -14,7 +13,6 @@ from .model import N_WORK, Mode
 if TYPE_CHECKING:
     from .model import MuscleModel
 
-CSV_LEADING_COLUMNS = ("t_s", "x_m", "v_m_s", "p_gauge_Pa")
 REST_SPEED_M_S = 1e-4
 """A load in a slip mode slower than this, with the net force inside the friction band, counts as at rest."""
 
@@ -79,7 +77,6 @@ class Result:
         if p.max() > fr.p_max_gauge_Pa:
             violations.append(f"pressure up to {p.max() / 1e5:.3f} bar, above the fitted {fr.p_max_gauge_Pa / 1e5:.2f} bar")
         final = model.rest_forces(float(t[-1]), Y[:, -1])
-        wall_time_s = wall_time_s  # the breakdown above is part of the run's cost
         return cls(name, t, Y[0].copy(), Y[1].copy(), p, modes, sig, transitions, stats, wall_time_s,
                    model.load.mass_kg, model.load.g_m_s2, float(loss_J.sum()), final, violations, model)
 
@@ -153,11 +150,6 @@ class Result:
         data = np.column_stack([np.asarray(v, dtype=float) for v in cols.values()])
         with atomic_path(path) as tmp:
             np.savetxt(tmp, data, delimiter=",", header=",".join(cols), comments="", fmt="%.10g")
-
-    def to_json(self, path) -> None:
-        """Write :meth:`summary` as JSON. Atomic."""
-        with atomic_path(path) as tmp:
-            tmp.write_text(json.dumps(self.summary(), indent=2) + "\n")
 
     def plot(self, path=None, **kwargs):
         """Plot contraction, pressure and forces (see :func:`pamsim.plotting.plot_result`)."""

@@ -22,7 +22,7 @@ from .constants import PA_PER_BAR
 from .errors import InputError
 from .elements.chamber import MuscleChamber
 from .elements.damping import DAMPING_MODELS
-from .elements.friction import FRICTION_MODELS, NEGATIVE_LEVEL_CHOICES
+from .elements.friction import FRICTION_MODELS, NEGATIVE_LEVEL_CHOICES, build_friction
 from .elements.load import HangingLoad
 from .elements.pressure_source import PrescribedPressure, ValveChamberSource
 from .elements.static_force import STATIC_FORCE_MODELS
@@ -35,7 +35,14 @@ from .simulator import SolverOptions
 
 
 # Schema: section -> {key: (type, required)}; a nested dict is a sub-table.
-_SIGNAL_KEYS = {"kind", "time_s", "start_s", "end_s", "tau_s", "file", "time_column", "value_column"}
+# Signal kind -> (keys without a unit, value keys that take the unit suffix of where the signal is used).
+_SIGNAL_KINDS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
+    "constant": ((), ("value",)),
+    "step": (("time_s",), ("initial", "final")),
+    "ramp": (("start_s", "end_s"), ("initial", "final")),
+    "lag": (("time_s", "tau_s"), ("initial", "final")),
+    "trace": (("file", "time_column", "value_column"), ()),
+}
 _SCHEMA: dict[str, dict[str, Any]] = {
     "": {"name": str, "description": str, "model": dict, "parameters": dict, "load": dict, "pressure": dict,
          "simulation": dict, "solver": dict, "controller": dict},
@@ -47,6 +54,7 @@ _SCHEMA: dict[str, dict[str, Any]] = {
     "simulation": {"duration_s": float, "sample_rate_Hz": float, "initial_contraction_m": float},
     "solver": {"method": str, "rtol": float, "max_events": int, "max_step_s": float},
 }
+_MAX_SAMPLES = 1e7  # 8 s at 1 kHz is 8,001; beyond this the output would not fit in memory comfortably
 _METHODS = ("LSODA", "RK45", "DOP853", "Radau", "BDF", "RK23")
 
 
@@ -124,8 +132,15 @@ class Scenario:
         opts = SolverOptions(method=method, rtol=rtol, sample_rate_Hz=sample_rate, max_events=int(max_events),
                              max_step_s=max_step)
         scenario = cls(name or spec.get("name") or "scenario", spec, params, duration, opts, Path(base_dir), origin)
+        if duration * sample_rate > _MAX_SAMPLES:
+            v.fail("simulation.sample_rate_Hz", sample_rate,
+                   f"with duration_s = {duration:g} this asks for more than {_MAX_SAMPLES:.0e} output samples")
         scenario._check_load(v)
-        scenario._build_source(v)  # validates the pressure section and any trace file
+        # Built once here, so a bad pressure section, trace file or external force fails now, not at run time.
+        ext = spec["load"].get("external_force")
+        object.__setattr__(scenario, "_source", scenario._build_source(v))
+        object.__setattr__(scenario, "_external_force",
+                           _signal(v, "load.external_force", ext, "_N", 1.0, Path(base_dir)) if ext else None)
         stops = EndStops.from_parameters(params)
         if not stops.x_low_m <= x0 <= stops.x_high_m:
             v.fail("simulation.initial_contraction_m", x0, f"must lie between the stops, 0 and {stops.x_high_m:.4f} m")
@@ -162,13 +177,9 @@ class Scenario:
     @property
     def final_pressure_gauge_Pa(self) -> float:
         """Supply pressure of the valve, or the final prescribed pressure [Pa gauge]."""
-        return self._final_pressure_Pa()
-
-    def _final_pressure_Pa(self) -> float:
-        src = self._build_source(_Validator(self.origin, self.base_dir))
-        if isinstance(src, ValveChamberSource):
-            return float(src.supply_gauge_Pa.final_value)
-        return float(src.p_gauge_Pa.final_value)
+        src = self._source
+        signal = src.supply_gauge_Pa if isinstance(src, ValveChamberSource) else src.p_gauge_Pa
+        return float(signal.final_value)
 
     def _check_load(self, v: "_Validator") -> None:
         load = self.spec["load"]
@@ -196,6 +207,11 @@ class Scenario:
             if supply > rating:
                 v.fail(f"pressure.{key}", pr[key], f"exceeds the muscle's rating of {rating / PA_PER_BAR:g} bar "
                        f"(parameter rated_pressure_gauge_Pa: {self.parameters.entries['rated_pressure_gauge_Pa'].source})")
+            if "initial_gauge_bar" in pr:
+                p0 = v.number("pressure.initial_gauge_bar", pr["initial_gauge_bar"]) * PA_PER_BAR
+                if not 0.0 <= p0 <= rating:
+                    v.fail("pressure.initial_gauge_bar", pr["initial_gauge_bar"],
+                           f"must lie between 0 and the rating, {rating / PA_PER_BAR:g} bar")
             if ("command" in pr) == ("valve_open_time_s" in pr):
                 raise ScenarioError(f"{self.origin}: [pressure] needs exactly one of valve_open_time_s or [pressure.command]")
             if "command" in pr:
@@ -227,23 +243,25 @@ class Scenario:
         """Compose the elements this scenario names into a :class:`MuscleModel`."""
         p = self.parameters
         m = self.spec["model"]
-        v = _Validator(self.origin, self.base_dir)
-        ext = self.spec["load"].get("external_force")
-        ext_sig = _signal(v, "load.external_force", ext, "_N", 1.0, self.base_dir) if ext else None
         return MuscleModel(
             static_force=STATIC_FORCE_MODELS[m["static_force"]](p),
-            friction=(FRICTION_MODELS[m["friction"]](p, m["friction_negative_level"]) if m["friction"] == "load_dependent"
-                      else FRICTION_MODELS[m["friction"]](p)),
+            friction=build_friction(m["friction"], p, m["friction_negative_level"]),
             damping=DAMPING_MODELS[m["damping"]](p),
-            load=HangingLoad(self.mass_kg, p["g_m_s2"], ext_sig),
+            load=HangingLoad(self.mass_kg, p["g_m_s2"], self._external_force),
             stops=EndStops.from_parameters(p),
-            source=self._build_source(v),
+            source=self._source,
             fit_range=FitRange(p["fit_x_min_m"], p["fit_x_max_m"], p["fit_p_max_Pa"]),
         )
 
     @property
     def initial_contraction_m(self) -> float:
         return float(self.spec["simulation"].get("initial_contraction_m", 0.0))
+
+    @property
+    def initial_pressure_gauge_Pa(self) -> float | None:
+        """Initial chamber pressure of a valve source [Pa gauge], or None for ambient."""
+        bar = self.spec["pressure"].get("initial_gauge_bar")
+        return None if bar is None else float(bar) * PA_PER_BAR
 
 
 def read_toml(path: Path, kind: str, error: type[InputError] = InputError) -> dict:
@@ -330,18 +348,14 @@ def _signal(v: _Validator, where: str, spec: Any, suffix: str, scale: float, bas
     """Build a signal from a table ``{kind = ..., ...}``; values are named ``initial<suffix>``, ``final<suffix>``."""
     if not isinstance(spec, dict):
         v.fail(where, spec, "must be a table with a 'kind'")
-    kinds = ("constant", "step", "ramp", "lag", "trace")
     kind = v.required(spec, where, "kind")
-    if kind not in kinds:
-        v.fail(f"{where}.kind", kind, "unknown signal kind", choices=kinds)
+    if kind not in _SIGNAL_KINDS:
+        v.fail(f"{where}.kind", kind, "unknown signal kind", choices=_SIGNAL_KINDS)
     suffixes = [(suffix, scale)] + ([alt_suffix] if alt_suffix else [])
-    value_keys = {f"{n}{s}" for n in ("initial", "final", "value") for s, _ in suffixes}
-    allowed = {"kind", "time_s", "start_s", "end_s", "tau_s", "initial", "final", "value"} if kind != "trace" else \
-        {"kind", "file", "time_column", "value_column"}
-    for key, value in spec.items():
-        base = key if key in _SIGNAL_KEYS else next((key[: -len(s)] for s, _ in suffixes if s and key.endswith(s)), key)
-        if key not in _SIGNAL_KEYS and key not in value_keys or base not in allowed:
-            known = sorted((allowed & _SIGNAL_KEYS) | {k for k in value_keys if k.split("_")[0] in allowed})
+    times, values = _SIGNAL_KINDS[kind]
+    known = ["kind", *times, *(f"{n}{s}" for n in values for s, _ in suffixes)]
+    for key in spec:
+        if key not in known:
             close = difflib.get_close_matches(key, known, n=1)
             hint = f" (did you mean {close[0]!r}?)" if close else f" (known: {', '.join(known)})"
             raise ScenarioError(f"{v.origin}: unknown key {where}.{key} for kind = {kind!r}{hint}")
@@ -378,7 +392,7 @@ def _signal(v: _Validator, where: str, spec: Any, suffix: str, scale: float, bas
 
 
 def _trace(v: _Validator, where: str, spec: Mapping, suffixes, base_dir: Path) -> Trace:
-    name = spec["file"]
+    name = v.required(spec, where, "file")
     if not isinstance(name, str):
         v.fail(f"{where}.file", name, "must be a string (a CSV path)")
     path = (base_dir / name) if not Path(name).is_absolute() else Path(name)

@@ -36,7 +36,6 @@ class _Signal:
         return self.final
 
 
-
 @dataclass(frozen=True)
 class Constant(_Signal):
     """A constant value."""
@@ -67,8 +66,6 @@ class Step(_Signal):
         return np.where(np.asarray(t) >= self.time_s, self.final, self.initial)
 
 
-
-
 @dataclass(frozen=True)
 class Ramp(_Signal):
     """Linear from ``initial`` at ``start_s`` to ``final`` at ``end_s``."""
@@ -83,8 +80,6 @@ class Ramp(_Signal):
         if isinstance(t, float):
             return float(np.interp(t, (self.start_s, self.end_s), (self.initial, self.final)))
         return np.interp(t, (self.start_s, self.end_s), (self.initial, self.final))
-
-
 
 
 @dataclass(frozen=True)
@@ -105,8 +100,6 @@ class FirstOrderLag(_Signal):
         t = np.asarray(t, dtype=float)
         lag = self.final + (self.initial - self.final) * np.exp(-np.maximum(t - self.time_s, 0.0) / self.tau_s)
         return np.where(t >= self.time_s, lag, self.initial)
-
-
 
 
 @dataclass(frozen=True)
@@ -130,10 +123,6 @@ class Trace(_Signal):
     @property
     def max_step_s(self) -> float:
         return float(np.min(np.diff(self.t_s)))
-
-    @property
-    def max_value(self) -> float:
-        return float(np.max(self.values))
 
 
 def max_step_hint_s(*signals) -> float:

@@ -112,8 +112,8 @@ def initial_mode(model: MuscleModel, t: float, y, stick_margin_N: float = Solver
 
 
 def simulate_model(model: MuscleModel, duration_s: float, options: SolverOptions | None = None,
-                   x0_m: float = 0.0, name: str = "") -> Result:
-    """Integrate ``model`` from rest at ``x0_m`` over ``[0, duration_s]``.
+                   x0_m: float = 0.0, name: str = "", p0_gauge_Pa: float | None = None) -> Result:
+    """Integrate ``model`` from rest at ``x0_m`` (chamber at ``p0_gauge_Pa``, if given) over ``[0, duration_s]``.
 
     Raises :class:`SolverFailure` when ``solve_ivp`` fails, the event count
     exceeds ``options.max_events``, or the switching stops making progress.
@@ -130,7 +130,7 @@ def simulate_model(model: MuscleModel, duration_s: float, options: SolverOptions
     held_max_step = min(opts.held_max_step_s, model.max_input_step_s)
 
     t = 0.0
-    y = model.initial_state(x0_m)
+    y = model.initial_state(x0_m, p0_gauge_Pa)
     mode = initial_mode(model, t, y, opts.stick_margin_N)
     ts, ys, modes = [], [], []
     transitions: list[TransitionEvent] = []

@@ -36,9 +36,13 @@ def equilibrium_contraction_m(static_force, p_gauge_Pa: float, load_N: float, x_
 
 
 def max_load_N(static_force, p_gauge_Pa: float, x_max_m: float, n_grid: int = 400) -> float:
-    """Force capability: the largest static force over the contraction range, at least that at x = 0."""
+    """Force capability: the largest static force over [0, x_max_m] (0 if it cannot pull at all).
+
+    Pass the fitted range as ``x_max_m``: beyond it the polynomial is an
+    extrapolation and its values say nothing about what the muscle can hold.
+    """
     x = np.linspace(0.0, x_max_m, n_grid)
-    return float(np.max(static_force.force_N(x, p_gauge_Pa)))
+    return max(float(np.max(static_force.force_N(x, p_gauge_Pa))), 0.0)
 
 
 def friction_band_m(static_force, friction, p_gauge_Pa: float, mass_kg: float, g_m_s2: float,
@@ -62,7 +66,7 @@ def static_report(params: Mapping[str, float], static_force, p_gauge_Pa: float, 
     x_hi = EndStops.from_parameters(params).x_high_m
     x_eq = equilibrium_contraction_m(static_force, p_gauge_Pa, load_N, x_hi)
     return {"pressure_gauge_Pa": p_gauge_Pa, "load_N": load_N, "equilibrium_contraction_m": x_eq,
-            "max_load_N": max_load_N(static_force, p_gauge_Pa, x_hi), "lifts_load": x_eq > 0.0,
+            "max_load_N": max_load_N(static_force, p_gauge_Pa, min(x_hi, params["fit_x_max_m"])), "lifts_load": x_eq > 0.0,
             "upper_stop_m": x_hi,
             "within_fit_range": bool(params["fit_x_min_m"] <= x_eq <= params["fit_x_max_m"]
                                      and p_gauge_Pa <= params["fit_p_max_Pa"])}

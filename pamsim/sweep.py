@@ -28,7 +28,7 @@ import numpy as np
 
 from .atomic import atomic_outputs
 from .constants import PA_PER_BAR
-from .elements.friction import FRICTION_MODELS
+from .elements.friction import FRICTION_MODELS, build_friction
 from .elements.static_force import STATIC_FORCE_MODELS
 from .elements.stops import EndStops
 from .errors import InputError
@@ -356,19 +356,16 @@ def _resolve(base_dir: Path, name: str) -> Path:
 # ---------------------------------------------------------------- running
 @dataclass(frozen=True)
 class _Task:
-    """What a worker needs to rebuild and run one scenario (Scenario objects do not pickle)."""
+    """One scenario to run in a worker (it pickles to a process or a distributed worker)."""
 
     kind: str  # "case", "frequency" or "response"
     key: tuple
-    spec: Mapping[str, Any]
-    name: str
-    base_dir: str
-    origin: str
+    scenario: Scenario
     keep_trace: bool
 
 
 def _task(kind: str, key: tuple, scenario: Scenario, keep_trace: bool = False) -> _Task:
-    return _Task(kind, key, dict(scenario.spec), scenario.name, str(scenario.base_dir), scenario.origin, keep_trace)
+    return _Task(kind, key, scenario, keep_trace)
 
 
 def run_task(task: _Task) -> dict:
@@ -379,8 +376,7 @@ def run_task(task: _Task) -> dict:
     from .api import simulate
 
     try:
-        scenario = Scenario.from_dict(task.spec, task.name, task.base_dir, task.origin)
-        result = simulate(scenario)
+        result = simulate(task.scenario)
         t_settled = settled_time_s(result.t_s, result.p_gauge_Pa)
         osc = estimate_oscillation(result.t_s, result.x_m, t_start_s=t_settled)
         out = {"final_contraction_m": float(result.x_m[-1]), "peak_contraction_m": float(result.x_m.max()),
@@ -516,7 +512,7 @@ def sweep(spec: SweepSpec | str | Path, executor: Executor | None = None, progre
     outputs = _execute(tasks, executor, ProgressBar(len(tasks)) if progress else None)
     wall = time.perf_counter() - start
     by_key = {(t.kind, t.key): o for t, o in zip(tasks, outputs)}
-    failures = [f"{t.name}: {o['error']}" for t, o in zip(tasks, outputs) if o["error"]]
+    failures = [f"{t.scenario.name}: {o['error']}" for t, o in zip(tasks, outputs) if o["error"]]
     rows = [_case_row(spec, i, case, by_key) for i, case in enumerate(spec.cases)]
     freq_rows = []
     if spec.frequency is not None:
@@ -573,7 +569,7 @@ def _case_row(spec: SweepSpec, i: int, case: SweepCase, by_key: Mapping) -> dict
            "equilibrium_error_m": x_eq - case.measured_contraction_m,
            "within_capability": bool(x_eq >= spec.capability_min_equilibrium_m)}
     for n, f in enumerate(spec.friction_models):
-        friction = FRICTION_MODELS[f](params)
+        friction = build_friction(f, params, spec.base.spec["model"]["friction_negative_level"])
         lo, hi = friction_band_m(static, friction, p_Pa, case.weight_N / params["g_m_s2"], params["g_m_s2"], x_hi)
         o = by_key[("case", (i, f))]
         # The first model's columns carry the plain names; the others are prefixed with the model name.

@@ -91,6 +91,20 @@ BAD_SCENARIOS = [
     ("missing trace", lambda s: s.replace('source = "valve"\nsupply_gauge_bar = 3.6\nvalve_open_time_s = 1.0',
                                           'source = "prescribed"\n[pressure.prescribed]\nkind = "trace"\nfile = "nope.csv"'),
      ["nope.csv", "not found"]),
+    ("parameter out of range", lambda s: s + "\n[parameters]\nD0_m = 0.0\n", ["D0_m", "0.0", "> 0"]),
+    ("inconsistent parameters", lambda s: s + "\n[parameters]\nvalve_b = 0.9995\n", ["valve_b", "valve_laminar_ratio"]),
+    ("key of another signal kind", lambda s: s.replace("valve_open_time_s = 1.0",
+                                                       '[pressure.command]\nkind = "step"\ntime_s = 1.0\nfinal = 1.0\ntau_s = 0.5'),
+     ["tau_s", "step"]),
+    ("trace without file", lambda s: s.replace('source = "valve"\nsupply_gauge_bar = 3.6\nvalve_open_time_s = 1.0',
+                                               'source = "prescribed"\n[pressure.prescribed]\nkind = "trace"'),
+     ["file", "missing"]),
+    ("bad external force", lambda s: s.replace("weight_N = 22.74", 'weight_N = 22.74\nexternal_force = { kind = "pulse" }'),
+     ["external_force", "pulse"]),
+    ("too many samples", lambda s: s.replace("duration_s = 2.0", "duration_s = 2.0\nsample_rate_Hz = 1e9"),
+     ["sample_rate_Hz", "samples"]),
+    ("initial pressure above rating", lambda s: s.replace("valve_open_time_s = 1.0", "valve_open_time_s = 1.0\ninitial_gauge_bar = 9.0"),
+     ["initial_gauge_bar", "rating"]),
     ("non-monotonic trace", lambda s: s.replace('source = "valve"\nsupply_gauge_bar = 3.6\nvalve_open_time_s = 1.0',
                                                 'source = "prescribed"\n[pressure.prescribed]\nkind = "trace"\nfile = "bad.csv"'),
      ["bad.csv", "increase", "line 4"]),
@@ -138,3 +152,31 @@ def test_solver_failure_exits_3_and_leaves_nothing(tmp_path):
     assert r.returncode == 3
     assert "max_events" in r.stderr and "Traceback" not in r.stderr
     assert not out.exists() or not any(out.iterdir())
+
+
+@pytest.mark.parametrize("command", [
+    ["run", SCENARIOS / "acra2012_fig4.toml", "-o"],
+    ["sweep", SCENARIOS / "acra2012_grid.toml", "-o"],
+    ["linearize", SCENARIOS / "acra2012_fig4.toml", "-o"],
+], ids=["run", "sweep", "linearize"])
+def test_output_folder_that_is_a_file_exits_2_before_running(tmp_path, command):
+    blocker = tmp_path / "taken"
+    blocker.write_text("not a folder")
+    for target in (blocker, blocker / "sub"):
+        r = pamsim(*command, target)
+        assert r.returncode == 2, r.stderr
+        assert "Traceback" not in r.stderr and str(blocker) in r.stderr
+        assert len(r.stderr.strip().splitlines()) == 1
+    assert blocker.read_text() == "not a folder"
+
+
+def test_output_files_get_ordinary_permissions(tmp_path):
+    import os
+    import stat
+
+    r = pamsim("run", SCENARIOS / "acra2012_fig4.toml", "-o", tmp_path / "o")
+    assert r.returncode == 0
+    umask = os.umask(0)
+    os.umask(umask)
+    for f in (tmp_path / "o").iterdir():
+        assert stat.S_IMODE(f.stat().st_mode) == 0o666 & ~umask, f.name

@@ -279,3 +279,20 @@ def test_with_changes_can_switch_the_pressure_source_and_scenarios_pickle(paper_
     assert "weight_N" not in heavier.spec["load"] and heavier.mass_kg == 3.0
     clone = pickle.loads(pickle.dumps(presc))
     assert np.array_equal(pamsim.simulate(clone).x_m, pamsim.simulate(presc).x_m)
+
+
+def test_initial_chamber_pressure_holds_an_initial_contraction():
+    """Starting at 20 mm with the closed chamber at the pressure that balances the weight there,
+    the load must stay put; at ambient pressure it falls to the lower stop."""
+    from scipy.optimize import brentq
+
+    base = {"load": {"weight_N": 22.74}, "simulation": {"duration_s": 1.0, "initial_contraction_m": 0.02},
+            "pressure": {"source": "valve", "supply_gauge_bar": 3.6, "command": {"kind": "constant", "value": 0.0}}}
+    model = pamsim.Scenario.from_dict(base).build_model()
+    p_hold = brentq(lambda p: model.static_force.force_N(0.02, p) - 22.74, 0.0, 4e5)
+    held = pamsim.simulate(pamsim.Scenario.from_dict(
+        {**base, "pressure": {**base["pressure"], "initial_gauge_bar": p_hold / 1e5}}))
+    assert held.final_mode == Mode.STICK and np.max(np.abs(held.x_m - 0.02)) == 0.0
+    assert held.p_gauge_Pa[0] == pytest.approx(p_hold)
+    dropped = pamsim.simulate(pamsim.Scenario.from_dict(base))
+    assert dropped.final_mode == Mode.STOP_LOW

@@ -45,12 +45,17 @@ def main(argv: list[str] | None = None) -> int:
     except SolverFailure as exc:
         print(f"pamsim: solver failure: {exc}", file=sys.stderr)
         return 3
+    except OSError as exc:
+        if isinstance(exc, BrokenPipeError):  # output piped into `head` and the like: not an error of ours
+            sys.stderr = open(os.devnull, "w")
+            return 0
+        # A file or folder named on the command line that cannot be read or written.
+        where = f"{exc.filename}: " if exc.filename else ""
+        print(f"pamsim: error: {where}{exc.strerror or exc}", file=sys.stderr)
+        return 2
     except KeyboardInterrupt:
         print("pamsim: interrupted", file=sys.stderr)
         return 130
-    except BrokenPipeError:  # output piped into `head` and the like: not an error of ours
-        sys.stderr = open(os.devnull, "w")
-        return 0
 
 
 def finite_float(text: str) -> float:

@@ -7,7 +7,7 @@ import argparse
 import json
 from pathlib import Path
 
-from ..atomic import atomic_outputs
+from ..atomic import atomic_outputs, ensure_output_dir
 
 
 def register(sub) -> None:
@@ -24,6 +24,7 @@ def run(args: argparse.Namespace) -> int:
     from ..control.closed_loop import run_closed_loop
     from ..control.plots import closed_loop_figure
 
+    ensure_output_dir(args.output)
     loop = run_closed_loop(args.scenario)
     name = loop.result.name
     names = [f"{name}.csv", f"{name}.json", f"{name}.png"]

@@ -10,12 +10,13 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 import math
 from pathlib import Path
 
 import numpy as np
 
-from ..atomic import atomic_outputs
+from ..atomic import atomic_outputs, ensure_output_dir
 from ..control.linear import VALVE_SLOPES, linearize
 from ..control.operating_point import held_equilibrium, open_valve_equilibrium, trajectory_point
 from ..control.system import FRICTION_KINDS, FrictionTreatment
@@ -91,6 +92,7 @@ def run(args: argparse.Namespace) -> int:
     from ..control.plots import bode_figure, pole_zero_figure
 
     scenario = load_scenario(args.scenario)
+    ensure_output_dir(args.output)
     model = scenario.build_model()
     supply = scenario.final_pressure_gauge_Pa
     if args.at_time is not None:
@@ -107,11 +109,13 @@ def run(args: argparse.Namespace) -> int:
     with atomic_outputs(args.output, names) as tmp:
         bode_figure(lin).savefig(tmp[names[0]], format="png", dpi=110)
         pole_zero_figure(lin).savefig(tmp[names[1]], format="png", dpi=110)
+    wrote = f"wrote {', '.join(str(Path(args.output) / n) for n in names)}"
     if args.json:
         print(json.dumps(rep, indent=2))
+        print(wrote, file=sys.stderr)  # stdout stays pure JSON
         return 0
     _print_text(lin, rep)
-    print(f"wrote {', '.join(str(Path(args.output) / n) for n in names)}")
+    print(wrote)
     return 0
 
 

@@ -7,7 +7,7 @@ import json
 import sys
 from pathlib import Path
 
-from ..atomic import atomic_outputs
+from ..atomic import atomic_outputs, ensure_output_dir
 from ..backends import BACKENDS, get_backend
 from ..scenario import load_scenario
 
@@ -25,6 +25,7 @@ def register(sub) -> None:
 
 def run(args: argparse.Namespace) -> int:
     scenario = load_scenario(args.scenario)
+    ensure_output_dir(args.output)  # before the run, not after it
     result = get_backend(args.backend)(scenario)
     names = [f"{scenario.name}.csv", f"{scenario.name}.json"] + ([] if args.no_plot else [f"{scenario.name}.png"])
     with atomic_outputs(args.output, names) as tmp:

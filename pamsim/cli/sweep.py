@@ -8,6 +8,7 @@ import sys
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
+from ..atomic import ensure_output_dir
 from ..sweep import load_sweep, sweep
 
 
@@ -35,6 +36,7 @@ def register(sub) -> None:
 
 def run(args: argparse.Namespace) -> int:
     spec = load_sweep(args.sweep_file)
+    ensure_output_dir(args.output)  # before the runs, not after them
     if args.workers == 1:
         result = sweep(spec, None, progress=not args.no_progress)
     else:

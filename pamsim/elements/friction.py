@@ -79,3 +79,10 @@ FRICTION_MODELS: dict[str, Callable[[Mapping[str, float]], object]] = {
     "constant": ConstantCoulomb.from_parameters,
     "none": NoCoulomb.from_parameters,
 }
+
+
+def build_friction(name: str, params: Mapping[str, float], negative_level: str = "clamp"):
+    """The friction element a scenario names; ``negative_level`` applies to the load-dependent law only."""
+    if name == "load_dependent":
+        return LoadDependentCoulomb.from_parameters(params, negative_level)
+    return FRICTION_MODELS[name](params)
