@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 
 from ..errors import InputError
 from ..parameters import PARAMETER_SETS
@@ -38,6 +39,15 @@ def run(args: argparse.Namespace) -> int:
 
 def markdown_table(ps) -> str:
     """The parameter table of ``docs/model.md``; a test keeps the two identical."""
-    lines = ["| name | value | unit | source | meaning |", "| --- | --- | --- | --- | --- |"]
-    lines += [f"| `{n}` | {v:.6g} | {u} | {s} | {d} |" for n, v, u, s, d in ps.table()]
+    lines = ["| name | value | unit | range | source | meaning |", "| --- | --- | --- | --- | --- | --- |"]
+    for name, p in ps.entries.items():
+        lines.append(f"| `{name}` | {p.value:.6g} | {p.unit} | {_range(p)} | {p.source} | {p.description} |")
     return "\n".join(lines)
+
+
+def _range(p) -> str:
+    if not (math.isfinite(p.lower) or math.isfinite(p.upper)):
+        return "any"
+    lo = ("(" if p.lower_open or not math.isfinite(p.lower) else "[") + (f"{p.lower:g}" if math.isfinite(p.lower) else "-inf")
+    hi = (f"{p.upper:g}" if math.isfinite(p.upper) else "inf") + (")" if p.upper_open or not math.isfinite(p.upper) else "]")
+    return f"{lo}, {hi}"
