@@ -394,10 +394,14 @@ def test_out_of_range_parameters_are_refused_by_fmu_and_scenario_alike(unzipped,
 
 @pytest.mark.parametrize("version", [2, 3])
 @pytest.mark.parametrize("values,message", [
+    ({"friction_negative_level": 2}, "friction_negative_level = 2: must lie in [0, 1]"),
     ({"friction_model": -1}, "friction_model = -1: must lie in [0, 2]"),
     ({"pressure_source": 2}, "pressure_source = 2: must lie in [0, 1]"),
     ({"release_margin_N": 1e-7}, "release_margin_N = 1e-07: must be above stick_margin_N = 1e-07"),
     ({"cs_relative_tolerance": 0.1}, "cs_relative_tolerance = 0.1: must lie in (0, 0.01]"),
+    ({"initial_pressure_gauge_Pa": -1e3}, "initial_pressure_gauge_Pa = -1000: must be >= 0"),
+    ({"initial_pressure_gauge_Pa": 5e5},
+     "initial_pressure_gauge_Pa = 500000: must be at most rated_pressure_gauge_Pa = 450000"),
     ({"initial_contraction_m": 0.12}, "initial_contraction_m = 0.12: must lie between the stops, 0 and 0.1157 m"),
     ({"initial_contraction_m": -1e-3}, "initial_contraction_m = -0.001: must lie between the stops"),
 ])
@@ -649,6 +653,99 @@ def test_other_element_choices_match_python_simulator(fmus, case, interface):
     # value, so the CS output lags by half a step (the lag rises at up to 10 bar/s).
     held = interface == "cs" and sc.spec["pressure"]["source"] == "prescribed"
     assert np.max(np.abs(tr["pressure_gauge_Pa"] - ref.p_gauge_Pa)) <= (1000.0 if held else 50.0)
+
+
+@pytest.mark.parametrize("interface", ["cs", "me"])
+def test_friction_negative_level_abs_matches_python_simulator(fmus, paper_results, interface):
+    """Fig. 6(b) (2 bar, 22.74 N: P - m is negative at the start) with the magnitude of the
+    negative friction level; it ends 1.2 mm away from the clamped run, so an FMU that ignored the
+    setting would fail."""
+    clamped = paper_results["acra2012_fig6b"][1]
+    sc = paper_results["acra2012_fig6b"][0].with_changes({"model": {"friction_negative_level": "abs"}})
+    assert start_values(sc)["friction_negative_level"] == 1
+    ref = pamsim.simulate(sc)
+    assert abs(ref.x_m[-1] - clamped.x_m[-1]) > 5 * MAX_DIFF_M
+    tr = run_cs(sc, 2, fmu_path=fmus[2]) if interface == "cs" else run_me(sc, 2, fmu_path=fmus[2])
+    d = _diff(tr, ref)
+    assert d.max() <= MAX_DIFF_M, f"max contraction difference {d.max() * 1e3:.4f} mm"
+    assert d[-1] <= FINAL_DIFF_M, f"final contraction difference {d[-1] * 1e3:.4f} mm"
+
+
+INITIAL_PRESSURE = """
+[load]
+weight_N = 22.74
+[pressure]
+source = "valve"
+supply_gauge_bar = 3.6
+valve_open_time_s = 1.0
+initial_gauge_bar = 2.5
+[simulation]
+duration_s = 3.0
+initial_contraction_m = 0.02
+"""
+
+
+def test_initial_pressure_sets_the_initial_chamber_state(unzipped):
+    import tomllib
+
+    from fmpy.fmi2 import FMU2Slave
+
+    sc = pamsim.Scenario.from_dict(tomllib.loads(INITIAL_PRESSURE), name="initial_pressure")
+    starts = start_values(sc)
+    assert starts["initial_pressure_gauge_Pa"] == pytest.approx(2.5e5)
+    fmu = FMU2Slave(guid=token(2), unzipDirectory=unzipped[2], modelIdentifier="pamsim_muscle", instanceName="p0")
+    fmu.instantiate()
+    api = _Api(fmu, 2)
+    for k, v in starts.items():
+        if isinstance(v, float):
+            api.set(k, v)
+    api.init()
+    p, m, x = api.get("chamber_pressure_abs_Pa", "air_mass_kg", "contraction_m")
+    fmu.terminate()
+    fmu.freeInstance()
+    model = sc.build_model()
+    expected = model.source.initial_state(0.02, 2.5e5)  # ValveChamberSource: [p_abs, air mass]
+    assert (x, p) == (0.02, pytest.approx(expected[0], rel=1e-12))
+    assert m == pytest.approx(expected[1], rel=1e-12)
+
+
+@pytest.mark.parametrize("interface", ["cs", "me"])
+def test_initial_pressure_matches_python_simulator(fmus, interface):
+    import tomllib
+
+    sc = pamsim.Scenario.from_dict(tomllib.loads(INITIAL_PRESSURE), name="initial_pressure")
+    ref = pamsim.simulate(sc)
+    if abs(ref.p_gauge_Pa[0] - 2.5e5) > 1.0:
+        pytest.skip("pamsim.simulate does not yet start the chamber at [pressure] initial_gauge_bar")
+    tr = run_cs(sc, 2, fmu_path=fmus[2]) if interface == "cs" else run_me(sc, 2, fmu_path=fmus[2])
+    assert abs(tr["pressure_gauge_Pa"][0] - 2.5e5) <= 1.0
+    d = _diff(tr, ref)
+    assert d.max() <= MAX_DIFF_M, f"max contraction difference {d.max() * 1e3:.4f} mm"
+    assert d[-1] <= FINAL_DIFF_M, f"final contraction difference {d[-1] * 1e3:.4f} mm"
+    assert np.max(np.abs(tr["pressure_gauge_Pa"] - ref.p_gauge_Pa)) <= 50.0
+
+
+@pytest.mark.parametrize("section,key", [("model", "friction_negative_level"), ("pressure", "initial_gauge_bar"),
+                                         ("simulation", "initial_contraction_m"), ("", "description")])
+def test_runner_refuses_scenario_settings_the_fmu_cannot_represent(fmus, monkeypatch, section, key):
+    """A scenario key the runner does not map to the FMU is refused, not silently dropped: with
+    the key taken out of the runner's list, a scenario that sets it cannot run."""
+    import tomllib
+
+    import pamsim.fmu.runner as runner
+
+    spec = tomllib.loads(INITIAL_PRESSURE)
+    spec["model"] = {"friction_negative_level": "abs"}
+    spec["description"] = "every key the test takes out"
+    sc = pamsim.Scenario.from_dict(spec, name="initial_pressure")
+    start_values(sc)
+    monkeypatch.setitem(runner.REPRESENTED, section, runner.REPRESENTED[section] - {key})
+    full = f"{section}.{key}" if section else key
+    with pytest.raises(pamsim.errors.InputError, match=re.escape(f"cannot represent scenario key {full!r}")):
+        start_values(sc)
+    for run in (run_cs, run_me):
+        with pytest.raises(pamsim.errors.InputError, match="cannot represent"):
+            run(sc, 2, fmu_path=fmus[2])
 
 
 # ------------------------------------------------------------------ docs

@@ -75,7 +75,8 @@ static double static_force_N(const double *r, double x, double p_gauge) {
            + (r[R_S1_N_per_m2] * x + r[R_S2_N_per_m]) * x + r[R_S3_N];
 }
 
-/* elements.friction: load-dependent (clamped at zero), constant, none */
+/* elements.friction: load-dependent (a negative level clamped at zero, or its magnitude:
+ * friction_negative_level), constant, none */
 static double coulomb_level_N(const PamCore *c, double x, double p_gauge) {
     const double *r = c->r;
     double level;
@@ -83,6 +84,7 @@ static double coulomb_level_N(const PamCore *c, double x, double p_gauge) {
     case 0:
         level = (p_gauge / PA_PER_BAR - r[R_phi_bar_per_kg] * r[R_load_mass_kg])
                 * ((r[R_N2_N_per_bar_m2] * x + r[R_N1_N_per_bar_m]) * x + r[R_N0_N_per_bar]);
+        if (c->i[I_friction_negative_level] == 1) return fabs(level);
         return level > 0.0 ? level : 0.0;
     case 1: return r[R_coulomb_constant_N];
     default: return 0.0;
@@ -273,6 +275,12 @@ int pam_check_parameters(PamCore *c) {
                  r[R_release_margin_N], r[R_stick_margin_N]);
         bad = -1;
     }
+    if (!(r[R_initial_pressure_gauge_Pa] <= r[R_rated_pressure_gauge_Pa])) {
+        pam_logf(c, PAM_LOG_ERROR,
+                 "invalid parameters: initial_pressure_gauge_Pa = %g: must be at most rated_pressure_gauge_Pa = %g",
+                 r[R_initial_pressure_gauge_Pa], r[R_rated_pressure_gauge_Pa]);
+        bad = -1;
+    }
     for (k = 0; k < PAM_NVARS; k++)
         if (PAM_VARS[k].causality == PAM_INPUT && pam_check_value(c, (unsigned)k + 1, r[PAM_VARS[k].index])) bad = -1;
     if (bad) return -1;
@@ -298,7 +306,7 @@ void pam_initialize(PamCore *c) {
     c->x_high_m = c->r[R_L0_m] - b / sqrt(3.0); /* braid lock at 54.7 deg, elements.stops */
     y[X] = c->r[R_initial_contraction_m];
     y[V] = 0.0;
-    y[P] = c->r[R_p_atm_Pa];
+    y[P] = c->r[R_p_atm_Pa] + c->r[R_initial_pressure_gauge_Pa]; /* ValveChamberSource.initial_state */
     y[M] = y[P] * volume_m3(c, y[X]) / (c->r[R_R_J_per_kg_K] * c->r[R_T_supply_K]);
     put_states(c, y);
     /* simulator.initial_mode */

@@ -39,7 +39,7 @@ void pam_reset(PamCore *c);
 /* Rejects a value (NaN, negative mass, pressure above rating, ...) with a logged message: returns -1. */
 int pam_check_value(PamCore *c, unsigned vr, double value);
 int pam_check_parameters(PamCore *c);
-/* Initial state from the parameters: load at rest, chamber at ambient pressure. */
+/* Initial state from the parameters: load at rest, chamber at initial_pressure_gauge_Pa. */
 void pam_initialize(PamCore *c);
 /* Derivatives, outputs and event indicators from the states, inputs and mode. */
 void pam_evaluate(PamCore *c);

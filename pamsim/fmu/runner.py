@@ -24,13 +24,14 @@ from typing import Sequence
 
 import numpy as np
 
+from ..constants import PA_PER_BAR
 from ..elements.pressure_source import ValveChamberSource
 from ..errors import InputError, SolverFailure
 from ..result import Result
 from ..scenario import Scenario
 from .build import build
 from .generate import token
-from .variables import DAMPING_CHOICES, FRICTION_CHOICES, SOURCE_CHOICES, VARIABLES, value_reference
+from .variables import DAMPING_CHOICES, FRICTION_CHOICES, NEGATIVE_LEVEL, SOURCE_CHOICES, VARIABLES, value_reference
 
 OUTPUTS = ("contraction_m", "velocity_m_s", "pressure_gauge_Pa", "chamber_pressure_abs_Pa", "air_mass_kg")
 INPUTS = ("valve_command", "supply_pressure_gauge_Pa", "prescribed_pressure_gauge_Pa", "load_mass_kg",
@@ -46,19 +47,59 @@ def cached_fmu(fmi_version: int = 2) -> Path:
     return path
 
 
+# The scenario keys the FMU represents, by section; any other key is refused (InputError) rather
+# than dropped, so a setting added to scenarios later cannot silently run a different model.
+# [solver] sets the Python integrator: the FMU's integrators are CVode at solver.rtol (ME) and its
+# own Dormand-Prince 5(4) (CS).  [controller] is read by ``pamsim control-example`` only, as with
+# the python backend.
+REPRESENTED = {
+    "": {"name", "description", "model", "parameters", "load", "pressure", "simulation", "solver", "controller"},
+    "model": {"parameter_set", "static_force", "friction", "damping", "friction_negative_level"},
+    "load": {"weight_N", "mass_kg", "external_force"},
+    "pressure": {"source", "supply_gauge_bar", "supply_gauge_Pa", "valve_open_time_s", "command", "prescribed",
+                 "initial_gauge_bar"},
+    "simulation": {"duration_s", "sample_rate_Hz", "initial_contraction_m"},
+    "solver": {"method", "rtol", "max_events", "max_step_s"},
+}
+
+
+def _refuse_unrepresented(scenario: Scenario) -> None:
+    spec = scenario.spec
+    for section, keys in REPRESENTED.items():
+        table = spec if not section else spec.get(section, {})
+        for key in table:
+            if key not in keys:
+                full = f"{section}.{key}" if section else key
+                raise InputError(f"{scenario.origin}: the FMU cannot represent scenario key {full!r}; "
+                                 "run it with the python backend")
+    model = spec["model"]
+    if model["static_force"] != "acra2012_polynomial":
+        raise InputError(f"{scenario.origin}: the FMU implements only the acra2012_polynomial static force, "
+                         f"not model.static_force = {model['static_force']!r}")
+    names = {v.name for v in VARIABLES if v.causality == "parameter" and v.kind == "real"}
+    missing = [k for k in scenario.parameters if k not in names]
+    if missing:
+        raise InputError(f"{scenario.origin}: the FMU has no parameter {missing[0]!r} "
+                         f"(parameter set {model['parameter_set']!r})")
+
+
 def start_values(scenario: Scenario) -> dict[str, float | int]:
-    """The scenario's parameters and element choices as FMU start values."""
+    """The scenario's parameters and element choices as FMU start values.
+
+    Raises :class:`~pamsim.errors.InputError` for a scenario setting the FMU cannot represent.
+    """
+    _refuse_unrepresented(scenario)
     model = scenario.spec["model"]
-    names = {v.name for v in VARIABLES if v.causality == "parameter"}
-    values: dict[str, float | int] = {k: float(scenario.parameters[k]) for k in scenario.parameters if k in names}
+    pressure = scenario.spec["pressure"]
+    values: dict[str, float | int] = {k: float(scenario.parameters[k]) for k in scenario.parameters}
     values["friction_model"] = FRICTION_CHOICES.index(model["friction"])
     values["damping_model"] = DAMPING_CHOICES.index(model["damping"])
-    values["pressure_source"] = SOURCE_CHOICES.index(scenario.spec["pressure"]["source"])
+    values["friction_negative_level"] = NEGATIVE_LEVEL.index(model.get("friction_negative_level", "clamp"))
+    values["pressure_source"] = SOURCE_CHOICES.index(pressure["source"])
     values["initial_contraction_m"] = scenario.initial_contraction_m
+    values["initial_pressure_gauge_Pa"] = float(pressure.get("initial_gauge_bar", 0.0)) * PA_PER_BAR
     values["stick_margin_N"] = scenario.solver.stick_margin_N
     values["release_margin_N"] = scenario.solver.release_margin_N
-    if model["static_force"] != "acra2012_polynomial":
-        raise InputError(f"the FMU implements only the acra2012_polynomial static force, not {model['static_force']!r}")
     return values
 
 
@@ -113,6 +154,7 @@ def run_cs(scenario: Scenario, fmi_version: int = 2, communication_times: Sequen
            fmu_path: Path | None = None) -> dict[str, np.ndarray]:
     """Co-simulate ``scenario``; outputs sampled at ``communication_times`` (default: the scenario's
     sample grid).  Every input jump is added as a communication point.  Returns named arrays."""
+    start = start_values(scenario)  # refuses what the FMU cannot represent before anything runs
     fmu_path = fmu_path or cached_fmu(fmi_version)
     inputs = ScenarioInputs(scenario)
     if communication_times is None:
@@ -130,7 +172,7 @@ def run_cs(scenario: Scenario, fmi_version: int = 2, communication_times: Sequen
         fmu.instantiate()
         if fmi_version == 2:
             fmu.setupExperiment(startTime=times[0], stopTime=times[-1])
-        _set(fmu, fmi_version, start_values(scenario))
+        _set(fmu, fmi_version, start)
         _set(fmu, fmi_version, inputs(times[0]))
         if fmi_version == 2:
             fmu.enterInitializationMode()
@@ -164,6 +206,7 @@ def run_me(scenario: Scenario, fmi_version: int = 2, fmu_path: Path | None = Non
     """Model exchange with fmpy's CVode at the scenario's tolerance; outputs on the sample grid."""
     from fmpy import simulate_fmu
 
+    start = start_values(scenario)
     fmu_path = fmu_path or cached_fmu(fmi_version)
     inputs = ScenarioInputs(scenario)
     dt = 1.0 / scenario.solver.sample_rate_Hz
@@ -180,7 +223,6 @@ def run_me(scenario: Scenario, fmi_version: int = 2, fmu_path: Path | None = Non
         vals.append(inputs(math.nextafter(t, -math.inf) if left else t))
     signals = np.array([tuple([t] + [v[n] for n in INPUTS]) for t, v in zip(t_in, vals)],
                        dtype=[("time", np.float64)] + [(n, np.float64) for n in INPUTS])
-    start = start_values(scenario)
     try:
         res = simulate_fmu(str(fmu_path), fmi_type="ModelExchange", solver="CVode", start_time=0.0,
                            stop_time=scenario.duration_s, output_interval=dt,

@@ -18,6 +18,7 @@ import math
 import re
 from dataclasses import dataclass
 
+from ..elements.friction import NEGATIVE_LEVEL_CHOICES
 from ..parameters import get_parameter_set
 from ..simulator import SolverOptions
 
@@ -29,6 +30,8 @@ DAMPING_CHOICES = ("paper", "linear", "none")
 """``damping_model`` values 0, 1, 2 (the scenario's ``model.damping`` names)."""
 SOURCE_CHOICES = ("valve", "prescribed")
 """``pressure_source`` values 0, 1 (the scenario's ``pressure.source`` names)."""
+NEGATIVE_LEVEL = NEGATIVE_LEVEL_CHOICES
+"""``friction_negative_level`` values 0, 1 (the scenario's ``model.friction_negative_level`` names)."""
 
 
 @dataclass(frozen=True)
@@ -87,7 +90,7 @@ def _table() -> tuple[Variable, ...]:
         _choice("damping_model", "viscous damping law: {}", DAMPING_CHOICES),
         _choice("pressure_source", "pressure source: {} (input prescribed_pressure_gauge_Pa)", SOURCE_CHOICES),
         Variable("initial_contraction_m", "real", "parameter", "fixed",
-                 "contraction at t = 0, load at rest, chamber at ambient pressure [m]", "m", 0.0, "exact"),
+                 "contraction at t = 0, load at rest, between the stops [m]", "m", 0.0, "exact"),
         Variable("stick_margin_N", "real", "parameter", "fixed",
                  "a stopping load is held when the net force exceeds friction by no more than this [N]",
                  "N", solver.stick_margin_N, "exact", lower=0.0),
@@ -100,6 +103,12 @@ def _table() -> tuple[Variable, ...]:
         Variable("cs_max_step_s", "real", "parameter", "fixed",
                  "largest internal step of the co-simulation integrator [s]", "s", 0.01, "exact",
                  lower=0.0, lower_open=True),
+        _choice("friction_negative_level", "load-dependent friction where its level "
+                "(P_bar - phi m)(N2 x^2 + N1 x + N0) is negative: {} (clamp: level 0; abs: its magnitude)",
+                NEGATIVE_LEVEL),
+        Variable("initial_pressure_gauge_Pa", "real", "parameter", "fixed",
+                 "chamber gauge pressure at t = 0 (valve source), at most rated_pressure_gauge_Pa [Pa]",
+                 "Pa", 0.0, "exact", lower=0.0),
         # Inputs.
         Variable("valve_command", "real", "input", "continuous",
                  "proportional 3/3 valve: 1 open to supply, 0 closed, -1 open to exhaust [1]", "1", 0.0),
