@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -27,3 +29,9 @@ def paper_results():
         sc = pamsim.load_scenario(SCENARIOS / f"{name}.toml")
         out[name] = (sc, pamsim.simulate(sc))
     return out
+
+
+def run_cli(*args, cwd=None):
+    """Run ``python -m pamsim ARGS`` as a user would; returns the CompletedProcess."""
+    return subprocess.run([sys.executable, "-m", "pamsim", *map(str, args)], capture_output=True, text=True,
+                          cwd=cwd, timeout=300)

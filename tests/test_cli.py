@@ -3,13 +3,12 @@
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
 
 import numpy as np
 import pytest
 
 from conftest import SCENARIOS
+from conftest import run_cli as pamsim
 
 BASE = """
 [load]
@@ -25,9 +24,6 @@ duration_s = 2.0
 """
 
 
-def pamsim(*args, cwd=None):
-    return subprocess.run([sys.executable, "-m", "pamsim", *map(str, args)], capture_output=True, text=True,
-                          cwd=cwd, timeout=300)
 
 
 def test_run_writes_csv_png_json(tmp_path):

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import json
 import math
-import subprocess
 import sys
 
 import control as ct
@@ -24,6 +23,7 @@ from pamsim.control.system import STATES, MusclePlant
 from pamsim.errors import InputError
 
 from conftest import ROOT, SCENARIOS
+from conftest import run_cli as _cli
 
 FIG4 = SCENARIOS / "acra2012_fig4.toml"
 CLOSED_LOOP = SCENARIOS / "closed_loop_position.toml"
@@ -356,9 +356,6 @@ def test_bad_controller_table_is_an_input_error():
 
 
 # ---------------------------------------------------------------- CLI
-def _cli(*args):
-    return subprocess.run([sys.executable, "-m", "pamsim", *map(str, args)], capture_output=True, text=True,
-                          cwd=ROOT, timeout=120)
 
 
 def test_cli_linearize_json(tmp_path):

@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 
 import pamsim
-from conftest import PAPER_SCENARIOS, SCENARIOS
+from conftest import PAPER_SCENARIOS, SCENARIOS, run_cli
 from pamsim.fmu import build
 from pamsim.fmu.generate import c_header, token
 from pamsim.fmu.runner import ScenarioInputs, run_cs, run_me, start_values
@@ -580,18 +580,14 @@ def test_model_exchange_events_protocol(fmus, version):
 
 
 def test_cli_build_and_run_with_fmu_backends(tmp_path):
-    def pamsim_cli(*args):
-        return subprocess.run([sys.executable, "-m", "pamsim", *map(str, args)], capture_output=True, text=True,
-                              timeout=300)
-
-    out = pamsim_cli("fmu", "build", "-o", tmp_path / "m.fmu", "--fmi", "3")
+    out = run_cli("fmu", "build", "-o", tmp_path / "m.fmu", "--fmi", "3")
     assert out.returncode == 0 and (tmp_path / "m.fmu").is_file(), out.stderr
-    bad = pamsim_cli("fmu", "build", "--fmi", "4")
+    bad = run_cli("fmu", "build", "--fmi", "4")
     assert bad.returncode == 2 and bad.stderr.count("\n") == 1 and "must be 2 or 3" in bad.stderr
     scenario = SCENARIOS / "acra2012_fig6b.toml"
     csvs = {}
     for backend in ("python", "fmu-cs", "fmu-me"):
-        r = pamsim_cli("run", scenario, "-o", tmp_path / backend, "--backend", backend, "--no-plot")
+        r = run_cli("run", scenario, "-o", tmp_path / backend, "--backend", backend, "--no-plot")
         assert r.returncode == 0, r.stderr
         with open(tmp_path / backend / "acra2012_fig6b.csv") as fh:
             header = fh.readline()

@@ -8,8 +8,6 @@ from __future__ import annotations
 
 import csv
 import math
-import subprocess
-import sys
 from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 from pathlib import Path
 
@@ -19,6 +17,7 @@ import pytest
 import pamsim
 from pamsim.oscillation import estimate_oscillation
 from pamsim.sweep import SweepError, load_sweep, sweep_from_dict
+from conftest import run_cli as _cli
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENARIOS = ROOT / "scenarios"
@@ -223,9 +222,6 @@ def test_any_executor_and_failed_cases_do_not_stop_the_sweep(tmp_path):
     assert "## Failed runs" in (tmp_path / "out" / "report.md").read_text()
 
 
-def _cli(*args, cwd=None):
-    return subprocess.run([sys.executable, "-m", "pamsim", *map(str, args)], capture_output=True, text=True,
-                          cwd=cwd, timeout=120)
 
 
 def test_cli_runs_a_small_sweep_with_progress(tmp_path):
