@@ -53,7 +53,8 @@ def plot_result(result: "Result", path=None, title: str | None = None, compare: 
     ax_f.set_xlabel("time [s]")
     ax_f.legend(loc="upper right", fontsize=8, ncol=3)
     ax_f.grid(alpha=0.3)
-    fig.suptitle(title or f"{result.name}: m = {result.mass_kg:.3f} kg")
+    fig.suptitle(title or f"{result.name}: {result.mass_kg * result.g_m_s2:.2f} N hanging weight "
+                          f"({result.mass_kg:.3f} kg), {result.p_gauge_Pa[-1] / PA_PER_BAR:.2f} bar at the end")
     if path is not None:
         with atomic_path(path) as tmp:
             fig.savefig(tmp, format="png", dpi=110)
