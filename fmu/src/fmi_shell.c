@@ -143,7 +143,8 @@ static int settable(FmuInstance *in, const char *function, unsigned vr) {
 /* Values may be read from the end of instantiation, and are then up to date. */
 static int begin_read(FmuInstance *in, const char *function, size_t nvr, size_t n_values) {
     if (!fmu_allowed(in, function, FMU_RUNNING) || n_values != nvr) return -1;
-    refresh(in, FMU_EVENT | FMU_CONT);
+    /* Co-simulation too: an input set at a communication point shows in the outputs at once. */
+    refresh(in, FMU_EVENT | FMU_CONT | FMU_STEP);
     return 0;
 }
 
@@ -362,8 +363,15 @@ int fmu_get_nominals(FmuInstance *in, const char *function, double nominals[], s
 
 int fmu_do_step(FmuInstance *in, const char *function, double current_time, double step_size) {
     if (!fmu_allowed(in, function, FMU_STEP) || !in->is_cs) return FMU_STEP_REFUSED;
-    if (!(step_size >= 0.0) || !isfinite(current_time)) {
-        pam_logf(&in->core, PAM_LOG_ERROR, "%s: invalid step size %g", function, step_size);
+    if (!(step_size >= 0.0) || !isfinite(step_size)) {
+        pam_logf(&in->core, PAM_LOG_ERROR, "%s: step size %g: must be a finite number >= 0", function, step_size);
+        return FMU_STEP_REJECTED;
+    }
+    /* The importer's time may differ from the FMU's by rounding (t + h computed on either side),
+     * not by more. */
+    if (!(fabs(current_time - in->core.time_s) <= 1e-12 * fmax(1.0, fabs(in->core.time_s)))) {
+        pam_logf(&in->core, PAM_LOG_ERROR, "%s: currentCommunicationPoint = %.16g s is not the FMU's time %.16g s",
+                 function, current_time, in->core.time_s);
         return FMU_STEP_REJECTED;
     }
     in->core.time_s = current_time;

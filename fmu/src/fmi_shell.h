@@ -14,6 +14,10 @@
 
 #include "pam_core.h"
 
+#if defined(__GNUC__)
+#pragma GCC visibility push(hidden)
+#endif
+
 /* The state machine of both standards (FMI 2.0 sec. 3.2.3 and 4.2.4, FMI 3.0 sec. 3.2 and 4.2);
  * an FMI 2.0 instance never enters FMU_CONFIG. */
 enum {
@@ -108,9 +112,14 @@ int fmu_get_event_indicators(FmuInstance *in, const char *function, double z[], 
 int fmu_get_nominals(FmuInstance *in, const char *function, double nominals[], size_t nx);
 
 /* Co-simulation.  FMU_STEP_REFUSED (wrong state or no co-simulation instance) and
- * FMU_STEP_REJECTED (invalid step) leave the instance as it was; FMU_STEP_FAILED leaves it in
- * FMU_ERROR at the last successful time. */
+ * FMU_STEP_REJECTED (a step size that is not a finite number >= 0, or a current communication point
+ * that is not the FMU's time) leave the instance as it was; FMU_STEP_FAILED leaves it in FMU_ERROR at
+ * the last successful time, with the states, mode and outputs of that instant. */
 enum { FMU_STEP_REFUSED = -1, FMU_STEP_REJECTED = -2, FMU_STEP_FAILED = -3 };
 int fmu_do_step(FmuInstance *in, const char *function, double current_time, double step_size);
+
+#if defined(__GNUC__)
+#pragma GCC visibility pop
+#endif
 
 #endif

@@ -64,7 +64,7 @@ def build(output_path: str | os.PathLike | None = None, fmi_version: int = 2) ->
         bin_dir = root / "binaries" / platform_folder(fmi_version)
         bin_dir.mkdir(parents=True)
         lib = bin_dir / (MODEL_IDENTIFIER + shared_library_suffix())
-        cmd = [compiler, "-shared", "-fPIC", "-O2", "-std=c99", "-Wall", "-I", str(src),
+        cmd = [compiler, "-shared", "-fPIC", "-O2", "-std=c99", "-Wall", "-fvisibility=hidden", "-I", str(src),
                *(str(src / name) for name in compiled_sources(fmi_version)), "-o", str(lib), "-lm"]
         proc = subprocess.run(cmd, capture_output=True, text=True)
         if proc.returncode != 0:

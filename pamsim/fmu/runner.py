@@ -33,7 +33,7 @@ from .build import build
 from .generate import token
 from .variables import DAMPING_CHOICES, FRICTION_CHOICES, NEGATIVE_LEVEL, SOURCE_CHOICES, VARIABLES, value_reference
 
-OUTPUTS = ("contraction_m", "velocity_m_s", "pressure_gauge_Pa", "chamber_pressure_abs_Pa", "air_mass_kg")
+OUTPUTS = ("contraction_m", "velocity_m_s", "p_gauge_Pa", "chamber_pressure_abs_Pa", "air_mass_kg")
 INPUTS = ("valve_command", "supply_pressure_gauge_Pa", "prescribed_pressure_gauge_Pa", "load_mass_kg",
           "external_force_N")
 

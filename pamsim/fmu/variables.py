@@ -7,9 +7,12 @@ hand.  Model parameters are taken from the parameter set
 ``shadow_6x300_acra2012`` (name, unit, start value, description), so a new
 parameter there becomes an FMU parameter on the next build.
 
-Value references are the 1-based position in the table (0 is ``time`` in
-FMI 3.0).  Integer variables are ``Integer`` in FMI 2.0 and ``Int32`` in
-FMI 3.0.
+Value references are pinned in :data:`VALUE_REFERENCES` (0 is ``time`` in
+FMI 3.0), so adding, moving or renaming a variable never renumbers the others;
+a variable not yet pinned there gets the next free number after the pinned
+ones, in table order (a test compares the table with the committed list
+``tests/data/fmu_value_references.csv``).  Integer variables are ``Integer``
+in FMI 2.0 and ``Int32`` in FMI 3.0.
 """
 
 from __future__ import annotations
@@ -19,7 +22,7 @@ import re
 from dataclasses import dataclass
 
 from ..elements.friction import NEGATIVE_LEVEL_CHOICES
-from ..parameters import get_parameter_set
+from ..parameters import LOAD_MASS, get_parameter_set
 from ..simulator import SolverOptions
 
 PARAMETER_SET = "shadow_6x300_acra2012"
@@ -32,6 +35,30 @@ SOURCE_CHOICES = ("valve", "prescribed")
 """``pressure_source`` values 0, 1 (the scenario's ``pressure.source`` names)."""
 NEGATIVE_LEVEL = NEGATIVE_LEVEL_CHOICES
 """``friction_negative_level`` values 0, 1 (the scenario's ``model.friction_negative_level`` names)."""
+
+
+VALUE_REFERENCES = {
+    # The parameter set shadow_6x300_acra2012.
+    "K1_N_per_bar_m2": 1, "K2_N_per_bar_m": 2, "C1_N_per_bar": 3, "S1_N_per_m2": 4, "S2_N_per_m": 5, "S3_N": 6,
+    "N2_N_per_bar_m2": 7, "N1_N_per_bar_m": 8, "N0_N_per_bar": 9, "phi_bar_per_kg": 10, "coulomb_constant_N": 11,
+    "D1_N_s_per_m": 12, "D2_N_s2_per_m2": 13, "L0_m": 14, "D0_m": 15, "braid_angle_rest_deg": 16,
+    "dead_volume_m3": 17, "valve_C_m3_per_s_Pa": 18, "valve_b": 19, "valve_laminar_ratio": 20, "rho0_kg_m3": 21,
+    "T0_K": 22, "polytropic_index": 23, "T_supply_K": 24, "R_J_per_kg_K": 25, "p_atm_Pa": 26, "g_m_s2": 27,
+    "rated_pressure_gauge_Pa": 28, "fit_x_min_m": 29, "fit_x_max_m": 30, "fit_p_max_Pa": 31, "stop_restitution": 32,
+    # The FMU's own parameters.
+    "friction_model": 33, "damping_model": 34, "pressure_source": 35, "initial_contraction_m": 36,
+    "stick_margin_N": 37, "release_margin_N": 38, "cs_relative_tolerance": 39, "cs_max_step_s": 40,
+    "friction_negative_level": 41, "initial_pressure_gauge_Pa": 42, "cs_max_internal_steps": 62,
+    # Inputs, states, derivatives, outputs, event indicators.
+    "valve_command": 43, "supply_pressure_gauge_Pa": 44, "prescribed_pressure_gauge_Pa": 45, "load_mass_kg": 46,
+    "external_force_N": 47, "contraction_m": 48, "velocity_m_s": 49, "chamber_pressure_abs_Pa": 50, "air_mass_kg": 51,
+    "der(contraction_m)": 52, "der(velocity_m_s)": 53, "der(chamber_pressure_abs_Pa)": 54, "der(air_mass_kg)": 55,
+    "p_gauge_Pa": 56, "F_static_N": 57, "F_friction_N": 58, "friction_mode": 59,
+    "event_indicator_1": 60, "event_indicator_2": 61,
+}
+"""Pinned value references.  Never change or reuse a number: a renamed variable keeps its number
+(``p_gauge_Pa``, ``F_static_N`` and ``F_friction_N`` were ``pressure_gauge_Pa``,
+``muscle_force_N`` and ``friction_force_N``), a removed one leaves a gap."""
 
 
 @dataclass(frozen=True)
@@ -111,13 +138,14 @@ def _table() -> tuple[Variable, ...]:
                  "Pa", 0.0, "exact", lower=0.0),
         # Inputs.
         Variable("valve_command", "real", "input", "continuous",
-                 "proportional 3/3 valve: 1 open to supply, 0 closed, -1 open to exhaust [1]", "1", 0.0),
+                 "proportional 3/3 valve: 1 open to supply, 0 closed, -1 open to exhaust [1]", "1", 0.0,
+                 lower=-1.0, upper=1.0),
         Variable("supply_pressure_gauge_Pa", "real", "input", "continuous",
-                 "valve supply gauge pressure, at most rated_pressure_gauge_Pa [Pa]", "Pa", 0.0),
+                 "valve supply gauge pressure, at most rated_pressure_gauge_Pa [Pa]", "Pa", 0.0, lower=0.0),
         Variable("prescribed_pressure_gauge_Pa", "real", "input", "continuous",
                  "chamber gauge pressure when pressure_source = 1 (prescribed) [Pa]", "Pa", 0.0),
-        Variable("load_mass_kg", "real", "input", "continuous",
-                 "hanging mass, holder included, > 0 [kg]", "kg", round(22.74 / params["g_m_s2"], 6)),
+        Variable("load_mass_kg", "real", "input", "continuous", f"{LOAD_MASS.description} [kg] (range: "
+                 f"{LOAD_MASS.source})", LOAD_MASS.unit, LOAD_MASS.value, lower=LOAD_MASS.lower),
         Variable("external_force_N", "real", "input", "continuous",
                  "extra force on the load, positive along the contraction [N]", "N", 0.0),
         # States (the two mechanical ones are also outputs).
@@ -138,11 +166,13 @@ def _table() -> tuple[Variable, ...]:
         Variable("der(air_mass_kg)", "real", "local", "continuous", "valve mass flow into the chamber [kg/s]",
                  "kg/s", initial="calculated", derivative_of="air_mass_kg"),
         # Outputs.
-        Variable("pressure_gauge_Pa", "real", "output", "continuous", "chamber gauge pressure [Pa]", "Pa",
+        # Named as the columns of pamsim.Result that hold the same quantity.
+        Variable("p_gauge_Pa", "real", "output", "continuous", "chamber gauge pressure [Pa]", "Pa",
                  initial="calculated"),
-        Variable("muscle_force_N", "real", "output", "continuous", "static muscle force F_static(x, p) [N]", "N",
+        Variable("F_static_N", "real", "output", "continuous",
+                 "static muscle force F_static(x, p) alone, without damping or friction [N]", "N",
                  initial="calculated"),
-        Variable("friction_force_N", "real", "output", "continuous",
+        Variable("F_friction_N", "real", "output", "continuous",
                  "friction force on the load along x; when held, whatever holds it [N]", "N", initial="calculated"),
         Variable("friction_mode", "integer", "output", "discrete",
                  "-1 slip down, 0 stick, 1 slip up, 2 on the lower stop, 3 on the upper stop (pamsim.model.Mode)",
@@ -152,17 +182,33 @@ def _table() -> tuple[Variable, ...]:
                  "sliding: velocity; held: upward force margin [m/s or N]", initial="calculated"),
         Variable("event_indicator_2", "real", "local", "continuous",
                  "sliding: distance to the stop ahead; stuck: downward force margin [m or N]", initial="calculated"),
+        Variable("cs_max_internal_steps", "integer", "parameter", "fixed",
+                 "co-simulation: a doStep that needs more internal steps than this fails (a bound on its "
+                 "run time) [1]", None, 10_000_000, "exact", lower=1, upper=2**31 - 1),
     ]
     return tuple(rows)
 
 
+def assign_value_references(variables, pinned) -> dict[str, int]:
+    """``{name: value reference}``: the pinned number, else the next free one after all pinned
+    numbers, in table order."""
+    out, nxt = {}, max(pinned.values(), default=0) + 1
+    for v in variables:
+        if v.name in pinned:
+            out[v.name] = pinned[v.name]
+        else:
+            out[v.name], nxt = nxt, nxt + 1
+    return out
+
+
 VARIABLES: tuple[Variable, ...] = _table()
 BY_NAME = {v.name: v for v in VARIABLES}
+_VRS = assign_value_references(VARIABLES, VALUE_REFERENCES)
 
 
 def value_reference(name: str) -> int:
-    """Value reference of ``name`` (1-based table position; 0 is FMI 3.0 ``time``)."""
-    return VARIABLES.index(BY_NAME[name]) + 1
+    """Value reference of ``name`` (pinned in :data:`VALUE_REFERENCES`; 0 is FMI 3.0 ``time``)."""
+    return _VRS[BY_NAME[name].name]
 
 
 STATES = tuple(v.derivative_of for v in VARIABLES if v.derivative_of)
