@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import pamsim
 from pamsim.fmu.variables import STATES, VARIABLES, value_reference
 from test_fmu import _Api, _error_status, _inputs_and_starts, _instance, _start_fig4
 
@@ -286,6 +287,11 @@ def test_absurd_load_mass_is_refused_by_its_range(fmus, version, capfd):
     assert f"load_mass_kg = 1e-12: must be >= {LOAD_MASS.lower:g}" in capfd.readouterr().out
     api.set("load_mass_kg", LOAD_MASS.lower)
     fmu.freeInstance()
+    # pamsim.Scenario refuses the same mass, from the same range.
+    spec = {"load": {"mass_kg": 1e-12}, "pressure": {"source": "valve", "supply_gauge_bar": 3.6},
+            "simulation": {"duration_s": 1.0}}
+    with pytest.raises(pamsim.ScenarioError, match=f"load.mass_kg = 1e-12: .* must be >= {LOAD_MASS.lower:g} kg"):
+        pamsim.Scenario.from_dict(spec)
 
 
 @pytest.mark.parametrize("version", [2, 3])
