@@ -24,7 +24,7 @@ import pamsim
 from conftest import PAPER_SCENARIOS, SCENARIOS, run_cli
 from pamsim.fmu import build
 from pamsim.fmu.generate import c_header, token
-from pamsim.fmu.runner import ScenarioInputs, run_cs, run_me, start_values
+from pamsim.fmu.runner import ScenarioInputs, run_cs, run_me, set_values, start_values
 from pamsim.fmu.variables import BY_NAME, VARIABLES, value_reference
 from pamsim.parameters import get_parameter_set
 
@@ -339,11 +339,7 @@ def _initialise_with(unzipped, version, values):
     fmu.instantiate()
     api = _Api(fmu, version)
     try:
-        for name, value in values.items():
-            if BY_NAME[name].kind == "integer":
-                (fmu.setInteger if version == 2 else fmu.setInt32)([value_reference(name)], [int(value)])
-            else:
-                api.set(name, float(value))
+        set_values(fmu, version, {n: int(x) if BY_NAME[n].kind == "integer" else float(x) for n, x in values.items()})
         if version == 2:
             fmu.setupExperiment(startTime=0.0)
         fmu.enterInitializationMode()
@@ -412,7 +408,7 @@ def test_invalid_fmu_parameters_fail_initialisation(unzipped, version, values, m
 def _header_bounds(version):
     """{name: (lower, upper, lower_open, upper_open)} parsed from the generated PAM_VARS[]."""
     num = lambda t: {"HUGE_VAL": math.inf, "-HUGE_VAL": -math.inf}.get(t) or float(t)  # noqa: E731
-    rows = re.findall(r'^    \{"([^"]+)", \'[ri]\', \d+, \w+, [^,]+, ([^,]+), ([^,]+), ([01]), ([01])\},$',
+    rows = re.findall(r'^    \{"([^"]+)", \'[rie]\', \d+, \w+, [^,]+, ([^,]+), ([^,]+), ([01]), ([01])\},$',
                       c_header(version), flags=re.M)
     assert len(rows) == len(VARIABLES)
     return {n: (num(lo), num(hi), lo_open == "1", hi_open == "1") for n, lo, hi, lo_open, hi_open in rows}

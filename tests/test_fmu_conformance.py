@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 
 import pamsim
+from pamsim.fmu.runner import set_values
 from pamsim.fmu.variables import STATES, VARIABLES, value_reference
 from test_fmu import _Api, _error_status, _inputs_and_starts, _instance, _start_fig4
 
@@ -154,11 +155,7 @@ def test_directional_derivative_with_mixed_knowns_matches_finite_differences(fmu
 def _cs(fmus, version, **start):
     fmu = _instance(fmus, version, "cs")
     api = _Api(fmu, version)
-    for k, v in start.items():
-        if isinstance(v, int):
-            (fmu.setInteger if version == 2 else fmu.setInt32)([value_reference(k)], [v])
-        else:
-            api.set(k, v)
+    set_values(fmu, version, start)
     api.init()
     return fmu, api
 

@@ -121,13 +121,14 @@ static void refresh(FmuInstance *in, int evaluate_in) {
     if (in->state & evaluate_in) pam_evaluate(&in->core);
 }
 
+/* kind: 'r' (Real / Float64), 'i' (Integer / Int32; in FMI 2.0 also an Enumeration), 'e' (FMI 3.0 Int64:
+ * an Enumeration). */
 static int check_vr(FmuInstance *in, const char *function, unsigned vr, char kind) {
-    if (vr < 1 || vr > PAM_NVARS || PAM_VARS[vr - 1].kind != kind) {
-        pam_logf(&in->core, PAM_LOG_ERROR, "%s: no %s variable with value reference %u", function,
-                 kind == 'r' ? in->flavour->real_type : in->flavour->integer_type, vr);
-        return 0;
-    }
-    return 1;
+    char has = vr >= 1 && vr <= PAM_NVARS ? PAM_VARS[vr - 1].kind : 0;
+    if (has == kind || (kind == 'i' && has == 'e' && !in->flavour->enums_are_int64)) return 1;
+    pam_logf(&in->core, PAM_LOG_ERROR, "%s: no %s variable with value reference %u", function,
+             kind == 'r' ? in->flavour->real_type : kind == 'i' ? in->flavour->integer_type : "Enumeration (Int64)", vr);
+    return 0;
 }
 
 /* Parameters before the end of initialisation, inputs at any time before termination. */
@@ -197,6 +198,30 @@ int fmu_set_integers(FmuInstance *in, const char *function, const unsigned vr[],
     for (k = 0; k < nvr; k++) {
         if (!check_vr(in, function, vr[k], 'i') || !settable(in, function, vr[k])) return -1;
         in->core.i[PAM_VARS[vr[k] - 1].index] = values[k];
+    }
+    return 0;
+}
+
+int fmu_get_enums(FmuInstance *in, const char *function, const unsigned vr[], size_t nvr, int64_t values[],
+                  size_t n_values) {
+    size_t k;
+    if (begin_read(in, function, nvr, n_values)) return -1;
+    for (k = 0; k < nvr; k++) {
+        if (!check_vr(in, function, vr[k], 'e')) return -1;
+        values[k] = in->core.i[PAM_VARS[vr[k] - 1].index];
+    }
+    return 0;
+}
+
+int fmu_set_enums(FmuInstance *in, const char *function, const unsigned vr[], size_t nvr, const int64_t values[],
+                  size_t n_values) {
+    size_t k;
+    if (!fmu_allowed(in, function, FMU_INSTANTIATED | FMU_INIT) || n_values != nvr) return -1;
+    for (k = 0; k < nvr; k++) {
+        if (!check_vr(in, function, vr[k], 'e') || !settable(in, function, vr[k])) return -1;
+        /* Out of int32 range is out of every choice's range: kept out of range for the parameter check. */
+        in->core.i[PAM_VARS[vr[k] - 1].index] = values[k] > INT32_MAX ? INT32_MAX
+                                                : values[k] < INT32_MIN ? INT32_MIN : (int32_t)values[k];
     }
     return 0;
 }

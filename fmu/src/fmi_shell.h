@@ -40,6 +40,7 @@ typedef struct {
     const char *integer_type;
     const char *differentiable; /* what GetDirectionalDerivative accepts, in its error */
     int time_is_vr0;            /* FMI 3.0 declares time as value reference 0 */
+    int enums_are_int64;        /* FMI 3.0 reads and writes Enumerations as Int64, FMI 2.0 as Integer */
     /* The states in which reading the continuous states, or their derivatives and the event
      * indicators, re-evaluates the model (derivatives: the same in both standards). */
     int states_evaluate_in;
@@ -86,6 +87,11 @@ int fmu_set_reals(FmuInstance *in, const char *function, const unsigned vr[], si
                   size_t n_values);
 int fmu_set_integers(FmuInstance *in, const char *function, const unsigned vr[], size_t nvr, const int32_t values[],
                      size_t n_values);
+/* Enumerations where they are Int64 (FMI 3.0). */
+int fmu_get_enums(FmuInstance *in, const char *function, const unsigned vr[], size_t nvr, int64_t values[],
+                  size_t n_values);
+int fmu_set_enums(FmuInstance *in, const char *function, const unsigned vr[], size_t nvr, const int64_t values[],
+                  size_t n_values);
 /* Access to a type the model has none of: fine if empty, else an error saying `what`. */
 int fmu_no_such_type(FmuInstance *in, const char *function, int states, size_t nvr, const char *what);
 

@@ -33,7 +33,7 @@ void pam_reset(PamCore *c) {
     int k;
     for (k = 0; k < PAM_NVARS; k++) {
         if (PAM_VARS[k].kind == 'r') c->r[PAM_VARS[k].index] = PAM_VARS[k].start;
-        else if (PAM_VARS[k].kind == 'i') c->i[PAM_VARS[k].index] = (int32_t)PAM_VARS[k].start;
+        else if (PAM_VARS[k].kind) c->i[PAM_VARS[k].index] = (int32_t)PAM_VARS[k].start;
     }
     c->time_s = 0.0;
     c->mode = PAM_STICK;

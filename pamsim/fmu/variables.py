@@ -70,7 +70,12 @@ class Variable:
     error control uses.  ``lower``/``upper`` (``*_open``: bound excluded) is
     the range a parameter must lie in, as :class:`pamsim.parameters.Parameter`;
     the C parameter check loops over these bounds (``PAM_VARS[]`` in
-    ``pam_variables.h``).  An integer choice's range is ``[0, len(choices) - 1]``.
+    ``pam_variables.h``).  An integer choice's range is ``[0, len(choices) - 1]``;
+    it is an Enumeration in ``modelDescription.xml``.  ``depends_on`` lists
+    the states and inputs an output, derivative or event indicator depends on
+    in continuous time (the ``ModelStructure`` dependencies); ``None`` leaves
+    them undeclared (depends on everything).  ``initial_depends_on`` does the
+    same for a state's initial value, over parameters and inputs.
     """
 
     name: str
@@ -88,6 +93,8 @@ class Variable:
     lower_open: bool = False
     upper_open: bool = False
     choices: tuple[str, ...] | None = None
+    depends_on: tuple[str, ...] | None = None
+    initial_depends_on: tuple[str, ...] | None = None
 
     @property
     def c_name(self) -> str:
@@ -103,6 +110,13 @@ def _choice(name: str, description: str, choices: tuple[str, ...]) -> Variable:
     """An integer parameter choosing one of ``choices`` (0 = the first, the default)."""
     return Variable(name, "integer", "parameter", "fixed", description.format(_choices(choices)), None, 0, "exact",
                     lower=0, upper=len(choices) - 1, choices=choices)
+
+
+X, V, P, M = "contraction_m", "velocity_m_s", "chamber_pressure_abs_Pa", "air_mass_kg"
+MECHANICS = (X, V, P, "prescribed_pressure_gauge_Pa", "load_mass_kg", "external_force_N")
+"""What the load's acceleration and the event indicators depend on: the state, the pressure (a state
+or an input, by ``pressure_source``), the load and the external force.  The mode is a discrete
+state: it changes only at events, so ``friction_mode`` depends on nothing in continuous time."""
 
 
 def _table() -> tuple[Variable, ...]:
@@ -150,38 +164,46 @@ def _table() -> tuple[Variable, ...]:
                  "extra force on the load, positive along the contraction [N]", "N", 0.0),
         # States (the two mechanical ones are also outputs).
         Variable("contraction_m", "real", "output", "continuous", "contraction x = L0 - L [m]", "m",
-                 initial="calculated", nominal=0.01),
+                 initial="calculated", nominal=0.01, depends_on=(X,), initial_depends_on=("initial_contraction_m",)),
         Variable("velocity_m_s", "real", "output", "continuous", "contraction velocity dx/dt [m/s]", "m/s",
-                 initial="calculated", nominal=0.1),
+                 initial="calculated", nominal=0.1, depends_on=(V,), initial_depends_on=()),
         Variable("chamber_pressure_abs_Pa", "real", "local", "continuous",
-                 "absolute chamber pressure (valve source) [Pa]", "Pa", initial="calculated", nominal=1e5),
+                 "absolute chamber pressure (valve source) [Pa]", "Pa", initial="calculated", nominal=1e5,
+                 initial_depends_on=("p_atm_Pa", "initial_pressure_gauge_Pa")),
         Variable("air_mass_kg", "real", "local", "continuous", "air mass in the chamber (valve source) [kg]",
-                 "kg", initial="calculated", nominal=1e-5),
+                 "kg", initial="calculated", nominal=1e-5,
+                 initial_depends_on=("p_atm_Pa", "initial_pressure_gauge_Pa", "initial_contraction_m", "L0_m", "D0_m",
+                                     "braid_angle_rest_deg", "dead_volume_m3", "R_J_per_kg_K", "T_supply_K")),
         Variable("der(contraction_m)", "real", "local", "continuous", "d contraction / dt [m/s]", "m/s",
-                 initial="calculated", derivative_of="contraction_m"),
+                 initial="calculated", derivative_of="contraction_m", depends_on=(V,)),
         Variable("der(velocity_m_s)", "real", "local", "continuous", "acceleration [m/s^2]", "m/s^2",
-                 initial="calculated", derivative_of="velocity_m_s"),
+                 initial="calculated", derivative_of="velocity_m_s", depends_on=MECHANICS),
         Variable("der(chamber_pressure_abs_Pa)", "real", "local", "continuous", "chamber pressure rate [Pa/s]",
-                 "Pa/s", initial="calculated", derivative_of="chamber_pressure_abs_Pa"),
+                 "Pa/s", initial="calculated", derivative_of="chamber_pressure_abs_Pa",
+                 depends_on=(X, V, P, M, "valve_command", "supply_pressure_gauge_Pa")),
         Variable("der(air_mass_kg)", "real", "local", "continuous", "valve mass flow into the chamber [kg/s]",
-                 "kg/s", initial="calculated", derivative_of="air_mass_kg"),
+                 "kg/s", initial="calculated", derivative_of="air_mass_kg",
+                 depends_on=(X, P, M, "valve_command", "supply_pressure_gauge_Pa")),
         # Outputs.
         # Named as the columns of pamsim.Result that hold the same quantity.
         Variable("p_gauge_Pa", "real", "output", "continuous", "chamber gauge pressure [Pa]", "Pa",
-                 initial="calculated"),
+                 initial="calculated", depends_on=(P, "prescribed_pressure_gauge_Pa")),
         Variable("F_static_N", "real", "output", "continuous",
                  "static muscle force F_static(x, p) alone, without damping or friction [N]", "N",
-                 initial="calculated"),
+                 initial="calculated", depends_on=(X, P, "prescribed_pressure_gauge_Pa")),
         Variable("F_friction_N", "real", "output", "continuous",
-                 "friction force on the load along x; when held, whatever holds it [N]", "N", initial="calculated"),
+                 "friction force on the load along x; when held, whatever holds it [N]", "N", initial="calculated",
+                 depends_on=(X, P, "prescribed_pressure_gauge_Pa", "load_mass_kg", "external_force_N")),
         Variable("friction_mode", "integer", "output", "discrete",
                  "-1 slip down, 0 stick, 1 slip up, 2 on the lower stop, 3 on the upper stop (pamsim.model.Mode)",
-                 initial="calculated"),
+                 initial="calculated", depends_on=()),
         # Event indicators (FMI 3.0 declares them as variables).
         Variable("event_indicator_1", "real", "local", "continuous",
-                 "sliding: velocity; held: upward force margin [m/s or N]", initial="calculated"),
+                 "sliding: velocity; held: upward force margin [m/s or N]", initial="calculated",
+                 depends_on=MECHANICS),
         Variable("event_indicator_2", "real", "local", "continuous",
-                 "sliding: distance to the stop ahead; stuck: downward force margin [m or N]", initial="calculated"),
+                 "sliding: distance to the stop ahead; stuck: downward force margin [m or N]", initial="calculated",
+                 depends_on=MECHANICS),
         Variable("cs_max_internal_steps", "integer", "parameter", "fixed",
                  "co-simulation: a doStep that needs more internal steps than this fails (a bound on its "
                  "run time) [1]", None, 10_000_000, "exact", lower=1, upper=2**31 - 1),
