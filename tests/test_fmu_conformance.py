@@ -8,8 +8,11 @@ from __future__ import annotations
 
 import csv
 import ctypes
+import math
+import re
 import shutil
 import subprocess
+import xml.etree.ElementTree as ET
 import zipfile
 from pathlib import Path
 
@@ -339,3 +342,256 @@ def test_adding_a_parameter_does_not_renumber_the_others(monkeypatch):
     committed = _committed_value_references()
     assert {n: vrs[n] for n in committed} == committed
     assert vrs["A_new_parameter_N"] == max(committed.values()) + 1
+
+
+# ------------------------------------------------------------------ model description
+
+
+def _model_description(fmus, version):
+    return ET.fromstring(zipfile.ZipFile(fmus[version]).read("modelDescription.xml"))
+
+
+def _declared_dependencies(fmus, version):
+    """{(section, unknown name): set of known names or None} from ModelStructure."""
+    root = _model_description(fmus, version)
+    if version == 2:
+        names = [e.get("name") for e in root.find("ModelVariables")]
+        name_of = lambda ref: names[int(ref) - 1]  # noqa: E731  (FMI 2.0: 1-based index)
+        pairs = [(sec.tag, u) for sec in root.find("ModelStructure") for u in sec]
+        attr = "index"
+    else:
+        by_vr = {e.get("valueReference"): e.get("name") for e in root.find("ModelVariables")}
+        name_of = by_vr.__getitem__  # noqa: E731
+        pairs = [(u.tag, u) for u in root.find("ModelStructure")]
+        attr = "valueReference"
+    out = {}
+    for section, u in pairs:
+        deps = u.get("dependencies")
+        out[section, name_of(u.get(attr))] = None if deps is None else {name_of(d) for d in deps.split()}
+    return out
+
+
+KNOWNS = list(STATES) + ["valve_command", "supply_pressure_gauge_Pa", "prescribed_pressure_gauge_Pa", "load_mass_kg",
+                         "external_force_N"]
+UNKNOWNS = ["contraction_m", "velocity_m_s", "p_gauge_Pa", "F_static_N", "F_friction_N", *DERIVATIVES,
+            "event_indicator_1", "event_indicator_2"]
+
+
+@pytest.mark.parametrize("version", [2, 3])
+@pytest.mark.parametrize("source", ["valve", "prescribed"])
+def test_declared_dependencies_cover_every_true_dependency(fmus, version, source):
+    """Perturb each state and input of a sliding load; every output, derivative and event indicator
+    that changes must declare that known (and friction_mode, a discrete state, none)."""
+    declared = _declared_dependencies(fmus, version)
+    section = {2: ("Outputs", "Derivatives"), 3: ("Output", "ContinuousStateDerivative", "EventIndicator")}[version]
+    deps = {name: d for (sec, name), d in declared.items() if sec in section}
+    assert set(deps) == set(UNKNOWNS + ["friction_mode"]) - ({"event_indicator_1", "event_indicator_2"}
+                                                            if version == 2 else set())
+    assert deps["friction_mode"] == set()
+    if source == "valve":
+        s = _Sliding(fmus, version, Y_SLIDING)
+    else:
+        s = _Sliding.__new__(_Sliding)
+        s.fmu, s.v = _instance(fmus, version, "me"), version
+        s.api = _Api(s.fmu, version)
+        set_values(s.fmu, version, {"pressure_source": 1, "prescribed_pressure_gauge_Pa": 3.6e5, "valve_command": 0.5,
+                                    "supply_pressure_gauge_Pa": 3e5})
+        s.api.init()
+        s._update()
+        s.fmu.enterContinuousTimeMode()
+        s.set_states(Y_SLIDING)
+    assert s.api.mode() == 1
+
+    def read():
+        return np.array(s.api.get(*UNKNOWNS))
+
+    base = read()
+    y0 = np.array(Y_SLIDING)
+    found = 0
+    for known in KNOWNS:
+        value = s.api.get(known)[0]
+        h = 1e-4 * max(abs(value), 1.0)
+        if known == "valve_command":
+            h = -0.25
+        if known in STATES:
+            y = y0.copy()
+            y[STATES.index(known)] += h
+            s.set_states(y)
+        else:
+            s.api.set(known, value + h)
+        changed = np.abs(read() - base) > 1e-12 * (1.0 + np.abs(base))
+        mode = s.api.mode()
+        s.set_states(y0) if known in STATES else s.api.set(known, value)
+        assert mode == 1
+        for name in np.array(UNKNOWNS)[changed]:
+            if version == 2 and name.startswith("event_indicator"):
+                continue  # FMI 2.0 declares no dependencies of event indicators
+            assert deps[name] is not None and known in deps[name], f"{name} depends on {known}: not declared"
+            found += 1
+    assert found >= (15 if source == "valve" else 10)
+    s.free()
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_declared_initial_dependencies_of_the_states_cover_every_parameter_they_depend_on(fmus, version):
+    declared = _declared_dependencies(fmus, version)
+    section = "InitialUnknowns" if version == 2 else "InitialUnknown"
+    fmu = _instance(fmus, version)
+    api = _Api(fmu, version)
+    if version == 2:
+        fmu.setupExperiment(startTime=0.0)
+    fmu.enterInitializationMode()
+    api.set("initial_contraction_m", 0.02)
+    api.set("initial_pressure_gauge_Pa", 1e5)
+    base = np.array(api.get(*STATES))
+    params = [v.name for v in VARIABLES if v.causality in ("parameter", "input") and v.kind == "real"]
+    for name in params:
+        value = api.get(name)[0]
+        api.set(name, value * (1 + 1e-6) if value else 1e-9)
+        changed = np.abs(np.array(api.get(*STATES)) - base) > 1e-13 * np.abs(base)
+        api.set(name, value)
+        for state in np.array(STATES)[changed]:
+            assert name in declared[section, state], f"the initial {state} depends on {name}: not declared"
+    fmu.exitInitializationMode()
+    fmu.terminate()
+    fmu.freeInstance()
+
+
+COMPANIONS = {("valve_laminar_ratio", -math.inf): {"valve_b": 0.0}, ("release_margin_N", -math.inf): {"stick_margin_N": 0.0}}
+"""Values a bound needs of other parameters to pass the checks between parameters."""
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_min_max_are_the_ranges_the_fmu_enforces(fmus, unzipped, version, capfd):
+    """Every variable with a checked range declares it; the declared bound is accepted and the next
+    double beyond it refused (inputs when set, parameters at the end of initialisation)."""
+    from test_fmu import _initialise_with
+
+    root = _model_description(fmus, version)
+    elements = {e.get("name"): (e[0] if version == 2 else e) for e in root.find("ModelVariables")}
+    checked = 0
+    for v in VARIABLES:
+        e = elements[v.name]
+        lo, hi = e.get("min"), e.get("max")
+        assert (lo is not None) == math.isfinite(v.lower) and (hi is not None) == math.isfinite(v.upper), v.name
+        for bound, outward in ((lo, -math.inf), (hi, math.inf)):
+            if bound is None or v.choices:
+                continue
+            value = int(bound) if v.kind == "integer" else float(bound)
+            beyond = value + (1 if outward > 0 else -1) if v.kind == "integer" else math.nextafter(value, outward)
+            if v.causality == "parameter":
+                # valve_b's own upper bound is unreachable: it must also stay below valve_laminar_ratio < 1.
+                if (v.name, outward) != ("valve_b", math.inf):
+                    values = {v.name: value, **COMPANIONS.get((v.name, outward), {})}
+                    assert _initialise_with(unzipped, version, values) == 0, (v.name, value)
+                assert _initialise_with(unzipped, version, {v.name: beyond}) == 3, (v.name, beyond)
+            else:
+                fmu = _instance(fmus, version)
+                api = _Api(fmu, version)
+                api.set(v.name, value)
+                assert _error_status(lambda: api.set(v.name, beyond)) == 3, (v.name, beyond)
+                fmu.freeInstance()
+            checked += 1
+    capfd.readouterr()
+    assert checked >= 25
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_integer_choices_are_enumerations(fmus, version, capfd):
+    from pamsim.fmu.variables import DAMPING_CHOICES, FRICTION_CHOICES, NEGATIVE_LEVEL, SOURCE_CHOICES
+
+    root = _model_description(fmus, version)
+    types = root.find("TypeDefinitions")
+    items = {}
+    for t in types:
+        enum = t.find("Enumeration") if version == 2 else t
+        items[t.get("name")] = tuple(i.get("name") for i in sorted(enum, key=lambda i: int(i.get("value"))))
+    elements = {e.get("name"): e for e in root.find("ModelVariables")}
+    for name, choices in (("friction_model", FRICTION_CHOICES), ("damping_model", DAMPING_CHOICES),
+                          ("pressure_source", SOURCE_CHOICES), ("friction_negative_level", NEGATIVE_LEVEL)):
+        e = elements[name][0] if version == 2 else elements[name]
+        assert e.tag == "Enumeration" and items[e.get("declaredType")] == choices
+    if version == 3:  # FMI 3.0 reads and writes an Enumeration as Int64, not as Int32
+        fmu = _instance(fmus, version)
+        vr = [value_reference("damping_model")]
+        fmu.setInt64(vr, [2])
+        fmu.enterInitializationMode()
+        assert fmu.getInt64(vr) == [2]
+        assert _error_status(lambda: fmu.setInt32(vr, [1])) == 3
+        assert "no Int32 variable with value reference" in capfd.readouterr().out
+        fmu.exitInitializationMode()
+        fmu.terminate()
+        fmu.freeInstance()
+
+
+def test_base_units_against_hand_conversions():
+    from pamsim.fmu.units import base_unit
+
+    assert base_unit("N") == (1.0, {"kg": 1, "m": 1, "s": -2})
+    assert base_unit("1") == (1.0, {})
+    deg = base_unit("deg")
+    assert deg[1] == {"rad": 1} and deg[0] == pytest.approx(math.pi / 180)
+    # 1 N/(bar m^2) = 1 N / (1e5 N/m^2 * m^2) = 1e-5 (dimensionless).
+    f, e = base_unit("N/(bar m^2)")
+    assert e == {} and f == pytest.approx(1e-5)
+    # 1 bar/kg = 1e5 Pa/kg = 1e5 m^-1 s^-2.
+    f, e = base_unit("bar/kg")
+    assert e == {"m": -1, "s": -2} and f == pytest.approx(1e5)
+    assert base_unit("J/(kg K)") == (1.0, {"m": 2, "s": -2, "K": -1})
+    assert base_unit("m^3/(s Pa)") == (1.0, {"kg": -1, "m": 4, "s": 1})
+    assert base_unit("N s^2/m^2") == (1.0, {"kg": 1, "m": -1})
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_every_unit_definition_has_its_base_unit(fmus, version):
+    from pamsim.fmu.units import base_unit
+
+    units = _model_description(fmus, version).find("UnitDefinitions")
+    declared = {v.unit for v in VARIABLES if v.unit}
+    assert {u.get("name") for u in units} == declared
+    for u in units:
+        factor, exponents = base_unit(u.get("name"))
+        b = u.find("BaseUnit")
+        assert {k: int(x) for k, x in b.attrib.items() if k != "factor"} == exponents
+        assert float(b.get("factor", 1.0)) == factor
+
+
+# ------------------------------------------------------------------ metadata and archive
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_metadata_and_documentation(fmus, version):
+    from pamsim.fmu.generate import generation_date
+
+    root = _model_description(fmus, version)
+    assert root.get("version") == pamsim.__version__
+    assert root.get("author") and "MIT" in root.get("license")
+    assert root.get("generationDateAndTime") == generation_date()
+    assert float(root.find("DefaultExperiment").get("stepSize")) == 1e-3
+    # Every category the C code logs under is declared.
+    shell = (Path(__file__).resolve().parents[1] / "fmu" / "src" / "fmi_shell.c").read_text()
+    used = set(re.search(r"level_category\[\] = \{([^}]*)\}", shell).group(1).replace('"', "").replace(" ", "")
+               .split(","))
+    assert {c.get("name") for c in root.find("LogCategories")} == used
+    with zipfile.ZipFile(fmus[version]) as zf:
+        page = zf.read("documentation/index.html").decode()
+    for v in VARIABLES:
+        assert f"<td>{v.name}</td>" in page.replace("&#x27;", "'")
+    assert "Co-Simulation" in page and "Model Exchange" in page
+
+
+def test_generation_date_comes_from_the_sources_and_the_archive_is_reproducible(tmp_path, monkeypatch):
+    from pamsim.fmu import build
+    from pamsim.fmu.generate import generation_date
+
+    monkeypatch.setenv("SOURCE_DATE_EPOCH", "1700000000")
+    assert generation_date() == "2023-11-14T22:13:20Z"
+    first = build(tmp_path / "a.fmu", 2).read_bytes()
+    second = build(tmp_path / "b.fmu", 2).read_bytes()
+    assert first == second
+    with zipfile.ZipFile(tmp_path / "a.fmu") as zf:
+        assert {i.date_time for i in zf.infolist()} == {(2023, 11, 14, 22, 13, 20)}
+        assert b'generationDateAndTime="2023-11-14T22:13:20Z"' in zf.read("modelDescription.xml")
+    monkeypatch.delenv("SOURCE_DATE_EPOCH")
+    date = generation_date()
+    assert date is None or re.fullmatch(r"\d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ", date)

@@ -204,7 +204,7 @@ def _fmi2() -> str:
                       causality=v.causality, variability=v.variability, initial=v.initial)
         start = _num(v.start) if v.start is not None else None
         if v.choices:
-            inner = f'<Enumeration{_attrs(declaredType=enumeration_type(v), start=start)}/>'
+            inner = f"<Enumeration{_attrs(declaredType=enumeration_type(v), **_limits(v), start=start)}/>"
         elif v.kind == "real":
             inner = (f'<Real{_attrs(unit=v.unit, **_limits(v), start=start, nominal=v.nominal)}'
                      f'{_attrs(derivative=index[v.derivative_of] if v.derivative_of else None)}/>')
@@ -245,7 +245,7 @@ def _fmi3() -> str:
                       causality=v.causality, variability=v.variability, initial=v.initial)
         start = _num(v.start) if v.start is not None else None
         if v.choices:
-            lines.append(f'    <Enumeration{head}{_attrs(declaredType=enumeration_type(v), start=start)}/>')
+            lines.append(f"    <Enumeration{head}{_attrs(declaredType=enumeration_type(v), **_limits(v), start=start)}/>")
         elif v.kind == "real":
             tail = _attrs(unit=v.unit, **_limits(v), start=start,
                           derivative=value_reference(v.derivative_of) if v.derivative_of else None,
@@ -365,7 +365,7 @@ def markdown_table() -> str:
     """The variable table for ``docs/fmu.md`` (a test checks the docs carry this exact text)."""
     rows = ["| name | causality | type | unit | start | range | description |", "|---|---|---|---|---|---|---|"]
     for v in VARIABLES:
-        kind = "Real / Float64" if v.kind == "real" else "Integer / Int32"
+        kind = "Real / Float64" if v.kind == "real" else "Enumeration" if v.choices else "Integer / Int32"
         start = "" if v.start is None else f"{v.start:g}" if isinstance(v.start, float) else str(v.start)
         desc = v.description.replace("|", "\\|")
         rows.append(f"| `{v.name}` | {v.causality} | {kind} | {v.unit or ''} | {start} | {range_text(v)} | {desc} |")
