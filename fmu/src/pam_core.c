@@ -247,7 +247,8 @@ int pam_check_parameters(PamCore *c) {
         const PamVarInfo *info = &PAM_VARS[k];
         double value = info->kind == 'r' ? r[info->index] : (double)c->i[info->index];
         if (info->causality == PAM_PARAMETER && range_violation(info, value, why, sizeof why)) {
-            pam_logf(c, PAM_LOG_ERROR, "invalid parameters: %s = %g: %s", info->name, value, why);
+            if (info->kind == 'r') pam_logf(c, PAM_LOG_ERROR, "invalid parameters: %s = %g: %s", info->name, value, why);
+            else pam_logf(c, PAM_LOG_ERROR, "invalid parameters: %s = %ld: %s", info->name, (long)c->i[info->index], why);
             bad = -1;
         }
     }
