@@ -19,9 +19,6 @@ import numpy as np
 
 from ..atomic import atomic_outputs
 from ..constants import PA_PER_BAR
-from ..elements.friction import build_friction
-from ..elements.static_force import STATIC_FORCE_MODELS
-from ..elements.stops import EndStops
 from ..oscillation import estimate_oscillation
 from ..scenario import Scenario
 from ..static import friction_band_m, static_report
@@ -239,18 +236,18 @@ _RUN_COLUMNS = ("final_contraction_m", "peak_contraction_m", "error_m", "at_rest
 def _case_row(spec: SweepSpec, i: int, case: SweepCase, by_key: Mapping) -> dict:
     """One summary row: inputs, static analysis, measurement, and each friction model's run."""
     params = spec.base.parameters
-    static = STATIC_FORCE_MODELS[spec.base.spec["model"]["static_force"]](params)
+    model = spec.case_scenario(case, spec.friction_models[0]).build_model()
     p_Pa = case.pressure_bar * PA_PER_BAR
-    x_eq = static_report(params, static, p_Pa, case.weight_N)["equilibrium_contraction_m"]
-    x_hi = EndStops.from_parameters(params).x_high_m
+    x_eq = static_report(params, model.static_force, p_Pa, case.weight_N)["equilibrium_contraction_m"]
     row = {"case": case.name, "weight_N": case.weight_N, "pressure_bar": case.pressure_bar,
            "pressure_step_bar": case.pressure_step_bar, "pressure_stable_bar": case.pressure_stable_bar,
            "measured_contraction_m": case.measured_contraction_m, "equilibrium_contraction_m": x_eq,
            "equilibrium_error_m": x_eq - case.measured_contraction_m,
            "within_capability": bool(x_eq >= spec.capability_min_equilibrium_m)}
     for n, f in enumerate(spec.friction_models):
-        friction = build_friction(f, params, spec.base.spec["model"]["friction_negative_level"])
-        lo, hi = friction_band_m(static, friction, p_Pa, case.weight_N / params["g_m_s2"], params["g_m_s2"], x_hi)
+        friction = spec.case_scenario(case, f).build_model().friction
+        lo, hi = friction_band_m(model.static_force, friction, p_Pa, model.load.mass_kg, model.load.g_m_s2,
+                                 model.stops.x_high_m)
         o = by_key[("case", (i, f))]
         # The first model's columns carry the plain names; the others are prefixed with the model name.
         prefix = "" if n == 0 else f"{f}_"
