@@ -19,6 +19,7 @@ from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
 from .. import __version__
+from ..references import REFERENCES
 from .units import base_unit
 from .variables import BY_NAME, EVENT_INDICATORS, STATES, VARIABLES, value_reference
 
@@ -376,8 +377,7 @@ USAGE = (
     ("What it is", DESCRIPTION + ". The same model as pamsim.simulate, compiled C with no Python inside; "
      "Model Exchange and Co-Simulation."),
     ("Driving it", "Set the parameters before the end of initialisation; the defaults are the Shadow 6 mm x 300 mm "
-     "muscle of 'A dynamic force model of a small and soft McKibben pneumatic muscle' (ACRA 2012) with a "
-     "22.74 N load. Drive valve_command (1 open to supply, 0 "
+     f"muscle of {REFERENCES['acra2012'].short} ({REFERENCES['acra2012'].full()}) with a 22.74 N load. Drive valve_command (1 open to supply, 0 "
      "closed, -1 open to exhaust) and supply_pressure_gauge_Pa, or with pressure_source = prescribed, "
      "prescribed_pressure_gauge_Pa; set load_mass_kg and external_force_N; read contraction_m, p_gauge_Pa, "
      "F_static_N, F_friction_N and friction_mode."),
