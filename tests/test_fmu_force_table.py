@@ -5,7 +5,6 @@ tabulated model itself evaluated in Python, and pamsim.simulate with the same mo
 from __future__ import annotations
 
 import ctypes
-import tomllib
 
 import numpy as np
 import pytest
@@ -17,7 +16,7 @@ from pamsim.fmu import build
 from pamsim.fmu.force_table import tabulate
 from pamsim.fmu.runner import force_table_for, run_cs, run_me, set_values, tabulate_model
 from pamsim.fmu.variables import value_reference
-from test_fmu import _Api, _error_status, _instance, _start_fig4
+from test_fmu import _Api, _initialise_with, _instance, _start_fig4
 
 RATED_PA = 4.5e5
 X_HIGH_M = 0.1157  # the braid-lock stop of the Shadow muscle (test_fmu: "between the stops, 0 and 0.1157 m")
@@ -104,38 +103,14 @@ def test_tabulated_polynomial_runs_as_the_exact_polynomial(tmp_path, version):
 
 
 @pytest.mark.parametrize("version", [2, 3])
-def test_fmu_without_a_table_refuses_the_table_choice(fmus, version, capfd):
-    fmu = _instance(fmus, version)
-    set_values(fmu, version, {"static_force_model": 1})
-    if version == 2:
-        fmu.setupExperiment(startTime=0.0)
-    fmu.enterInitializationMode()
-    assert _error_status(fmu.exitInitializationMode) == 3
-    assert "static_force_model = 1 (table): this FMU was built without a force table" in capfd.readouterr().out
-    fmu.freeInstance()
-    # A choice the C core does not have at all is refused by the generated range.
-    fmu = _instance(fmus, version)
-    set_values(fmu, version, {"static_force_model": 2})
-    if version == 2:
-        fmu.setupExperiment(startTime=0.0)
-    fmu.enterInitializationMode()
-    assert _error_status(fmu.exitInitializationMode) == 3
-    assert "static_force_model = 2: must lie in [0, 1]" in capfd.readouterr().out
-    fmu.freeInstance()
-
-
-SMOOTH_SCENARIO = """
-[model]
-static_force = "smooth_test_force"
-[load]
-weight_N = 22.74
-[pressure]
-source = "valve"
-supply_gauge_bar = 3.6
-valve_open_time_s = 1.0
-[simulation]
-duration_s = 8.0
-"""
+@pytest.mark.parametrize("choice,message", [
+    (1, "static_force_model = 1 (table): this FMU was built without a force table"),
+    (2, "static_force_model = 2: must lie in [0, 1]"),  # a choice the C core does not have at all
+])
+def test_fmu_without_a_table_refuses_the_table_choice(unzipped, version, choice, message, capfd):
+    capfd.readouterr()
+    assert _initialise_with(unzipped, version, {"static_force_model": choice}) == 3
+    assert message in capfd.readouterr().out
 
 
 @pytest.mark.parametrize("interface", ["cs", "me"])
@@ -143,7 +118,8 @@ def test_scenario_with_another_static_model_runs_on_its_table_like_python(monkey
     """The runner tabulates a scenario's non-polynomial static force, builds the FMU with the table
     and starts it on the table; the run matches pamsim.simulate within 0.2 mm."""
     monkeypatch.setitem(STATIC_FORCE_MODELS, "smooth_test_force", SmoothForce.from_parameters)
-    sc = pamsim.Scenario.from_dict(tomllib.loads(SMOOTH_SCENARIO), name="smooth")
+    fig4 = pamsim.load_scenario(SCENARIOS / "acra2012_fig4.toml")
+    sc = fig4.with_changes({"model": {"static_force": "smooth_test_force"}})
     table = force_table_for(sc)
     assert table is not None and table.model_name == "smooth_test_force"
     assert force_table_for(pamsim.load_scenario(SCENARIOS / "acra2012_fig4.toml")) is None
