@@ -335,7 +335,8 @@ def test_adding_a_parameter_does_not_renumber_the_others(monkeypatch):
 
     params = get_parameter_set(variables.PARAMETER_SET)
     extra = ParameterSet(params.name, params.citation,
-                         {"A_new_parameter_N": Parameter(1.0, "N", "test", "a parameter added first"), **params.entries})
+                         {"A_new_parameter_N": Parameter(1.0, "N", "test", "a parameter added first"),
+                          **params.entries})
     monkeypatch.setattr(variables, "get_parameter_set", lambda name: extra)
     table = variables._table()
     assert table[0].name == "A_new_parameter_N"
@@ -458,7 +459,8 @@ def test_declared_initial_dependencies_of_the_states_cover_every_parameter_they_
     fmu.freeInstance()
 
 
-COMPANIONS = {("valve_laminar_ratio", -math.inf): {"valve_b": 0.0}, ("release_margin_N", -math.inf): {"stick_margin_N": 0.0}}
+COMPANIONS = {("valve_laminar_ratio", -math.inf): {"valve_b": 0.0},
+              ("release_margin_N", -math.inf): {"stick_margin_N": 0.0}}
 """Values a bound needs of other parameters to pass the checks between parameters."""
 
 
