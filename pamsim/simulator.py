@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from .errors import SolverFailure
+from .errors import InputError, SolverFailure
 from .model import Mode, MuscleModel
 from .result import Result, TransitionEvent
 
@@ -52,12 +52,50 @@ class SolverOptions:
 
 _SCALE = {"x_m": 1e-2, "v_m_s": 1e-1, "p_abs_Pa": 1e5, "air_mass_kg": 1e-5}
 _REST = (Mode.STICK, Mode.STOP_LOW, Mode.STOP_HIGH)
+_HOLD_S = 1e-9
+"""First hold [s] of a load whose slip from rest ended as it began.
+
+A load at zero velocity whose net force beats friction by a little, but is
+falling fast (a controller venting), turns back within a time and speed below
+the integrator's resolution: the slip segment ends with a velocity event at
+its own start, and deciding the mode again from the same forces would repeat
+it forever.  The load is then held for this time, doubled at each repetition,
+and its mode decided again from the forces at the end of the hold.  The motion
+lost is of the order of the integrator's velocity tolerance times the hold.
+"""
+_MAX_ZERO_LENGTH = 30
+"""Zero-length segments in a row (the last hold is then 2**29 ns, about 0.5 s) before it is a solver failure."""
 
 
 def _event(fun, direction: float):
     fun.terminal = True
     fun.direction = direction
     return fun
+
+
+_ON_SURFACE = 1e-12
+"""Magnitude [m, m/s or N] given to an event function that is exactly zero at its segment's start."""
+
+
+def _from_start(fun, t0: float, y0: np.ndarray):
+    """``fun`` with its value at the segment start ``t0`` taken from the exact start state ``y0``.
+
+    A segment can start on an event surface (a load released from rest starts
+    at v = 0, and the velocity event watches v).  The dense interpolant need
+    not reproduce ``y0`` exactly at ``t0`` (LSODA gives v = -5e-23), so the
+    root finder could see no sign change at a crossing that does happen later
+    in the step.  The start value is therefore taken from ``y0``, and if it is
+    zero, placed on the side the mode implies (before the crossing the event
+    looks for): the segment's own start is never an event.
+    """
+    g0 = float(fun(t0, y0))
+    if g0 == 0.0:
+        g0 = -fun.direction * _ON_SURFACE
+
+    def guarded(t, y):
+        return g0 if t <= t0 else fun(t, y)
+
+    return _event(guarded, fun.direction)
 
 
 class _Events:
@@ -138,10 +176,11 @@ def simulate_model(model: MuscleModel, duration_s: float, options: SolverOptions
     nfev = 0
     n_segments = 0
     n_zero = 0
+    hold_until = math.inf  # end of a short hold after a slip too small to resolve (see _HOLD_S)
     next_sample = 0
 
     while t < duration_s:
-        t_break = next(b for b in breaks if b > t)
+        t_break = min(next(b for b in breaks if b > t), hold_until)
         j = np.searchsorted(grid, t_break, side="right")
         t_eval = grid[next_sample:j]
         if t_eval.size == 0 or t_eval[-1] < t_break:
@@ -152,9 +191,17 @@ def simulate_model(model: MuscleModel, duration_s: float, options: SolverOptions
         # so a jump cannot hide a crossing that happened before it.
         t_left = events.t_left = float(np.nextafter(t_break, -math.inf))
         max_step = opts.max_step_s if mode.is_slip else min(opts.max_step_s, held_max_step)
-        sol = solve_ivp(lambda tt, yy: model.rhs(tt if tt < t_left else t_left, yy, seg_mode), (t, t_break), y,
-                        method=opts.method, t_eval=t_eval, events=[f for _, f in named], rtol=opts.rtol,
-                        atol=atol, max_step=max_step)
+        try:
+            sol = solve_ivp(lambda tt, yy: model.rhs(tt if tt < t_left else t_left, yy, seg_mode), (t, t_break), y,
+                            method=opts.method, t_eval=t_eval, events=[_from_start(f, t, y) for _, f in named],
+                            rtol=opts.rtol, atol=atol, max_step=max_step)
+        except (InputError, SolverFailure):
+            raise
+        except Exception as exc:
+            # solve_ivp and its root finder signal numerical trouble with plain exceptions (ValueError
+            # from brentq, ZeroDivisionError, LinAlgError...); to the caller it is a solver failure (exit 3).
+            raise SolverFailure(f"solve_ivp raised {type(exc).__name__} at t = {t:.6g} s in mode {mode.label}: "
+                                f"{exc}") from exc
         nfev += sol.nfev
         n_segments += 1
         if sol.status == -1:
@@ -170,11 +217,16 @@ def simulate_model(model: MuscleModel, duration_s: float, options: SolverOptions
             kind = named[k][0]
             t_event = float(sol.t_events[k][0])
             y = np.array(sol.y_events[k][0], dtype=float)
-            n_zero = n_zero + 1 if t_event - t <= 1e-12 * max(1.0, t) else 0
-            if n_zero > 50:
+            zero_length = t_event - t <= 1e-12 * max(1.0, t)
+            n_zero = n_zero + 1 if zero_length else 0
+            if n_zero > _MAX_ZERO_LENGTH:
                 raise SolverFailure(f"event switching made no progress at t = {t_event:.9g} s ({kind})")
             old = mode
             mode = _transition(model, kind, t_event, y, mode, opts, impact_loss_J, m)
+            hold_until = math.inf
+            if kind == "velocity_zero" and zero_length and mode.is_slip:
+                mode = Mode.STICK
+                hold_until = t_event + _HOLD_S * 2.0 ** (n_zero - 1)
             transitions.append(TransitionEvent(t_event, kind, old.label, mode.label, float(y[0])))
             if len(transitions) > opts.max_events:
                 raise SolverFailure(f"more than {opts.max_events} events by t = {t_event:.6g} s "
@@ -182,6 +234,7 @@ def simulate_model(model: MuscleModel, duration_s: float, options: SolverOptions
             t = t_event
         else:
             t = t_break
+            hold_until = math.inf
             y = sol.y[:, -1].copy()
             if mode in _REST:
                 mode = _rest_mode(model, t, y, mode, opts.stick_margin_N)

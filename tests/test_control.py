@@ -393,3 +393,15 @@ def test_cli_load_beyond_capability_exits_2(tmp_path):
         proc = _cli("linearize", heavy, *extra, "-o", tmp_path)
         assert proc.returncode == 2, proc.stderr
         assert ("force capability" in proc.stderr) and "Traceback" not in proc.stderr
+
+
+def test_closed_loop_release_that_turns_back_at_once_does_not_crash():
+    """The reviewer's reproduction: 32.74 N from 10 mm to 30 mm.  A slip starts at v = 0 and turns back
+    within the integrator's resolution while the controller vents; the run must finish and settle."""
+    sc = pamsim.load_scenario(CLOSED_LOOP)
+    heavy = sc.with_changes({"load": {"weight_N": 32.74}, "simulation": {"initial_contraction_m": 0.010}})
+    run = run_closed_loop(heavy, {"target_contraction_mm": 30.0})
+    res = run.result
+    assert res.t_s[-1] == pytest.approx(sc.duration_s)
+    assert res.at_rest_at_end
+    assert abs(res.x_m[-1] - 0.030) <= run.config.spec["steady_state_error_max_mm"] * 1e-3

@@ -296,3 +296,22 @@ def test_initial_chamber_pressure_holds_an_initial_contraction():
     assert held.p_gauge_Pa[0] == pytest.approx(p_hold)
     dropped = pamsim.simulate(pamsim.Scenario.from_dict(base))
     assert dropped.final_mode == Mode.STOP_LOW
+
+
+def test_exception_inside_the_integrator_is_a_solver_failure():
+    """Whatever solve_ivp or an element raises during the integration reaches the caller as SolverFailure."""
+    import dataclasses
+
+    from pamsim.errors import SolverFailure
+
+    sc = pamsim.load_scenario(SCENARIOS / "acra2012_fig4.toml")
+    model = sc.build_model()
+
+    def broken_force(t_s):
+        if t_s > 1.5:
+            raise ZeroDivisionError("division by zero in a user's force signal")
+        return 0.0 * t_s
+
+    load = dataclasses.replace(model.load, external_force_N=broken_force)
+    with pytest.raises(SolverFailure, match="ZeroDivisionError.*t = 1"):
+        pamsim.simulate_model(dataclasses.replace(model, load=load), 3.0)
