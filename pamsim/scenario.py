@@ -131,7 +131,11 @@ class Scenario:
         max_step = v.positive("solver.max_step_s", solver.get("max_step_s", math.inf))
         opts = SolverOptions(method=method, rtol=rtol, sample_rate_Hz=sample_rate, max_events=int(max_events),
                              max_step_s=max_step)
-        scenario = cls(name or spec.get("name") or "scenario", spec, params, duration, opts, Path(base_dir), origin)
+        name = name or spec.get("name") or "scenario"
+        if any(bad in name for bad in ("/", "\\", "..", "\0")):
+            # The name is the stem of the output files: it must not lead out of the output folder.
+            v.fail("name", name, "must be a plain file name stem, without path separators or '..'")
+        scenario = cls(name, spec, params, duration, opts, Path(base_dir), origin)
         if duration * sample_rate > _MAX_SAMPLES:
             v.fail("simulation.sample_rate_Hz", sample_rate,
                    f"with duration_s = {duration:g} this asks for more than {_MAX_SAMPLES:.0e} output samples")

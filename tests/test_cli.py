@@ -104,23 +104,45 @@ BAD_SCENARIOS = [
     ("non-monotonic trace", lambda s: s.replace('source = "valve"\nsupply_gauge_bar = 3.6\nvalve_open_time_s = 1.0',
                                                 'source = "prescribed"\n[pressure.prescribed]\nkind = "trace"\nfile = "bad.csv"'),
      ["bad.csv", "increase", "line 4"]),
+    ("name leaving the output folder", lambda s: 'name = "../../escaped"\n' + s, ["name", "../../escaped", "'..'"]),
+    ("name with a separator", lambda s: 'name = "sub/dir"\n' + s, ["name", "sub/dir", "separator"]),
 ]
 
 
+def _cli_in_process(capsys, *args) -> tuple[int, str]:
+    """Run ``pamsim ARGS`` in this process (the same main() as the console script); (exit code, stderr)."""
+    from pamsim.cli import main
+
+    code = main([str(a) for a in args])
+    return code, capsys.readouterr().err
+
+
 @pytest.mark.parametrize("case_id, edit, words", BAD_SCENARIOS, ids=[c[0] for c in BAD_SCENARIOS])
-def test_bad_scenario_exits_2_with_one_clear_line(tmp_path, case_id, edit, words):
+def test_bad_scenario_exits_2_with_one_clear_line(tmp_path, capsys, case_id, edit, words):
     (tmp_path / "bad.csv").write_text("t_s,p_gauge_bar\n0,0\n1,2\n0.5,3\n")
     sc = tmp_path / "case.toml"
     sc.write_text(edit(BASE))
     out = tmp_path / "out"
-    r = pamsim("run", sc, "-o", out)
-    assert r.returncode == 2, (r.stdout, r.stderr)
-    lines = r.stderr.strip().splitlines()
-    assert len(lines) == 1 and "Traceback" not in r.stderr
+    code, err = _cli_in_process(capsys, "run", sc, "-o", out)
+    assert code == 2, err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in err
     assert str(sc) in lines[0]
     for word in words:
         assert word in lines[0], lines[0]
-    assert not out.exists() or not any(out.iterdir())
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("case_id", ["unknown key", "nan", "not toml"])
+def test_bad_scenario_through_the_console_script(tmp_path, case_id):
+    """A representative few of the table above, as a user runs them (a separate process)."""
+    edit, words = next((e, w) for c, e, w in BAD_SCENARIOS if c == case_id)
+    sc = tmp_path / "case.toml"
+    sc.write_text(edit(BASE))
+    r = pamsim("run", sc, "-o", tmp_path / "out")
+    assert r.returncode == 2 and "Traceback" not in r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1 and all(w in r.stderr for w in words)
+    assert not (tmp_path / "out").exists()
 
 
 BAD_ARGS = [
