@@ -41,7 +41,7 @@ def test_nlsys_names_and_rhs_are_the_models(fig4):
     sys_nl = muscle_nlsys(model, FrictionTreatment("sliding", direction=1.0))
     assert list(sys_nl.state_labels) == ["x_m", "v_m_s", "p_abs_Pa", "air_mass_kg"]
     assert list(sys_nl.input_labels) == ["valve_command", "supply_gauge_Pa", "F_ext_N"]
-    assert list(sys_nl.output_labels) == ["contraction_m", "p_gauge_Pa", "F_muscle_N"]
+    assert list(sys_nl.output_labels) == ["contraction_m", "p_gauge_Pa", "F_tendon_N"]
     x = np.array([0.03, 0.01, 3.0e5, 2.0e-5])
     u = np.array([0.4, 3.6e5, 1.5])
     y = np.concatenate([x, np.zeros(4)])

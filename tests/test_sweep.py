@@ -267,3 +267,22 @@ def test_bad_sweep_files_exit_2_naming_the_problem(tmp_path, label):
 
 def test_sweep_error_is_an_input_error():
     assert issubclass(SweepError, pamsim.errors.InputError)
+
+
+def test_pamsim_sweep_is_the_package_and_runs_a_sweep(tmp_path):
+    """``pamsim.sweep`` must be both: ``pamsim.sweep.load_sweep`` (the package) and ``pamsim.sweep(spec)``."""
+    import importlib
+    import subprocess
+    import sys
+
+    mod = importlib.import_module("pamsim.sweep")
+    assert mod is pamsim.sweep and mod.load_sweep is load_sweep
+    spec = sweep_from_dict({"base_scenario": "acra2012_fig5.toml", "case": [{"weight_N": 12.74, "pressure_bar": 3.6}]},
+                           base_dir=Path(__file__).resolve().parents[1] / "scenarios")
+    direct = pamsim.sweep.run_sweep(spec)
+    via_call = pamsim.sweep(spec)
+    assert via_call.rows[0]["final_contraction_m"] == direct.rows[0]["final_contraction_m"]
+    # A fresh interpreter that imports the submodule by name sees the package, not a function.
+    code = "import pamsim.sweep; print(pamsim.sweep.load_sweep.__module__)"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.strip() == "pamsim.sweep.spec"

@@ -1,14 +1,14 @@
-"""``report.md`` of a sweep: error statistics, cases not at rest, frequencies, failures."""
+"""``report.md`` of a sweep: error statistics, cases not at rest, frequencies, failures.
+
+Takes a :class:`pamsim.sweep.SweepResult` without importing it (the result imports this module).
+"""
 
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
 
 import numpy as np
 
-if TYPE_CHECKING:
-    from .sweep import SweepResult
 
 
 def error_stats_mm(errors_m: np.ndarray) -> tuple[float, float, int]:
