@@ -315,3 +315,15 @@ def test_exception_inside_the_integrator_is_a_solver_failure():
     load = dataclasses.replace(model.load, external_force_N=broken_force)
     with pytest.raises(SolverFailure, match="ZeroDivisionError.*t = 1"):
         pamsim.simulate_model(dataclasses.replace(model, load=load), 3.0)
+
+
+def test_simulate_accepts_a_path_and_refuses_other_types(paper_results):
+    from pathlib import Path
+
+    _, expected = paper_results["acra2012_fig4"]
+    for given in (str(SCENARIOS / "acra2012_fig4.toml"), Path(SCENARIOS / "acra2012_fig4.toml")):
+        res = pamsim.simulate(given)
+        assert res.name == "acra2012_fig4"
+        np.testing.assert_array_equal(res.x_m, expected.x_m)
+    with pytest.raises(TypeError, match="Scenario or the path"):
+        pamsim.simulate({"load": {"weight_N": 1.0}})
