@@ -19,7 +19,6 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 from .errors import InputError, SolverFailure
 from .model import Mode, MuscleModel
@@ -156,6 +155,8 @@ def simulate_model(model: MuscleModel, duration_s: float, options: SolverOptions
     Raises :class:`SolverFailure` when ``solve_ivp`` fails, the event count
     exceeds ``options.max_events``, or the switching stops making progress.
     """
+    from scipy.integrate import solve_ivp  # here, not at the top: `pamsim --help` should not pay for it
+
     opts = options or SolverOptions()
     wall0 = time.perf_counter()
     names = model.state_names

@@ -7,8 +7,14 @@ import json
 import numpy as np
 import pytest
 
+import tomllib
+
 from conftest import SCENARIOS
 from conftest import run_cli as pamsim
+
+def pamsim_toml(path):
+    return tomllib.loads(path.read_text())
+
 
 BASE = """
 [load]
@@ -162,14 +168,105 @@ def test_bad_arguments_exit_2(args, word, tmp_path):
     assert "Traceback" not in r.stderr and word in r.stderr
 
 
-def test_solver_failure_exits_3_and_leaves_nothing(tmp_path):
+def test_solver_failure_exits_3_and_leaves_nothing(tmp_path, capsys):
     sc = tmp_path / "few.toml"
     sc.write_text(BASE + "\n[solver]\nmax_events = 1\n")
-    out = tmp_path / "out"
-    r = pamsim("run", sc, "-o", out)
-    assert r.returncode == 3
-    assert "max_events" in r.stderr and "Traceback" not in r.stderr
-    assert not out.exists() or not any(out.iterdir())
+    out = tmp_path / "new" / "out"
+    code, err = _cli_in_process(capsys, "run", sc, "-o", out)
+    assert code == 3
+    assert "max_events" in err and "Traceback" not in err
+    assert not (tmp_path / "new").exists()  # neither the folder nor the parent the command created
+
+
+def test_late_write_error_and_interrupt_leave_no_folder(tmp_path, capsys, monkeypatch):
+    import os
+
+    import pamsim.api
+
+    sc = tmp_path / "ok.toml"
+    sc.write_text(BASE)
+    real_replace = os.replace
+
+    def refuse_final_move(src, dst):
+        if str(dst).endswith(".json"):
+            raise OSError(28, "No space left on device")
+        return real_replace(src, dst)
+
+    monkeypatch.setattr(os, "replace", refuse_final_move)
+    code, err = _cli_in_process(capsys, "run", sc, "-o", tmp_path / "full", "--no-plot")
+    assert code == 2 and "No space left" in err
+    assert not (tmp_path / "full").exists()
+    monkeypatch.setattr(os, "replace", real_replace)
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(pamsim.api, "run", interrupted)
+    code, err = _cli_in_process(capsys, "run", sc, "-o", tmp_path / "stopped")
+    assert code == 130 and not (tmp_path / "stopped").exists()
+
+
+def test_existing_output_folder_is_kept_after_a_failure(tmp_path, capsys):
+    sc = tmp_path / "few.toml"
+    sc.write_text(BASE + "\n[solver]\nmax_events = 1\n")
+    out = tmp_path / "mine"
+    out.mkdir()
+    assert _cli_in_process(capsys, "run", sc, "-o", out)[0] == 3
+    assert out.is_dir() and not any(out.iterdir())
+
+
+def test_run_a_folder_runs_every_scenario_and_the_controller(tmp_path, capsys):
+    """`pamsim run scenarios/` runs each scenario file (not the sweep file), closed_loop_position with its
+    controller: it must reach the 40 mm target; open loop the load would drop onto the stop."""
+    out = tmp_path / "all"
+    code, err = _cli_in_process(capsys, "run", SCENARIOS, "-o", out, "--no-plot")
+    assert code == 0, err
+    stems = sorted(p.stem for p in SCENARIOS.glob("*.toml") if "base_scenario" not in p.read_text())
+    assert sorted({p.stem for p in out.iterdir()}) == stems
+    summary = json.loads((out / "closed_loop_position.json").read_text())
+    controller = pamsim_toml(SCENARIOS / "closed_loop_position.toml")["controller"]
+    target_m = controller["target_contraction_mm"] * 1e-3
+    tolerance_m = controller["spec"]["steady_state_error_max_mm"] * 1e-3
+    assert abs(summary["final_contraction_m"] - target_m) <= tolerance_m
+    assert summary["controller"]["meets_spec"] is True
+    csv = np.loadtxt(out / "closed_loop_position.csv", delimiter=",", skiprows=1, max_rows=3)
+    assert csv[0, 1] == pytest.approx(0.020)  # held at the initial contraction, not dropped
+
+
+def test_controller_scenario_on_an_fmu_backend_is_refused(tmp_path, capsys):
+    code, err = _cli_in_process(capsys, "run", SCENARIOS / "closed_loop_position.toml", "-o", tmp_path / "o",
+                                "--backend", "fmu-cs")
+    assert code == 2 and "controller" in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "o").exists()
+
+
+def test_two_scenarios_with_one_name_are_refused(tmp_path, capsys):
+    for stem in ("a", "b"):
+        (tmp_path / f"{stem}.toml").write_text('name = "same"\n' + BASE)
+    code, err = _cli_in_process(capsys, "run", tmp_path / "a.toml", tmp_path / "b.toml", "-o", tmp_path / "o")
+    assert code == 2 and "same" in err and not (tmp_path / "o").exists()
+
+
+HEAVY_MODULES = ("scipy.integrate", "scipy.optimize", "matplotlib", "control", "fmpy")
+
+
+@pytest.mark.parametrize("argv", [["--help"], ["static", "--pressure-bar", "3", "--load-N", "10"]],
+                         ids=["help", "static"])
+def test_quick_commands_do_not_import_heavy_modules(argv):
+    """`pamsim --help` and `pamsim static` must start fast: no integrators, plotting, python-control or
+    fmpy.  Counted in a fresh interpreter, not timed."""
+    import subprocess
+    import sys
+
+    probe = ("import runpy, sys\n"
+             f"sys.argv = ['pamsim', *{argv!r}]\n"
+             "try:\n    runpy.run_module('pamsim', run_name='__main__')\nexcept SystemExit:\n    pass\n"
+             f"heavy = sorted(m for m in sys.modules if m.startswith({HEAVY_MODULES!r}))\n"
+             "sys.stderr.write('HEAVY=' + ','.join(heavy) + '\\n')\n")
+    r = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=120)
+    line = next(ln for ln in r.stderr.splitlines() if ln.startswith("HEAVY="))
+    assert line == "HEAVY=", line
+    assert "usage" in r.stdout or "equilibrium" in r.stdout
 
 
 @pytest.mark.parametrize("command", [
