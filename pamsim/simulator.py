@@ -161,7 +161,7 @@ def simulate_model(model: MuscleModel, duration_s: float, options: SolverOptions
     wall0 = time.perf_counter()
     names = model.state_names
     atol = np.array([opts.rtol * _SCALE.get(n, 0.1) for n in names])
-    n_samples = int(round(duration_s * opts.sample_rate_Hz)) + 1
+    n_samples = max(2, int(round(duration_s * opts.sample_rate_Hz)) + 1)  # the last sample is at the end
     grid = np.linspace(0.0, duration_s, n_samples)
     breaks = sorted({b for b in model.breakpoints if 0.0 < b < duration_s} | {duration_s})
     events = _Events(model, opts)
@@ -179,13 +179,11 @@ def simulate_model(model: MuscleModel, duration_s: float, options: SolverOptions
     n_zero = 0
     hold_until = math.inf  # end of a short hold after a slip too small to resolve (see _HOLD_S)
     next_sample = 0
+    low_x, peak_x, peak_p = math.inf, -math.inf, -math.inf  # over every integrator step and event, not the samples
 
     while t < duration_s:
         t_break = min(next(b for b in breaks if b > t), hold_until)
         j = np.searchsorted(grid, t_break, side="right")
-        t_eval = grid[next_sample:j]
-        if t_eval.size == 0 or t_eval[-1] < t_break:
-            t_eval = np.append(t_eval, t_break)
         named = events.by_mode[mode]
         seg_mode = mode
         # An input that jumps at t_break belongs to the next segment: this one sees its left limit,
@@ -194,7 +192,7 @@ def simulate_model(model: MuscleModel, duration_s: float, options: SolverOptions
         max_step = opts.max_step_s if mode.is_slip else min(opts.max_step_s, held_max_step)
         try:
             sol = solve_ivp(lambda tt, yy: model.rhs(tt if tt < t_left else t_left, yy, seg_mode), (t, t_break), y,
-                            method=opts.method, t_eval=t_eval, events=[_from_start(f, t, y) for _, f in named],
+                            method=opts.method, dense_output=True, events=[_from_start(f, t, y) for _, f in named],
                             rtol=opts.rtol, atol=atol, max_step=max_step)
         except (InputError, SolverFailure):
             raise
@@ -207,12 +205,20 @@ def simulate_model(model: MuscleModel, duration_s: float, options: SolverOptions
         n_segments += 1
         if sol.status == -1:
             raise SolverFailure(f"solve_ivp failed at t = {t:.6g} s in mode {mode.label}: {sol.message}")
-        keep = np.isin(sol.t, grid[next_sample:j])
-        if keep.any():
-            ts.append(sol.t[keep])
-            ys.append(sol.y[:, keep])
-            modes.append(np.full(int(keep.sum()), int(mode)))
-            next_sample += int(keep.sum())
+        # sol.t, sol.y: every step of the integrator, ending at the event or at t_break.
+        samples = grid[next_sample:j]
+        samples = samples[samples <= sol.t[-1]]
+        if samples.size:
+            ts.append(samples)
+            ys.append(sol.sol(samples))
+            modes.append(np.full(samples.size, int(mode)))
+            next_sample += samples.size
+        # x is monotonic within a segment (the velocity keeps its sign between events), so its peak
+        # is at a step; the pressure's peak is taken over the steps as well.
+        low_x, peak_x = min(low_x, float(sol.y[0].min())), max(peak_x, float(sol.y[0].max()))
+        p_steps = model.source.pressure_gauge_Pa(sol.y[2:2 + model.n_source], model.source.inputs(
+            np.minimum(sol.t, t_left)))
+        peak_p = max(peak_p, float(np.max(p_steps)))
         if sol.status == 1:
             k = next(i for i, te in enumerate(sol.t_events) if len(te))
             kind = named[k][0]
@@ -246,7 +252,8 @@ def simulate_model(model: MuscleModel, duration_s: float, options: SolverOptions
     return Result.from_trace(model, name, t_out, Y, mode_arr, transitions, impact_loss_J,
                              {"rhs_evaluations": int(nfev), "events": len(transitions), "segments": n_segments,
                               "method": opts.method, "rtol": opts.rtol},
-                             time.perf_counter() - wall0)
+                             time.perf_counter() - wall0,
+                             peaks={"x_m": peak_x, "p_gauge_Pa": peak_p, "x_min_m": low_x})
 
 
 def _transition(model: MuscleModel, kind: str, t: float, y: np.ndarray, mode: Mode, opts: SolverOptions,

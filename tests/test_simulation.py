@@ -327,3 +327,21 @@ def test_simulate_accepts_a_path_and_refuses_other_types(paper_results):
         np.testing.assert_array_equal(res.x_m, expected.x_m)
     with pytest.raises(TypeError, match="Scenario or the path"):
         pamsim.simulate({"load": {"weight_N": 1.0}})
+
+
+def test_summary_comes_from_the_solution_not_the_samples():
+    """Final state, peak and rest do not depend on the output rate; the last sample is at the end time;
+    the peak is where the load stopped rising (an event of the solution, between samples)."""
+    base = pamsim.load_scenario(SCENARIOS / "acra2012_fig4.toml")
+    runs = {rate: pamsim.simulate(base.with_changes({"simulation": {"sample_rate_Hz": rate}}))
+            for rate in (0.05, 0.3, 1000.0)}
+    ref = runs[1000.0].summary()
+    top = max(e.x_m for e in runs[1000.0].transitions if e.kind == "velocity_zero" and e.from_mode == "slip_up")
+    assert ref["peak_contraction_m"] == pytest.approx(top, abs=1e-12)
+    for rate, res in runs.items():
+        s = res.summary()
+        assert res.t_s[-1] == base.duration_s
+        for key in ("final_contraction_m", "peak_contraction_m", "final_pressure_gauge_Pa"):
+            assert s[key] == pytest.approx(ref[key], rel=1e-9), (rate, key)
+        assert (s["final_mode"], s["at_rest_at_end"]) == (ref["final_mode"], ref["at_rest_at_end"])
+        assert s["peak_contraction_m"] >= res.x_m.max()

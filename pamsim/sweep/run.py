@@ -56,7 +56,7 @@ def run_task(task: _Task) -> dict:
         result = simulate(task.scenario)
         t_settled = settled_time_s(result.t_s, result.p_gauge_Pa)
         osc = estimate_oscillation(result.t_s, result.x_m, t_start_s=t_settled)
-        out = {"final_contraction_m": float(result.x_m[-1]), "peak_contraction_m": float(result.x_m.max()),
+        out = {"final_contraction_m": float(result.x_m[-1]), "peak_contraction_m": result.peak_contraction_m,
                "at_rest": bool(result.at_rest_at_end), "final_mode": result.final_mode.label,
                "frequency_Hz": osc.frequency_Hz, "damping_ratio": osc.damping_ratio,
                "n_half_cycles": osc.n_half_cycles, "settled_time_s": t_settled,
