@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import os
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Callable
 
 from .errors import InputError
 from .result import Result
@@ -31,15 +31,16 @@ def as_scenario(scenario: "Scenario | str | os.PathLike") -> Scenario:
                     f"not {type(scenario).__name__}")
 
 
-def simulate(scenario: "Scenario | str | os.PathLike") -> Result:
+def simulate(scenario: "Scenario | str | os.PathLike", progress: "Callable[[float], None] | None" = None) -> Result:
     """Run ``scenario`` (a :class:`Scenario` or a scenario file's path) with the Python (solve_ivp) backend.
 
-    Returns its :class:`Result`.
+    Returns its :class:`Result`.  ``progress`` is called with the simulated
+    time reached (see :func:`~pamsim.simulator.simulate_model`).
     """
     scenario = as_scenario(scenario)
     return simulate_model(scenario.build_model(), scenario.duration_s, scenario.solver,
                           x0_m=scenario.initial_contraction_m, name=scenario.name,
-                          p0_gauge_Pa=scenario.initial_pressure_gauge_Pa)
+                          p0_gauge_Pa=scenario.initial_pressure_gauge_Pa, progress=progress)
 
 
 @dataclass
@@ -77,12 +78,14 @@ class ScenarioRun:
         return closed_loop_figure(self.closed_loop)
 
 
-def run(scenario: "Scenario | str | os.PathLike", backend: str = "python") -> ScenarioRun:
+def run(scenario: "Scenario | str | os.PathLike", backend: str = "python",
+        progress: "Callable[[float], None] | None" = None) -> ScenarioRun:
     """Run ``scenario`` on ``backend`` (a name of :data:`pamsim.backends.BACKENDS`).
 
     A scenario with a ``[controller]`` table runs with its controller
     (python backend only: the FMU has no controller, and running it open
-    loop would silently give a different system).
+    loop would silently give a different system).  ``progress`` receives the
+    simulated time reached (python backend; the FMU backends do not report it).
     """
     from .backends import BACKENDS, get_backend
 
@@ -95,6 +98,8 @@ def run(scenario: "Scenario | str | os.PathLike", backend: str = "python") -> Sc
                              "run this scenario with --backend python")
         from .control.closed_loop import run_closed_loop
 
-        loop = run_closed_loop(scenario)
+        loop = run_closed_loop(scenario, progress=progress)
         return ScenarioRun(loop.result, backend, loop)
+    if backend == "python":
+        return ScenarioRun(simulate(scenario, progress), backend)
     return ScenarioRun(get_backend(backend)(scenario), backend)

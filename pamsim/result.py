@@ -13,6 +13,9 @@ from .model import N_WORK, Mode
 if TYPE_CHECKING:
     from .model import MuscleModel
 
+CSV_BYTES_PER_VALUE = 17
+"""Upper bound of one CSV value: ``%.10g`` writes at most 16 characters (``-1.234567891e-05``), plus a comma."""
+
 REST_SPEED_M_S = 1e-4
 """A load in a slip mode slower than this, with the net force inside the friction band, counts as at rest."""
 
@@ -151,6 +154,18 @@ class Result:
         return s
 
     # ------------------------------------------------------------------ output
+    @classmethod
+    def csv_bytes_estimate(cls, model: "MuscleModel", n_samples: int) -> int:
+        """Upper bound [bytes] of the CSV of a run of ``model`` with ``n_samples`` samples.
+
+        The columns are those of a one-sample result of the same model, each
+        value at most :data:`CSV_BYTES_PER_VALUE` bytes.
+        """
+        y0 = model.initial_state()
+        one = cls.from_trace(model, "", np.zeros(1), y0[:, None], np.zeros(1, dtype=int), [], [],
+                             {"events": 0, "rhs_evaluations": 0, "segments": 0}, 0.0)
+        return int(n_samples) * len(one.columns()) * CSV_BYTES_PER_VALUE
+
     def columns(self) -> dict[str, np.ndarray]:
         cols = {"t_s": self.t_s, "x_m": self.x_m, "v_m_s": self.v_m_s, "p_gauge_Pa": self.p_gauge_Pa,
                 "mode": self.mode}

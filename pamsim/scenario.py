@@ -55,6 +55,11 @@ _SCHEMA: dict[str, dict[str, Any]] = {
     "solver": {"method": str, "rtol": float, "max_events": int, "max_step_s": float},
 }
 _MAX_SAMPLES = 1e7  # 8 s at 1 kHz is 8,001; beyond this the output would not fit in memory comfortably
+MIN_MAX_STEP_S = 1e-6
+"""Smallest ``solver.max_step_s`` [s]: a thousandth of the shortest time scale of the model (the valve's
+millisecond pressure transients); smaller steps only make a run hang."""
+MAX_STEPS = 1e7
+"""``solver.max_step_s`` may not ask for more steps than this over the run (minutes of computing)."""
 _METHODS = ("LSODA", "RK45", "DOP853", "Radau", "BDF", "RK23")
 
 
@@ -129,6 +134,10 @@ class Scenario:
         if max_events < 1:
             v.fail("solver.max_events", max_events, "must be at least 1")
         max_step = v.positive("solver.max_step_s", solver.get("max_step_s", math.inf))
+        smallest_step = max(MIN_MAX_STEP_S, duration / MAX_STEPS)
+        if max_step < smallest_step:
+            v.fail("solver.max_step_s", max_step, f"must be at least {smallest_step:.3g} s (1 us, and no more than "
+                   f"{MAX_STEPS:.0e} steps over duration_s = {duration:g} s)")
         opts = SolverOptions(method=method, rtol=rtol, sample_rate_Hz=sample_rate, max_events=int(max_events),
                              max_step_s=max_step)
         name = name or spec.get("name") or "scenario"

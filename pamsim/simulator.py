@@ -17,6 +17,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
@@ -49,6 +50,9 @@ class SolverOptions:
     release_margin_N: float = 2e-7
 
 
+PROGRESS_EVERY = 2000
+"""Right-hand-side evaluations between two progress reports inside a segment (a few milliseconds)."""
+
 _SCALE = {"x_m": 1e-2, "v_m_s": 1e-1, "p_abs_Pa": 1e5, "air_mass_kg": 1e-5}
 _REST = (Mode.STICK, Mode.STOP_LOW, Mode.STOP_HIGH)
 _HOLD_S = 1e-9
@@ -64,6 +68,11 @@ lost is of the order of the integrator's velocity tolerance times the hold.
 """
 _MAX_ZERO_LENGTH = 30
 """Zero-length segments in a row (the last hold is then 2**29 ns, about 0.5 s) before it is a solver failure."""
+
+
+def n_samples(duration_s: float, sample_rate_Hz: float) -> int:
+    """Number of output samples: round(duration x rate) + 1, evenly spaced, at least the start and the end."""
+    return max(2, int(round(duration_s * sample_rate_Hz)) + 1)
 
 
 def _event(fun, direction: float):
@@ -149,8 +158,13 @@ def initial_mode(model: MuscleModel, t: float, y, stick_margin_N: float = Solver
 
 
 def simulate_model(model: MuscleModel, duration_s: float, options: SolverOptions | None = None,
-                   x0_m: float = 0.0, name: str = "", p0_gauge_Pa: float | None = None) -> Result:
+                   x0_m: float = 0.0, name: str = "", p0_gauge_Pa: float | None = None,
+                   progress: Callable[[float], None] | None = None) -> Result:
     """Integrate ``model`` from rest at ``x0_m`` (chamber at ``p0_gauge_Pa``, if given) over ``[0, duration_s]``.
+
+    ``progress``, if given, is called with the simulated time [s] reached, at
+    every segment and every ``PROGRESS_EVERY`` right-hand-side evaluations
+    within one (a long run with a small ``max_step_s`` can stay in one segment).
 
     Raises :class:`SolverFailure` when ``solve_ivp`` fails, the event count
     exceeds ``options.max_events``, or the switching stops making progress.
@@ -161,8 +175,7 @@ def simulate_model(model: MuscleModel, duration_s: float, options: SolverOptions
     wall0 = time.perf_counter()
     names = model.state_names
     atol = np.array([opts.rtol * _SCALE.get(n, 0.1) for n in names])
-    n_samples = max(2, int(round(duration_s * opts.sample_rate_Hz)) + 1)  # the last sample is at the end
-    grid = np.linspace(0.0, duration_s, n_samples)
+    grid = np.linspace(0.0, duration_s, n_samples(duration_s, opts.sample_rate_Hz))
     breaks = sorted({b for b in model.breakpoints if 0.0 < b < duration_s} | {duration_s})
     events = _Events(model, opts)
     m = model.load.mass_kg
@@ -181,7 +194,18 @@ def simulate_model(model: MuscleModel, duration_s: float, options: SolverOptions
     next_sample = 0
     low_x, peak_x, peak_p = math.inf, -math.inf, -math.inf  # over every integrator step and event, not the samples
 
+    calls = 0
+
+    def rhs(tt, yy):
+        nonlocal calls
+        calls += 1
+        if progress is not None and calls % PROGRESS_EVERY == 0:
+            progress(tt)
+        return model.rhs(tt if tt < t_left else t_left, yy, seg_mode)
+
     while t < duration_s:
+        if progress is not None:
+            progress(t)
         t_break = min(next(b for b in breaks if b > t), hold_until)
         j = np.searchsorted(grid, t_break, side="right")
         named = events.by_mode[mode]
@@ -191,7 +215,7 @@ def simulate_model(model: MuscleModel, duration_s: float, options: SolverOptions
         t_left = events.t_left = float(np.nextafter(t_break, -math.inf))
         max_step = opts.max_step_s if mode.is_slip else min(opts.max_step_s, held_max_step)
         try:
-            sol = solve_ivp(lambda tt, yy: model.rhs(tt if tt < t_left else t_left, yy, seg_mode), (t, t_break), y,
+            sol = solve_ivp(rhs, (t, t_break), y,
                             method=opts.method, dense_output=True, events=[_from_start(f, t, y) for _, f in named],
                             rtol=opts.rtol, atol=atol, max_step=max_step)
         except (InputError, SolverFailure):
@@ -246,6 +270,8 @@ def simulate_model(model: MuscleModel, duration_s: float, options: SolverOptions
             if mode in _REST:
                 mode = _rest_mode(model, t, y, mode, opts.stick_margin_N)
 
+    if progress is not None:
+        progress(duration_s)
     t_out = np.concatenate(ts)
     Y = np.concatenate(ys, axis=1)
     mode_arr = np.concatenate(modes)
@@ -277,4 +303,4 @@ def _transition(model: MuscleModel, kind: str, t: float, y: np.ndarray, mode: Mo
     return _rest_mode(model, t, y, Mode.STOP_LOW if low else Mode.STOP_HIGH, opts.stick_margin_N)
 
 
-__all__ = ["SolverFailure", "SolverOptions", "simulate_model", "initial_mode"]
+__all__ = ["SolverFailure", "SolverOptions", "simulate_model", "initial_mode", "n_samples"]

@@ -12,6 +12,12 @@ import tomllib
 from conftest import SCENARIOS
 from conftest import run_cli as pamsim
 
+def pamsim_load(path):
+    import pamsim
+
+    return pamsim.load_scenario(path)
+
+
 def pamsim_toml(path):
     return tomllib.loads(path.read_text())
 
@@ -111,6 +117,9 @@ BAD_SCENARIOS = [
                                                 'source = "prescribed"\n[pressure.prescribed]\nkind = "trace"\nfile = "bad.csv"'),
      ["bad.csv", "increase", "line 4"]),
     ("name leaving the output folder", lambda s: 'name = "../../escaped"\n' + s, ["name", "../../escaped", "'..'"]),
+    ("max_step below its bound", lambda s: s + "\n[solver]\nmax_step_s = 1e-12\n", ["max_step_s", "1e-12", "at least"]),
+    ("output too large", lambda s: s.replace("duration_s = 2.0", "duration_s = 9000.0"),
+     ["sample_rate_Hz", "MB", "--max-csv-MB"]),
     ("name with a separator", lambda s: 'name = "sub/dir"\n' + s, ["name", "sub/dir", "separator"]),
 ]
 
@@ -295,3 +304,21 @@ def test_output_files_get_ordinary_permissions(tmp_path):
     os.umask(umask)
     for f in (tmp_path / "o").iterdir():
         assert stat.S_IMODE(f.stat().st_mode) == 0o666 & ~umask, f.name
+
+
+def test_csv_size_limit_can_be_raised_and_its_estimate_bounds_the_file(tmp_path, capsys):
+    """A run refused for its output size runs with a higher --max-csv-MB; the estimate is an upper bound of
+    the file written, and not a loose one (within a factor of three)."""
+    from pamsim.result import Result
+    from pamsim.simulator import n_samples
+
+    sc = tmp_path / "small.toml"
+    sc.write_text(BASE)
+    code, err = _cli_in_process(capsys, "run", sc, "-o", tmp_path / "o", "--no-plot", "--max-csv-MB", "0.1")
+    assert code == 2 and "--max-csv-MB" in err and not (tmp_path / "o").exists()
+    code, err = _cli_in_process(capsys, "run", sc, "-o", tmp_path / "o", "--no-plot", "--max-csv-MB", "10")
+    assert code == 0, err
+    scenario = pamsim_load(sc)
+    estimate = Result.csv_bytes_estimate(scenario.build_model(), n_samples(scenario.duration_s, 1000.0))
+    actual = (tmp_path / "o" / "small.csv").stat().st_size
+    assert actual <= estimate <= 3 * actual

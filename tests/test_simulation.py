@@ -345,3 +345,15 @@ def test_summary_comes_from_the_solution_not_the_samples():
             assert s[key] == pytest.approx(ref[key], rel=1e-9), (rate, key)
         assert (s["final_mode"], s["at_rest_at_end"]) == (ref["final_mode"], ref["at_rest_at_end"])
         assert s["peak_contraction_m"] >= res.x_m.max()
+
+
+def test_progress_is_reported_inside_a_long_segment():
+    """With a small max_step_s one segment takes many steps: progress must come from inside it, in order,
+    and end at the duration."""
+    sc = pamsim.load_scenario(SCENARIOS / "acra2012_fig4.toml").with_changes(
+        {"simulation": {"duration_s": 0.9}, "solver": {"max_step_s": 1e-4}})  # before the valve opens: one segment
+    seen = []
+    res = pamsim.simulate(sc, progress=seen.append)
+    assert res.stats["segments"] == 1
+    assert len(seen) > 3 and seen[-1] == 0.9 and 0.0 < seen[1] < 0.9
+    assert all(b >= a for a, b in zip(seen, seen[1:]))

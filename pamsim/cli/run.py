@@ -16,6 +16,10 @@ from pathlib import Path
 from ..atomic import atomic_outputs, output_folder
 from ..backends import BACKENDS
 from ..errors import InputError
+from . import finite_float
+
+MAX_CSV_MB = 200.0
+"""Default limit of ``pamsim run --max-csv-MB``: a CSV beyond it is refused before the run."""
 
 
 def register(sub) -> None:
@@ -28,6 +32,10 @@ def register(sub) -> None:
     p.add_argument("--backend", default="python", choices=sorted(BACKENDS),
                    help="python (solve_ivp, default) or an FMU importer")
     p.add_argument("--no-plot", action="store_true", help="skip the PNG")
+    p.add_argument("--max-csv-MB", type=finite_float, default=MAX_CSV_MB, metavar="MB",
+                   help=f"refuse a run whose CSV could exceed this size (default {MAX_CSV_MB:g} MB; "
+                        "the estimate is an upper bound, about twice the usual size)")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr (shown after 1 s)")
     p.set_defaults(func=run)
 
 
@@ -63,6 +71,7 @@ def run(args: argparse.Namespace) -> int:
             raise InputError(f"{sc.origin}: name = {sc.name!r}: {seen[sc.name]} has the same name; "
                              "their outputs would overwrite each other")
         seen[sc.name] = sc.origin
+        _check_csv_size(sc, args.max_csv_MB)
     missed = 0
     with output_folder(args.output) as out:  # checked before the runs; removed again if nothing gets written
         for scenario in scenarios:
@@ -70,11 +79,29 @@ def run(args: argparse.Namespace) -> int:
     return 1 if missed else 0
 
 
+def _check_csv_size(scenario, limit_MB: float) -> None:
+    from ..result import Result
+    from ..simulator import n_samples
+
+    n = n_samples(scenario.duration_s, scenario.solver.sample_rate_Hz)
+    size_MB = Result.csv_bytes_estimate(scenario.build_model(), n) / 1e6
+    if size_MB > limit_MB:
+        raise InputError(f"{scenario.origin}: simulation.sample_rate_Hz = {scenario.solver.sample_rate_Hz:g}: "
+                         f"{n} samples over {scenario.duration_s:g} s make a CSV of up to {size_MB:.0f} MB, above "
+                         f"the limit of {limit_MB:g} MB (lower the rate, or raise the limit with --max-csv-MB)")
+
+
 def _run_one(scenario, args: argparse.Namespace, out: Path) -> list[str]:
     """Run one scenario and write its files; returns the controller specification items it misses."""
+    from tqdm import tqdm
+
     from ..api import run as run_scenario
 
-    outcome = run_scenario(scenario, args.backend)
+    # Shown only for runs that last over a second; cleared when done.
+    with tqdm(total=scenario.duration_s, desc=scenario.name, unit="s simulated", delay=1.0, leave=False,
+              file=sys.stderr, disable=args.no_progress, bar_format="{l_bar}{bar}| {n:.3g}/{total:g} s "
+              "[{elapsed}<{remaining}]") as bar:
+        outcome = run_scenario(scenario, args.backend, progress=lambda t: bar.update(t - bar.n))
     result = outcome.result
     names = [f"{scenario.name}.csv", f"{scenario.name}.json"] + ([] if args.no_plot else [f"{scenario.name}.png"])
     summary = outcome.summary()
