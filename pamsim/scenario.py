@@ -207,6 +207,8 @@ class Scenario:
         pr = self.spec["pressure"]
         p = self.parameters
         source = v.required(pr, "pressure", "source")
+        if not isinstance(source, str):
+            v.fail("pressure.source", source, "must be a string", choices=("valve", "prescribed"))
         rating = p["rated_pressure_gauge_Pa"]
         if source == "valve":
             v.allowed("pressure", pr, {"source", "supply_gauge_bar", "supply_gauge_Pa", "valve_open_time_s",
@@ -362,7 +364,7 @@ def _signal(v: _Validator, where: str, spec: Any, suffix: str, scale: float, bas
     if not isinstance(spec, dict):
         v.fail(where, spec, "must be a table with a 'kind'")
     kind = v.required(spec, where, "kind")
-    if kind not in _SIGNAL_KINDS:
+    if not isinstance(kind, str) or kind not in _SIGNAL_KINDS:
         v.fail(f"{where}.kind", kind, "unknown signal kind", choices=_SIGNAL_KINDS)
     suffixes = [(suffix, scale)] + ([alt_suffix] if alt_suffix else [])
     times, values = _SIGNAL_KINDS[kind]
