@@ -28,6 +28,9 @@ SETTLED_FRACTION = 0.05
 """The pressure counts as settled once it stays within 5 % of its step of its final value; the
 oscillation is estimated from then on, so creep driven by a still-rising pressure is not counted."""
 
+LAST_WINDOW_S = 1.0
+"""Window at the end of each run over which the remaining motion (peak to peak) is reported [s]."""
+
 FIGURES = ("error_heatmap.png", "steady_state_vs_pressure.png", "time_responses.png", "frequency_vs_load.png")
 
 
@@ -56,10 +59,13 @@ def run_task(task: _Task) -> dict:
         result = simulate(task.scenario)
         t_settled = settled_time_s(result.t_s, result.p_gauge_Pa)
         osc = estimate_oscillation(result.t_s, result.x_m, t_start_s=t_settled)
+        last = result.t_s >= result.t_s[-1] - LAST_WINDOW_S
         out = {"final_contraction_m": float(result.x_m[-1]), "peak_contraction_m": result.peak_contraction_m,
                "at_rest": bool(result.at_rest_at_end), "final_mode": result.final_mode.label,
+               "last_second_peak_to_peak_m": float(np.ptp(result.x_m[last])),
                "frequency_Hz": osc.frequency_Hz, "damping_ratio": osc.damping_ratio,
-               "n_half_cycles": osc.n_half_cycles, "settled_time_s": t_settled,
+               "n_half_cycles": osc.n_half_cycles, "half_period_asymmetry": osc.half_period_asymmetry,
+               "settled_time_s": t_settled,
                "wall_time_s": float(result.wall_time_s), "error": ""}
         if task.keep_trace:
             out["t_s"] = result.t_s
@@ -174,8 +180,8 @@ def run_sweep(spec: SweepSpec | str | Path, executor: Executor | None = None, pr
             row = {"weight_N": w, "pressure_bar": spec.frequency.pressure_bar}
             for f in spec.friction_models:
                 o = by_key[("frequency", (w, f))]
-                for k in ("frequency_Hz", "damping_ratio", "n_half_cycles", "final_contraction_m",
-                          "peak_contraction_m", "at_rest"):
+                for k in ("frequency_Hz", "damping_ratio", "n_half_cycles", "half_period_asymmetry",
+                          "final_contraction_m", "peak_contraction_m", "at_rest"):
                     row[f"{f}_{k}"] = o.get(k, math.nan)
             freq_rows.append(row)
     responses = {s.name: {f: by_key[("response", (s.name, f))] for f in spec.friction_models}
@@ -207,8 +213,8 @@ def _execute(tasks: list[_Task], executor: Executor | None, bar) -> list[dict]:
     return outputs
 
 
-_RUN_COLUMNS = ("final_contraction_m", "peak_contraction_m", "error_m", "at_rest", "final_mode", "frequency_Hz",
-                "damping_ratio", "n_half_cycles", "failure")
+_RUN_COLUMNS = ("final_contraction_m", "peak_contraction_m", "error_m", "at_rest", "final_mode",
+                "last_second_peak_to_peak_m", "frequency_Hz", "damping_ratio", "n_half_cycles", "failure")
 
 
 def _case_row(spec: SweepSpec, i: int, case: SweepCase, by_key: Mapping) -> dict:
