@@ -38,8 +38,7 @@ SMALL_SWEEP = {"name": "fuzz", "base_scenario": str(SCENARIOS / "acra2012_fig4.t
                "frequency": {"pressure_bar": 3.6, "weight_N": [12.74, 22.74],
                              "pressure": {"source": "prescribed",
                                           "prescribed": {"kind": "lag", "time_s": 0.5, "tau_s": 0.01,
-                                                         "final_gauge_bar": 3.6}},
-                             "simulation": {"duration_s": 3.0}}}
+                                                         "final_gauge_bar": 3.6}}}}
 
 # Values of every TOML type, with the awkward numbers a user can type.
 NUMBERS = st.one_of(st.integers(min_value=-(2 ** 63), max_value=2 ** 63 - 1),
@@ -149,4 +148,9 @@ def test_the_fuzzing_covers_at_least_2000_documents():
 @pytest.mark.parametrize("name", sorted(VALID))
 def test_the_unmutated_files_are_valid(name):
     """The seeds of the mutations are themselves valid (else every mutation would be an error)."""
-    _outcome_scenario(VALID[name])
+    pamsim.Scenario.from_dict(VALID[name], base_dir=SCENARIOS, origin=name).build_model()
+
+
+def test_the_unmutated_sweep_is_valid():
+    spec = sweep_from_dict(SMALL_SWEEP, base_dir=SCENARIOS, origin="fuzz_sweep.toml")
+    assert len(spec.cases) == 4 and spec.frequency is not None
