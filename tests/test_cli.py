@@ -55,23 +55,23 @@ def test_run_writes_csv_png_json(tmp_path):
     assert (out / "acra2012_fig4.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
-def test_run_warns_outside_the_fitted_range(tmp_path):
+def test_run_warns_outside_the_fitted_range(tmp_path, cli):
     sc = tmp_path / "high.toml"
     sc.write_text(BASE.replace("3.6", "4.4"))
-    r = pamsim("run", sc, "-o", tmp_path / "o", "--no-plot")
+    r = cli("run", sc, "-o", tmp_path / "o", "--no-plot")
     assert r.returncode == 0, r.stderr
     assert "warning" in r.stderr and "fitted" in r.stderr
 
 
-def test_static_json_matches_hand_values():
-    r = pamsim("static", "--pressure-bar", "2.8", "--load-N", "12.74", "--json")
+def test_static_json_matches_hand_values(cli):
+    r = cli("static", "--pressure-bar", "2.8", "--load-N", "12.74", "--json")
     assert r.returncode == 0, r.stderr
     out = json.loads(r.stdout)
     x = out["equilibrium_contraction_m"]
     F = (-476.95 * x * x - 188.39 * x + 23.90) * 2.8 + 2562.4 * x * x - 245.48 * x - 11.56
     assert F == pytest.approx(12.74, abs=1e-6)
     assert out["max_load_N"] == pytest.approx(23.90 * 2.8 - 11.56, rel=1e-9)
-    text = pamsim("static", "--pressure-bar", "2.8", "--load-N", "12.74")
+    text = cli("static", "--pressure-bar", "2.8", "--load-N", "12.74")
     assert text.returncode == 0 and f"{x * 1e3:.3f} mm" in text.stdout
 
 
@@ -171,8 +171,9 @@ BAD_ARGS = [
 
 
 @pytest.mark.parametrize("args, word", BAD_ARGS, ids=[" ".join(a[:2]) + " " + w for a, w in BAD_ARGS])
-def test_bad_arguments_exit_2(args, word, tmp_path):
-    r = pamsim(*args, cwd=tmp_path)
+def test_bad_arguments_exit_2(args, word, tmp_path, cli, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    r = cli(*args)
     assert r.returncode == 2
     assert "Traceback" not in r.stderr and word in r.stderr
 
@@ -283,22 +284,22 @@ def test_quick_commands_do_not_import_heavy_modules(argv):
     ["sweep", SCENARIOS / "acra2012_grid.toml", "-o"],
     ["linearize", SCENARIOS / "acra2012_fig4.toml", "-o"],
 ], ids=["run", "sweep", "linearize"])
-def test_output_folder_that_is_a_file_exits_2_before_running(tmp_path, command):
+def test_output_folder_that_is_a_file_exits_2_before_running(tmp_path, cli, command):
     blocker = tmp_path / "taken"
     blocker.write_text("not a folder")
     for target in (blocker, blocker / "sub"):
-        r = pamsim(*command, target)
+        r = cli(*command, target)
         assert r.returncode == 2, r.stderr
         assert "Traceback" not in r.stderr and str(blocker) in r.stderr
         assert len(r.stderr.strip().splitlines()) == 1
     assert blocker.read_text() == "not a folder"
 
 
-def test_output_files_get_ordinary_permissions(tmp_path):
+def test_output_files_get_ordinary_permissions(tmp_path, cli):
     import os
     import stat
 
-    r = pamsim("run", SCENARIOS / "acra2012_fig4.toml", "-o", tmp_path / "o")
+    r = cli("run", SCENARIOS / "acra2012_fig4.toml", "-o", tmp_path / "o")
     assert r.returncode == 0
     umask = os.umask(0)
     os.umask(umask)

@@ -23,7 +23,6 @@ from pamsim.control.system import STATES, MusclePlant
 from pamsim.errors import InputError
 
 from conftest import ROOT, SCENARIOS
-from conftest import run_cli as _cli
 
 FIG4 = SCENARIOS / "acra2012_fig4.toml"
 CLOSED_LOOP = SCENARIOS / "closed_loop_position.toml"
@@ -358,8 +357,8 @@ def test_bad_controller_table_is_an_input_error():
 # ---------------------------------------------------------------- CLI
 
 
-def test_cli_linearize_json(tmp_path):
-    proc = _cli("linearize", FIG4, "--contraction-mm", "30", "--json", "-o", tmp_path)
+def test_cli_linearize_json(tmp_path, cli):
+    proc = cli("linearize", FIG4, "--contraction-mm", "30", "--json", "-o", tmp_path)
     assert proc.returncode == 0, proc.stderr
     rep = json.loads(proc.stdout)
     for key in ("A", "B", "C", "D", "poles", "natural_frequency_Hz", "damping_ratio", "states", "inputs", "outputs"):
@@ -378,19 +377,19 @@ def test_cli_linearize_json(tmp_path):
     (("--contraction-mm", "-3"), "outside the model's range"),
     (("--at-time", "100"), "must lie in"),
 ])
-def test_cli_bad_operating_points_exit_2(tmp_path, args, words):
-    proc = _cli("linearize", FIG4, *args, "-o", tmp_path / "out")
+def test_cli_bad_operating_points_exit_2(tmp_path, cli, args, words):
+    proc = cli("linearize", FIG4, *args, "-o", tmp_path / "out")
     assert proc.returncode == 2
     assert words in proc.stderr and "Traceback" not in proc.stderr
     assert len(proc.stderr.strip().splitlines()) == 1
     assert not (tmp_path / "out").exists()  # found after the folder was made: it goes again
 
 
-def test_cli_load_beyond_capability_exits_2(tmp_path):
+def test_cli_load_beyond_capability_exits_2(tmp_path, cli):
     heavy = tmp_path / "heavy.toml"
     heavy.write_text(FIG4.read_text().replace("weight_N = 22.74", "weight_N = 80.0"))
     for extra in ((), ("--contraction-mm", "30")):
-        proc = _cli("linearize", heavy, *extra, "-o", tmp_path)
+        proc = cli("linearize", heavy, *extra, "-o", tmp_path)
         assert proc.returncode == 2, proc.stderr
         assert ("force capability" in proc.stderr) and "Traceback" not in proc.stderr
 

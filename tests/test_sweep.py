@@ -39,8 +39,15 @@ def serial(grid_spec):
 
 @pytest.fixture(scope="module")
 def parallel(grid_spec):
+    """Every seventh case and three of the frequency loads, on two worker processes (the serial fixture
+    has run them all; comparing a subset keeps the suite fast)."""
+    import dataclasses
+
+    subset = dataclasses.replace(grid_spec, cases=grid_spec.cases[::7], time_responses=(),
+                                 frequency=dataclasses.replace(grid_spec.frequency,
+                                                               weights_N=grid_spec.frequency.weights_N[::3]))
     with ProcessPoolExecutor(max_workers=2) as pool:
-        return pamsim.sweep(grid_spec, pool)
+        return pamsim.sweep(subset, pool)
 
 
 @pytest.fixture(scope="module")
@@ -176,16 +183,21 @@ def test_frequency_falls_with_load_at_3p6_bar(serial):
 
 
 def test_parallel_gives_the_serial_numbers(serial, parallel):
-    assert len(parallel.rows) == len(serial.rows)
-    for a, b in zip(serial.rows, parallel.rows):
+    by_case = {r["case"]: r for r in serial.rows}
+    assert len(parallel.rows) == len(serial.rows[::7]) >= 9
+    for b in parallel.rows:
+        a = by_case[b["case"]]
         assert a.keys() == b.keys()
         for k in a:
             if isinstance(a[k], float):
                 assert (a[k] == b[k]) or (math.isnan(a[k]) and math.isnan(b[k])), (a["case"], k)
             else:
                 assert a[k] == b[k], (a["case"], k)
-    np.testing.assert_array_equal([r["load_dependent_frequency_Hz"] for r in serial.frequency_rows],
-                                  [r["load_dependent_frequency_Hz"] for r in parallel.frequency_rows])
+    freq = {r["weight_N"]: r["load_dependent_frequency_Hz"] for r in serial.frequency_rows}
+    assert len(parallel.frequency_rows) >= 3
+    for r in parallel.frequency_rows:
+        a, b = freq[r["weight_N"]], r["load_dependent_frequency_Hz"]
+        assert a == b or (math.isnan(a) and math.isnan(b)), r["weight_N"]
 
 
 def test_outputs_are_complete(written):
@@ -275,7 +287,7 @@ BAD_FILES = {
 
 
 @pytest.mark.parametrize("label", sorted(BAD_FILES))
-def test_bad_sweep_files_exit_2_naming_the_problem(tmp_path, label):
+def test_bad_sweep_files_exit_2_naming_the_problem(tmp_path, cli, label):
     body, needle = BAD_FILES[label]
     (tmp_path / "bad.csv").write_text("weight_N,pressure_stable_bar,contraction_mm\n12.74,3.6,70\n")
     path = tmp_path / "sweep.toml"
@@ -284,7 +296,7 @@ def test_bad_sweep_files_exit_2_naming_the_problem(tmp_path, label):
         load_sweep(path)
     assert needle in str(err.value) and str(path) in str(err.value)
     if label in ("unknown axis", "empty axis", "data columns"):  # the issue's three, end to end
-        proc = _cli("sweep", path, "-o", tmp_path / "out")
+        proc = cli("sweep", path, "-o", tmp_path / "out")
         assert proc.returncode == 2
         assert needle in proc.stderr and len(proc.stderr.strip().splitlines()) == 1
         assert not (tmp_path / "out").exists() or not any((tmp_path / "out").iterdir())
