@@ -195,17 +195,20 @@ def simulate_model(model: MuscleModel, duration_s: float, options: SolverOptions
     low_x, peak_x, peak_p = math.inf, -math.inf, -math.inf  # over every integrator step and event, not the samples
 
     calls = 0
+    reached = 0.0  # reported time: the RHS is also evaluated at trial points, which need not increase
 
     def rhs(tt, yy):
-        nonlocal calls
+        nonlocal calls, reached
         calls += 1
         if progress is not None and calls % PROGRESS_EVERY == 0:
-            progress(tt)
+            reached = max(reached, tt)
+            progress(reached)
         return model.rhs(tt if tt < t_left else t_left, yy, seg_mode)
 
     while t < duration_s:
         if progress is not None:
-            progress(t)
+            reached = max(reached, t)
+            progress(reached)
         t_break = min(next(b for b in breaks if b > t), hold_until)
         j = np.searchsorted(grid, t_break, side="right")
         named = events.by_mode[mode]

@@ -167,6 +167,7 @@ BAD_ARGS = [
     (["static", "--pressure-bar", "abc", "--load-N", "10"], "abc"),
     (["static", "--pressure-bar", "nan", "--load-N", "10"], "nan"),
     (["static", "--pressure-bar", "3", "--load-N", "10", "--set", "festo"], "festo"),
+    (["run", str(SCENARIOS / "acra2012_fig4.toml"), "--max-csv-MB", "0"], "--max-csv-MB"),
 ]
 
 

@@ -64,6 +64,8 @@ def scenario_paths(arguments: list[str]) -> list[Path]:
 def run(args: argparse.Namespace) -> int:
     from ..scenario import load_scenario
 
+    if not args.max_csv_MB > 0:
+        raise InputError(f"--max-csv-MB = {args.max_csv_MB:g}: must be positive")
     scenarios = [load_scenario(p) for p in scenario_paths(args.scenario)]  # every file checked before any run
     seen = {}
     for sc in scenarios:
