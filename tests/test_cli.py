@@ -324,3 +324,11 @@ def test_csv_size_limit_can_be_raised_and_its_estimate_bounds_the_file(tmp_path,
     estimate = Result.csv_bytes_estimate(scenario.build_model(), n_samples(scenario.duration_s, 1000.0))
     actual = (tmp_path / "o" / "small.csv").stat().st_size
     assert actual <= estimate <= 3 * actual
+
+
+def test_a_key_typed_with_a_newline_still_gives_one_line(tmp_path, capsys):
+    """Found by the fuzzing: unknown keys were quoted raw, so a key with a newline split the message."""
+    sc = tmp_path / "nl.toml"
+    sc.write_text(BASE.replace("[pressure]", '"weight\\nN" = 1.0\n[pressure]'))
+    code, err = _cli_in_process(capsys, "run", sc, "-o", tmp_path / "o")
+    assert code == 2 and len(err.strip().splitlines()) == 1 and "weight\\nN" in err
