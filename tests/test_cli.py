@@ -329,6 +329,7 @@ def test_csv_size_limit_can_be_raised_and_its_estimate_bounds_the_file(tmp_path,
 def test_a_key_typed_with_a_newline_still_gives_one_line(tmp_path, capsys):
     """Found by the fuzzing: unknown keys were quoted raw, so a key with a newline split the message."""
     sc = tmp_path / "nl.toml"
-    sc.write_text(BASE.replace("[pressure]", '"weight\\nN" = 1.0\n[pressure]'))
+    sc.write_text(BASE.replace("valve_open_time_s = 1.0",
+                               '[pressure.command]\nkind = "constant"\nvalue = 1.0\n"tau\\ns" = 1.0'))
     code, err = _cli_in_process(capsys, "run", sc, "-o", tmp_path / "o")
-    assert code == 2 and len(err.strip().splitlines()) == 1 and "weight\\nN" in err
+    assert code == 2 and len(err.strip().splitlines()) == 1 and "tau\\ns" in err, err
