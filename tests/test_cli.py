@@ -261,18 +261,19 @@ def test_two_scenarios_with_one_name_are_refused(tmp_path, capsys):
 HEAVY_MODULES = ("scipy.integrate", "scipy.optimize", "matplotlib", "control", "fmpy")
 
 
-@pytest.mark.parametrize("argv", [["--help"], ["static", "--pressure-bar", "3", "--load-N", "10"]],
+@pytest.mark.parametrize("argv, heavy", [(["--help"], HEAVY_MODULES + ("numpy",)),
+                                         (["static", "--pressure-bar", "3", "--load-N", "10"], HEAVY_MODULES)],
                          ids=["help", "static"])
-def test_quick_commands_do_not_import_heavy_modules(argv):
-    """`pamsim --help` and `pamsim static` must start fast: no integrators, plotting, python-control or
-    fmpy.  Counted in a fresh interpreter, not timed."""
+def test_quick_commands_do_not_import_heavy_modules(argv, heavy):
+    """`pamsim --help` and `pamsim static` must start fast: no integrators, optimizers, plotting,
+    python-control or fmpy (and for --help not even numpy).  Counted in a fresh interpreter, not timed."""
     import subprocess
     import sys
 
     probe = ("import runpy, sys\n"
              f"sys.argv = ['pamsim', *{argv!r}]\n"
              "try:\n    runpy.run_module('pamsim', run_name='__main__')\nexcept SystemExit:\n    pass\n"
-             f"heavy = sorted(m for m in sys.modules if m.startswith({HEAVY_MODULES!r}))\n"
+             f"heavy = sorted(m for m in sys.modules if m.startswith({heavy!r}))\n"
              "sys.stderr.write('HEAVY=' + ','.join(heavy) + '\\n')\n")
     r = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=120)
     line = next(ln for ln in r.stderr.splitlines() if ln.startswith("HEAVY="))

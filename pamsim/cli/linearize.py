@@ -14,8 +14,6 @@ import sys
 import math
 from pathlib import Path
 
-import numpy as np
-
 from ..atomic import atomic_outputs, output_folder
 from ..control.choices import FRICTION_KINDS, VALVE_SLOPES
 from . import finite_float
@@ -43,6 +41,8 @@ def register(sub) -> None:
 
 
 def _matrix(a) -> list[list[float]]:
+    import numpy as np  # the CLI's modules import nothing heavy at the top: `pamsim --help` stays fast
+
     return [[float(v) for v in row] for row in np.atleast_2d(a)]
 
 
@@ -128,6 +128,8 @@ def _linearize_and_plot(scenario, args: argparse.Namespace, out: Path):
 
 
 def _print_text(lin, rep: dict) -> None:
+    import numpy as np
+
     np.set_printoptions(precision=6, linewidth=140)
     print(f"operating point: {lin.op.description}")
     print(f"friction: {rep['friction']}; valve slope at command 0: {lin.valve_slope}")
