@@ -8,8 +8,11 @@ of the inputs, and the simulator then decides the next mode from the forces
 (MODEL_NOTES sec. 4).  Two thresholds keep the switching free of chatter: a
 held load is released only when the net force exceeds friction by
 ``release_margin_N``, and a stopping load is held when it exceeds it by no
-more than ``stick_margin_N`` < ``release_margin_N``.  So every new segment
-starts strictly inside its mode and has positive length.
+more than ``stick_margin_N`` < ``release_margin_N``.  A segment that starts on
+an event surface does not see its own start as an event (:func:`_from_start`);
+a slip too small for the integrator to resolve ends in a short hold
+(``_HOLD_S``).  Summary extremes are taken over every integrator step, the
+samples from the dense output (docs/model.md sec. 4).
 """
 
 from __future__ import annotations
