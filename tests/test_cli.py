@@ -124,21 +124,19 @@ BAD_SCENARIOS = [
 ]
 
 
-def _cli_in_process(capsys, *args) -> tuple[int, str]:
-    """Run ``pamsim ARGS`` in this process (the same main() as the console script); (exit code, stderr)."""
-    from pamsim.cli import main
-
-    code = main([str(a) for a in args])
-    return code, capsys.readouterr().err
+def _code_err(cli, *args) -> tuple[int, str]:
+    """Exit code and stderr of ``pamsim ARGS`` run in this process (the ``cli`` fixture)."""
+    r = cli(*args)
+    return r.returncode, r.stderr
 
 
 @pytest.mark.parametrize("case_id, edit, words", BAD_SCENARIOS, ids=[c[0] for c in BAD_SCENARIOS])
-def test_bad_scenario_exits_2_with_one_clear_line(tmp_path, capsys, case_id, edit, words):
+def test_bad_scenario_exits_2_with_one_clear_line(tmp_path, cli, case_id, edit, words):
     (tmp_path / "bad.csv").write_text("t_s,p_gauge_bar\n0,0\n1,2\n0.5,3\n")
     sc = tmp_path / "case.toml"
     sc.write_text(edit(BASE))
     out = tmp_path / "out"
-    code, err = _cli_in_process(capsys, "run", sc, "-o", out)
+    code, err = _code_err(cli, "run", sc, "-o", out)
     assert code == 2, err
     lines = err.strip().splitlines()
     assert len(lines) == 1 and "Traceback" not in err
@@ -179,17 +177,17 @@ def test_bad_arguments_exit_2(args, word, tmp_path, cli, monkeypatch):
     assert "Traceback" not in r.stderr and word in r.stderr
 
 
-def test_solver_failure_exits_3_and_leaves_nothing(tmp_path, capsys):
+def test_solver_failure_exits_3_and_leaves_nothing(tmp_path, cli):
     sc = tmp_path / "few.toml"
     sc.write_text(BASE + "\n[solver]\nmax_events = 1\n")
     out = tmp_path / "new" / "out"
-    code, err = _cli_in_process(capsys, "run", sc, "-o", out)
+    code, err = _code_err(cli, "run", sc, "-o", out)
     assert code == 3
     assert "max_events" in err and "Traceback" not in err
     assert not (tmp_path / "new").exists()  # neither the folder nor the parent the command created
 
 
-def test_late_write_error_and_interrupt_leave_no_folder(tmp_path, capsys, monkeypatch):
+def test_late_write_error_and_interrupt_leave_no_folder(tmp_path, cli, monkeypatch):
     import os
 
     import pamsim.api
@@ -204,7 +202,7 @@ def test_late_write_error_and_interrupt_leave_no_folder(tmp_path, capsys, monkey
         return real_replace(src, dst)
 
     monkeypatch.setattr(os, "replace", refuse_final_move)
-    code, err = _cli_in_process(capsys, "run", sc, "-o", tmp_path / "full", "--no-plot")
+    code, err = _code_err(cli, "run", sc, "-o", tmp_path / "full", "--no-plot")
     assert code == 2 and "No space left" in err
     assert not (tmp_path / "full").exists()
     monkeypatch.setattr(os, "replace", real_replace)
@@ -213,24 +211,24 @@ def test_late_write_error_and_interrupt_leave_no_folder(tmp_path, capsys, monkey
         raise KeyboardInterrupt
 
     monkeypatch.setattr(pamsim.api, "run", interrupted)
-    code, err = _cli_in_process(capsys, "run", sc, "-o", tmp_path / "stopped")
+    code, err = _code_err(cli, "run", sc, "-o", tmp_path / "stopped")
     assert code == 130 and not (tmp_path / "stopped").exists()
 
 
-def test_existing_output_folder_is_kept_after_a_failure(tmp_path, capsys):
+def test_existing_output_folder_is_kept_after_a_failure(tmp_path, cli):
     sc = tmp_path / "few.toml"
     sc.write_text(BASE + "\n[solver]\nmax_events = 1\n")
     out = tmp_path / "mine"
     out.mkdir()
-    assert _cli_in_process(capsys, "run", sc, "-o", out)[0] == 3
+    assert _code_err(cli, "run", sc, "-o", out)[0] == 3
     assert out.is_dir() and not any(out.iterdir())
 
 
-def test_run_a_folder_runs_every_scenario_and_the_controller(tmp_path, capsys):
+def test_run_a_folder_runs_every_scenario_and_the_controller(tmp_path, cli):
     """`pamsim run scenarios/` runs each scenario file (not the sweep file), closed_loop_position with its
     controller: it must reach the 40 mm target; open loop the load would drop onto the stop."""
     out = tmp_path / "all"
-    code, err = _cli_in_process(capsys, "run", SCENARIOS, "-o", out, "--no-plot")
+    code, err = _code_err(cli, "run", SCENARIOS, "-o", out, "--no-plot")
     assert code == 0, err
     stems = sorted(p.stem for p in SCENARIOS.glob("*.toml") if "base_scenario" not in p.read_text())
     assert sorted({p.stem for p in out.iterdir()}) == stems
@@ -244,17 +242,17 @@ def test_run_a_folder_runs_every_scenario_and_the_controller(tmp_path, capsys):
     assert csv[0, 1] == pytest.approx(0.020)  # held at the initial contraction, not dropped
 
 
-def test_controller_scenario_on_an_fmu_backend_is_refused(tmp_path, capsys):
-    code, err = _cli_in_process(capsys, "run", SCENARIOS / "closed_loop_position.toml", "-o", tmp_path / "o",
+def test_controller_scenario_on_an_fmu_backend_is_refused(tmp_path, cli):
+    code, err = _code_err(cli, "run", SCENARIOS / "closed_loop_position.toml", "-o", tmp_path / "o",
                                 "--backend", "fmu-cs")
     assert code == 2 and "controller" in err and len(err.strip().splitlines()) == 1
     assert not (tmp_path / "o").exists()
 
 
-def test_two_scenarios_with_one_name_are_refused(tmp_path, capsys):
+def test_two_scenarios_with_one_name_are_refused(tmp_path, cli):
     for stem in ("a", "b"):
         (tmp_path / f"{stem}.toml").write_text('name = "same"\n' + BASE)
-    code, err = _cli_in_process(capsys, "run", tmp_path / "a.toml", tmp_path / "b.toml", "-o", tmp_path / "o")
+    code, err = _code_err(cli, "run", tmp_path / "a.toml", tmp_path / "b.toml", "-o", tmp_path / "o")
     assert code == 2 and "same" in err and not (tmp_path / "o").exists()
 
 
@@ -309,7 +307,7 @@ def test_output_files_get_ordinary_permissions(tmp_path, cli):
         assert stat.S_IMODE(f.stat().st_mode) == 0o666 & ~umask, f.name
 
 
-def test_csv_size_limit_can_be_raised_and_its_estimate_bounds_the_file(tmp_path, capsys):
+def test_csv_size_limit_can_be_raised_and_its_estimate_bounds_the_file(tmp_path, cli):
     """A run refused for its output size runs with a higher --max-csv-MB; the estimate is an upper bound of
     the file written, and not a loose one (within a factor of three)."""
     from pamsim.result import Result
@@ -317,9 +315,9 @@ def test_csv_size_limit_can_be_raised_and_its_estimate_bounds_the_file(tmp_path,
 
     sc = tmp_path / "small.toml"
     sc.write_text(BASE)
-    code, err = _cli_in_process(capsys, "run", sc, "-o", tmp_path / "o", "--no-plot", "--max-csv-MB", "0.1")
+    code, err = _code_err(cli, "run", sc, "-o", tmp_path / "o", "--no-plot", "--max-csv-MB", "0.1")
     assert code == 2 and "--max-csv-MB" in err and not (tmp_path / "o").exists()
-    code, err = _cli_in_process(capsys, "run", sc, "-o", tmp_path / "o", "--no-plot", "--max-csv-MB", "10")
+    code, err = _code_err(cli, "run", sc, "-o", tmp_path / "o", "--no-plot", "--max-csv-MB", "10")
     assert code == 0, err
     scenario = pamsim_load(sc)
     estimate = Result.csv_bytes_estimate(scenario.build_model(), n_samples(scenario.duration_s, 1000.0))
@@ -327,10 +325,10 @@ def test_csv_size_limit_can_be_raised_and_its_estimate_bounds_the_file(tmp_path,
     assert actual <= estimate <= 3 * actual
 
 
-def test_a_key_typed_with_a_newline_still_gives_one_line(tmp_path, capsys):
+def test_a_key_typed_with_a_newline_still_gives_one_line(tmp_path, cli):
     """Found by the fuzzing: unknown keys were quoted raw, so a key with a newline split the message."""
     sc = tmp_path / "nl.toml"
     sc.write_text(BASE.replace("valve_open_time_s = 1.0",
                                '[pressure.command]\nkind = "constant"\nvalue = 1.0\n"tau\\ns" = 1.0'))
-    code, err = _cli_in_process(capsys, "run", sc, "-o", tmp_path / "o")
+    code, err = _code_err(cli, "run", sc, "-o", tmp_path / "o")
     assert code == 2 and len(err.strip().splitlines()) == 1 and "tau\\ns" in err, err
