@@ -124,8 +124,8 @@ def _shadow_6x300_acra2012() -> ParameterSet:
         "D2_N_s2_per_m2": P(0.80, "N s^2/m^2", f"{ACRA2012} Table 4", "damping: quadratic coefficient (skin friction)"),
         # Geometry.
         "L0_m": P(0.300, "m", f"{ACRA2012} sec. 3 (Shadow 6 mm x 300 mm muscle)", "nominal (preloaded rest) length", lower=0.0, lower_open=True),
-        "D0_m": P(0.006, "m", f"{ACRA2012} sec. 3 (Shadow 6 mm x 300 mm muscle)", "rest diameter", lower=0.0, lower_open=True),
-        "braid_angle_rest_deg": P(20.0, "deg", "assumed: MODEL_NOTES sec. 6; gives 8.5 cm^3 at rest and ~3x at 75 mm", "braid angle to the axis at rest length", lower=0.0, upper=BRAID_LOCK_DEG, lower_open=True, upper_open=True),
+        "r0_m": P(0.003, "m", f"{ACRA2012} sec. 3 (Shadow 6 mm x 300 mm muscle: 6 mm diameter)", "braid radius at rest", lower=0.0, lower_open=True),
+        "theta0_deg": P(20.0, "deg", "assumed: MODEL_NOTES sec. 6; gives 8.5 cm^3 at rest and ~3x at 75 mm", "braid angle to the axis at rest length", lower=0.0, upper=BRAID_LOCK_DEG, lower_open=True, upper_open=True),
         "dead_volume_m3": P(1.0e-6, "m^3", "assumed: fittings and ~8 cm of 4 mm tube between valve and muscle", "volume between valve and muscle", lower=0.0),
         # Valve, ISO 6358 (not in the paper; MODEL_NOTES sec. 6).
         "valve_C_m3_per_s_Pa": P(1.0e-9, "m^3/(s Pa)", "assumed: small solenoid valve, low end of 1e-9..4e-9 (MODEL_NOTES sec. 6); the paper's transients last seconds", "sonic conductance", lower=0.0),
@@ -161,8 +161,8 @@ def get_parameter_set(name: str) -> ParameterSet:
 
 
 def braid_geometry(params: Mapping[str, float]) -> tuple[float, float]:
-    """Thread length b [m] and number of turns n [-] from L0, D0 and the rest braid angle."""
-    theta = math.radians(params["braid_angle_rest_deg"])
+    """Thread length b [m] and number of turns n [-] from L0, r0 and the rest braid angle theta0."""
+    theta = math.radians(params["theta0_deg"])
     b = params["L0_m"] / math.cos(theta)
-    n = b * math.sin(theta) / (math.pi * params["D0_m"])
+    n = b * math.sin(theta) / (2.0 * math.pi * params["r0_m"])
     return b, n

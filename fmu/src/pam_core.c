@@ -47,9 +47,9 @@ void pam_reset(PamCore *c) {
 
 /* pamsim.parameters.braid_geometry */
 static void braid_geometry(const double *r, double *b, double *n) {
-    double theta = r[R_braid_angle_rest_deg] * PI / 180.0;
+    double theta = r[R_theta0_deg] * PI / 180.0;
     *b = r[R_L0_m] / cos(theta);
-    *n = *b * sin(theta) / (PI * r[R_D0_m]);
+    *n = *b * sin(theta) / (2.0 * PI * r[R_r0_m]);
 }
 
 /* elements.chamber.MuscleChamber.volume_m3 / dvolume_dx_m2 */
