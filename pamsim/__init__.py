@@ -7,6 +7,7 @@
 
 from .api import simulate
 from .model import Mode, MuscleModel
+from .muscles import load_muscle
 from .parameters import PARAMETER_SETS, ParameterSet, get_parameter_set
 from .result import Result
 from .scenario import Scenario, ScenarioError, load_scenario
@@ -15,5 +16,5 @@ from .sweep import sweep  # the function pamsim.sweep(...); the module stays imp
 
 __all__ = ["simulate", "load_scenario", "Scenario", "ScenarioError", "Result", "Mode", "MuscleModel",
            "PARAMETER_SETS", "ParameterSet", "get_parameter_set", "SolverFailure", "SolverOptions",
-           "simulate_model"]
+           "simulate_model", "load_muscle"]
 __version__ = "0.1.0"

@@ -1,16 +1,20 @@
 """Static (quasi-static) force of the muscle, F_static(x, p).
 
-Positive force contracts the muscle (lifts the load).  Other static models
-plug in by providing ``force_N(x_m, p_gauge_Pa)`` and ``name``; the registry
-``STATIC_FORCE_MODELS`` maps a scenario's ``static_force`` key to a builder.
+Positive force contracts the muscle (lifts the load).  The models themselves
+live in the static-model library :mod:`pamsim.static_models` (one registry);
+``STATIC_FORCE_MODELS`` is a read-only view of it that maps a scenario's
+``static_force`` key to a builder taking the muscle's parameters.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Callable, Mapping, Protocol
+from collections.abc import Mapping
+from typing import Callable, Iterator, Protocol
 
-from ..constants import PA_PER_BAR
+from ..static_models import REGISTRY
+from ..static_models.acra2012 import Acra2012Polynomial
+
+__all__ = ["StaticForceModel", "Acra2012Polynomial", "STATIC_FORCE_MODELS"]
 
 
 class StaticForceModel(Protocol):
@@ -22,29 +26,17 @@ class StaticForceModel(Protocol):
         """Static force [N] at contraction ``x_m`` [m] and gauge pressure [Pa]."""
 
 
-@dataclass(frozen=True)
-class Acra2012Polynomial:
-    """Paper eq. (3)/(11): ``(K1 x^2 + K2 x + C1) P + S1 x^2 + S2 x + S3``, P in bar."""
+class _Builders(Mapping[str, Callable]):
+    """name -> ``spec.build`` for every model of the library registry."""
 
-    K1_N_per_bar_m2: float
-    K2_N_per_bar_m: float
-    C1_N_per_bar: float
-    S1_N_per_m2: float
-    S2_N_per_m: float
-    S3_N: float
-    name: str = "acra2012_polynomial"
+    def __getitem__(self, name: str) -> Callable:
+        return REGISTRY[name].build
 
-    @classmethod
-    def from_parameters(cls, p: Mapping[str, float]) -> "Acra2012Polynomial":
-        return cls(p["K1_N_per_bar_m2"], p["K2_N_per_bar_m"], p["C1_N_per_bar"],
-                   p["S1_N_per_m2"], p["S2_N_per_m"], p["S3_N"])
+    def __iter__(self) -> Iterator[str]:
+        return iter(REGISTRY)
 
-    def force_N(self, x_m, p_gauge_Pa):
-        p_bar = p_gauge_Pa / PA_PER_BAR
-        return (((self.K1_N_per_bar_m2 * x_m + self.K2_N_per_bar_m) * x_m + self.C1_N_per_bar) * p_bar
-                + (self.S1_N_per_m2 * x_m + self.S2_N_per_m) * x_m + self.S3_N)
+    def __len__(self) -> int:
+        return len(REGISTRY)
 
 
-STATIC_FORCE_MODELS: dict[str, Callable[[Mapping[str, float]], StaticForceModel]] = {
-    "acra2012_polynomial": Acra2012Polynomial.from_parameters,
-}
+STATIC_FORCE_MODELS: Mapping[str, Callable] = _Builders()

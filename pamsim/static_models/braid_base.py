@@ -1,0 +1,43 @@
+"""Common base of the models built on braid kinematics (Gaylord and its descendants)."""
+
+from __future__ import annotations
+
+from typing import Mapping
+
+from .base import Domain, StaticForce, rated_pressure_Pa
+from .geometry import Braid
+
+GEOMETRY = ("L0_m", "r0_m", "theta0_deg")
+"""Rest length, braid radius at rest and rest braid angle from the axis: what every braid model needs."""
+WALL = GEOMETRY + ("wall_thickness_m",)
+
+
+class BraidModel(StaticForce):
+    """A static model of a braided muscle: rest geometry, domain and a few constants.
+
+    ``x_max_m`` is the largest valid contraction; by default the Gaylord
+    kinematic limit (braid angle 54.7356 deg), past which an inextensible braid
+    cannot shorten without the bladder pushing it.
+    """
+
+    name = ""
+
+    def __init__(self, params: Mapping[str, float], variant: str = "default"):
+        self.g = Braid.from_parameters(params)
+        self.variant = variant
+        self.L0 = self.g.L0
+        self.b2 = self.g.b ** 2
+        self.k_gaylord = 1.0 / (4.0 * 3.141592653589793 * self.g.N ** 2)
+        self.domain = Domain(0.0, self.x_max_m(params), 0.0, rated_pressure_Pa(params))
+
+    def x_max_m(self, params: Mapping[str, float]) -> float:
+        """Largest contraction of the domain [m]; subclasses with a bladder may extend or shrink it."""
+        return self.g.x_lock_m
+
+    def gaylord_N(self, L, p):
+        """Gaylord's ideal force [N] at length ``L`` [m]: ``p (3 L^2 - b^2) / (4 pi N^2)`` (Kothera eq. 2)."""
+        return p * (3.0 * L * L - self.b2) * self.k_gaylord
+
+    def sin_theta(self, L):
+        """Sine of the braid angle from the axis at length ``L``: ``sqrt(1 - (L/b)^2)``."""
+        return (1.0 - L * L / self.b2) ** 0.5
