@@ -29,7 +29,6 @@ import numpy as np
 from .atomic import atomic_outputs
 from .constants import PA_PER_BAR
 from .elements.friction import FRICTION_MODELS, build_friction
-from .elements.static_force import STATIC_FORCE_MODELS
 from .elements.stops import EndStops
 from .errors import InputError
 from .oscillation import estimate_oscillation
@@ -559,7 +558,7 @@ _RUN_COLUMNS = ("final_contraction_m", "peak_contraction_m", "error_m", "at_rest
 def _case_row(spec: SweepSpec, i: int, case: SweepCase, by_key: Mapping) -> dict:
     """One summary row: inputs, static analysis, measurement, and each friction model's run."""
     params = spec.base.parameters
-    static = STATIC_FORCE_MODELS[spec.base.spec["model"]["static_force"]](params)
+    static = spec.base.static_model()
     p_Pa = case.pressure_bar * PA_PER_BAR
     x_eq = static_report(params, static, p_Pa, case.weight_N)["equilibrium_contraction_m"]
     x_hi = EndStops.from_parameters(params).x_high_m
