@@ -85,6 +85,15 @@ KNOWN = MappingProxyType({
     "devolder_F_min_N": _any("de Volder force floor (<= 0 stops pushing forces)"),
     "devolder_k_b_N_per_m": _nonneg("de Volder bladder spring stiffness"),
     "devolder_l_b0_m": _any("de Volder length above which the bladder spring engages"),
+    # Hocking, Pillsbury, Sangian (survey eqs. 37, 39, 40).
+    "hocking_E2_Pa": _any("Hocking stress polynomial, quadratic coefficient"),
+    "hocking_E3_Pa": _any("Hocking stress polynomial, cubic coefficient"),
+    "hocking_P_c_Pa": _any("Hocking dead-band pressure"),
+    "pillsbury_E1I_Pa": _any("Pillsbury linear modulus, pressure-independent part"),
+    "pillsbury_E1S": _any("Pillsbury linear modulus, pressure coefficient"),
+    "pillsbury_E2I_Pa": _any("Pillsbury quadratic modulus, pressure-independent part"),
+    "pillsbury_E2S": _any("Pillsbury quadratic modulus, pressure coefficient"),
+    "sangian_Pbar_Pa": _any("Sangian threshold (dead-band) pressure"),
     # ACRA 2012 polynomial, friction, damping (the Shadow muscle).
     "K1_N_per_bar_m2": _any("static force: pressure term, x^2 coefficient"),
     "K2_N_per_bar_m": _any("static force: pressure term, x coefficient"),

@@ -90,13 +90,15 @@ class StaticForce:
 
         The domain is scanned from its low end for the first fall of
         ``force_N - load_N`` through zero, which is then refined by ``brentq``.
-        Returns ``x_min_m`` when the muscle cannot lift the load there, and
-        ``nan`` when the force stays above the load over the whole domain.
+        Returns the domain's low end when the muscle cannot lift the load there,
+        and ``nan`` when the force stays above the load over the whole domain.
         """
         p = float(p_gauge_Pa)
         lo = max(self.domain.x_min_m, 0.0) if self.domain.x_max_m > 0.0 else self.domain.x_min_m
         xs = np.linspace(lo, self.domain.x_max_m, n_scan + 1)
         g = np.asarray(self.force_N(xs, p), dtype=float) - load_N
+        # Round-off: Gaylord's force is exactly zero at the kinematic limit (the domain's end).
+        g[np.abs(g) <= 1e-12 * np.max(np.abs(g))] = 0.0
         if g[0] <= 0.0:
             return float(xs[0])
         below = np.nonzero(g <= 0.0)[0]
