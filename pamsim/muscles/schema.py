@@ -152,3 +152,6 @@ KNOWN = MappingProxyType({
     "stop_restitution": Known("coefficient of restitution of both stops", 0.0, 1.0),
 })
 """name -> :class:`Known` for every parameter a muscle file may give."""
+
+FILE_INPUTS = ("force_map_file",)
+"""Model inputs that are files, not numbers (given by a muscle file's top-level ``force_map`` key)."""

@@ -14,6 +14,7 @@ from __future__ import annotations
 import difflib
 import math
 from dataclasses import dataclass, field
+from pathlib import Path
 from types import MappingProxyType
 from typing import Callable, Mapping
 
@@ -160,7 +161,8 @@ class StaticModelSpec:
             raise InputError(f"static model {self.name!r}: variant = {variant!r}: unknown "
                              f"(choose from {', '.join(self.variants)})")
         merged = dict(self.optional)
-        merged.update({k: float(v) for k, v in params.items()})
+        # Values are numbers, except file paths such as force_map_file.
+        merged.update({k: v if isinstance(v, (str, Path)) else float(v) for k, v in params.items()})
         return self.builder(MappingProxyType(merged), variant)
 
 
