@@ -233,3 +233,27 @@ def test_miniature_muscle_full_error_ranking_as_the_survey_reports():
     by_survey = sorted(ranked, key=lambda k: MINIATURE[k][5])
     by_us = sorted(ranked, key=lambda k: abs(_contraction_mm(k) - MEASURED_MM))
     assert by_us == by_survey
+
+
+# ---------------------------------------------------- the survey's two-phase model, phase 1
+def test_two_phase_inflection_pressure_with_the_load_left_to_the_braid():
+    """Spec S-34: with the load neglected in phase 1, Pbar = 64.9 kPa and u_r = delta at contact."""
+    from pamsim.static_models.two_phase import TwoPhaseTube
+    tube = TwoPhaseTube.from_parameters(load_muscle("mpam_survey_40mm").parameters)
+    P = tube.inflection_pressure_Pa()
+    assert P == pytest.approx(64.9e3, rel=0.005)
+    u_r, u_z = tube.phase1_displacements_m(P)
+    assert u_r == pytest.approx(0.04e-3, rel=0.01) and u_z > 0.0  # phase 1 lengthens the muscle
+
+
+def test_two_phase_printed_load_term_has_no_inflection_pressure():
+    """Spec sec. 7 (not reproduced 3): the survey's P_sil = F/(pi r_i^2) stretches the tube ~73 % under 0.05 N."""
+    from pamsim.errors import InputError
+    from pamsim.static_models.two_phase import TwoPhaseTube
+    tube = TwoPhaseTube.from_parameters(load_muscle("mpam_survey_40mm").parameters)
+    strain = tube.phase1_displacements_m(0.0, 0.05, "printed")[1] / tube.l0
+    assert strain == pytest.approx(0.73, abs=0.01)
+    with pytest.raises(InputError, match="kinematic limit"):
+        tube.inflection_pressure_Pa(0.05, "printed")
+    with pytest.raises(InputError, match="touches the sleeve at zero pressure"):
+        tube.inflection_pressure_Pa(0.05, "annulus")
