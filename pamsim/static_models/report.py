@@ -1,15 +1,19 @@
 """Paper numbers reproduced by the static-model library, as Markdown tables.
 
 Run ``python -m pamsim.static_models.report`` (``--models`` for the model table
-only); ``docs/static_models.md`` quotes its output.
+only, ``--muscles`` for the shipped muscles); ``docs/static_models.md`` quotes its output.
 """
 
 from __future__ import annotations
 
 import argparse
 
-from ..muscles import load_muscle
+from ..muscles import load_muscle, shipped_names
 from . import REGISTRY, get
+from .sources import ACRA2012, KOTHERA2009, OGDEN, SURVEY
+
+SHORT_SOURCES = {KOTHERA2009: "Kothera et al. 2009", SURVEY: "the survey", ACRA2012: "ACRA 2012", OGDEN: "the Ogden paper"}
+"""Full citations are given once in the docs; the model table uses these short forms."""
 
 PSI_PA = 6894.757293168361
 """Pascals per psi (Kothera's pressures are psi gauge; the exact conversion)."""
@@ -42,8 +46,21 @@ def model_table() -> str:
     """Every registered model: name, kind, variants, required parameters, source."""
     lines = ["| model | kind | variants (default first) | required parameters | source |", "|---|---|---|---|---|"]
     for name, s in REGISTRY.items():
+        source = s.source
+        for full, short in SHORT_SOURCES.items():
+            source = source.replace(full, short)
         lines.append(f"| `{name}` | {s.kind} | {', '.join(s.variants)} | {', '.join(f'`{p}`' for p in s.parameters)} "
-                     f"| {s.source} |")
+                     f"| {source} |")
+    return "\n".join(lines)
+
+
+def muscle_table() -> str:
+    """Every shipped muscle: default model, number of applicable models, gaps."""
+    lines = ["| muscle | description | default model | applicable models | gaps listed |", "|---|---|---|---|---|"]
+    for name in shipped_names():
+        m = load_muscle(name)
+        lines.append(f"| `{name}` | {m.description} | `{m.default_static_force}` | {len(m.applicable_models())} "
+                     f"| {len(m.gaps)} |")
     return "\n".join(lines)
 
 
@@ -76,7 +93,11 @@ def miniature_table() -> str:
 def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--models", action="store_true", help="print only the table of models")
+    ap.add_argument("--muscles", action="store_true", help="print only the table of shipped muscles")
     args = ap.parse_args(argv)
+    if args.muscles:
+        print(muscle_table())
+        return
     print(model_table())
     if args.models:
         return
