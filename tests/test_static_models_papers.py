@@ -257,3 +257,19 @@ def test_two_phase_printed_load_term_has_no_inflection_pressure():
         tube.inflection_pressure_Pa(0.05, "printed")
     with pytest.raises(InputError, match="touches the sleeve at zero pressure"):
         tube.inflection_pressure_Pa(0.05, "annulus")
+
+
+@pytest.mark.parametrize("c1_sign", [-1.0, 1.0])
+def test_two_phase_phase2_has_no_compressive_contact_solution(c1_sign):
+    """Why mpam_two_phase is not a registry model: with the specification's phase-2 equations every
+    solution has a tensile contact pressure, and there is none at the survey's test pressure."""
+    from pamsim.static_models.two_phase import TwoPhaseTube
+    p = load_muscle("mpam_survey_45mm").parameters
+    tube = TwoPhaseTube.from_parameters(p)
+    args = (p["n_fibres"], p["fibre_radius_m"], 3e9, p["end_cone_length_m"], c1_sign)  # E_nylon 3 GPa: assumed
+    found = 0
+    for P in (7e4, 1e5, 2e5, 4e5, 7.58e5):
+        sols = tube.phase2_solutions(P, *args)
+        found += len(sols)
+        assert all(s["P_o_Pa"] < 0.0 and s["F_e_N"] < 0.0 for s in sols)
+    assert tube.phase2_solutions(7.58e5, *args) == [] and found > 0
