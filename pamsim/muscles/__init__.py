@@ -17,6 +17,7 @@ from typing import Any, Mapping
 from ..errors import InputError
 from ..parameters import Parameter, ParameterSet
 from ..static_models import REGISTRY, StaticForce
+from ..static_models import get as get_model
 from ..static_models.base import did_you_mean
 from .schema import KNOWN, LOCK_DEG, unit_of
 
@@ -26,7 +27,7 @@ class MuscleError(InputError):
 
 
 TOP_KEYS = ("name", "description", "citation", "default_static_force", "rated_pressure_gauge_Pa", "gaps",
-            "parameters", "data")
+            "force_map", "parameters", "data")
 ENTRY_KEYS = ("value", "source", "description", "unit")
 
 
@@ -42,6 +43,7 @@ class Muscle:
     origin : the file it was read from.
     gaps : values the source does not give (said, not invented).
     data_file : measured points shipped with the muscle, or None.
+    force_map_file : measured F(x, p) table for the ``force_map`` model, or None.
     """
 
     name: str
@@ -52,18 +54,26 @@ class Muscle:
     origin: Path
     gaps: tuple[str, ...] = ()
     data_file: Path | None = field(default=None)
+    force_map_file: Path | None = field(default=None)
+
+    def model_inputs(self) -> dict:
+        """What a static model is built from: the parameter values and, if any, the force-map file."""
+        inputs: dict = dict(self.parameters)
+        if self.force_map_file is not None:
+            inputs["force_map_file"] = self.force_map_file
+        return inputs
 
     def applicable_models(self) -> list[str]:
-        """Names of the library models whose required parameters this muscle gives."""
-        return [name for name, spec in REGISTRY.items() if not spec.missing(self.parameters)]
+        """Names of the library models whose required inputs this muscle gives."""
+        inputs = self.model_inputs()
+        return [name for name, spec in REGISTRY.items() if not spec.missing(inputs)]
 
     def static_force(self, model: str | None = None, variant: str | None = None,
                      overrides: Mapping[str, float] | None = None) -> StaticForce:
         """Build a library model (default: the muscle's own) for this muscle."""
-        from ..static_models import get
-        params = dict(self.parameters)
+        params = self.model_inputs()
         params.update(overrides or {})
-        return get(model or self.default_static_force).build(params, variant)
+        return get_model(model or self.default_static_force).build(params, variant)
 
 
 def shipped_names() -> list[str]:
@@ -135,6 +145,12 @@ def muscle_from_dict(raw: Mapping[str, Any], origin: str | Path = "<dict>") -> M
     _convert_radial_angle(fail, entries)
     _complete_wall(fail, entries)
     _check_geometry(fail, entries)
+    force_map_file = None
+    if "force_map" in raw:
+        fm = raw["force_map"]
+        if not isinstance(fm, str) or not (origin.parent / fm).is_file():
+            raise fail("force_map", fm, "must name a CSV file next to the muscle file")
+        force_map_file = (origin.parent / fm).resolve()
     data_file = None
     if "data" in raw:
         data = raw["data"]
@@ -145,7 +161,7 @@ def muscle_from_dict(raw: Mapping[str, Any], origin: str | Path = "<dict>") -> M
             raise fail("data.file", data["file"], f"no such file next to the muscle file ({data_file})")
     params = ParameterSet(strings["name"], strings["citation"], entries)
     return Muscle(strings["name"], strings["description"], strings["citation"], model, params, origin,
-                  tuple(gaps), data_file)
+                  tuple(gaps), data_file, force_map_file)
 
 
 def _entry(fail, name: str, table: Any) -> Parameter:

@@ -85,6 +85,41 @@ KNOWN = MappingProxyType({
     "devolder_F_min_N": _any("de Volder force floor (<= 0 stops pushing forces)"),
     "devolder_k_b_N_per_m": _nonneg("de Volder bladder spring stiffness"),
     "devolder_l_b0_m": _any("de Volder length above which the bladder spring engages"),
+    # Hocking, Pillsbury, Sangian (survey eqs. 37, 39, 40).
+    "hocking_E2_Pa": _any("Hocking stress polynomial, quadratic coefficient"),
+    "hocking_E3_Pa": _any("Hocking stress polynomial, cubic coefficient"),
+    "hocking_P_c_Pa": _any("Hocking dead-band pressure"),
+    "pillsbury_E1I_Pa": _any("Pillsbury linear modulus, pressure-independent part"),
+    "pillsbury_E1S": _any("Pillsbury linear modulus, pressure coefficient"),
+    "pillsbury_E2I_Pa": _any("Pillsbury quadratic modulus, pressure-independent part"),
+    "pillsbury_E2S": _any("Pillsbury quadratic modulus, pressure coefficient"),
+    "sangian_Pbar_Pa": _any("Sangian threshold (dead-band) pressure"),
+    # Normalised-Gaylord models with fitted factors and empirical laws (survey eqs. 6, 13, 14, 33, 41, 43, 44, 46-49).
+    "tondu_kappa1": _any("Tondu-Lopez k_eps: amplitude of the exponential"),
+    "tondu_kappa2": _any("Tondu-Lopez k_eps: constant"),
+    "tondu_pressure_unit_Pa": _pos("Tondu-Lopez k_eps: pressure unit of exp(-p)"),
+    "itto_kappa1": _any("Itto k_eps: amplitude"), "itto_kappa2_per_Pa": _any("Itto k_eps: pressure rate"),
+    "itto_kappa3": _any("Itto k_eps: constant (text form)"),
+    "meller_kappa1_m2": _any("Meller blocked force: slope in pressure"), "meller_kappa2_N": _any("Meller blocked force: offset"),
+    "meller_kappa3": _any("Meller free contraction per ln(p/p_u)"),
+    "meller_pressure_unit_Pa": _pos("Meller: pressure unit of ln(p)"),
+    "andrikopoulos_F_max_N": _pos("Andrikopoulos calibration: blocked force at P_test"),
+    "andrikopoulos_x_max_m": _pos("Andrikopoulos calibration: free stroke at P_test"),
+    "andrikopoulos_P_test_Pa": _pos("Andrikopoulos calibration pressure"),
+    "alpha_l_per_K": _any("thermal expansion coefficient of the bladder"),
+    "delta_T_K": _any("temperature change from the calibration"),
+    **{f"takosoglu_kappa{i}": _any(f"Takosoglu constant kappa{i}") for i in (1, 3, 4, 6)},
+    "takosoglu_kappa2_Pa": _pos("Takosoglu exponent: pressure scale"), "takosoglu_kappa5_Pa": _pos("Takosoglu q1: pressure scale"),
+    "bundle_kappa1_m2": _any("muscle-bundle law kappa1"), "bundle_kappa2_N": _any("muscle-bundle law kappa2"),
+    "bundle_kappa3_m2": _any("muscle-bundle law kappa3"),
+    **{f"emp46_k{i}_m2": _any(f"empirical eq. (46) k{i}") for i in (1, 2, 3)},
+    **{f"emp46_k{i}_N": _any(f"empirical eq. (46) k{i}") for i in (4, 5, 6, 7, 8)},
+    **{f"emp47_k{i}_N": _any(f"empirical eq. (47) k{i}") for i in (1, 2, 3)},
+    **{f"emp47_k{i}_m2": _any(f"empirical eq. (47) k{i}") for i in (4, 5)},
+    "emp48_k1_m2_per_Pa": _any("empirical eq. (48) k1"), "emp48_k2_m2": _any("empirical eq. (48) k2"),
+    "emp48_k3_N": _any("empirical eq. (48) k3"), "emp48_k4_m2": _any("empirical eq. (48) k4"), "emp48_k5_N": _any("empirical eq. (48) k5"),
+    "emp49_k1": _any("empirical eq. (49) k1"), "emp49_Fmax_N": _any("empirical eq. (49) F_max"),
+    "emp49_eps_max": Known("empirical eq. (49) eps_max", 0.0, 1.0, True, True),
     # ACRA 2012 polynomial, friction, damping (the Shadow muscle).
     "K1_N_per_bar_m2": _any("static force: pressure term, x^2 coefficient"),
     "K2_N_per_bar_m": _any("static force: pressure term, x coefficient"),
@@ -117,3 +152,6 @@ KNOWN = MappingProxyType({
     "stop_restitution": Known("coefficient of restitution of both stops", 0.0, 1.0),
 })
 """name -> :class:`Known` for every parameter a muscle file may give."""
+
+FILE_INPUTS = ("force_map_file",)
+"""Model inputs that are files, not numbers (given by a muscle file's top-level ``force_map`` key)."""

@@ -14,6 +14,7 @@ from __future__ import annotations
 import difflib
 import math
 from dataclasses import dataclass, field
+from pathlib import Path
 from types import MappingProxyType
 from typing import Callable, Mapping
 
@@ -90,13 +91,15 @@ class StaticForce:
 
         The domain is scanned from its low end for the first fall of
         ``force_N - load_N`` through zero, which is then refined by ``brentq``.
-        Returns ``x_min_m`` when the muscle cannot lift the load there, and
-        ``nan`` when the force stays above the load over the whole domain.
+        Returns the domain's low end when the muscle cannot lift the load there,
+        and ``nan`` when the force stays above the load over the whole domain.
         """
         p = float(p_gauge_Pa)
         lo = max(self.domain.x_min_m, 0.0) if self.domain.x_max_m > 0.0 else self.domain.x_min_m
         xs = np.linspace(lo, self.domain.x_max_m, n_scan + 1)
         g = np.asarray(self.force_N(xs, p), dtype=float) - load_N
+        # Round-off: Gaylord's force is exactly zero at the kinematic limit (the domain's end).
+        g[np.abs(g) <= 1e-12 * np.max(np.abs(g))] = 0.0
         if g[0] <= 0.0:
             return float(xs[0])
         below = np.nonzero(g <= 0.0)[0]
@@ -158,7 +161,8 @@ class StaticModelSpec:
             raise InputError(f"static model {self.name!r}: variant = {variant!r}: unknown "
                              f"(choose from {', '.join(self.variants)})")
         merged = dict(self.optional)
-        merged.update({k: float(v) for k, v in params.items()})
+        # Values are numbers, except file paths such as force_map_file.
+        merged.update({k: v if isinstance(v, (str, Path)) else float(v) for k, v in params.items()})
         return self.builder(MappingProxyType(merged), variant)
 
 

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from typing import Mapping
 
+from scipy.optimize import brentq
+
 from .base import Domain, StaticForce, rated_pressure_Pa
 from .geometry import Braid
 
@@ -41,3 +43,32 @@ class BraidModel(StaticForce):
     def sin_theta(self, L):
         """Sine of the braid angle from the axis at length ``L``: ``sqrt(1 - (L/b)^2)``."""
         return (1.0 - L * L / self.b2) ** 0.5
+
+
+class BladderModel(BraidModel):
+    """A braid model with a constant-volume bladder: the domain ends where the bladder fills the braid.
+
+    With a nonzero ``tip_factor`` ``k`` the model is evaluated at a tip-corrected
+    length ``L' = L - k (R(L) - R0)`` (Kothera eq. 24: ``k = 2``, explicit radius
+    ``R(L)``; Hocking: ``k = 2 (pi/2 - 1)``), and the domain shrinks so that ``L'``
+    stays valid.  Subclasses set ``tip_factor`` before calling ``__init__``.
+    """
+
+    tip_factor = 0.0
+
+    def x_max_m(self, params):
+        margin = 1e-9 * self.L0  # keeps the square root of the thickness formula real at the domain's end
+        x_fill = self.g.x_fill_m() - margin
+        if not self.tip_factor:
+            return x_fill
+        L_fill = self.L0 - x_fill
+        return self.L0 - brentq(lambda L: self.tip_length_m(L) - L_fill, L_fill, self.L0, xtol=1e-15) - margin
+
+    def tip_length_m(self, L):
+        """Tip-corrected cylindrical length ``L - k (R(L) - R0)`` [m]."""
+        return L - self.tip_factor * (self.g.radius_m(L) - self.g.r0)
+
+    def effective_length_m(self, x_m):
+        """Length at which the cylinder formulas are evaluated: ``L`` or the tip-corrected ``L'``."""
+        L = self.L0 - x_m
+        return self.tip_length_m(L) if self.tip_factor else L
