@@ -16,6 +16,7 @@ from .muscles import Muscle, load_muscle
 from .muscles.schema import KNOWN
 from .parameters import ParameterSet, dynamics_parameters, known_parameter
 from .static_models import REGISTRY, StaticModelSpec
+from .static_models.base import did_you_mean
 
 Fail = Callable[..., None]
 Key = Callable[[str, str], str]
@@ -31,7 +32,9 @@ def with_overrides(params: ParameterSet, overrides: Mapping[str, Any], fail: Fai
     values, added = {}, {}
     for name, value in overrides.items():
         if name not in params and name not in KNOWN:
-            fail(key("parameter", name), value, "unknown parameter", sorted(set(params) | set(KNOWN)))
+            fail(key("parameter", name), value,
+                 "unknown parameter" + (did_you_mean(name, sorted(set(params) | set(KNOWN))) or " (`pamsim params` "
+                                        "lists a muscle's parameters)"))
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             fail(key("parameter", name), value, f"must be a number, not {type(value).__name__}")
         (values if name in params else added)[name] = float(value)
