@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from typing import Any, Callable, Mapping
 
+from .errors import InputError
 from .muscles import Muscle, load_muscle
 from .muscles.schema import KNOWN
 from .parameters import ParameterSet, dynamics_parameters, known_parameter
@@ -32,9 +33,7 @@ def with_overrides(params: ParameterSet, overrides: Mapping[str, Any], fail: Fai
     values, added = {}, {}
     for name, value in overrides.items():
         if name not in params and name not in KNOWN:
-            fail(key("parameter", name), value,
-                 "unknown parameter" + (did_you_mean(name, sorted(set(params) | set(KNOWN))) or " (`pamsim params` "
-                                        "lists a muscle's parameters)"))
+            fail(key("parameter", name), value, "unknown parameter" + _suggest(name, sorted(set(params) | set(KNOWN))))
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             fail(key("parameter", name), value, f"must be a number, not {type(value).__name__}")
         (values if name in params else added)[name] = float(value)
@@ -46,6 +45,14 @@ def with_overrides(params: ParameterSet, overrides: Mapping[str, Any], fail: Fai
     for name, value, why in params.violations():
         fail(key("parameter", name), value, why)
     return params
+
+
+def _suggest(name: str, names: list[str]) -> str:
+    """The names that extend ``name`` by a unit suffix (``valve_C`` -> ``valve_C_m3_per_s_Pa``), else the closest."""
+    longer = [n for n in names if n.startswith(name + "_")]
+    if longer:
+        return f" (did you mean {' or '.join(repr(n) for n in longer[:3])}?)"
+    return did_you_mean(name, names) or " (`pamsim params` lists a muscle's parameters)"
 
 
 def applicable_model(name: str, variant: str | None, muscle: Muscle, params: Mapping[str, float], fail: Fail,
@@ -63,22 +70,30 @@ def applicable_model(name: str, variant: str | None, muscle: Muscle, params: Map
     return spec
 
 
+def _defaults(fail: Fail | None, key: Key | None) -> tuple[Fail, Key]:
+    def default_fail(k, value, why, choices=None):
+        raise InputError(f"{k} = {value!r}: {why}" + (did_you_mean(value, choices) if choices else ""))
+
+    return (fail or default_fail,
+            key or (lambda kind, name: {"parameter": name, "model": "model", "variant": "variant"}[kind]))
+
+
+def muscle_parameters(muscle: str, overrides: Mapping[str, Any] | None = None, fail: Fail | None = None,
+                      key: Key | None = None) -> tuple[Muscle, ParameterSet]:
+    """Load ``muscle`` (name or path): ``(muscle, its parameters with the dynamics' defaults and overrides)``."""
+    fail, key = _defaults(fail, key)
+    m = load_muscle(muscle)
+    return m, with_overrides(dynamics_parameters(m.parameters), overrides or {}, fail, key, "override")
+
+
 def prepare(muscle: str, model: str | None = None, overrides: Mapping[str, Any] | None = None,
             variant: str | None = None, fail: Fail | None = None, key: Key | None = None):
     """Load ``muscle`` and return ``(muscle, parameters, built static model)`` for static queries.
 
-    The Python face of ``pamsim force`` / ``pamsim static`` / ``pamsim atlas``:
-    without ``fail`` every mistake raises :class:`~pamsim.errors.InputError`.
+    The Python face of ``pamsim force`` / ``pamsim static``: without ``fail``
+    every mistake raises :class:`~pamsim.errors.InputError`.
     """
-    from .errors import InputError
-
-    def default_fail(k, value, why, choices=None):
-        raise InputError(f"{k} = {value!r}: {why}" + (f" (choose from {', '.join(map(str, choices))})"
-                                                     if choices and len(choices) < 20 else ""))
-
-    fail = fail or default_fail
-    key = key or (lambda kind, name: {"parameter": name, "model": "model", "variant": "variant"}[kind])
-    m = load_muscle(muscle)
-    params = with_overrides(dynamics_parameters(m.parameters), overrides or {}, fail, key, "override")
+    fail, key = _defaults(fail, key)
+    m, params = muscle_parameters(muscle, overrides, fail, key)
     spec = applicable_model(model or m.default_static_force, variant, m, params, fail, key)
     return m, params, spec.build(params, variant)

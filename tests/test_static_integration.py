@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import csv
 import json
 import math
 from pathlib import Path
@@ -339,3 +340,33 @@ def test_bad_cli_values_exit_2_naming_them(args, words):
     assert "\n" not in line and "Traceback" not in line
     for w in words:
         assert w in line
+
+
+# ---------------------------------------------------------------- atlas
+def test_atlas_writes_curves_table_and_figures_of_every_applicable_model(tmp_path):
+    out = tmp_path / "atlas"
+    r = run_cli("atlas", "--muscle", "mpam_survey_45mm", "-o", out)
+    assert r.returncode == 0, r.stderr
+    m = load_muscle("mpam_survey_45mm")
+    rows = list(csv.DictReader((out / "atlas_table.csv").open()))
+    assert [row["model"] for row in rows] == m.applicable_models()
+    p = dynamics_parameters(m.parameters)
+    for row in rows:  # each row from the model itself (its own blocked force and free contraction)
+        model = REGISTRY[row["model"]].build(p)
+        P = float(row["pressure_bar"]) * 1e5
+        assert float(row["blocked_force_N"]) == pytest.approx(float(model.force_N(0.0, P)), rel=1e-5)
+        free = float(row["free_contraction_mm"])
+        assert free == pytest.approx(model.free_contraction_m(P) * 1e3, rel=1e-5, nan_ok=True)
+    # The survey's measured point (758 kPa, 13 mm) sets the pressure and is overlaid.
+    assert [float(r["pressure_bar"]) for r in rows][:1] == [7.58]
+    curves = list(csv.DictReader((out / "atlas_curves.csv").open()))
+    assert len(curves) == len(rows) * 201
+    for name in ("atlas_7.58bar.png", "atlas_all.png", "atlas_table.md"):
+        assert (out / name).stat().st_size > 0
+
+
+def test_atlas_refuses_a_model_that_does_not_apply_and_writes_nothing(tmp_path):
+    out = tmp_path / "atlas"
+    r = run_cli("atlas", "--muscle", "shadow_6x300_acra2012", "--models", "gaylord,chou_hannaford", "-o", out)
+    assert r.returncode == 2 and "chou_hannaford" in r.stderr and "wall_thickness_m" in r.stderr
+    assert not out.exists()

@@ -25,6 +25,7 @@ COMMANDS = (
     "pamsim.cli.models",
     "pamsim.cli.muscles",
     "pamsim.cli.force",
+    "pamsim.cli.atlas",
 )
 
 
