@@ -10,10 +10,6 @@ import argparse
 
 from ..muscles import load_muscle, shipped_names
 from . import REGISTRY, get
-from .sources import ACRA2012, KOTHERA2009, OGDEN, SURVEY
-
-SHORT_SOURCES = {KOTHERA2009: "Kothera et al. 2009", SURVEY: "the survey", ACRA2012: "ACRA 2012", OGDEN: "the Ogden paper"}
-"""Full citations are given once in the docs; the model table uses these short forms."""
 
 PSI_PA = 6894.757293168361
 """Pascals per psi (Kothera's pressures are psi gauge; the exact conversion)."""
@@ -46,11 +42,8 @@ def model_table() -> str:
     """Every registered model: name, kind, variants, required parameters, source."""
     lines = ["| model | kind | variants (default first) | required parameters | source |", "|---|---|---|---|---|"]
     for name, s in REGISTRY.items():
-        source = s.source
-        for full, short in SHORT_SOURCES.items():
-            source = source.replace(full, short)
         lines.append(f"| `{name}` | {s.kind} | {', '.join(s.variants)} | {', '.join(f'`{p}`' for p in s.parameters)} "
-                     f"| {source} |")
+                     f"| {s.source} |")
     return "\n".join(lines)
 
 
