@@ -273,3 +273,15 @@ def test_two_phase_phase2_has_no_compressive_contact_solution(c1_sign):
         found += len(sols)
         assert all(s["P_o_Pa"] < 0.0 and s["F_e_N"] < 0.0 for s in sols)
     assert tube.phase2_solutions(7.58e5, *args) == [] and found > 0
+
+
+def test_report_prints_every_table_the_docs_quote(capsys):
+    from pamsim.static_models import REGISTRY
+    from pamsim.static_models.report import main
+    main([])
+    out = capsys.readouterr().out
+    assert all(f"| `{name}` |" in out for name in REGISTRY)
+    assert "| lambda_F G+cMR+B+T | 0.970 / 0.926 / 0.889 | 0.970 / 0.926 / 0.889 |" in out
+    assert out.count("| not reproduced |") == 3 and "4 of 56 within 0.1 N" in out
+    main(["--muscles"])
+    assert "| `kothera2009_5a` |" in capsys.readouterr().out
