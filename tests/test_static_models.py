@@ -157,3 +157,13 @@ def test_zang_by_hand():
     assert get("takosoglu").build({**MPAM_45, "takosoglu_kappa1": 0.0, "takosoglu_kappa2_Pa": 1.0, "takosoglu_kappa3": 2.0,
                                    "takosoglu_kappa4": 0.0, "takosoglu_kappa5_Pa": 1.0, "takosoglu_kappa6": g.q1},
                                   "printed").force_N(x, p) == pytest.approx(4 * get("gaylord").build(MPAM_45).force_N(x, p))
+
+
+def test_stiffness_is_minus_the_derivative_of_the_force():
+    g = Braid.from_parameters(MPAM_45)
+    m = get("gaylord").build(MPAM_45)
+    x, p = 0.005, 7.58e5
+    L = g.L0 - x
+    assert m.stiffness_N_per_m(x, p) == pytest.approx(6 * L * p / (4 * math.pi * g.N ** 2), rel=1e-7)  # dF/dL by hand
+    xs = np.array([0.001, 0.004])
+    assert np.allclose(m.stiffness_N_per_m(xs, p), 6 * (g.L0 - xs) * p / (4 * math.pi * g.N ** 2), rtol=1e-7)

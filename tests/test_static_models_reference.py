@@ -150,8 +150,7 @@ def test_chou_hannaford_constant_friction_value(i, r):
 # --------------------------------------------------------------------- the survey's miniature muscle
 def _stiffness_N_per_mm(model, over, P=7.58e5, load=0.05):
     m = get(model).build({**MPAM45, **over})
-    x, h = m.free_contraction_m(P, load), 1e-6
-    return -(m.force_N(x + h, P) - m.force_N(x - h, P)) / (2 * h) / 1e3
+    return m.stiffness_N_per_m(m.free_contraction_m(P, load), P) / 1e3
 
 
 @pytest.mark.parametrize("i, r", rows(lambda r: _model(r).startswith("EXPERIMENT") and "45mm" in r["muscle"]))

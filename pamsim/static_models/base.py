@@ -85,6 +85,10 @@ class StaticForce:
         """Force [N] at zero contraction (the blocked force); ``p_gauge_Pa`` a float or an array."""
         return self.force_N(np.zeros_like(p_gauge_Pa, dtype=float) if np.ndim(p_gauge_Pa) else 0.0, p_gauge_Pa)
 
+    def stiffness_N_per_m(self, x_m, p_gauge_Pa, h_m: float = 1e-7):
+        """Axial stiffness ``-dF/dx`` [N/m] by a central difference of step ``h_m`` (no domain check)."""
+        return (self.force_N(x_m - h_m, p_gauge_Pa) - self.force_N(x_m + h_m, p_gauge_Pa)) / (2.0 * h_m)
+
     def free_contraction_m(self, p_gauge_Pa: float, load_N: float = 0.0, n_scan: int = 200) -> float:
         """Contraction [m] at which the force equals ``load_N`` (static equilibrium).
 
