@@ -285,3 +285,14 @@ def test_report_prints_every_table_the_docs_quote(capsys):
     assert out.count("| not reproduced |") == 3 and "4 of 56 within 0.1 N" in out
     main(["--muscles"])
     assert "| `kothera2009_5a` |" in capsys.readouterr().out
+
+
+def test_kothera_tip_radius_explicit_and_implicit():
+    """Spec K-5: lambda_F of 5a at 60 psi is 0.8893 with R(L) and 0.8910 with R(L') solved implicitly."""
+    for variant, expected in (("explicit_radius", 0.8893), ("implicit_radius", 0.8910)):
+        m = kothera("kothera_energy_tips", variant)
+        assert 1.0 - m.free_contraction_m(60 * PSI) / K5A["L0_m"] == pytest.approx(expected, abs=1e-4)
+        L = K5A["L0_m"] - 0.01
+        Lc = m.tip_length_m(L)
+        R_at = m.g.radius_m(Lc if variant == "implicit_radius" else L)
+        assert Lc == pytest.approx(L - 2 * (R_at - K5A["r0_m"]), rel=1e-12)
