@@ -13,7 +13,7 @@ from .result import Result
 from .scenario import Scenario, ScenarioError, load_scenario
 from .simulator import SolverFailure, SolverOptions, simulate_model
 from . import static_models
-from .sweep import sweep  # the function pamsim.sweep(...); the module stays importable as pamsim.sweep
+from . import sweep  # a callable package: pamsim.sweep(spec, executor) runs a sweep
 
 __all__ = ["simulate", "load_scenario", "Scenario", "ScenarioError", "Result", "Mode", "MuscleModel",
            "ParameterSet", "get_parameter_set", "SolverFailure", "SolverOptions",

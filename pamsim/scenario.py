@@ -22,11 +22,11 @@ from .constants import PA_PER_BAR
 from .errors import InputError
 from .elements.chamber import MuscleChamber
 from .elements.damping import DAMPING_MODELS
-from .elements.friction import FRICTION_MODELS, NEGATIVE_LEVEL_CHOICES, build_friction
+from .elements.friction import FRICTION_MODELS, NEGATIVE_LEVEL_CHOICES
 from .elements.load import HangingLoad
 from .elements.pressure_source import PrescribedPressure, ValveChamberSource
 from .elements.force_clip import NEGATIVE_FORCE_CHOICES
-from .elements.muscle_force import dynamics_static_force
+from .elements.static_force import STATIC_FORCE_MODELS
 from .elements.stops import EndStops
 from .elements.valve import Iso6358Orifice, ProportionalValve33
 from .model import FitRange, MuscleModel
@@ -248,9 +248,7 @@ class Scenario:
 
     def _build_static_force(self):
         m = self.spec["model"]
-        return dynamics_static_force(m["static_force"], self.parameters,
-                                     (0.0, EndStops.from_parameters(self.parameters).x_high_m),
-                                     m.get("static_force_variant"), m["static_force_negative"])
+        return STATIC_FORCE_MODELS[m["static_force"]](self.parameters, m)
 
     def build_model(self) -> MuscleModel:
         """Compose the elements this scenario names into a :class:`MuscleModel`."""
@@ -259,8 +257,8 @@ class Scenario:
         domain = self._static_force.domain
         return MuscleModel(
             static_force=self._static_force,
-            friction=build_friction(m["friction"], p, m["friction_negative_level"]),
-            damping=DAMPING_MODELS[m["damping"]](p),
+            friction=FRICTION_MODELS[m["friction"]](p, m),
+            damping=DAMPING_MODELS[m["damping"]](p, m),
             load=HangingLoad(self.mass_kg, p["g_m_s2"], self._external_force),
             stops=EndStops.from_parameters(p),
             source=self._source,

@@ -92,3 +92,78 @@ def test_free_contraction_solves_the_equilibrium():
     L = math.sqrt((4 * math.pi * g.N ** 2 * 0.05 / 7.58e5 + g.b ** 2) / 3)
     assert x == pytest.approx(g.L0 - L, rel=1e-9)
     assert model.free_contraction_m(1e3, 5.0) == 0.0  # cannot lift it
+
+
+def _gaylord_expansion():
+    """Gaylord's normalised law as a polynomial in eps: A p ((q1 - q2) - 2 q1 eps + q1 eps^2)."""
+    g = Braid.from_parameters(MPAM_45)
+    A = math.pi * g.r0 ** 2
+    return A * (g.q1 - g.q2), -2 * A * g.q1, A * g.q1, g
+
+
+def _reductions():
+    a0, a1, a2, g = _gaylord_expansion()
+    blocked_ptest = math.pi * g.r0 ** 2 * 4e5 * (g.q1 - g.q2)
+    W = {**MPAM_45, "E_bladder_Pa": 0.0}
+    return {  # model: (parameters with the extra constants that make it its parent, variant, parent)
+        "tondu_lopez": (MPAM_45, None, "gaylord"),
+        "de_volder": (MPAM_45, None, "gaylord"),
+        "itto": ({**MPAM_45, "itto_kappa1": 0.5, "itto_kappa2_per_Pa": 0.0}, "eq44", "gaylord"),
+        "andrikopoulos": ({**MPAM_45, "andrikopoulos_F_max_N": blocked_ptest, "andrikopoulos_P_test_Pa": 4e5,
+                           "andrikopoulos_x_max_m": g.x_lock_m}, None, "gaylord"),
+        "takosoglu": ({**MPAM_45, "takosoglu_kappa1": 0.0, "takosoglu_kappa2_Pa": 1.0, "takosoglu_kappa3": 2.0,
+                       "takosoglu_kappa4": 0.0, "takosoglu_kappa5_Pa": 1.0, "takosoglu_kappa6": g.q1}, None, "gaylord"),
+        "mpam_bundle_empirical": ({**MPAM_45, "bundle_kappa1_m2": a2, "bundle_kappa2_N": 0.0,
+                                   "bundle_kappa3_m2": a0 - a2}, None, "gaylord"),
+        "empirical_poly46": ({**MPAM_45, "emp46_k1_m2": a0, "emp46_k2_m2": a1, "emp46_k3_m2": a2,
+                              **{f"emp46_k{i}_N": 0.0 for i in range(4, 9)}}, None, "gaylord"),
+        "sangian": (W, None, "gaylord"),
+        "hocking": (W, None, "gaylord"),
+        "neo_hookean": (W, None, "gaylord"),
+        "kothera_force_balance": (W, None, "gaylord"),
+        "pillsbury": ({**MPAM_45, "pillsbury_E1I_Pa": 0.0, "pillsbury_E1S": 0.0}, None, "chou_hannaford"),
+    }
+
+
+@pytest.mark.parametrize("model", list(_reductions()))
+def test_each_model_reduces_to_its_parent_when_its_extra_constants_vanish(model):
+    params, variant, parent = _reductions()[model]
+    m, ref = get(model).build(params, variant), get(parent).build(MPAM_45)
+    x = np.linspace(0.0, 0.99 * min(m.domain.x_max_m, ref.domain.x_max_m), 30)
+    p = np.array([1e5, 4e5, 7.58e5])[:, None]
+    assert np.allclose(m.force_N(x, p), ref.force_N(x, p), rtol=1e-9, atol=1e-12 * ref.blocked_force_N(7.58e5))
+
+
+def test_linear_empirical_laws_are_gaylords_first_order_expansion():
+    a0, a1, a2, g = _gaylord_expansion()
+    eps = np.linspace(0.0, 0.2, 9)
+    p = 5e5
+    first_order = p * (a0 + a1 * eps)
+    m47 = get("empirical_poly47").build({**MPAM_45, "emp47_k1_N": 0.0, "emp47_k2_N": 0.0, "emp47_k3_N": 0.0,
+                                         "emp47_k4_m2": a0, "emp47_k5_m2": a1})
+    m48 = get("empirical_poly48").build({**MPAM_45, "emp48_k1_m2_per_Pa": 0.0, "emp48_k2_m2": a1, "emp48_k3_N": 0.0,
+                                         "emp48_k4_m2": a0, "emp48_k5_N": 0.0})
+    m49 = get("empirical_linear").build({**MPAM_45, "emp49_k1": 0.5, "emp49_Fmax_N": 4.0, "emp49_eps_max": 0.25})
+    for m in (m47, m48):
+        assert np.allclose(m.force_N(eps * g.L0, p), first_order, rtol=1e-12)
+    assert m49.force_N(0.0, 1e5) == pytest.approx(2.0) and m49.force_N(0.25 * g.L0, 7e5) == pytest.approx(0.0, abs=1e-12)
+
+
+def test_zang_by_hand():
+    g = Braid.from_parameters(MPAM_45)
+    x, p = 0.004, 6e5
+    hand = 2 * math.pi * g.r0 ** 2 * p * (1 - x / g.L0) ** 2 / math.tan(g.theta0) ** 2
+    assert get("zang").build(MPAM_45).force_N(x, p) == pytest.approx(hand, rel=1e-12)
+    assert get("takosoglu").build({**MPAM_45, "takosoglu_kappa1": 0.0, "takosoglu_kappa2_Pa": 1.0, "takosoglu_kappa3": 2.0,
+                                   "takosoglu_kappa4": 0.0, "takosoglu_kappa5_Pa": 1.0, "takosoglu_kappa6": g.q1},
+                                  "printed").force_N(x, p) == pytest.approx(4 * get("gaylord").build(MPAM_45).force_N(x, p))
+
+
+def test_stiffness_is_minus_the_derivative_of_the_force():
+    g = Braid.from_parameters(MPAM_45)
+    m = get("gaylord").build(MPAM_45)
+    x, p = 0.005, 7.58e5
+    L = g.L0 - x
+    assert m.stiffness_N_per_m(x, p) == pytest.approx(6 * L * p / (4 * math.pi * g.N ** 2), rel=1e-7)  # dF/dL by hand
+    xs = np.array([0.001, 0.004])
+    assert np.allclose(m.stiffness_N_per_m(xs, p), 6 * (g.L0 - xs) * p / (4 * math.pi * g.N ** 2), rtol=1e-7)

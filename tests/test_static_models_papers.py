@@ -273,3 +273,26 @@ def test_two_phase_phase2_has_no_compressive_contact_solution(c1_sign):
         found += len(sols)
         assert all(s["P_o_Pa"] < 0.0 and s["F_e_N"] < 0.0 for s in sols)
     assert tube.phase2_solutions(7.58e5, *args) == [] and found > 0
+
+
+def test_report_prints_every_table_the_docs_quote(capsys):
+    from pamsim.static_models import REGISTRY
+    from pamsim.static_models.report import main
+    main([])
+    out = capsys.readouterr().out
+    assert all(f"| `{name}` |" in out for name in REGISTRY)
+    assert "| lambda_F G+cMR+B+T | 0.970 / 0.926 / 0.889 | 0.970 / 0.926 / 0.889 |" in out
+    assert out.count("| not reproduced |") == 3 and "4 of 56 within 0.1 N" in out
+    main(["--muscles"])
+    assert "| `kothera2009_5a` |" in capsys.readouterr().out
+
+
+def test_kothera_tip_radius_explicit_and_implicit():
+    """Spec K-5: lambda_F of 5a at 60 psi is 0.8893 with R(L) and 0.8910 with R(L') solved implicitly."""
+    for variant, expected in (("explicit_radius", 0.8893), ("implicit_radius", 0.8910)):
+        m = kothera("kothera_energy_tips", variant)
+        assert 1.0 - m.free_contraction_m(60 * PSI) / K5A["L0_m"] == pytest.approx(expected, abs=1e-4)
+        L = K5A["L0_m"] - 0.01
+        Lc = m.tip_length_m(L)
+        R_at = m.g.radius_m(Lc if variant == "implicit_radius" else L)
+        assert Lc == pytest.approx(L - 2 * (R_at - K5A["r0_m"]), rel=1e-12)

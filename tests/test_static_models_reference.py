@@ -9,7 +9,6 @@ listed, so none is dropped silently.
 from __future__ import annotations
 
 import math
-import re
 
 import numpy as np
 import pytest
@@ -18,7 +17,7 @@ from pamsim.muscles import load_muscle
 from pamsim.paperdata import acra2012_steady_state
 from pamsim.static_models import get
 from pamsim.static_models.geometry import Braid
-from pamsim.static_models.reference import reference_points
+from pamsim.static_models.reference import acra_point, is_acra_point, reference_points, table3_estimate_N
 
 ROWS = reference_points()
 PSI = 6894.757293168361
@@ -34,16 +33,6 @@ def rows(predicate):
 
 def _model(r):
     return r["model"]
-
-
-def is_acra_point(r):
-    return _model(r).startswith("A-2") and r["pressure_value"].replace(".", "", 1).isdigit()
-
-
-def acra_point(r):
-    """(pressure [Pa], contraction [m]) of an ACRA table row."""
-    x_mm = float(re.search(r"x=(-?[\d.]+) mm", r["contraction_or_length"]).group(1))
-    return float(r["pressure_value"]) * 1e5, x_mm * 1e-3
 
 
 def hung_weight_N(r):
@@ -120,7 +109,7 @@ TABLE3_MATCHES = {(2.04, 24.45), (3.634, 59.67), (2.815, 10.542), (3.227, 11.1)}
 
 
 def _table3(r):
-    return is_acra_point(r) and re.search(r"estimate (-?[\d.]+)", r["tolerance_or_reported_error"])
+    return is_acra_point(r) and table3_estimate_N(r) is not None
 
 
 @pytest.mark.parametrize("i, r", [
@@ -130,8 +119,7 @@ def _table3(r):
     for i, r in enumerate(ROWS) if _table3(r)])
 def test_acra_table3_estimate(i, r):
     P, x = acra_point(r)
-    estimate = float(re.search(r"estimate (-?[\d.]+)", r["tolerance_or_reported_error"]).group(1))
-    assert POLY.force_N(x, P) == pytest.approx(estimate, abs=0.1)
+    assert POLY.force_N(x, P) == pytest.approx(table3_estimate_N(r), abs=0.1)
 
 
 @pytest.mark.parametrize("i, r", rows(lambda r: _model(r).startswith("A-2") and "plateau" in r["tolerance_or_reported_error"]))
@@ -150,8 +138,7 @@ def test_chou_hannaford_constant_friction_value(i, r):
 # --------------------------------------------------------------------- the survey's miniature muscle
 def _stiffness_N_per_mm(model, over, P=7.58e5, load=0.05):
     m = get(model).build({**MPAM45, **over})
-    x, h = m.free_contraction_m(P, load), 1e-6
-    return -(m.force_N(x + h, P) - m.force_N(x - h, P)) / (2 * h) / 1e3
+    return m.stiffness_N_per_m(m.free_contraction_m(P, load), P) / 1e3
 
 
 @pytest.mark.parametrize("i, r", rows(lambda r: _model(r).startswith("EXPERIMENT") and "45mm" in r["muscle"]))

@@ -1,36 +1,42 @@
 """Static (quasi-static) force of the muscle, F_static(x, p).
 
-Positive force contracts the muscle (lifts the load).  The models themselves
-live in the static-model library :mod:`pamsim.static_models` (one registry);
-``STATIC_FORCE_MODELS`` is a read-only view of it that maps a scenario's
-``static_force`` key to a builder taking the muscle's parameters.
+Positive force contracts the muscle (lifts the load).  The models live in the
+static-model library :mod:`pamsim.static_models` (one registry); any of them
+meets :class:`pamsim.elements.contracts.StaticForce`.  ``STATIC_FORCE_MODELS``
+is a read-only view of that registry which maps a scenario's ``static_force``
+key to a builder ``builder(params, options)`` of the force as the dynamics
+apply it (:func:`pamsim.elements.muscle_force.dynamics_static_force`: tabulated
+if implicit, clipped at zero unless ``static_force_negative = "keep"``).
+Whether a model applies to a muscle is checked where the muscle is known
+(:func:`pamsim.muscle_setup.applicable_model`).
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Callable, Iterator, Protocol
+from typing import Iterator
 
 from ..static_models import REGISTRY
 from ..static_models.acra2012 import Acra2012Polynomial
+from .contracts import NO_OPTIONS, Builder, ElementOptions, StaticForce
+from .muscle_force import dynamics_static_force
+from .stops import EndStops
 
-__all__ = ["StaticForceModel", "Acra2012Polynomial", "STATIC_FORCE_MODELS"]
-
-
-class StaticForceModel(Protocol):
-    """What the simulator needs of a static force model."""
-
-    name: str
-
-    def force_N(self, x_m, p_gauge_Pa):
-        """Static force [N] at contraction ``x_m`` [m] and gauge pressure [Pa]."""
+__all__ = ["Acra2012Polynomial", "STATIC_FORCE_MODELS"]
 
 
-class _Builders(Mapping[str, Callable]):
-    """name -> ``spec.build`` for every model of the library registry."""
+class _Builders(Mapping[str, Builder[StaticForce]]):
+    """name -> ``builder(params, options)`` for every library model."""
 
-    def __getitem__(self, name: str) -> Callable:
-        return REGISTRY[name].build
+    def __getitem__(self, name: str) -> Builder[StaticForce]:
+        if name not in REGISTRY:
+            raise KeyError(name)
+
+        def build(params: Mapping[str, float], options: ElementOptions = NO_OPTIONS) -> StaticForce:
+            return dynamics_static_force(name, params, (0.0, EndStops.from_parameters(params).x_high_m),
+                                         options.get("static_force_variant"),
+                                         options.get("static_force_negative", "clip"))
+        return build
 
     def __iter__(self) -> Iterator[str]:
         return iter(REGISTRY)
@@ -39,4 +45,4 @@ class _Builders(Mapping[str, Callable]):
         return len(REGISTRY)
 
 
-STATIC_FORCE_MODELS: Mapping[str, Callable] = _Builders()
+STATIC_FORCE_MODELS: Mapping[str, Builder[StaticForce]] = _Builders()

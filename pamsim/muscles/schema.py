@@ -148,7 +148,7 @@ KNOWN = MappingProxyType({
     "g_m_s2": _pos("gravity"),
     "fit_x_min_m": _any("fitted range of the polynomial: lowest contraction"),
     "fit_x_max_m": _any("fitted range of the polynomial: highest contraction"),
-    "fit_p_max_Pa": _pos("fitted range of the polynomial: highest pressure"),
+    "fit_p_max_Pa": _any("fitted range of the polynomial: highest pressure"),
     "stop_restitution": Known("coefficient of restitution of both stops", 0.0, 1.0),
 })
 """name -> :class:`Known` for every parameter a muscle file may give."""

@@ -14,7 +14,7 @@ from ..constants import PA_PER_BAR
 from .base import Domain, StaticForce, StaticModelSpec
 from .sources import ACRA2012
 
-SOURCE = ACRA2012 + ", eqs. (3) and (11)"
+SOURCE = ACRA2012 + " eqs. (3) and (11)"
 COEFFICIENTS = ("K1_N_per_bar_m2", "K2_N_per_bar_m", "C1_N_per_bar", "S1_N_per_m2", "S2_N_per_m", "S3_N")
 
 
@@ -36,7 +36,8 @@ class Acra2012Polynomial(StaticForce):
     name: str = "acra2012_polynomial"
 
     @classmethod
-    def from_parameters(cls, p: Mapping[str, float]) -> "Acra2012Polynomial":
+    def from_parameters(cls, p: Mapping[str, float], options: Mapping[str, str] | None = None) -> "Acra2012Polynomial":
+        """Build from a parameter mapping; ``options`` (the scenario's model choices) is not used."""
         domain = Domain(p.get("fit_x_min_m", -math.inf), p.get("fit_x_max_m", math.inf),
                         0.0, p.get("fit_p_max_Pa", math.inf))
         return cls(*(p[k] for k in COEFFICIENTS), domain=domain)

@@ -82,17 +82,21 @@ class StaticForce:
         return self.force_N(x_m, p_gauge_Pa)
 
     def blocked_force_N(self, p_gauge_Pa):
-        """Force [N] at zero contraction (the blocked force)."""
-        return self.force_N(0.0 * np.asarray(p_gauge_Pa, dtype=float) if np.ndim(p_gauge_Pa) else 0.0,
-                            p_gauge_Pa)
+        """Force [N] at zero contraction (the blocked force); ``p_gauge_Pa`` a float or an array."""
+        return self.force_N(np.zeros_like(p_gauge_Pa, dtype=float) if np.ndim(p_gauge_Pa) else 0.0, p_gauge_Pa)
+
+    def stiffness_N_per_m(self, x_m, p_gauge_Pa, h_m: float = 1e-7):
+        """Axial stiffness ``-dF/dx`` [N/m] by a central difference of step ``h_m`` (no domain check)."""
+        return (self.force_N(x_m - h_m, p_gauge_Pa) - self.force_N(x_m + h_m, p_gauge_Pa)) / (2.0 * h_m)
 
     def free_contraction_m(self, p_gauge_Pa: float, load_N: float = 0.0, n_scan: int = 200) -> float:
         """Contraction [m] at which the force equals ``load_N`` (static equilibrium).
 
-        The domain is scanned from its low end for the first fall of
+        The domain is scanned from ``max(x_min_m, 0)`` (the muscle at rest or,
+        for a domain that starts above zero, its low end) for the first fall of
         ``force_N - load_N`` through zero, which is then refined by ``brentq``.
-        Returns the domain's low end when the muscle cannot lift the load there,
-        and ``nan`` when the force stays above the load over the whole domain.
+        Returns that start when the muscle cannot lift the load there, and
+        ``nan`` when the force stays above the load over the whole domain.
         """
         p = float(p_gauge_Pa)
         lo = max(self.domain.x_min_m, 0.0) if self.domain.x_max_m > 0.0 else self.domain.x_min_m

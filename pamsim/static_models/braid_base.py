@@ -64,9 +64,20 @@ class BladderModel(BraidModel):
         L_fill = self.L0 - x_fill
         return self.L0 - brentq(lambda L: self.tip_length_m(L) - L_fill, L_fill, self.L0, xtol=1e-15) - margin
 
+    implicit_tips = False
+    """Evaluate the tip radius at the corrected length, ``L' = L - k (R(L') - R0)`` (Kothera leaves it open)."""
+
     def tip_length_m(self, L):
-        """Tip-corrected cylindrical length ``L - k (R(L) - R0)`` [m]."""
-        return L - self.tip_factor * (self.g.radius_m(L) - self.g.r0)
+        """Tip-corrected cylindrical length ``L - k (R(L) - R0)`` [m], or its implicit form.
+
+        The implicit form is solved by fixed-point iteration from the explicit value;
+        the map contracts by ``k |dR/dL|``, well below one inside the domain.
+        """
+        Lc = L - self.tip_factor * (self.g.radius_m(L) - self.g.r0)
+        if self.implicit_tips:
+            for _ in range(60):
+                Lc = L - self.tip_factor * (self.g.radius_m(Lc) - self.g.r0)
+        return Lc
 
     def effective_length_m(self, x_m):
         """Length at which the cylinder formulas are evaluated: ``L`` or the tip-corrected ``L'``."""

@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 
 from .base import StaticModelSpec
-from .braid_base import GEOMETRY, WALL, BladderModel, BraidModel
+from .braid_base import WALL, BladderModel, BraidModel
 from .sources import SURVEY
 
 HOCKING_OPTIONAL = {"hocking_E2_Pa": 0.0, "hocking_E3_Pa": 0.0, "hocking_P_c_Pa": 0.0}

@@ -28,6 +28,7 @@ class KotheraEnergy(BladderModel):
     def __init__(self, params, variant="default", *, name, stretch, braid, tips):
         self.name, self.stretch = name, stretch
         self.tip_factor = 2.0 if tips else 0.0
+        self.implicit_tips = variant == "implicit_radius"
         super().__init__(params, variant)
         self.energy = MooneyRivlin(params["C10_Pa"], params["C01_Pa"])
         g = self.g
@@ -122,7 +123,8 @@ SPECS = (
                     summary="K-4: Gaylord - corrected Mooney-Rivlin - braid stretch"),
     StaticModelSpec("kothera_energy_tips", "closed-form", f"{KOTHERA2009} eqs. (23)-(25)",
                     WALL + MOONEY_RIVLIN + BRAID, _energy("kothera_energy_tips", "mean_radius", True, True),
-                    summary="K-5: K-4 evaluated at the tip-corrected length"),
+                    variants=("explicit_radius", "implicit_radius"),
+                    summary="K-5: K-4 evaluated at the tip-corrected length (tip radius R(L), or R(L') implicitly)"),
     StaticModelSpec("kothera_force_balance", "closed-form",
                     f"{KOTHERA2009} eqs. (26)-(29), hoop-term sign corrected (= Ferraresi, {SURVEY} eq. (16), repaired)",
                     WALL + ("E_bladder_Pa",), KotheraForceBalance, variants=("corrected", "printed"),

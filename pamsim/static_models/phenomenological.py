@@ -140,31 +140,48 @@ class Takosoglu(NormalisedGaylord):
         return self.a * p_gauge_Pa * (q1 * (1.0 - x_m / self.L0) ** n - self.q2)
 
 
+def _bundle(e, p, c):
+    return c["kappa2"] + p * (c["kappa1"] * (1.0 - e) ** 2 + c["kappa3"])
+
+
+def _poly46(e, p, c):
+    return (c["k1"] + (c["k2"] + c["k3"] * e) * e) * p + c["k4"] + (c["k5"] + (c["k6"] + (c["k7"] + c["k8"] * e) * e) * e) * e
+
+
+def _poly47(e, p, c):
+    return c["k1"] + (c["k2"] + c["k3"] * e) * e + (c["k4"] + c["k5"] * e) * p
+
+
+def _poly48(e, p, c):
+    return ((c["k1"] * p + c["k2"]) * p + c["k3"]) * e + c["k4"] * p + c["k5"]
+
+
+def _linear49(e, p, c):
+    return c["k1"] * c["Fmax"] * (1.0 - e / c["eps"]) + 0.0 * p  # 0 p: broadcasts like the others
+
+
+LAWS = {"mpam_bundle_empirical": _bundle, "empirical_poly46": _poly46, "empirical_poly47": _poly47,
+        "empirical_poly48": _poly48, "empirical_linear": _linear49}
+"""name -> ``law(eps, p, coefficients)``: survey eqs. (41), (46), (47), (48) without its rate term, (49)."""
+
+
 class Empirical(StaticForce):
     """Survey eqs. (41)/(46)-(49): polynomials in ``eps = x/L0`` and ``p`` with fitted coefficients.
 
-    Only ``L0_m`` is needed; the domain is ``0 <= eps < 1`` (``eps <= eps_max`` for eq. 49).
+    Only ``L0_m`` is needed; the domain is ``0 <= eps <= 0.99`` (``eps <= eps_max`` for eq. 49).
+    Coefficients are named ``<law>_<symbol>_<unit>``; the law sees them by symbol.
     """
 
     def __init__(self, params, variant="default", *, name, coefficients):
         self.name = name
+        self.law = LAWS[name]
         self.L0 = params["L0_m"]
         self.c = {k.split("_")[1]: params[k] for k in coefficients}
         x_max = params["emp49_eps_max"] * self.L0 if name == "empirical_linear" else 0.99 * self.L0
         self.domain = Domain(0.0, x_max, 0.0, rated_pressure_Pa(params))
 
     def force_N(self, x_m, p_gauge_Pa):
-        e, p, c = x_m / self.L0, p_gauge_Pa, self.c
-        if self.name == "mpam_bundle_empirical":
-            return c["kappa2"] + p * (c["kappa1"] * (1.0 - e) ** 2 + c["kappa3"])
-        if self.name == "empirical_poly46":
-            return ((c["k1"] + (c["k2"] + c["k3"] * e) * e) * p
-                    + c["k4"] + (c["k5"] + (c["k6"] + (c["k7"] + c["k8"] * e) * e) * e) * e)
-        if self.name == "empirical_poly47":
-            return c["k1"] + (c["k2"] + c["k3"] * e) * e + (c["k4"] + c["k5"] * e) * p
-        if self.name == "empirical_poly48":
-            return ((c["k1"] * p + c["k2"]) * p + c["k3"]) * e + c["k4"] * p + c["k5"]
-        return c["k1"] * c["Fmax"] * (1.0 - e / c["eps"]) + 0.0 * p
+        return self.law(x_m / self.L0, p_gauge_Pa, self.c)
 
 
 def _empirical(name, coefficients):
