@@ -4,8 +4,11 @@ The fig4 scenario (ACRA 2012 Figure 4: valve step to 3.6 bar at 1 s, 8 s, LSODA 
 run with each library model on the Shadow muscle where the model applies to it; a model that needs
 values the Shadow muscle does not give (wall thickness, bladder constants, fibres) runs the same
 scenario on Kothera's actuator 5a (friction and damping: the assumed defaults), with the load at
-30 % of that model's blocked force at 3.6 bar.  One more row forces Kothera's energy model through
-the table the dynamics use for implicit models, to show what a tabulated model costs.
+30 % of that model's blocked force at 3.6 bar.  The runs differ in their dynamics too (a model that
+lifts the load higher or a muscle without friction oscillates longer and takes more steps), so the
+ratio is the cost of a model's whole run, not of its force evaluation alone.  Two more rows force the
+polynomial and Kothera's energy model through the table the dynamics use for implicit models: the
+polynomial's table follows the polynomial's own trajectory, so its ratio is the table's cost.
 
 Target (issue): a paper scenario with an implicit (tabulated) model costs at most 3x the
 polynomial's run.  Each figure is the median of --repeats runs (default 3), wall time of
@@ -94,23 +97,27 @@ def main() -> None:
         t, res = _time(sc, args.repeats)
         print(f"{model:38s} {sc.muscle.name:24s} {REGISTRY[model].kind:12s} {t * 1e3:10.1f} {t / t_poly:7.2f} "
               f"{res.x_m[-1] * 1e3:12.3f}")
-    # The table path: kothera_energy marked implicit, so the dynamics tabulate it.
-    implicit = dataclasses.replace(REGISTRY["kothera_energy"], kind="implicit")
-    original = muscle_force.get
-    muscle_force.get = lambda name: implicit if name == "kothera_energy" else original(name)
-    try:
-        t_build = time.perf_counter()
-        sc = _scenario(base, "kothera_energy")
-        t_build = time.perf_counter() - t_build
-        t, res = _time(sc, args.repeats)
-    finally:
-        muscle_force.get = original
-    ratio = t / t_poly
-    print(f"{'kothera_energy as a table':38s} {sc.muscle.name:24s} {'(tabulated)':12s} {t * 1e3:10.1f} {ratio:7.2f} "
-          f"{res.x_m[-1] * 1e3:12.3f}")
-    print(f"table build (401 x 41 points, once per muscle and model): {t_build * 1e3:.0f} ms")
-    print(f"tabulated model vs polynomial: {ratio:.2f}x (target <= {TARGET_RATIO_IMPLICIT:g}x: "
-          f"{'met' if ratio <= TARGET_RATIO_IMPLICIT else 'NOT met'})")
+    # The table path: a model marked implicit, so the dynamics tabulate it.  The polynomial through its
+    # table follows the same trajectory as the polynomial itself, so the ratio is the table's own cost.
+    for model in ("acra2012_polynomial", "kothera_energy"):
+        implicit = dataclasses.replace(REGISTRY[model], kind="implicit")
+        original = muscle_force.get
+        muscle_force.get = lambda name, m=model, s=implicit: s if name == m else original(name)
+        try:
+            t_build = time.perf_counter()
+            sc = _scenario(base, model)
+            t_build = time.perf_counter() - t_build
+            t, res = _time(sc, args.repeats)
+        finally:
+            muscle_force.get = original
+        t_closed, _ = _time(_scenario(base, model), args.repeats)
+        print(f"{model + ' as a table':38s} {sc.muscle.name:24s} {'(tabulated)':12s} {t * 1e3:10.1f} {t / t_poly:7.2f} "
+              f"{res.x_m[-1] * 1e3:12.3f}   vs its closed form: {t / t_closed:.2f}x; "
+              f"scenario validation with the table build: {t_build * 1e3:.0f} ms")
+        if model == "acra2012_polynomial":
+            ratio = t / t_poly
+            print(f"  the fig4 run through a table costs {ratio:.2f}x the polynomial's run (target <= "
+                  f"{TARGET_RATIO_IMPLICIT:g}x: {'met' if ratio <= TARGET_RATIO_IMPLICIT else 'NOT met'})")
     table_errors()
 
 
