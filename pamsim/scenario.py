@@ -154,14 +154,20 @@ class Scenario:
         Keys are merged into each section, except that a change of
         ``pressure.source`` replaces the whole ``[pressure]`` table (the keys of
         one source mean nothing to the other), and naming one of a pair of
-        alternatives (``weight_N``/``mass_kg``, ``supply_gauge_bar``/``supply_gauge_Pa``)
-        drops the other.
+        alternatives (``weight_N``/``mass_kg``, ``supply_gauge_bar``/``supply_gauge_Pa``,
+        ``muscle``/``parameter_set``) drops the other.  A new muscle without a
+        new ``static_force`` takes its own default model if the old muscle ran its default.
         """
         spec = copy.deepcopy(dict(self.spec))
         for section, values in changes.items():
             old = spec.get(section, {})
             if section == "pressure" and "source" in values and values["source"] != old.get("source"):
                 old = {}
+            if section == "model" and ({"muscle", "parameter_set"} & set(values)):
+                old = {k: v for k, v in old.items() if k not in ("muscle", "parameter_set")}
+                if "static_force" not in values and old.get("static_force") == self.muscle.default_static_force:
+                    old.pop("static_force", None)
+                    old.pop("static_force_variant", None)
             spec[section] = {**old, **copy.deepcopy(dict(values))}
             for pair in (("weight_N", "mass_kg"), ("supply_gauge_bar", "supply_gauge_Pa")):
                 given = [k for k in pair if k in values]

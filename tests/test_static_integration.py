@@ -414,3 +414,12 @@ def test_docs_list_the_dynamics_defaults():
     from pamsim.cli.params import defaults_table
 
     assert defaults_table() in (ROOT / "docs" / "model.md").read_text()
+
+
+def test_with_changes_to_another_muscle_takes_its_default_model():
+    base = pamsim.load_scenario(SCENARIOS / "acra2012_fig4.toml")  # parameter_set = the Shadow muscle
+    k = base.with_changes({"model": {"muscle": "kothera2009_5a"}, "load": {"weight_N": 10.0}})
+    assert k.spec["model"]["static_force"] == load_muscle("kothera2009_5a").default_static_force
+    g = base.with_changes({"model": {"static_force": "gaylord"}})
+    assert g.with_changes({"model": {"parameter_set": "mpam_survey_45mm"}, "load": {"weight_N": 0.05},
+                           "pressure": {"supply_gauge_bar": 3.0}}).spec["model"]["static_force"] == "gaylord"
