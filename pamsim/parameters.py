@@ -110,6 +110,14 @@ class ParameterSet(Mapping[str, float]):
 
 
 
+LOAD_MASS = Parameter(
+    round(22.74 / 9.81, 6), "kg", "assumed: lower bound 1 g, about 1/280 of the paper's lightest load "
+    "(the 2.74 N holder); lighter loads make the hanging mass's dynamics needlessly stiff (a 1e-12 kg load "
+    "oscillates at MHz)", "hanging mass, holder included; start value: the paper's 22.74 N (Fig. 4)", lower=1e-3)
+"""The hanging load's mass and its range: checked by ``pamsim.Scenario`` and, through the FMU's
+generated variable table, by the FMU's ``load_mass_kg`` input."""
+
+
 _SHADOW = "the Shadow 6 mm x 300 mm muscle's value (ACRA 2012 paper)"
 DYNAMICS_DEFAULTS: Mapping[str, tuple[float, str]] = MappingProxyType({
     # Friction and damping: measured for the Shadow muscle only.

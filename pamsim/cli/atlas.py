@@ -4,8 +4,6 @@ from __future__ import annotations
 
 import argparse
 
-from ..atlas import build_atlas
-from ..atomic import ensure_output_dir
 from ..errors import InputError
 from . import muscle_args
 
@@ -29,6 +27,9 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..atlas import build_atlas
+    from ..atomic import ensure_output_dir
+
     pressures = None
     if args.pressures_bar is not None:
         try:

@@ -5,7 +5,6 @@ from __future__ import annotations
 import argparse
 import json
 
-from ..static_models import REGISTRY
 
 
 def register(sub) -> None:
@@ -17,6 +16,8 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..static_models import REGISTRY
+
     rows = [{"name": s.name, "kind": s.kind, "source": s.source, "parameters": list(s.parameters),
              "optional": dict(s.optional), "variants": list(s.variants)} for s in REGISTRY.values()]
     if args.json:

@@ -5,7 +5,6 @@ from __future__ import annotations
 import argparse
 import json
 
-from ..muscles import load_muscle, shipped_names
 
 
 def register(sub) -> None:
@@ -17,6 +16,8 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..muscles import load_muscle, shipped_names
+
     rows = []
     for name in shipped_names():
         m = load_muscle(name)

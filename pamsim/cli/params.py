@@ -6,8 +6,6 @@ import argparse
 import json
 import math
 
-from ..muscles.schema import unit_of
-from ..parameters import DYNAMICS_DEFAULTS
 from . import muscle_args
 
 
@@ -53,6 +51,9 @@ def markdown_table(ps) -> str:
 
 def defaults_table() -> str:
     """The dynamics defaults of ``docs/model.md``; a test keeps the two identical."""
+    from ..muscles.schema import unit_of
+    from ..parameters import DYNAMICS_DEFAULTS
+
     lines = ["| name | value | unit | source |", "| --- | --- | --- | --- |"]
     for name, (value, source) in DYNAMICS_DEFAULTS.items():
         lines.append(f"| `{name}` | {value:.6g} | {unit_of(name)} | {source} |")

@@ -7,7 +7,6 @@ import json
 
 from ..constants import PA_PER_BAR
 from ..errors import InputError
-from ..static import static_report
 from . import finite_float, muscle_args
 
 
@@ -23,6 +22,8 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..static import static_report
+
     muscle, params, model = muscle_args.resolve(args)
     rating = params["rated_pressure_gauge_Pa"]
     if args.pressure_bar < 0 or args.pressure_bar * PA_PER_BAR > rating:

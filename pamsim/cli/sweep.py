@@ -8,8 +8,7 @@ import sys
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
-from ..atomic import ensure_output_dir
-from ..sweep import load_sweep, run_sweep
+from ..atomic import output_folder
 
 
 def _workers(text: str) -> int:
@@ -35,14 +34,16 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..sweep import load_sweep, run_sweep
+
     spec = load_sweep(args.sweep_file)
-    ensure_output_dir(args.output)  # before the runs, not after them
-    if args.workers == 1:
-        result = run_sweep(spec, None, progress=not args.no_progress)
-    else:
-        with ProcessPoolExecutor(max_workers=args.workers) as pool:
-            result = run_sweep(spec, pool, progress=not args.no_progress)
-    names = result.write(args.output)
+    with output_folder(args.output) as out:  # checked before the runs; removed again if nothing gets written
+        if args.workers == 1:
+            result = run_sweep(spec, None, progress=not args.no_progress)
+        else:
+            with ProcessPoolExecutor(max_workers=args.workers) as pool:
+                result = run_sweep(spec, pool, progress=not args.no_progress)
+        names = result.write(out)
     for failure in result.failures:
         print(f"pamsim: warning: failed run {failure}", file=sys.stderr)
     print(f"{spec.name}: {len(result.rows)} cases, {len(result.failures)} failed runs, "
