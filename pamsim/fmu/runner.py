@@ -102,9 +102,11 @@ def _refuse_unrepresented(scenario: Scenario) -> None:
     if model["static_force_negative"] != "clip":
         raise InputError(f"{scenario.origin}: the FMU clips a negative static force at zero, "
                          f"not model.static_force_negative = {model['static_force_negative']!r}")
+    # A muscle parameter that is not an FMU parameter (wall_thickness_m, E_bladder_Pa, ...) can only
+    # shape the static force; the FMU gets it baked into the force table.
     names = {v.name for v in VARIABLES if v.causality == "parameter" and v.kind == "real"}
     missing = [k for k in scenario.parameters if k not in names]
-    if missing:
+    if missing and model["static_force"] == "acra2012_polynomial":
         raise InputError(f"{scenario.origin}: the FMU has no parameter {missing[0]!r} "
                          f"(muscle {model['muscle']!r})")
 
@@ -117,7 +119,8 @@ def start_values(scenario: Scenario) -> dict[str, float | int]:
     _refuse_unrepresented(scenario)
     model = scenario.spec["model"]
     pressure = scenario.spec["pressure"]
-    values: dict[str, float | int] = {k: float(scenario.parameters[k]) for k in scenario.parameters}
+    names = {v.name for v in VARIABLES if v.causality == "parameter" and v.kind == "real"}
+    values: dict[str, float | int] = {k: float(scenario.parameters[k]) for k in scenario.parameters if k in names}
     values["static_force_model"] = STATIC_FORCE_CHOICES.index(
         "acra2012_polynomial" if model["static_force"] == "acra2012_polynomial" else "table")
     values["friction_model"] = FRICTION_CHOICES.index(model["friction"])
