@@ -15,12 +15,8 @@ NEGATIVE_FORCE_CHOICES = ("clip", "keep")
 """``static_force_negative`` choices: ``clip`` (default) sets a negative force to zero, ``keep`` applies it."""
 
 
-@dataclass(frozen=True)
-class ClippedStaticForce:
-    """``max(inner.force_N(x, p), 0)``, for floats and numpy arrays alike.
-
-    ``name`` and ``domain`` are the inner model's.
-    """
+class WrappedStaticForce:
+    """Base of a static model wrapped for the dynamics: ``name`` and ``domain`` are those of ``inner``."""
 
     inner: object
 
@@ -31,6 +27,13 @@ class ClippedStaticForce:
     @property
     def domain(self):
         return self.inner.domain
+
+
+@dataclass(frozen=True)
+class ClippedStaticForce(WrappedStaticForce):
+    """``max(inner.force_N(x, p), 0)``, for floats and numpy arrays alike."""
+
+    inner: object
 
     def force_N(self, x_m, p_gauge_Pa):
         """Pulling force [N] at contraction ``x_m`` [m] and gauge pressure [Pa], never negative."""

@@ -15,11 +15,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .force_clip import WrappedStaticForce
+
 _PROBE = 21
 
 
 @dataclass(frozen=True)
-class DomainClampedForce:
+class DomainClampedForce(WrappedStaticForce):
     """``inner.force_N`` at ``(x, p)`` moved into ``[x_lo, x_hi] x [p_lo, p_hi]`` [m, Pa]."""
 
     inner: object
@@ -27,14 +29,6 @@ class DomainClampedForce:
     x_hi: float
     p_lo: float
     p_hi: float
-
-    @property
-    def name(self) -> str:
-        return self.inner.name
-
-    @property
-    def domain(self):
-        return self.inner.domain
 
     def force_N(self, x_m, p_gauge_Pa):
         """Force [N] at the nearest point of the domain to ``(x_m, p_gauge_Pa)``."""

@@ -54,13 +54,16 @@ def tabulate_model(scenario: Scenario, points: tuple[int, int] = DEFAULT_POINTS)
     between the end stops and the gauge pressure from 0 to ``rated_pressure_gauge_Pa``, narrowed to
     the model's own ``domain`` where it declares one."""
     model = scenario.build_model()
+    # The raw library model: the C core clips a negative force itself, and a table of the clipped
+    # force would smear its kink over a cell.
+    force = scenario.static_model()
     x_lo, x_hi = model.stops.x_low_m, model.stops.x_high_m
     p_lo, p_hi = 0.0, float(scenario.parameters["rated_pressure_gauge_Pa"])
-    domain = getattr(model.static_force, "domain", None)
+    domain = getattr(force, "domain", None)
     if domain is not None:
         x_lo, x_hi = max(x_lo, domain.x_min_m), min(x_hi, domain.x_max_m)
         p_lo, p_hi = max(p_lo, domain.p_min_Pa), min(p_hi, domain.p_max_Pa)
-    return tabulate(model.static_force, (x_lo, x_hi), (p_lo, p_hi), points,
+    return tabulate(force, (x_lo, x_hi), (p_lo, p_hi), points,
                     model_name=scenario.spec["model"]["static_force"])
 
 

@@ -19,9 +19,15 @@ from types import MappingProxyType
 from typing import Callable, Mapping
 
 import numpy as np
-from scipy.optimize import brentq
 
 from ..errors import InputError
+
+def brentq(*args, **kwargs):
+    """``scipy.optimize.brentq``, imported on first use: ``pamsim static`` starts without scipy.optimize."""
+    from scipy.optimize import brentq as _brentq
+
+    return _brentq(*args, **kwargs)
+
 
 KINDS = ("closed-form", "implicit", "table")
 """closed-form: F(x, p) is an explicit formula; implicit: it needs a scalar root

@@ -4,9 +4,8 @@ from __future__ import annotations
 
 from typing import Mapping
 
-from scipy.optimize import brentq
 
-from .base import Domain, StaticForce, rated_pressure_Pa
+from .base import Domain, StaticForce, rated_pressure_Pa, brentq
 from .geometry import Braid
 
 GEOMETRY = ("L0_m", "r0_m", "theta0_deg")

@@ -17,7 +17,6 @@ import math
 from pathlib import Path
 
 import numpy as np
-from scipy.interpolate import RectBivariateSpline
 
 from ..errors import InputError
 from .base import Domain, StaticForce, StaticModelSpec
@@ -82,6 +81,8 @@ class ForceMap(StaticForce):
 
     def __init__(self, x_m: np.ndarray, p_Pa: np.ndarray, F_N: np.ndarray, origin: str = "<table>"):
         self.origin = origin
+        from scipy.interpolate import RectBivariateSpline  # on use: `pamsim static` starts without it
+
         self.spline = RectBivariateSpline(x_m, p_Pa, F_N, kx=min(3, len(x_m) - 1), ky=min(3, len(p_Pa) - 1), s=0)
         self.domain = Domain(float(x_m[0]), float(x_m[-1]), float(p_Pa[0]), float(p_Pa[-1]))
 

@@ -13,7 +13,7 @@ import math
 from dataclasses import dataclass
 from typing import Mapping
 
-from scipy.optimize import brentq
+from .base import brentq
 
 
 

@@ -30,8 +30,8 @@ import math
 from dataclasses import dataclass
 from typing import Mapping
 
-from scipy.optimize import brentq
 
+from .base import brentq
 from ..errors import InputError
 
 LOAD_TREATMENTS = ("neglected", "printed", "annulus")
