@@ -17,20 +17,21 @@ __version__ = "0.1.0"
 _WHERE = {
     "simulate": "api", "run": "api",
     "Mode": "model", "MuscleModel": "model",
-    "PARAMETER_SETS": "parameters", "ParameterSet": "parameters", "get_parameter_set": "parameters",
+    "ParameterSet": "parameters", "get_parameter_set": "parameters",
+    "load_muscle": "muscles",
     "Result": "result",
     "Scenario": "scenario", "ScenarioError": "scenario", "load_scenario": "scenario",
     "SolverFailure": "simulator", "SolverOptions": "simulator", "simulate_model": "simulator",
 }
 
 __all__ = ["simulate", "run", "load_scenario", "Scenario", "ScenarioError", "Result", "Mode", "MuscleModel",
-           "PARAMETER_SETS", "ParameterSet", "get_parameter_set", "SolverFailure", "SolverOptions",
-           "simulate_model"]
+           "ParameterSet", "get_parameter_set", "SolverFailure", "SolverOptions",
+           "simulate_model", "load_muscle", "static_models"]
 
 
 def __getattr__(name: str):
-    if name == "sweep":
-        return importlib.import_module(".sweep", __name__)  # importing it binds pamsim.sweep for good
+    if name in ("sweep", "static_models"):
+        return importlib.import_module(f".{name}", __name__)  # importing it binds pamsim.NAME for good
     if name not in _WHERE:
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
     value = getattr(importlib.import_module(f".{_WHERE[name]}", __name__), name)
@@ -39,4 +40,4 @@ def __getattr__(name: str):
 
 
 def __dir__():
-    return sorted(set(globals()) | set(_WHERE) | {"sweep"})
+    return sorted(set(globals()) | set(_WHERE) | {"sweep", "static_models"})

@@ -21,6 +21,10 @@ COMMANDS = (
     "pamsim.cli.fmu",
     "pamsim.cli.linearize",
     "pamsim.cli.params",
+    "pamsim.cli.models",
+    "pamsim.cli.muscles",
+    "pamsim.cli.force",
+    "pamsim.cli.atlas",
 )
 
 

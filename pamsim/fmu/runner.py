@@ -54,13 +54,16 @@ def tabulate_model(scenario: Scenario, points: tuple[int, int] = DEFAULT_POINTS)
     between the end stops and the gauge pressure from 0 to ``rated_pressure_gauge_Pa``, narrowed to
     the model's own ``domain`` where it declares one."""
     model = scenario.build_model()
+    # The raw library model: the C core clips a negative force itself, and a table of the clipped
+    # force would smear its kink over a cell.
+    force = scenario.static_model()
     x_lo, x_hi = model.stops.x_low_m, model.stops.x_high_m
     p_lo, p_hi = 0.0, float(scenario.parameters["rated_pressure_gauge_Pa"])
-    domain = getattr(model.static_force, "domain", None)
+    domain = getattr(force, "domain", None)
     if domain is not None:
         x_lo, x_hi = max(x_lo, domain.x_min_m), min(x_hi, domain.x_max_m)
         p_lo, p_hi = max(p_lo, domain.p_min_Pa), min(p_hi, domain.p_max_Pa)
-    return tabulate(model.static_force, (x_lo, x_hi), (p_lo, p_hi), points,
+    return tabulate(force, (x_lo, x_hi), (p_lo, p_hi), points,
                     model_name=scenario.spec["model"]["static_force"])
 
 
@@ -79,7 +82,8 @@ def force_table_for(scenario: Scenario) -> ForceTable | None:
 # the python backend.
 REPRESENTED = {
     "": {"name", "description", "model", "parameters", "load", "pressure", "simulation", "solver", "controller"},
-    "model": {"parameter_set", "static_force", "friction", "damping", "friction_negative_level"},
+    "model": {"muscle", "parameter_set", "static_force", "static_force_negative", "friction", "damping",
+              "friction_negative_level"},
     "load": {"weight_N", "mass_kg", "external_force"},
     "pressure": {"source", "supply_gauge_bar", "supply_gauge_Pa", "valve_open_time_s", "command", "prescribed",
                  "initial_gauge_bar"},
@@ -98,11 +102,16 @@ def _refuse_unrepresented(scenario: Scenario) -> None:
                 raise InputError(f"{scenario.origin}: the FMU cannot represent scenario key {full!r}; "
                                  "run it with the python backend")
     model = spec["model"]
+    if model["static_force_negative"] != "clip":
+        raise InputError(f"{scenario.origin}: the FMU clips a negative static force at zero, "
+                         f"not model.static_force_negative = {model['static_force_negative']!r}")
+    # A muscle parameter that is not an FMU parameter (wall_thickness_m, E_bladder_Pa, ...) can only
+    # shape the static force; the FMU gets it baked into the force table.
     names = {v.name for v in VARIABLES if v.causality == "parameter" and v.kind == "real"}
     missing = [k for k in scenario.parameters if k not in names]
-    if missing:
+    if missing and model["static_force"] == "acra2012_polynomial":
         raise InputError(f"{scenario.origin}: the FMU has no parameter {missing[0]!r} "
-                         f"(parameter set {model['parameter_set']!r})")
+                         f"(muscle {model['muscle']!r})")
 
 
 def start_values(scenario: Scenario) -> dict[str, float | int]:
@@ -113,7 +122,8 @@ def start_values(scenario: Scenario) -> dict[str, float | int]:
     _refuse_unrepresented(scenario)
     model = scenario.spec["model"]
     pressure = scenario.spec["pressure"]
-    values: dict[str, float | int] = {k: float(scenario.parameters[k]) for k in scenario.parameters}
+    names = {v.name for v in VARIABLES if v.causality == "parameter" and v.kind == "real"}
+    values: dict[str, float | int] = {k: float(scenario.parameters[k]) for k in scenario.parameters if k in names}
     values["static_force_model"] = STATIC_FORCE_CHOICES.index(
         "acra2012_polynomial" if model["static_force"] == "acra2012_polynomial" else "table")
     values["friction_model"] = FRICTION_CHOICES.index(model["friction"])

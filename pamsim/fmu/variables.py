@@ -44,7 +44,7 @@ VALUE_REFERENCES = {
     # The parameter set shadow_6x300_acra2012.
     "K1_N_per_bar_m2": 1, "K2_N_per_bar_m": 2, "C1_N_per_bar": 3, "S1_N_per_m2": 4, "S2_N_per_m": 5, "S3_N": 6,
     "N2_N_per_bar_m2": 7, "N1_N_per_bar_m": 8, "N0_N_per_bar": 9, "phi_bar_per_kg": 10, "coulomb_constant_N": 11,
-    "D1_N_s_per_m": 12, "D2_N_s2_per_m2": 13, "L0_m": 14, "D0_m": 15, "braid_angle_rest_deg": 16,
+    "D1_N_s_per_m": 12, "D2_N_s2_per_m2": 13, "L0_m": 14, "r0_m": 15, "theta0_deg": 16,
     "dead_volume_m3": 17, "valve_C_m3_per_s_Pa": 18, "valve_b": 19, "valve_laminar_ratio": 20, "rho0_kg_m3": 21,
     "T0_K": 22, "polytropic_index": 23, "T_supply_K": 24, "R_J_per_kg_K": 25, "p_atm_Pa": 26, "g_m_s2": 27,
     "rated_pressure_gauge_Pa": 28, "fit_x_min_m": 29, "fit_x_max_m": 30, "fit_p_max_Pa": 31, "stop_restitution": 32,
@@ -62,7 +62,8 @@ VALUE_REFERENCES = {
 }
 """Pinned value references.  Never change or reuse a number: a renamed variable keeps its number
 (``p_gauge_Pa``, ``F_static_N`` and ``F_friction_N`` were ``pressure_gauge_Pa``,
-``muscle_force_N`` and ``friction_force_N``), a removed one leaves a gap."""
+``muscle_force_N`` and ``friction_force_N``; ``r0_m`` and ``theta0_deg`` were ``D0_m`` and
+``braid_angle_rest_deg``), a removed one leaves a gap."""
 
 
 @dataclass(frozen=True)
@@ -177,8 +178,8 @@ def _table() -> tuple[Variable, ...]:
                  initial_depends_on=("p_atm_Pa", "initial_pressure_gauge_Pa")),
         Variable("air_mass_kg", "real", "local", "continuous", "air mass in the chamber (valve source) [kg]",
                  "kg", initial="calculated", nominal=1e-5,
-                 initial_depends_on=("p_atm_Pa", "initial_pressure_gauge_Pa", "initial_contraction_m", "L0_m", "D0_m",
-                                     "braid_angle_rest_deg", "dead_volume_m3", "R_J_per_kg_K", "T_supply_K")),
+                 initial_depends_on=("p_atm_Pa", "initial_pressure_gauge_Pa", "initial_contraction_m", "L0_m", "r0_m",
+                                     "theta0_deg", "dead_volume_m3", "R_J_per_kg_K", "T_supply_K")),
         Variable("der(contraction_m)", "real", "local", "continuous", "d contraction / dt [m/s]", "m/s",
                  initial="calculated", derivative_of="contraction_m", depends_on=(V,)),
         Variable("der(velocity_m_s)", "real", "local", "continuous", "acceleration [m/s^2]", "m/s^2",
