@@ -40,6 +40,25 @@ from .sources import SURVEY
 LOAD_TREATMENTS = ("neglected", "printed", "annulus")
 
 
+def davis_min_angle_rad(strands: float, strand_radius_m: float, r_o_m: float) -> float:
+    """Davis's smallest braid angle ``theta_min``, where the strands touch (survey eq. 10)."""
+    return 0.5 * math.asin(strand_radius_m * strands / (math.pi * r_o_m))
+
+
+def davis_factor(strands: float, strand_radius_m: float, r_o_m: float) -> float:
+    """``sin^2(theta_min) cos^2(theta_min)`` (the contact fraction's numerator in survey eq. 79)."""
+    tmin = davis_min_angle_rad(strands, strand_radius_m, r_o_m)
+    return (math.sin(tmin) * math.cos(tmin)) ** 2
+
+
+def contact_area_m2(davis: float, theta: float, r_m: float, r_b_m: float, l0_m: float, cone_m: float,
+                    c3: float) -> float:
+    """Survey eq. (79): braid-tube contact area, Davis's fraction of the cylinder plus the full conical ends."""
+    sc = (math.sin(theta) * math.cos(theta)) ** 2
+    return (davis / sc * 2 * math.pi * r_m * (l0_m - 2 * cone_m) * (1 + c3)
+            + 2 * math.pi * (r_b_m + r_m) * cone_m * (1 + c3))
+
+
 @dataclass(frozen=True)
 class TwoPhaseTube:
     """Silicone tube and sleeve of a miniature muscle (SI units).
@@ -74,16 +93,40 @@ class TwoPhaseTube:
         area = {"neglected": math.inf, "printed": math.pi * self.r_i ** 2, "annulus": math.pi * D}[load]
         return p_gauge_Pa * self.r_i ** 2 / D + load_N / area
 
-    def phase1_displacements_m(self, p_gauge_Pa: float, load_N: float = 0.0, load: str = "neglected") -> tuple[float, float]:
-        """Survey eq. (62): radial displacement of the tube's outer surface and axial end displacement [m]
-        (positive = the muscle lengthens)."""
+    def displacements_m(self, p_gauge_Pa: float, P_s_Pa: float) -> tuple[float, float]:
+        """Survey eq. (62) for end stress ``P_s_Pa``: radial displacement of the tube's outer surface and
+        axial end displacement [m] (positive = the muscle lengthens)."""
         L1, L2 = self.lame
         D = self.r_o ** 2 - self.r_i ** 2
         k = 1.0 / (L2 * (3 * L1 + 2 * L2))
-        Ps = self.end_stress_Pa(p_gauge_Pa, load_N, load)
-        u_r = self.r_o * k * (2 * (L1 + L2) * self.r_i ** 2 / D * p_gauge_Pa - L1 / 2 * Ps)
-        u_z = L1 * self.l0 * k * (-p_gauge_Pa * self.r_i ** 2 / D + Ps * (L1 + L2) / L1)
+        u_r = self.r_o * k * (2 * (L1 + L2) * self.r_i ** 2 / D * p_gauge_Pa - L1 / 2 * P_s_Pa)
+        u_z = L1 * self.l0 * k * (-p_gauge_Pa * self.r_i ** 2 / D + P_s_Pa * (L1 + L2) / L1)
         return u_r, u_z
+
+    def end_stress_for_contraction_Pa(self, p_gauge_Pa: float, x_m: float) -> float:
+        """The end stress ``P_s`` at which eq. (62)'s axial displacement is ``-x_m`` (contraction imposed)."""
+        L1, L2 = self.lame
+        D = self.r_o ** 2 - self.r_i ** 2
+        k = 1.0 / (L2 * (3 * L1 + 2 * L2))
+        return (-x_m / (self.l0 * k) + L1 * p_gauge_Pa * self.r_i ** 2 / D) / (L1 + L2)
+
+    def phase1_displacements_m(self, p_gauge_Pa: float, load_N: float = 0.0, load: str = "neglected") -> tuple[float, float]:
+        """Survey eq. (62) under an axial load: ``(u_r, u_z)`` [m] (positive ``u_z`` = the muscle lengthens)."""
+        return self.displacements_m(p_gauge_Pa, self.end_stress_Pa(p_gauge_Pa, load_N, load))
+
+    def sleeve_gap_m(self, u_r_m: float, c3: float) -> float:
+        """Survey eq. (68): tube radius minus sleeve radius for tube displacement ``u_r_m`` and axial strain ``c3``.
+
+        Raises
+        ------
+        InputError
+            When ``c3`` lies beyond the braid's kinematic limit (no sleeve radius exists).
+        """
+        c = math.cos(self.theta0) * (1 + c3)
+        if c >= 1.0:
+            raise InputError(f"two-phase model: the tube's axial strain {c3:.3g} lies beyond the braid's kinematic limit")
+        r_b = self.r_o + self.gap
+        return u_r_m - self.gap - r_b * (math.sqrt(1 - c * c) / math.sin(self.theta0) - 1)
 
     def contact_gap_m(self, p_gauge_Pa: float, load_N: float = 0.0, load: str = "neglected") -> float:
         """Survey eq. (69) rebuilt: tube radius minus sleeve radius (zero at the inflection pressure).
@@ -94,12 +137,10 @@ class TwoPhaseTube:
             When the tube is stretched past the braid's kinematic limit (no sleeve radius exists).
         """
         u_r, u_z = self.phase1_displacements_m(p_gauge_Pa, load_N, load)
-        c = math.cos(self.theta0) * (1 + u_z / self.l0)
-        if c >= 1.0:
-            raise InputError(f"two-phase model: load = {load!r}: the tube's axial strain {u_z / self.l0:.3g} at "
-                             f"{p_gauge_Pa:g} Pa lies beyond the braid's kinematic limit")
-        r_b = self.r_o + self.gap
-        return u_r - self.gap - r_b * (math.sqrt(1 - c * c) / math.sin(self.theta0) - 1)
+        try:
+            return self.sleeve_gap_m(u_r, u_z / self.l0)
+        except InputError as e:
+            raise InputError(f"two-phase model: load = {load!r}: at {p_gauge_Pa:g} Pa: {e}") from None
 
     def inflection_pressure_Pa(self, load_N: float = 0.0, load: str = "neglected", p_max_Pa: float = 1e7) -> float:
         """Gauge pressure at which the tube touches the sleeve (end of phase 1), by ``brentq``.
@@ -120,6 +161,18 @@ class TwoPhaseTube:
             raise InputError(f"two-phase model: no contact below {p_max_Pa:g} Pa")
         return brentq(lambda p: self.contact_gap_m(p, load_N, load), 0.0, p_max_Pa, xtol=1e-6)
 
+    def constants(self, P: float, P_o: float, P_s: float, c1_sign: float = -1.0) -> tuple[float, float, float]:
+        """Survey eq. (60): ``(c1, c2, c3)`` for inner, outer and end pressures [Pa]; ``c1_sign`` is the sign
+        of ``P_o r_o^2`` in ``c1`` (-1 the specification's correction, +1 as printed)."""
+        L1, L2 = self.lame
+        ro, ri = self.r_o, self.r_i
+        D = ro ** 2 - ri ** 2
+        k = 1.0 / (L2 * (3 * L1 + 2 * L2))
+        c1 = (L1 + 2 * L2) * k / 2 * ((P * ri ** 2 + c1_sign * P_o * ro ** 2) / D - P_s * L1 / (L1 + 2 * L2))
+        c2 = ri ** 2 * ro ** 2 * (P - P_o) / (2 * L2 * D)
+        c3 = L1 * k * ((-P * ri ** 2 + P_o * ro ** 2) / D + P_s * (L1 + L2) / L1)
+        return c1, c2, c3
+
     def phase2_solutions(self, p_gauge_Pa: float, strands: float, strand_radius_m: float, E_nylon_Pa: float,
                          cone_length_m: float, c1_sign: float = -1.0, n_scan: int = 4000) -> list[dict]:
         """Every braid angle solving the phase-2 equations at ``p_gauge_Pa`` (scan + ``brentq``).
@@ -137,22 +190,18 @@ class TwoPhaseTube:
         k = 1.0 / (L2 * (3 * L1 + 2 * L2))
         nyl = strands * math.pi * strand_radius_m ** 2 * E_nylon_Pa
         f_nyl = nyl / (nyl + math.cos(th0) * A_sil * self.E)  # share of F_e carried by the braid, eq. (74)
-        tmin = 0.5 * math.asin(strand_radius_m * strands / (math.pi * ro))  # Davis, survey eq. (10)
-        davis = (math.sin(tmin) * math.cos(tmin)) ** 2
+        davis = davis_factor(strands, strand_radius_m, ro)
         P = p_gauge_Pa
 
         def state(th):
             c3 = math.cos(th) / math.cos(th0) - 1.0
             r = ro * math.sin(th) / math.sin(th0)
-            sc = (math.sin(th) * math.cos(th)) ** 2
-            S = davis / sc * 2 * math.pi * r * (l0 - 2 * cone_length_m) * (1 + c3) \
-                + 2 * math.pi * (r_b + r) * cone_length_m * (1 + c3)
+            S = contact_area_m2(davis, th, r, r_b, l0, cone_length_m, c3)
             po = f_nyl * (l0 / r_b) * math.tan(th) * math.tan(th0) / S  # eqs. (78)-(80), per newton of F_e
             ps = (1.0 - f_nyl) / A_sil
             F_e = (c3 + k * L1 * P * ri ** 2 / D) / (k * L1 * (po * ro ** 2 / D + ps * (L1 + L2) / L1))
             Po, Ps = po * F_e, ps * F_e
-            c2 = ri ** 2 * ro ** 2 * (P - Po) / (2 * L2 * D)
-            c1 = (L1 + 2 * L2) * k / 2 * ((P * ri ** 2 + c1_sign * Po * ro ** 2) / D - Ps * L1 / (L1 + 2 * L2))
+            c1, c2, _ = self.constants(P, Po, Ps, c1_sign)
             return c1 + c2 / ro ** 2 - (math.sin(th) / math.sin(th0) - 1.0), c3, F_e, Po
 
         lo, hi = max(1e-6, th0 - 0.3), math.radians(89.0)
@@ -208,17 +257,15 @@ class TwoPhaseForce(StaticForce):
         self.variant = variant
         self.printed = variant == "printed"
         t = self.tube
-        self.L1, self.L2 = t.lame
         self.D = t.r_o ** 2 - t.r_i ** 2
         self.A_sil = math.pi * self.D
-        self.k = 1.0 / (self.L2 * (3 * self.L1 + 2 * self.L2))
         self.r_b = t.r_o + t.gap
         self.m = params["n_fibres"]
         self.strand_stiffness_N = self.m * math.pi * params["fibre_radius_m"] ** 2 * params["E_nylon_Pa"]
         self.cone = params["end_cone_length_m"]
         self.F_u = params["two_phase_F_u_N"]
-        tmin = 0.5 * math.asin(params["fibre_radius_m"] * self.m / (math.pi * t.r_o))  # Davis, survey eq. (10)
-        self.davis = (math.sin(tmin) * math.cos(tmin)) ** 2
+        self.davis = davis_factor(self.m, params["fibre_radius_m"], t.r_o)
+        tmin = davis_min_angle_rad(self.m, params["fibre_radius_m"], t.r_o)
         self.load_area = math.pi * t.r_i ** 2 if self.printed else self.A_sil
         # The braid jams when its strands touch, at 90 deg - theta_min (Davis, survey eq. 10); the tube
         # may carry the muscle past Gaylord's 54.7 deg (the survey's Fig. 19 "slightly overshoots").
@@ -229,24 +276,12 @@ class TwoPhaseForce(StaticForce):
         self.domain = Domain(0.0, x_max, 0.0, self.p_cap_Pa)
         self.domain = Domain(0.0, x_max, 0.0, self._largest_physical_pressure_Pa())
 
-    # -- eq. (60): the tube's constants for pressures P (inside), P_o (outside), P_s (ends)
-    def constants(self, P: float, P_o: float, P_s: float) -> tuple[float, float, float]:
-        """Survey eq. (60): ``(c1, c2, c3)``; the sign of ``P_o r_o^2`` in ``c1`` per variant."""
-        L1, L2, k, D, ro, ri = self.L1, self.L2, self.k, self.D, self.tube.r_o, self.tube.r_i
-        sign = 1.0 if self.printed else -1.0
-        c1 = (L1 + 2 * L2) * k / 2 * ((P * ri ** 2 + sign * P_o * ro ** 2) / D - P_s * L1 / (L1 + 2 * L2))
-        c2 = ri ** 2 * ro ** 2 * (P - P_o) / (2 * L2 * D)
-        c3 = L1 * k * ((-P * ri ** 2 + P_o * ro ** 2) / D + P_s * (L1 + L2) / L1)
-        return c1, c2, c3
-
     def braid_force_N(self, theta: float, c1: float, c2: float, c3: float, P_o: float) -> float:
         """Axial braid force ``F_nyl`` whose radial pull (eq. 78) over the contact area (eq. 79) is ``P_o``."""
         t = self.tube
         u_r = c1 * t.r_o + c2 / t.r_o
         r = u_r if self.printed else t.r_o + u_r
-        sc = (math.sin(theta) * math.cos(theta)) ** 2
-        S = (self.davis / sc * 2 * math.pi * r * (t.l0 - 2 * self.cone) * (1 + c3)
-             + 2 * math.pi * (self.r_b + r) * self.cone * (1 + c3))
+        S = contact_area_m2(self.davis, theta, r, self.r_b, t.l0, self.cone, c3)
         g = math.sin(theta) ** 2 / math.cos(theta) if self.printed else math.tan(theta)
         return P_o * S / ((t.l0 / self.r_b) * g * math.tan(t.theta0))
 
@@ -254,7 +289,7 @@ class TwoPhaseForce(StaticForce):
         """The five phase-2 equations at contraction ``x_m`` (dimensionless; zero at a solution)."""
         t = self.tube
         c3 = -x_m / t.l0
-        e1, e2, e3 = self.constants(P, P_o, P_s)
+        e1, e2, e3 = self.tube.constants(P, P_o, P_s, 1.0 if self.printed else -1.0)
         F_nyl = self.braid_force_N(theta, c1, c2, c3, P_o)
         stretch = 1.0 + F_nyl / (self.strand_stiffness_N * math.cos(theta))
         if self.printed:  # eq. (70): no gap
@@ -296,17 +331,14 @@ class TwoPhaseForce(StaticForce):
 
     def phase1_force_N(self, x_m: float, p_gauge_Pa: float) -> float:
         """Eq. (62) with ``u_z = -x``: the axial load that holds the free tube at contraction ``x``."""
-        t, P = self.tube, p_gauge_Pa
-        P_s = (-x_m / (t.l0 * self.k) + self.L1 * P * t.r_i ** 2 / self.D) / (self.L1 + self.L2)
-        return (P_s - P * t.r_i ** 2 / self.D) * self.load_area - self.F_u
+        P_s = self.tube.end_stress_for_contraction_Pa(p_gauge_Pa, x_m)
+        return (P_s - p_gauge_Pa * self.tube.r_i ** 2 / self.D) * self.load_area - self.F_u
 
     def in_contact(self, x_m: float, p_gauge_Pa: float) -> bool:
         """Whether the phase-1 tube at contraction ``x`` would reach the sleeve (eq. 68 > 0): phase 2."""
-        t, P = self.tube, p_gauge_Pa
-        P_s = (-x_m / (t.l0 * self.k) + self.L1 * P * t.r_i ** 2 / self.D) / (self.L1 + self.L2)
-        u_r = t.r_o * self.k * (2 * (self.L1 + self.L2) * t.r_i ** 2 / self.D * P - self.L1 / 2 * P_s)
-        c = math.cos(t.theta0) * (1.0 - x_m / t.l0)
-        return u_r - t.gap - self.r_b * (math.sqrt(1.0 - c * c) / math.sin(t.theta0) - 1.0) > 0.0
+        t = self.tube
+        u_r, _ = t.displacements_m(p_gauge_Pa, t.end_stress_for_contraction_Pa(p_gauge_Pa, x_m))
+        return t.sleeve_gap_m(u_r, -x_m / t.l0) > 0.0
 
     def _force_scalar(self, x_m: float, p_gauge_Pa: float) -> float:
         if not self.in_contact(x_m, p_gauge_Pa):
