@@ -385,7 +385,7 @@ class TwoPhaseForce(StaticForce):
         for _ in range(n_bisect):
             mid = 0.5 * (good + bad)
             good, bad = (mid, bad) if self._row_is_physical(mid, xs) else (good, mid)
-        return good
+        return float(good)
 
 
 def _build(params, variant):
