@@ -213,7 +213,8 @@ def test_kothera_length_independence(i, r):
 
 # --------------------------------------------------------------------- coverage
 UNTESTABLE = {
-    "S-34": "two-phase model: errors against the survey's Figs. 13-19, whose data are not in the text",
+    "S-34": "two-phase model: errors against the survey's Figs. 13-19, whose data are not in the text (its 758 kPa "
+            "datum and stiffness are tested in test_static_models_two_phase.py)",
     "S-03": "survey error against Fig. 13/14 curves (not in the text) with best-fit parameters (not given)",
     "S-18": "Liu's model is not implementable (garbled, needs a shooting method); Fig. 13/14 data missing",
     "S-11": "survey error against Fig. 13/14 curves (not in the text) with best-fit parameters (not given)",

@@ -40,6 +40,7 @@ ASSUMED = {  # model: constants assumed for the test only (no paper gives them),
     "empirical_linear": {"emp49_k1": 1.0, "emp49_Fmax_N": 2.0, "emp49_eps_max": 0.28},
     "pillsbury": {"pillsbury_E1I_Pa": 0.35e6, "pillsbury_E1S": 0.1},
     "ogden": {"ogden_mu1_Pa": 0.35e6 / 3, "ogden_alpha1": 2.0},
+    "mpam_two_phase": {"E_nylon_Pa": 3e9},  # nylon 6: 2-4 GPa; the survey gives none
 }
 
 
@@ -48,7 +49,10 @@ THICK_WALL = ("Chou and Hannaford's constant-thickness term grows faster than Ga
               "contraction; the specification calls the model unphysical for thick walls")
 PRINTED_HOOP = ("the printed hoop-term sign of Kothera's eq. (29) makes the bladder pull harder the more it contracts "
                 "(the reason the corrected sign is the default)")
+PHASE1_PUSH = ("two-phase model, printed: its domain ends inside phase 1 (about 65 kPa), where the free tube lengthens "
+               "with pressure (Poisson) and so pushes harder at rest the higher the pressure")
 KNOWN_INSANE = {  # (model, variant, muscle): why the physics check must fail
+    ("mpam_two_phase", "printed", "assumed"): PHASE1_PUSH,
     **{("chou_hannaford", "default", f"kothera2009_3{c}"): THICK_WALL for c in "abc"},
     **{("kothera_force_balance", "printed", f"kothera2009_{n}{c}"): PRINTED_HOOP for n in "345" for c in "abc"},
 }
@@ -71,7 +75,10 @@ def cases():
         if model in ASSUMED:
             found = True
             for variant in spec.variants:
-                out.append(pytest.param(model, {**MPAM, **ASSUMED[model]}, variant, id=f"{model}-{variant}-assumed"))
+                why = KNOWN_INSANE.get((model, variant, "assumed"))
+                marks = pytest.mark.xfail(strict=True, reason=why) if why else ()
+                out.append(pytest.param(model, {**MPAM, **ASSUMED[model]}, variant, id=f"{model}-{variant}-assumed",
+                                        marks=marks))
         if model == "ogden":
             k = MUSCLES["kothera2009_5a"].parameters
             out.append(pytest.param(model, {**k, "ogden_mu1_Pa": 2 * k["C10_Pa"], "ogden_alpha1": 2.0,

@@ -78,6 +78,7 @@ KNOWN = MappingProxyType({
     "E_nylon_Pa": _pos("Young's modulus of the nylon braid strands (two-phase model)"),
     "sleeve_gap_m": _nonneg("radial gap between tube and braided sleeve at rest"),
     "end_cone_length_m": _nonneg("length of each fully contacting conical end"),
+    "two_phase_F_u_N": _any("two-phase model: unaccounted axial force F_u (survey eq. 71), taken off the pull"),
     "rated_pressure_gauge_Pa": _pos("highest supply pressure accepted (gauge)"),
     # de Volder (survey eq. 35).
     "devolder_P_corr_Pa": _any("de Volder dead-band pressure"),

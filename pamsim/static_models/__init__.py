@@ -11,10 +11,10 @@ from __future__ import annotations
 from types import MappingProxyType
 
 from ..errors import InputError
-from . import acra2012, elastic_survey, force_map, gaylord, hyperelastic, kothera, phenomenological
+from . import acra2012, elastic_survey, force_map, gaylord, hyperelastic, kothera, phenomenological, two_phase
 from .base import KINDS, Domain, StaticForce, StaticModelDomainError, StaticModelSpec, did_you_mean
 
-_FAMILIES = (acra2012, gaylord, kothera, hyperelastic, elastic_survey, phenomenological, force_map)
+_FAMILIES = (acra2012, gaylord, kothera, hyperelastic, elastic_survey, phenomenological, two_phase, force_map)
 
 REGISTRY = MappingProxyType({spec.name: spec for family in _FAMILIES for spec in family.SPECS})
 """name -> :class:`StaticModelSpec` for every library model."""
