@@ -29,7 +29,7 @@ from .elements.static_force import STATIC_FORCE_MODELS
 from .elements.stops import EndStops
 from .elements.valve import Iso6358Orifice, ProportionalValve33
 from .model import FitRange, MuscleModel
-from .parameters import PARAMETER_SETS, ParameterSet
+from .parameters import LOAD_MASS, PARAMETER_SETS, ParameterSet
 from .signals import Constant, FirstOrderLag, Ramp, Step, Trace
 from .simulator import SolverOptions
 
@@ -189,6 +189,9 @@ class Scenario:
         value = v.number(f"load.{key}", load[key])
         if value <= 0:
             v.fail(f"load.{key}", value, "must be positive")
+        why = LOAD_MASS.violation(self.mass_kg)  # the FMU's load_mass_kg input has the same range
+        if why:
+            v.fail(f"load.{key}", value, f"the mass {self.mass_kg:g} kg {why} kg")
 
     def _build_source(self, v: "_Validator"):
         pr = self.spec["pressure"]

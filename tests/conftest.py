@@ -31,6 +31,23 @@ def paper_results():
     return out
 
 
+@pytest.fixture(scope="session")
+def fmus(tmp_path_factory):
+    """{FMI version: path} of the FMU built once per session from the current sources."""
+    from pamsim.fmu import build
+
+    folder = tmp_path_factory.mktemp("fmu")
+    return {v: build(folder / f"pamsim_muscle_fmi{v}.fmu", v) for v in (2, 3)}
+
+
+@pytest.fixture(scope="session")
+def unzipped(fmus):
+    """{FMI version: folder} of the extracted session FMUs."""
+    from fmpy import extract
+
+    return {v: extract(fmus[v]) for v in (2, 3)}
+
+
 def run_cli(*args, cwd=None):
     """Run ``python -m pamsim ARGS`` as a user would; returns the CompletedProcess."""
     return subprocess.run([sys.executable, "-m", "pamsim", *map(str, args)], capture_output=True, text=True,

@@ -31,9 +31,9 @@ from ..result import Result
 from ..scenario import Scenario
 from .build import build
 from .generate import token
-from .variables import DAMPING_CHOICES, FRICTION_CHOICES, NEGATIVE_LEVEL, SOURCE_CHOICES, VARIABLES, value_reference
+from .variables import BY_NAME, DAMPING_CHOICES, FRICTION_CHOICES, NEGATIVE_LEVEL, SOURCE_CHOICES, VARIABLES, value_reference
 
-OUTPUTS = ("contraction_m", "velocity_m_s", "pressure_gauge_Pa", "chamber_pressure_abs_Pa", "air_mass_kg")
+OUTPUTS = ("contraction_m", "velocity_m_s", "p_gauge_Pa", "chamber_pressure_abs_Pa", "air_mass_kg")
 INPUTS = ("valve_command", "supply_pressure_gauge_Pa", "prescribed_pressure_gauge_Pa", "load_mass_kg",
           "external_force_N")
 
@@ -141,13 +141,19 @@ def _instantiate(fmu_path: Path, fmi_version: int, interface: str):
     return md, fmu, unzipdir
 
 
-def _set(fmu, fmi_version: int, values: dict):
-    reals = {value_reference(k): v for k, v in values.items() if isinstance(v, float)}
-    ints = {value_reference(k): v for k, v in values.items() if not isinstance(v, float)}
-    if reals:
-        (fmu.setReal if fmi_version == 2 else fmu.setFloat64)(list(reals), list(reals.values()))
-    if ints:
-        (fmu.setInteger if fmi_version == 2 else fmu.setInt32)(list(ints), list(ints.values()))
+def set_values(fmu, fmi_version: int, values: dict) -> None:
+    """Set ``{name: value}`` on an fmpy instance: floats as Real / Float64, the rest as Integer
+    (FMI 2.0) or, in FMI 3.0, Int32 and, for the Enumerations (integer choices), Int64."""
+    groups: dict[str, dict[int, float | int]] = {"real": {}, "int": {}, "enum": {}}
+    for k, v in values.items():
+        group = "real" if isinstance(v, float) else "enum" if BY_NAME[k].choices and fmi_version == 3 else "int"
+        groups[group][value_reference(k)] = v
+    setters = {"real": fmu.setReal if fmi_version == 2 else fmu.setFloat64,
+               "int": fmu.setInteger if fmi_version == 2 else fmu.setInt32,
+               "enum": None if fmi_version == 2 else fmu.setInt64}
+    for group, vrs in groups.items():
+        if vrs:
+            setters[group](list(vrs), list(vrs.values()))
 
 
 def run_cs(scenario: Scenario, fmi_version: int = 2, communication_times: Sequence[float] | None = None,
@@ -172,8 +178,8 @@ def run_cs(scenario: Scenario, fmi_version: int = 2, communication_times: Sequen
         fmu.instantiate()
         if fmi_version == 2:
             fmu.setupExperiment(startTime=times[0], stopTime=times[-1])
-        _set(fmu, fmi_version, start)
-        _set(fmu, fmi_version, inputs(times[0]))
+        set_values(fmu, fmi_version, start)
+        set_values(fmu, fmi_version, inputs(times[0]))
         if fmi_version == 2:
             fmu.enterInitializationMode()
         else:
@@ -185,7 +191,7 @@ def run_cs(scenario: Scenario, fmi_version: int = 2, communication_times: Sequen
             if k + 1 < len(times):
                 # Inputs are held over a step; the midpoint value is the second-order choice for
                 # smooth signals, and jumps fall on communication points.
-                _set(fmu, fmi_version, inputs(0.5 * (t + times[k + 1])))
+                set_values(fmu, fmi_version, inputs(0.5 * (t + times[k + 1])))
                 fmu.doStep(currentCommunicationPoint=t, communicationStepSize=times[k + 1] - t)
         fmu.terminate()
     except Exception as exc:  # fmpy raises a bare Exception carrying the FMI status
