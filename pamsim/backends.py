@@ -12,12 +12,18 @@ from typing import Callable
 
 # name -> "module:function"
 BACKENDS: dict[str, str] = {
-    "python": "pamsim.api:simulate",
+    "python": "pamsim.api:simulate_python",
+    "native": "pamsim.native:simulate",
     "fmu-cs": "pamsim.fmu.runner:simulate_cs",
     "fmu-me": "pamsim.fmu.runner:simulate_me",
 }
 
 
 def get_backend(name: str) -> Callable:
+    """The function that runs a scenario on backend ``name``; ``InputError`` for an unknown name."""
+    if name not in BACKENDS:
+        from .errors import InputError
+
+        raise InputError(f"unknown backend {name!r} (choose from {', '.join(BACKENDS)})")
     module, func = BACKENDS[name].split(":")
     return getattr(importlib.import_module(module), func)

@@ -13,10 +13,11 @@ from dataclasses import dataclass, replace
 from types import MappingProxyType
 from typing import Mapping
 
+from .core_table import BRAID_LOCK_SEC2, ORDER_CHECKS
 from .references import REFERENCES
 
 ACRA2012 = REFERENCES["acra2012"].short
-BRAID_LOCK_DEG = math.degrees(math.acos(1.0 / math.sqrt(3.0)))
+BRAID_LOCK_DEG = math.degrees(math.acos(1.0 / math.sqrt(BRAID_LOCK_SEC2)))
 """Braid angle at which a McKibben braid locks (54.7356 deg): the muscle cannot shorten further."""
 
 
@@ -94,10 +95,9 @@ class ParameterSet(Mapping[str, float]):
         if out:
             return out
         v = self
-        if "valve_b" in v and "valve_laminar_ratio" in v and not v["valve_b"] < v["valve_laminar_ratio"]:
-            out.append(("valve_b", v["valve_b"], f"must be below valve_laminar_ratio = {v['valve_laminar_ratio']:g}"))
-        if "fit_x_min_m" in v and "fit_x_max_m" in v and not v["fit_x_min_m"] < v["fit_x_max_m"]:
-            out.append(("fit_x_min_m", v["fit_x_min_m"], f"must be below fit_x_max_m = {v['fit_x_max_m']:g}"))
+        for a, b in ORDER_CHECKS:
+            if a in v and b in v and not v[a] < v[b]:
+                out.append((a, v[a], f"must be below {b} = {v[b]:g}"))
         return out
 
     def table(self) -> list[tuple[str, float, str, str, str]]:

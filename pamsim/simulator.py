@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from .core_table import MAX_ZERO_LENGTH_EVENTS
 from .errors import SolverFailure
 from .model import Mode, MuscleModel
 from .result import Result, TransitionEvent
@@ -171,7 +172,7 @@ def simulate_model(model: MuscleModel, duration_s: float, options: SolverOptions
             t_event = float(sol.t_events[k][0])
             y = np.array(sol.y_events[k][0], dtype=float)
             n_zero = n_zero + 1 if t_event - t <= 1e-12 * max(1.0, t) else 0
-            if n_zero > 50:
+            if n_zero > MAX_ZERO_LENGTH_EVENTS:
                 raise SolverFailure(f"event switching made no progress at t = {t_event:.9g} s ({kind})")
             old = mode
             mode = _transition(model, kind, t_event, y, mode, opts, impact_loss_J, m)

@@ -12,6 +12,7 @@ import math
 from dataclasses import dataclass
 from typing import Mapping
 
+from ..core_table import BRAID_LOCK_SEC2, MIN_REBOUND_SPEED_M_S
 from ..parameters import braid_geometry
 
 
@@ -22,13 +23,13 @@ class EndStops:
     x_low_m: float
     x_high_m: float
     restitution: float
-    min_rebound_speed_m_s: float = 1e-3
+    min_rebound_speed_m_s: float = MIN_REBOUND_SPEED_M_S
 
     @classmethod
     def from_parameters(cls, p: Mapping[str, float]) -> "EndStops":
         b, _ = braid_geometry(p)
         # Braid lock at 54.7 deg (cos^2 = 1/3): L_lock = b / sqrt(3), MODEL_NOTES sec. 5.
-        return cls(0.0, p["L0_m"] - b / math.sqrt(3.0), p["stop_restitution"])
+        return cls(0.0, p["L0_m"] - b / math.sqrt(BRAID_LOCK_SEC2), p["stop_restitution"])
 
     def rebound_speed_m_s(self, impact_speed_m_s: float) -> float:
         """Speed after an impact; below ``min_rebound_speed_m_s`` the load stays on the stop."""

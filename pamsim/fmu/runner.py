@@ -25,6 +25,7 @@ from typing import Sequence
 import numpy as np
 
 from ..constants import PA_PER_BAR
+from ..core_table import unimplemented_choice
 from ..elements.pressure_source import ValveChamberSource
 from ..errors import InputError, SolverFailure
 from ..result import Result
@@ -76,6 +77,10 @@ def _refuse_unrepresented(scenario: Scenario) -> None:
     if model["static_force"] != "acra2012_polynomial":
         raise InputError(f"{scenario.origin}: the FMU implements only the acra2012_polynomial static force, "
                          f"not model.static_force = {model['static_force']!r}")
+    lacking = unimplemented_choice(spec)
+    if lacking:
+        raise InputError(f"{scenario.origin}: {lacking[0]} = {lacking[1]!r}: the C core does not implement it; "
+                         "run it with the python backend")
     names = {v.name for v in VARIABLES if v.causality == "parameter" and v.kind == "real"}
     missing = [k for k in scenario.parameters if k not in names]
     if missing:
