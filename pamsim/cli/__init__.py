@@ -25,17 +25,24 @@ COMMANDS = (
 )
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+    """The parser of every subcommand, or only of ``command`` if it names one.
+
+    Registering one command imports only its module: ``pamsim sweep`` need not import
+    python-control (about a second) for ``pamsim linearize``'s argument choices.
+    """
     parser = argparse.ArgumentParser(prog="pamsim", description="McKibben muscle simulator")
     parser.add_argument("--version", action="version", version="pamsim " + __import__("pamsim").__version__)
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for name in COMMANDS:
+    chosen = f"pamsim.cli.{command.replace('-', '_')}" if command else None
+    for name in (chosen,) if chosen in COMMANDS else COMMANDS:
         importlib.import_module(name).register(sub)
     return parser
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = build_parser()
+    argv = sys.argv[1:] if argv is None else list(argv)
+    parser = build_parser(argv[0] if argv else None)
     args = parser.parse_args(argv)
     try:
         return int(args.func(args) or 0)
