@@ -8,7 +8,7 @@ import sys
 from pathlib import Path
 
 from ..atomic import atomic_outputs, ensure_output_dir
-from ..backends import BACKENDS, get_backend
+from ..backends import BACKENDS, check_backend, get_backend
 from ..scenario import load_scenario
 
 
@@ -25,6 +25,7 @@ def register(sub) -> None:
 
 def run(args: argparse.Namespace) -> int:
     scenario = load_scenario(args.scenario)
+    check_backend(args.backend, scenario)  # a setting the backend cannot honour: no output folder
     ensure_output_dir(args.output)  # before the run, not after it
     result = get_backend(args.backend)(scenario)
     names = [f"{scenario.name}.csv", f"{scenario.name}.json"] + ([] if args.no_plot else [f"{scenario.name}.png"])

@@ -11,6 +11,7 @@ from pathlib import Path
 from ..atomic import ensure_output_dir
 from ..backends import BACKENDS
 from ..sweep import load_sweep, run_sweep
+from ..sweep.run import check_backend
 
 
 def _workers(text: str) -> int:
@@ -39,6 +40,7 @@ def register(sub) -> None:
 
 def run(args: argparse.Namespace) -> int:
     spec = load_sweep(args.sweep_file)
+    check_backend(spec, args.backend or spec.backend)
     ensure_output_dir(args.output)  # before the runs, not after them
     if args.workers == 1:
         result = run_sweep(spec, None, progress=not args.no_progress, backend=args.backend)

@@ -190,6 +190,7 @@ def run_sweep(spec: SweepSpec | str | Path, executor: Executor | None = None, pr
     if not isinstance(spec, SweepSpec):
         spec = load_sweep(spec)
     backend = backend or spec.backend
+    check_backend(spec, backend)
     tasks = [_task("case", (i, f), spec.case_scenario(c, f), backend=backend) for i, c in enumerate(spec.cases)
              for f in spec.friction_models]
     if spec.frequency is not None:
@@ -197,7 +198,6 @@ def run_sweep(spec: SweepSpec | str | Path, executor: Executor | None = None, pr
                   for w in spec.frequency.weights_N for f in spec.friction_models]
     tasks += [_task("response", (s.name, f), s.with_changes({"model": {"friction": f}}), True, backend)
               for s in spec.time_responses for f in spec.friction_models]
-    _refuse_for_backend(tasks, backend)
     start = time.perf_counter()
     outputs = _execute(tasks, executor, ProgressBar(len(tasks)) if progress else None)
     wall = time.perf_counter() - start
@@ -219,16 +219,20 @@ def run_sweep(spec: SweepSpec | str | Path, executor: Executor | None = None, pr
     return SweepResult(spec, rows, freq_rows, responses, wall, failures)
 
 
-def _refuse_for_backend(tasks: list[_Task], backend: str) -> None:
-    """Raise ``InputError`` naming the first setting some task's backend cannot honour, before any run."""
-    from ..backends import get_backend
+def check_backend(spec: SweepSpec, backend: str) -> None:
+    """Raise ``InputError`` naming the first setting of the sweep that ``backend`` cannot honour.
 
-    get_backend(backend)  # an unknown name
-    if backend == "native":
-        from ..native import refuse_unsupported
+    The cases differ from their base scenario only in load and pressure, so the base, the
+    frequency study and the time responses under each friction model stand for all of them.
+    """
+    from ..backends import check_backend as check_scenario
 
-        for task in tasks:
-            refuse_unsupported(task.scenario)
+    scenarios = [spec.base] + [s for s in spec.time_responses]
+    if spec.frequency is not None:
+        scenarios.append(spec.frequency_scenario(spec.frequency.weights_N[0], spec.friction_models[0]))
+    for scenario in scenarios:
+        for friction in spec.friction_models:
+            check_scenario(backend, scenario.with_changes({"model": {"friction": friction}}))
 
 
 def _execute(tasks: list[_Task], executor: Executor | None, bar: ProgressBar | None) -> list[dict]:

@@ -1,0 +1,116 @@
+"""One table for what Python and C share: the committed C header is the generated one, Python reads
+its constants from the table, and every Python registry entry either has a C counterpart or is
+refused cleanly by the native and FMU backends."""
+
+from __future__ import annotations
+
+import re
+
+import pytest
+
+import pamsim
+from pamsim import core_table
+from pamsim.elements.damping import DAMPING_MODELS
+from pamsim.elements.friction import FRICTION_MODELS, NEGATIVE_LEVEL_CHOICES, ConstantCoulomb
+from pamsim.elements.static_force import STATIC_FORCE_MODELS, Acra2012Polynomial
+from pamsim.elements.stops import EndStops
+from pamsim.errors import InputError
+from pamsim.fmu.generate import c_source_dir, shared_header
+from pamsim.fmu.runner import start_values
+from pamsim.model import Mode
+from pamsim.parameters import get_parameter_set
+
+from conftest import SCENARIOS
+
+REGISTRIES = {"static_force": STATIC_FORCE_MODELS, "friction": FRICTION_MODELS, "damping": DAMPING_MODELS,
+              "friction_negative_level": dict.fromkeys(NEGATIVE_LEVEL_CHOICES), "source": {"valve": 0, "prescribed": 0}}
+
+
+def test_committed_shared_header_is_the_generated_one():
+    committed = (c_source_dir() / "src" / "pam_shared.h").read_text()
+    assert committed == shared_header(), "run: python -m pamsim.fmu.generate --shared-header"
+
+
+def test_header_carries_every_shared_constant_mode_and_choice():
+    text = shared_header()
+    for const in core_table.CONSTANTS:
+        assert re.search(rf"#define {const.c_name} {re.escape(repr(const.value))} ", text)
+    for m in Mode:
+        assert f"PAM_{m.name} = {int(m)}" in text
+    for key, choices in core_table.C_CHOICES.items():
+        for i, choice in enumerate(choices):
+            assert f"PAM_{core_table.c_identifier(key)}_{core_table.c_identifier(choice)} = {i}" in text
+
+
+def test_the_core_uses_the_generated_names_not_literals():
+    """The C core takes its constants and choice codes from pam_shared.h: no copies of the numbers."""
+    core = (c_source_dir() / "src" / "pam_core.c").read_text()
+    assert not re.search(r"case [0-9]+:", core)
+    assert "sqrt(3.0)" not in core
+    for literal in ("1e-9", "1e-3", "1.0e5"):
+        assert not re.search(rf"#define \w+ {re.escape(literal)}\b", core)
+
+
+def test_python_reads_the_same_constants():
+    p = get_parameter_set("shadow_6x300_acra2012")
+    stops = EndStops.from_parameters(p)
+    assert stops.min_rebound_speed_m_s == core_table.MIN_REBOUND_SPEED_M_S
+    b = p["L0_m"] / __import__("math").cos(__import__("math").radians(p["braid_angle_rest_deg"]))
+    assert stops.x_high_m == p["L0_m"] - b / core_table.BRAID_LOCK_SEC2 ** 0.5
+
+
+def _scenario(key: str, value: str) -> pamsim.Scenario:
+    base = pamsim.load_scenario(SCENARIOS / "acra2012_fig4.toml")
+    where = core_table.SCENARIO_KEYS[key]
+    section, name = where.split(".")
+    if where == "pressure.source":
+        return base.with_changes({"pressure": {"source": value, "prescribed": {"kind": "constant", "value_gauge_bar": 3}}})
+    return base.with_changes({section: {name: value}})
+
+
+def _assert_refused_by_native_and_fmu(scenario: pamsim.Scenario, key: str, value: str) -> None:
+    where = core_table.SCENARIO_KEYS[key]
+    for refuse in (lambda: pamsim.simulate(scenario, backend="native"), lambda: start_values(scenario)):
+        with pytest.raises(InputError, match=rf"{re.escape(where)} = {value!r}"):
+            refuse()
+
+
+@pytest.mark.parametrize("key", sorted(REGISTRIES))
+def test_every_registry_entry_has_a_c_counterpart_or_is_refused_cleanly(key):
+    for value in REGISTRIES[key]:
+        if value in core_table.C_CHOICES[key]:
+            continue  # implemented in C: the conformance suite compares it with Python
+        _assert_refused_by_native_and_fmu(_scenario(key, value), key, value)
+
+
+@pytest.mark.parametrize("key, registry, builder", [
+    ("friction", FRICTION_MODELS, ConstantCoulomb.from_parameters),
+    ("static_force", STATIC_FORCE_MODELS, Acra2012Polynomial.from_parameters),
+])
+def test_a_new_python_element_is_refused_by_the_c_backends_until_the_core_has_it(monkeypatch, key, registry,
+                                                                                   builder):
+    """Adding an element to a Python registry alone must not run the C backends silently with
+    another element (or zero friction), nor end in a bare ValueError."""
+    monkeypatch.setitem(registry, "added_in_python_only", builder)
+    _assert_refused_by_native_and_fmu(_scenario(key, "added_in_python_only"), key, "added_in_python_only")
+
+
+def test_order_checks_are_shared_by_the_parameter_set_and_the_core():
+    from pamsim.native import library
+
+    p = get_parameter_set("shadow_6x300_acra2012")
+    for a, b in core_table.ORDER_CHECKS:
+        bad = p.with_overrides({a: p[b]}, source="test")
+        assert any(name == a and f"below {b}" in why for name, _, why in bad.violations())
+    # The core checks the same pairs: a scenario's parameters swapped past each other are refused.
+    sc = pamsim.load_scenario(SCENARIOS / "acra2012_fig4.toml")
+    from pamsim.native.backend import _run, case_inputs
+
+    case = case_inputs(sc)
+    for a, b in core_table.ORDER_CHECKS:
+        reals = case.reals.copy()
+        reals[library.REAL_INDEX[a]] = reals[library.REAL_INDEX[b]]
+        out = _run([case.__class__(reals, case.ints, case.duration_s, case.n_samples, case.segment_t_s,
+                                   case.segment_u, case.max_events)], [10])
+        assert out["status"][0] == 1 and out["messages"][0].startswith(f"invalid parameters: {a} = ")
+        assert f"must be below {b}" in out["messages"][0]
