@@ -111,6 +111,6 @@ def test_order_checks_are_shared_by_the_parameter_set_and_the_core():
         reals = case.reals.copy()
         reals[library.REAL_INDEX[a]] = reals[library.REAL_INDEX[b]]
         out = _run([case.__class__(reals, case.ints, case.duration_s, case.n_samples, case.segment_t_s,
-                                   case.segment_u, case.max_events)], [10])
+                                   case.segment_u, case.max_events, case.model)], [10])
         assert out["status"][0] == 1 and out["messages"][0].startswith(f"invalid parameters: {a} = ")
         assert f"must be below {b}" in out["messages"][0]

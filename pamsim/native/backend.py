@@ -60,6 +60,7 @@ class CaseInputs:
     segment_t_s: np.ndarray
     segment_u: np.ndarray
     max_events: int
+    model: MuscleModel
 
 
 def refuse_unsupported(scenario: Scenario) -> None:
@@ -145,7 +146,7 @@ def case_inputs(scenario: Scenario) -> CaseInputs:
         if sig is not None:
             u[:, k] = sig(mid)
     u[:, lib.INPUTS.index("load_mass_kg")] = model.load.mass_kg
-    return CaseInputs(reals, ints, T, n_samples, starts, u, opts.max_events)
+    return CaseInputs(reals, ints, T, n_samples, starts, u, opts.max_events, model)
 
 
 def _run(cases: Sequence[CaseInputs], capacity: Sequence[int]) -> dict:
@@ -166,7 +167,7 @@ def _result(scenario: Scenario, case: CaseInputs, out: dict, i: int, wall_time_s
         raise SolverFailure(f"native backend: {message}")
     if status == 3:
         raise SolverFailure(f"more than {case.max_events} events (raise [solver] max_events if this is expected)")
-    model = scenario.build_model()
+    model = case.model
     first, n = int(out["sample_offset"][i]), case.n_samples
     rows = slice(first, first + n)
     S = out["samples"][len(lib.SAMPLE_COLUMNS) * first:len(lib.SAMPLE_COLUMNS) * (first + n)].reshape(-1, n)
