@@ -45,7 +45,7 @@ HOLD_STEPS_PER_TAU = 10
 """A first-order lag is held over at most tau / 10 (and never longer than one output sample)."""
 METHOD_LABEL = "native DOPRI5(4)"
 _EXACT = (Constant, Step)  # constant between breakpoints: held exactly
-_STATE_ROWS = {2: [0, 1, 2, 3, 4, 5, 6, 7], 0: [0, 1, 4, 5, 6, 7]}  # Result's state rows, by source state count
+_STATE_ROWS = {2: slice(0, 8), 0: [0, 1, 4, 5, 6, 7]}  # Result's state rows by source state count (a view if it can)
 _DEFAULT_MAX_STEP_S = float(lib.REAL_DEFAULTS[lib.REAL_INDEX["cs_max_step_s"]])
 
 
