@@ -59,8 +59,13 @@ C_CHOICES: dict[str, tuple[str, ...]] = {
     "damping": ("paper", "linear", "none"),
     "source": ("valve", "prescribed"),
     "friction_negative_level": ("clamp", "abs"),
+    "static_force_model": ("acra2012_polynomial", "table"),
 }
 """The element choices the C core implements, by scenario key, in the order of their C enumeration.
+
+``static_force_model`` is the FMU's own choice between the polynomial and a force table baked
+into the FMU at build time (:mod:`pamsim.fmu.force_table`), through which the FMU runs any
+scenario static force; the native library has no table and refuses other static forces.
 
 A choice in a Python registry but not here is refused by the native and FMU
 backends (``InputError`` naming the key); ``tests/test_native_table.py``
@@ -79,9 +84,14 @@ ORDER_CHECKS: tuple[tuple[str, str], ...] = (
 """Parameter pairs ``(a, b)`` that must satisfy ``a < b`` (``ParameterSet.violations`` and the C check)."""
 
 
-def unimplemented_choice(spec) -> tuple[str, str] | None:
-    """The first ``(scenario key, value)`` of a scenario ``spec`` that names a choice the C core lacks, or None."""
+def unimplemented_choice(spec, skip: tuple[str, ...] = ()) -> tuple[str, str] | None:
+    """The first ``(scenario key, value)`` of a scenario ``spec`` that names a choice the C core lacks, or None.
+
+    ``skip`` names :data:`C_CHOICES` keys a backend handles otherwise (the FMU tabulates any static force).
+    """
     for key, where in SCENARIO_KEYS.items():
+        if key in skip:
+            continue
         section, name = where.split(".")
         value = spec.get(section, {}).get(name)
         if value is not None and value not in C_CHOICES[key]:

@@ -248,6 +248,13 @@ def test_fmu_without_binaries_rebuilds_with_fmpy_compile(fmus, paper_results, tm
                           timeout=300)
     assert proc.returncode == 0, proc.stderr[-2000:]
     assert any(n.startswith("binaries/") and n.endswith(".so") for n in zipfile.ZipFile(stripped).namelist())
+    if shutil.which("nm"):  # the rebuilt binary, compiled without -fvisibility=hidden, exports only FMI functions
+        with zipfile.ZipFile(stripped) as zf:
+            so = next(n for n in zf.namelist() if n.endswith(".so"))
+            (tmp_path / "rebuilt.so").write_bytes(zf.read(so))
+        nm = subprocess.run(["nm", "-D", "--defined-only", str(tmp_path / "rebuilt.so")], capture_output=True,
+                            text=True, check=True).stdout.split()
+        assert not [s for s in nm if s.startswith(("pam_", "fmu_"))]
     sc, ref = paper_results["acra2012_fig5"]
     rebuilt = run_cs(sc, version, fmu_path=stripped)
     original = run_cs(sc, version, fmu_path=fmus[version])

@@ -522,6 +522,13 @@ def test_integer_choices_are_enumerations(fmus, version, capfd):
         fmu.exitInitializationMode()
         fmu.terminate()
         fmu.freeInstance()
+        # A value beyond int32 is not wrapped into range: it is refused as out of range.
+        fmu = _instance(fmus, version)
+        fmu.setInt64(vr, [2**32 + 1])
+        fmu.enterInitializationMode()
+        assert _error_status(fmu.exitInitializationMode) == 3
+        assert "invalid parameters: damping_model = 2147483647: must lie in [0, 2]" in capfd.readouterr().out
+        fmu.freeInstance()
 
 
 def test_base_units_against_hand_conversions():

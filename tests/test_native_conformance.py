@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from pamsim.core_table import BRAID_LOCK_SEC2, C_CHOICES, EVENT_V_TOL_M_S, EVENT_X_TOL_M
+from pamsim.core_table import BRAID_LOCK_SEC2, C_CHOICES, EVENT_V_TOL_M_S, EVENT_X_TOL_M, SCENARIO_KEYS
 from pamsim.elements.chamber import MuscleChamber
 from pamsim.elements.damping import DAMPING_MODELS
 from pamsim.elements.friction import FRICTION_MODELS
@@ -56,7 +56,7 @@ def _points():
     rng = np.random.default_rng(SEED)
     n = N_POINTS
     params = _random_parameters(rng, n)
-    choice = {key: rng.integers(0, len(values), n) for key, values in C_CHOICES.items()}
+    choice = {key: rng.integers(0, len(C_CHOICES[key]), n) for key in SCENARIO_KEYS}
     mode = rng.choice([int(m) for m in Mode], n)
     b = params["L0_m"] / np.cos(np.radians(params["braid_angle_rest_deg"]))
     x_high = params["L0_m"] - b / np.sqrt(BRAID_LOCK_SEC2)
@@ -209,9 +209,9 @@ QUANTITY_SCALES = ("static_force_N", "coulomb_level_N", "damping_force_N", "valv
 def test_points_cover_every_mode_and_element_choice(evaluated):
     for m in Mode:
         assert np.count_nonzero(evaluated["mode"] == int(m)) > 1000
-    for key, values in C_CHOICES.items():
-        for i in range(len(values)):
-            assert np.count_nonzero(evaluated["choice"][key] == i) > N_POINTS // (2 * len(values))
+    for key in SCENARIO_KEYS:
+        for i in range(len(C_CHOICES[key])):
+            assert np.count_nonzero(evaluated["choice"][key] == i) > N_POINTS // (2 * len(C_CHOICES[key]))
     level = evaluated["python"]["coulomb_level_N"]
     assert np.count_nonzero(level == 0.0) > 100  # the clamp of a negative load-dependent level is exercised
 

@@ -164,15 +164,29 @@ int fmu_get_reals(FmuInstance *in, const char *function, const unsigned vr[], si
     return 0;
 }
 
-int fmu_get_integers(FmuInstance *in, const char *function, const unsigned vr[], size_t nvr, int32_t values[],
-                     size_t n_values) {
+/* Integers and enumerations share i[]: `kind` 'i' reads into values32, 'e' (FMI 3.0 Int64) into values64. */
+static int get_ints(FmuInstance *in, const char *function, const unsigned vr[], size_t nvr, size_t n_values, char kind,
+                    int32_t values32[], int64_t values64[]) {
     size_t k;
     if (begin_read(in, function, nvr, n_values)) return -1;
     for (k = 0; k < nvr; k++) {
-        if (!check_vr(in, function, vr[k], 'i')) return -1;
-        values[k] = in->core.i[PAM_VARS[vr[k] - 1].index];
+        int32_t value;
+        if (!check_vr(in, function, vr[k], kind)) return -1;
+        value = in->core.i[PAM_VARS[vr[k] - 1].index];
+        if (kind == 'e') values64[k] = value;
+        else values32[k] = value;
     }
     return 0;
+}
+
+int fmu_get_integers(FmuInstance *in, const char *function, const unsigned vr[], size_t nvr, int32_t values[],
+                     size_t n_values) {
+    return get_ints(in, function, vr, nvr, n_values, 'i', values, NULL);
+}
+
+int fmu_get_enums(FmuInstance *in, const char *function, const unsigned vr[], size_t nvr, int64_t values[],
+                  size_t n_values) {
+    return get_ints(in, function, vr, nvr, n_values, 'e', NULL, values);
 }
 
 int fmu_set_reals(FmuInstance *in, const char *function, const unsigned vr[], size_t nvr, const double values[],
@@ -191,39 +205,28 @@ int fmu_set_reals(FmuInstance *in, const char *function, const unsigned vr[], si
     return 0;
 }
 
-int fmu_set_integers(FmuInstance *in, const char *function, const unsigned vr[], size_t nvr, const int32_t values[],
-                     size_t n_values) {
+static int set_ints(FmuInstance *in, const char *function, const unsigned vr[], size_t nvr, size_t n_values, char kind,
+                    const int32_t values32[], const int64_t values64[]) {
     size_t k;
     if (!fmu_allowed(in, function, FMU_INSTANTIATED | FMU_INIT) || n_values != nvr) return -1;
     for (k = 0; k < nvr; k++) {
-        if (!check_vr(in, function, vr[k], 'i') || !settable(in, function, vr[k])) return -1;
-        in->core.i[PAM_VARS[vr[k] - 1].index] = values[k];
+        int64_t value = kind == 'e' ? values64[k] : values32[k];
+        if (!check_vr(in, function, vr[k], kind) || !settable(in, function, vr[k])) return -1;
+        /* Beyond int32 is beyond every choice's range: clamped, it stays out of range for the parameter check. */
+        in->core.i[PAM_VARS[vr[k] - 1].index] = value > INT32_MAX ? INT32_MAX
+                                                : value < INT32_MIN ? INT32_MIN : (int32_t)value;
     }
     return 0;
 }
 
-int fmu_get_enums(FmuInstance *in, const char *function, const unsigned vr[], size_t nvr, int64_t values[],
-                  size_t n_values) {
-    size_t k;
-    if (begin_read(in, function, nvr, n_values)) return -1;
-    for (k = 0; k < nvr; k++) {
-        if (!check_vr(in, function, vr[k], 'e')) return -1;
-        values[k] = in->core.i[PAM_VARS[vr[k] - 1].index];
-    }
-    return 0;
+int fmu_set_integers(FmuInstance *in, const char *function, const unsigned vr[], size_t nvr, const int32_t values[],
+                     size_t n_values) {
+    return set_ints(in, function, vr, nvr, n_values, 'i', values, NULL);
 }
 
 int fmu_set_enums(FmuInstance *in, const char *function, const unsigned vr[], size_t nvr, const int64_t values[],
                   size_t n_values) {
-    size_t k;
-    if (!fmu_allowed(in, function, FMU_INSTANTIATED | FMU_INIT) || n_values != nvr) return -1;
-    for (k = 0; k < nvr; k++) {
-        if (!check_vr(in, function, vr[k], 'e') || !settable(in, function, vr[k])) return -1;
-        /* Out of int32 range is out of every choice's range: kept out of range for the parameter check. */
-        in->core.i[PAM_VARS[vr[k] - 1].index] = values[k] > INT32_MAX ? INT32_MAX
-                                                : values[k] < INT32_MIN ? INT32_MIN : (int32_t)values[k];
-    }
-    return 0;
+    return set_ints(in, function, vr, nvr, n_values, 'e', NULL, values);
 }
 
 int fmu_no_such_type(FmuInstance *in, const char *function, int states, size_t nvr, const char *what) {

@@ -1,6 +1,7 @@
 /* pamsim muscle model core; see pam_core.h.  Every equation mirrors a
  * pamsim element (names given at each function) so the two can be compared. */
 #include "pam_core.h"
+#include "pam_force_table.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -67,9 +68,38 @@ static double pressure_gauge_Pa(const PamCore *c, const double *y) {
     return y[P] - c->r[R_p_atm_Pa];
 }
 
-/* elements.static_force.Acra2012Polynomial */
-static double static_force_N(const double *r, double x, double p_gauge) {
+/* The force table baked in at build time (pamsim.fmu.force_table): bicubic Hermite interpolation
+ * of the value and the derivatives F_x, F_p, F_xp at the four corners of the cell holding (x, p).
+ * Outside the grid the edge cell's cubic extrapolates. */
+static double table_force_N(double x, double p) {
+    double u = (x - PAM_FT_X0) / PAM_FT_DX, w = (p - PAM_FT_P0) / PAM_FT_DP, s, t, f = 0.0;
+    int i = (int)floor(u), j = (int)floor(w), a, b;
+    if (i < 0) i = 0;
+    if (i > PAM_FT_NX - 2) i = PAM_FT_NX - 2;
+    if (j < 0) j = 0;
+    if (j > PAM_FT_NP - 2) j = PAM_FT_NP - 2;
+    s = u - i;
+    t = w - j;
+    {
+        /* Hermite basis: value and slope weights of the cell's low (0) and high (1) corner. */
+        double vs[2] = {(2 * s - 3) * s * s + 1, (3 - 2 * s) * s * s}, ds[2] = {((s - 2) * s + 1) * s, (s - 1) * s * s};
+        double vt[2] = {(2 * t - 3) * t * t + 1, (3 - 2 * t) * t * t}, dt[2] = {((t - 2) * t + 1) * t, (t - 1) * t * t};
+        for (a = 0; a < 2; a++)
+            for (b = 0; b < 2; b++) {
+                const double *n = PAM_FT[(i + a) * PAM_FT_NP + (j + b)];
+                f += vs[a] * vt[b] * n[0] + ds[a] * PAM_FT_DX * vt[b] * n[1] + vs[a] * dt[b] * PAM_FT_DP * n[2]
+                     + ds[a] * PAM_FT_DX * dt[b] * PAM_FT_DP * n[3];
+            }
+    }
+    return f;
+}
+
+/* elements.static_force: the ACRA 2012 polynomial, exact (static_force_model 0), or the force table
+ * of any other static model (1) */
+static double static_force_N(const PamCore *c, double x, double p_gauge) {
+    const double *r = c->r;
     double p_bar = p_gauge / PA_PER_BAR;
+    if (c->i[I_static_force_model] == PAM_STATIC_FORCE_MODEL_TABLE) return table_force_N(x, p_gauge);
     return ((r[R_K1_N_per_bar_m2] * x + r[R_K2_N_per_bar_m]) * x + r[R_C1_N_per_bar]) * p_bar
            + (r[R_S1_N_per_m2] * x + r[R_S2_N_per_m]) * x + r[R_S3_N];
 }
@@ -132,7 +162,7 @@ static void chamber_derivatives(const PamCore *c, const double *y, double v, dou
 /* MuscleModel.rest_forces: net force at zero velocity and the Coulomb level [N] */
 static void rest_forces(const PamCore *c, const double *y, double *net, double *level) {
     double p = pressure_gauge_Pa(c, y);
-    *net = static_force_N(c->r, y[X], p) - c->r[R_load_mass_kg] * c->r[R_g_m_s2] + c->r[R_external_force_N];
+    *net = static_force_N(c, y[X], p) - c->r[R_load_mass_kg] * c->r[R_g_m_s2] + c->r[R_external_force_N];
     *level = coulomb_level_N(c, y[X], p);
 }
 
@@ -144,7 +174,7 @@ static void rhs(PamCore *c, int mode, const double *y, double *dy) {
     c->n_rhs++;
     if (slip) {
         double p = pressure_gauge_Pa(c, y), m = r[R_load_mass_kg];
-        double F = static_force_N(r, y[X], p) - damping_force_N(c, v) - (double)mode * coulomb_level_N(c, y[X], p)
+        double F = static_force_N(c, y[X], p) - damping_force_N(c, v) - (double)mode * coulomb_level_N(c, y[X], p)
                    - m * r[R_g_m_s2] + r[R_external_force_N];
         dy[X] = v;
         dy[V] = F / m;
@@ -255,7 +285,8 @@ int pam_check_parameters(PamCore *c) {
         const PamVarInfo *info = &PAM_VARS[k];
         double value = info->kind == 'r' ? r[info->index] : (double)c->i[info->index];
         if (info->causality == PAM_PARAMETER && range_violation(info, value, why, sizeof why)) {
-            pam_logf(c, PAM_LOG_ERROR, "invalid parameters: %s = %g: %s", info->name, value, why);
+            if (info->kind == 'r') pam_logf(c, PAM_LOG_ERROR, "invalid parameters: %s = %g: %s", info->name, value, why);
+            else pam_logf(c, PAM_LOG_ERROR, "invalid parameters: %s = %ld: %s", info->name, (long)c->i[info->index], why);
             bad = -1;
         }
     }
@@ -272,6 +303,11 @@ int pam_check_parameters(PamCore *c) {
     if (!(r[R_release_margin_N] > r[R_stick_margin_N])) {
         pam_logf(c, PAM_LOG_ERROR, "invalid parameters: release_margin_N = %g: must be above stick_margin_N = %g",
                  r[R_release_margin_N], r[R_stick_margin_N]);
+        bad = -1;
+    }
+    if (c->i[I_static_force_model] == PAM_STATIC_FORCE_MODEL_TABLE && PAM_FT_NX < 2) {
+        pam_logf(c, PAM_LOG_ERROR, "invalid parameters: static_force_model = 1 (table): this FMU was built without "
+                 "a force table (build it with pamsim fmu build --scenario)");
         bad = -1;
     }
     if (!(r[R_initial_pressure_gauge_Pa] <= r[R_rated_pressure_gauge_Pa])) {
@@ -330,7 +366,7 @@ void pam_evaluate(PamCore *c) {
         friction = -net;
     else friction = 0.0;
     c->r[R_p_gauge_Pa] = pressure_gauge_Pa(c, y);
-    c->r[R_F_static_N] = static_force_N(c->r, y[X], c->r[R_p_gauge_Pa]);
+    c->r[R_F_static_N] = static_force_N(c, y[X], c->r[R_p_gauge_Pa]);
     c->r[R_F_friction_N] = friction;
     c->i[I_friction_mode] = mode;
 }

@@ -22,6 +22,8 @@ enum { PAM_DAMPING_PAPER = 0, PAM_DAMPING_LINEAR = 1, PAM_DAMPING_NONE = 2 };
 enum { PAM_SOURCE_VALVE = 0, PAM_SOURCE_PRESCRIBED = 1 };
 /* friction_negative_level: the element choices the core implements (pamsim.core_table.C_CHOICES) */
 enum { PAM_FRICTION_NEGATIVE_LEVEL_CLAMP = 0, PAM_FRICTION_NEGATIVE_LEVEL_ABS = 1 };
+/* static_force_model: the element choices the core implements (pamsim.core_table.C_CHOICES) */
+enum { PAM_STATIC_FORCE_MODEL_ACRA2012_POLYNOMIAL = 0, PAM_STATIC_FORCE_MODEL_TABLE = 1 };
 
 /* Parameter pairs (a, b) that must satisfy a < b (pamsim.core_table.ORDER_CHECKS). */
 #define PAM_N_ORDER_CHECKS 2

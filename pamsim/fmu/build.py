@@ -19,6 +19,7 @@ import zipfile
 from pathlib import Path
 
 from ..errors import InputError
+from .force_table import ForceTable
 from .generate import (MODEL_IDENTIFIER, compiled_sources, generation_date, model_description, write_documentation,
                        write_sources)
 
@@ -54,8 +55,13 @@ def default_output(fmi_version: int) -> Path:
     return Path(f"{MODEL_IDENTIFIER}_fmi{fmi_version}.fmu")
 
 
-def build(output_path: str | os.PathLike | None = None, fmi_version: int = 2) -> Path:
+def build(output_path: str | os.PathLike | None = None, fmi_version: int = 2,
+          force_table: ForceTable | None = None) -> Path:
     """Generate, compile and zip the FMU; return the path of the ``.fmu`` file.
+
+    ``force_table`` (:func:`pamsim.fmu.force_table.tabulate`) bakes a static force table into the
+    FMU, which then starts with ``static_force_model`` = table; without one the FMU has only the
+    exact ACRA 2012 polynomial.
 
     Raises :class:`~pamsim.errors.InputError` for an unknown FMI version, a
     missing C compiler or a failed compilation (with the compiler's message).
@@ -71,12 +77,12 @@ def build(output_path: str | os.PathLike | None = None, fmi_version: int = 2) ->
     with tempfile.TemporaryDirectory(prefix="pamsim-fmu-") as tmp:
         root = Path(tmp)
         src = root / "sources"
-        write_sources(src, fmi_version)
-        (root / "modelDescription.xml").write_text(model_description(fmi_version))
+        write_sources(src, fmi_version, force_table)
+        (root / "modelDescription.xml").write_text(model_description(fmi_version, force_table))
         bin_dir = root / "binaries" / platform_folder(fmi_version)
         bin_dir.mkdir(parents=True)
         lib = bin_dir / (MODEL_IDENTIFIER + shared_library_suffix())
-        write_documentation(root / "documentation", fmi_version)
+        write_documentation(root / "documentation", fmi_version, force_table)
         # Only the FMI functions are exported; relative source paths keep the temporary folder's name
         # out of the binary, so that the same sources give the same archive.
         cmd = [compiler, "-shared", "-fPIC", "-O2", "-std=c99", "-Wall", "-fvisibility=hidden", "-I", ".",

@@ -19,13 +19,17 @@ from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
 from .. import __version__
+from ..references import REFERENCES
 from .units import base_unit
-from .variables import BY_NAME, EVENT_INDICATORS, STATES, VARIABLES, value_reference
+from .force_table import EMPTY_HEADER, ForceTable
+from .variables import BY_NAME, EVENT_INDICATORS, STATES, VARIABLES, value_reference, with_force_table
 
 MODEL_NAME = "pamsim_muscle"
 MODEL_IDENTIFIER = "pamsim_muscle"
 C_DIR = Path(__file__).resolve().parents[2] / "fmu"  # the source tree; an installed wheel has pamsim.fmu.csrc
 CORE_SOURCES = ("pam_core.c", "pam_core.h", "pam_shared.h", "fmi_shell.c", "fmi_shell.h")
+"""The hand-written C sources (pam_shared.h is generated but committed); ``pam_variables.h`` and
+``pam_force_table.h`` are generated at build time."""
 WRAPPERS = {2: "fmi2_wrapper.c", 3: "fmi3_wrapper.c"}
 HEADERS = {2: ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h"),
            3: ("fmi3Functions.h", "fmi3FunctionTypes.h", "fmi3PlatformTypes.h")}
@@ -83,13 +87,15 @@ def table_text() -> str:
     return "\n".join(repr(v) for v in VARIABLES)
 
 
-def token(fmi_version: int) -> str:
+def token(fmi_version: int, table: ForceTable | None = None) -> str:
     h = hashlib.sha256()
     src = c_source_dir() / "src"
     for name in CORE_SOURCES + (WRAPPERS[fmi_version],):
         h.update((src / name).read_bytes())
     h.update(table_text().encode())
     h.update(str(fmi_version).encode())
+    if table is not None:
+        h.update(table.digest().encode())
     return "{" + str(uuid.UUID(bytes=h.digest()[:16])) + "}"
 
 
@@ -165,20 +171,22 @@ def _dependencies(names, key) -> dict[str, str]:
     return {"dependencies": " ".join(str(key(n)) for n in sorted(names, key=key))}
 
 
-def _header(fmi_version: int) -> str:
+def _header(fmi_version: int, table: ForceTable | None) -> str:
     token_attr = "guid" if fmi_version == 2 else "instantiationToken"
-    attrs = _attrs(modelName=MODEL_NAME, **{token_attr: token(fmi_version)}, description=DESCRIPTION, author=AUTHOR,
+    attrs = _attrs(modelName=MODEL_NAME, **{token_attr: token(fmi_version, table)},
+                   description=DESCRIPTION + (f"; static force: a table of {table.model_name}" if table else ""), author=AUTHOR,
                    version=__version__, license=LICENSE, generationTool="pamsim.fmu",
                    generationDateAndTime=generation_date(), variableNamingConvention="flat")
     extra = ' numberOfEventIndicators="2"' if fmi_version == 2 else ""
     return f'<fmiModelDescription fmiVersion="{fmi_version}.0"{attrs}{extra}>'
 
 
-def model_description(fmi_version: int) -> str:
+def model_description(fmi_version: int, table: ForceTable | None = None) -> str:
+    """``modelDescription.xml``; ``table``: the force table the FMU is built with, if any."""
     if fmi_version == 2:
-        return _fmi2()
+        return _fmi2(table)
     if fmi_version == 3:
-        return _fmi3()
+        return _fmi3(table)
     raise ValueError(f"FMI version must be 2 or 3, not {fmi_version!r}")
 
 
@@ -186,9 +194,10 @@ def _attrs(**kw) -> str:
     return "".join(f" {k}={quoteattr(str(v))}" for k, v in kw.items() if v is not None)
 
 
-def _fmi2() -> str:
+def _fmi2(table: ForceTable | None) -> str:
+    variables = with_force_table(VARIABLES, table is not None)
     src_files = "".join(f'\n      <File name="{n}"/>' for n in compiled_sources(2))
-    lines = ['<?xml version="1.0" encoding="UTF-8"?>', _header(2),
+    lines = ['<?xml version="1.0" encoding="UTF-8"?>', _header(2, table),
              f'  <ModelExchange modelIdentifier="{MODEL_IDENTIFIER}" canGetAndSetFMUstate="true"'
              ' canSerializeFMUstate="true" providesDirectionalDerivative="true"'
              ' canNotUseMemoryManagementFunctions="true">',
@@ -198,8 +207,8 @@ def _fmi2() -> str:
              ' canNotUseMemoryManagementFunctions="true">',
              f'    <SourceFiles>{src_files}\n    </SourceFiles>', '  </CoSimulation>']
     lines += _unit_definitions() + _type_definitions(2) + _common_elements() + ['  <ModelVariables>']
-    index = {v.name: i for i, v in enumerate(VARIABLES, start=1)}  # FMI 2.0 refers to variables by position
-    for v in VARIABLES:
+    index = {v.name: i for i, v in enumerate(variables, start=1)}  # FMI 2.0 refers to variables by position
+    for v in variables:
         head = _attrs(name=v.name, valueReference=value_reference(v.name), description=v.description,
                       causality=v.causality, variability=v.variability, initial=v.initial)
         start = _num(v.start) if v.start is not None else None
@@ -212,8 +221,8 @@ def _fmi2() -> str:
             inner = f'<Integer{_attrs(**_limits(v), start=start)}/>'
         lines.append(f'    <ScalarVariable{head}>\n      {inner}\n    </ScalarVariable>')
     lines.append('  </ModelVariables>')
-    outputs = [v for v in VARIABLES if v.causality == "output"]
-    derivs = [v for v in VARIABLES if v.derivative_of]
+    outputs = [v for v in variables if v.causality == "output"]
+    derivs = [v for v in variables if v.derivative_of]
     states = [BY_NAME[s] for s in STATES]
     initial = sorted({v.name: v for v in outputs + derivs + states}.values(), key=lambda v: index[v.name])
 
@@ -230,8 +239,9 @@ def _fmi2() -> str:
     return "\n".join(lines)
 
 
-def _fmi3() -> str:
-    lines = ['<?xml version="1.0" encoding="UTF-8"?>', _header(3),
+def _fmi3(table: ForceTable | None) -> str:
+    variables = with_force_table(VARIABLES, table is not None)
+    lines = ['<?xml version="1.0" encoding="UTF-8"?>', _header(3, table),
              f'  <ModelExchange modelIdentifier="{MODEL_IDENTIFIER}" canGetAndSetFMUState="true"'
              ' canSerializeFMUState="true" providesDirectionalDerivatives="true"/>',
              f'  <CoSimulation modelIdentifier="{MODEL_IDENTIFIER}" canHandleVariableCommunicationStepSize="true"'
@@ -240,7 +250,7 @@ def _fmi3() -> str:
     lines += ['  <ModelVariables>',
               '    <Float64 name="time" valueReference="0" causality="independent" variability="continuous"'
               ' description="simulation time [s]" unit="s"/>']
-    for v in VARIABLES:
+    for v in variables:
         head = _attrs(name=v.name, valueReference=value_reference(v.name), description=v.description,
                       causality=v.causality, variability=v.variability, initial=v.initial)
         start = _num(v.start) if v.start is not None else None
@@ -254,8 +264,8 @@ def _fmi3() -> str:
         else:
             lines.append(f'    <Int32{head}{_attrs(**_limits(v), start=start)}/>')
     lines.append('  </ModelVariables>')
-    outputs = [v for v in VARIABLES if v.causality == "output"]
-    derivs = [v for v in VARIABLES if v.derivative_of]
+    outputs = [v for v in variables if v.causality == "output"]
+    derivs = [v for v in variables if v.derivative_of]
     states = [BY_NAME[s] for s in STATES]
     initial = sorted({v.name: v for v in outputs + derivs + states}.values(), key=lambda v: value_reference(v.name))
     lines.append('  <ModelStructure>')
@@ -287,20 +297,21 @@ def _c_bound(x: float) -> str:
     return repr(float(x))
 
 
-def c_header(fmi_version: int) -> str:
+def c_header(fmi_version: int, table: ForceTable | None = None) -> str:
     """``pam_variables.h``: indices into the value arrays, value references, start values, the token."""
-    reals = [v for v in VARIABLES if v.kind == "real"]
-    ints = [v for v in VARIABLES if v.kind == "integer"]
-    n_slots = max(value_reference(v.name) for v in VARIABLES)
+    variables = with_force_table(VARIABLES, table is not None)
+    reals = [v for v in variables if v.kind == "real"]
+    ints = [v for v in variables if v.kind == "integer"]
+    n_slots = max(value_reference(v.name) for v in variables)
     kinds = {"parameter": "PAM_PARAMETER", "input": "PAM_INPUT", "output": "PAM_OUTPUT", "local": "PAM_LOCAL"}
     out = ["/* Generated by pamsim.fmu.generate from pamsim/fmu/variables.py. Do not edit. */",
            "#ifndef PAM_VARIABLES_H", "#define PAM_VARIABLES_H", "", "#include <math.h>", "",
-           f'#define PAM_TOKEN "{token(fmi_version)}"', f"#define PAM_NR {len(reals)}", f"#define PAM_NI {len(ints)}",
+           f'#define PAM_TOKEN "{token(fmi_version, table)}"', f"#define PAM_NR {len(reals)}", f"#define PAM_NI {len(ints)}",
            f"#define PAM_NVARS {n_slots}", f"#define PAM_NX {len(STATES)}",
            f"#define PAM_NZ {len(EVENT_INDICATORS)}", ""]
     out += [f"#define R_{v.c_name} {i}" for i, v in enumerate(reals)]
     out += [f"#define I_{v.c_name} {i}" for i, v in enumerate(ints)]
-    out += [f"#define VR_{v.c_name} {value_reference(v.name)}u" for v in VARIABLES]
+    out += [f"#define VR_{v.c_name} {value_reference(v.name)}u" for v in variables]
     out += ["", "typedef enum { PAM_PARAMETER, PAM_INPUT, PAM_OUTPUT, PAM_LOCAL } PamCausality;",
             "/* kind: 'r' real, 'i' integer, 'e' enumeration (in i[]), 0 an unused value reference.  lower/upper: the range a parameter",
             " * or input must lie in (-/+HUGE_VAL: none); *_open: the bound is excluded. */",
@@ -312,7 +323,7 @@ def c_header(fmi_version: int) -> str:
             "static const PamVarInfo PAM_VARS[PAM_NVARS] = {"]
     slots = ['    {"", 0, 0, PAM_LOCAL, 0.0, -HUGE_VAL, HUGE_VAL, 0, 0},'] * n_slots
     ri = ii = 0
-    for v in VARIABLES:
+    for v in variables:
         if v.kind == "real":
             kind, idx, ri = "'r'", ri, ri + 1
         else:  # an Enumeration ('e') is an Integer in FMI 2.0 but an Int64 in FMI 3.0
@@ -325,14 +336,14 @@ def c_header(fmi_version: int) -> str:
     out += ["};", "", "/* Continuous states and their derivatives, in state-vector order (indices into r[]). */",
             "static const int PAM_STATE_R[PAM_NX] = {" + ", ".join(f"R_{BY_NAME[s].c_name}" for s in STATES) + "};",
             "static const int PAM_DERIV_R[PAM_NX] = {"
-            + ", ".join(f"R_{v.c_name}" for v in VARIABLES if v.derivative_of) + "};",
+            + ", ".join(f"R_{v.c_name}" for v in variables if v.derivative_of) + "};",
             "static const double PAM_NOMINAL[PAM_NX] = {"
             + ", ".join(repr(float(BY_NAME[s].nominal)) for s in STATES) + "};",
             "", "#endif", ""]
     return "\n".join(out)
 
 
-def write_sources(dest: Path, fmi_version: int) -> list[str]:
+def write_sources(dest: Path, fmi_version: int, table: ForceTable | None = None) -> list[str]:
     """Write the sources an FMU ships (C files, generated header, FMI headers, licence) into ``dest``."""
     dest.mkdir(parents=True, exist_ok=True)
     root = c_source_dir()
@@ -344,9 +355,10 @@ def write_sources(dest: Path, fmi_version: int) -> list[str]:
         (dest / name).write_bytes((root / "include" / f"fmi{fmi_version}" / name).read_bytes())
         names.append(name)
     (dest / "FMI_HEADERS_LICENSE.txt").write_bytes((root / "include" / "LICENSE.txt").read_bytes())
-    (dest / "pam_variables.h").write_text(c_header(fmi_version))
+    (dest / "pam_variables.h").write_text(c_header(fmi_version, table))
+    (dest / "pam_force_table.h").write_text(table.c_header() if table is not None else EMPTY_HEADER)
     (dest / "buildDescription.xml").write_text(build_description(fmi_version))
-    return names + ["pam_variables.h", "buildDescription.xml"]
+    return names + ["pam_variables.h", "pam_force_table.h", "buildDescription.xml"]
 
 
 def range_text(v) -> str:
@@ -376,8 +388,7 @@ USAGE = (
     ("What it is", DESCRIPTION + ". The same model as pamsim.simulate, compiled C with no Python inside; "
      "Model Exchange and Co-Simulation."),
     ("Driving it", "Set the parameters before the end of initialisation; the defaults are the Shadow 6 mm x 300 mm "
-     "muscle of 'A dynamic force model of a small and soft McKibben pneumatic muscle' (ACRA 2012) with a "
-     "22.74 N load. Drive valve_command (1 open to supply, 0 "
+     f"muscle of {REFERENCES['acra2012'].short} ({REFERENCES['acra2012'].full()}) with a 22.74 N load. Drive valve_command (1 open to supply, 0 "
      "closed, -1 open to exhaust) and supply_pressure_gauge_Pa, or with pressure_source = prescribed, "
      "prescribed_pressure_gauge_Pa; set load_mass_kg and external_force_N; read contraction_m, p_gauge_Pa, "
      "F_static_N, F_friction_N and friction_mode."),
@@ -392,10 +403,11 @@ USAGE = (
 """The usage page in the FMU's documentation/index.html."""
 
 
-def documentation_html(fmi_version: int) -> str:
+def documentation_html(fmi_version: int, table: ForceTable | None = None) -> str:
     """``documentation/index.html``: a short usage page and the variable table."""
+    variables = with_force_table(VARIABLES, table is not None)
     rows = []
-    for v in VARIABLES:
+    for v in variables:
         cells = (str(value_reference(v.name)), v.name, v.causality, v.kind, v.unit or "",
                  "" if v.start is None else f"{v.start:g}" if isinstance(v.start, float) else str(v.start),
                  range_text(v), ", ".join(f"{i} = {c}" for i, c in enumerate(v.choices or ())), v.description)
@@ -409,10 +421,10 @@ def documentation_html(fmi_version: int) -> str:
             + "\n</table>\n</body>\n</html>\n")
 
 
-def write_documentation(dest: Path, fmi_version: int) -> None:
+def write_documentation(dest: Path, fmi_version: int, table: ForceTable | None = None) -> None:
     """Write the FMU's ``documentation/`` folder into ``dest``."""
     dest.mkdir(parents=True, exist_ok=True)
-    (dest / "index.html").write_text(documentation_html(fmi_version))
+    (dest / "index.html").write_text(documentation_html(fmi_version, table))
 
 
 def shared_header() -> str:

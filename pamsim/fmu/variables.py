@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from ..core_table import C_CHOICES
 from ..parameters import LOAD_MASS, get_parameter_set
@@ -33,6 +33,9 @@ DAMPING_CHOICES = C_CHOICES["damping"]
 """``damping_model`` values 0, 1, 2 (the scenario's ``model.damping`` names)."""
 SOURCE_CHOICES = C_CHOICES["source"]
 """``pressure_source`` values 0, 1 (the scenario's ``pressure.source`` names)."""
+STATIC_FORCE_CHOICES = C_CHOICES["static_force_model"]
+"""``static_force_model`` values 0, 1: the ACRA 2012 polynomial, exact, or the force table baked into the FMU at
+build time (any other static model; :mod:`pamsim.fmu.force_table`)."""
 NEGATIVE_LEVEL = C_CHOICES["friction_negative_level"]
 """``friction_negative_level`` values 0, 1 (the scenario's ``model.friction_negative_level`` names)."""
 
@@ -49,6 +52,7 @@ VALUE_REFERENCES = {
     "friction_model": 33, "damping_model": 34, "pressure_source": 35, "initial_contraction_m": 36,
     "stick_margin_N": 37, "release_margin_N": 38, "cs_relative_tolerance": 39, "cs_max_step_s": 40,
     "friction_negative_level": 41, "initial_pressure_gauge_Pa": 42, "cs_max_internal_steps": 62,
+    "static_force_model": 63,
     # Inputs, states, derivatives, outputs, event indicators.
     "valve_command": 43, "supply_pressure_gauge_Pa": 44, "prescribed_pressure_gauge_Pa": 45, "load_mass_kg": 46,
     "external_force_N": 47, "contraction_m": 48, "velocity_m_s": 49, "chamber_pressure_abs_Pa": 50, "air_mass_kg": 51,
@@ -204,6 +208,8 @@ def _table() -> tuple[Variable, ...]:
         Variable("event_indicator_2", "real", "local", "continuous",
                  "sliding: distance to the stop ahead; stuck: downward force margin [m or N]", initial="calculated",
                  depends_on=MECHANICS),
+        _choice("static_force_model", "static force: {} (the force table baked into this FMU at build time; "
+                "0 uses the parameters K1..S3)", STATIC_FORCE_CHOICES),
         Variable("cs_max_internal_steps", "integer", "parameter", "fixed",
                  "co-simulation: a doStep that needs more internal steps than this fails (a bound on its "
                  "run time) [1]", None, 10_000_000, "exact", lower=1, upper=2**31 - 1),
@@ -221,6 +227,15 @@ def assign_value_references(variables, pinned) -> dict[str, int]:
         else:
             out[v.name], nxt = nxt, nxt + 1
     return out
+
+
+def with_force_table(variables: tuple[Variable, ...], has_table: bool) -> tuple[Variable, ...]:
+    """The table of an FMU built with (``has_table``) or without a force table: with one, the FMU
+    starts on it (``static_force_model`` = table)."""
+    if not has_table:
+        return variables
+    return tuple(replace(v, start=STATIC_FORCE_CHOICES.index("table")) if v.name == "static_force_model" else v
+                 for v in variables)
 
 
 VARIABLES: tuple[Variable, ...] = _table()

@@ -20,6 +20,7 @@ from pathlib import Path
 
 from ..errors import InputError
 from ..fmu.build import shared_library_suffix
+from ..fmu.force_table import EMPTY_HEADER
 from ..fmu.generate import c_header, c_source_dir
 
 SOURCES = ("pam_native.c", "pam_native.h", "pam_core.c", "pam_core.h", "pam_shared.h")
@@ -49,6 +50,7 @@ def library_token(cc: str) -> str:
     for name in SOURCES:
         h.update(name.encode() + b"\0" + (src / name).read_bytes())
     h.update(c_header(2).encode())
+    h.update(EMPTY_HEADER.encode())
     h.update("\0".join((cc, *FLAGS)).encode())
     return h.hexdigest()[:24]
 
@@ -70,6 +72,8 @@ def library_path() -> Path:
     with tempfile.TemporaryDirectory(prefix="build-", dir=folder) as tmp:
         work = Path(tmp)
         (work / "pam_variables.h").write_text(c_header(2))
+        # No force table: the library runs the polynomial; other static forces are refused before a run.
+        (work / "pam_force_table.h").write_text(EMPTY_HEADER)
         src = c_source_dir() / "src"
         partial = work / path.name
         cmd = [cc, *FLAGS, "-I", str(work), "-I", str(src), str(src / "pam_native.c"), "-o", str(partial), "-lm"]
