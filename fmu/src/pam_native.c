@@ -38,22 +38,44 @@ static void powers_W(const PamCore *c, const double *y, double *P) {
     P[W_EXTERNAL] = c->r[R_external_force_N] * v;
 }
 
-static void state_at(const DpStages *s, const double *y0, double t0, double h, double t, double *y) {
-    if (s) dp_dense(s, y0, h, (t - t0) / h, y);
-    else memcpy(y, y0, sizeof(double) * PAM_NX);
+/* One step's dense output (Shampine's 4th-order extension, DP_P of pam_core.c) as a polynomial,
+ * y(t0 + th h) = y0 + sum_j q[j] th^(j+1), factored once per step rather than once per sample:
+ * sampling at 1 kHz evaluates it several times per step.  A NULL stages (a held load at rest) is
+ * the constant y0. */
+typedef struct {
+    double t0, h, y0[PAM_NX], q[4][PAM_NX];
+} DensePoly;
+
+static void dense_poly(DensePoly *d, const DpStages *s, const double *y0, double t0, double h) {
+    int n, j, st;
+    d->t0 = t0;
+    d->h = h;
+    memcpy(d->y0, y0, sizeof d->y0);
+    for (j = 0; j < 4; j++)
+        for (n = 0; n < PAM_NX; n++) {
+            double acc = 0.0;
+            if (s)
+                for (st = 0; st < 7; st++) acc += s->k[st][n] * DP_P[st][j];
+            d->q[j][n] = h * acc;
+        }
 }
 
-/* Adds the work done from t0 to t1 within one step: 3-point Gauss-Legendre on the dense output
+static void state_at(const DensePoly *d, double t, double *y) {
+    double th = d->h > 0.0 ? (t - d->t0) / d->h : 0.0;
+    int n;
+    for (n = 0; n < PAM_NX; n++) y[n] = d->y0[n] + th * (d->q[0][n] + th * (d->q[1][n] + th * (d->q[2][n] + th * d->q[3][n])));
+}
+
+/* Adds the work done from ta to tb within one step: 3-point Gauss-Legendre on the dense output
  * (exact for polynomials of degree 5, so its error is below the dense output's own). */
-static void add_work(const PamCore *c, const DpStages *s, const double *y0, double t0, double h, double t1,
-                     double *work) {
+static void add_work(const PamCore *c, const DensePoly *d, int moving, double ta, double tb, double *work) {
     static const double node[3] = {-0.7745966692414834, 0.0, 0.7745966692414834};
     static const double weight[3] = {5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0};
-    double half = 0.5 * (t1 - t0), y[PAM_NX], P[N_WORK];
+    double half = 0.5 * (tb - ta), y[PAM_NX], P[N_WORK];
     int q, k;
-    if (!s || !(half > 0.0)) return; /* a held load does no work */
+    if (!moving || !(half > 0.0)) return; /* a held load does no work */
     for (q = 0; q < 3; q++) {
-        state_at(s, y0, t0, h, t0 + half * (1.0 + node[q]), y);
+        state_at(d, ta + half * (1.0 + node[q]), y);
         powers_W(c, y, P);
         for (k = 0; k < N_WORK; k++) work[k] += weight[q] * half * P[k];
     }
@@ -75,19 +97,22 @@ static void record(Run *run, const double *y, const double *work) {
     run->next_sample++;
 }
 
-/* The samples inside an accepted step come from its dense output, as solve_ivp's t_eval. */
+/* The samples inside an accepted step come from its dense output, as solve_ivp's t_eval; the work
+ * integrals are carried from sample to sample. */
 static void on_step(void *env, double t0, double t1, double h, const double *y0, const void *stages) {
     Run *run = (Run *)env;
-    const DpStages *s = (const DpStages *)stages;
-    double y[PAM_NX], work[N_WORK];
+    DensePoly d;
+    double y[PAM_NX], ta = t0;
+    int moving = stages != NULL && sliding(run->core.mode);
+    dense_poly(&d, (const DpStages *)stages, y0, t0, h);
     while (run->next_sample < run->n_samples && sample_time(run, run->next_sample) <= t1) {
         double t = sample_time(run, run->next_sample);
-        memcpy(work, run->work, sizeof work);
-        add_work(&run->core, s, y0, t0, h, t, work);
-        state_at(s, y0, t0, h, t, y);
-        record(run, y, work);
+        add_work(&run->core, &d, moving, ta, t, run->work);
+        ta = t;
+        state_at(&d, t, y);
+        record(run, y, run->work);
     }
-    add_work(&run->core, s, y0, t0, h, t1, run->work);
+    add_work(&run->core, &d, moving, ta, t1, run->work);
 }
 
 static int event_kind(int from, int to, const PamCore *c, const double *y_after) {
