@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from pamsim.core_table import BRAID_LOCK_SEC2, C_CHOICES, EVENT_V_TOL_M_S, EVENT_X_TOL_M, SCENARIO_KEYS
+from pamsim.core_table import C_CHOICES, EVENT_V_TOL_M_S, EVENT_X_TOL_M, SCENARIO_KEYS
 from pamsim.elements.chamber import MuscleChamber
 from pamsim.elements.damping import DAMPING_MODELS
 from pamsim.elements.friction import FRICTION_MODELS
@@ -47,7 +47,8 @@ def _random_parameters(rng, n):
     params["valve_b"] = rng.uniform(0.0, 0.6, n)
     params["valve_laminar_ratio"] = rng.uniform(0.95, 0.9999, n)
     params["polytropic_index"] = rng.choice([1.0, 1.2, 1.4], n)
-    params["braid_angle_rest_deg"] = rng.uniform(10.0, 40.0, n)
+    angle = "theta0_deg" if "theta0_deg" in base else "braid_angle_rest_deg"  # renamed on another branch
+    params[angle] = rng.uniform(10.0, 40.0, n)
     params["stop_restitution"] = rng.uniform(0.0, 1.0, n)
     return params
 
@@ -58,11 +59,9 @@ def _points():
     params = _random_parameters(rng, n)
     choice = {key: rng.integers(0, len(C_CHOICES[key]), n) for key in SCENARIO_KEYS}
     mode = rng.choice([int(m) for m in Mode], n)
-    b = params["L0_m"] / np.cos(np.radians(params["braid_angle_rest_deg"]))
-    x_high = params["L0_m"] - b / np.sqrt(BRAID_LOCK_SEC2)
-    x = rng.uniform(0.0, 1.0, n) * x_high
+    x = rng.uniform(0.0, 1.0, n)  # as a fraction of the braid-lock contraction, on the stop in a stop mode
     x[mode == Mode.STOP_LOW] = 0.0
-    x[mode == Mode.STOP_HIGH] = x_high[mode == Mode.STOP_HIGH]
+    x[mode == Mode.STOP_HIGH] = 1.0
     v = rng.uniform(-0.5, 0.5, n) * (np.abs(mode) == 1)  # a held load is at rest
     p_abs = rng.uniform(0.3e5, 5.5e5, n)
     inputs = {"valve_command": rng.choice([-1.0, 0.0, 1.0, 0.5], n) * rng.choice([1.0, rng.uniform()], n),
@@ -137,7 +136,8 @@ def evaluated():
     for k in range(n):
         p = {name: float(values[k]) for name, values in params.items()}
         model = _model(p, choice, inputs, k)
-        x, v, p_abs, temperature = raw_states[k]
+        fraction, v, p_abs, temperature = raw_states[k]
+        x = fraction * model.stops.x_high_m
         valve = isinstance(model.source, ValveChamberSource)
         chamber = MuscleChamber.from_parameters(p)
         volume = chamber.volume_m3(x)

@@ -18,7 +18,7 @@ from pamsim.errors import InputError
 from pamsim.fmu.generate import c_source_dir, shared_header
 from pamsim.fmu.runner import start_values
 from pamsim.model import Mode
-from pamsim.parameters import get_parameter_set
+from pamsim.parameters import braid_geometry, get_parameter_set
 
 from conftest import SCENARIOS
 
@@ -55,7 +55,7 @@ def test_python_reads_the_same_constants():
     p = get_parameter_set("shadow_6x300_acra2012")
     stops = EndStops.from_parameters(p)
     assert stops.min_rebound_speed_m_s == core_table.MIN_REBOUND_SPEED_M_S
-    b = p["L0_m"] / __import__("math").cos(__import__("math").radians(p["braid_angle_rest_deg"]))
+    b, _ = braid_geometry(p)
     assert stops.x_high_m == p["L0_m"] - b / core_table.BRAID_LOCK_SEC2 ** 0.5
 
 
