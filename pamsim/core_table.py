@@ -34,7 +34,9 @@ class SharedConstant:
 MIN_REBOUND_SPEED_M_S = 1e-3
 """A rebound slower than this off an end stop is no rebound: the load stays on the stop [m/s]."""
 MAX_ZERO_LENGTH_EVENTS = 50
-"""More events than this at one instant means the switching makes no progress (a solver failure)."""
+"""In the C core, more events than this at one instant means the switching makes no progress (a solver
+failure).  The Python simulator holds such a load briefly instead and has its own limit
+(``pamsim.simulator._MAX_ZERO_LENGTH``), so this one is the C core's alone."""
 EVENT_V_TOL_M_S = 1e-9
 """C event indicators on velocity are shifted by this, so v = 0 right after a release is no event [m/s]."""
 EVENT_X_TOL_M = 1e-9

@@ -20,29 +20,21 @@ COMMANDS = (
     "pamsim.cli.sweep",
     "pamsim.cli.fmu",
     "pamsim.cli.linearize",
-    "pamsim.cli.control_example",
     "pamsim.cli.params",
 )
 
 
-def build_parser(command: str | None = None) -> argparse.ArgumentParser:
-    """The parser of every subcommand, or only of ``command`` if it names one.
-
-    Registering one command imports only its module: ``pamsim sweep`` need not import
-    python-control (about a second) for ``pamsim linearize``'s argument choices.
-    """
+def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="pamsim", description="McKibben muscle simulator")
     parser.add_argument("--version", action="version", version="pamsim " + __import__("pamsim").__version__)
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    chosen = f"pamsim.cli.{command.replace('-', '_')}" if command else None
-    for name in (chosen,) if chosen in COMMANDS else COMMANDS:
+    for name in COMMANDS:
         importlib.import_module(name).register(sub)
     return parser
 
 
 def main(argv: list[str] | None = None) -> int:
-    argv = sys.argv[1:] if argv is None else list(argv)
-    parser = build_parser(argv[0] if argv else None)
+    parser = build_parser()
     args = parser.parse_args(argv)
     try:
         return int(args.func(args) or 0)

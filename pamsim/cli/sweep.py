@@ -8,10 +8,8 @@ import sys
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
-from ..atomic import ensure_output_dir
+from ..atomic import output_folder
 from ..backends import BACKENDS
-from ..sweep import load_sweep, run_sweep
-from ..sweep.run import check_backend
 
 
 def _workers(text: str) -> int:
@@ -39,15 +37,18 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..sweep import load_sweep, run_sweep
+    from ..sweep.run import check_backend
+
     spec = load_sweep(args.sweep_file)
-    check_backend(spec, args.backend or spec.backend)
-    ensure_output_dir(args.output)  # before the runs, not after them
-    if args.workers == 1:
-        result = run_sweep(spec, None, progress=not args.no_progress, backend=args.backend)
-    else:
-        with ProcessPoolExecutor(max_workers=args.workers) as pool:
-            result = run_sweep(spec, pool, progress=not args.no_progress, backend=args.backend)
-    names = result.write(args.output)
+    check_backend(spec, args.backend or spec.backend)  # before the output folder and the runs
+    with output_folder(args.output) as out:  # checked before the runs; removed again if nothing gets written
+        if args.workers == 1:
+            result = run_sweep(spec, None, progress=not args.no_progress, backend=args.backend)
+        else:
+            with ProcessPoolExecutor(max_workers=args.workers) as pool:
+                result = run_sweep(spec, pool, progress=not args.no_progress, backend=args.backend)
+        names = result.write(out)
     for failure in result.failures:
         print(f"pamsim: warning: failed run {failure}", file=sys.stderr)
     print(f"{spec.name}: {len(result.rows)} cases, {len(result.failures)} failed runs, "

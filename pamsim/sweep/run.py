@@ -61,7 +61,7 @@ def run_task(task: _Task) -> dict:
         t_settled = settled_time_s(result.t_s, result.p_gauge_Pa)
         osc = estimate_oscillation(result.t_s, result.x_m, t_start_s=t_settled)
         last = result.t_s >= result.t_s[-1] - LAST_WINDOW_S
-        out = {"final_contraction_m": float(result.x_m[-1]), "peak_contraction_m": float(result.x_m.max()),
+        out = {"final_contraction_m": float(result.x_m[-1]), "peak_contraction_m": result.peak_contraction_m,
                "at_rest": bool(result.at_rest_at_end), "final_mode": result.final_mode.label,
                "last_second_peak_to_peak_m": float(np.ptp(result.x_m[last])),
                "frequency_Hz": osc.frequency_Hz, "damping_ratio": osc.damping_ratio,
@@ -84,33 +84,6 @@ def settled_time_s(t_s: np.ndarray, p_gauge_Pa: np.ndarray, fraction: float = SE
         return float(t_s[0])
     outside = np.flatnonzero(np.abs(p_gauge_Pa - p_gauge_Pa[-1]) > fraction * step)
     return float(t_s[outside[-1] + 1]) if outside.size else float(t_s[0])
-
-
-class ProgressBar:
-    """A one-line text progress bar with an ETA, redrawn on a terminal and printed every 10 % otherwise."""
-
-    def __init__(self, total: int, stream=None, width: int = 30):
-        self.total = total
-        self.stream = stream if stream is not None else sys.stderr
-        self.width = width
-        self.start = time.perf_counter()
-        self.interactive = bool(getattr(self.stream, "isatty", lambda: False)())
-        self._last_decile = -1
-
-    def update(self, done: int, failed: int) -> None:
-        """Show ``done`` of ``total`` finished, ``failed`` of them failed."""
-        elapsed = time.perf_counter() - self.start
-        eta = elapsed / done * (self.total - done) if done else math.nan
-        filled = int(self.width * done / self.total) if self.total else self.width
-        line = (f"[{'#' * filled}{'.' * (self.width - filled)}] {done}/{self.total} runs, {failed} failed, "
-                f"{elapsed:.1f} s elapsed, ETA {eta:.1f} s")
-        decile = 10 * done // max(self.total, 1)
-        if self.interactive:
-            self.stream.write("\r" + line + ("\n" if done == self.total else ""))
-        elif decile != self._last_decile:
-            self.stream.write(line + "\n")
-        self._last_decile = decile
-        self.stream.flush()
 
 
 @dataclass
@@ -199,7 +172,11 @@ def run_sweep(spec: SweepSpec | str | Path, executor: Executor | None = None, pr
     tasks += [_task("response", (s.name, f), s.with_changes({"model": {"friction": f}}), True, backend)
               for s in spec.time_responses for f in spec.friction_models]
     start = time.perf_counter()
-    outputs = _execute(tasks, executor, ProgressBar(len(tasks)) if progress else None)
+    from tqdm import tqdm
+
+    with tqdm(total=len(tasks), unit="run", desc=spec.name, file=sys.stderr, disable=not progress,
+              dynamic_ncols=True) as bar:
+        outputs = _execute(tasks, executor, bar)
     wall = time.perf_counter() - start
     by_key = {(t.kind, t.key): o for t, o in zip(tasks, outputs)}
     failures = [f"{t.scenario.name}: {o['error']}" for t, o in zip(tasks, outputs) if o["error"]]
@@ -235,26 +212,27 @@ def check_backend(spec: SweepSpec, backend: str) -> None:
             check_scenario(backend, scenario.with_changes({"model": {"friction": friction}}))
 
 
-def _execute(tasks: list[_Task], executor: Executor | None, bar: ProgressBar | None) -> list[dict]:
+def _execute(tasks: list[_Task], executor: Executor | None, bar) -> list[dict]:
+    """Run the tasks (here or on ``executor``), advancing the tqdm ``bar`` by one per finished run."""
     outputs: list[dict | None] = [None] * len(tasks)
     failed = 0
     if executor is None:
         for i, task in enumerate(tasks):
             outputs[i] = run_task(task)
             failed += bool(outputs[i]["error"])
-            if bar:
-                bar.update(i + 1, failed)
+            bar.set_postfix(failed=failed, refresh=False)
+            bar.update(1)
         return outputs
     futures = {executor.submit(run_task, task): i for i, task in enumerate(tasks)}
-    for done, fut in enumerate(as_completed(futures), start=1):
+    for fut in as_completed(futures):
         i = futures[fut]
         try:
             outputs[i] = fut.result()
         except Exception as exc:  # noqa: BLE001 -- a dead worker fails its case, not the sweep
             outputs[i] = {"error": f"{type(exc).__name__}: {exc}"}
         failed += bool(outputs[i]["error"])
-        if bar:
-            bar.update(done, failed)
+        bar.set_postfix(failed=failed, refresh=False)
+        bar.update(1)
     return outputs
 
 
