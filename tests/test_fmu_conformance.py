@@ -193,10 +193,14 @@ def test_co_simulation_outputs_follow_inputs_set_at_a_communication_point(fmus, 
     fmu.freeInstance()
 
 
-def _last_successful_time(fmu, version, result=None):
-    if version == 2:
-        return fmu.getRealStatus(2)  # fmi2LastSuccessfulTime
-    return result
+def _fmi3_do_step(fmu, t, h):
+    """fmi3DoStep called directly (fmpy's doStep does not return lastSuccessfulTime on an error):
+    (status, lastSuccessfulTime)."""
+    flags = [ctypes.c_bool(False) for _ in range(3)]
+    last = ctypes.c_double(-1.0)
+    status = fmu.dll.fmi3DoStep(ctypes.c_void_p(fmu.component), ctypes.c_double(t), ctypes.c_double(h),
+                                ctypes.c_bool(False), *[ctypes.byref(f) for f in flags], ctypes.byref(last))
+    return status, last.value
 
 
 @pytest.mark.parametrize("version", [2, 3])
@@ -217,7 +221,9 @@ def test_do_step_refuses_invalid_time_arguments(fmus, version, t, h, message, ca
     # Refused, not half done: the instance is where it was and steps on from there.
     assert api.get("contraction_m", "p_gauge_Pa") == before
     if version == 2:
-        assert fmu.getRealStatus(2) == 0.1
+        assert fmu.getRealStatus(2) == 0.1  # fmi2LastSuccessfulTime
+    else:
+        assert _fmi3_do_step(fmu, t, h) == (3, 0.1)
     api.step(0.1, 0.1)
     fmu.terminate()
     fmu.freeInstance()
@@ -234,13 +240,8 @@ def test_failed_step_leaves_outputs_mode_and_time_at_one_instant(fmus, version, 
         assert _error_status(lambda: api.step(0.0, 3.0)) == 3
         t_ok = fmu.getRealStatus(2)
     else:
-        # fmpy's doStep does not return lastSuccessfulTime on an error: call the function directly.
-        flags = [ctypes.c_bool(False) for _ in range(3)]
-        last = ctypes.c_double(-1.0)
-        status = fmu.dll.fmi3DoStep(ctypes.c_void_p(fmu.component), ctypes.c_double(0.0), ctypes.c_double(3.0),
-                                    ctypes.c_bool(False), *[ctypes.byref(f) for f in flags], ctypes.byref(last))
+        status, t_ok = _fmi3_do_step(fmu, 0.0, 3.0)
         assert status == 3
-        t_ok = last.value
     assert "more than 40 internal steps" in capfd.readouterr().out
     assert 0.0 < t_ok < 3.0
     got = api.get("contraction_m", "velocity_m_s", "p_gauge_Pa") + [api.mode()]
@@ -334,7 +335,8 @@ def test_adding_a_parameter_does_not_renumber_the_others(monkeypatch):
 
     params = get_parameter_set(variables.PARAMETER_SET)
     extra = ParameterSet(params.name, params.citation,
-                         {"A_new_parameter_N": Parameter(1.0, "N", "test", "a parameter added first"), **params.entries})
+                         {"A_new_parameter_N": Parameter(1.0, "N", "test", "a parameter added first"),
+                          **params.entries})
     monkeypatch.setattr(variables, "get_parameter_set", lambda name: extra)
     table = variables._table()
     assert table[0].name == "A_new_parameter_N"
@@ -457,7 +459,8 @@ def test_declared_initial_dependencies_of_the_states_cover_every_parameter_they_
     fmu.freeInstance()
 
 
-COMPANIONS = {("valve_laminar_ratio", -math.inf): {"valve_b": 0.0}, ("release_margin_N", -math.inf): {"stick_margin_N": 0.0}}
+COMPANIONS = {("valve_laminar_ratio", -math.inf): {"valve_b": 0.0},
+              ("release_margin_N", -math.inf): {"stick_margin_N": 0.0}}
 """Values a bound needs of other parameters to pass the checks between parameters."""
 
 

@@ -143,3 +143,19 @@ def test_cli_builds_a_table_fmu_from_a_scenario(tmp_path):
     start = {v.name: v.start for v in md.modelVariables}
     assert start["static_force_model"] == "1"
     assert value_reference("static_force_model") == 63
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_table_choice_without_a_table_reads_nan_during_initialisation(fmus, version):
+    """Before the choice is refused (at the end of initialisation), a derivative read evaluates the
+    model: the missing table gives NaN, not a read outside the table's memory."""
+    fmu = _instance(fmus, version, "me")
+    set_values(fmu, version, {"static_force_model": 1, "initial_contraction_m": 0.02})
+    if version == 2:
+        fmu.setupExperiment(startTime=0.0)
+    fmu.enterInitializationMode()
+    dx = np.zeros(4)
+    get = fmu.getDerivatives if version == 2 else fmu.getContinuousStateDerivatives
+    get(dx.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), 4)  # evaluates the model, outputs included
+    assert np.isnan(_Api(fmu, version).get("F_static_N")[0])
+    fmu.freeInstance()

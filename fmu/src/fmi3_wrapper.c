@@ -451,7 +451,7 @@ fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunicationPoi
     *eventHandlingNeeded = fmi3False;
     *terminateSimulation = fmi3False;
     *earlyReturn = fmi3False;
-    if (rc != FMU_STEP_REJECTED) *lastSuccessfulTime = FMU(instance)->core.time_s;
+    *lastSuccessfulTime = FMU(instance)->core.time_s; /* a refused step leaves it where it was */
     return STATUS(rc);
 }
 

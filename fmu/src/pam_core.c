@@ -73,11 +73,12 @@ static double pressure_gauge_Pa(const PamCore *c, const double *y) {
  * Outside the grid the edge cell's cubic extrapolates. */
 static double table_force_N(double x, double p) {
     double u = (x - PAM_FT_X0) / PAM_FT_DX, w = (p - PAM_FT_P0) / PAM_FT_DP, s, t, f = 0.0;
-    int i = (int)floor(u), j = (int)floor(w), a, b;
-    if (i < 0) i = 0;
-    if (i > PAM_FT_NX - 2) i = PAM_FT_NX - 2;
-    if (j < 0) j = 0;
-    if (j > PAM_FT_NP - 2) j = PAM_FT_NP - 2;
+    int i, j, a, b;
+    /* No table (the parameter check refuses the choice; an initialisation-mode read may still get here). */
+    if (PAM_FT_NX < 2 || PAM_FT_NP < 2) return NAN;
+    /* Clamped as doubles, so that a non-finite argument cannot make an out-of-range index. */
+    i = (int)fmin(fmax(floor(u), 0.0), PAM_FT_NX - 2.0);
+    j = (int)fmin(fmax(floor(w), 0.0), PAM_FT_NP - 2.0);
     s = u - i;
     t = w - j;
     {

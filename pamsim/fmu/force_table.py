@@ -58,7 +58,8 @@ class ForceTable:
             f'#define PAM_FT_MODEL "{self.model_name}"',
             f"#define PAM_FT_NX {nx}", f"#define PAM_FT_NP {n_p}",
             f"#define PAM_FT_X0 {self.x_min_m!r}", f"#define PAM_FT_DX {(self.x_max_m - self.x_min_m) / (nx - 1)!r}",
-            f"#define PAM_FT_P0 {self.p_min_Pa!r}", f"#define PAM_FT_DP {(self.p_max_Pa - self.p_min_Pa) / (n_p - 1)!r}",
+            f"#define PAM_FT_P0 {self.p_min_Pa!r}",
+            f"#define PAM_FT_DP {(self.p_max_Pa - self.p_min_Pa) / (n_p - 1)!r}",
             "/* (F, dF/dx, dF/dp, d2F/dx dp) at node (i, j), index i * PAM_FT_NP + j. */",
             "static const double PAM_FT[PAM_FT_NX * PAM_FT_NP][4] = {", rows, "};", "", "#endif", ""])
 

@@ -146,7 +146,8 @@ def _table() -> tuple[Variable, ...]:
                  "relative tolerance of the co-simulation integrator (Dormand-Prince 5(4)) [1]", "1", 1e-8, "exact",
                  lower=0.0, upper=1e-2, lower_open=True),
         Variable("cs_max_step_s", "real", "parameter", "fixed",
-                 "largest internal step of the co-simulation integrator [s]", "s", 0.01, "exact",
+                 "largest internal step of the co-simulation integrator while the load slides [s]", "s", 0.01,
+                 "exact",
                  lower=0.0, lower_open=True),
         _choice("friction_negative_level", "load-dependent friction where its level "
                 "(P_bar - phi m)(N2 x^2 + N1 x + N0) is negative: {} (clamp: level 0; abs: its magnitude)",
