@@ -121,3 +121,31 @@ def test_order_checks_are_shared_by_the_parameter_set_and_the_core():
                                    case.segment_u, case.max_events, case.model)], [10])
         assert out["status"][0] == 1 and out["messages"][0].startswith(f"invalid parameters: {a} = ")
         assert f"must be below {b}" in out["messages"][0]
+
+
+def test_library_is_cached_where_documented_and_rebuilt_when_a_source_changes(tmp_path, monkeypatch):
+    """``$PAMSIM_NATIVE_CACHE/TOKEN/``: the same sources give the same file, an edited source a new one."""
+    import shutil
+
+    from pamsim.native import build
+
+    monkeypatch.setenv(build.CACHE_ENV, str(tmp_path / "cache"))
+    first = build.library_path()
+    assert first.is_file() and first.parent.parent == tmp_path / "cache"
+    assert build.library_path() == first  # cached: not rebuilt
+    sources = tmp_path / "sources"
+    shutil.copytree(c_source_dir(), sources)
+    with open(sources / "src" / "pam_native.c", "a") as fh:
+        fh.write("\n/* an edit */\n")
+    monkeypatch.setattr(build, "c_source_dir", lambda: sources)
+    second = build.library_path()
+    assert second.is_file() and second.parent != first.parent
+
+
+def test_missing_compiler_is_an_input_error(monkeypatch):
+    from pamsim.native import build
+
+    monkeypatch.setenv("CC", "")
+    monkeypatch.setattr(build.shutil, "which", lambda name: None)
+    with pytest.raises(InputError, match="needs a C compiler"):
+        build.library_path()
