@@ -31,13 +31,31 @@ def as_scenario(scenario: "Scenario | str | os.PathLike") -> Scenario:
                     f"not {type(scenario).__name__}")
 
 
-def simulate(scenario: "Scenario | str | os.PathLike", progress: "Callable[[float], None] | None" = None) -> Result:
-    """Run ``scenario`` (a :class:`Scenario` or a scenario file's path) with the Python (solve_ivp) backend.
+def simulate(scenario: "Scenario | str | os.PathLike", backend: str = "python",
+             progress: "Callable[[float], None] | None" = None) -> Result:
+    """Run ``scenario`` (a :class:`Scenario` or a scenario file's path) and return its :class:`Result`.
 
-    Returns its :class:`Result`.  ``progress`` is called with the simulated
-    time reached (see :func:`~pamsim.simulator.simulate_model`).
+    Parameters
+    ----------
+    scenario : Scenario, str or PathLike
+        The scenario, or the path of its file.
+    backend : str
+        ``"python"`` (solve_ivp, the default), ``"native"`` (the C core as a shared library), or an
+        FMU importer (``"fmu-cs"``, ``"fmu-me"``); see :data:`pamsim.backends.BACKENDS`.  A setting a
+        backend cannot honour raises :class:`~pamsim.errors.InputError` naming it.
+    progress : callable, optional
+        Called with the simulated time reached (python backend; the others do not report it).
     """
     scenario = as_scenario(scenario)
+    if backend == "python":
+        return simulate_python(scenario, progress)
+    from .backends import get_backend
+
+    return get_backend(backend)(scenario)
+
+
+def simulate_python(scenario: Scenario, progress: "Callable[[float], None] | None" = None) -> Result:
+    """Backend ``python``: integrate ``scenario`` with ``scipy.integrate.solve_ivp``."""
     return simulate_model(scenario.build_model(), scenario.duration_s, scenario.solver,
                           x0_m=scenario.initial_contraction_m, name=scenario.name,
                           p0_gauge_Pa=scenario.initial_pressure_gauge_Pa, progress=progress)
@@ -87,7 +105,7 @@ def run(scenario: "Scenario | str | os.PathLike", backend: str = "python",
     loop would silently give a different system).  ``progress`` receives the
     simulated time reached (python backend; the FMU backends do not report it).
     """
-    from .backends import BACKENDS, get_backend
+    from .backends import BACKENDS
 
     scenario = as_scenario(scenario)
     if backend not in BACKENDS:
@@ -100,6 +118,4 @@ def run(scenario: "Scenario | str | os.PathLike", backend: str = "python",
 
         loop = run_closed_loop(scenario, progress=progress)
         return ScenarioRun(loop.result, backend, loop)
-    if backend == "python":
-        return ScenarioRun(simulate(scenario, progress), backend)
-    return ScenarioRun(get_backend(backend)(scenario), backend)
+    return ScenarioRun(simulate(scenario, backend, progress), backend)

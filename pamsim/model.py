@@ -137,6 +137,11 @@ class MuscleModel:
         s = y[2:2 + self.n_source]
         return np.array([0.0, 0.0, *self.source.derivatives(s, y[0], 0.0, source_inputs), 0.0, 0.0, 0.0, 0.0])
 
+    def pressure_trace_Pa(self, t, Y) -> np.ndarray:
+        """Gauge pressure [Pa] the mechanics see at times ``t`` of a trace ``Y`` (one column per time)."""
+        S = Y[2:2 + self.n_source]
+        return np.asarray(self.source.pressure_gauge_Pa(S, self.source.inputs(t)), dtype=float) + 0.0 * t
+
     def breakdown(self, t, Y, modes) -> dict[str, np.ndarray]:
         """Force components [N] along x (positive contracts) and source outputs for a trace.
 
@@ -145,7 +150,7 @@ class MuscleModel:
         """
         x, v = Y[0], Y[1]
         S = Y[2:2 + self.n_source]
-        p = np.asarray(self.source.pressure_gauge_Pa(S, self.source.inputs(t)), dtype=float) + 0.0 * t
+        p = self.pressure_trace_Pa(t, Y)
         F_s = np.asarray(self.static_force.force_N(x, p), dtype=float)
         F_c = np.asarray(self.friction.level_N(x, p, self.load.mass_kg), dtype=float) + 0.0 * t
         F_e = np.asarray(self.load.external_N(t), dtype=float) + 0.0 * t

@@ -133,7 +133,9 @@ def _turning_indices(y: np.ndarray, hysteresis: float) -> list[int]:
     found: list[int] = []
     direction = 0
     extreme = 0
-    for i in range(1, y.size):
+    n = y.size
+    y = y.tolist()  # Python floats: indexing a numpy array per sample costs several times more
+    for i in range(1, n):
         if direction == 0:
             # The first motion away from the start sets the direction; the start itself is not
             # a turning point (the response to a step begins there, not an oscillation).
@@ -148,7 +150,7 @@ def _turning_indices(y: np.ndarray, hysteresis: float) -> list[int]:
             extreme = i
     # The last running extreme is a turning point if the trace stopped there (stuck, or
     # turned back by less than the hysteresis) rather than still moving at the end.
-    if direction != 0 and extreme <= y.size - 3:
+    if direction != 0 and extreme <= n - 3:
         found.append(extreme)
     return found
 

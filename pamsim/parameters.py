@@ -20,6 +20,9 @@ from dataclasses import dataclass, replace
 from types import MappingProxyType
 from typing import Mapping
 
+from .core_table import ORDER_CHECKS
+
+
 @dataclass(frozen=True)
 class Parameter:
     """One parameter value with its unit, provenance, meaning and physical range.
@@ -94,10 +97,9 @@ class ParameterSet(Mapping[str, float]):
         if out:
             return out
         v = self
-        if "valve_b" in v and "valve_laminar_ratio" in v and not v["valve_b"] < v["valve_laminar_ratio"]:
-            out.append(("valve_b", v["valve_b"], f"must be below valve_laminar_ratio = {v['valve_laminar_ratio']:g}"))
-        if "fit_x_min_m" in v and "fit_x_max_m" in v and not v["fit_x_min_m"] < v["fit_x_max_m"]:
-            out.append(("fit_x_min_m", v["fit_x_min_m"], f"must be below fit_x_max_m = {v['fit_x_max_m']:g}"))
+        for a, b in ORDER_CHECKS:
+            if a in v and b in v and not v[a] < v[b]:
+                out.append((a, v[a], f"must be below {b} = {v[b]:g}"))
         if "wall_thickness_m" in v and "r0_m" in v and not v["r0_m"] > v["wall_thickness_m"]:
             out.append(("r0_m", v["r0_m"], f"must exceed the bladder wall thickness wall_thickness_m = "
                         f"{v['wall_thickness_m']:g}"))

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -18,6 +19,34 @@ CSV_BYTES_PER_VALUE = 17
 
 REST_SPEED_M_S = 1e-4
 """A load in a slip mode slower than this, with the net force inside the friction band, counts as at rest."""
+
+
+class Signals(Mapping):
+    """``Result.signals``: the work integrals at once, the force breakdown and source outputs
+    (:meth:`MuscleModel.breakdown`) when first read, since a sweep reads only a few figures of
+    each run and the breakdown costs more than a native run."""
+
+    def __init__(self, work: dict[str, np.ndarray], model: "MuscleModel", t, Y, modes):
+        self._work = work
+        self._trace = (model, t, Y, modes)
+        self._all: dict[str, np.ndarray] | None = None
+
+    def _everything(self) -> dict[str, np.ndarray]:
+        if self._all is None:
+            model, t, Y, modes = self._trace
+            sig = model.breakdown(t, Y, modes)
+            sig.pop("p_gauge_Pa")
+            self._all = {**sig, **self._work}
+        return self._all
+
+    def __getitem__(self, key: str) -> np.ndarray:
+        return self._work[key] if key in self._work else self._everything()[key]
+
+    def __iter__(self):
+        return iter(self._everything())
+
+    def __len__(self) -> int:
+        return len(self._everything())
 
 
 @dataclass(frozen=True)
@@ -50,7 +79,7 @@ class Result:
     v_m_s: np.ndarray
     p_gauge_Pa: np.ndarray
     mode: np.ndarray
-    signals: dict[str, np.ndarray]
+    signals: Mapping[str, np.ndarray]
     transitions: list[TransitionEvent]
     stats: dict
     wall_time_s: float
@@ -67,14 +96,13 @@ class Result:
     @classmethod
     def from_trace(cls, model: "MuscleModel", name, t, Y, modes, transitions, impact_losses, stats, wall_time_s,
                    peaks: dict[str, float] | None = None):
-        sig = model.breakdown(t, Y, modes)
-        for i, key in enumerate(model.state_names[-N_WORK:]):
-            sig[key] = Y[-N_WORK + i]
+        work = {key: Y[-N_WORK + i] for i, key in enumerate(model.state_names[-N_WORK:])}
         loss_t = np.array([a for a, _ in impact_losses])
         loss_J = np.array([b for _, b in impact_losses])
         cum = np.concatenate([[0.0], np.cumsum(loss_J)])
-        sig["E_impacts_J"] = cum[np.searchsorted(loss_t, t, side="right")]
-        p = sig.pop("p_gauge_Pa")
+        work["E_impacts_J"] = cum[np.searchsorted(loss_t, t, side="right")]
+        sig = Signals(work, model, t, Y, modes)
+        p = model.pressure_trace_Pa(t, Y)
         fr = model.fit_range
         peaks = dict(peaks or {})
         x_lo = min(peaks.get("x_min_m", np.inf), Y[0].min())

@@ -8,15 +8,15 @@
 #include <stdio.h>
 #include <string.h>
 
-#define PA_PER_BAR 1.0e5
+#define PA_PER_BAR PAM_PA_PER_BAR
 #define PI 3.14159265358979323846
-/* Event indicators are shifted by these so that a new mode starts strictly
- * inside its region (v = 0 after a release is not an event) and the event
- * test after root location has the same margin on either side of the root. */
-#define V_TOL_M_S 1e-9
-#define X_TOL_M 1e-9
-#define MIN_REBOUND_M_S 1e-3 /* pamsim.elements.stops.EndStops.min_rebound_speed_m_s */
-#define MAX_ZERO_LENGTH_EVENTS 50 /* pamsim.simulator: "made no progress" */
+/* Event indicators are shifted by PAM_V_TOL_M_S and PAM_X_TOL_M (pam_shared.h) so that a new mode
+ * starts strictly inside its region (v = 0 after a release is not an event) and the event test after
+ * root location has the same margin on either side of the root. */
+#define V_TOL_M_S PAM_V_TOL_M_S
+#define X_TOL_M PAM_X_TOL_M
+#define MIN_REBOUND_M_S PAM_MIN_REBOUND_M_S
+#define MAX_ZERO_LENGTH_EVENTS PAM_MAX_ZERO_LENGTH_EVENTS
 
 enum { X = 0, V = 1, P = 2, M = 3 };
 
@@ -64,7 +64,7 @@ static double dvolume_dx_m2(const PamCore *c, double x) {
 }
 
 static double pressure_gauge_Pa(const PamCore *c, const double *y) {
-    if (c->i[I_pressure_source] == 1) return c->r[R_prescribed_pressure_gauge_Pa];
+    if (c->i[I_pressure_source] == PAM_SOURCE_PRESCRIBED) return c->r[R_prescribed_pressure_gauge_Pa];
     return y[P] - c->r[R_p_atm_Pa];
 }
 
@@ -100,7 +100,7 @@ static double table_force_N(double x, double p) {
 static double static_force_N(const PamCore *c, double x, double p_gauge) {
     const double *r = c->r;
     double p_bar = p_gauge / PA_PER_BAR, f;
-    if (c->i[I_static_force_model] == 1) f = table_force_N(x, p_gauge);
+    if (c->i[I_static_force_model] == PAM_STATIC_FORCE_MODEL_TABLE) f = table_force_N(x, p_gauge);
     else f = ((r[R_K1_N_per_bar_m2] * x + r[R_K2_N_per_bar_m]) * x + r[R_C1_N_per_bar]) * p_bar
              + (r[R_S1_N_per_m2] * x + r[R_S2_N_per_m]) * x + r[R_S3_N];
     return f > 0.0 ? f : 0.0;
@@ -112,12 +112,12 @@ static double coulomb_level_N(const PamCore *c, double x, double p_gauge) {
     const double *r = c->r;
     double level;
     switch (c->i[I_friction_model]) {
-    case 0:
+    case PAM_FRICTION_LOAD_DEPENDENT:
         level = (p_gauge / PA_PER_BAR - r[R_phi_bar_per_kg] * r[R_load_mass_kg])
                 * ((r[R_N2_N_per_bar_m2] * x + r[R_N1_N_per_bar_m]) * x + r[R_N0_N_per_bar]);
-        if (c->i[I_friction_negative_level] == 1) return fabs(level);
+        if (c->i[I_friction_negative_level] == PAM_FRICTION_NEGATIVE_LEVEL_ABS) return fabs(level);
         return level > 0.0 ? level : 0.0;
-    case 1: return r[R_coulomb_constant_N];
+    case PAM_FRICTION_CONSTANT: return r[R_coulomb_constant_N];
     default: return 0.0;
     }
 }
@@ -125,8 +125,8 @@ static double coulomb_level_N(const PamCore *c, double x, double p_gauge) {
 /* elements.damping: paper D1 v + D2 v|v|, linear |D1| v, none */
 static double damping_force_N(const PamCore *c, double v) {
     switch (c->i[I_damping_model]) {
-    case 0: return (c->r[R_D1_N_s_per_m] + c->r[R_D2_N_s2_per_m2] * fabs(v)) * v;
-    case 1: return fabs(c->r[R_D1_N_s_per_m]) * v;
+    case PAM_DAMPING_PAPER: return (c->r[R_D1_N_s_per_m] + c->r[R_D2_N_s2_per_m2] * fabs(v)) * v;
+    case PAM_DAMPING_LINEAR: return fabs(c->r[R_D1_N_s_per_m]) * v;
     default: return 0.0;
     }
 }
@@ -184,7 +184,7 @@ static void rhs(PamCore *c, int mode, const double *y, double *dy) {
         dy[X] = 0.0;
         dy[V] = 0.0;
     }
-    if (c->i[I_pressure_source] == 0) chamber_derivatives(c, y, v, &dy[P], &dy[M]);
+    if (c->i[I_pressure_source] == PAM_SOURCE_VALVE) chamber_derivatives(c, y, v, &dy[P], &dy[M]);
     else dy[P] = dy[M] = 0.0;
 }
 
@@ -263,6 +263,14 @@ int pam_check_value(PamCore *c, unsigned vr, double value) {
     return 0;
 }
 
+/* The value of the real variable called `name` (the order checks name parameters; NaN if none is). */
+static double named_real(const PamCore *c, const char *name) {
+    int k;
+    for (k = 0; k < PAM_NVARS; k++)
+        if (PAM_VARS[k].kind == 'r' && strcmp(PAM_VARS[k].name, name) == 0) return c->r[PAM_VARS[k].index];
+    return NAN;
+}
+
 int pam_check_parameters(PamCore *c) {
     const double *r = c->r;
     int bad = 0, k;
@@ -286,22 +294,20 @@ int pam_check_parameters(PamCore *c) {
     }
     if (bad) return -1;
     /* Checks between parameters (ParameterSet.violations) and of the FMU's own parameters. */
-    if (!(r[R_valve_b] < r[R_valve_laminar_ratio])) {
-        pam_logf(c, PAM_LOG_ERROR, "invalid parameters: valve_b = %g: must be below valve_laminar_ratio = %g",
-                 r[R_valve_b], r[R_valve_laminar_ratio]);
-        bad = -1;
-    }
-    if (!(r[R_fit_x_min_m] < r[R_fit_x_max_m])) {
-        pam_logf(c, PAM_LOG_ERROR, "invalid parameters: fit_x_min_m = %g: must be below fit_x_max_m = %g",
-                 r[R_fit_x_min_m], r[R_fit_x_max_m]);
-        bad = -1;
+    for (k = 0; k < PAM_N_ORDER_CHECKS; k++) {
+        double a = named_real(c, PAM_ORDER_CHECKS[k][0]), below = named_real(c, PAM_ORDER_CHECKS[k][1]);
+        if (!(a < below)) {
+            pam_logf(c, PAM_LOG_ERROR, "invalid parameters: %s = %g: must be below %s = %g", PAM_ORDER_CHECKS[k][0], a,
+                     PAM_ORDER_CHECKS[k][1], below);
+            bad = -1;
+        }
     }
     if (!(r[R_release_margin_N] > r[R_stick_margin_N])) {
         pam_logf(c, PAM_LOG_ERROR, "invalid parameters: release_margin_N = %g: must be above stick_margin_N = %g",
                  r[R_release_margin_N], r[R_stick_margin_N]);
         bad = -1;
     }
-    if (c->i[I_static_force_model] == 1 && PAM_FT_NX < 2) {
+    if (c->i[I_static_force_model] == PAM_STATIC_FORCE_MODEL_TABLE && PAM_FT_NX < 2) {
         pam_logf(c, PAM_LOG_ERROR, "invalid parameters: static_force_model = 1 (table): this FMU was built without "
                  "a force table (build it with pamsim fmu build --scenario)");
         bad = -1;
@@ -316,7 +322,7 @@ int pam_check_parameters(PamCore *c) {
         if (PAM_VARS[k].causality == PAM_INPUT && pam_check_value(c, (unsigned)k + 1, r[PAM_VARS[k].index])) bad = -1;
     if (bad) return -1;
     braid_geometry(r, &b, &n);
-    x_high = r[R_L0_m] - b / sqrt(3.0);
+    x_high = r[R_L0_m] - b / sqrt(PAM_BRAID_LOCK_SEC2);
     if (!(r[R_initial_contraction_m] >= 0.0 && r[R_initial_contraction_m] <= x_high)) {
         pam_logf(c, PAM_LOG_ERROR,
                  "invalid parameters: initial_contraction_m = %g: must lie between the stops, 0 and %.4f m "
@@ -334,7 +340,7 @@ void pam_initialize(PamCore *c) {
     c->braid_b_m = b;
     c->braid_turns = n;
     c->x_low_m = 0.0;
-    c->x_high_m = c->r[R_L0_m] - b / sqrt(3.0); /* braid lock at 54.7 deg, elements.stops */
+    c->x_high_m = c->r[R_L0_m] - b / sqrt(PAM_BRAID_LOCK_SEC2); /* braid lock at 54.7 deg, elements.stops */
     y[X] = c->r[R_initial_contraction_m];
     y[V] = 0.0;
     y[P] = c->r[R_p_atm_Pa] + c->r[R_initial_pressure_gauge_Pa]; /* ValveChamberSource.initial_state */
@@ -509,7 +515,7 @@ static int first_crossing(const PamCore *c, const DpStages *s, const double *y, 
 static int settle_chamber(PamCore *c, double *y) {
     const double *r = c->r;
     double u = r[R_valve_command], p_src, dp, vol, T_in, settled[PAM_NX];
-    if (sliding(c->mode) || c->i[I_pressure_source] != 0 || u == 0.0) return 0;
+    if (sliding(c->mode) || c->i[I_pressure_source] != PAM_SOURCE_VALVE || u == 0.0) return 0;
     p_src = u > 0.0 ? r[R_supply_pressure_gauge_Pa] + r[R_p_atm_Pa] : r[R_p_atm_Pa];
     dp = p_src - y[P];
     if (dp == 0.0 || !(fabs(dp) <= r[R_cs_relative_tolerance] * (PAM_NOMINAL[P] + fabs(p_src)))) return 0;
@@ -554,6 +560,7 @@ int pam_do_step(PamCore *c, double t_end) {
          * the solution is constant, however long the step. */
         for (n = 0; n < PAM_NX && at_rest; n++) at_rest = s.k[0][n] == 0.0;
         if (at_rest) {
+            if (c->on_step) c->on_step(c->step_env, t, t_end, 0.0, y, NULL);
             t = t_end;
             break;
         }
@@ -587,11 +594,15 @@ int pam_do_step(PamCore *c, double t_end) {
             }
             if (hi < 1.0) dp_dense(&s, y, h, hi, ye);
             else memcpy(ye, y1, sizeof ye);
+            if (c->on_step) c->on_step(c->step_env, t, hi < 1.0 ? t + hi * h : (last ? t_end : t + h), h, y, &s);
             t = hi < 1.0 ? t + hi * h : (last ? t_end : t + h);
             memcpy(y, ye, sizeof y);
             put_states(c, y);
             {
-                int old = c->mode, jumped = transition(c, y);
+                double y_before[PAM_NX];
+                int old = c->mode, jumped;
+                memcpy(y_before, y, sizeof y_before);
+                jumped = transition(c, y);
                 if (!jumped && c->mode == old) {
                     if (++zero_length > MAX_ZERO_LENGTH_EVENTS) {
                         pam_logf(c, PAM_LOG_ERROR, "event switching made no progress at t = %.9g s", t);
@@ -600,12 +611,14 @@ int pam_do_step(PamCore *c, double t_end) {
                 } else {
                     zero_length = 0;
                     c->n_events++;
+                    if (c->on_event) c->on_event(c->event_env, t, old, c->mode, y_before, y);
                 }
             }
             c->h_s = fmax(fmin(h * hi, h_max), 1e-6);
             rhs(c, c->mode, y, s.k[0]);
             continue;
         }
+        if (c->on_step) c->on_step(c->step_env, t, last ? t_end : t + h, h, y, &s);
         t = last ? t_end : t + h;
         memcpy(y, y1, sizeof y);
         memcpy(s.k[0], s.k[6], sizeof s.k[0]);

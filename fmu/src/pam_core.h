@@ -14,6 +14,7 @@
 
 #include <stdint.h>
 #include "pam_variables.h"
+#include "pam_shared.h" /* constants and choices shared with Python, generated */
 
 /* Only the FMI functions leave the shared library (also when it is rebuilt by fmpy or cmake
  * without -fvisibility=hidden). */
@@ -21,11 +22,17 @@
 #pragma GCC visibility push(hidden)
 #endif
 
-/* pamsim.model.Mode */
-enum { PAM_SLIP_DOWN = -1, PAM_STICK = 0, PAM_SLIP_UP = 1, PAM_STOP_LOW = 2, PAM_STOP_HIGH = 3 };
 enum { PAM_LOG_INFO = 0, PAM_LOG_WARNING = 1, PAM_LOG_ERROR = 2 };
 
 typedef void (*PamLogFn)(void *env, int level, const char *message);
+/* Called by pam_do_step at each located event that changed the mode or the states: the time, the
+ * mode before and after, and the states just before and just after the jump (NULL for the FMU). */
+/* Called by pam_do_step for each accepted step from t0_s to t1_s, before any event at t1_s: y0 and
+ * the step's stages (the dense output of pam_core.c on [t0_s, t0_s + h_s]), or NULL stages for a held
+ * load whose states stay y0 (NULL for the FMU). */
+typedef void (*PamStepFn)(void *env, double t0_s, double t1_s, double h_s, const double *y0, const void *stages);
+typedef void (*PamEventFn)(void *env, double t_s, int from_mode, int to_mode, const double *y_before,
+                           const double *y_after);
 
 typedef struct PamCore {
     double r[PAM_NR];
@@ -39,6 +46,10 @@ typedef struct PamCore {
     long n_steps, n_rhs, n_events;
     PamLogFn log;
     void *log_env;
+    PamEventFn on_event;
+    void *event_env;
+    PamStepFn on_step;
+    void *step_env;
 } PamCore;
 
 void pam_reset(PamCore *c);

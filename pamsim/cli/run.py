@@ -14,7 +14,7 @@ import tomllib
 from pathlib import Path
 
 from ..atomic import atomic_outputs, output_folder
-from ..backends import BACKENDS
+from ..backends import BACKENDS, check_backend
 from ..errors import InputError
 from . import finite_float
 
@@ -74,6 +74,7 @@ def run(args: argparse.Namespace) -> int:
                              "their outputs would overwrite each other")
         seen[sc.name] = sc.origin
         _check_csv_size(sc, args.max_csv_MB)
+        check_backend(args.backend, sc)  # a setting the backend cannot honour, before any run
     missed = 0
     with output_folder(args.output) as out:  # checked before the runs; removed again if nothing gets written
         for scenario in scenarios:

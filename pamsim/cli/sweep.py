@@ -9,6 +9,7 @@ from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 from ..atomic import output_folder
+from ..backends import BACKENDS
 
 
 def _workers(text: str) -> int:
@@ -29,20 +30,24 @@ def register(sub) -> None:
     p.add_argument("-o", "--output", default="out", help="output directory (default: out)")
     p.add_argument("--workers", type=_workers, default=os.cpu_count() or 1,
                    help="worker processes (default: number of CPUs; 1 runs in this process)")
+    p.add_argument("--backend", choices=sorted(BACKENDS), default=None,
+                   help="backend of every run (default: the sweep file's backend key, else python)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
     from ..sweep import load_sweep, run_sweep
+    from ..sweep.run import check_backend
 
     spec = load_sweep(args.sweep_file)
+    check_backend(spec, args.backend or spec.backend)  # before the output folder and the runs
     with output_folder(args.output) as out:  # checked before the runs; removed again if nothing gets written
         if args.workers == 1:
-            result = run_sweep(spec, None, progress=not args.no_progress)
+            result = run_sweep(spec, None, progress=not args.no_progress, backend=args.backend)
         else:
             with ProcessPoolExecutor(max_workers=args.workers) as pool:
-                result = run_sweep(spec, pool, progress=not args.no_progress)
+                result = run_sweep(spec, pool, progress=not args.no_progress, backend=args.backend)
         names = result.write(out)
     for failure in result.failures:
         print(f"pamsim: warning: failed run {failure}", file=sys.stderr)

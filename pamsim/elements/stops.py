@@ -11,6 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Mapping
 
+from ..core_table import MIN_REBOUND_SPEED_M_S
 from ..static_models.geometry import Braid
 
 
@@ -21,7 +22,7 @@ class EndStops:
     x_low_m: float
     x_high_m: float
     restitution: float
-    min_rebound_speed_m_s: float = 1e-3
+    min_rebound_speed_m_s: float = MIN_REBOUND_SPEED_M_S
 
     @classmethod
     def from_parameters(cls, p: Mapping[str, float]) -> "EndStops":

@@ -25,6 +25,7 @@ from typing import Sequence
 import numpy as np
 
 from ..constants import PA_PER_BAR
+from ..core_table import unimplemented_choice
 from ..elements.pressure_source import ValveChamberSource
 from ..errors import InputError, SolverFailure
 from ..result import Result
@@ -107,6 +108,10 @@ def _refuse_unrepresented(scenario: Scenario) -> None:
                          f"not model.static_force_negative = {model['static_force_negative']!r}")
     # A muscle parameter that is not an FMU parameter (wall_thickness_m, E_bladder_Pa, ...) can only
     # shape the static force; the FMU gets it baked into the force table.
+    lacking = unimplemented_choice(spec, skip=("static_force",))  # any static force: through the force table
+    if lacking:
+        raise InputError(f"{scenario.origin}: {lacking[0]} = {lacking[1]!r}: the C core does not implement it; "
+                         "run it with the python backend")
     names = {v.name for v in VARIABLES if v.causality == "parameter" and v.kind == "real"}
     missing = [k for k in scenario.parameters if k not in names]
     if missing and model["static_force"] == "acra2012_polynomial":

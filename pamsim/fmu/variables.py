@@ -21,22 +21,22 @@ import math
 import re
 from dataclasses import dataclass, replace
 
-from ..elements.friction import NEGATIVE_LEVEL_CHOICES
+from ..core_table import C_CHOICES
 from ..parameters import LOAD_MASS, get_parameter_set
 from ..simulator import SolverOptions
 
 PARAMETER_SET = "shadow_6x300_acra2012"
 
-FRICTION_CHOICES = ("load_dependent", "constant", "none")
+FRICTION_CHOICES = C_CHOICES["friction"]
 """``friction_model`` values 0, 1, 2 (the scenario's ``model.friction`` names)."""
-DAMPING_CHOICES = ("paper", "linear", "none")
+DAMPING_CHOICES = C_CHOICES["damping"]
 """``damping_model`` values 0, 1, 2 (the scenario's ``model.damping`` names)."""
-SOURCE_CHOICES = ("valve", "prescribed")
+SOURCE_CHOICES = C_CHOICES["source"]
 """``pressure_source`` values 0, 1 (the scenario's ``pressure.source`` names)."""
-STATIC_FORCE_CHOICES = ("acra2012_polynomial", "table")
+STATIC_FORCE_CHOICES = C_CHOICES["static_force_model"]
 """``static_force_model`` values 0, 1: the ACRA 2012 polynomial, exact, or the force table baked into the FMU at
 build time (any other static model; :mod:`pamsim.fmu.force_table`)."""
-NEGATIVE_LEVEL = NEGATIVE_LEVEL_CHOICES
+NEGATIVE_LEVEL = C_CHOICES["friction_negative_level"]
 """``friction_negative_level`` values 0, 1 (the scenario's ``model.friction_negative_level`` names)."""
 
 

@@ -11,8 +11,10 @@ import math
 from dataclasses import dataclass
 from types import MappingProxyType
 
+from ..core_table import BRAID_LOCK_SEC2
+
 INF = math.inf
-LOCK_DEG = math.degrees(math.acos(1.0 / math.sqrt(3.0)))
+LOCK_DEG = math.degrees(math.acos(1.0 / math.sqrt(BRAID_LOCK_SEC2)))
 """Braid angle from the axis at which the braid locks (54.7356 deg)."""
 
 SUFFIX_UNITS = (  # longest first: "_N_per_bar_m2" before "_m2" before "_m"

@@ -13,6 +13,7 @@ import math
 from dataclasses import dataclass
 from typing import Mapping
 
+from ..core_table import BRAID_LOCK_SEC2
 from .base import brentq
 
 
@@ -60,7 +61,7 @@ class Braid:
     @property
     def x_lock_m(self) -> float:
         """Contraction at the Gaylord kinematic limit, where ``3 cos^2(theta) = 1``."""
-        return self.L0 - self.b / math.sqrt(3.0)
+        return self.L0 - self.b / math.sqrt(BRAID_LOCK_SEC2)
 
     @property
     def q1(self) -> float:
@@ -90,7 +91,7 @@ class Braid:
         def g(L):
             return self.radius_m(L) ** 2 - self.Vb / (math.pi * L)
         L_lo = 1e-9 * self.L0
-        L_peak = self.b / math.sqrt(3.0)  # R^2 L is largest here, so g's root lies below it
+        L_peak = self.b / math.sqrt(BRAID_LOCK_SEC2)  # R^2 L is largest here, so g's root lies below it
         if g(L_peak) <= 0.0:
             return 0.0
         return self.L0 - brentq(g, L_lo, L_peak, xtol=1e-15)

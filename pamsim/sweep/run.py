@@ -42,10 +42,11 @@ class _Task:
     key: tuple
     scenario: Scenario
     keep_trace: bool
+    backend: str = "python"
 
 
-def _task(kind: str, key: tuple, scenario: Scenario, keep_trace: bool = False) -> _Task:
-    return _Task(kind, key, scenario, keep_trace)
+def _task(kind: str, key: tuple, scenario: Scenario, keep_trace: bool = False, backend: str = "python") -> _Task:
+    return _Task(kind, key, scenario, keep_trace, backend)
 
 
 def run_task(task: _Task) -> dict:
@@ -56,7 +57,7 @@ def run_task(task: _Task) -> dict:
     from ..api import simulate
 
     try:
-        result = simulate(task.scenario)
+        result = simulate(task.scenario, task.backend)
         t_settled = settled_time_s(result.t_s, result.p_gauge_Pa)
         osc = estimate_oscillation(result.t_s, result.x_m, t_start_s=t_settled)
         last = result.t_s >= result.t_s[-1] - LAST_WINDOW_S
@@ -136,7 +137,8 @@ def _fmt(value: Any) -> Any:
     return value
 
 
-def run_sweep(spec: SweepSpec | str | Path, executor: Executor | None = None, progress: bool = False) -> SweepResult:
+def run_sweep(spec: SweepSpec | str | Path, executor: Executor | None = None, progress: bool = False,
+              backend: str | None = None) -> SweepResult:
     """Run every case of a sweep under every friction model, and the frequency and response studies.
 
     Parameters
@@ -149,6 +151,9 @@ def run_sweep(spec: SweepSpec | str | Path, executor: Executor | None = None, pr
         one after the other in this process.  The numbers do not depend on it.
     progress : bool
         Show a progress bar with an ETA on stderr.
+    backend : str, optional
+        The backend of every run (:data:`pamsim.backends.BACKENDS`); default: the sweep file's
+        ``backend`` key, else ``"python"``.  Every scenario is checked against it before anything runs.
 
     Returns
     -------
@@ -157,12 +162,14 @@ def run_sweep(spec: SweepSpec | str | Path, executor: Executor | None = None, pr
     """
     if not isinstance(spec, SweepSpec):
         spec = load_sweep(spec)
-    tasks = [_task("case", (i, f), spec.case_scenario(c, f)) for i, c in enumerate(spec.cases)
+    backend = backend or spec.backend
+    check_backend(spec, backend)
+    tasks = [_task("case", (i, f), spec.case_scenario(c, f), backend=backend) for i, c in enumerate(spec.cases)
              for f in spec.friction_models]
     if spec.frequency is not None:
-        tasks += [_task("frequency", (w, f), spec.frequency_scenario(w, f))
+        tasks += [_task("frequency", (w, f), spec.frequency_scenario(w, f), backend=backend)
                   for w in spec.frequency.weights_N for f in spec.friction_models]
-    tasks += [_task("response", (s.name, f), s.with_changes({"model": {"friction": f}}), keep_trace=True)
+    tasks += [_task("response", (s.name, f), s.with_changes({"model": {"friction": f}}), True, backend)
               for s in spec.time_responses for f in spec.friction_models]
     start = time.perf_counter()
     from tqdm import tqdm
@@ -187,6 +194,22 @@ def run_sweep(spec: SweepSpec | str | Path, executor: Executor | None = None, pr
     responses = {s.name: {f: by_key[("response", (s.name, f))] for f in spec.friction_models}
                  for s in spec.time_responses}
     return SweepResult(spec, rows, freq_rows, responses, wall, failures)
+
+
+def check_backend(spec: SweepSpec, backend: str) -> None:
+    """Raise ``InputError`` naming the first setting of the sweep that ``backend`` cannot honour.
+
+    The cases differ from their base scenario only in load and pressure, so the base, the
+    frequency study and the time responses under each friction model stand for all of them.
+    """
+    from ..backends import check_backend as check_scenario
+
+    scenarios = [spec.base] + [s for s in spec.time_responses]
+    if spec.frequency is not None:
+        scenarios.append(spec.frequency_scenario(spec.frequency.weights_N[0], spec.friction_models[0]))
+    for scenario in scenarios:
+        for friction in spec.friction_models:
+            check_scenario(backend, scenario.with_changes({"model": {"friction": friction}}))
 
 
 def _execute(tasks: list[_Task], executor: Executor | None, bar) -> list[dict]:

@@ -21,7 +21,7 @@ from ..errors import InputError
 from ..scenario import Scenario, load_scenario, read_toml
 
 _TOP_KEYS = {"name", "description", "base_scenario", "friction_models", "capability_min_equilibrium_mm",
-             "measured", "cases", "axes", "case", "frequency", "time_responses"}
+             "backend", "measured", "cases", "axes", "case", "frequency", "time_responses"}
 _MEASURED_KEYS = {"file", "weight_column", "pressure_column", "contraction_column", "nominal_pressure_column"}
 _AXES = {"pressure_bar", "weight_N"}
 _FREQUENCY_KEYS = {"pressure_bar", "weight_N", "pressure"}
@@ -69,6 +69,8 @@ class SweepSpec:
     capability_min_equilibrium_m: float
     frequency: FrequencyStudy | None = None
     time_responses: tuple[Scenario, ...] = ()
+    backend: str = "python"
+    """The backend that runs every case (:data:`pamsim.backends.BACKENDS`); ``pamsim sweep --backend`` overrides it."""
 
     def case_scenario(self, case: SweepCase, friction: str) -> Scenario:
         """The base scenario with the case's load and pressure and the given friction model."""
@@ -133,7 +135,8 @@ def sweep_from_dict(spec: Mapping[str, Any], base_dir: str | Path = ".", origin:
                           for n in names)
     result = SweepSpec(_typed(origin, "name", spec.get("name", default_name), str),
                        _typed(origin, "description", spec.get("description", ""), str), origin, base, cases,
-                       frictions, threshold_mm * 1e-3, frequency, responses)
+                       frictions, threshold_mm * 1e-3, frequency, responses,
+                       _backend(origin, spec.get("backend", "python")))
     # Build every scenario once so a bad value (a pressure above the rating...) fails before the run.
     try:
         for case in cases:
@@ -146,6 +149,14 @@ def sweep_from_dict(spec: Mapping[str, Any], base_dir: str | Path = ".", origin:
     except InputError as exc:  # a ScenarioError names the base file; say which sweep produced the value
         raise SweepError(f"{origin}: a case does not make a valid scenario: {exc}") from None
     return result
+
+
+def _backend(origin: str, name: Any) -> str:
+    from ..backends import BACKENDS
+
+    if name not in BACKENDS:
+        _fail(origin, "backend", name, "unknown backend", BACKENDS)
+    return name
 
 
 def _cases(origin: str, spec: Mapping[str, Any], measured: list[dict] | None) -> tuple[SweepCase, ...]:

@@ -1,0 +1,220 @@
+"""The native backend: scenarios run by the C core (``pamsim.simulate(scenario, backend="native")``).
+
+Every case's inputs are built here (parameters, element choices, and the
+input signals as segments over which they are held); the library then runs a
+whole batch in one call, and the traces become the same :class:`Result` as the
+Python backend's: columns, modes, events, work integrals and summary.
+
+Differences from the Python backend, all documented in ``docs/scaling.md``:
+
+- the integrator is the core's Dormand-Prince 5(4) at the scenario's ``rtol``
+  (``solver.method`` may be ``LSODA``, the automatic choice, or ``RK45``, the
+  same method; the implicit ones are refused);
+- the work integrals are trapezoid sums over the sample grid with every event
+  as a node (the Python backend integrates them as states);
+- a signal that is neither constant nor a step (ramp, lag, trace, external
+  force) is held at its midpoint value over intervals of at most
+  :func:`hold_interval_s`, a second-order approximation.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+from typing import Sequence
+
+import numpy as np
+
+from ..core_table import C_CHOICES, SCENARIO_KEYS, unimplemented_choice
+from ..elements.pressure_source import ValveChamberSource
+from ..errors import InputError, SolverFailure
+from ..fmu.runner import REPRESENTED
+from ..model import Mode, MuscleModel
+from ..result import Result, TransitionEvent
+from ..scenario import Scenario
+from ..signals import Constant, FirstOrderLag, Step
+from . import library as lib
+
+METHODS = ("LSODA", "RK45")
+"""``solver.method`` values the native backend honours: its Dormand-Prince 5(4) is RK45's method, and
+LSODA is the automatic choice of a non-stiff method for this non-stiff model.  Others are refused."""
+BATCH_EVENT_CAPACITY = 1024
+"""Events kept per case in a batch; a case with more is run again alone, with room for ``max_events``."""
+HOLD_STEPS_PER_TAU = 10
+"""A first-order lag is held over at most tau / 10 (and never longer than one output sample)."""
+METHOD_LABEL = "native DOPRI5(4)"
+_EXACT = (Constant, Step)  # constant between breakpoints: held exactly
+_STATE_ROWS = {2: slice(0, 8), 0: [0, 1, 4, 5, 6, 7]}  # Result's state rows by source state count (a view if it can)
+_DEFAULT_MAX_STEP_S = float(lib.REAL_DEFAULTS[lib.REAL_INDEX["cs_max_step_s"]])
+
+
+@dataclass(frozen=True)
+class CaseInputs:
+    """One case as the library takes it: variable values, grid, input segments, event room."""
+
+    reals: np.ndarray
+    ints: np.ndarray
+    duration_s: float
+    n_samples: int
+    segment_t_s: np.ndarray
+    segment_u: np.ndarray
+    max_events: int
+    model: MuscleModel
+
+
+def refuse_unsupported(scenario: Scenario) -> None:
+    """Raise :class:`InputError` naming the first setting of ``scenario`` the native backend cannot honour."""
+    spec = scenario.spec
+    where = scenario.origin
+    for section, keys in REPRESENTED.items():
+        table = spec if not section else spec.get(section, {})
+        for key in sorted(set(table) - keys):
+            name = f"{section}.{key}" if section else key
+            raise InputError(f"{where}: {name}: the native backend cannot honour this key; "
+                             "run it with the python backend")
+    lacking = unimplemented_choice(spec)
+    if lacking:
+        key = next(k for k, w in SCENARIO_KEYS.items() if w == lacking[0])
+        raise InputError(f"{where}: {lacking[0]} = {lacking[1]!r}: the C core implements only "
+                         f"{', '.join(C_CHOICES[key])}; run it with the python backend")
+    method = spec.get("solver", {}).get("method", "LSODA")
+    if method not in METHODS:
+        raise InputError(f"{where}: solver.method = {method!r}: the native backend integrates with Dormand-Prince "
+                         f"5(4) and honours only {', '.join(METHODS)}; run it with the python backend")
+    for name in scenario.parameters.entries:
+        if name not in lib.REAL_INDEX:
+            raise InputError(f"{where}: parameters.{name}: the C core has no such parameter "
+                             f"(parameter set {spec['model']['parameter_set']!r}); run it with the python backend")
+
+
+def _signals(model: MuscleModel) -> tuple:
+    """The input signals in :data:`library.INPUTS` order (None where a source has no such input)."""
+    src = model.source
+    if isinstance(src, ValveChamberSource):
+        return src.command, src.supply_gauge_Pa, None, None, model.load.external_force_N
+    return None, None, src.p_gauge_Pa, None, model.load.external_force_N
+
+
+def hold_interval_s(signals, sample_interval_s: float) -> float:
+    """Longest interval a signal is held over: inf if every signal is constant or a step, else one output
+    sample, shortened to tau / :data:`HOLD_STEPS_PER_TAU` for a first-order lag."""
+    hold = math.inf
+    for sig in signals:
+        if sig is None or isinstance(sig, _EXACT):
+            continue
+        hold = min(hold, sample_interval_s)
+        if isinstance(sig, FirstOrderLag):
+            hold = min(hold, sig.tau_s / HOLD_STEPS_PER_TAU)
+    return hold
+
+
+def case_inputs(scenario: Scenario) -> CaseInputs:
+    """The library's inputs for ``scenario``; refuses (``InputError``) what the backend cannot honour."""
+    refuse_unsupported(scenario)
+    model = scenario.build_model()
+    spec = scenario.spec
+    opts = scenario.solver
+    T = scenario.duration_s
+    n_samples = int(round(T * opts.sample_rate_Hz)) + 1
+    reals = lib.REAL_DEFAULTS.copy()
+    for name, value in scenario.parameters.items():
+        reals[lib.REAL_INDEX[name]] = value
+    fmu_own = {"initial_contraction_m": scenario.initial_contraction_m,
+               "initial_pressure_gauge_Pa": scenario.initial_pressure_gauge_Pa or 0.0,
+               "stick_margin_N": opts.stick_margin_N, "release_margin_N": opts.release_margin_N,
+               "cs_relative_tolerance": opts.rtol,
+               "cs_max_step_s": opts.max_step_s if math.isfinite(opts.max_step_s) else _DEFAULT_MAX_STEP_S}
+    for name, value in fmu_own.items():
+        reals[lib.REAL_INDEX[name]] = value
+    ints = lib.INT_DEFAULTS.copy()
+    choices = {"friction_model": ("friction", spec["model"]["friction"]),
+               "damping_model": ("damping", spec["model"]["damping"]),
+               "pressure_source": ("source", spec["pressure"]["source"]),
+               "friction_negative_level": ("friction_negative_level", spec["model"]["friction_negative_level"])}
+    for name, (key, value) in choices.items():
+        ints[lib.INT_INDEX[name]] = C_CHOICES[key].index(value)
+    signals = _signals(model)
+    hold = hold_interval_s(signals, T / max(n_samples - 1, 1))
+    bounds = {0.0} | {float(b) for b in model.breakpoints if 0.0 < b < T}
+    if math.isfinite(hold):
+        bounds |= set(np.linspace(0.0, T, int(math.ceil(T / hold)) + 1)[:-1].tolist())
+    starts = np.array(sorted(bounds))
+    mid = 0.5 * (starts + np.append(starts[1:], T))  # a step's value is constant inside its segment
+    u = np.zeros((len(starts), len(lib.INPUTS)))
+    for k, sig in enumerate(signals):
+        if sig is not None:
+            u[:, k] = sig(mid)
+    u[:, lib.INPUTS.index("load_mass_kg")] = model.load.mass_kg
+    return CaseInputs(reals, ints, T, n_samples, starts, u, opts.max_events, model)
+
+
+def _run(cases: Sequence[CaseInputs], capacity: Sequence[int]) -> dict:
+    return lib.run_batch(np.array([c.reals for c in cases]), np.array([c.ints for c in cases]),
+                         np.array([c.duration_s for c in cases]), np.array([c.n_samples for c in cases]),
+                         np.array([len(c.segment_t_s) for c in cases]),
+                         np.concatenate([c.segment_t_s for c in cases]), np.concatenate([c.segment_u for c in cases]),
+                         np.asarray(capacity))
+
+
+def _result(scenario: Scenario, case: CaseInputs, out: dict, i: int, wall_time_s: float) -> Result:
+    """Case ``i`` of a batch's output as a :class:`Result`, or the error it ended with."""
+    status = int(out["status"][i])
+    message = out["messages"][i]
+    if status == 1:
+        raise InputError(f"{scenario.origin}: {message}")
+    if status == 2:
+        raise SolverFailure(f"native backend: {message}")
+    if status == 3:
+        raise SolverFailure(f"more than {case.max_events} events (raise [solver] max_events if this is expected)")
+    model = case.model
+    first, n = int(out["sample_offset"][i]), case.n_samples
+    rows = slice(first, first + n)
+    S = out["samples"][len(lib.SAMPLE_COLUMNS) * first:len(lib.SAMPLE_COLUMNS) * (first + n)].reshape(-1, n)
+    Y = S[_STATE_ROWS[model.n_source]]
+    events = out["events"][out["event_offset"][i]:out["event_offset"][i] + out["n_events"][i]]
+    transitions = [TransitionEvent(float(e[0]), lib.EVENT_KINDS[int(e[1])], Mode(int(e[2])).label,
+                                   Mode(int(e[3])).label, float(e[4])) for e in events]
+    losses = [(float(e[0]), float(e[5])) for e in events]
+    n_rhs, _, segments = (int(v) for v in out["stats"][i])
+    stats = {"rhs_evaluations": n_rhs, "events": len(transitions), "segments": segments, "method": METHOD_LABEL,
+             "rtol": scenario.solver.rtol}
+    t = np.linspace(0.0, case.duration_s, case.n_samples)
+    return Result.from_trace(model, scenario.name, t, Y, out["modes"][rows].astype(int), transitions, losses,
+                             stats, wall_time_s)
+
+
+def simulate_batch(scenarios: Sequence[Scenario], return_exceptions: bool = False) -> list:
+    """Run many scenarios in one library call and return their :class:`Result` s, in order.
+
+    Parameters
+    ----------
+    scenarios : sequence of Scenario
+        Each is checked first: a setting the native backend cannot honour raises
+        :class:`~pamsim.errors.InputError` naming it, before anything runs.
+    return_exceptions : bool
+        Put a failed case's exception in its place in the list instead of raising it.
+    """
+    cases = [case_inputs(s) for s in scenarios]
+    wall0 = time.perf_counter()
+    out = _run(cases, [min(c.max_events + 1, BATCH_EVENT_CAPACITY) for c in cases])
+    wall = (time.perf_counter() - wall0) / max(len(cases), 1)
+    results = []
+    for i, (scenario, case) in enumerate(zip(scenarios, cases)):
+        try:
+            if out["status"][i] == 3 and case.max_events + 1 > BATCH_EVENT_CAPACITY:
+                again = time.perf_counter()
+                alone = _run([case], [case.max_events + 1])
+                results.append(_result(scenario, case, alone, 0, time.perf_counter() - again))
+            else:
+                results.append(_result(scenario, case, out, i, wall))
+        except (InputError, SolverFailure) as exc:
+            if not return_exceptions:
+                raise
+            results.append(exc)
+    return results
+
+
+def simulate(scenario: Scenario) -> Result:
+    """Backend ``native``: run ``scenario`` with the C core and return its :class:`Result`."""
+    return simulate_batch([scenario])[0]

@@ -1,0 +1,84 @@
+"""Build the native library from the C core, once per version of the sources.
+
+The library is compiled with the system C compiler (``cc``, or ``CC``) on
+first use and kept in a cache folder: ``$PAMSIM_NATIVE_CACHE`` if set, else
+``pamsim-native/`` in the system temp folder.  Its sub-folder is named by a
+hash of the C sources, the generated variable header, the compiler and its
+flags, so a change to any of them builds a new library and an old one is
+never loaded by mistake.  Concurrent first uses (the workers of a sweep)
+each compile into a private file and move it into place atomically.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import shutil
+import subprocess
+import tempfile
+from pathlib import Path
+
+from ..errors import InputError
+from ..fmu.build import shared_library_suffix
+from ..fmu.force_table import EMPTY_HEADER
+from ..fmu.generate import c_header, c_source_dir
+
+SOURCES = ("pam_native.c", "pam_native.h", "pam_core.c", "pam_core.h", "pam_shared.h")
+"""The C files the library is built from (pam_native.c includes pam_core.c: one translation unit)."""
+FLAGS = ("-shared", "-fPIC", "-O2", "-std=c99", "-Wall", "-fvisibility=hidden")
+LIBRARY_NAME = "libpamsim_native"
+CACHE_ENV = "PAMSIM_NATIVE_CACHE"
+
+
+def compiler() -> str:
+    """The C compiler: ``$CC``, else ``cc`` or ``gcc`` on the path."""
+    found = os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc")
+    if not found:
+        raise InputError("the native backend needs a C compiler (install gcc, or set CC)")
+    return found
+
+
+def cache_root() -> Path:
+    """Where built libraries are kept (``$PAMSIM_NATIVE_CACHE`` or the temp folder's ``pamsim-native``)."""
+    return Path(os.environ.get(CACHE_ENV) or Path(tempfile.gettempdir()) / "pamsim-native")
+
+
+def library_token(cc: str) -> str:
+    """Hash of everything that goes into the library: sources, generated header, compiler, flags."""
+    h = hashlib.sha256()
+    src = c_source_dir() / "src"
+    for name in SOURCES:
+        h.update(name.encode() + b"\0" + (src / name).read_bytes())
+    h.update(c_header(2).encode())
+    h.update(EMPTY_HEADER.encode())
+    h.update("\0".join((cc, *FLAGS)).encode())
+    return h.hexdigest()[:24]
+
+
+def library_path() -> Path:
+    """The path of the library built from the current sources, compiling it if it is not cached.
+
+    Raises
+    ------
+    InputError
+        Without a C compiler, or if the compilation fails (with the compiler's message).
+    """
+    cc = compiler()
+    folder = cache_root() / library_token(cc)
+    path = folder / (LIBRARY_NAME + shared_library_suffix())
+    if path.is_file():
+        return path
+    folder.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(prefix="build-", dir=folder) as tmp:
+        work = Path(tmp)
+        (work / "pam_variables.h").write_text(c_header(2))
+        # No force table: the library runs the polynomial; other static forces are refused before a run.
+        (work / "pam_force_table.h").write_text(EMPTY_HEADER)
+        src = c_source_dir() / "src"
+        partial = work / path.name
+        cmd = [cc, *FLAGS, "-I", str(work), "-I", str(src), str(src / "pam_native.c"), "-o", str(partial), "-lm"]
+        proc = subprocess.run(cmd, capture_output=True, text=True)
+        if proc.returncode != 0:
+            raise InputError(f"compiling the native library failed ({cc} ...): {proc.stderr.strip()}")
+        os.replace(partial, path)
+    return path

@@ -1,0 +1,182 @@
+"""The native backend end to end: the paper scenarios against the Python backend, the Result it
+returns, its batch entry point, refusals of what it cannot honour, the CLI and sweeps."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import pamsim
+from pamsim.errors import InputError, SolverFailure
+from pamsim.native import simulate_batch
+from pamsim.native.backend import hold_interval_s
+from pamsim.sweep import sweep_from_dict
+from pamsim.sweep.spec import SweepError
+
+from conftest import PAPER_SCENARIOS, SCENARIOS, run_cli
+
+# Both backends integrate to rtol 1e-6 (LSODA and Dormand-Prince 5(4), absolute tolerances rtol x
+# 10 mm on the contraction), so they agree to a few multiples of 1e-8 m per unit error; 5 um is
+# 1/10,000 of the paper's contractions and 1/40 of its 0.2 mm reading resolution.
+X_TOL_M = 5e-6
+
+
+@pytest.fixture(scope="module")
+def native_results():
+    scenarios = [pamsim.load_scenario(SCENARIOS / f"{name}.toml") for name in PAPER_SCENARIOS]
+    return dict(zip(PAPER_SCENARIOS, simulate_batch(scenarios)))
+
+
+@pytest.mark.parametrize("name", PAPER_SCENARIOS)
+def test_paper_scenarios_match_the_python_backend(paper_results, native_results, name):
+    _, py = paper_results[name]
+    nat = native_results[name]
+    assert abs(nat.x_m[-1] - py.x_m[-1]) < X_TOL_M
+    assert abs(nat.x_m.max() - py.x_m.max()) < X_TOL_M
+    assert np.max(np.abs(nat.x_m - py.x_m)) < 2 * X_TOL_M
+    assert np.max(np.abs(nat.p_gauge_Pa - py.p_gauge_Pa)) < 1e-4 * 4e5  # 1e-4 of the supply
+    assert nat.final_mode == py.final_mode
+    # The same events, in the same order, at nearly the same times.
+    assert [(e.kind, e.from_mode, e.to_mode) for e in nat.transitions] == \
+        [(e.kind, e.from_mode, e.to_mode) for e in py.transitions]
+    assert max(abs(a.t_s - b.t_s) for a, b in zip(nat.transitions, py.transitions)) < 1e-4
+
+
+@pytest.mark.parametrize("name", PAPER_SCENARIOS)
+def test_energy_balance_closes_and_matches_the_python_work(paper_results, native_results, name):
+    """The work integrals (Gauss quadrature on the dense output) close the balance as the Python
+    backend's (integrated as states) do, and agree with them term by term."""
+    _, py = paper_results[name]
+    nat, ref = native_results[name].energy_balance(), py.energy_balance()
+    assert nat["relative"] < 1e-4
+    for term in ("W_muscle_J", "E_friction_J", "E_damping_J", "E_impacts_J", "dPE_J"):
+        assert abs(nat[term] - ref[term]) <= 1e-4 * max(abs(ref["W_muscle_J"]), 1e-3), term
+
+
+def test_result_has_the_python_backends_columns_summary_and_event_records(paper_results, native_results):
+    _, py = paper_results["acra2012_fig6b"]
+    nat = native_results["acra2012_fig6b"]
+    assert list(nat.columns()) == list(py.columns())
+    assert np.array_equal(nat.t_s, py.t_s)
+    assert set(nat.summary()) == set(py.summary())
+    assert set(nat.stats) == set(py.stats) and nat.stats["method"] == "native DOPRI5(4)"
+    assert nat.summary()["events"] == len(nat.transitions) == len(py.transitions) > 20
+    # The modes on the sample grid are those of the Python run, except within a sample of an event.
+    differ = np.flatnonzero(nat.mode != py.mode)
+    times = np.array([e.t_s for e in py.transitions])
+    assert all(np.min(np.abs(times - nat.t_s[k])) < 2e-3 for k in differ)
+
+
+def test_batch_gives_the_single_runs_results_bit_for_bit():
+    a = pamsim.load_scenario(SCENARIOS / "acra2012_fig4.toml")
+    b = a.with_changes({"load": {"weight_N": 42.74}, "model": {"friction": "constant", "damping": "linear"}})
+    c = a.with_changes({"pressure": {"source": "prescribed", "prescribed": {"kind": "step", "time_s": 0.5,
+                                                                             "final_gauge_bar": 3.0}}})
+    batch = simulate_batch([a, b, c])
+    for scenario, res in zip((a, b, c), batch):
+        alone = pamsim.simulate(scenario, backend="native")
+        assert np.array_equal(res.x_m, alone.x_m) and np.array_equal(res.p_gauge_Pa, alone.p_gauge_Pa)
+        assert res.transitions == alone.transitions
+
+
+def test_other_element_choices_and_initial_state_match_the_python_backend():
+    base = pamsim.load_scenario(SCENARIOS / "acra2012_fig4.toml")
+    variants = [{"model": {"friction": "constant", "damping": "linear"}},
+                {"model": {"friction": "none", "damping": "none"}, "load": {"weight_N": 12.74}},
+                {"model": {"friction_negative_level": "abs"}, "load": {"weight_N": 52.74}},
+                {"pressure": {"initial_gauge_bar": 1.0}, "simulation": {"initial_contraction_m": 0.01}},
+                {"parameters": {"stop_restitution": 0.5}, "load": {"weight_N": 2.74}}]
+    scenarios = [base.with_changes(v) for v in variants]
+    for scenario, nat in zip(scenarios, simulate_batch(scenarios)):
+        py = pamsim.simulate(scenario)
+        assert abs(nat.x_m[-1] - py.x_m[-1]) < X_TOL_M, scenario.spec
+        assert nat.energy_balance()["relative"] < 1e-3
+
+
+def test_smooth_signals_are_held_over_short_intervals():
+    """A 10 ms pressure lag is held over 1 ms pieces at its midpoint values: a second-order
+    approximation, within 2e-5 m of the exact input (about 1e-4 of the contraction)."""
+    sc = pamsim.Scenario.from_dict({"load": {"weight_N": 22.74}, "simulation": {"duration_s": 4.0},
+                                    "pressure": {"source": "prescribed", "prescribed": {
+                                        "kind": "lag", "time_s": 1.0, "tau_s": 0.01, "final_gauge_bar": 3.6}}})
+    model = sc.build_model()
+    assert hold_interval_s([model.source.p_gauge_Pa], 1e-3) == pytest.approx(1e-3)
+    nat, py = pamsim.simulate(sc, backend="native"), pamsim.simulate(sc)
+    assert np.max(np.abs(nat.x_m - py.x_m)) < 2e-5
+    assert nat.energy_balance()["relative"] < 1e-3
+
+
+def test_too_many_events_is_a_solver_failure_on_both_backends():
+    sc = pamsim.load_scenario(SCENARIOS / "acra2012_fig6b.toml").with_changes({"solver": {"max_events": 5}})
+    for backend in ("python", "native"):
+        with pytest.raises(SolverFailure, match="more than 5 events"):
+            pamsim.simulate(sc, backend=backend)
+
+
+@pytest.mark.parametrize("changes, key", [
+    ({"solver": {"method": "Radau"}}, "solver.method"),
+    ({"solver": {"method": "DOP853"}}, "solver.method"),
+])
+def test_settings_it_cannot_honour_are_refused_naming_the_key(changes, key):
+    sc = pamsim.load_scenario(SCENARIOS / "acra2012_fig4.toml").with_changes(changes)
+    with pytest.raises(InputError, match=key.replace(".", r"\.")):
+        pamsim.simulate(sc, backend="native")
+
+
+def test_unknown_backend_is_an_input_error():
+    sc = pamsim.load_scenario(SCENARIOS / "acra2012_fig4.toml")
+    with pytest.raises(InputError, match="unknown backend 'c'"):
+        pamsim.simulate(sc, backend="c")
+
+
+def test_cli_run_native_writes_the_python_backends_files(tmp_path):
+    proc = run_cli("run", SCENARIOS / "acra2012_fig4.toml", "--backend", "native", "-o", tmp_path, "--no-plot")
+    assert proc.returncode == 0, proc.stderr
+    summary = json.loads((tmp_path / "acra2012_fig4.json").read_text())
+    assert summary["backend"] == "native"
+    header = (tmp_path / "acra2012_fig4.csv").read_text().splitlines()[0]
+    assert header.startswith("t_s,x_m,v_m_s,p_gauge_Pa,mode,")
+
+
+def test_cli_run_native_refuses_with_one_line_and_exit_2(tmp_path):
+    scenario = tmp_path / "radau.toml"
+    scenario.write_text((SCENARIOS / "acra2012_fig4.toml").read_text().replace('"LSODA"', '"Radau"'))
+    out = tmp_path / "out"
+    proc = run_cli("run", scenario, "--backend", "native", "-o", out)
+    assert proc.returncode == 2
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and "solver.method" in lines[0] and "Radau" in lines[0] and "radau.toml" in lines[0]
+    assert not out.exists()
+
+
+def test_sweep_backend_key_runs_natively_and_matches_python():
+    spec = {"base_scenario": "acra2012_fig5.toml", "friction_models": ["load_dependent", "constant"],
+            "case": [{"weight_N": 12.74, "pressure_bar": 3.6}, {"weight_N": 32.74, "pressure_bar": 2.4}]}
+    native = pamsim.sweep(sweep_from_dict({**spec, "backend": "native"}, base_dir=SCENARIOS))
+    python = pamsim.sweep(sweep_from_dict(spec, base_dir=SCENARIOS))
+    for a, b in zip(native.rows, python.rows):
+        assert a["failure"] == "" and abs(a["final_contraction_m"] - b["final_contraction_m"]) < X_TOL_M
+        assert abs(a["constant_final_contraction_m"] - b["constant_final_contraction_m"]) < X_TOL_M
+
+
+def test_sweep_refuses_unknown_backend_and_unsupported_settings_before_running(tmp_path):
+    with pytest.raises(SweepError, match="backend = 'cuda'"):
+        sweep_from_dict({"base_scenario": "acra2012_fig5.toml", "backend": "cuda",
+                         "case": [{"weight_N": 12.74, "pressure_bar": 3.6}]}, base_dir=SCENARIOS)
+    base = tmp_path / "base.toml"
+    base.write_text((SCENARIOS / "acra2012_fig5.toml").read_text().replace('"LSODA"', '"BDF"'))
+    spec = sweep_from_dict({"base_scenario": str(base), "case": [{"weight_N": 12.74, "pressure_bar": 3.6}]})
+    with pytest.raises(InputError, match="solver.method"):
+        pamsim.sweep(spec, backend="native")
+    proc = run_cli("sweep", _write_sweep(tmp_path, base), "--backend", "native", "--workers", "1", "-o",
+                   tmp_path / "out")
+    assert proc.returncode == 2 and "solver.method" in proc.stderr and not (tmp_path / "out").exists()
+
+
+def _write_sweep(folder: Path, base: Path) -> Path:
+    path = folder / "sweep.toml"
+    path.write_text(f'base_scenario = "{base.name}"\n[[case]]\nweight_N = 12.74\npressure_bar = 3.6\n')
+    return path
