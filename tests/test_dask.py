@@ -17,7 +17,7 @@ import pytest
 
 import pamsim
 from pamsim.cli import main as cli_main
-from pamsim.sweep import sweep_from_dict
+from pamsim.sweep import dask_cluster, sweep_from_dict
 from pamsim.sweep.run import auto_chunk_size
 from conftest import run_cli as _cli
 
@@ -127,23 +127,24 @@ def test_dask_without_the_extra_is_one_line_naming_it(tmp_path, monkeypatch, cap
     assert not (tmp_path / "out").exists()
 
 
-def test_unreachable_scheduler_is_one_line_exit_2(tmp_path):
+def test_unreachable_scheduler_is_one_line_exit_2(tmp_path, monkeypatch, capsys):
     (tmp_path / "s.toml").write_text(f'base_scenario = "{FIG4}"\n[axes]\npressure_bar = [3.6]\nweight_N = [22.74]\n')
-    proc = _cli("sweep", tmp_path / "s.toml", "-o", tmp_path / "out", "--dask", "tcp://127.0.0.1:9")
-    lines = proc.stderr.strip().splitlines()
-    assert proc.returncode == 2 and len(lines) == 1 and "--dask tcp://127.0.0.1:9" in lines[0], proc.stderr
+    monkeypatch.setattr(dask_cluster, "CONNECT_TIMEOUT_S", 1.0)
+    code = cli_main(["sweep", str(tmp_path / "s.toml"), "-o", str(tmp_path / "out"), "--dask", "tcp://127.0.0.1:9"])
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(lines) == 1 and "--dask tcp://127.0.0.1:9" in lines[0], lines
     assert not (tmp_path / "out").exists()
 
 
-def test_cli_dask_local_writes_the_same_tables_as_one_worker(tmp_path):
+def test_cli_dask_local_writes_the_same_tables_as_the_serial_api(tmp_path):
     (tmp_path / "s.toml").write_text(
         f'base_scenario = "{FIG4}"\n[axes]\npressure_bar = [3.6]\nweight_N = [12.74, 22.74]\n'
         '[uncertainty]\nsamples = 2\nseed = 5\n[uncertainty.parameters.N0_N_per_bar]\n'
         'distribution = "normal"\nmean = 6.87\nstd = 0.3\nlower = 6.0\nupper = 7.5\n')
-    one = _cli("sweep", tmp_path / "s.toml", "-o", tmp_path / "one", "--workers", "1", "--no-progress")
+    pamsim.sweep(tmp_path / "s.toml").write(tmp_path / "one")
     dask = _cli("sweep", tmp_path / "s.toml", "-o", tmp_path / "dask", "--dask-local", "2", "--chunk-size", "2",
                 "--no-progress")
-    assert one.returncode == 0 and dask.returncode == 0, dask.stderr
+    assert dask.returncode == 0, dask.stderr
     assert "Dask LocalCluster of 2 worker process(es)" in dask.stdout
     for name in ("summary.csv", "uncertainty_samples.csv", "uncertainty_summary.csv"):
         assert (tmp_path / "dask" / name).read_bytes() == (tmp_path / "one" / name).read_bytes(), name
