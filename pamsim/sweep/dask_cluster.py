@@ -17,6 +17,7 @@ cases become failed rows (``KilledWorker``) while the sweep completes.
 from __future__ import annotations
 
 import contextlib
+import logging
 from concurrent.futures import Executor
 from typing import Iterator
 
@@ -69,7 +70,9 @@ def dask_executor(address: str | None = None, local_workers: int | None = None) 
             where = f"Dask scheduler {address}"
         else:
             cluster = stack.enter_context(distributed.LocalCluster(
-                n_workers=local_workers, threads_per_worker=1, processes=True, dashboard_address=None))
+                n_workers=local_workers, threads_per_worker=1, processes=True, dashboard_address=None,
+                # Workers log a lost heartbeat as an error while the cluster shuts down; not the user's concern.
+                silence_logs=logging.CRITICAL))
             client = stack.enter_context(distributed.Client(cluster))
             where = f"Dask LocalCluster of {local_workers} worker process(es)"
         yield client.get_executor(pure=False), where
