@@ -38,6 +38,27 @@ def ensure_output_dir(directory: str | os.PathLike) -> Path:
 
 
 @contextlib.contextmanager
+def output_folder(directory: str | os.PathLike):
+    """:func:`ensure_output_dir` for a block of work that may fail: yields the folder.
+
+    If the block raises (an input error found late, a solver failure, a
+    write error, an interrupt), the folders this call created are removed again
+    when they are still empty, so a failed command leaves no trace.
+    """
+    directory = Path(directory)
+    created = [p for p in (directory, *directory.parents) if not p.exists() and not p.is_symlink()]  # deepest first
+    try:
+        yield ensure_output_dir(directory)
+    except BaseException:
+        for folder in created:
+            try:
+                folder.rmdir()
+            except OSError:  # not empty (something else wrote there) or already gone
+                break
+        raise
+
+
+@contextlib.contextmanager
 def atomic_path(path: str | os.PathLike):
     """Yield a temporary path; on success it is renamed to ``path``, on error removed."""
     path = Path(path)

@@ -2,7 +2,14 @@
 
 
 class InputError(ValueError):
-    """Bad user input (scenario file, CLI argument, parameter); exit code 2."""
+    """Bad user input (scenario file, CLI argument, parameter); exit code 2.
+
+    The message is one line whatever it quotes: a key or file name typed with
+    a newline or another control character shows it escaped (``\\n``).
+    """
+
+    def __init__(self, message: str = ""):
+        super().__init__("".join(c if c.isprintable() else repr(c)[1:-1] for c in str(message)))
 
 
 class SolverFailure(RuntimeError):

@@ -152,6 +152,14 @@ def _shadow_6x300_acra2012() -> ParameterSet:
     return ParameterSet("shadow_6x300_acra2012", "Shadow Robot 6 mm x 300 mm muscle, " + REFERENCES["acra2012"].full(), e)
 
 
+LOAD_MASS = Parameter(
+    round(22.74 / 9.81, 6), "kg", "assumed: lower bound 1 g, about 1/280 of the paper's lightest load "
+    "(the 2.74 N holder); lighter loads make the hanging mass's dynamics needlessly stiff (a 1e-12 kg load "
+    "oscillates at MHz)", "hanging mass, holder included; start value: the paper's 22.74 N (Fig. 4)", lower=1e-3)
+"""The hanging load's mass and its range: checked by ``pamsim.Scenario`` and, through the FMU's
+generated variable table, by the FMU's ``load_mass_kg`` input."""
+
+
 PARAMETER_SETS: Mapping[str, ParameterSet] = MappingProxyType({
     "shadow_6x300_acra2012": _shadow_6x300_acra2012(),
 })

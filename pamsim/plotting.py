@@ -13,28 +13,49 @@ from .atomic import atomic_path
 from .constants import PA_PER_BAR
 
 
-_FORCES = (("F_static_N", "static"), ("F_gravity_N", "gravity"), ("F_friction_N", "friction"),
-           ("F_damping_N", "damping"), ("F_stop_N", "stop contact"), ("F_external_N", "external"))
+FORCE_STYLE: dict[str, tuple[str, str]] = {
+    "F_static_N": ("static", "C0"),
+    "F_gravity_N": ("gravity", "C7"),
+    "F_friction_N": ("friction", "C1"),
+    "F_damping_N": ("damping", "C2"),
+    "F_stop_N": ("stop contact", "C5"),
+    "F_external_N": ("external", "C4"),
+}
+"""Force key -> (legend label, colour): each force keeps its colour in every figure, whichever others are drawn."""
+
+HELD_STYLE: dict[int, tuple[str, str]] = {0: ("stuck (friction)", "0.85"), 2: ("on the lower stop", "#f2dcc0"),
+                                          3: ("on the upper stop", "#cfe0f0")}
+"""Held mode value -> (legend label, shade) of the time the load spends still."""
+
+X_LABEL = "contraction x [mm]\n(positive: shorter, lifts the load)"
+F_LABEL = "force on the load [N]\n(positive lifts)"
 
 
-def plot_result(result: "Result", path=None, title: str | None = None, compare: "list[Result] | None" = None) -> Figure:
+def shade_held(ax, t_s: np.ndarray, mode: np.ndarray) -> None:
+    """Shade the time the load is held: stuck by friction, or resting on a stop."""
+    for value, (label, colour) in HELD_STYLE.items():
+        held = mode == value
+        if held.any():
+            ax.fill_between(t_s, 0, 1, where=held, transform=ax.get_xaxis_transform(), color=colour, lw=0,
+                            label=label)
+
+
+def result_figure(result: "Result", title: str | None = None, compare: "list[Result] | None" = None,
+                  backend: str = "python") -> Figure:
     """Contraction, pressure and force components against time.
 
     ``compare`` overlays the contraction of other results (for example the
-    constant-friction model).  With ``path`` the figure is written there (PNG,
-    atomically) as well as returned.
+    constant-friction model).  A ``backend`` other than ``"python"`` is named
+    in the title.
     """
     fig = Figure(figsize=(9, 9), constrained_layout=True)
     ax_x, ax_p, ax_f = fig.subplots(3, 1, sharex=True)
     t = result.t_s
-    ax_x.plot(t, result.x_m * 1e3, color="C0", label=result.name)
-    for other in compare or []:
-        ax_x.plot(other.t_s, other.x_m * 1e3, "--", label=other.name)
-    held = result.mode == 0
-    if held.any():
-        ax_x.fill_between(t, 0, 1, where=held, transform=ax_x.get_xaxis_transform(), color="0.85", lw=0,
-                          label="stuck (friction)")
-    ax_x.set_ylabel("contraction x [mm]")
+    shade_held(ax_x, t, result.mode)
+    ax_x.plot(t, result.x_m * 1e3, color="k", label=result.name)
+    for k, other in enumerate(compare or []):
+        ax_x.plot(other.t_s, other.x_m * 1e3, "--", color=f"C{k}", label=other.name)
+    ax_x.set_ylabel(X_LABEL)
     ax_x.legend(loc="lower right", fontsize=8)
     ax_x.grid(alpha=0.3)
 
@@ -45,16 +66,26 @@ def plot_result(result: "Result", path=None, title: str | None = None, compare: 
     ax_p.legend(loc="lower right", fontsize=8)
     ax_p.grid(alpha=0.3)
 
-    for key, label in _FORCES:
+    for key, (label, colour) in FORCE_STYLE.items():
         values = result.signals[key]
         if np.any(values != 0.0):
-            ax_f.plot(t, values, label=label, lw=1)
-    ax_f.set_ylabel("force on the load [N]")
+            ax_f.plot(t, values, label=label, color=colour, lw=1)
+    ax_f.axhline(0.0, color="k", lw=0.5)
+    ax_f.set_ylabel(F_LABEL)
     ax_f.set_xlabel("time [s]")
     ax_f.legend(loc="upper right", fontsize=8, ncol=3)
     ax_f.grid(alpha=0.3)
-    fig.suptitle(title or f"{result.name}: {result.mass_kg * result.g_m_s2:.2f} N hanging weight "
-                          f"({result.mass_kg:.3f} kg), {result.p_gauge_Pa[-1] / PA_PER_BAR:.2f} bar at the end")
+    default = (f"{result.name}: {result.mass_kg * result.g_m_s2:.2f} N hanging weight "
+               f"({result.mass_kg:.3f} kg), {result.p_gauge_Pa[-1] / PA_PER_BAR:.2f} bar at the end")
+    if backend != "python":
+        default += f"\n{backend} backend (the exported FMU)"
+    fig.suptitle(title or default)
+    return fig
+
+
+def plot_result(result: "Result", path=None, **kwargs) -> Figure:
+    """:func:`result_figure`, written to ``path`` (PNG, atomically) if one is given."""
+    fig = result_figure(result, **kwargs)
     if path is not None:
         with atomic_path(path) as tmp:
             fig.savefig(tmp, format="png", dpi=110)

@@ -13,6 +13,9 @@ from .model import N_WORK, Mode
 if TYPE_CHECKING:
     from .model import MuscleModel
 
+CSV_BYTES_PER_VALUE = 17
+"""Upper bound of one CSV value: ``%.10g`` writes at most 16 characters (``-1.234567891e-05``), plus a comma."""
+
 REST_SPEED_M_S = 1e-4
 """A load in a slip mode slower than this, with the net force inside the friction band, counts as at rest."""
 
@@ -56,10 +59,14 @@ class Result:
     impact_loss_J: float
     final_rest_forces_N: tuple[float, float]
     fit_range_violations: list[str] = field(default_factory=list)
+    peaks: dict[str, float] = field(default_factory=dict)
+    """Largest ``x_m`` and ``p_gauge_Pa`` and smallest ``x_min_m`` of the integrated solution (every step and
+    event), where the backend knows them; the samples may miss a peak between them."""
     model: "MuscleModel | None" = field(default=None, repr=False)
 
     @classmethod
-    def from_trace(cls, model: "MuscleModel", name, t, Y, modes, transitions, impact_losses, stats, wall_time_s):
+    def from_trace(cls, model: "MuscleModel", name, t, Y, modes, transitions, impact_losses, stats, wall_time_s,
+                   peaks: dict[str, float] | None = None):
         sig = model.breakdown(t, Y, modes)
         for i, key in enumerate(model.state_names[-N_WORK:]):
             sig[key] = Y[-N_WORK + i]
@@ -69,16 +76,20 @@ class Result:
         sig["E_impacts_J"] = cum[np.searchsorted(loss_t, t, side="right")]
         p = sig.pop("p_gauge_Pa")
         fr = model.fit_range
+        peaks = dict(peaks or {})
+        x_lo = min(peaks.get("x_min_m", np.inf), Y[0].min())
+        x_hi = max(peaks.get("x_m", -np.inf), Y[0].max())
+        p_hi = max(peaks.get("p_gauge_Pa", -np.inf), p.max())
         violations = []
-        if Y[0].min() < fr.x_min_m:
-            violations.append(f"contraction down to {Y[0].min() * 1e3:.2f} mm, below the fitted {fr.x_min_m * 1e3:.2f} mm")
-        if Y[0].max() > fr.x_max_m:
-            violations.append(f"contraction up to {Y[0].max() * 1e3:.2f} mm, above the fitted {fr.x_max_m * 1e3:.1f} mm")
-        if p.max() > fr.p_max_gauge_Pa:
-            violations.append(f"pressure up to {p.max() / 1e5:.3f} bar, above the fitted {fr.p_max_gauge_Pa / 1e5:.2f} bar")
+        if x_lo < fr.x_min_m:
+            violations.append(f"contraction down to {x_lo * 1e3:.2f} mm, below the fitted {fr.x_min_m * 1e3:.2f} mm")
+        if x_hi > fr.x_max_m:
+            violations.append(f"contraction up to {x_hi * 1e3:.2f} mm, above the fitted {fr.x_max_m * 1e3:.1f} mm")
+        if p_hi > fr.p_max_gauge_Pa:
+            violations.append(f"pressure up to {p_hi / 1e5:.3f} bar, above the fitted {fr.p_max_gauge_Pa / 1e5:.2f} bar")
         final = model.rest_forces(float(t[-1]), Y[:, -1])
         return cls(name, t, Y[0].copy(), Y[1].copy(), p, modes, sig, transitions, stats, wall_time_s,
-                   model.load.mass_kg, model.load.g_m_s2, float(loss_J.sum()), final, violations, model)
+                   model.load.mass_kg, model.load.g_m_s2, float(loss_J.sum()), final, violations, peaks=peaks, model=model)
 
     # ------------------------------------------------------------------ queries
     @property
@@ -92,6 +103,11 @@ class Result:
             return True
         net, level = self.final_rest_forces_N
         return abs(self.v_m_s[-1]) < REST_SPEED_M_S and abs(net) <= level + 1e-3
+
+    @property
+    def peak_contraction_m(self) -> float:
+        """Largest contraction of the run: of the integrated solution where known, else of the samples."""
+        return float(max(self.peaks.get("x_m", -np.inf), self.x_m.max()))
 
     @property
     def out_of_fit_range(self) -> bool:
@@ -119,10 +135,10 @@ class Result:
         s = {
             "scenario": self.name,
             "final_contraction_m": float(self.x_m[-1]),
-            "peak_contraction_m": float(self.x_m.max()),
+            "peak_contraction_m": self.peak_contraction_m,
             "final_velocity_m_s": float(self.v_m_s[-1]),
             "final_pressure_gauge_Pa": float(self.p_gauge_Pa[-1]),
-            "peak_pressure_gauge_Pa": float(self.p_gauge_Pa.max()),
+            "peak_pressure_gauge_Pa": float(max(self.peaks.get("p_gauge_Pa", -np.inf), self.p_gauge_Pa.max())),
             "final_mode": self.final_mode.label,
             "at_rest_at_end": bool(self.at_rest_at_end),
             "final_net_force_N": float(self.final_rest_forces_N[0]),
@@ -138,6 +154,18 @@ class Result:
         return s
 
     # ------------------------------------------------------------------ output
+    @classmethod
+    def csv_bytes_estimate(cls, model: "MuscleModel", n_samples: int) -> int:
+        """Upper bound [bytes] of the CSV of a run of ``model`` with ``n_samples`` samples.
+
+        The columns are those of a one-sample result of the same model, each
+        value at most :data:`CSV_BYTES_PER_VALUE` bytes.
+        """
+        y0 = model.initial_state()
+        one = cls.from_trace(model, "", np.zeros(1), y0[:, None], np.zeros(1, dtype=int), [], [],
+                             {"events": 0, "rhs_evaluations": 0, "segments": 0}, 0.0)
+        return int(n_samples) * len(one.columns()) * CSV_BYTES_PER_VALUE
+
     def columns(self) -> dict[str, np.ndarray]:
         cols = {"t_s": self.t_s, "x_m": self.x_m, "v_m_s": self.v_m_s, "p_gauge_Pa": self.p_gauge_Pa,
                 "mode": self.mode}

@@ -29,7 +29,7 @@ from .elements.static_force import STATIC_FORCE_MODELS
 from .elements.stops import EndStops
 from .elements.valve import Iso6358Orifice, ProportionalValve33
 from .model import FitRange, MuscleModel
-from .parameters import PARAMETER_SETS, ParameterSet
+from .parameters import LOAD_MASS, PARAMETER_SETS, ParameterSet
 from .signals import Constant, FirstOrderLag, Ramp, Step, Trace
 from .simulator import SolverOptions
 
@@ -55,6 +55,11 @@ _SCHEMA: dict[str, dict[str, Any]] = {
     "solver": {"method": str, "rtol": float, "max_events": int, "max_step_s": float},
 }
 _MAX_SAMPLES = 1e7  # 8 s at 1 kHz is 8,001; beyond this the output would not fit in memory comfortably
+MIN_MAX_STEP_S = 1e-6
+"""Smallest ``solver.max_step_s`` [s]: a thousandth of the shortest time scale of the model (the valve's
+millisecond pressure transients); smaller steps only make a run hang."""
+MAX_STEPS = 1e7
+"""``solver.max_step_s`` may not ask for more steps than this over the run (minutes of computing)."""
 _METHODS = ("LSODA", "RK45", "DOP853", "Radau", "BDF", "RK23")
 
 
@@ -129,9 +134,17 @@ class Scenario:
         if max_events < 1:
             v.fail("solver.max_events", max_events, "must be at least 1")
         max_step = v.positive("solver.max_step_s", solver.get("max_step_s", math.inf))
+        smallest_step = max(MIN_MAX_STEP_S, duration / MAX_STEPS)
+        if max_step < smallest_step:
+            v.fail("solver.max_step_s", max_step, f"must be at least {smallest_step:.3g} s (1 us, and no more than "
+                   f"{MAX_STEPS:.0e} steps over duration_s = {duration:g} s)")
         opts = SolverOptions(method=method, rtol=rtol, sample_rate_Hz=sample_rate, max_events=int(max_events),
                              max_step_s=max_step)
-        scenario = cls(name or spec.get("name") or "scenario", spec, params, duration, opts, Path(base_dir), origin)
+        name = name or spec.get("name") or "scenario"
+        if any(bad in name for bad in ("/", "\\", "..", "\0")):
+            # The name is the stem of the output files: it must not lead out of the output folder.
+            v.fail("name", name, "must be a plain file name stem, without path separators or '..'")
+        scenario = cls(name, spec, params, duration, opts, Path(base_dir), origin)
         if duration * sample_rate > _MAX_SAMPLES:
             v.fail("simulation.sample_rate_Hz", sample_rate,
                    f"with duration_s = {duration:g} this asks for more than {_MAX_SAMPLES:.0e} output samples")
@@ -189,11 +202,16 @@ class Scenario:
         value = v.number(f"load.{key}", load[key])
         if value <= 0:
             v.fail(f"load.{key}", value, "must be positive")
+        why = LOAD_MASS.violation(self.mass_kg)  # the FMU's load_mass_kg input has the same range
+        if why:
+            v.fail(f"load.{key}", value, f"the mass {self.mass_kg:g} kg {why} kg")
 
     def _build_source(self, v: "_Validator"):
         pr = self.spec["pressure"]
         p = self.parameters
         source = v.required(pr, "pressure", "source")
+        if not isinstance(source, str):
+            v.fail("pressure.source", source, "must be a string", choices=("valve", "prescribed"))
         rating = p["rated_pressure_gauge_Pa"]
         if source == "valve":
             v.allowed("pressure", pr, {"source", "supply_gauge_bar", "supply_gauge_Pa", "valve_open_time_s",
@@ -349,7 +367,7 @@ def _signal(v: _Validator, where: str, spec: Any, suffix: str, scale: float, bas
     if not isinstance(spec, dict):
         v.fail(where, spec, "must be a table with a 'kind'")
     kind = v.required(spec, where, "kind")
-    if kind not in _SIGNAL_KINDS:
+    if not isinstance(kind, str) or kind not in _SIGNAL_KINDS:
         v.fail(f"{where}.kind", kind, "unknown signal kind", choices=_SIGNAL_KINDS)
     suffixes = [(suffix, scale)] + ([alt_suffix] if alt_suffix else [])
     times, values = _SIGNAL_KINDS[kind]

@@ -8,8 +8,11 @@ of the inputs, and the simulator then decides the next mode from the forces
 (MODEL_NOTES sec. 4).  Two thresholds keep the switching free of chatter: a
 held load is released only when the net force exceeds friction by
 ``release_margin_N``, and a stopping load is held when it exceeds it by no
-more than ``stick_margin_N`` < ``release_margin_N``.  So every new segment
-starts strictly inside its mode and has positive length.
+more than ``stick_margin_N`` < ``release_margin_N``.  A segment that starts on
+an event surface does not see its own start as an event (:func:`_from_start`);
+a slip too small for the integrator to resolve ends in a short hold
+(``_HOLD_S``).  Summary extremes are taken over every integrator step, the
+samples from the dense output (docs/model.md sec. 4).
 """
 
 from __future__ import annotations
@@ -17,11 +20,11 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
-from .errors import SolverFailure
+from .errors import InputError, SolverFailure
 from .model import Mode, MuscleModel
 from .result import Result, TransitionEvent
 
@@ -50,14 +53,60 @@ class SolverOptions:
     release_margin_N: float = 2e-7
 
 
+PROGRESS_EVERY = 2000
+"""Right-hand-side evaluations between two progress reports inside a segment (a few milliseconds)."""
+
 _SCALE = {"x_m": 1e-2, "v_m_s": 1e-1, "p_abs_Pa": 1e5, "air_mass_kg": 1e-5}
 _REST = (Mode.STICK, Mode.STOP_LOW, Mode.STOP_HIGH)
+_HOLD_S = 1e-9
+"""First hold [s] of a load whose slip from rest ended as it began.
+
+A load at zero velocity whose net force beats friction by a little, but is
+falling fast (a controller venting), turns back within a time and speed below
+the integrator's resolution: the slip segment ends with a velocity event at
+its own start, and deciding the mode again from the same forces would repeat
+it forever.  The load is then held for this time, doubled at each repetition,
+and its mode decided again from the forces at the end of the hold.  The motion
+lost is of the order of the integrator's velocity tolerance times the hold.
+"""
+_MAX_ZERO_LENGTH = 30
+"""Zero-length segments in a row (the last hold is then 2**29 ns, about 0.5 s) before it is a solver failure."""
+
+
+def n_samples(duration_s: float, sample_rate_Hz: float) -> int:
+    """Number of output samples: round(duration x rate) + 1, evenly spaced, at least the start and the end."""
+    return max(2, int(round(duration_s * sample_rate_Hz)) + 1)
 
 
 def _event(fun, direction: float):
     fun.terminal = True
     fun.direction = direction
     return fun
+
+
+_ON_SURFACE = 1e-12
+"""Magnitude [m, m/s or N] given to an event function that is exactly zero at its segment's start."""
+
+
+def _from_start(fun, t0: float, y0: np.ndarray):
+    """``fun`` with its value at the segment start ``t0`` taken from the exact start state ``y0``.
+
+    A segment can start on an event surface (a load released from rest starts
+    at v = 0, and the velocity event watches v).  The dense interpolant need
+    not reproduce ``y0`` exactly at ``t0`` (LSODA gives v = -5e-23), so the
+    root finder could see no sign change at a crossing that does happen later
+    in the step.  The start value is therefore taken from ``y0``, and if it is
+    zero, placed on the side the mode implies (before the crossing the event
+    looks for): the segment's own start is never an event.
+    """
+    g0 = float(fun(t0, y0))
+    if g0 == 0.0:
+        g0 = -fun.direction * _ON_SURFACE
+
+    def guarded(t, y):
+        return g0 if t <= t0 else fun(t, y)
+
+    return _event(guarded, fun.direction)
 
 
 class _Events:
@@ -112,18 +161,24 @@ def initial_mode(model: MuscleModel, t: float, y, stick_margin_N: float = Solver
 
 
 def simulate_model(model: MuscleModel, duration_s: float, options: SolverOptions | None = None,
-                   x0_m: float = 0.0, name: str = "", p0_gauge_Pa: float | None = None) -> Result:
+                   x0_m: float = 0.0, name: str = "", p0_gauge_Pa: float | None = None,
+                   progress: Callable[[float], None] | None = None) -> Result:
     """Integrate ``model`` from rest at ``x0_m`` (chamber at ``p0_gauge_Pa``, if given) over ``[0, duration_s]``.
+
+    ``progress``, if given, is called with the simulated time [s] reached, at
+    every segment and every ``PROGRESS_EVERY`` right-hand-side evaluations
+    within one (a long run with a small ``max_step_s`` can stay in one segment).
 
     Raises :class:`SolverFailure` when ``solve_ivp`` fails, the event count
     exceeds ``options.max_events``, or the switching stops making progress.
     """
+    from scipy.integrate import solve_ivp  # here, not at the top: `pamsim --help` should not pay for it
+
     opts = options or SolverOptions()
     wall0 = time.perf_counter()
     names = model.state_names
     atol = np.array([opts.rtol * _SCALE.get(n, 0.1) for n in names])
-    n_samples = int(round(duration_s * opts.sample_rate_Hz)) + 1
-    grid = np.linspace(0.0, duration_s, n_samples)
+    grid = np.linspace(0.0, duration_s, n_samples(duration_s, opts.sample_rate_Hz))
     breaks = sorted({b for b in model.breakpoints if 0.0 < b < duration_s} | {duration_s})
     events = _Events(model, opts)
     m = model.load.mass_kg
@@ -138,43 +193,77 @@ def simulate_model(model: MuscleModel, duration_s: float, options: SolverOptions
     nfev = 0
     n_segments = 0
     n_zero = 0
+    hold_until = math.inf  # end of a short hold after a slip too small to resolve (see _HOLD_S)
     next_sample = 0
+    low_x, peak_x, peak_p = math.inf, -math.inf, -math.inf  # over every integrator step and event, not the samples
+
+    calls = 0
+    reached = 0.0  # reported time: the RHS is also evaluated at trial points, which need not increase
+
+    def rhs(tt, yy):
+        nonlocal calls, reached
+        calls += 1
+        if progress is not None and calls % PROGRESS_EVERY == 0:
+            reached = max(reached, tt)
+            progress(reached)
+        return model.rhs(tt if tt < t_left else t_left, yy, seg_mode)
 
     while t < duration_s:
-        t_break = next(b for b in breaks if b > t)
+        if progress is not None:
+            reached = max(reached, t)
+            progress(reached)
+        t_break = min(next(b for b in breaks if b > t), hold_until)
         j = np.searchsorted(grid, t_break, side="right")
-        t_eval = grid[next_sample:j]
-        if t_eval.size == 0 or t_eval[-1] < t_break:
-            t_eval = np.append(t_eval, t_break)
         named = events.by_mode[mode]
         seg_mode = mode
         # An input that jumps at t_break belongs to the next segment: this one sees its left limit,
         # so a jump cannot hide a crossing that happened before it.
         t_left = events.t_left = float(np.nextafter(t_break, -math.inf))
         max_step = opts.max_step_s if mode.is_slip else min(opts.max_step_s, held_max_step)
-        sol = solve_ivp(lambda tt, yy: model.rhs(tt if tt < t_left else t_left, yy, seg_mode), (t, t_break), y,
-                        method=opts.method, t_eval=t_eval, events=[f for _, f in named], rtol=opts.rtol,
-                        atol=atol, max_step=max_step)
+        try:
+            sol = solve_ivp(rhs, (t, t_break), y,
+                            method=opts.method, dense_output=True, events=[_from_start(f, t, y) for _, f in named],
+                            rtol=opts.rtol, atol=atol, max_step=max_step)
+        except (InputError, SolverFailure):
+            raise
+        except Exception as exc:
+            # solve_ivp and its root finder signal numerical trouble with plain exceptions (ValueError
+            # from brentq, ZeroDivisionError, LinAlgError...); to the caller it is a solver failure (exit 3).
+            raise SolverFailure(f"solve_ivp raised {type(exc).__name__} at t = {t:.6g} s in mode {mode.label}: "
+                                f"{exc}") from exc
         nfev += sol.nfev
         n_segments += 1
         if sol.status == -1:
             raise SolverFailure(f"solve_ivp failed at t = {t:.6g} s in mode {mode.label}: {sol.message}")
-        keep = np.isin(sol.t, grid[next_sample:j])
-        if keep.any():
-            ts.append(sol.t[keep])
-            ys.append(sol.y[:, keep])
-            modes.append(np.full(int(keep.sum()), int(mode)))
-            next_sample += int(keep.sum())
+        # sol.t, sol.y: every step of the integrator, ending at the event or at t_break.
+        samples = grid[next_sample:j]
+        samples = samples[samples <= sol.t[-1]]
+        if samples.size:
+            ts.append(samples)
+            ys.append(sol.sol(samples))
+            modes.append(np.full(samples.size, int(mode)))
+            next_sample += samples.size
+        # x is monotonic within a segment (the velocity keeps its sign between events), so its peak
+        # is at a step; the pressure's peak is taken over the steps as well.
+        low_x, peak_x = min(low_x, float(sol.y[0].min())), max(peak_x, float(sol.y[0].max()))
+        p_steps = model.source.pressure_gauge_Pa(sol.y[2:2 + model.n_source], model.source.inputs(
+            np.minimum(sol.t, t_left)))
+        peak_p = max(peak_p, float(np.max(p_steps)))
         if sol.status == 1:
             k = next(i for i, te in enumerate(sol.t_events) if len(te))
             kind = named[k][0]
             t_event = float(sol.t_events[k][0])
             y = np.array(sol.y_events[k][0], dtype=float)
-            n_zero = n_zero + 1 if t_event - t <= 1e-12 * max(1.0, t) else 0
-            if n_zero > 50:
+            zero_length = t_event - t <= 1e-12 * max(1.0, t)
+            n_zero = n_zero + 1 if zero_length else 0
+            if n_zero > _MAX_ZERO_LENGTH:
                 raise SolverFailure(f"event switching made no progress at t = {t_event:.9g} s ({kind})")
             old = mode
             mode = _transition(model, kind, t_event, y, mode, opts, impact_loss_J, m)
+            hold_until = math.inf
+            if kind == "velocity_zero" and zero_length and mode.is_slip:
+                mode = Mode.STICK
+                hold_until = t_event + _HOLD_S * 2.0 ** (n_zero - 1)
             transitions.append(TransitionEvent(t_event, kind, old.label, mode.label, float(y[0])))
             if len(transitions) > opts.max_events:
                 raise SolverFailure(f"more than {opts.max_events} events by t = {t_event:.6g} s "
@@ -182,17 +271,21 @@ def simulate_model(model: MuscleModel, duration_s: float, options: SolverOptions
             t = t_event
         else:
             t = t_break
+            hold_until = math.inf
             y = sol.y[:, -1].copy()
             if mode in _REST:
                 mode = _rest_mode(model, t, y, mode, opts.stick_margin_N)
 
+    if progress is not None:
+        progress(duration_s)
     t_out = np.concatenate(ts)
     Y = np.concatenate(ys, axis=1)
     mode_arr = np.concatenate(modes)
     return Result.from_trace(model, name, t_out, Y, mode_arr, transitions, impact_loss_J,
                              {"rhs_evaluations": int(nfev), "events": len(transitions), "segments": n_segments,
                               "method": opts.method, "rtol": opts.rtol},
-                             time.perf_counter() - wall0)
+                             time.perf_counter() - wall0,
+                             peaks={"x_m": peak_x, "p_gauge_Pa": peak_p, "x_min_m": low_x})
 
 
 def _transition(model: MuscleModel, kind: str, t: float, y: np.ndarray, mode: Mode, opts: SolverOptions,
@@ -216,4 +309,4 @@ def _transition(model: MuscleModel, kind: str, t: float, y: np.ndarray, mode: Mo
     return _rest_mode(model, t, y, Mode.STOP_LOW if low else Mode.STOP_HIGH, opts.stick_margin_N)
 
 
-__all__ = ["SolverFailure", "SolverOptions", "simulate_model", "initial_mode"]
+__all__ = ["SolverFailure", "SolverOptions", "simulate_model", "initial_mode", "n_samples"]

@@ -7,7 +7,6 @@ from __future__ import annotations
 from typing import Mapping
 
 import numpy as np
-from scipy.optimize import brentq
 
 from .elements.stops import EndStops
 
@@ -23,7 +22,25 @@ def _first_fall_through_zero(excess, x_max_m: float, n_grid: int = 400) -> float
     if falls.size == 0:
         return float(x_max_m)
     i = int(falls[0])
-    return float(brentq(excess, x[i], x[i + 1], xtol=1e-12))
+    return _bisect_falling(excess, float(x[i]), float(x[i + 1]))
+
+
+def _bisect_falling(excess, a: float, b: float, xtol: float = 1e-12) -> float:
+    """Root of ``excess`` in [a, b] with ``excess(a) > 0 >= excess(b)``, by bisection to ``xtol``.
+
+    Plain bisection rather than scipy's brentq: importing scipy.optimize costs
+    several times the rest of ``pamsim static`` (the command must start fast),
+    and about 30 halvings of one grid cell reach ``xtol``.
+    """
+    while b - a > xtol:
+        mid = 0.5 * (a + b)
+        if mid in (a, b):  # no float between them
+            break
+        if excess(mid) > 0.0:
+            a = mid
+        else:
+            b = mid
+    return 0.5 * (a + b)
 
 
 def equilibrium_contraction_m(static_force, p_gauge_Pa: float, load_N: float, x_max_m: float) -> float:

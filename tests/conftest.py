@@ -31,7 +31,44 @@ def paper_results():
     return out
 
 
+@pytest.fixture(scope="session")
+def fmus(tmp_path_factory):
+    """{FMI version: path} of the FMU built once per session from the current sources."""
+    from pamsim.fmu import build
+
+    folder = tmp_path_factory.mktemp("fmu")
+    return {v: build(folder / f"pamsim_muscle_fmi{v}.fmu", v) for v in (2, 3)}
+
+
+@pytest.fixture(scope="session")
+def unzipped(fmus):
+    """{FMI version: folder} of the extracted session FMUs."""
+    from fmpy import extract
+
+    return {v: extract(fmus[v]) for v in (2, 3)}
+
+
 def run_cli(*args, cwd=None):
     """Run ``python -m pamsim ARGS`` as a user would; returns the CompletedProcess."""
     return subprocess.run([sys.executable, "-m", "pamsim", *map(str, args)], capture_output=True, text=True,
                           cwd=cwd, timeout=300)
+
+
+@pytest.fixture
+def cli(capsys):
+    """Run ``pamsim ARGS`` in this process (the console script's ``main()``); returns a CompletedProcess.
+
+    Most CLI tests use this: a subprocess costs an interpreter and the imports every time.  A few
+    representative tests still go through :func:`run_cli`.
+    """
+    from pamsim.cli import main
+
+    def run(*args):
+        try:
+            code = main([str(a) for a in args])
+        except SystemExit as exc:  # argparse's own errors
+            code = exc.code if isinstance(exc.code, int) else 1
+        out = capsys.readouterr()
+        return subprocess.CompletedProcess(args, code, out.out, out.err)
+
+    return run

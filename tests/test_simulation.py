@@ -296,3 +296,64 @@ def test_initial_chamber_pressure_holds_an_initial_contraction():
     assert held.p_gauge_Pa[0] == pytest.approx(p_hold)
     dropped = pamsim.simulate(pamsim.Scenario.from_dict(base))
     assert dropped.final_mode == Mode.STOP_LOW
+
+
+def test_exception_inside_the_integrator_is_a_solver_failure():
+    """Whatever solve_ivp or an element raises during the integration reaches the caller as SolverFailure."""
+    import dataclasses
+
+    from pamsim.errors import SolverFailure
+
+    sc = pamsim.load_scenario(SCENARIOS / "acra2012_fig4.toml")
+    model = sc.build_model()
+
+    def broken_force(t_s):
+        if t_s > 1.5:
+            raise ZeroDivisionError("division by zero in a user's force signal")
+        return 0.0 * t_s
+
+    load = dataclasses.replace(model.load, external_force_N=broken_force)
+    with pytest.raises(SolverFailure, match="ZeroDivisionError.*t = 1"):
+        pamsim.simulate_model(dataclasses.replace(model, load=load), 3.0)
+
+
+def test_simulate_accepts_a_path_and_refuses_other_types(paper_results):
+    from pathlib import Path
+
+    _, expected = paper_results["acra2012_fig4"]
+    for given in (str(SCENARIOS / "acra2012_fig4.toml"), Path(SCENARIOS / "acra2012_fig4.toml")):
+        res = pamsim.simulate(given)
+        assert res.name == "acra2012_fig4"
+        np.testing.assert_array_equal(res.x_m, expected.x_m)
+    with pytest.raises(TypeError, match="Scenario or the path"):
+        pamsim.simulate({"load": {"weight_N": 1.0}})
+
+
+def test_summary_comes_from_the_solution_not_the_samples():
+    """Final state, peak and rest do not depend on the output rate; the last sample is at the end time;
+    the peak is where the load stopped rising (an event of the solution, between samples)."""
+    base = pamsim.load_scenario(SCENARIOS / "acra2012_fig4.toml")
+    runs = {rate: pamsim.simulate(base.with_changes({"simulation": {"sample_rate_Hz": rate}}))
+            for rate in (0.05, 0.3, 1000.0)}
+    ref = runs[1000.0].summary()
+    top = max(e.x_m for e in runs[1000.0].transitions if e.kind == "velocity_zero" and e.from_mode == "slip_up")
+    assert ref["peak_contraction_m"] == pytest.approx(top, abs=1e-12)
+    for rate, res in runs.items():
+        s = res.summary()
+        assert res.t_s[-1] == base.duration_s
+        for key in ("final_contraction_m", "peak_contraction_m", "final_pressure_gauge_Pa"):
+            assert s[key] == pytest.approx(ref[key], rel=1e-9), (rate, key)
+        assert (s["final_mode"], s["at_rest_at_end"]) == (ref["final_mode"], ref["at_rest_at_end"])
+        assert s["peak_contraction_m"] >= res.x_m.max()
+
+
+def test_progress_is_reported_inside_a_long_segment():
+    """With a small max_step_s one segment takes many steps: progress must come from inside it, in order,
+    and end at the duration."""
+    sc = pamsim.load_scenario(SCENARIOS / "acra2012_fig4.toml").with_changes(
+        {"simulation": {"duration_s": 0.9}, "solver": {"max_step_s": 1e-4}})  # before the valve opens: one segment
+    seen = []
+    res = pamsim.simulate(sc, progress=seen.append)
+    assert res.stats["segments"] == 1
+    assert len(seen) > 3 and seen[-1] == 0.9 and 0.0 < seen[1] < 0.9
+    assert all(b >= a for a, b in zip(seen, seen[1:]))

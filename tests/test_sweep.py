@@ -39,8 +39,15 @@ def serial(grid_spec):
 
 @pytest.fixture(scope="module")
 def parallel(grid_spec):
+    """Every seventh case and three of the frequency loads, on two worker processes (the serial fixture
+    has run them all; comparing a subset keeps the suite fast)."""
+    import dataclasses
+
+    subset = dataclasses.replace(grid_spec, cases=grid_spec.cases[::7], time_responses=(),
+                                 frequency=dataclasses.replace(grid_spec.frequency,
+                                                               weights_N=grid_spec.frequency.weights_N[::3]))
     with ProcessPoolExecutor(max_workers=2) as pool:
-        return pamsim.sweep(grid_spec, pool)
+        return pamsim.sweep(subset, pool)
 
 
 @pytest.fixture(scope="module")
@@ -93,18 +100,38 @@ def test_static_equilibrium_matches_the_polynomial(serial):
             _equilibrium_mm(r["pressure_bar"], r["weight_N"]), abs=1e-6)
 
 
+def _measured_rows() -> list[dict]:
+    with open(DATA) as fh:
+        return [{k: float(v) for k, v in row.items()}
+                for row in csv.DictReader(line for line in fh if not line.startswith("#"))]
+
+
+def _independent_errors_mm(threshold_mm: float) -> dict[tuple[float, float], float]:
+    """(weight, stable pressure) -> equilibrium minus measured [mm], from the data file and the written-out
+    polynomial alone, for the cases whose equilibrium is at least ``threshold_mm``."""
+    out = {}
+    for m in _measured_rows():
+        x = _equilibrium_mm(m["pressure_stable_bar"], m["weight_N"])
+        if x >= threshold_mm:
+            out[(m["weight_N"], m["pressure_stable_bar"])] = x - m["contraction_stable_mm"]
+    return out
+
+
 def test_within_capability_static_rms_is_what_the_paper_polynomial_gives(serial, written):
-    """The issue's target (<= 1.5 mm over equilibrium >= 5 mm) is NOT met by the paper's coefficients:
-    the RMS is 1.65 mm, dominated by 2.02 bar / 32.74 N (-4.8 mm), a case next to the capability edge.
-    Past 7 mm the RMS is within 1.5 mm.  See docs/validation.md."""
+    """The sweep's within-capability cases, RMS and worst case are those of the paper's polynomial applied
+    to the measured data directly.  The issue's target (<= 1.5 mm over equilibrium >= 5 mm) is not met
+    by those coefficients; past 7 mm it is (docs/validation.md)."""
+    expected = _independent_errors_mm(5.0)
     within = _within(serial.rows)
-    assert len(within) == 28
+    assert {(r["weight_N"], r["pressure_bar"]) for r in within} == set(expected)
     rms = _rms_mm([r["equilibrium_error_m"] for r in within])
-    assert 1.5 < rms < 1.8
+    assert rms == pytest.approx(float(np.sqrt(np.mean(np.square(list(expected.values()))))), rel=1e-6)
     worst = max(within, key=lambda r: abs(r["equilibrium_error_m"]))
-    assert (worst["weight_N"], worst["pressure_bar"]) == (32.74, 2.02)
-    assert _rms_mm([r["equilibrium_error_m"] for r in _within(serial.rows, 7.0)]) <= 1.5
-    assert f"| 28 | {rms:.2f} |" in (written / "report.md").read_text()
+    assert (worst["weight_N"], worst["pressure_bar"]) == max(expected, key=lambda k: abs(expected[k]))
+    past7 = _independent_errors_mm(7.0)
+    assert _rms_mm([r["equilibrium_error_m"] for r in _within(serial.rows, 7.0)]) == pytest.approx(
+        float(np.sqrt(np.mean(np.square(list(past7.values()))))), rel=1e-6)
+    assert f"| {len(expected)} | {rms:.2f} |" in (written / "report.md").read_text()
 
 
 @pytest.mark.xfail(strict=True, reason="issue 3 target not met by the paper's polynomial: RMS 1.65 mm > 1.5 mm "
@@ -117,7 +144,7 @@ def test_report_gives_both_friction_models(serial, written):
     report = (written / "report.md").read_text()
     for f in ("load_dependent", "constant"):
         vals = [r[("" if f == "load_dependent" else "constant_") + "error_m"] for r in _within(serial.rows)]
-        assert f"{f} friction, within capability | 28 | {_rms_mm(vals):.2f} |" in report
+        assert f"{f} friction, within capability | {len(vals)} | {_rms_mm(vals):.2f} |" in report
 
 
 def test_rest_at_the_end(serial):
@@ -156,16 +183,21 @@ def test_frequency_falls_with_load_at_3p6_bar(serial):
 
 
 def test_parallel_gives_the_serial_numbers(serial, parallel):
-    assert len(parallel.rows) == len(serial.rows)
-    for a, b in zip(serial.rows, parallel.rows):
+    by_case = {r["case"]: r for r in serial.rows}
+    assert len(parallel.rows) == len(serial.rows[::7]) >= 9
+    for b in parallel.rows:
+        a = by_case[b["case"]]
         assert a.keys() == b.keys()
         for k in a:
             if isinstance(a[k], float):
                 assert (a[k] == b[k]) or (math.isnan(a[k]) and math.isnan(b[k])), (a["case"], k)
             else:
                 assert a[k] == b[k], (a["case"], k)
-    np.testing.assert_array_equal([r["load_dependent_frequency_Hz"] for r in serial.frequency_rows],
-                                  [r["load_dependent_frequency_Hz"] for r in parallel.frequency_rows])
+    freq = {r["weight_N"]: r["load_dependent_frequency_Hz"] for r in serial.frequency_rows}
+    assert len(parallel.frequency_rows) >= 3
+    for r in parallel.frequency_rows:
+        a, b = freq[r["weight_N"]], r["load_dependent_frequency_Hz"]
+        assert a == b or (math.isnan(a) and math.isnan(b)), r["weight_N"]
 
 
 def test_outputs_are_complete(written):
@@ -235,7 +267,7 @@ def test_cli_runs_a_small_sweep_with_progress(tmp_path):
         '[axes]\npressure_bar = [2.8, 3.6]\nweight_N = [12.74, 22.74]\n')
     proc = _cli("sweep", tmp_path / "s.toml", "-o", tmp_path / "out", "--workers", "2")
     assert proc.returncode == 0, proc.stderr
-    assert "ETA" in proc.stderr and "4/4 runs" in proc.stderr
+    assert "4/4" in proc.stderr and "failed=0" in proc.stderr  # the tqdm bar
     with open(tmp_path / "out" / "summary.csv") as fh:
         assert len(list(csv.DictReader(fh))) == 4
 
@@ -255,7 +287,7 @@ BAD_FILES = {
 
 
 @pytest.mark.parametrize("label", sorted(BAD_FILES))
-def test_bad_sweep_files_exit_2_naming_the_problem(tmp_path, label):
+def test_bad_sweep_files_exit_2_naming_the_problem(tmp_path, cli, label):
     body, needle = BAD_FILES[label]
     (tmp_path / "bad.csv").write_text("weight_N,pressure_stable_bar,contraction_mm\n12.74,3.6,70\n")
     path = tmp_path / "sweep.toml"
@@ -264,7 +296,7 @@ def test_bad_sweep_files_exit_2_naming_the_problem(tmp_path, label):
         load_sweep(path)
     assert needle in str(err.value) and str(path) in str(err.value)
     if label in ("unknown axis", "empty axis", "data columns"):  # the issue's three, end to end
-        proc = _cli("sweep", path, "-o", tmp_path / "out")
+        proc = cli("sweep", path, "-o", tmp_path / "out")
         assert proc.returncode == 2
         assert needle in proc.stderr and len(proc.stderr.strip().splitlines()) == 1
         assert not (tmp_path / "out").exists() or not any((tmp_path / "out").iterdir())

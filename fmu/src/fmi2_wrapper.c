@@ -14,6 +14,7 @@ static const FmuFlavour FMI2 = {.standard = "FMI 2.0",
                                 .integer_type = "Integer",
                                 .differentiable = "Real variables",
                                 .time_is_vr0 = 0,
+                                .enums_are_int64 = 0,
                                 .states_evaluate_in = 0,
                                 .derivatives_evaluate_in = FMU_INIT | FMU_EVENT | FMU_CONT | FMU_TERMINATED};
 

@@ -15,6 +15,7 @@ static const FmuFlavour FMI3 = {.standard = "FMI 3.0",
                                 .integer_type = "Int32",
                                 .differentiable = "Float64 scalars",
                                 .time_is_vr0 = 1,
+                                .enums_are_int64 = 1,
                                 .states_evaluate_in = FMU_EVENT | FMU_CONT,
                                 /* As FMI 2: a read after Terminate or during initialization sees the current values. */
                                 .derivatives_evaluate_in = FMU_INIT | FMU_EVENT | FMU_CONT | FMU_TERMINATED};
@@ -143,6 +144,16 @@ fmi3Status fmi3SetInt32(fmi3Instance instance, const fmi3ValueReference vr[], si
     return STATUS(fmu_set_integers(FMU(instance), __func__, vr, nvr, values, nValues));
 }
 
+fmi3Status fmi3GetInt64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3Int64 values[],
+                        size_t nValues) {
+    return STATUS(fmu_get_enums(FMU(instance), __func__, vr, nvr, values, nValues));
+}
+
+fmi3Status fmi3SetInt64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3Int64 values[],
+                        size_t nValues) {
+    return STATUS(fmu_set_enums(FMU(instance), __func__, vr, nvr, values, nValues));
+}
+
 /* The model has no variables of the other types: any non-empty access is an error. */
 #define NO_SUCH_TYPE(NAME, CTYPE, CONST)                                                                            \
     fmi3Status NAME(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, CONST CTYPE values[],        \
@@ -158,7 +169,6 @@ NO_SUCH_TYPE(fmi3GetUInt8, fmi3UInt8, )
 NO_SUCH_TYPE(fmi3GetInt16, fmi3Int16, )
 NO_SUCH_TYPE(fmi3GetUInt16, fmi3UInt16, )
 NO_SUCH_TYPE(fmi3GetUInt32, fmi3UInt32, )
-NO_SUCH_TYPE(fmi3GetInt64, fmi3Int64, )
 NO_SUCH_TYPE(fmi3GetUInt64, fmi3UInt64, )
 NO_SUCH_TYPE(fmi3GetBoolean, fmi3Boolean, )
 NO_SUCH_TYPE(fmi3GetString, fmi3String, )
@@ -168,7 +178,6 @@ NO_SUCH_TYPE(fmi3SetUInt8, fmi3UInt8, const)
 NO_SUCH_TYPE(fmi3SetInt16, fmi3Int16, const)
 NO_SUCH_TYPE(fmi3SetUInt16, fmi3UInt16, const)
 NO_SUCH_TYPE(fmi3SetUInt32, fmi3UInt32, const)
-NO_SUCH_TYPE(fmi3SetInt64, fmi3Int64, const)
 NO_SUCH_TYPE(fmi3SetUInt64, fmi3UInt64, const)
 NO_SUCH_TYPE(fmi3SetBoolean, fmi3Boolean, const)
 NO_SUCH_TYPE(fmi3SetString, fmi3String, const)

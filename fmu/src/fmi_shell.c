@@ -121,13 +121,14 @@ static void refresh(FmuInstance *in, int evaluate_in) {
     if (in->state & evaluate_in) pam_evaluate(&in->core);
 }
 
+/* kind: 'r' (Real / Float64), 'i' (Integer / Int32; in FMI 2.0 also an Enumeration), 'e' (FMI 3.0 Int64:
+ * an Enumeration). */
 static int check_vr(FmuInstance *in, const char *function, unsigned vr, char kind) {
-    if (vr < 1 || vr > PAM_NVARS || PAM_VARS[vr - 1].kind != kind) {
-        pam_logf(&in->core, PAM_LOG_ERROR, "%s: no %s variable with value reference %u", function,
-                 kind == 'r' ? in->flavour->real_type : in->flavour->integer_type, vr);
-        return 0;
-    }
-    return 1;
+    char has = vr >= 1 && vr <= PAM_NVARS ? PAM_VARS[vr - 1].kind : 0;
+    if (has == kind || (kind == 'i' && has == 'e' && !in->flavour->enums_are_int64)) return 1;
+    pam_logf(&in->core, PAM_LOG_ERROR, "%s: no %s variable with value reference %u", function,
+             kind == 'r' ? in->flavour->real_type : kind == 'i' ? in->flavour->integer_type : "Enumeration (Int64)", vr);
+    return 0;
 }
 
 /* Parameters before the end of initialisation, inputs at any time before termination. */
@@ -143,7 +144,8 @@ static int settable(FmuInstance *in, const char *function, unsigned vr) {
 /* Values may be read from the end of instantiation, and are then up to date. */
 static int begin_read(FmuInstance *in, const char *function, size_t nvr, size_t n_values) {
     if (!fmu_allowed(in, function, FMU_RUNNING) || n_values != nvr) return -1;
-    refresh(in, FMU_EVENT | FMU_CONT);
+    /* Co-simulation too: an input set at a communication point shows in the outputs at once. */
+    refresh(in, FMU_EVENT | FMU_CONT | FMU_STEP);
     return 0;
 }
 
@@ -162,15 +164,29 @@ int fmu_get_reals(FmuInstance *in, const char *function, const unsigned vr[], si
     return 0;
 }
 
-int fmu_get_integers(FmuInstance *in, const char *function, const unsigned vr[], size_t nvr, int32_t values[],
-                     size_t n_values) {
+/* Integers and enumerations share i[]: `kind` 'i' reads into values32, 'e' (FMI 3.0 Int64) into values64. */
+static int get_ints(FmuInstance *in, const char *function, const unsigned vr[], size_t nvr, size_t n_values, char kind,
+                    int32_t values32[], int64_t values64[]) {
     size_t k;
     if (begin_read(in, function, nvr, n_values)) return -1;
     for (k = 0; k < nvr; k++) {
-        if (!check_vr(in, function, vr[k], 'i')) return -1;
-        values[k] = in->core.i[PAM_VARS[vr[k] - 1].index];
+        int32_t value;
+        if (!check_vr(in, function, vr[k], kind)) return -1;
+        value = in->core.i[PAM_VARS[vr[k] - 1].index];
+        if (kind == 'e') values64[k] = value;
+        else values32[k] = value;
     }
     return 0;
+}
+
+int fmu_get_integers(FmuInstance *in, const char *function, const unsigned vr[], size_t nvr, int32_t values[],
+                     size_t n_values) {
+    return get_ints(in, function, vr, nvr, n_values, 'i', values, NULL);
+}
+
+int fmu_get_enums(FmuInstance *in, const char *function, const unsigned vr[], size_t nvr, int64_t values[],
+                  size_t n_values) {
+    return get_ints(in, function, vr, nvr, n_values, 'e', NULL, values);
 }
 
 int fmu_set_reals(FmuInstance *in, const char *function, const unsigned vr[], size_t nvr, const double values[],
@@ -189,15 +205,28 @@ int fmu_set_reals(FmuInstance *in, const char *function, const unsigned vr[], si
     return 0;
 }
 
-int fmu_set_integers(FmuInstance *in, const char *function, const unsigned vr[], size_t nvr, const int32_t values[],
-                     size_t n_values) {
+static int set_ints(FmuInstance *in, const char *function, const unsigned vr[], size_t nvr, size_t n_values, char kind,
+                    const int32_t values32[], const int64_t values64[]) {
     size_t k;
     if (!fmu_allowed(in, function, FMU_INSTANTIATED | FMU_INIT) || n_values != nvr) return -1;
     for (k = 0; k < nvr; k++) {
-        if (!check_vr(in, function, vr[k], 'i') || !settable(in, function, vr[k])) return -1;
-        in->core.i[PAM_VARS[vr[k] - 1].index] = values[k];
+        int64_t value = kind == 'e' ? values64[k] : values32[k];
+        if (!check_vr(in, function, vr[k], kind) || !settable(in, function, vr[k])) return -1;
+        /* Beyond int32 is beyond every choice's range: clamped, it stays out of range for the parameter check. */
+        in->core.i[PAM_VARS[vr[k] - 1].index] = value > INT32_MAX ? INT32_MAX
+                                                : value < INT32_MIN ? INT32_MIN : (int32_t)value;
     }
     return 0;
+}
+
+int fmu_set_integers(FmuInstance *in, const char *function, const unsigned vr[], size_t nvr, const int32_t values[],
+                     size_t n_values) {
+    return set_ints(in, function, vr, nvr, n_values, 'i', values, NULL);
+}
+
+int fmu_set_enums(FmuInstance *in, const char *function, const unsigned vr[], size_t nvr, const int64_t values[],
+                  size_t n_values) {
+    return set_ints(in, function, vr, nvr, n_values, 'e', NULL, values);
 }
 
 int fmu_no_such_type(FmuInstance *in, const char *function, int states, size_t nvr, const char *what) {
@@ -362,8 +391,15 @@ int fmu_get_nominals(FmuInstance *in, const char *function, double nominals[], s
 
 int fmu_do_step(FmuInstance *in, const char *function, double current_time, double step_size) {
     if (!fmu_allowed(in, function, FMU_STEP) || !in->is_cs) return FMU_STEP_REFUSED;
-    if (!(step_size >= 0.0) || !isfinite(current_time)) {
-        pam_logf(&in->core, PAM_LOG_ERROR, "%s: invalid step size %g", function, step_size);
+    if (!(step_size >= 0.0) || !isfinite(step_size)) {
+        pam_logf(&in->core, PAM_LOG_ERROR, "%s: step size %g: must be a finite number >= 0", function, step_size);
+        return FMU_STEP_REJECTED;
+    }
+    /* The importer's time may differ from the FMU's by rounding (t + h computed on either side),
+     * not by more. */
+    if (!(fabs(current_time - in->core.time_s) <= 1e-12 * fmax(1.0, fabs(in->core.time_s)))) {
+        pam_logf(&in->core, PAM_LOG_ERROR, "%s: currentCommunicationPoint = %.16g s is not the FMU's time %.16g s",
+                 function, current_time, in->core.time_s);
         return FMU_STEP_REJECTED;
     }
     in->core.time_s = current_time;

@@ -14,6 +14,10 @@
 
 #include "pam_core.h"
 
+#if defined(__GNUC__)
+#pragma GCC visibility push(hidden)
+#endif
+
 /* The state machine of both standards (FMI 2.0 sec. 3.2.3 and 4.2.4, FMI 3.0 sec. 3.2 and 4.2);
  * an FMI 2.0 instance never enters FMU_CONFIG. */
 enum {
@@ -36,6 +40,7 @@ typedef struct {
     const char *integer_type;
     const char *differentiable; /* what GetDirectionalDerivative accepts, in its error */
     int time_is_vr0;            /* FMI 3.0 declares time as value reference 0 */
+    int enums_are_int64;        /* FMI 3.0 reads and writes Enumerations as Int64, FMI 2.0 as Integer */
     /* The states in which reading the continuous states, or their derivatives and the event
      * indicators, re-evaluates the model (derivatives: the same in both standards). */
     int states_evaluate_in;
@@ -82,6 +87,11 @@ int fmu_set_reals(FmuInstance *in, const char *function, const unsigned vr[], si
                   size_t n_values);
 int fmu_set_integers(FmuInstance *in, const char *function, const unsigned vr[], size_t nvr, const int32_t values[],
                      size_t n_values);
+/* Enumerations where they are Int64 (FMI 3.0). */
+int fmu_get_enums(FmuInstance *in, const char *function, const unsigned vr[], size_t nvr, int64_t values[],
+                  size_t n_values);
+int fmu_set_enums(FmuInstance *in, const char *function, const unsigned vr[], size_t nvr, const int64_t values[],
+                  size_t n_values);
 /* Access to a type the model has none of: fine if empty, else an error saying `what`. */
 int fmu_no_such_type(FmuInstance *in, const char *function, int states, size_t nvr, const char *what);
 
@@ -108,9 +118,14 @@ int fmu_get_event_indicators(FmuInstance *in, const char *function, double z[], 
 int fmu_get_nominals(FmuInstance *in, const char *function, double nominals[], size_t nx);
 
 /* Co-simulation.  FMU_STEP_REFUSED (wrong state or no co-simulation instance) and
- * FMU_STEP_REJECTED (invalid step) leave the instance as it was; FMU_STEP_FAILED leaves it in
- * FMU_ERROR at the last successful time. */
+ * FMU_STEP_REJECTED (a step size that is not a finite number >= 0, or a current communication point
+ * that is not the FMU's time) leave the instance as it was; FMU_STEP_FAILED leaves it in FMU_ERROR at
+ * the last successful time, with the states, mode and outputs of that instant. */
 enum { FMU_STEP_REFUSED = -1, FMU_STEP_REJECTED = -2, FMU_STEP_FAILED = -3 };
 int fmu_do_step(FmuInstance *in, const char *function, double current_time, double step_size);
+
+#if defined(__GNUC__)
+#pragma GCC visibility pop
+#endif
 
 #endif

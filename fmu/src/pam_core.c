@@ -1,6 +1,7 @@
 /* pamsim muscle model core; see pam_core.h.  Every equation mirrors a
  * pamsim element (names given at each function) so the two can be compared. */
 #include "pam_core.h"
+#include "pam_force_table.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -16,7 +17,6 @@
 #define X_TOL_M 1e-9
 #define MIN_REBOUND_M_S 1e-3 /* pamsim.elements.stops.EndStops.min_rebound_speed_m_s */
 #define MAX_ZERO_LENGTH_EVENTS 50 /* pamsim.simulator: "made no progress" */
-#define MAX_STEPS_PER_CALL 10000000L
 
 enum { X = 0, V = 1, P = 2, M = 3 };
 
@@ -34,7 +34,7 @@ void pam_reset(PamCore *c) {
     int k;
     for (k = 0; k < PAM_NVARS; k++) {
         if (PAM_VARS[k].kind == 'r') c->r[PAM_VARS[k].index] = PAM_VARS[k].start;
-        else c->i[PAM_VARS[k].index] = (int32_t)PAM_VARS[k].start;
+        else if (PAM_VARS[k].kind) c->i[PAM_VARS[k].index] = (int32_t)PAM_VARS[k].start;
     }
     c->time_s = 0.0;
     c->mode = PAM_STICK;
@@ -68,9 +68,38 @@ static double pressure_gauge_Pa(const PamCore *c, const double *y) {
     return y[P] - c->r[R_p_atm_Pa];
 }
 
-/* elements.static_force.Acra2012Polynomial */
-static double static_force_N(const double *r, double x, double p_gauge) {
+/* The force table baked in at build time (pamsim.fmu.force_table): bicubic Hermite interpolation
+ * of the value and the derivatives F_x, F_p, F_xp at the four corners of the cell holding (x, p).
+ * Outside the grid the edge cell's cubic extrapolates. */
+static double table_force_N(double x, double p) {
+    double u = (x - PAM_FT_X0) / PAM_FT_DX, w = (p - PAM_FT_P0) / PAM_FT_DP, s, t, f = 0.0;
+    int i = (int)floor(u), j = (int)floor(w), a, b;
+    if (i < 0) i = 0;
+    if (i > PAM_FT_NX - 2) i = PAM_FT_NX - 2;
+    if (j < 0) j = 0;
+    if (j > PAM_FT_NP - 2) j = PAM_FT_NP - 2;
+    s = u - i;
+    t = w - j;
+    {
+        /* Hermite basis: value and slope weights of the cell's low (0) and high (1) corner. */
+        double vs[2] = {(2 * s - 3) * s * s + 1, (3 - 2 * s) * s * s}, ds[2] = {((s - 2) * s + 1) * s, (s - 1) * s * s};
+        double vt[2] = {(2 * t - 3) * t * t + 1, (3 - 2 * t) * t * t}, dt[2] = {((t - 2) * t + 1) * t, (t - 1) * t * t};
+        for (a = 0; a < 2; a++)
+            for (b = 0; b < 2; b++) {
+                const double *n = PAM_FT[(i + a) * PAM_FT_NP + (j + b)];
+                f += vs[a] * vt[b] * n[0] + ds[a] * PAM_FT_DX * vt[b] * n[1] + vs[a] * dt[b] * PAM_FT_DP * n[2]
+                     + ds[a] * PAM_FT_DX * dt[b] * PAM_FT_DP * n[3];
+            }
+    }
+    return f;
+}
+
+/* elements.static_force: the ACRA 2012 polynomial, exact (static_force_model 0), or the force table
+ * of any other static model (1) */
+static double static_force_N(const PamCore *c, double x, double p_gauge) {
+    const double *r = c->r;
     double p_bar = p_gauge / PA_PER_BAR;
+    if (c->i[I_static_force_model] == 1) return table_force_N(x, p_gauge);
     return ((r[R_K1_N_per_bar_m2] * x + r[R_K2_N_per_bar_m]) * x + r[R_C1_N_per_bar]) * p_bar
            + (r[R_S1_N_per_m2] * x + r[R_S2_N_per_m]) * x + r[R_S3_N];
 }
@@ -133,7 +162,7 @@ static void chamber_derivatives(const PamCore *c, const double *y, double v, dou
 /* MuscleModel.rest_forces: net force at zero velocity and the Coulomb level [N] */
 static void rest_forces(const PamCore *c, const double *y, double *net, double *level) {
     double p = pressure_gauge_Pa(c, y);
-    *net = static_force_N(c->r, y[X], p) - c->r[R_load_mass_kg] * c->r[R_g_m_s2] + c->r[R_external_force_N];
+    *net = static_force_N(c, y[X], p) - c->r[R_load_mass_kg] * c->r[R_g_m_s2] + c->r[R_external_force_N];
     *level = coulomb_level_N(c, y[X], p);
 }
 
@@ -145,7 +174,7 @@ static void rhs(PamCore *c, int mode, const double *y, double *dy) {
     c->n_rhs++;
     if (slip) {
         double p = pressure_gauge_Pa(c, y), m = r[R_load_mass_kg];
-        double F = static_force_N(r, y[X], p) - damping_force_N(c, v) - (double)mode * coulomb_level_N(c, y[X], p)
+        double F = static_force_N(c, y[X], p) - damping_force_N(c, v) - (double)mode * coulomb_level_N(c, y[X], p)
                    - m * r[R_g_m_s2] + r[R_external_force_N];
         dy[X] = v;
         dy[V] = F / m;
@@ -191,39 +220,6 @@ static void put_states(PamCore *c, const double *y) {
 
 /* ------------------------------------------------------------ checks */
 
-int pam_check_value(PamCore *c, unsigned vr, double value) {
-    const PamVarInfo *info;
-    if (vr < 1 || vr > PAM_NVARS) return 0;
-    info = &PAM_VARS[vr - 1];
-    if (!isfinite(value)) {
-        pam_logf(c, PAM_LOG_ERROR, "%s = %g: must be a finite number", info->name, value);
-        return -1;
-    }
-    if (vr == VR_load_mass_kg && !(value > 0.0)) {
-        pam_logf(c, PAM_LOG_ERROR, "load_mass_kg = %g: the hanging mass must be positive", value);
-        return -1;
-    }
-    if ((vr == VR_supply_pressure_gauge_Pa || vr == VR_prescribed_pressure_gauge_Pa)
-        && value > c->r[R_rated_pressure_gauge_Pa]) {
-        pam_logf(c, PAM_LOG_ERROR, "%s = %g Pa: exceeds the muscle's rating rated_pressure_gauge_Pa = %g Pa",
-                 info->name, value, c->r[R_rated_pressure_gauge_Pa]);
-        return -1;
-    }
-    if (vr == VR_supply_pressure_gauge_Pa && value < 0.0) {
-        pam_logf(c, PAM_LOG_ERROR, "supply_pressure_gauge_Pa = %g Pa: must not be negative", value);
-        return -1;
-    }
-    if (vr == VR_prescribed_pressure_gauge_Pa && value < -c->r[R_p_atm_Pa]) {
-        pam_logf(c, PAM_LOG_ERROR, "prescribed_pressure_gauge_Pa = %g Pa: below vacuum", value);
-        return -1;
-    }
-    if (vr == VR_valve_command && (value < -1.0 || value > 1.0)) {
-        pam_logf(c, PAM_LOG_ERROR, "valve_command = %g: must lie in [-1, 1]", value);
-        return -1;
-    }
-    return 0;
-}
-
 /* pamsim.parameters.Parameter.violation: 1 and the reason in `why` if `value` is outside the
  * generated range of `info`, else 0. */
 static int range_violation(const PamVarInfo *info, double value, char *why, size_t size) {
@@ -236,6 +232,33 @@ static int range_violation(const PamVarInfo *info, double value, char *why, size
         snprintf(why, size, "must lie in %c%g, %g%c", info->lower_open ? '(' : '[', info->lower, info->upper,
                  info->upper_open ? ')' : ']');
     return 1;
+}
+
+int pam_check_value(PamCore *c, unsigned vr, double value) {
+    const PamVarInfo *info;
+    char why[160];
+    if (vr < 1 || vr > PAM_NVARS) return 0;
+    info = &PAM_VARS[vr - 1];
+    if (!isfinite(value)) {
+        pam_logf(c, PAM_LOG_ERROR, "%s = %g: must be a finite number", info->name, value);
+        return -1;
+    }
+    /* An input's own range, generated from pamsim/fmu/variables.py (load_mass_kg: pamsim.parameters.LOAD_MASS). */
+    if (info->causality == PAM_INPUT && range_violation(info, value, why, sizeof why)) {
+        pam_logf(c, PAM_LOG_ERROR, "%s = %g: %s", info->name, value, why);
+        return -1;
+    }
+    if ((vr == VR_supply_pressure_gauge_Pa || vr == VR_prescribed_pressure_gauge_Pa)
+        && value > c->r[R_rated_pressure_gauge_Pa]) {
+        pam_logf(c, PAM_LOG_ERROR, "%s = %g Pa: exceeds the muscle's rating rated_pressure_gauge_Pa = %g Pa",
+                 info->name, value, c->r[R_rated_pressure_gauge_Pa]);
+        return -1;
+    }
+    if (vr == VR_prescribed_pressure_gauge_Pa && value < -c->r[R_p_atm_Pa]) {
+        pam_logf(c, PAM_LOG_ERROR, "prescribed_pressure_gauge_Pa = %g Pa: below vacuum", value);
+        return -1;
+    }
+    return 0;
 }
 
 int pam_check_parameters(PamCore *c) {
@@ -254,7 +277,8 @@ int pam_check_parameters(PamCore *c) {
         const PamVarInfo *info = &PAM_VARS[k];
         double value = info->kind == 'r' ? r[info->index] : (double)c->i[info->index];
         if (info->causality == PAM_PARAMETER && range_violation(info, value, why, sizeof why)) {
-            pam_logf(c, PAM_LOG_ERROR, "invalid parameters: %s = %g: %s", info->name, value, why);
+            if (info->kind == 'r') pam_logf(c, PAM_LOG_ERROR, "invalid parameters: %s = %g: %s", info->name, value, why);
+            else pam_logf(c, PAM_LOG_ERROR, "invalid parameters: %s = %ld: %s", info->name, (long)c->i[info->index], why);
             bad = -1;
         }
     }
@@ -273,6 +297,11 @@ int pam_check_parameters(PamCore *c) {
     if (!(r[R_release_margin_N] > r[R_stick_margin_N])) {
         pam_logf(c, PAM_LOG_ERROR, "invalid parameters: release_margin_N = %g: must be above stick_margin_N = %g",
                  r[R_release_margin_N], r[R_stick_margin_N]);
+        bad = -1;
+    }
+    if (c->i[I_static_force_model] == 1 && PAM_FT_NX < 2) {
+        pam_logf(c, PAM_LOG_ERROR, "invalid parameters: static_force_model = 1 (table): this FMU was built without "
+                 "a force table (build it with pamsim fmu build --scenario)");
         bad = -1;
     }
     if (!(r[R_initial_pressure_gauge_Pa] <= r[R_rated_pressure_gauge_Pa])) {
@@ -330,9 +359,9 @@ void pam_evaluate(PamCore *c) {
     else if (mode == PAM_STICK || (mode == PAM_STOP_LOW && net > 0.0) || (mode == PAM_STOP_HIGH && net < 0.0))
         friction = -net;
     else friction = 0.0;
-    c->r[R_pressure_gauge_Pa] = pressure_gauge_Pa(c, y);
-    c->r[R_muscle_force_N] = static_force_N(c->r, y[X], c->r[R_pressure_gauge_Pa]);
-    c->r[R_friction_force_N] = friction;
+    c->r[R_p_gauge_Pa] = pressure_gauge_Pa(c, y);
+    c->r[R_F_static_N] = static_force_N(c, y[X], c->r[R_p_gauge_Pa]);
+    c->r[R_F_friction_N] = friction;
     c->i[I_friction_mode] = mode;
 }
 
@@ -447,13 +476,66 @@ static double min_indicator(const PamCore *c, const double *y) {
     return fmin(z[0], z[1]);
 }
 
+static int sliding(int mode) { return mode == PAM_SLIP_UP || mode == PAM_SLIP_DOWN; }
+
+/* Where an indicator first reaches zero over an accepted step, as a fraction of the step in
+ * (lo, hi], or 0 if none does.  A sliding step is checked at its end (cs_max_step_s keeps it short
+ * against a sign change and back).  A held load's step is not limited by cs_max_step_s (its chamber
+ * pressure moves monotonically toward its source, so its force margins seldom turn back), so a long
+ * one is also checked at HELD_CHECKS points of its dense output. */
+#define HELD_CHECKS 16
+static int first_crossing(const PamCore *c, const DpStages *s, const double *y, const double *y1, double h,
+                          double *lo, double *hi) {
+    int n = (!sliding(c->mode) && h > c->r[R_cs_max_step_s]) ? HELD_CHECKS : 1, k;
+    double ye[PAM_NX];
+    for (k = 1; k <= n; k++) {
+        if (k < n) dp_dense(s, y, h, (double)k / n, ye);
+        if (min_indicator(c, k < n ? ye : y1) <= 0.0) {
+            *lo = (double)(k - 1) / n;
+            *hi = (double)k / n;
+            return 1;
+        }
+    }
+    return 0;
+}
+
+/* A held load's chamber within the integrator's error scale of its source's pressure is set to that
+ * pressure (its air mass moved by the same amount of gas), so that its derivatives are exactly zero:
+ * the rest of its exponential approach is below the tolerance, and an explicit integrator would
+ * follow it in steps of the chamber's time constant (milliseconds) for ever.  Not where the change
+ * would cross an event indicator.  Returns 1 if it changed y. */
+static int settle_chamber(PamCore *c, double *y) {
+    const double *r = c->r;
+    double u = r[R_valve_command], p_src, dp, vol, T_in, settled[PAM_NX];
+    if (sliding(c->mode) || c->i[I_pressure_source] != 0 || u == 0.0) return 0;
+    p_src = u > 0.0 ? r[R_supply_pressure_gauge_Pa] + r[R_p_atm_Pa] : r[R_p_atm_Pa];
+    dp = p_src - y[P];
+    if (dp == 0.0 || !(fabs(dp) <= r[R_cs_relative_tolerance] * (PAM_NOMINAL[P] + fabs(p_src)))) return 0;
+    vol = volume_m3(c, y[X]);
+    T_in = dp > 0.0 ? r[R_T_supply_K] : y[P] * vol / (y[M] * r[R_R_J_per_kg_K]);
+    memcpy(settled, y, sizeof settled);
+    settled[P] = p_src;
+    settled[M] += dp * vol / (r[R_polytropic_index] * r[R_R_J_per_kg_K] * T_in);
+    if (min_indicator(c, settled) <= 0.0) return 0;
+    memcpy(y, settled, sizeof settled);
+    return 1;
+}
+
+/* Leaves the instance at the last instant reached (time, states, mode and outputs agree) and fails. */
+static int step_failed(PamCore *c, double t, const double *y) {
+    c->time_s = t;
+    put_states(c, y);
+    pam_evaluate(c);
+    return -1;
+}
+
 int pam_do_step(PamCore *c, double t_end) {
     double y[PAM_NX], y1[PAM_NX], t = c->time_s, h_max = c->r[R_cs_max_step_s];
     DpStages s;
-    long steps = 0;
-    int zero_length = 0;
+    long steps = 0, max_steps = c->i[I_cs_max_internal_steps];
+    int zero_length = 0, n;
     get_states(c, y);
-    if (c->inputs_changed && c->mode != PAM_SLIP_UP && c->mode != PAM_SLIP_DOWN) {
+    if (c->inputs_changed && !sliding(c->mode)) {
         /* simulator: a held load is re-checked where its inputs jump */
         int old = c->mode;
         c->mode = rest_mode(c, y, c->mode);
@@ -463,16 +545,26 @@ int pam_do_step(PamCore *c, double t_end) {
     rhs(c, c->mode, y, s.k[0]);
     /* A remainder below the time resolution (left by an event located just before t_end) is not a step. */
     while (t_end - t > 1e-13 * fmax(1.0, fabs(t_end))) {
-        double h = fmin(fmin(c->h_s, h_max), t_end - t), err, factor;
-        int last = h >= t_end - t;
-        if (++steps > MAX_STEPS_PER_CALL) {
-            pam_logf(c, PAM_LOG_ERROR, "more than %ld internal steps between t = %.9g s and %.9g s", MAX_STEPS_PER_CALL,
-                     c->time_s, t_end);
-            return -1;
+        double h, err, factor, lo = 0.0, hi = 1.0;
+        int last, at_rest = !sliding(c->mode);
+        if (settle_chamber(c, y)) rhs(c, c->mode, y, s.k[0]);
+        /* A held load whose chamber does not change stays as it is while the inputs are held:
+         * the solution is constant, however long the step. */
+        for (n = 0; n < PAM_NX && at_rest; n++) at_rest = s.k[0][n] == 0.0;
+        if (at_rest) {
+            t = t_end;
+            break;
+        }
+        h = fmin(sliding(c->mode) ? fmin(c->h_s, h_max) : c->h_s, t_end - t);
+        last = h >= t_end - t;
+        if (++steps > max_steps) {
+            pam_logf(c, PAM_LOG_ERROR, "more than %ld internal steps (cs_max_internal_steps) between t = %.9g s "
+                     "and %.9g s", max_steps, c->time_s, t_end);
+            return step_failed(c, t, y);
         }
         if (h < 1e-14 * fmax(1.0, fabs(t))) {
             pam_logf(c, PAM_LOG_ERROR, "step size underflow at t = %.9g s", t);
-            return -1;
+            return step_failed(c, t, y);
         }
         err = dp_step(c, y, h, &s, y1);
         if (!(err <= 1.0)) {
@@ -481,9 +573,9 @@ int pam_do_step(PamCore *c, double t_end) {
         }
         factor = err == 0.0 ? 10.0 : fmin(10.0, fmax(0.2, 0.9 * pow(err, -0.2)));
         c->n_steps++;
-        if (min_indicator(c, y1) <= 0.0) {
+        if (first_crossing(c, &s, y, y1, h, &lo, &hi)) {
             /* Locate the first crossing on the dense output; keep the far side so that the event test holds. */
-            double lo = 0.0, hi = 1.0, ye[PAM_NX];
+            double ye[PAM_NX];
             int it;
             for (it = 0; it < 100 && (hi - lo) * h > 1e-15 * fmax(1.0, fabs(t)); it++) {
                 double mid = 0.5 * (lo + hi);
@@ -501,14 +593,14 @@ int pam_do_step(PamCore *c, double t_end) {
                 if (!jumped && c->mode == old) {
                     if (++zero_length > MAX_ZERO_LENGTH_EVENTS) {
                         pam_logf(c, PAM_LOG_ERROR, "event switching made no progress at t = %.9g s", t);
-                        return -1;
+                        return step_failed(c, t, y);
                     }
                 } else {
                     zero_length = 0;
                     c->n_events++;
                 }
             }
-            c->h_s = fmax(h * hi, 1e-6);
+            c->h_s = fmax(fmin(h * hi, h_max), 1e-6);
             rhs(c, c->mode, y, s.k[0]);
             continue;
         }
@@ -530,29 +622,46 @@ static double *value_ptr(PamCore *c, unsigned vr) {
     return &c->r[PAM_VARS[vr - 1].index];
 }
 
+/* The scale of a known's finite-difference step: its value, or where that is zero its nominal
+ * (states), its start value, or 1. */
+static double known_scale(unsigned vr, double value) {
+    int k;
+    if (value != 0.0) return fabs(value);
+    for (k = 0; k < PAM_NX; k++)
+        if (PAM_STATE_R[k] == PAM_VARS[vr - 1].index) return PAM_NOMINAL[k];
+    return PAM_VARS[vr - 1].start != 0.0 ? fabs(PAM_VARS[vr - 1].start) : 1.0;
+}
+
+/* sum_k seed[k] d(unknowns)/d(knowns[k]): one central difference per known, each with a step
+ * relative to that known's own scale, since the knowns may be of any scale (m and Pa) and a seed
+ * may hold zeros. */
 int pam_directional_derivative(PamCore *c, const unsigned *unknowns, int n_unknowns, const unsigned *knowns,
                                int n_knowns, const double *seed, double *sensitivity) {
-    double saved[PAM_NR], up[PAM_NR], eps = 0.0;
+    double saved[PAM_NR], up[PAM_NR];
     int k, u;
     for (k = 0; k < n_knowns; k++)
         if (!value_ptr(c, knowns[k])) return -1;
-    for (u = 0; u < n_unknowns; u++)
-        if (!value_ptr(c, unknowns[u])) return -1;
-    memcpy(saved, c->r, sizeof saved);
-    for (k = 0; k < n_knowns; k++) eps = fmax(eps, fabs(*value_ptr(c, knowns[k])) / (fabs(seed[k]) + 1e-300));
-    /* A relative step suits states of very different scales (m and Pa). */
-    eps = 1e-6 * (eps > 0.0 ? eps : 1.0);
-    for (k = 0; k < n_knowns; k++) *value_ptr(c, knowns[k]) += eps * seed[k];
-    pam_evaluate(c);
-    memcpy(up, c->r, sizeof up);
-    memcpy(c->r, saved, sizeof saved);
-    for (k = 0; k < n_knowns; k++) *value_ptr(c, knowns[k]) -= eps * seed[k];
-    pam_evaluate(c);
     for (u = 0; u < n_unknowns; u++) {
-        int idx = PAM_VARS[unknowns[u] - 1].index;
-        sensitivity[u] = (up[idx] - c->r[idx]) / (2.0 * eps);
+        if (!value_ptr(c, unknowns[u])) return -1;
+        sensitivity[u] = 0.0;
     }
-    memcpy(c->r, saved, sizeof saved);
+    memcpy(saved, c->r, sizeof saved);
+    for (k = 0; k < n_knowns; k++) {
+        double *known = value_ptr(c, knowns[k]), h;
+        if (seed[k] == 0.0) continue;
+        h = 1e-6 * known_scale(knowns[k], *known);
+        *known = saved[PAM_VARS[knowns[k] - 1].index] + h;
+        pam_evaluate(c);
+        memcpy(up, c->r, sizeof up);
+        memcpy(c->r, saved, sizeof saved);
+        *known = saved[PAM_VARS[knowns[k] - 1].index] - h;
+        pam_evaluate(c);
+        for (u = 0; u < n_unknowns; u++) {
+            int idx = PAM_VARS[unknowns[u] - 1].index;
+            sensitivity[u] += seed[k] * (up[idx] - c->r[idx]) / (2.0 * h);
+        }
+        memcpy(c->r, saved, sizeof saved);
+    }
     pam_evaluate(c);
     return 0;
 }

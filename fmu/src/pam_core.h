@@ -15,6 +15,12 @@
 #include <stdint.h>
 #include "pam_variables.h"
 
+/* Only the FMI functions leave the shared library (also when it is rebuilt by fmpy or cmake
+ * without -fvisibility=hidden). */
+#if defined(__GNUC__)
+#pragma GCC visibility push(hidden)
+#endif
+
 /* pamsim.model.Mode */
 enum { PAM_SLIP_DOWN = -1, PAM_STICK = 0, PAM_SLIP_UP = 1, PAM_STOP_LOW = 2, PAM_STOP_HIGH = 3 };
 enum { PAM_LOG_INFO = 0, PAM_LOG_WARNING = 1, PAM_LOG_ERROR = 2 };
@@ -45,11 +51,16 @@ void pam_initialize(PamCore *c);
 void pam_evaluate(PamCore *c);
 /* Model-exchange event update: apply one mode transition; returns 1 if x or v jumped. */
 int pam_event_update(PamCore *c);
-/* Co-simulation: integrate to t_end with the inputs held; 0 on success, -1 on failure (logged). */
+/* Co-simulation: integrate to t_end with the inputs held; 0 on success, -1 on failure (logged), which
+ * leaves time_s, the states, the mode and the outputs at the last instant reached. */
 int pam_do_step(PamCore *c, double t_end);
-/* Directional derivative d(unknowns)/d(knowns) * seed by central differences, mode held. */
+/* Directional derivative d(unknowns)/d(knowns) * seed: a central difference per known, mode held. */
 int pam_directional_derivative(PamCore *c, const unsigned *unknowns, int n_unknowns, const unsigned *knowns,
                                int n_knowns, const double *seed, double *sensitivity);
 void pam_logf(PamCore *c, int level, const char *fmt, ...);
+
+#if defined(__GNUC__)
+#pragma GCC visibility pop
+#endif
 
 #endif

@@ -20,7 +20,6 @@ COMMANDS = (
     "pamsim.cli.sweep",
     "pamsim.cli.fmu",
     "pamsim.cli.linearize",
-    "pamsim.cli.control_example",
     "pamsim.cli.params",
 )
 

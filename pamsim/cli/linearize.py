@@ -14,13 +14,8 @@ import sys
 import math
 from pathlib import Path
 
-import numpy as np
-
-from ..atomic import atomic_outputs, ensure_output_dir
-from ..control.linear import VALVE_SLOPES, linearize
-from ..control.operating_point import held_equilibrium, open_valve_equilibrium, trajectory_point
-from ..control.system import FRICTION_KINDS, FrictionTreatment
-from ..scenario import load_scenario
+from ..atomic import atomic_outputs, output_folder
+from ..control.choices import FRICTION_KINDS, VALVE_SLOPES
 from . import finite_float
 
 
@@ -46,6 +41,8 @@ def register(sub) -> None:
 
 
 def _matrix(a) -> list[list[float]]:
+    import numpy as np  # the CLI's modules import nothing heavy at the top: `pamsim --help` stays fast
+
     return [[float(v) for v in row] for row in np.atleast_2d(a)]
 
 
@@ -89,10 +86,28 @@ def report(lin) -> dict:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..control.plots import bode_figure, pole_zero_figure
+    from ..scenario import load_scenario
 
     scenario = load_scenario(args.scenario)
-    ensure_output_dir(args.output)
+    with output_folder(args.output) as out:  # removed again if the operating point turns out bad
+        lin, rep, names = _linearize_and_plot(scenario, args, out)
+    wrote = f"wrote {', '.join(str(out / n) for n in names)}"
+    if args.json:
+        print(json.dumps(rep, indent=2))
+        print(wrote, file=sys.stderr)  # stdout stays pure JSON
+        return 0
+    _print_text(lin, rep)
+    print(wrote)
+    return 0
+
+
+def _linearize_and_plot(scenario, args: argparse.Namespace, out: Path):
+    """Linearise at the operating point the arguments choose and write the plots; (model, report, file names)."""
+    from ..control.linear import linearize
+    from ..control.operating_point import held_equilibrium, open_valve_equilibrium, trajectory_point
+    from ..control.plots import bode_figure, pole_zero_figure
+    from ..control.system import FrictionTreatment
+
     model = scenario.build_model()
     supply = scenario.final_pressure_gauge_Pa
     if args.at_time is not None:
@@ -106,20 +121,15 @@ def run(args: argparse.Namespace) -> int:
     rep = report(lin)
     stem = f"{scenario.name}_linear"
     names = [f"{stem}_bode.png", f"{stem}_pzmap.png"]
-    with atomic_outputs(args.output, names) as tmp:
+    with atomic_outputs(out, names) as tmp:
         bode_figure(lin).savefig(tmp[names[0]], format="png", dpi=110)
         pole_zero_figure(lin).savefig(tmp[names[1]], format="png", dpi=110)
-    wrote = f"wrote {', '.join(str(Path(args.output) / n) for n in names)}"
-    if args.json:
-        print(json.dumps(rep, indent=2))
-        print(wrote, file=sys.stderr)  # stdout stays pure JSON
-        return 0
-    _print_text(lin, rep)
-    print(wrote)
-    return 0
+    return lin, rep, names
 
 
 def _print_text(lin, rep: dict) -> None:
+    import numpy as np
+
     np.set_printoptions(precision=6, linewidth=140)
     print(f"operating point: {lin.op.description}")
     print(f"friction: {rep['friction']}; valve slope at command 0: {lin.valve_slope}")

@@ -1,46 +1,132 @@
-"""``pamsim run SCENARIO -o DIR``: simulate one scenario, write CSV, PNG and JSON."""
+"""``pamsim run SCENARIO... -o DIR``: simulate scenarios, write NAME.csv, NAME.png and NAME.json for each.
+
+A scenario with a ``[controller]`` table runs with its controller.  A folder
+stands for the scenario files in it (sweep files, which name a
+``base_scenario``, are left to ``pamsim sweep``).
+"""
 
 from __future__ import annotations
 
 import argparse
 import json
 import sys
+import tomllib
 from pathlib import Path
 
-from ..atomic import atomic_outputs, ensure_output_dir
-from ..backends import BACKENDS, get_backend
-from ..scenario import load_scenario
+from ..atomic import atomic_outputs, output_folder
+from ..backends import BACKENDS
+from ..errors import InputError
+from . import finite_float
+
+MAX_CSV_MB = 200.0
+"""Default limit of ``pamsim run --max-csv-MB``: a CSV beyond it is refused before the run."""
 
 
 def register(sub) -> None:
-    p = sub.add_parser("run", help="simulate a scenario file",
-                       description="Simulate a scenario and write NAME.csv, NAME.png and NAME.json into DIR.")
-    p.add_argument("scenario", help="scenario TOML file")
+    p = sub.add_parser("run", help="simulate scenario files",
+                       description="Simulate scenarios and write NAME.csv, NAME.png and NAME.json for each into "
+                                   "DIR.  A scenario with a [controller] table runs with its controller; exit "
+                                   "code 1 if such a run misses its [controller.spec].")
+    p.add_argument("scenario", nargs="+", help="scenario TOML files, or folders of them (e.g. scenarios/)")
     p.add_argument("-o", "--output", default="out", help="output directory (default: out)")
     p.add_argument("--backend", default="python", choices=sorted(BACKENDS),
                    help="python (solve_ivp, default) or an FMU importer")
     p.add_argument("--no-plot", action="store_true", help="skip the PNG")
+    p.add_argument("--max-csv-MB", type=finite_float, default=MAX_CSV_MB, metavar="MB",
+                   help=f"refuse a run whose CSV could exceed this size (default {MAX_CSV_MB:g} MB; "
+                        "the estimate is an upper bound, about twice the usual size)")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr (shown after 1 s)")
     p.set_defaults(func=run)
 
 
+def _is_sweep_file(path: Path) -> bool:
+    try:
+        return "base_scenario" in tomllib.loads(path.read_text())
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError, OSError):
+        return False  # load_scenario reports it
+
+
+def scenario_paths(arguments: list[str]) -> list[Path]:
+    """The scenario files the arguments name: files as given, folders as their ``*.toml`` files (sorted)."""
+    paths = []
+    for arg in arguments:
+        path = Path(arg)
+        if path.is_dir():
+            found = [p for p in sorted(path.glob("*.toml")) if not _is_sweep_file(p)]
+            if not found:
+                raise InputError(f"{path}: no scenario files (*.toml) in this folder")
+            paths += found
+        else:
+            paths.append(path)
+    return paths
+
+
 def run(args: argparse.Namespace) -> int:
-    scenario = load_scenario(args.scenario)
-    ensure_output_dir(args.output)  # before the run, not after it
-    result = get_backend(args.backend)(scenario)
+    from ..scenario import load_scenario
+
+    if not args.max_csv_MB > 0:
+        raise InputError(f"--max-csv-MB = {args.max_csv_MB:g}: must be positive")
+    scenarios = [load_scenario(p) for p in scenario_paths(args.scenario)]  # every file checked before any run
+    seen = {}
+    for sc in scenarios:
+        if sc.name in seen:
+            raise InputError(f"{sc.origin}: name = {sc.name!r}: {seen[sc.name]} has the same name; "
+                             "their outputs would overwrite each other")
+        seen[sc.name] = sc.origin
+        _check_csv_size(sc, args.max_csv_MB)
+    missed = 0
+    with output_folder(args.output) as out:  # checked before the runs; removed again if nothing gets written
+        for scenario in scenarios:
+            missed += bool(_run_one(scenario, args, out))
+    return 1 if missed else 0
+
+
+def _check_csv_size(scenario, limit_MB: float) -> None:
+    from ..result import Result
+    from ..simulator import n_samples
+
+    n = n_samples(scenario.duration_s, scenario.solver.sample_rate_Hz)
+    size_MB = Result.csv_bytes_estimate(scenario.build_model(), n) / 1e6
+    if size_MB > limit_MB:
+        raise InputError(f"{scenario.origin}: simulation.sample_rate_Hz = {scenario.solver.sample_rate_Hz:g}: "
+                         f"{n} samples over {scenario.duration_s:g} s make a CSV of up to {size_MB:.0f} MB, above "
+                         f"the limit of {limit_MB:g} MB (lower the rate, or raise the limit with --max-csv-MB)")
+
+
+def _run_one(scenario, args: argparse.Namespace, out: Path) -> list[str]:
+    """Run one scenario and write its files; returns the controller specification items it misses."""
+    from tqdm import tqdm
+
+    from ..api import run as run_scenario
+
+    # Shown only for runs that last over a second; cleared when done.
+    with tqdm(total=scenario.duration_s, desc=scenario.name, unit="s simulated", delay=1.0, leave=False,
+              file=sys.stderr, disable=args.no_progress, bar_format="{l_bar}{bar}| {n:.3g}/{total:g} s "
+              "[{elapsed}<{remaining}]") as bar:
+        outcome = run_scenario(scenario, args.backend, progress=lambda t: bar.update(t - bar.n))
+    result = outcome.result
     names = [f"{scenario.name}.csv", f"{scenario.name}.json"] + ([] if args.no_plot else [f"{scenario.name}.png"])
-    with atomic_outputs(args.output, names) as tmp:
+    summary = outcome.summary()
+    with atomic_outputs(out, names) as tmp:
         result.to_csv(tmp[names[0]])
-        summary = result.summary()
-        summary["backend"] = args.backend
         tmp[names[1]].write_text(json.dumps(summary, indent=2) + "\n")
         if not args.no_plot:
-            result.plot(tmp[names[2]])
+            outcome.figure().savefig(tmp[names[2]], format="png", dpi=110)
     for warning in result.fit_range_violations:
-        print(f"pamsim: warning: left the polynomial's fitted range: {warning}", file=sys.stderr)
+        print(f"pamsim: warning: {scenario.name}: left the polynomial's fitted range: {warning}", file=sys.stderr)
     s = summary
     print(f"{scenario.name}: final contraction {s['final_contraction_m'] * 1e3:.2f} mm "
           f"(peak {s['peak_contraction_m'] * 1e3:.2f} mm), final pressure {s['final_pressure_gauge_Pa'] / 1e5:.3f} bar, "
           f"{'at rest' if s['at_rest_at_end'] else 'still moving'} ({s['final_mode']}), {s['events']} events, "
           f"{s['rhs_evaluations']} RHS evaluations, {s['wall_time_s'] * 1e3:.0f} ms")
-    print(f"wrote {', '.join(str(Path(args.output) / n) for n in names)}")
-    return 0
+    if outcome.closed_loop is not None:
+        c = s["controller"]
+        m = c["metrics"]
+        print(f"  controller: rise time {m['rise_time_s'] * 1e3:.1f} ms, overshoot {m['overshoot_percent']:.2f} %, "
+              f"settling time {m['settling_time_s'] * 1e3:.1f} ms, steady-state error "
+              f"{m['steady_state_error_mm']:.3f} mm; gains K (x [1/m], v [s/m], p [1/Pa], z [1/(m s)]): "
+              + ", ".join(f"{k:.4g}" for k in c["gains_K"]))
+        print("  meets its specification" if not outcome.failures
+              else "  misses its specification: " + "; ".join(outcome.failures))
+    print(f"wrote {', '.join(str(out / n) for n in names)}")
+    return outcome.failures

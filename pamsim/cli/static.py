@@ -9,7 +9,6 @@ from ..constants import PA_PER_BAR
 from ..elements.static_force import STATIC_FORCE_MODELS
 from ..errors import InputError
 from ..parameters import PARAMETER_SETS
-from ..static import static_report
 from . import finite_float
 
 
@@ -26,6 +25,8 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..static import static_report
+
     if args.set not in PARAMETER_SETS:
         raise InputError(f"--set = {args.set!r}: unknown parameter set (choose from {', '.join(PARAMETER_SETS)})")
     if args.static_force not in STATIC_FORCE_MODELS:

@@ -10,9 +10,7 @@ import sys
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
-from ..atomic import ensure_output_dir
-from ..sweep import load_sweep, run_sweep
-from ..sweep.dask_cluster import dask_executor
+from ..atomic import output_folder
 
 
 def _workers(text: str) -> int:
@@ -45,6 +43,9 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..sweep import load_sweep, run_sweep
+    from ..sweep.dask_cluster import dask_executor
+
     spec = load_sweep(args.sweep_file)
     workers = args.workers or os.cpu_count() or 1
     with contextlib.ExitStack() as stack:
@@ -56,9 +57,9 @@ def run(args: argparse.Namespace) -> int:
         else:
             executor = stack.enter_context(ProcessPoolExecutor(max_workers=workers))
             where = f"{workers} worker processes"
-        ensure_output_dir(args.output)  # before the runs, not after them
-        result = run_sweep(spec, executor, progress=not args.no_progress, chunk_size=args.chunk_size)
-    names = result.write(args.output)
+        with output_folder(args.output) as out:  # checked before the runs; removed again if nothing gets written
+            result = run_sweep(spec, executor, progress=not args.no_progress, chunk_size=args.chunk_size)
+            names = result.write(out)
     for failure in result.failures:
         print(f"pamsim: warning: failed run {failure}", file=sys.stderr)
     samples = f", {spec.uncertainty.samples} uncertainty samples" if spec.uncertainty is not None else ""

@@ -28,7 +28,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
-from typing import Any, Mapping
+from typing import Any, Callable, Mapping
 
 import control as ct
 import numpy as np
@@ -349,7 +349,8 @@ class ClosedLoopRun:
                 "events": int(self.result.stats["events"]), "wall_time_s": float(self.result.wall_time_s)}
 
 
-def run_closed_loop(scenario: Scenario | str, overrides: Mapping[str, Any] | None = None) -> ClosedLoopRun:
+def run_closed_loop(scenario: Scenario | str, overrides: Mapping[str, Any] | None = None,
+                    progress: Callable[[float], None] | None = None) -> ClosedLoopRun:
     """Design the controller of ``scenario`` and run it on the hybrid model.
 
     Parameters
@@ -359,6 +360,8 @@ def run_closed_loop(scenario: Scenario | str, overrides: Mapping[str, Any] | Non
     overrides : mapping, optional
         Replacement ``[controller]`` keys (e.g. ``{"integrator_deadband_mm": 0}``
         to see the friction limit cycle).
+    progress : callable, optional
+        Called with the simulated time reached (see :func:`~pamsim.simulator.simulate_model`).
     """
     if not isinstance(scenario, Scenario):
         scenario = load_scenario(scenario)
@@ -371,7 +374,7 @@ def run_closed_loop(scenario: Scenario | str, overrides: Mapping[str, Any] | Non
     design = design_lqr(model, config, scenario.final_pressure_gauge_Pa)
     cl_model = closed_loop_model(scenario, config, design)
     result = simulate_model(cl_model, scenario.duration_s, scenario.solver, x0_m=scenario.initial_contraction_m,
-                            name=scenario.name)
+                            name=scenario.name, progress=progress)
     x0 = scenario.initial_contraction_m
     band = config.spec.get("settling_band_mm", 0.5) * 1e-3
     metrics = step_metrics(result.t_s, result.x_m, config.step_time_s, x0, config.target_contraction_m, band)

@@ -34,10 +34,10 @@ import numpy as np
 
 from ..errors import InputError
 from ..model import MuscleModel
+from .choices import VALVE_SLOPES
 from .operating_point import OperatingPoint
 from .system import INPUT_SCALES, INPUTS, OUTPUTS, STATE_SCALES, STATES, FrictionTreatment, MusclePlant
 
-VALVE_SLOPES = ("mean", "fill", "vent")
 RELATIVE_STEP = 1e-5
 """Finite-difference step as a fraction of each variable's typical magnitude."""
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.figure import Figure
 
+from ..plotting import X_LABEL, shade_held
 from .linear import LinearModel
 
 _BODE_CHANNELS = (("valve_command", "contraction_m"), ("valve_command", "p_gauge_Pa"),
@@ -73,13 +74,11 @@ def closed_loop_figure(run) -> Figure:
     res = run.result
     fig = Figure(figsize=(9, 8.5), constrained_layout=True)
     ax_x, ax_p, ax_u = fig.subplots(3, 1, sharex=True)
+    shade_held(ax_x, res.t_s, res.mode)
     ax_x.plot(res.t_s, res.signals["reference_m"] * 1e3, "k--", lw=1, label="reference")
     ax_x.plot(run.linear_t_s, run.linear_x_m * 1e3, color="C1", lw=1, label="linear loop (design model)")
     ax_x.plot(res.t_s, res.x_m * 1e3, color="C0", label="hybrid model")
-    held = res.mode == 0
-    if held.any():
-        ax_x.plot(res.t_s[held], res.x_m[held] * 1e3, ".", ms=1.5, color="k", label="stuck (friction)")
-    ax_x.set_ylabel("contraction [mm]")
+    ax_x.set_ylabel(X_LABEL)
     ax_x.legend(loc="lower right", fontsize=8)
     ax_p.plot(res.t_s, res.p_gauge_Pa / 1e5, color="C3", label="chamber")
     ax_p.plot(res.t_s, res.signals["feedforward_gauge_Pa"] / 1e5, ":", color="k", label="holding pressure (feedforward)")

@@ -19,6 +19,7 @@ import control as ct
 import numpy as np
 
 from ..elements.pressure_source import ValveChamberSource
+from .choices import FRICTION_KINDS
 from ..errors import InputError
 from ..model import N_WORK, MuscleModel
 
@@ -35,7 +36,6 @@ STATE_SCALES = (1e-2, 1e-1, 1e5, 1e-5)
 INPUT_SCALES = (1.0, 1e5, 1.0)
 """Typical magnitude of each input (full valve opening, 1 bar, 1 N)."""
 
-FRICTION_KINDS = ("dropped", "regularised", "sliding")
 
 
 @dataclass(frozen=True)

@@ -8,6 +8,7 @@ Linux), so ``fmpy compile`` can rebuild the same archive elsewhere.
 
 from __future__ import annotations
 
+import datetime
 import os
 import platform
 import shutil
@@ -18,7 +19,9 @@ import zipfile
 from pathlib import Path
 
 from ..errors import InputError
-from .generate import MODEL_IDENTIFIER, compiled_sources, model_description, write_sources
+from .force_table import ForceTable
+from .generate import (MODEL_IDENTIFIER, compiled_sources, generation_date, model_description, write_documentation,
+                       write_sources)
 
 FMI_VERSIONS = (2, 3)
 
@@ -38,12 +41,27 @@ def shared_library_suffix() -> str:
     return {"darwin": ".dylib", "win32": ".dll"}.get(sys.platform, ".so")
 
 
+def _zip_time() -> tuple[int, int, int, int, int, int]:
+    """The archive's file dates: the model description's generation date (from the sources, not the
+    clock), or the zip format's earliest date where there is none."""
+    stamp = generation_date()
+    if stamp is None:
+        return (1980, 1, 1, 0, 0, 0)
+    d = datetime.datetime.strptime(stamp, "%Y-%m-%dT%H:%M:%SZ")
+    return (max(d.year, 1980), d.month, d.day, d.hour, d.minute, d.second)
+
+
 def default_output(fmi_version: int) -> Path:
     return Path(f"{MODEL_IDENTIFIER}_fmi{fmi_version}.fmu")
 
 
-def build(output_path: str | os.PathLike | None = None, fmi_version: int = 2) -> Path:
+def build(output_path: str | os.PathLike | None = None, fmi_version: int = 2,
+          force_table: ForceTable | None = None) -> Path:
     """Generate, compile and zip the FMU; return the path of the ``.fmu`` file.
+
+    ``force_table`` (:func:`pamsim.fmu.force_table.tabulate`) bakes a static force table into the
+    FMU, which then starts with ``static_force_model`` = table; without one the FMU has only the
+    exact ACRA 2012 polynomial.
 
     Raises :class:`~pamsim.errors.InputError` for an unknown FMI version, a
     missing C compiler or a failed compilation (with the compiler's message).
@@ -59,21 +77,28 @@ def build(output_path: str | os.PathLike | None = None, fmi_version: int = 2) ->
     with tempfile.TemporaryDirectory(prefix="pamsim-fmu-") as tmp:
         root = Path(tmp)
         src = root / "sources"
-        write_sources(src, fmi_version)
-        (root / "modelDescription.xml").write_text(model_description(fmi_version))
+        write_sources(src, fmi_version, force_table)
+        (root / "modelDescription.xml").write_text(model_description(fmi_version, force_table))
         bin_dir = root / "binaries" / platform_folder(fmi_version)
         bin_dir.mkdir(parents=True)
         lib = bin_dir / (MODEL_IDENTIFIER + shared_library_suffix())
-        cmd = [compiler, "-shared", "-fPIC", "-O2", "-std=c99", "-Wall", "-I", str(src),
-               *(str(src / name) for name in compiled_sources(fmi_version)), "-o", str(lib), "-lm"]
-        proc = subprocess.run(cmd, capture_output=True, text=True)
+        write_documentation(root / "documentation", fmi_version, force_table)
+        # Only the FMI functions are exported; relative source paths keep the temporary folder's name
+        # out of the binary, so that the same sources give the same archive.
+        cmd = [compiler, "-shared", "-fPIC", "-O2", "-std=c99", "-Wall", "-fvisibility=hidden", "-I", ".",
+               *compiled_sources(fmi_version), "-o", str(lib), "-lm"]
+        proc = subprocess.run(cmd, capture_output=True, text=True, cwd=src)
         if proc.returncode != 0:
             raise InputError(f"compiling the FMU failed ({' '.join(cmd[:2])} ...): {proc.stderr.strip()}")
         out.parent.mkdir(parents=True, exist_ok=True)
         partial = out.with_name(f".{out.name}.{os.getpid()}.tmp")  # concurrent builds of one cache entry
+        stamp = _zip_time()
         with zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED) as zf:
             for path in sorted(root.rglob("*")):
                 if path.is_file():
-                    zf.write(path, path.relative_to(root).as_posix())
+                    info = zipfile.ZipInfo(path.relative_to(root).as_posix(), date_time=stamp)
+                    info.external_attr = 0o644 << 16
+                    info.compress_type = zipfile.ZIP_DEFLATED
+                    zf.writestr(info, path.read_bytes())
         os.replace(partial, out)
     return out

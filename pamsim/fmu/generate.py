@@ -8,23 +8,60 @@ any change gives a new token.
 
 from __future__ import annotations
 
+import datetime
 import hashlib
+import html
 import math
+import os
+import subprocess
 import uuid
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
-from .variables import BY_NAME, EVENT_INDICATORS, STATES, VARIABLES, value_reference
+from .. import __version__
+from ..references import REFERENCES
+from .units import base_unit
+from .force_table import EMPTY_HEADER, ForceTable
+from .variables import BY_NAME, EVENT_INDICATORS, STATES, VARIABLES, value_reference, with_force_table
 
 MODEL_NAME = "pamsim_muscle"
 MODEL_IDENTIFIER = "pamsim_muscle"
 C_DIR = Path(__file__).resolve().parents[2] / "fmu"  # the source tree; an installed wheel has pamsim.fmu.csrc
 CORE_SOURCES = ("pam_core.c", "pam_core.h", "fmi_shell.c", "fmi_shell.h")
+"""The hand-written C sources; ``pam_variables.h`` and ``pam_force_table.h`` are generated."""
 WRAPPERS = {2: "fmi2_wrapper.c", 3: "fmi3_wrapper.c"}
 HEADERS = {2: ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h"),
            3: ("fmi3Functions.h", "fmi3FunctionTypes.h", "fmi3PlatformTypes.h")}
 DESCRIPTION = ("McKibben muscle lifting a hanging load (ACRA 2012 model, pamsim): static force polynomial, "
                "load-dependent Coulomb friction with stick/slip, damping, ISO 6358 valve and chamber, end stops")
+
+
+AUTHOR = "pamsim developers"
+LICENSE = "MIT (pamsim); the FMI headers in sources/ are under their own licence (FMI_HEADERS_LICENSE.txt)"
+DEFAULT_STEP_S = 1e-3
+"""DefaultExperiment stepSize: the communication step of the tests and the docs' examples."""
+
+
+def generation_date() -> str | None:
+    """``generationDateAndTime``, reproducible: from the sources, never from the clock.
+
+    ``SOURCE_DATE_EPOCH`` if set (the reproducible-builds convention), else the commit time of the
+    newest commit that touched the FMU's sources or generator in a git checkout, else ``None``
+    (the attribute is left out, as from an installed wheel outside git).
+    """
+    epoch = os.environ.get("SOURCE_DATE_EPOCH")
+    if epoch is None:
+        here = Path(__file__).resolve().parent
+        try:
+            proc = subprocess.run(["git", "log", "-1", "--format=%ct", "--", str(c_source_dir()), str(here)],
+                                  cwd=here, capture_output=True, text=True, timeout=30)
+            epoch = proc.stdout.strip() if proc.returncode == 0 else ""
+        except (OSError, subprocess.SubprocessError):
+            epoch = ""
+    if not epoch:
+        return None
+    stamp = datetime.datetime.fromtimestamp(int(epoch), datetime.timezone.utc)
+    return stamp.strftime("%Y-%m-%dT%H:%M:%SZ")
 
 
 def compiled_sources(fmi_version: int) -> tuple[str, ...]:
@@ -49,13 +86,15 @@ def table_text() -> str:
     return "\n".join(repr(v) for v in VARIABLES)
 
 
-def token(fmi_version: int) -> str:
+def token(fmi_version: int, table: ForceTable | None = None) -> str:
     h = hashlib.sha256()
     src = c_source_dir() / "src"
     for name in CORE_SOURCES + (WRAPPERS[fmi_version],):
         h.update((src / name).read_bytes())
     h.update(table_text().encode())
     h.update(str(fmi_version).encode())
+    if table is not None:
+        h.update(table.digest().encode())
     return "{" + str(uuid.UUID(bytes=h.digest()[:16])) + "}"
 
 
@@ -67,11 +106,86 @@ def _units() -> list[str]:
     return sorted({v.unit for v in VARIABLES if v.unit})
 
 
-def model_description(fmi_version: int) -> str:
+def _unit_definitions() -> list[str]:
+    """``<UnitDefinitions>`` with each unit's SI ``<BaseUnit>`` (the same element in FMI 2.0 and 3.0)."""
+    lines = ["  <UnitDefinitions>"]
+    for u in _units():
+        factor, exponents = base_unit(u)
+        base = _attrs(**exponents, factor=repr(factor) if factor != 1.0 else None)
+        lines.append(f"    <Unit{_attrs(name=u)}>\n      <BaseUnit{base}/>\n    </Unit>")
+    return lines + ["  </UnitDefinitions>"]
+
+
+def enumeration_type(v) -> str:
+    """The declared type of an integer choice: ``friction_model`` -> ``FrictionModel``."""
+    return "".join(part.capitalize() for part in v.name.split("_"))
+
+
+def _type_definitions(fmi_version: int) -> list[str]:
+    lines = ["  <TypeDefinitions>"]
+    for v in VARIABLES:
+        if not v.choices:
+            continue
+        items = [f'      <Item{_attrs(name=c, value=i)}/>' for i, c in enumerate(v.choices)]
+        if fmi_version == 2:
+            lines += [f"    <SimpleType{_attrs(name=enumeration_type(v))}>", "    <Enumeration>"]
+            lines += items + ["    </Enumeration>", "    </SimpleType>"]
+        else:
+            lines += [f"    <EnumerationType{_attrs(name=enumeration_type(v))}>"] + items + ["    </EnumerationType>"]
+    return lines + ["  </TypeDefinitions>"]
+
+
+LOG_CATEGORIES = (("logStatusOK", "informative messages (only with debug logging on)"),
+                  ("logStatusWarning", "warnings"),
+                  ("logStatusError", "errors: refused values and calls, failed steps, invalid parameters"))
+"""The categories the C code logs under (fmi_shell.c, level_category)."""
+
+
+def _common_elements() -> list[str]:
+    lines = ["  <LogCategories>"]
+    lines += [f"    <Category{_attrs(name=n, description=d)}/>" for n, d in LOG_CATEGORIES]
+    lines += ["  </LogCategories>",
+              f'  <DefaultExperiment startTime="0.0" stopTime="8.0" tolerance="1e-06" stepSize="{DEFAULT_STEP_S!r}"/>']
+    return lines
+
+
+def _limits(v) -> dict[str, str]:
+    """``min``/``max`` from the range the C check enforces; an excluded bound becomes the nearest
+    included double (XML bounds are inclusive)."""
+    out = {}
+    if math.isfinite(v.lower):
+        out["min"] = v.lower if not v.lower_open else math.nextafter(v.lower, math.inf)
+    if math.isfinite(v.upper):
+        out["max"] = v.upper if not v.upper_open else math.nextafter(v.upper, -math.inf)
+    if v.kind == "integer":
+        return {k: str(int(x)) for k, x in out.items()}
+    return {k: repr(float(x)) for k, x in out.items()}
+
+
+def _dependencies(names, key) -> dict[str, str]:
+    """The ``dependencies`` attribute over ``names`` (FMI 2.0 ``index`` numbers or FMI 3.0 value
+    references via ``key``), or nothing where the table leaves them undeclared (``None``)."""
+    if names is None:
+        return {}
+    return {"dependencies": " ".join(str(key(n)) for n in sorted(names, key=key))}
+
+
+def _header(fmi_version: int, table: ForceTable | None) -> str:
+    token_attr = "guid" if fmi_version == 2 else "instantiationToken"
+    attrs = _attrs(modelName=MODEL_NAME, **{token_attr: token(fmi_version, table)},
+                   description=DESCRIPTION + (f"; static force: a table of {table.model_name}" if table else ""), author=AUTHOR,
+                   version=__version__, license=LICENSE, generationTool="pamsim.fmu",
+                   generationDateAndTime=generation_date(), variableNamingConvention="flat")
+    extra = ' numberOfEventIndicators="2"' if fmi_version == 2 else ""
+    return f'<fmiModelDescription fmiVersion="{fmi_version}.0"{attrs}{extra}>'
+
+
+def model_description(fmi_version: int, table: ForceTable | None = None) -> str:
+    """``modelDescription.xml``; ``table``: the force table the FMU is built with, if any."""
     if fmi_version == 2:
-        return _fmi2()
+        return _fmi2(table)
     if fmi_version == 3:
-        return _fmi3()
+        return _fmi3(table)
     raise ValueError(f"FMI version must be 2 or 3, not {fmi_version!r}")
 
 
@@ -79,12 +193,10 @@ def _attrs(**kw) -> str:
     return "".join(f" {k}={quoteattr(str(v))}" for k, v in kw.items() if v is not None)
 
 
-def _fmi2() -> str:
-    tok = token(2)
+def _fmi2(table: ForceTable | None) -> str:
+    variables = with_force_table(VARIABLES, table is not None)
     src_files = "".join(f'\n      <File name="{n}"/>' for n in compiled_sources(2))
-    lines = ['<?xml version="1.0" encoding="UTF-8"?>',
-             f'<fmiModelDescription fmiVersion="2.0"{_attrs(modelName=MODEL_NAME, guid=tok, description=DESCRIPTION)}'
-             ' generationTool="pamsim.fmu" variableNamingConvention="flat" numberOfEventIndicators="2">',
+    lines = ['<?xml version="1.0" encoding="UTF-8"?>', _header(2, table),
              f'  <ModelExchange modelIdentifier="{MODEL_IDENTIFIER}" canGetAndSetFMUstate="true"'
              ' canSerializeFMUstate="true" providesDirectionalDerivative="true"'
              ' canNotUseMemoryManagementFunctions="true">',
@@ -92,74 +204,78 @@ def _fmi2() -> str:
              f'  <CoSimulation modelIdentifier="{MODEL_IDENTIFIER}" canHandleVariableCommunicationStepSize="true"'
              ' canGetAndSetFMUstate="true" canSerializeFMUstate="true" providesDirectionalDerivative="true"'
              ' canNotUseMemoryManagementFunctions="true">',
-             f'    <SourceFiles>{src_files}\n    </SourceFiles>', '  </CoSimulation>',
-             '  <UnitDefinitions>']
-    lines += [f'    <Unit{_attrs(name=u)}/>' for u in _units()]
-    lines += ['  </UnitDefinitions>', '  <DefaultExperiment startTime="0.0" stopTime="8.0" tolerance="1e-06"/>',
-              '  <ModelVariables>']
-    index = {}
-    for i, v in enumerate(VARIABLES, start=1):
-        index[v.name] = i
+             f'    <SourceFiles>{src_files}\n    </SourceFiles>', '  </CoSimulation>']
+    lines += _unit_definitions() + _type_definitions(2) + _common_elements() + ['  <ModelVariables>']
+    index = {v.name: i for i, v in enumerate(variables, start=1)}  # FMI 2.0 refers to variables by position
+    for v in variables:
         head = _attrs(name=v.name, valueReference=value_reference(v.name), description=v.description,
                       causality=v.causality, variability=v.variability, initial=v.initial)
-        if v.kind == "real":
-            inner = _attrs(unit=v.unit, start=_num(v.start) if v.start is not None else None,
-                           derivative=index[v.derivative_of] if v.derivative_of else None,
-                           nominal=v.nominal)
-            lines.append(f'    <ScalarVariable{head}>\n      <Real{inner}/>\n    </ScalarVariable>')
+        start = _num(v.start) if v.start is not None else None
+        if v.choices:
+            inner = f"<Enumeration{_attrs(declaredType=enumeration_type(v), **_limits(v), start=start)}/>"
+        elif v.kind == "real":
+            inner = (f'<Real{_attrs(unit=v.unit, **_limits(v), start=start, nominal=v.nominal)}'
+                     f'{_attrs(derivative=index[v.derivative_of] if v.derivative_of else None)}/>')
         else:
-            inner = _attrs(start=v.start)
-            lines.append(f'    <ScalarVariable{head}>\n      <Integer{inner}/>\n    </ScalarVariable>')
+            inner = f'<Integer{_attrs(**_limits(v), start=start)}/>'
+        lines.append(f'    <ScalarVariable{head}>\n      {inner}\n    </ScalarVariable>')
     lines.append('  </ModelVariables>')
-    outputs = [index[v.name] for v in VARIABLES if v.causality == "output"]
-    derivs = [index[v.name] for v in VARIABLES if v.derivative_of]
-    initial = sorted(set(outputs + derivs + [index[s] for s in STATES]))
+    outputs = [v for v in variables if v.causality == "output"]
+    derivs = [v for v in variables if v.derivative_of]
+    states = [BY_NAME[s] for s in STATES]
+    initial = sorted({v.name: v for v in outputs + derivs + states}.values(), key=lambda v: index[v.name])
+
+    def unknown(v, deps):
+        return f'      <Unknown index="{index[v.name]}"{_attrs(**deps)}/>'
+
     lines += ['  <ModelStructure>', '    <Outputs>']
-    lines += [f'      <Unknown index="{i}"/>' for i in outputs]
+    lines += [unknown(v, _dependencies(v.depends_on, index.get)) for v in outputs]
     lines += ['    </Outputs>', '    <Derivatives>']
-    lines += [f'      <Unknown index="{i}"/>' for i in derivs]
+    lines += [unknown(v, _dependencies(v.depends_on, index.get)) for v in derivs]
     lines += ['    </Derivatives>', '    <InitialUnknowns>']
-    lines += [f'      <Unknown index="{i}"/>' for i in initial]
+    lines += [unknown(v, _dependencies(v.initial_depends_on, index.get)) for v in initial]
     lines += ['    </InitialUnknowns>', '  </ModelStructure>', '</fmiModelDescription>', '']
     return "\n".join(lines)
 
 
-def _fmi3() -> str:
-    tok = token(3)
-    lines = ['<?xml version="1.0" encoding="UTF-8"?>',
-             f'<fmiModelDescription fmiVersion="3.0"'
-             f'{_attrs(modelName=MODEL_NAME, instantiationToken=tok, description=DESCRIPTION)}'
-             ' generationTool="pamsim.fmu" variableNamingConvention="flat">',
+def _fmi3(table: ForceTable | None) -> str:
+    variables = with_force_table(VARIABLES, table is not None)
+    lines = ['<?xml version="1.0" encoding="UTF-8"?>', _header(3, table),
              f'  <ModelExchange modelIdentifier="{MODEL_IDENTIFIER}" canGetAndSetFMUState="true"'
              ' canSerializeFMUState="true" providesDirectionalDerivatives="true"/>',
              f'  <CoSimulation modelIdentifier="{MODEL_IDENTIFIER}" canHandleVariableCommunicationStepSize="true"'
-             ' canGetAndSetFMUState="true" canSerializeFMUState="true" providesDirectionalDerivatives="true"/>',
-             '  <UnitDefinitions>']
-    lines += [f'    <Unit{_attrs(name=u)}/>' for u in _units()]
-    lines += ['  </UnitDefinitions>', '  <DefaultExperiment startTime="0.0" stopTime="8.0" tolerance="1e-06"/>',
-              '  <ModelVariables>',
+             ' canGetAndSetFMUState="true" canSerializeFMUState="true" providesDirectionalDerivatives="true"/>']
+    lines += _unit_definitions() + _type_definitions(3) + _common_elements()
+    lines += ['  <ModelVariables>',
               '    <Float64 name="time" valueReference="0" causality="independent" variability="continuous"'
               ' description="simulation time [s]" unit="s"/>']
-    for v in VARIABLES:
-        vr = value_reference(v.name)
-        head = _attrs(name=v.name, valueReference=vr, description=v.description, causality=v.causality,
-                      variability=v.variability, initial=v.initial)
-        if v.kind == "real":
-            tail = _attrs(unit=v.unit, start=_num(v.start) if v.start is not None else None,
+    for v in variables:
+        head = _attrs(name=v.name, valueReference=value_reference(v.name), description=v.description,
+                      causality=v.causality, variability=v.variability, initial=v.initial)
+        start = _num(v.start) if v.start is not None else None
+        if v.choices:
+            lines.append(f"    <Enumeration{head}{_attrs(declaredType=enumeration_type(v), **_limits(v), start=start)}/>")
+        elif v.kind == "real":
+            tail = _attrs(unit=v.unit, **_limits(v), start=start,
                           derivative=value_reference(v.derivative_of) if v.derivative_of else None,
                           nominal=v.nominal)
             lines.append(f'    <Float64{head}{tail}/>')
         else:
-            lines.append(f'    <Int32{head}{_attrs(start=v.start)}/>')
+            lines.append(f'    <Int32{head}{_attrs(**_limits(v), start=start)}/>')
     lines.append('  </ModelVariables>')
-    outputs = [value_reference(v.name) for v in VARIABLES if v.causality == "output"]
-    derivs = [value_reference(v.name) for v in VARIABLES if v.derivative_of]
-    initial = sorted(set(outputs + derivs + [value_reference(s) for s in STATES]))
+    outputs = [v for v in variables if v.causality == "output"]
+    derivs = [v for v in variables if v.derivative_of]
+    states = [BY_NAME[s] for s in STATES]
+    initial = sorted({v.name: v for v in outputs + derivs + states}.values(), key=lambda v: value_reference(v.name))
     lines.append('  <ModelStructure>')
-    lines += [f'    <Output valueReference="{vr}"/>' for vr in outputs]
-    lines += [f'    <ContinuousStateDerivative valueReference="{vr}"/>' for vr in derivs]
-    lines += [f'    <InitialUnknown valueReference="{vr}"/>' for vr in initial]
-    lines += [f'    <EventIndicator valueReference="{value_reference(n)}"/>' for n in EVENT_INDICATORS]
+    lines += [f'    <Output valueReference="{value_reference(v.name)}"{_attrs(**_dependencies(v.depends_on, value_reference))}/>'
+              for v in outputs]
+    lines += [f'    <ContinuousStateDerivative valueReference="{value_reference(v.name)}"'
+              f'{_attrs(**_dependencies(v.depends_on, value_reference))}/>' for v in derivs]
+    lines += [f'    <InitialUnknown valueReference="{value_reference(v.name)}"'
+              f'{_attrs(**_dependencies(v.initial_depends_on, value_reference))}/>' for v in initial]
+    lines += [f'    <EventIndicator valueReference="{value_reference(n)}"'
+              f'{_attrs(**_dependencies(BY_NAME[n].depends_on, value_reference))}/>' for n in EVENT_INDICATORS]
     lines += ['  </ModelStructure>', '</fmiModelDescription>', '']
     return "\n".join(lines)
 
@@ -180,46 +296,53 @@ def _c_bound(x: float) -> str:
     return repr(float(x))
 
 
-def c_header(fmi_version: int) -> str:
+def c_header(fmi_version: int, table: ForceTable | None = None) -> str:
     """``pam_variables.h``: indices into the value arrays, value references, start values, the token."""
-    reals = [v for v in VARIABLES if v.kind == "real"]
-    ints = [v for v in VARIABLES if v.kind == "integer"]
+    variables = with_force_table(VARIABLES, table is not None)
+    reals = [v for v in variables if v.kind == "real"]
+    ints = [v for v in variables if v.kind == "integer"]
+    n_slots = max(value_reference(v.name) for v in variables)
     kinds = {"parameter": "PAM_PARAMETER", "input": "PAM_INPUT", "output": "PAM_OUTPUT", "local": "PAM_LOCAL"}
     out = ["/* Generated by pamsim.fmu.generate from pamsim/fmu/variables.py. Do not edit. */",
            "#ifndef PAM_VARIABLES_H", "#define PAM_VARIABLES_H", "", "#include <math.h>", "",
-           f'#define PAM_TOKEN "{token(fmi_version)}"', f"#define PAM_NR {len(reals)}", f"#define PAM_NI {len(ints)}",
-           f"#define PAM_NVARS {len(VARIABLES)}", f"#define PAM_NX {len(STATES)}",
+           f'#define PAM_TOKEN "{token(fmi_version, table)}"', f"#define PAM_NR {len(reals)}", f"#define PAM_NI {len(ints)}",
+           f"#define PAM_NVARS {n_slots}", f"#define PAM_NX {len(STATES)}",
            f"#define PAM_NZ {len(EVENT_INDICATORS)}", ""]
     out += [f"#define R_{v.c_name} {i}" for i, v in enumerate(reals)]
     out += [f"#define I_{v.c_name} {i}" for i, v in enumerate(ints)]
-    out += [f"#define VR_{v.c_name} {value_reference(v.name)}u" for v in VARIABLES]
+    out += [f"#define VR_{v.c_name} {value_reference(v.name)}u" for v in variables]
     out += ["", "typedef enum { PAM_PARAMETER, PAM_INPUT, PAM_OUTPUT, PAM_LOCAL } PamCausality;",
-            "/* lower/upper: the range a parameter must lie in (-/+HUGE_VAL: none); *_open: the bound is excluded. */",
+            "/* kind: 'r' real, 'i' integer, 'e' enumeration (in i[]), 0 an unused value reference.  lower/upper: the range a parameter",
+            " * or input must lie in (-/+HUGE_VAL: none); *_open: the bound is excluded. */",
             "typedef struct {",
             "    const char *name; char kind; int index; PamCausality causality; double start;",
             "    double lower, upper; int lower_open, upper_open;",
             "} PamVarInfo;",
-            "", "/* Indexed by value reference - 1. */", "static const PamVarInfo PAM_VARS[PAM_NVARS] = {"]
+            "", "/* Indexed by value reference - 1 (the numbers are pinned, so there may be gaps). */",
+            "static const PamVarInfo PAM_VARS[PAM_NVARS] = {"]
+    slots = ['    {"", 0, 0, PAM_LOCAL, 0.0, -HUGE_VAL, HUGE_VAL, 0, 0},'] * n_slots
     ri = ii = 0
-    for v in VARIABLES:
+    for v in variables:
         if v.kind == "real":
             kind, idx, ri = "'r'", ri, ri + 1
-        else:
-            kind, idx, ii = "'i'", ii, ii + 1
+        else:  # an Enumeration ('e') is an Integer in FMI 2.0 but an Int64 in FMI 3.0
+            kind, idx, ii = ("'e'" if v.choices else "'i'"), ii, ii + 1
         start = repr(float(v.start)) if v.start is not None else "0.0"
-        out.append(f'    {{"{v.name}", {kind}, {idx}, {kinds[v.causality]}, {start}, {_c_bound(v.lower)}, '
-                   f'{_c_bound(v.upper)}, {int(v.lower_open)}, {int(v.upper_open)}}},')
+        slots[value_reference(v.name) - 1] = (
+            f'    {{"{v.name}", {kind}, {idx}, {kinds[v.causality]}, {start}, {_c_bound(v.lower)}, '
+            f'{_c_bound(v.upper)}, {int(v.lower_open)}, {int(v.upper_open)}}},')
+    out += slots
     out += ["};", "", "/* Continuous states and their derivatives, in state-vector order (indices into r[]). */",
             "static const int PAM_STATE_R[PAM_NX] = {" + ", ".join(f"R_{BY_NAME[s].c_name}" for s in STATES) + "};",
             "static const int PAM_DERIV_R[PAM_NX] = {"
-            + ", ".join(f"R_{v.c_name}" for v in VARIABLES if v.derivative_of) + "};",
+            + ", ".join(f"R_{v.c_name}" for v in variables if v.derivative_of) + "};",
             "static const double PAM_NOMINAL[PAM_NX] = {"
             + ", ".join(repr(float(BY_NAME[s].nominal)) for s in STATES) + "};",
             "", "#endif", ""]
     return "\n".join(out)
 
 
-def write_sources(dest: Path, fmi_version: int) -> list[str]:
+def write_sources(dest: Path, fmi_version: int, table: ForceTable | None = None) -> list[str]:
     """Write the sources an FMU ships (C files, generated header, FMI headers, licence) into ``dest``."""
     dest.mkdir(parents=True, exist_ok=True)
     root = c_source_dir()
@@ -231,9 +354,10 @@ def write_sources(dest: Path, fmi_version: int) -> list[str]:
         (dest / name).write_bytes((root / "include" / f"fmi{fmi_version}" / name).read_bytes())
         names.append(name)
     (dest / "FMI_HEADERS_LICENSE.txt").write_bytes((root / "include" / "LICENSE.txt").read_bytes())
-    (dest / "pam_variables.h").write_text(c_header(fmi_version))
+    (dest / "pam_variables.h").write_text(c_header(fmi_version, table))
+    (dest / "pam_force_table.h").write_text(table.c_header() if table is not None else EMPTY_HEADER)
     (dest / "buildDescription.xml").write_text(build_description(fmi_version))
-    return names + ["pam_variables.h", "buildDescription.xml"]
+    return names + ["pam_variables.h", "pam_force_table.h", "buildDescription.xml"]
 
 
 def range_text(v) -> str:
@@ -252,8 +376,51 @@ def markdown_table() -> str:
     """The variable table for ``docs/fmu.md`` (a test checks the docs carry this exact text)."""
     rows = ["| name | causality | type | unit | start | range | description |", "|---|---|---|---|---|---|---|"]
     for v in VARIABLES:
-        kind = "Real / Float64" if v.kind == "real" else "Integer / Int32"
+        kind = "Real / Float64" if v.kind == "real" else "Enumeration" if v.choices else "Integer / Int32"
         start = "" if v.start is None else f"{v.start:g}" if isinstance(v.start, float) else str(v.start)
         desc = v.description.replace("|", "\\|")
         rows.append(f"| `{v.name}` | {v.causality} | {kind} | {v.unit or ''} | {start} | {range_text(v)} | {desc} |")
     return "\n".join(rows) + "\n"
+
+
+USAGE = (
+    ("What it is", DESCRIPTION + ". The same model as pamsim.simulate, compiled C with no Python inside; "
+     "Model Exchange and Co-Simulation."),
+    ("Driving it", "Set the parameters before the end of initialisation; the defaults are the Shadow 6 mm x 300 mm "
+     f"muscle of {REFERENCES['acra2012'].short} ({REFERENCES['acra2012'].full()}) with a 22.74 N load. Drive valve_command (1 open to supply, 0 "
+     "closed, -1 open to exhaust) and supply_pressure_gauge_Pa, or with pressure_source = prescribed, "
+     "prescribed_pressure_gauge_Pa; set load_mass_kg and external_force_N; read contraction_m, p_gauge_Pa, "
+     "F_static_N, F_friction_N and friction_mode."),
+    ("Co-Simulation", "The FMU integrates with its own Dormand-Prince 5(4) solver (cs_relative_tolerance, "
+     "cs_max_step_s) and locates the stick/slip and end-stop events inside each step; inputs are held over a "
+     "step, and any step size works."),
+    ("Model Exchange", "The importer integrates the four states; the two event indicators change sign at the "
+     "stick/slip and end-stop events, handled at the event update."),
+    ("Errors", "A refused value or call returns an error status and logs one message naming the variable and the "
+     "limit (log categories logStatusError, logStatusWarning, logStatusOK)."),
+)
+"""The usage page in the FMU's documentation/index.html."""
+
+
+def documentation_html(fmi_version: int, table: ForceTable | None = None) -> str:
+    """``documentation/index.html``: a short usage page and the variable table."""
+    variables = with_force_table(VARIABLES, table is not None)
+    rows = []
+    for v in variables:
+        cells = (str(value_reference(v.name)), v.name, v.causality, v.kind, v.unit or "",
+                 "" if v.start is None else f"{v.start:g}" if isinstance(v.start, float) else str(v.start),
+                 range_text(v), ", ".join(f"{i} = {c}" for i, c in enumerate(v.choices or ())), v.description)
+        rows.append("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in cells) + "</tr>")
+    head = "".join(f"<th>{h}</th>" for h in ("value reference", "name", "causality", "type", "unit", "start",
+                                              "range", "choices", "description"))
+    sections = "".join(f"<h2>{html.escape(t)}</h2>\n<p>{html.escape(p)}</p>\n" for t, p in USAGE)
+    return (f'<!DOCTYPE html>\n<html lang="en">\n<head><meta charset="utf-8"><title>{MODEL_NAME} (FMI '
+            f'{fmi_version}.0)</title></head>\n<body>\n<h1>{MODEL_NAME}: pamsim {__version__}, FMI {fmi_version}.0'
+            f'</h1>\n{sections}<h2>Variables</h2>\n<table>\n<tr>{head}</tr>\n' + "\n".join(rows)
+            + "\n</table>\n</body>\n</html>\n")
+
+
+def write_documentation(dest: Path, fmi_version: int, table: ForceTable | None = None) -> None:
+    """Write the FMU's ``documentation/`` folder into ``dest``."""
+    dest.mkdir(parents=True, exist_ok=True)
+    (dest / "index.html").write_text(documentation_html(fmi_version, table))

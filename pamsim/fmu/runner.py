@@ -30,21 +30,46 @@ from ..errors import InputError, SolverFailure
 from ..result import Result
 from ..scenario import Scenario
 from .build import build
+from .force_table import DEFAULT_POINTS, ForceTable, tabulate
 from .generate import token
-from .variables import DAMPING_CHOICES, FRICTION_CHOICES, NEGATIVE_LEVEL, SOURCE_CHOICES, VARIABLES, value_reference
+from .variables import (BY_NAME, DAMPING_CHOICES, FRICTION_CHOICES, NEGATIVE_LEVEL, SOURCE_CHOICES,
+                        STATIC_FORCE_CHOICES, VARIABLES, value_reference)
 
-OUTPUTS = ("contraction_m", "velocity_m_s", "pressure_gauge_Pa", "chamber_pressure_abs_Pa", "air_mass_kg")
+OUTPUTS = ("contraction_m", "velocity_m_s", "p_gauge_Pa", "chamber_pressure_abs_Pa", "air_mass_kg")
 INPUTS = ("valve_command", "supply_pressure_gauge_Pa", "prescribed_pressure_gauge_Pa", "load_mass_kg",
           "external_force_N")
 
 
-def cached_fmu(fmi_version: int = 2) -> Path:
-    """An FMU built from the current sources, kept in the temp folder under its token."""
-    folder = Path(tempfile.gettempdir()) / "pamsim-fmu" / token(fmi_version).strip("{}")
+def cached_fmu(fmi_version: int = 2, force_table: ForceTable | None = None) -> Path:
+    """An FMU built from the current sources (and ``force_table``), kept in the temp folder under its token."""
+    folder = Path(tempfile.gettempdir()) / "pamsim-fmu" / token(fmi_version, force_table).strip("{}")
     path = folder / f"pamsim_muscle_fmi{fmi_version}.fmu"
     if not path.is_file():
-        build(path, fmi_version)
+        build(path, fmi_version, force_table)
     return path
+
+
+def tabulate_model(scenario: Scenario, points: tuple[int, int] = DEFAULT_POINTS) -> ForceTable:
+    """The scenario's static force tabulated for the FMU, over its valid domain: the contraction
+    between the end stops and the gauge pressure from 0 to ``rated_pressure_gauge_Pa``, narrowed to
+    the model's own ``domain`` where it declares one."""
+    model = scenario.build_model()
+    x_lo, x_hi = model.stops.x_low_m, model.stops.x_high_m
+    p_lo, p_hi = 0.0, float(scenario.parameters["rated_pressure_gauge_Pa"])
+    domain = getattr(model.static_force, "domain", None)
+    if domain is not None:
+        x_lo, x_hi = max(x_lo, domain.x_min_m), min(x_hi, domain.x_max_m)
+        p_lo, p_hi = max(p_lo, domain.p_min_Pa), min(p_hi, domain.p_max_Pa)
+    return tabulate(model.static_force, (x_lo, x_hi), (p_lo, p_hi), points,
+                    model_name=scenario.spec["model"]["static_force"])
+
+
+def force_table_for(scenario: Scenario) -> ForceTable | None:
+    """The force table the FMU needs for the scenario: none for the ACRA 2012 polynomial, which the
+    C core computes exactly; any other static model as a table."""
+    if scenario.spec["model"]["static_force"] == "acra2012_polynomial":
+        return None
+    return tabulate_model(scenario)
 
 
 # The scenario keys the FMU represents, by section; any other key is refused (InputError) rather
@@ -73,9 +98,6 @@ def _refuse_unrepresented(scenario: Scenario) -> None:
                 raise InputError(f"{scenario.origin}: the FMU cannot represent scenario key {full!r}; "
                                  "run it with the python backend")
     model = spec["model"]
-    if model["static_force"] != "acra2012_polynomial":
-        raise InputError(f"{scenario.origin}: the FMU implements only the acra2012_polynomial static force, "
-                         f"not model.static_force = {model['static_force']!r}")
     names = {v.name for v in VARIABLES if v.causality == "parameter" and v.kind == "real"}
     missing = [k for k in scenario.parameters if k not in names]
     if missing:
@@ -92,6 +114,8 @@ def start_values(scenario: Scenario) -> dict[str, float | int]:
     model = scenario.spec["model"]
     pressure = scenario.spec["pressure"]
     values: dict[str, float | int] = {k: float(scenario.parameters[k]) for k in scenario.parameters}
+    values["static_force_model"] = STATIC_FORCE_CHOICES.index(
+        "acra2012_polynomial" if model["static_force"] == "acra2012_polynomial" else "table")
     values["friction_model"] = FRICTION_CHOICES.index(model["friction"])
     values["damping_model"] = DAMPING_CHOICES.index(model["damping"])
     values["friction_negative_level"] = NEGATIVE_LEVEL.index(model.get("friction_negative_level", "clamp"))
@@ -141,13 +165,19 @@ def _instantiate(fmu_path: Path, fmi_version: int, interface: str):
     return md, fmu, unzipdir
 
 
-def _set(fmu, fmi_version: int, values: dict):
-    reals = {value_reference(k): v for k, v in values.items() if isinstance(v, float)}
-    ints = {value_reference(k): v for k, v in values.items() if not isinstance(v, float)}
-    if reals:
-        (fmu.setReal if fmi_version == 2 else fmu.setFloat64)(list(reals), list(reals.values()))
-    if ints:
-        (fmu.setInteger if fmi_version == 2 else fmu.setInt32)(list(ints), list(ints.values()))
+def set_values(fmu, fmi_version: int, values: dict) -> None:
+    """Set ``{name: value}`` on an fmpy instance: floats as Real / Float64, the rest as Integer
+    (FMI 2.0) or, in FMI 3.0, Int32 and, for the Enumerations (integer choices), Int64."""
+    groups: dict[str, dict[int, float | int]] = {"real": {}, "int": {}, "enum": {}}
+    for k, v in values.items():
+        group = "real" if isinstance(v, float) else "enum" if BY_NAME[k].choices and fmi_version == 3 else "int"
+        groups[group][value_reference(k)] = v
+    setters = {"real": fmu.setReal if fmi_version == 2 else fmu.setFloat64,
+               "int": fmu.setInteger if fmi_version == 2 else fmu.setInt32,
+               "enum": None if fmi_version == 2 else fmu.setInt64}
+    for group, vrs in groups.items():
+        if vrs:
+            setters[group](list(vrs), list(vrs.values()))
 
 
 def run_cs(scenario: Scenario, fmi_version: int = 2, communication_times: Sequence[float] | None = None,
@@ -155,7 +185,7 @@ def run_cs(scenario: Scenario, fmi_version: int = 2, communication_times: Sequen
     """Co-simulate ``scenario``; outputs sampled at ``communication_times`` (default: the scenario's
     sample grid).  Every input jump is added as a communication point.  Returns named arrays."""
     start = start_values(scenario)  # refuses what the FMU cannot represent before anything runs
-    fmu_path = fmu_path or cached_fmu(fmi_version)
+    fmu_path = fmu_path or cached_fmu(fmi_version, force_table_for(scenario))
     inputs = ScenarioInputs(scenario)
     if communication_times is None:
         n = int(round(scenario.duration_s * scenario.solver.sample_rate_Hz))
@@ -172,8 +202,8 @@ def run_cs(scenario: Scenario, fmi_version: int = 2, communication_times: Sequen
         fmu.instantiate()
         if fmi_version == 2:
             fmu.setupExperiment(startTime=times[0], stopTime=times[-1])
-        _set(fmu, fmi_version, start)
-        _set(fmu, fmi_version, inputs(times[0]))
+        set_values(fmu, fmi_version, start)
+        set_values(fmu, fmi_version, inputs(times[0]))
         if fmi_version == 2:
             fmu.enterInitializationMode()
         else:
@@ -185,7 +215,7 @@ def run_cs(scenario: Scenario, fmi_version: int = 2, communication_times: Sequen
             if k + 1 < len(times):
                 # Inputs are held over a step; the midpoint value is the second-order choice for
                 # smooth signals, and jumps fall on communication points.
-                _set(fmu, fmi_version, inputs(0.5 * (t + times[k + 1])))
+                set_values(fmu, fmi_version, inputs(0.5 * (t + times[k + 1])))
                 fmu.doStep(currentCommunicationPoint=t, communicationStepSize=times[k + 1] - t)
         fmu.terminate()
     except Exception as exc:  # fmpy raises a bare Exception carrying the FMI status
@@ -207,7 +237,7 @@ def run_me(scenario: Scenario, fmi_version: int = 2, fmu_path: Path | None = Non
     from fmpy import simulate_fmu
 
     start = start_values(scenario)
-    fmu_path = fmu_path or cached_fmu(fmi_version)
+    fmu_path = fmu_path or cached_fmu(fmi_version, force_table_for(scenario))
     inputs = ScenarioInputs(scenario)
     dt = 1.0 / scenario.solver.sample_rate_Hz
     grid = np.linspace(0.0, scenario.duration_s, int(round(scenario.duration_s / dt)) + 1)
@@ -266,7 +296,7 @@ def simulate_fmu(scenario: Scenario, interface: str = "cs", fmi_version: int = 2
     """Run ``scenario`` through the FMU (``interface`` "cs" or "me") and return a :class:`Result`."""
     if interface not in ("cs", "me"):
         raise InputError(f"FMU interface must be 'cs' or 'me', not {interface!r}")
-    fmu_path = cached_fmu(fmi_version)
+    fmu_path = cached_fmu(fmi_version, force_table_for(scenario))
     wall0 = time.perf_counter()
     trace = run_cs(scenario, fmi_version, fmu_path=fmu_path) if interface == "cs" else \
         run_me(scenario, fmi_version, fmu_path=fmu_path)

@@ -7,19 +7,22 @@ hand.  Model parameters are taken from the parameter set
 ``shadow_6x300_acra2012`` (name, unit, start value, description), so a new
 parameter there becomes an FMU parameter on the next build.
 
-Value references are the 1-based position in the table (0 is ``time`` in
-FMI 3.0).  Integer variables are ``Integer`` in FMI 2.0 and ``Int32`` in
-FMI 3.0.
+Value references are pinned in :data:`VALUE_REFERENCES` (0 is ``time`` in
+FMI 3.0), so adding, moving or renaming a variable never renumbers the others;
+a variable not yet pinned there gets the next free number after the pinned
+ones, in table order (a test compares the table with the committed list
+``tests/data/fmu_value_references.csv``).  Integer variables are ``Integer``
+in FMI 2.0 and ``Int32`` in FMI 3.0.
 """
 
 from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from ..elements.friction import NEGATIVE_LEVEL_CHOICES
-from ..parameters import get_parameter_set
+from ..parameters import LOAD_MASS, get_parameter_set
 from ..simulator import SolverOptions
 
 PARAMETER_SET = "shadow_6x300_acra2012"
@@ -30,8 +33,36 @@ DAMPING_CHOICES = ("paper", "linear", "none")
 """``damping_model`` values 0, 1, 2 (the scenario's ``model.damping`` names)."""
 SOURCE_CHOICES = ("valve", "prescribed")
 """``pressure_source`` values 0, 1 (the scenario's ``pressure.source`` names)."""
+STATIC_FORCE_CHOICES = ("acra2012_polynomial", "table")
+"""``static_force_model`` values 0, 1: the ACRA 2012 polynomial, exact, or the force table baked into the FMU at
+build time (any other static model; :mod:`pamsim.fmu.force_table`)."""
 NEGATIVE_LEVEL = NEGATIVE_LEVEL_CHOICES
 """``friction_negative_level`` values 0, 1 (the scenario's ``model.friction_negative_level`` names)."""
+
+
+VALUE_REFERENCES = {
+    # The parameter set shadow_6x300_acra2012.
+    "K1_N_per_bar_m2": 1, "K2_N_per_bar_m": 2, "C1_N_per_bar": 3, "S1_N_per_m2": 4, "S2_N_per_m": 5, "S3_N": 6,
+    "N2_N_per_bar_m2": 7, "N1_N_per_bar_m": 8, "N0_N_per_bar": 9, "phi_bar_per_kg": 10, "coulomb_constant_N": 11,
+    "D1_N_s_per_m": 12, "D2_N_s2_per_m2": 13, "L0_m": 14, "D0_m": 15, "braid_angle_rest_deg": 16,
+    "dead_volume_m3": 17, "valve_C_m3_per_s_Pa": 18, "valve_b": 19, "valve_laminar_ratio": 20, "rho0_kg_m3": 21,
+    "T0_K": 22, "polytropic_index": 23, "T_supply_K": 24, "R_J_per_kg_K": 25, "p_atm_Pa": 26, "g_m_s2": 27,
+    "rated_pressure_gauge_Pa": 28, "fit_x_min_m": 29, "fit_x_max_m": 30, "fit_p_max_Pa": 31, "stop_restitution": 32,
+    # The FMU's own parameters.
+    "friction_model": 33, "damping_model": 34, "pressure_source": 35, "initial_contraction_m": 36,
+    "stick_margin_N": 37, "release_margin_N": 38, "cs_relative_tolerance": 39, "cs_max_step_s": 40,
+    "friction_negative_level": 41, "initial_pressure_gauge_Pa": 42, "cs_max_internal_steps": 62,
+    "static_force_model": 63,
+    # Inputs, states, derivatives, outputs, event indicators.
+    "valve_command": 43, "supply_pressure_gauge_Pa": 44, "prescribed_pressure_gauge_Pa": 45, "load_mass_kg": 46,
+    "external_force_N": 47, "contraction_m": 48, "velocity_m_s": 49, "chamber_pressure_abs_Pa": 50, "air_mass_kg": 51,
+    "der(contraction_m)": 52, "der(velocity_m_s)": 53, "der(chamber_pressure_abs_Pa)": 54, "der(air_mass_kg)": 55,
+    "p_gauge_Pa": 56, "F_static_N": 57, "F_friction_N": 58, "friction_mode": 59,
+    "event_indicator_1": 60, "event_indicator_2": 61,
+}
+"""Pinned value references.  Never change or reuse a number: a renamed variable keeps its number
+(``p_gauge_Pa``, ``F_static_N`` and ``F_friction_N`` were ``pressure_gauge_Pa``,
+``muscle_force_N`` and ``friction_force_N``), a removed one leaves a gap."""
 
 
 @dataclass(frozen=True)
@@ -43,7 +74,12 @@ class Variable:
     error control uses.  ``lower``/``upper`` (``*_open``: bound excluded) is
     the range a parameter must lie in, as :class:`pamsim.parameters.Parameter`;
     the C parameter check loops over these bounds (``PAM_VARS[]`` in
-    ``pam_variables.h``).  An integer choice's range is ``[0, len(choices) - 1]``.
+    ``pam_variables.h``).  An integer choice's range is ``[0, len(choices) - 1]``;
+    it is an Enumeration in ``modelDescription.xml``.  ``depends_on`` lists
+    the states and inputs an output, derivative or event indicator depends on
+    in continuous time (the ``ModelStructure`` dependencies); ``None`` leaves
+    them undeclared (depends on everything).  ``initial_depends_on`` does the
+    same for a state's initial value, over parameters and inputs.
     """
 
     name: str
@@ -61,6 +97,8 @@ class Variable:
     lower_open: bool = False
     upper_open: bool = False
     choices: tuple[str, ...] | None = None
+    depends_on: tuple[str, ...] | None = None
+    initial_depends_on: tuple[str, ...] | None = None
 
     @property
     def c_name(self) -> str:
@@ -76,6 +114,13 @@ def _choice(name: str, description: str, choices: tuple[str, ...]) -> Variable:
     """An integer parameter choosing one of ``choices`` (0 = the first, the default)."""
     return Variable(name, "integer", "parameter", "fixed", description.format(_choices(choices)), None, 0, "exact",
                     lower=0, upper=len(choices) - 1, choices=choices)
+
+
+X, V, P, M = "contraction_m", "velocity_m_s", "chamber_pressure_abs_Pa", "air_mass_kg"
+MECHANICS = (X, V, P, "prescribed_pressure_gauge_Pa", "load_mass_kg", "external_force_N")
+"""What the load's acceleration and the event indicators depend on: the state, the pressure (a state
+or an input, by ``pressure_source``), the load and the external force.  The mode is a discrete
+state: it changes only at events, so ``friction_mode`` depends on nothing in continuous time."""
 
 
 def _table() -> tuple[Variable, ...]:
@@ -111,58 +156,96 @@ def _table() -> tuple[Variable, ...]:
                  "Pa", 0.0, "exact", lower=0.0),
         # Inputs.
         Variable("valve_command", "real", "input", "continuous",
-                 "proportional 3/3 valve: 1 open to supply, 0 closed, -1 open to exhaust [1]", "1", 0.0),
+                 "proportional 3/3 valve: 1 open to supply, 0 closed, -1 open to exhaust [1]", "1", 0.0,
+                 lower=-1.0, upper=1.0),
         Variable("supply_pressure_gauge_Pa", "real", "input", "continuous",
-                 "valve supply gauge pressure, at most rated_pressure_gauge_Pa [Pa]", "Pa", 0.0),
+                 "valve supply gauge pressure, at most rated_pressure_gauge_Pa [Pa]", "Pa", 0.0, lower=0.0),
         Variable("prescribed_pressure_gauge_Pa", "real", "input", "continuous",
                  "chamber gauge pressure when pressure_source = 1 (prescribed) [Pa]", "Pa", 0.0),
-        Variable("load_mass_kg", "real", "input", "continuous",
-                 "hanging mass, holder included, > 0 [kg]", "kg", round(22.74 / params["g_m_s2"], 6)),
+        Variable("load_mass_kg", "real", "input", "continuous", f"{LOAD_MASS.description} [kg] (range: "
+                 f"{LOAD_MASS.source})", LOAD_MASS.unit, LOAD_MASS.value, lower=LOAD_MASS.lower),
         Variable("external_force_N", "real", "input", "continuous",
                  "extra force on the load, positive along the contraction [N]", "N", 0.0),
         # States (the two mechanical ones are also outputs).
         Variable("contraction_m", "real", "output", "continuous", "contraction x = L0 - L [m]", "m",
-                 initial="calculated", nominal=0.01),
+                 initial="calculated", nominal=0.01, depends_on=(X,), initial_depends_on=("initial_contraction_m",)),
         Variable("velocity_m_s", "real", "output", "continuous", "contraction velocity dx/dt [m/s]", "m/s",
-                 initial="calculated", nominal=0.1),
+                 initial="calculated", nominal=0.1, depends_on=(V,), initial_depends_on=()),
         Variable("chamber_pressure_abs_Pa", "real", "local", "continuous",
-                 "absolute chamber pressure (valve source) [Pa]", "Pa", initial="calculated", nominal=1e5),
+                 "absolute chamber pressure (valve source) [Pa]", "Pa", initial="calculated", nominal=1e5,
+                 initial_depends_on=("p_atm_Pa", "initial_pressure_gauge_Pa")),
         Variable("air_mass_kg", "real", "local", "continuous", "air mass in the chamber (valve source) [kg]",
-                 "kg", initial="calculated", nominal=1e-5),
+                 "kg", initial="calculated", nominal=1e-5,
+                 initial_depends_on=("p_atm_Pa", "initial_pressure_gauge_Pa", "initial_contraction_m", "L0_m", "D0_m",
+                                     "braid_angle_rest_deg", "dead_volume_m3", "R_J_per_kg_K", "T_supply_K")),
         Variable("der(contraction_m)", "real", "local", "continuous", "d contraction / dt [m/s]", "m/s",
-                 initial="calculated", derivative_of="contraction_m"),
+                 initial="calculated", derivative_of="contraction_m", depends_on=(V,)),
         Variable("der(velocity_m_s)", "real", "local", "continuous", "acceleration [m/s^2]", "m/s^2",
-                 initial="calculated", derivative_of="velocity_m_s"),
+                 initial="calculated", derivative_of="velocity_m_s", depends_on=MECHANICS),
         Variable("der(chamber_pressure_abs_Pa)", "real", "local", "continuous", "chamber pressure rate [Pa/s]",
-                 "Pa/s", initial="calculated", derivative_of="chamber_pressure_abs_Pa"),
+                 "Pa/s", initial="calculated", derivative_of="chamber_pressure_abs_Pa",
+                 depends_on=(X, V, P, M, "valve_command", "supply_pressure_gauge_Pa")),
         Variable("der(air_mass_kg)", "real", "local", "continuous", "valve mass flow into the chamber [kg/s]",
-                 "kg/s", initial="calculated", derivative_of="air_mass_kg"),
+                 "kg/s", initial="calculated", derivative_of="air_mass_kg",
+                 depends_on=(X, P, M, "valve_command", "supply_pressure_gauge_Pa")),
         # Outputs.
-        Variable("pressure_gauge_Pa", "real", "output", "continuous", "chamber gauge pressure [Pa]", "Pa",
-                 initial="calculated"),
-        Variable("muscle_force_N", "real", "output", "continuous", "static muscle force F_static(x, p) [N]", "N",
-                 initial="calculated"),
-        Variable("friction_force_N", "real", "output", "continuous",
-                 "friction force on the load along x; when held, whatever holds it [N]", "N", initial="calculated"),
+        # Named as the columns of pamsim.Result that hold the same quantity.
+        Variable("p_gauge_Pa", "real", "output", "continuous", "chamber gauge pressure [Pa]", "Pa",
+                 initial="calculated", depends_on=(P, "prescribed_pressure_gauge_Pa")),
+        Variable("F_static_N", "real", "output", "continuous",
+                 "static muscle force F_static(x, p) alone, without damping or friction [N]", "N",
+                 initial="calculated", depends_on=(X, P, "prescribed_pressure_gauge_Pa")),
+        Variable("F_friction_N", "real", "output", "continuous",
+                 "friction force on the load along x; when held, whatever holds it [N]", "N", initial="calculated",
+                 depends_on=(X, P, "prescribed_pressure_gauge_Pa", "load_mass_kg", "external_force_N")),
         Variable("friction_mode", "integer", "output", "discrete",
                  "-1 slip down, 0 stick, 1 slip up, 2 on the lower stop, 3 on the upper stop (pamsim.model.Mode)",
-                 initial="calculated"),
+                 initial="calculated", depends_on=()),
         # Event indicators (FMI 3.0 declares them as variables).
         Variable("event_indicator_1", "real", "local", "continuous",
-                 "sliding: velocity; held: upward force margin [m/s or N]", initial="calculated"),
+                 "sliding: velocity; held: upward force margin [m/s or N]", initial="calculated",
+                 depends_on=MECHANICS),
         Variable("event_indicator_2", "real", "local", "continuous",
-                 "sliding: distance to the stop ahead; stuck: downward force margin [m or N]", initial="calculated"),
+                 "sliding: distance to the stop ahead; stuck: downward force margin [m or N]", initial="calculated",
+                 depends_on=MECHANICS),
+        _choice("static_force_model", "static force: {} (the force table baked into this FMU at build time; "
+                "0 uses the parameters K1..S3)", STATIC_FORCE_CHOICES),
+        Variable("cs_max_internal_steps", "integer", "parameter", "fixed",
+                 "co-simulation: a doStep that needs more internal steps than this fails (a bound on its "
+                 "run time) [1]", None, 10_000_000, "exact", lower=1, upper=2**31 - 1),
     ]
     return tuple(rows)
 
 
+def assign_value_references(variables, pinned) -> dict[str, int]:
+    """``{name: value reference}``: the pinned number, else the next free one after all pinned
+    numbers, in table order."""
+    out, nxt = {}, max(pinned.values(), default=0) + 1
+    for v in variables:
+        if v.name in pinned:
+            out[v.name] = pinned[v.name]
+        else:
+            out[v.name], nxt = nxt, nxt + 1
+    return out
+
+
+def with_force_table(variables: tuple[Variable, ...], has_table: bool) -> tuple[Variable, ...]:
+    """The table of an FMU built with (``has_table``) or without a force table: with one, the FMU
+    starts on it (``static_force_model`` = table)."""
+    if not has_table:
+        return variables
+    return tuple(replace(v, start=STATIC_FORCE_CHOICES.index("table")) if v.name == "static_force_model" else v
+                 for v in variables)
+
+
 VARIABLES: tuple[Variable, ...] = _table()
 BY_NAME = {v.name: v for v in VARIABLES}
+_VRS = assign_value_references(VARIABLES, VALUE_REFERENCES)
 
 
 def value_reference(name: str) -> int:
-    """Value reference of ``name`` (1-based table position; 0 is FMI 3.0 ``time``)."""
-    return VARIABLES.index(BY_NAME[name]) + 1
+    """Value reference of ``name`` (pinned in :data:`VALUE_REFERENCES`; 0 is FMI 3.0 ``time``)."""
+    return _VRS[BY_NAME[name].name]
 
 
 STATES = tuple(v.derivative_of for v in VARIABLES if v.derivative_of)

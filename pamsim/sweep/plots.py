@@ -169,21 +169,28 @@ def frequency_figure(result: "SweepResult") -> Figure:
     rows = result.frequency_rows
     if not rows:
         return _empty(fig, "no [frequency] study in the sweep file")
-    ax = fig.subplots()
+    models = result.spec.friction_models
+    # The half-cycle counts go in a strip of their own under the plot, one row per friction model,
+    # so that no label can sit on a marker.
+    ax, strip = fig.subplots(2, 1, sharex=True, height_ratios=[5, 0.35 * len(models) + 0.3])
     w = np.array([r["weight_N"] for r in rows])
-    for k, f in enumerate(result.spec.friction_models):
+    for k, f in enumerate(models):
         freq = np.array([r[f"{f}_frequency_Hz"] for r in rows], dtype=float)
         n = [r[f"{f}_n_half_cycles"] for r in rows]
         ax.plot(w, freq, "o-" if k == 0 else "s--", color=f"C{k}", ms=7, mfc="none" if k else None,
                 label=f"{f} friction")
         for wi, fi, ni in zip(w, freq, n):
-            if math.isfinite(fi):
-                ax.annotate(f"n={ni}", (wi, fi), textcoords="offset points", xytext=(6, 6 if k == 0 else -12),
-                            fontsize=7, color=f"C{k}")
-    ax.set_xlabel("hanging weight [N]")
+            strip.text(wi, len(models) - k, f"{ni}" if math.isfinite(fi) else "-", ha="center", va="center",
+                       fontsize=8, color=f"C{k}")
+    strip.set_ylim(0.4, len(models) + 0.6)
+    strip.set_yticks(range(len(models), 0, -1), [f"n ({f})" for f in models], fontsize=7)
+    strip.tick_params(axis="y", length=0)
+    for side in ("top", "right", "left"):
+        strip.spines[side].set_visible(False)
+    strip.set_xlabel("hanging weight [N]")
     ax.set_ylabel("oscillation frequency [Hz]")
     ax.grid(alpha=0.3)
     ax.legend()
     fig.suptitle(f"Oscillation frequency at {result.spec.frequency.pressure_bar:g} bar "
-                 "(n = half-cycles seen after the pressure settled)", fontsize=11)
+                 "(n: half-cycles seen after the pressure settled)", fontsize=11)
     return fig

@@ -90,7 +90,7 @@ def run_task(task: _Task) -> dict:
         t_settled = settled_time_s(result.t_s, result.p_gauge_Pa)
         osc = estimate_oscillation(result.t_s, result.x_m, t_start_s=t_settled)
         last = result.t_s >= result.t_s[-1] - LAST_WINDOW_S
-        out = {"final_contraction_m": float(result.x_m[-1]), "peak_contraction_m": float(result.x_m.max()),
+        out = {"final_contraction_m": float(result.x_m[-1]), "peak_contraction_m": result.peak_contraction_m,
                "at_rest": bool(result.at_rest_at_end), "final_mode": result.final_mode.label,
                "last_second_peak_to_peak_m": float(np.ptp(result.x_m[last])),
                "frequency_Hz": osc.frequency_Hz, "damping_ratio": osc.damping_ratio,
@@ -117,33 +117,6 @@ def settled_time_s(t_s: np.ndarray, p_gauge_Pa: np.ndarray, fraction: float = SE
         return float(t_s[0])
     outside = np.flatnonzero(np.abs(p_gauge_Pa - p_gauge_Pa[-1]) > fraction * step)
     return float(t_s[outside[-1] + 1]) if outside.size else float(t_s[0])
-
-
-class ProgressBar:
-    """A one-line text progress bar with an ETA, redrawn on a terminal and printed every 10 % otherwise."""
-
-    def __init__(self, total: int, stream=None, width: int = 30):
-        self.total = total
-        self.stream = stream if stream is not None else sys.stderr
-        self.width = width
-        self.start = time.perf_counter()
-        self.interactive = bool(getattr(self.stream, "isatty", lambda: False)())
-        self._last_decile = -1
-
-    def update(self, done: int, failed: int) -> None:
-        """Show ``done`` of ``total`` finished, ``failed`` of them failed."""
-        elapsed = time.perf_counter() - self.start
-        eta = elapsed / done * (self.total - done) if done else math.nan
-        filled = int(self.width * done / self.total) if self.total else self.width
-        line = (f"[{'#' * filled}{'.' * (self.width - filled)}] {done}/{self.total} runs, {failed} failed, "
-                f"{elapsed:.1f} s elapsed, ETA {eta:.1f} s")
-        decile = 10 * done // max(self.total, 1)
-        if self.interactive:
-            self.stream.write("\r" + line + ("\n" if done == self.total else ""))
-        elif decile != self._last_decile:
-            self.stream.write(line + "\n")
-        self._last_decile = decile
-        self.stream.flush()
 
 
 @dataclass
@@ -251,8 +224,11 @@ def run_sweep(spec: SweepSpec | str | Path, executor: Executor | None = None, pr
                       for k, values in enumerate(samples.values)]
     if chunk_size is not None and (isinstance(chunk_size, bool) or not isinstance(chunk_size, int) or chunk_size < 1):
         raise InputError(f"chunk_size = {chunk_size!r}: must be a positive integer")
-    outputs = _execute(tasks, executor, ProgressBar(len(tasks)) if progress else None,
-                       chunk_size or auto_chunk_size(len(tasks)))
+    from tqdm import tqdm
+
+    with tqdm(total=len(tasks), unit="run", desc=spec.name, file=sys.stderr, disable=not progress,
+              dynamic_ncols=True) as bar:
+        outputs = _execute(tasks, executor, bar, chunk_size or auto_chunk_size(len(tasks)))
     wall = time.perf_counter() - start
     by_key = {(t.kind, t.key): o for t, o in zip(tasks, outputs)}
     failures = [f"{t.scenario.name}{f' sample {t.key[0]}' if t.kind == 'sample' else ''}: {o['error']}"
@@ -277,20 +253,20 @@ def run_sweep(spec: SweepSpec | str | Path, executor: Executor | None = None, pr
     return SweepResult(spec, rows, freq_rows, responses, wall, failures, study)
 
 
-def _execute(tasks: list[_Task], executor: Executor | None, bar: ProgressBar | None,
-             chunk_size: int = 1) -> list[dict]:
+def _execute(tasks: list[_Task], executor: Executor | None, bar, chunk_size: int = 1) -> list[dict]:
+    """Run the tasks (here, or on ``executor`` in chunks of ``chunk_size``), advancing the tqdm ``bar``
+    by one per finished run."""
     outputs: list[dict | None] = [None] * len(tasks)
     failed = 0
     if executor is None:
         for i, task in enumerate(tasks):
             outputs[i] = run_task(task)
             failed += bool(outputs[i]["error"])
-            if bar:
-                bar.update(i + 1, failed)
+            bar.set_postfix(failed=failed, refresh=False)
+            bar.update(1)
         return outputs
     starts = range(0, len(tasks), chunk_size)
     futures = {executor.submit(run_chunk, tasks[i:i + chunk_size]): i for i in starts}
-    done = 0
     for fut in as_completed(futures):
         i = futures[fut]
         n = min(chunk_size, len(tasks) - i)
@@ -299,10 +275,9 @@ def _execute(tasks: list[_Task], executor: Executor | None, bar: ProgressBar | N
         except Exception as exc:  # noqa: BLE001 -- a dead worker fails its chunk's cases, not the sweep
             chunk = [{"error": f"{type(exc).__name__}: {exc}"}] * n
         outputs[i:i + n] = chunk
-        done += n
         failed += sum(bool(o["error"]) for o in chunk)
-        if bar:
-            bar.update(done, failed)
+        bar.set_postfix(failed=failed, refresh=False)
+        bar.update(n)
     return outputs
 
 

@@ -122,7 +122,7 @@ def sweep_from_dict(spec: Mapping[str, Any], base_dir: str | Path = ".", origin:
     if not frictions:
         raise SweepError(f"{origin}: friction_models = []: name at least one friction model")
     for f in frictions:
-        if f not in FRICTION_MODELS:
+        if not isinstance(f, str) or f not in FRICTION_MODELS:
             _fail(origin, "friction_models", f, "unknown friction model", FRICTION_MODELS)
     threshold_mm = _number(origin, "capability_min_equilibrium_mm", spec.get("capability_min_equilibrium_mm", 5.0))
     measured = _read_measured(origin, base_dir, spec["measured"]) if "measured" in spec else None

@@ -1,0 +1,145 @@
+"""A static force reaches the FMU as a table F(x, p) baked in at build time and interpolated by one
+C routine; the ACRA 2012 polynomial stays exact in C.  References: the exact-polynomial FMU, the
+tabulated model itself evaluated in Python, and pamsim.simulate with the same model."""
+
+from __future__ import annotations
+
+import ctypes
+
+import numpy as np
+import pytest
+
+import pamsim
+from conftest import SCENARIOS
+from pamsim.elements.static_force import STATIC_FORCE_MODELS
+from pamsim.fmu import build
+from pamsim.fmu.force_table import tabulate
+from pamsim.fmu.runner import force_table_for, run_cs, run_me, set_values, tabulate_model
+from pamsim.fmu.variables import value_reference
+from test_fmu import _Api, _initialise_with, _instance, _start_fig4
+
+RATED_PA = 4.5e5
+X_HIGH_M = 0.1157  # the braid-lock stop of the Shadow muscle (test_fmu: "between the stops, 0 and 0.1157 m")
+
+
+class SmoothForce:
+    """A static force that is not polynomial in x or p (so the table cannot be exact):
+    72 N of blocked force at 3.6 bar, falling exponentially with contraction, against a tanh spring."""
+
+    name = "smooth_test_force"
+
+    @classmethod
+    def from_parameters(cls, params, options=None):
+        return cls()
+
+    def force_N(self, x_m, p_gauge_Pa):
+        x, p = np.asarray(x_m, dtype=float), np.asarray(p_gauge_Pa, dtype=float)
+        return 1.2e-4 * p * np.exp(-x / 0.035) * np.sqrt(1.0 + p / 2e5) - 8.0 * np.tanh(x / 0.02)
+
+
+def _forces_through_fmu(path, version, x, p):
+    """F_static_N of the FMU at each (x, p gauge), set as Model Exchange states."""
+    fmu = _instance({version: path}, version, "me")
+    api = _Api(fmu, version)
+    api.init()
+    fmu.newDiscreteStates() if version == 2 else fmu.updateDiscreteStates()
+    fmu.enterContinuousTimeMode()
+    out = []
+    for xi, pi in zip(x, p):
+        y = np.array([xi, 0.0, pi + 101325.0, 1e-5])
+        fmu.setContinuousStates(y.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), 4)
+        out.append(api.get("F_static_N")[0])
+    fmu.terminate()
+    fmu.freeInstance()
+    return np.array(out)
+
+
+@pytest.fixture(scope="module")
+def smooth_fmus(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("table")
+    table = tabulate(SmoothForce(), (0.0, X_HIGH_M), (0.0, RATED_PA))
+    return {v: build(folder / f"smooth{v}.fmu", v, table) for v in (2, 3)}
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_interpolation_error_within_a_thousandth_of_the_blocked_force(smooth_fmus, version):
+    rng = np.random.default_rng(8)
+    x = rng.uniform(0.0, X_HIGH_M, 400)
+    p = rng.uniform(0.0, RATED_PA, 400)
+    model = SmoothForce()
+    blocked = float(model.force_N(0.0, RATED_PA))
+    error = np.abs(_forces_through_fmu(smooth_fmus[version], version, x, p) - model.force_N(x, p))
+    assert error.max() <= 1e-3 * blocked, f"{error.max():.3g} N against {1e-3 * blocked:.3g} N"
+    # The criterion can fail: a 5 x 3 table of the same model misses it.
+    coarse = build(smooth_fmus[version].with_name(f"coarse{version}.fmu"), version,
+                   tabulate(model, (0.0, X_HIGH_M), (0.0, RATED_PA), points=(5, 3)))
+    assert np.abs(_forces_through_fmu(coarse, version, x, p) - model.force_N(x, p)).max() > 1e-3 * blocked
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_tabulated_polynomial_runs_as_the_exact_polynomial(tmp_path, version):
+    """Fig. 4 in co-simulation on the polynomial's table and on the exact polynomial (one FMU, both
+    choices): the bicubic table reproduces a force cubic in x and p, so the runs agree."""
+    sc = pamsim.load_scenario(SCENARIOS / "acra2012_fig4.toml")
+    path = build(tmp_path / "poly_table.fmu", version, tabulate_model(sc))
+    runs = {}
+    for choice in (0, 1):
+        fmu = _instance({version: path}, version)
+        api = _Api(fmu, version)
+        set_values(fmu, version, {"static_force_model": choice})
+        _start_fig4(api)
+        api.init()
+        x = []
+        for k in range(80):
+            api.step(k * 0.1, 0.1)
+            x.append(api.get("contraction_m", "F_static_N"))
+        runs[choice] = np.array(x)
+        fmu.terminate()
+        fmu.freeInstance()
+    assert runs[0][-1, 0] > 0.05  # the load rose
+    # Equal up to the rounding of the node derivatives (finite differences): 1e-8 of the blocked force.
+    dx, dF = np.max(np.abs(runs[0] - runs[1]), axis=0)
+    assert dx <= 1e-8 and dF <= 1e-6, (dx, dF)
+
+
+@pytest.mark.parametrize("version", [2, 3])
+@pytest.mark.parametrize("choice,message", [
+    (1, "static_force_model = 1 (table): this FMU was built without a force table"),
+    (2, "static_force_model = 2: must lie in [0, 1]"),  # a choice the C core does not have at all
+])
+def test_fmu_without_a_table_refuses_the_table_choice(unzipped, version, choice, message, capfd):
+    capfd.readouterr()
+    assert _initialise_with(unzipped, version, {"static_force_model": choice}) == 3
+    assert message in capfd.readouterr().out
+
+
+@pytest.mark.parametrize("interface", ["cs", "me"])
+def test_scenario_with_another_static_model_runs_on_its_table_like_python(monkeypatch, interface):
+    """The runner tabulates a scenario's non-polynomial static force, builds the FMU with the table
+    and starts it on the table; the run matches pamsim.simulate within 0.2 mm."""
+    monkeypatch.setitem(STATIC_FORCE_MODELS, "smooth_test_force", SmoothForce.from_parameters)
+    fig4 = pamsim.load_scenario(SCENARIOS / "acra2012_fig4.toml")
+    sc = fig4.with_changes({"model": {"static_force": "smooth_test_force"}})
+    table = force_table_for(sc)
+    assert table is not None and table.model_name == "smooth_test_force"
+    assert force_table_for(pamsim.load_scenario(SCENARIOS / "acra2012_fig4.toml")) is None
+    ref = pamsim.simulate(sc)
+    assert ref.x_m.max() > 0.02  # the load moved
+    tr = run_cs(sc, 2) if interface == "cs" else run_me(sc, 2)
+    assert np.allclose(tr["t_s"], ref.t_s, atol=1e-9)
+    d = np.abs(tr["contraction_m"] - ref.x_m)
+    assert d.max() <= 0.2e-3, f"max contraction difference {d.max() * 1e3:.4f} mm"
+
+
+def test_cli_builds_a_table_fmu_from_a_scenario(tmp_path):
+    from conftest import run_cli
+
+    out = run_cli("fmu", "build", "--scenario", SCENARIOS / "acra2012_fig4.toml", "-o", tmp_path / "t.fmu")
+    assert out.returncode == 0, out.stderr
+    assert "table of acra2012_polynomial" in out.stdout
+    from fmpy import read_model_description
+
+    md = read_model_description(str(tmp_path / "t.fmu"))
+    start = {v.name: v.start for v in md.modelVariables}
+    assert start["static_force_model"] == "1"
+    assert value_reference("static_force_model") == 63
