@@ -8,7 +8,6 @@ import math
 import os
 import signal
 import sys
-import threading
 import time
 from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 from pathlib import Path
@@ -86,26 +85,18 @@ def test_automatic_chunk_size_amortises_large_sweeps():
 
 def test_a_worker_killed_mid_sweep_is_retried_and_the_sweep_completes(spec, serial, client):
     pids = set(client.run(os.getpid).values())
-    killed = []
-
-    def kill_one_worker_once_busy():
-        deadline = time.monotonic() + 60
-        while time.monotonic() < deadline:
-            busy = [w for w, keys in client.processing().items() if keys]
-            if busy:
-                pid = client.run(os.getpid, workers=[busy[0]])[busy[0]]
-                time.sleep(0.3)  # well inside a run of several tenths of a second
-                os.kill(pid, signal.SIGKILL)
-                killed.append(pid)
-                return
-            time.sleep(0.02)
-
-    killer = threading.Thread(target=kill_one_worker_once_busy, daemon=True)
-    killer.start()
     with ThreadPoolExecutor(1) as outer:  # bound the wait: a hung sweep fails the test, not the session
-        result = outer.submit(pamsim.sweep, spec, client.get_executor(pure=False), chunk_size=1).result(timeout=240)
-    killer.join(timeout=5)
-    assert killed and killed[0] in pids
+        running = outer.submit(pamsim.sweep, spec, client.get_executor(pure=False), chunk_size=1)
+        deadline = time.monotonic() + 60
+        busy = []
+        while not busy and time.monotonic() < deadline:
+            busy = [w for w, keys in client.processing().items() if keys]
+            time.sleep(0.01)
+        pid = client.run(os.getpid, workers=[busy[0]])[busy[0]]
+        os.kill(pid, signal.SIGKILL)
+        killed_mid_sweep = not running.done()
+        result = running.result(timeout=240)
+    assert pid in pids and killed_mid_sweep
     # The scheduler re-ran the dead worker's chunk elsewhere (or reported it failed): every row is there,
     # and every row that did not fail carries the serial numbers.
     assert len(result.rows) == len(serial.rows)
@@ -116,6 +107,23 @@ def test_a_worker_killed_mid_sweep_is_retried_and_the_sweep_completes(spec, seri
     for r in failed:
         assert "KilledWorker" in r["failure"] + r["constant_failure"]
     client.wait_for_workers(2, timeout=60)  # the nanny restarts it for the tests that follow
+
+
+def test_a_process_pool_worker_killed_mid_sweep_fails_its_chunks_and_the_sweep_completes(spec, serial):
+    with ProcessPoolExecutor(max_workers=2) as pool, ThreadPoolExecutor(1) as outer:
+        running = outer.submit(pamsim.sweep, spec, pool, chunk_size=1)
+        deadline = time.monotonic() + 60
+        while not pool._processes and time.monotonic() < deadline:  # CPython's pool keeps {pid: process}
+            time.sleep(0.02)
+        time.sleep(0.2)  # the workers hold their first chunks (starting a worker takes longer)
+        os.kill(next(iter(pool._processes)), signal.SIGKILL)
+        result = running.result(timeout=240)
+    assert len(result.rows) == len(serial.rows)
+    errors = [r["failure"] + r["constant_failure"] for r in result.rows]
+    assert any("BrokenProcessPool" in e for e in errors)
+    for row, ref, e in zip(result.rows, serial.rows, errors):
+        if not e:
+            assert all(_same(row[k], ref[k]) for k in ref)
 
 
 def test_dask_without_the_extra_is_one_line_naming_it(tmp_path, monkeypatch, capsys):
