@@ -1,8 +1,10 @@
-"""``pamsim sweep SWEEP.toml -o DIR [--workers N]``: run a sweep, write summary, report and figures."""
+"""``pamsim sweep SWEEP.toml -o DIR [--workers N | --dask ADDRESS | --dask-local N] [--chunk-size N]``:
+run a sweep, write summary, report and figures."""
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import sys
 from concurrent.futures import ProcessPoolExecutor
@@ -28,8 +30,15 @@ def register(sub) -> None:
                                    "summary.csv, report.md and PNG figures into DIR.")
     p.add_argument("sweep_file", help="sweep TOML file (see scenarios/acra2012_grid.toml)")
     p.add_argument("-o", "--output", default="out", help="output directory (default: out)")
-    p.add_argument("--workers", type=_workers, default=os.cpu_count() or 1,
-                   help="worker processes (default: number of CPUs; 1 runs in this process)")
+    where = p.add_mutually_exclusive_group()
+    where.add_argument("--workers", type=_workers, default=None,
+                       help="worker processes (default: number of CPUs; 1 runs in this process)")
+    where.add_argument("--dask", metavar="ADDRESS",
+                       help="run on a running Dask scheduler, e.g. tcp://host:8786 (needs pamsim[dask])")
+    where.add_argument("--dask-local", metavar="N", type=_workers,
+                       help="start a Dask LocalCluster of N worker processes (needs pamsim[dask])")
+    p.add_argument("--chunk-size", metavar="N", type=_workers, default=None,
+                   help="runs per executor task (default: about 64 chunks, at most 50 runs each)")
     p.add_argument("--backend", choices=sorted(BACKENDS), default=None,
                    help="backend of every run (default: the sweep file's backend key, else python)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
@@ -38,20 +47,29 @@ def register(sub) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ..sweep import load_sweep, run_sweep
+    from ..sweep.dask_cluster import dask_executor
     from ..sweep.run import check_backend
 
     spec = load_sweep(args.sweep_file)
     check_backend(spec, args.backend or spec.backend)  # before the output folder and the runs
-    with output_folder(args.output) as out:  # checked before the runs; removed again if nothing gets written
-        if args.workers == 1:
-            result = run_sweep(spec, None, progress=not args.no_progress, backend=args.backend)
+    workers = args.workers or os.cpu_count() or 1
+    with contextlib.ExitStack() as stack:
+        # A missing Dask or an unreachable scheduler fails before the output folder is made.
+        if args.dask is not None or args.dask_local is not None:
+            executor, where = stack.enter_context(dask_executor(args.dask, args.dask_local))
+        elif workers == 1:
+            executor, where = None, "1 worker"
         else:
-            with ProcessPoolExecutor(max_workers=args.workers) as pool:
-                result = run_sweep(spec, pool, progress=not args.no_progress, backend=args.backend)
-        names = result.write(out)
+            executor = stack.enter_context(ProcessPoolExecutor(max_workers=workers))
+            where = f"{workers} worker processes"
+        with output_folder(args.output) as out:  # checked before the runs; removed again if nothing gets written
+            result = run_sweep(spec, executor, progress=not args.no_progress, backend=args.backend,
+                               chunk_size=args.chunk_size)
+            names = result.write(out)
     for failure in result.failures:
         print(f"pamsim: warning: failed run {failure}", file=sys.stderr)
-    print(f"{spec.name}: {len(result.rows)} cases, {len(result.failures)} failed runs, "
-          f"{result.wall_time_s:.2f} s on {args.workers} worker(s)")
+    samples = f", {spec.uncertainty.samples} uncertainty samples" if spec.uncertainty is not None else ""
+    print(f"{spec.name}: {len(result.rows)} cases{samples}, {len(result.failures)} failed runs, "
+          f"{result.wall_time_s:.2f} s on {where}")
     print(f"wrote {', '.join(str(Path(args.output) / n) for n in names)}")
     return 0

@@ -19,10 +19,12 @@ import numpy as np
 
 from ..atomic import atomic_outputs
 from ..constants import PA_PER_BAR
+from ..errors import InputError
 from ..oscillation import estimate_oscillation
 from ..scenario import Scenario
 from ..static import friction_band_m, static_report
 from .spec import SweepCase, SweepSpec, load_sweep
+from .uncertainty import UncertaintyResult
 
 SETTLED_FRACTION = 0.05
 """The pressure counts as settled once it stays within 5 % of its step of its final value; the
@@ -31,6 +33,8 @@ oscillation is estimated from then on, so creep driven by a still-rising pressur
 LAST_WINDOW_S = 1.0
 """Window at the end of each run over which the remaining motion (peak to peak) is reported [s]."""
 
+UNCERTAINTY_TABLES = ("uncertainty_samples.csv", "uncertainty_summary.csv")
+
 FIGURES = ("error_heatmap.png", "steady_state_vs_pressure.png", "time_responses.png", "frequency_vs_load.png")
 
 
@@ -38,15 +42,38 @@ FIGURES = ("error_heatmap.png", "steady_state_vs_pressure.png", "time_responses.
 class _Task:
     """One scenario to run in a worker (it pickles to a process or a distributed worker)."""
 
-    kind: str  # "case", "frequency" or "response"
+    kind: str  # "case", "frequency", "response" or "sample"
     key: tuple
     scenario: Scenario
     keep_trace: bool
     backend: str = "python"
+    # Parameter values applied in the worker, so that thousands of samples of one base scenario
+    # send the scenario once per chunk (pickle shares it) and build their variants where they run.
+    parameters: tuple[tuple[str, float], ...] = ()
 
 
-def _task(kind: str, key: tuple, scenario: Scenario, keep_trace: bool = False, backend: str = "python") -> _Task:
-    return _Task(kind, key, scenario, keep_trace, backend)
+def _task(kind: str, key: tuple, scenario: Scenario, keep_trace: bool = False, backend: str = "python",
+          parameters: tuple[tuple[str, float], ...] = ()) -> _Task:
+    return _Task(kind, key, scenario, keep_trace, backend, parameters)
+
+
+MAX_AUTO_CHUNK = 50
+"""Largest chunk chosen automatically: big enough to amortise the per-task overhead of a scheduler
+(milliseconds) against runs of about 20 ms, small enough to balance the load and lose little work
+when a worker dies."""
+
+AUTO_CHUNKS = 64
+"""Chunks the automatic size aims at (fewer when capped by :data:`MAX_AUTO_CHUNK`)."""
+
+
+def auto_chunk_size(n_tasks: int) -> int:
+    """Runs per executor task when none is given: ``ceil(n / 64)``, between 1 and 50."""
+    return max(1, min(MAX_AUTO_CHUNK, math.ceil(n_tasks / AUTO_CHUNKS)))
+
+
+def run_chunk(tasks: list[_Task]) -> list[dict]:
+    """Run a chunk of tasks one after the other in one worker (one executor task, one round trip)."""
+    return [run_task(task) for task in tasks]
 
 
 def run_task(task: _Task) -> dict:
@@ -57,7 +84,10 @@ def run_task(task: _Task) -> dict:
     from ..api import simulate
 
     try:
-        result = simulate(task.scenario, task.backend)
+        scenario = task.scenario
+        if task.parameters:
+            scenario = scenario.with_changes({"parameters": dict(task.parameters)})
+        result = simulate(scenario, task.backend)
         t_settled = settled_time_s(result.t_s, result.p_gauge_Pa)
         osc = estimate_oscillation(result.t_s, result.x_m, t_start_s=t_settled)
         last = result.t_s >= result.t_s[-1] - LAST_WINDOW_S
@@ -67,6 +97,7 @@ def run_task(task: _Task) -> dict:
                "frequency_Hz": osc.frequency_Hz, "damping_ratio": osc.damping_ratio,
                "n_half_cycles": osc.n_half_cycles, "half_period_asymmetry": osc.half_period_asymmetry,
                "settled_time_s": t_settled,
+               "contraction_settled_time_s": settled_time_s(result.t_s, result.x_m),
                "wall_time_s": float(result.wall_time_s), "error": ""}
         if task.keep_trace:
             out["t_s"] = result.t_s
@@ -78,7 +109,10 @@ def run_task(task: _Task) -> dict:
 
 
 def settled_time_s(t_s: np.ndarray, p_gauge_Pa: np.ndarray, fraction: float = SETTLED_FRACTION) -> float:
-    """First time after which the pressure stays within ``fraction`` of its step of its final value."""
+    """First time after which a signal stays within ``fraction`` of its step of its final value.
+
+    Used for the pressure (``p_gauge_Pa``) and, in uncertainty studies, for the contraction.
+    """
     step = abs(float(p_gauge_Pa[-1] - p_gauge_Pa[0]))
     if step == 0.0:
         return float(t_s[0])
@@ -96,6 +130,7 @@ class SweepResult:
     responses: dict[str, dict[str, dict]]
     wall_time_s: float
     failures: list[str] = field(default_factory=list)
+    uncertainty: UncertaintyResult | None = None
 
     def columns(self) -> list[str]:
         """Column names of ``summary.csv``."""
@@ -112,11 +147,22 @@ class SweepResult:
         from .report import write_report
         from .plots import write_figures
 
-        names = ["summary.csv", "report.md", *FIGURES]
+        from .uncertainty_plots import FIGURES as UNCERTAINTY_FIGURES, write_uncertainty_figures
+
+        study = self.uncertainty
+        # A pure uncertainty study (no cases) writes only its own outputs.
+        names = ["summary.csv", "report.md", *FIGURES] if self.spec.cases or study is None else []
+        if study is not None:
+            names += [*UNCERTAINTY_TABLES, "uncertainty.md", *UNCERTAINTY_FIGURES]
         with atomic_outputs(directory, names) as tmp:
-            self.to_csv(tmp["summary.csv"])
-            tmp["report.md"].write_text(write_report(self))
-            write_figures(self, {n: tmp[n] for n in FIGURES})
+            if "summary.csv" in names:
+                self.to_csv(tmp["summary.csv"])
+                tmp["report.md"].write_text(write_report(self))
+                write_figures(self, {n: tmp[n] for n in FIGURES})
+            if study is not None:
+                study.write_tables(*(tmp[n] for n in UNCERTAINTY_TABLES))
+                tmp["uncertainty.md"].write_text(study.report(self.spec.name))
+                write_uncertainty_figures(study, {n: tmp[n] for n in UNCERTAINTY_FIGURES})
         return names
 
     def to_csv(self, path: str | Path) -> None:
@@ -138,7 +184,7 @@ def _fmt(value: Any) -> Any:
 
 
 def run_sweep(spec: SweepSpec | str | Path, executor: Executor | None = None, progress: bool = False,
-              backend: str | None = None) -> SweepResult:
+              backend: str | None = None, chunk_size: int | None = None) -> SweepResult:
     """Run every case of a sweep under every friction model, and the frequency and response studies.
 
     Parameters
@@ -154,6 +200,10 @@ def run_sweep(spec: SweepSpec | str | Path, executor: Executor | None = None, pr
     backend : str, optional
         The backend of every run (:data:`pamsim.backends.BACKENDS`); default: the sweep file's
         ``backend`` key, else ``"python"``.  Every scenario is checked against it before anything runs.
+    chunk_size : int, optional
+        Runs sent to the executor as one task (default :func:`auto_chunk_size`).
+        Larger chunks amortise the per-task cost of a cluster scheduler; smaller
+        ones balance the load better.  Ignored without an executor.
 
     Returns
     -------
@@ -172,14 +222,23 @@ def run_sweep(spec: SweepSpec | str | Path, executor: Executor | None = None, pr
     tasks += [_task("response", (s.name, f), s.with_changes({"model": {"friction": f}}), True, backend)
               for s in spec.time_responses for f in spec.friction_models]
     start = time.perf_counter()
+    samples = spec.uncertainty.draw() if spec.uncertainty is not None else None
+    if samples is not None:
+        for f in spec.friction_models:
+            base = spec.base.with_changes({"model": {"friction": f}})
+            tasks += [_task("sample", (k, f), base, backend=backend, parameters=tuple(zip(samples.names, map(float, values))))
+                      for k, values in enumerate(samples.values)]
+    if chunk_size is not None and (isinstance(chunk_size, bool) or not isinstance(chunk_size, int) or chunk_size < 1):
+        raise InputError(f"chunk_size = {chunk_size!r}: must be a positive integer")
     from tqdm import tqdm
 
     with tqdm(total=len(tasks), unit="run", desc=spec.name, file=sys.stderr, disable=not progress,
               dynamic_ncols=True) as bar:
-        outputs = _execute(tasks, executor, bar)
+        outputs = _execute(tasks, executor, bar, chunk_size or auto_chunk_size(len(tasks)))
     wall = time.perf_counter() - start
     by_key = {(t.kind, t.key): o for t, o in zip(tasks, outputs)}
-    failures = [f"{t.scenario.name}: {o['error']}" for t, o in zip(tasks, outputs) if o["error"]]
+    failures = [f"{t.scenario.name}{f' sample {t.key[0]}' if t.kind == 'sample' else ''}: {o['error']}"
+                for t, o in zip(tasks, outputs) if o["error"]]
     rows = [_case_row(spec, i, case, by_key) for i, case in enumerate(spec.cases)]
     freq_rows = []
     if spec.frequency is not None:
@@ -193,7 +252,11 @@ def run_sweep(spec: SweepSpec | str | Path, executor: Executor | None = None, pr
             freq_rows.append(row)
     responses = {s.name: {f: by_key[("response", (s.name, f))] for f in spec.friction_models}
                  for s in spec.time_responses}
-    return SweepResult(spec, rows, freq_rows, responses, wall, failures)
+    study = None
+    if samples is not None:
+        study = UncertaintyResult(spec.uncertainty, samples, {
+            f: [by_key[("sample", (k, f))] for k in range(len(samples.values))] for f in spec.friction_models})
+    return SweepResult(spec, rows, freq_rows, responses, wall, failures, study)
 
 
 def check_backend(spec: SweepSpec, backend: str) -> None:
@@ -212,8 +275,9 @@ def check_backend(spec: SweepSpec, backend: str) -> None:
             check_scenario(backend, scenario.with_changes({"model": {"friction": friction}}))
 
 
-def _execute(tasks: list[_Task], executor: Executor | None, bar) -> list[dict]:
-    """Run the tasks (here or on ``executor``), advancing the tqdm ``bar`` by one per finished run."""
+def _execute(tasks: list[_Task], executor: Executor | None, bar, chunk_size: int = 1) -> list[dict]:
+    """Run the tasks (here, or on ``executor`` in chunks of ``chunk_size``), advancing the tqdm ``bar``
+    by one per finished run."""
     outputs: list[dict | None] = [None] * len(tasks)
     failed = 0
     if executor is None:
@@ -223,16 +287,19 @@ def _execute(tasks: list[_Task], executor: Executor | None, bar) -> list[dict]:
             bar.set_postfix(failed=failed, refresh=False)
             bar.update(1)
         return outputs
-    futures = {executor.submit(run_task, task): i for i, task in enumerate(tasks)}
+    starts = range(0, len(tasks), chunk_size)
+    futures = {executor.submit(run_chunk, tasks[i:i + chunk_size]): i for i in starts}
     for fut in as_completed(futures):
         i = futures[fut]
+        n = min(chunk_size, len(tasks) - i)
         try:
-            outputs[i] = fut.result()
-        except Exception as exc:  # noqa: BLE001 -- a dead worker fails its case, not the sweep
-            outputs[i] = {"error": f"{type(exc).__name__}: {exc}"}
-        failed += bool(outputs[i]["error"])
+            chunk = fut.result()
+        except Exception as exc:  # noqa: BLE001 -- a dead worker fails its chunk's cases, not the sweep
+            chunk = [{"error": f"{type(exc).__name__}: {exc}"}] * n
+        outputs[i:i + n] = chunk
+        failed += sum(bool(o["error"]) for o in chunk)
         bar.set_postfix(failed=failed, refresh=False)
-        bar.update(1)
+        bar.update(n)
     return outputs
 
 

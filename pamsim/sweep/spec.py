@@ -14,14 +14,17 @@ import difflib
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Mapping
+from typing import TYPE_CHECKING, Any, Mapping
 
 from ..elements.friction import FRICTION_MODELS
 from ..errors import InputError
 from ..scenario import Scenario, load_scenario, read_toml
 
+if TYPE_CHECKING:
+    from .uncertainty import UncertaintySpec
+
 _TOP_KEYS = {"name", "description", "base_scenario", "friction_models", "capability_min_equilibrium_mm",
-             "backend", "measured", "cases", "axes", "case", "frequency", "time_responses"}
+             "backend", "measured", "cases", "axes", "case", "frequency", "time_responses", "uncertainty"}
 _MEASURED_KEYS = {"file", "weight_column", "pressure_column", "contraction_column", "nominal_pressure_column"}
 _AXES = {"pressure_bar", "weight_N"}
 _FREQUENCY_KEYS = {"pressure_bar", "weight_N", "pressure"}
@@ -71,6 +74,7 @@ class SweepSpec:
     time_responses: tuple[Scenario, ...] = ()
     backend: str = "python"
     """The backend that runs every case (:data:`pamsim.backends.BACKENDS`); ``pamsim sweep --backend`` overrides it."""
+    uncertainty: "UncertaintySpec | None" = None
 
     def case_scenario(self, case: SweepCase, friction: str) -> Scenario:
         """The base scenario with the case's load and pressure and the given friction model."""
@@ -124,7 +128,14 @@ def sweep_from_dict(spec: Mapping[str, Any], base_dir: str | Path = ".", origin:
             _fail(origin, "friction_models", f, "unknown friction model", FRICTION_MODELS)
     threshold_mm = _number(origin, "capability_min_equilibrium_mm", spec.get("capability_min_equilibrium_mm", 5.0))
     measured = _read_measured(origin, base_dir, spec["measured"]) if "measured" in spec else None
-    cases = _cases(origin, spec, measured)
+    uncertainty = None
+    if "uncertainty" in spec:
+        from .uncertainty import parse_uncertainty  # it uses this module's checks
+
+        uncertainty = parse_uncertainty(origin, spec["uncertainty"], base)
+    # An uncertainty study samples the base scenario itself and needs no cases.
+    no_cases = uncertainty is not None and not any(k in spec for k in ("cases", "axes", "case"))
+    cases = () if no_cases else _cases(origin, spec, measured)
     frequency = _frequency(origin, spec["frequency"]) if "frequency" in spec else None
     responses = ()
     if "time_responses" in spec:
@@ -136,7 +147,7 @@ def sweep_from_dict(spec: Mapping[str, Any], base_dir: str | Path = ".", origin:
     result = SweepSpec(_typed(origin, "name", spec.get("name", default_name), str),
                        _typed(origin, "description", spec.get("description", ""), str), origin, base, cases,
                        frictions, threshold_mm * 1e-3, frequency, responses,
-                       _backend(origin, spec.get("backend", "python")))
+                       _backend(origin, spec.get("backend", "python")), uncertainty)
     # Build every scenario once so a bad value (a pressure above the rating...) fails before the run.
     try:
         for case in cases:

@@ -1,0 +1,281 @@
+"""Uncertainty studies: the ``[uncertainty]`` table of a sweep file, its samples and their summary.
+
+Parameters of the base scenario are drawn from normal, uniform or lognormal
+distributions, each truncated to its bounds, by plain random sampling or a
+Latin hypercube (:mod:`scipy.stats.qmc`), from a fixed seed.  Every sample is
+run under every friction model of the sweep; the summary gives quantiles of the
+final and peak contraction and of the contraction's settling time.  The format
+is described in ``docs/scaling.md`` and ``scenarios/acra2012_fig4_uncertainty.toml``.
+
+Bounds are handled by *truncation*: a uniform number ``u`` in [0, 1) is mapped to
+``F(lower) + u (F(upper) - F(lower))`` and through the inverse CDF ``F^-1``.  This
+has the same distribution as drawing and rejecting values outside the bounds, keeps
+the sample count fixed, and keeps a Latin hypercube stratified (rejection would not).
+"""
+
+from __future__ import annotations
+
+import csv
+import inspect
+import math
+from dataclasses import dataclass
+from typing import Any, Mapping
+
+import numpy as np
+from scipy import stats
+from scipy.stats import qmc
+
+from ..scenario import Scenario
+
+DISTRIBUTIONS = {
+    "normal": ("mean", "std"),
+    "uniform": (),
+    "lognormal": ("median", "sigma"),
+}
+"""Distribution names and their shape keys (besides ``lower`` and ``upper``, which every one needs).
+``lognormal``: ``ln(value)`` is normal with mean ``ln(median)`` and standard deviation ``sigma``."""
+
+SAMPLING = ("latin_hypercube", "random")
+
+QUANTITIES = {
+    "final_contraction_m": "final contraction [mm]",
+    "peak_contraction_m": "peak contraction [mm]",
+    "contraction_settled_time_s": "settling time [s]",
+}
+"""Summarised outputs of each run and their axis labels (contractions shown in mm)."""
+
+DEFAULT_QUANTILES = (0.05, 0.25, 0.5, 0.75, 0.95)
+MIN_BOUND_MASS = 1e-9
+"""Bounds holding less probability than this exclude the distribution: an error, not a silent clamp."""
+
+_TABLE_KEYS = {"samples", "seed", "sampling", "quantiles", "parameters"}
+_PARAM_KEYS = {"distribution", "relative", "lower", "upper", "mean", "std", "median", "sigma"}
+
+
+@dataclass(frozen=True)
+class ParameterDistribution:
+    """One sampled parameter: a distribution truncated to ``[lower, upper]``.
+
+    With ``relative`` the distribution is of a factor applied to the base
+    scenario's value ``nominal`` (so ``lower = 0.9, upper = 1.1`` is +-10 %).
+    """
+
+    name: str
+    distribution: str
+    lower: float
+    upper: float
+    shape: tuple[float, ...]
+    relative: bool
+    nominal: float
+
+    def frozen(self):
+        """The untruncated scipy distribution (of the factor when ``relative``)."""
+        if self.distribution == "normal":
+            return stats.norm(loc=self.shape[0], scale=self.shape[1])
+        if self.distribution == "lognormal":
+            return stats.lognorm(s=self.shape[1], scale=self.shape[0])
+        return stats.uniform(loc=self.lower, scale=self.upper - self.lower)
+
+    def bound_mass(self) -> float:
+        """Probability of the untruncated distribution inside the bounds."""
+        d = self.frozen()
+        return float(d.cdf(self.upper) - d.cdf(self.lower))
+
+    def transform(self, u: np.ndarray) -> np.ndarray:
+        """Values of the parameter (in its own unit) for uniform numbers ``u`` in [0, 1)."""
+        d = self.frozen()
+        lo, hi = d.cdf(self.lower), d.cdf(self.upper)
+        x = np.clip(d.ppf(lo + np.asarray(u, dtype=float) * (hi - lo)), self.lower, self.upper)
+        return x * self.nominal if self.relative else x
+
+    def describe(self) -> str:
+        """One line for reports, e.g. ``uniform factor on [0.9, 1.1] x 1e-09``."""
+        shape = ", ".join(f"{k} = {v:g}" for k, v in zip(DISTRIBUTIONS[self.distribution], self.shape))
+        what = f"{self.distribution}({shape})" if shape else self.distribution
+        bounds = f"on [{self.lower:g}, {self.upper:g}]"
+        return f"{what} factor {bounds} x {self.nominal:g}" if self.relative else f"{what} {bounds}"
+
+
+@dataclass(frozen=True)
+class Samples:
+    """Drawn parameter values: ``values[k, j]`` is parameter ``names[j]`` of sample ``k``."""
+
+    names: tuple[str, ...]
+    values: np.ndarray
+
+
+@dataclass(frozen=True)
+class UncertaintySpec:
+    """A validated ``[uncertainty]`` table."""
+
+    parameters: tuple[ParameterDistribution, ...]
+    samples: int
+    seed: int
+    sampling: str
+    quantiles: tuple[float, ...] = DEFAULT_QUANTILES
+
+    def uniforms(self) -> np.ndarray:
+        """The ``(samples, parameters)`` array of uniform numbers in [0, 1) behind :meth:`draw`."""
+        d = len(self.parameters)
+        rng = np.random.default_rng(self.seed)
+        if self.sampling == "random":
+            return rng.random((self.samples, d))
+        # scipy >= 1.15 names the generator ``rng``; older versions call it ``seed``.
+        kw = "rng" if "rng" in inspect.signature(qmc.LatinHypercube).parameters else "seed"
+        return qmc.LatinHypercube(d=d, **{kw: rng}).random(self.samples)
+
+    def draw(self) -> Samples:
+        """The samples; the same seed gives the same values on every machine and executor."""
+        u = self.uniforms()
+        cols = [p.transform(u[:, j]) for j, p in enumerate(self.parameters)]
+        return Samples(tuple(p.name for p in self.parameters), np.column_stack(cols))
+
+
+# ---------------------------------------------------------------- reading the table
+def parse_uncertainty(origin: str, table: Any, base: Scenario) -> UncertaintySpec:
+    """Validate an ``[uncertainty]`` table against the base scenario's parameter set.
+
+    Every mistake raises :class:`pamsim.sweep.SweepError` naming the file, the key and the value.
+    """
+    from .spec import SweepError, _check_keys, _fail, _number, _required, _typed
+
+    _check_keys(origin, "[uncertainty]", "uncertainty.", table, _TABLE_KEYS)
+    n = _required(origin, table, "samples", int, "uncertainty.")
+    if isinstance(n, bool) or n < 1:
+        _fail(origin, "uncertainty.samples", n, "must be a positive integer")
+    seed = _required(origin, table, "seed", int, "uncertainty.")
+    if isinstance(seed, bool) or seed < 0:
+        _fail(origin, "uncertainty.seed", seed, "must be a non-negative integer")
+    sampling = _typed(origin, "uncertainty.sampling", table.get("sampling", "latin_hypercube"), str)
+    if sampling not in SAMPLING:
+        _fail(origin, "uncertainty.sampling", sampling, "unknown sampling", SAMPLING)
+    quantiles = table.get("quantiles", list(DEFAULT_QUANTILES))
+    if not isinstance(quantiles, list) or not quantiles:
+        _fail(origin, "uncertainty.quantiles", quantiles, "must be a non-empty list of numbers in [0, 1]")
+    for q in quantiles:
+        if not 0.0 <= _number(origin, "uncertainty.quantiles", q) <= 1.0:
+            _fail(origin, "uncertainty.quantiles", q, "must lie in [0, 1]")
+    params = _required(origin, table, "parameters", dict, "uncertainty.")
+    if not params:
+        raise SweepError(f"{origin}: uncertainty.parameters is empty: name at least one parameter to sample")
+    dists = []
+    for name, entry in params.items():
+        if name not in base.parameters.entries:
+            _fail(origin, f"uncertainty.parameters.{name}", entry, "unknown parameter", base.parameters.entries)
+        dists.append(_distribution(origin, f"uncertainty.parameters.{name}", name, entry, base))
+    return UncertaintySpec(tuple(dists), n, seed, sampling, tuple(float(q) for q in quantiles))
+
+
+def _distribution(origin: str, where: str, name: str, entry: Any, base: Scenario) -> ParameterDistribution:
+    from .spec import _check_keys, _fail, _number, _required, _typed
+
+    _check_keys(origin, f"[{where}]", where + ".", entry, _PARAM_KEYS)
+    kind = _required(origin, entry, "distribution", str, where + ".")
+    if kind not in DISTRIBUTIONS:
+        _fail(origin, f"{where}.distribution", kind, "unknown distribution", DISTRIBUTIONS)
+    allowed = {"distribution", "relative", "lower", "upper", *DISTRIBUTIONS[kind]}
+    for key in entry:
+        if key not in allowed:
+            _fail(origin, f"{where}.{key}", entry[key], f"does not apply to a {kind} distribution "
+                  f"(it takes {', '.join(sorted(allowed - {'distribution'}))})")
+    relative = _typed(origin, f"{where}.relative", entry.get("relative", False), bool)
+    lower = _required(origin, entry, "lower", float, where + ".")
+    upper = _required(origin, entry, "upper", float, where + ".")
+    if not lower < upper:
+        _fail(origin, f"{where}.upper", upper, f"must be above lower = {lower:g}")
+    shape = tuple(_required(origin, entry, k, float, where + ".") for k in DISTRIBUTIONS[kind])
+    if kind in ("normal", "lognormal") and not shape[1] > 0:
+        _fail(origin, f"{where}.{DISTRIBUTIONS[kind][1]}", shape[1], "must be positive")
+    if kind == "lognormal" and not shape[0] > 0:
+        _fail(origin, f"{where}.median", shape[0], "must be positive")
+    nominal = float(base.parameters[name])
+    if relative and nominal == 0.0:
+        _fail(origin, f"{where}.relative", True, "the base value is 0, so a factor cannot vary it")
+    dist = ParameterDistribution(name, kind, lower, upper, shape, relative, nominal)
+    mass = dist.bound_mass()
+    if not mass >= MIN_BOUND_MASS:
+        _fail(origin, f"{where}.lower", lower, f"the bounds [{lower:g}, {upper:g}] exclude the {kind} "
+              f"distribution (probability inside {mass:.3g})")
+    rule = base.parameters.entries[name]
+    for key, bound in (("lower", lower), ("upper", upper)):
+        value = bound * nominal if relative else bound
+        why = rule.violation(value)
+        if why is not None:
+            _fail(origin, f"{where}.{key}", bound, f"gives {name} = {value:g}, which {why}")
+    return dist
+
+
+# ---------------------------------------------------------------- results
+@dataclass
+class UncertaintyResult:
+    """The runs of an uncertainty study: ``outputs[friction][k]`` is sample ``k``'s run."""
+
+    spec: UncertaintySpec
+    samples: Samples
+    outputs: Mapping[str, list[dict]]
+
+    def values(self, friction: str, quantity: str) -> np.ndarray:
+        """``quantity`` of every successful run of ``friction`` (failed runs left out)."""
+        v = np.array([o.get(quantity, math.nan) for o in self.outputs[friction] if not o["error"]], dtype=float)
+        return v[np.isfinite(v)]
+
+    def failed(self, friction: str) -> int:
+        """Number of failed runs under ``friction``."""
+        return sum(bool(o["error"]) for o in self.outputs[friction])
+
+    def quantile_rows(self) -> list[dict]:
+        """One row per friction model and quantity: count, mean, standard deviation and quantiles."""
+        rows = []
+        for f in self.outputs:
+            for q in QUANTITIES:
+                v = self.values(f, q)
+                row = {"friction_model": f, "quantity": q, "runs": int(v.size), "failed": self.failed(f),
+                       "mean": float(v.mean()) if v.size else math.nan,
+                       "std": float(v.std(ddof=1)) if v.size > 1 else math.nan}
+                for p in self.spec.quantiles:
+                    row[f"q{p:g}"] = float(np.quantile(v, p)) if v.size else math.nan
+                rows.append(row)
+        return rows
+
+    def sample_rows(self) -> list[dict]:
+        """One row per run: sample number, friction model, parameter values and outputs."""
+        rows = []
+        for f, outs in self.outputs.items():
+            for k, o in enumerate(outs):
+                row = {"sample": k, "friction_model": f}
+                row.update(zip(self.samples.names, map(float, self.samples.values[k])))
+                row.update({q: o.get(q, math.nan) for q in QUANTITIES})
+                row["at_rest"] = o.get("at_rest", math.nan)
+                row["failure"] = o["error"]
+                rows.append(row)
+        return rows
+
+    def write_tables(self, samples_path, summary_path) -> None:
+        """Write the per-run and the quantile tables as CSV (the caller stages them atomically)."""
+        for path, rows in ((samples_path, self.sample_rows()), (summary_path, self.quantile_rows())):
+            with open(path, "w", newline="") as fh:
+                w = csv.DictWriter(fh, fieldnames=list(rows[0]))
+                w.writeheader()
+                for row in rows:
+                    w.writerow({k: (f"{v:.9g}" if isinstance(v, float) else v) for k, v in row.items()})
+
+    def report(self, sweep_name: str) -> str:
+        """The markdown text of ``uncertainty.md``."""
+        s = self.spec
+        out = [f"# Uncertainty study: {sweep_name}", "",
+               f"{s.samples} samples ({s.sampling.replace('_', ' ')}, seed {s.seed}) of {len(s.parameters)} "
+               f"parameters, each run under {', '.join(self.outputs)} friction; distributions truncated to "
+               "their bounds.", "", "| parameter | distribution |", "|---|---|"]
+        out += [f"| {p.name} | {p.describe()} |" for p in s.parameters]
+        out += ["", "Contractions in mm; the settling time is the first time (from the start of the run) after "
+                "which the contraction stays within 5 % of its change of its final value.", "",
+                "| friction | quantity | runs | failed | mean | std | "
+                + " | ".join(f"q{p:g}" for p in s.quantiles) + " |", "|---|---|---|---|---|---|"
+                + "---|" * len(s.quantiles)]
+        for row in self.quantile_rows():
+            scale = 1e3 if row["quantity"].endswith("_m") else 1.0
+            nums = [row["mean"], row["std"], *(row[f"q{p:g}"] for p in s.quantiles)]
+            out.append(f"| {row['friction_model']} | {QUANTITIES[row['quantity']]} | {row['runs']} | {row['failed']} | "
+                       + " | ".join(f"{v * scale:.4g}" for v in nums) + " |")
+        out += ["", "![histograms](uncertainty_histograms.png)", "", "![ECDF](uncertainty_ecdf.png)", ""]
+        return "\n".join(out)

@@ -1,0 +1,59 @@
+"""Figures of an uncertainty study: histograms and empirical CDFs of the summarised outputs.
+
+Each function returns a matplotlib ``Figure`` (no pyplot state) for a
+:class:`pamsim.sweep.uncertainty.UncertaintyResult`; the caller saves it.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from .uncertainty import QUANTITIES, UncertaintyResult
+
+_DPI = 110
+FIGURES = ("uncertainty_histograms.png", "uncertainty_ecdf.png")
+
+
+def _panels(result: UncertaintyResult, title: str):
+    fig = Figure(figsize=(13, 4), constrained_layout=True)
+    axes = fig.subplots(1, len(QUANTITIES))
+    fig.suptitle(f"{title}: {result.spec.samples} samples, seed {result.spec.seed}")
+    for ax, (q, label) in zip(axes, QUANTITIES.items()):
+        scale = 1e3 if q.endswith("_m") else 1.0
+        ax.set_xlabel(label)
+        for f in result.outputs:
+            yield fig, ax, f, np.sort(result.values(f, q)) * scale
+
+
+def histogram_figure(result: UncertaintyResult) -> Figure:
+    """One histogram panel per quantity, one outline per friction model, median dashed."""
+    fig = None
+    for fig, ax, f, v in _panels(result, "Histograms"):
+        if v.size:
+            _, _, patches = ax.hist(v, bins=min(50, max(5, int(np.sqrt(v.size)))), histtype="step", label=f)
+            ax.axvline(np.median(v), ls="--", lw=0.8, color=patches[0].get_edgecolor())
+        ax.set_ylabel("runs")
+        ax.legend(fontsize=8)
+    return fig
+
+
+def ecdf_figure(result: UncertaintyResult) -> Figure:
+    """One empirical-CDF panel per quantity, with the study's quantiles marked."""
+    fig = None
+    for fig, ax, f, v in _panels(result, "Empirical CDF"):
+        if v.size:
+            ax.step(v, np.arange(1, v.size + 1) / v.size, where="post", label=f)
+        for p in result.spec.quantiles:
+            ax.axhline(p, lw=0.5, color="0.7")
+        ax.set_ylabel("fraction of runs <= value")
+        ax.set_ylim(0, 1)
+        ax.legend(fontsize=8)
+    return fig
+
+
+def write_uncertainty_figures(result: UncertaintyResult, paths) -> None:
+    """Save the two figures to ``paths`` (keys are the names in :data:`FIGURES`)."""
+    makers = {"uncertainty_histograms.png": histogram_figure, "uncertainty_ecdf.png": ecdf_figure}
+    for name, path in paths.items():
+        makers[name](result).savefig(path, format="png", dpi=_DPI)

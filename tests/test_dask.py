@@ -1,0 +1,158 @@
+"""Sweeps in chunks and on a Dask LocalCluster of worker processes: same numbers as the serial run,
+a killed worker does not stop the sweep, and a clear error without Dask.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import signal
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
+from pathlib import Path
+
+import pytest
+
+import pamsim
+from pamsim.cli import main as cli_main
+from pamsim.sweep import dask_cluster, sweep_from_dict
+from pamsim.sweep.run import auto_chunk_size
+from conftest import run_cli as _cli
+
+distributed = pytest.importorskip("distributed", reason="Dask is the optional extra pamsim[dask] (in [test])")
+
+ROOT = Path(__file__).resolve().parents[1]
+FIG4 = str(ROOT / "scenarios" / "acra2012_fig4.toml")
+SWEEP = {"base_scenario": FIG4, "friction_models": ["load_dependent", "constant"],
+         "axes": {"pressure_bar": [2.8, 3.6], "weight_N": [12.74, 32.74]},
+         "uncertainty": {"samples": 3, "seed": 11, "parameters": {
+             "valve_C_m3_per_s_Pa": {"distribution": "uniform", "relative": True, "lower": 0.9, "upper": 1.1}}}}
+
+
+def _same(a, b) -> bool:
+    """Equal bit for bit, NaN equal to NaN."""
+    if isinstance(a, float) and isinstance(b, float):
+        return a == b or (math.isnan(a) and math.isnan(b))
+    return a == b
+
+
+def _assert_identical(result, reference):
+    assert [r.keys() for r in result.rows] == [r.keys() for r in reference.rows]
+    for row, ref in zip(result.rows, reference.rows):
+        assert all(_same(row[k], ref[k]) for k in ref), (row, ref)
+    for f, outs in reference.uncertainty.outputs.items():
+        for o, ref in zip(result.uncertainty.outputs[f], outs):
+            assert all(_same(o[k], ref[k]) for k in ref if k != "wall_time_s"), (o, ref)
+
+
+@pytest.fixture(scope="module")
+def spec():
+    return sweep_from_dict(SWEEP)
+
+
+@pytest.fixture(scope="module")
+def serial(spec):
+    return pamsim.sweep(spec)
+
+
+@pytest.fixture(scope="module")
+def client():
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster, distributed.Client(cluster) as c:
+        yield c
+
+
+def test_dask_local_cluster_gives_the_serial_numbers_bit_for_bit(spec, serial, client):
+    assert serial.failures == [] and len(serial.rows) == 4
+    for chunk_size in (None, 3):  # automatic (1 run per task here) and 3 runs per task
+        result = pamsim.sweep(spec, client.get_executor(pure=False), chunk_size=chunk_size)
+        _assert_identical(result, serial)
+
+
+def test_chunked_process_pool_gives_the_serial_numbers(spec, serial):
+    with ProcessPoolExecutor(max_workers=2) as pool:
+        _assert_identical(pamsim.sweep(spec, pool, chunk_size=4), serial)
+
+
+def test_automatic_chunk_size_amortises_large_sweeps():
+    assert auto_chunk_size(14) == 1
+    assert auto_chunk_size(156) == 3           # the grid: 52 tasks
+    assert auto_chunk_size(10_000) == 50       # capped: 200 tasks
+    with pytest.raises(pamsim.errors.InputError, match="chunk_size = 0"):
+        pamsim.sweep(sweep_from_dict(SWEEP), ThreadPoolExecutor(1), chunk_size=0)
+
+
+def test_a_worker_killed_mid_sweep_is_retried_and_the_sweep_completes(spec, serial, client):
+    pids = set(client.run(os.getpid).values())
+    with ThreadPoolExecutor(1) as outer:  # bound the wait: a hung sweep fails the test, not the session
+        running = outer.submit(pamsim.sweep, spec, client.get_executor(pure=False), chunk_size=1)
+        deadline = time.monotonic() + 60
+        busy = []
+        while not busy and time.monotonic() < deadline:
+            busy = [w for w, keys in client.processing().items() if keys]
+            time.sleep(0.01)
+        pid = client.run(os.getpid, workers=[busy[0]])[busy[0]]
+        os.kill(pid, signal.SIGKILL)
+        killed_mid_sweep = not running.done()
+        result = running.result(timeout=240)
+    assert pid in pids and killed_mid_sweep
+    # The scheduler re-ran the dead worker's chunk elsewhere (or reported it failed): every row is there,
+    # and every row that did not fail carries the serial numbers.
+    assert len(result.rows) == len(serial.rows)
+    failed = [r for r in result.rows if r["failure"] or r["constant_failure"]]
+    ok = [(r, s) for r, s in zip(result.rows, serial.rows) if r not in failed]
+    for row, ref in ok:
+        assert all(_same(row[k], ref[k]) for k in ref)
+    for r in failed:
+        assert "KilledWorker" in r["failure"] + r["constant_failure"]
+    client.wait_for_workers(2, timeout=60)  # the nanny restarts it for the tests that follow
+
+
+def test_a_process_pool_worker_killed_mid_sweep_fails_its_chunks_and_the_sweep_completes(spec, serial):
+    with ProcessPoolExecutor(max_workers=2) as pool, ThreadPoolExecutor(1) as outer:
+        running = outer.submit(pamsim.sweep, spec, pool, chunk_size=1)
+        deadline = time.monotonic() + 60
+        while not pool._processes and time.monotonic() < deadline:  # CPython's pool keeps {pid: process}
+            time.sleep(0.02)
+        time.sleep(0.2)  # the workers hold their first chunks (starting a worker takes longer)
+        os.kill(next(iter(pool._processes)), signal.SIGKILL)
+        result = running.result(timeout=240)
+    assert len(result.rows) == len(serial.rows)
+    errors = [r["failure"] + r["constant_failure"] for r in result.rows]
+    assert any("BrokenProcessPool" in e for e in errors)
+    for row, ref, e in zip(result.rows, serial.rows, errors):
+        if not e:
+            assert all(_same(row[k], ref[k]) for k in ref)
+
+
+def test_dask_without_the_extra_is_one_line_naming_it(tmp_path, monkeypatch, capsys):
+    (tmp_path / "s.toml").write_text(f'base_scenario = "{FIG4}"\n[axes]\npressure_bar = [3.6]\nweight_N = [22.74]\n')
+    monkeypatch.setitem(sys.modules, "distributed", None)  # import distributed now raises ImportError
+    code = cli_main(["sweep", str(tmp_path / "s.toml"), "-o", str(tmp_path / "out"), "--dask", "tcp://h:8786"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and "pamsim[dask]" in err[0]
+    assert not (tmp_path / "out").exists()
+
+
+def test_unreachable_scheduler_is_one_line_exit_2(tmp_path, monkeypatch, capsys):
+    (tmp_path / "s.toml").write_text(f'base_scenario = "{FIG4}"\n[axes]\npressure_bar = [3.6]\nweight_N = [22.74]\n')
+    monkeypatch.setattr(dask_cluster, "CONNECT_TIMEOUT_S", 1.0)
+    code = cli_main(["sweep", str(tmp_path / "s.toml"), "-o", str(tmp_path / "out"), "--dask", "tcp://127.0.0.1:9"])
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(lines) == 1 and "--dask tcp://127.0.0.1:9" in lines[0], lines
+    assert not (tmp_path / "out").exists()
+
+
+def test_cli_dask_local_writes_the_same_tables_as_the_serial_api(tmp_path):
+    (tmp_path / "s.toml").write_text(
+        f'base_scenario = "{FIG4}"\n[axes]\npressure_bar = [3.6]\nweight_N = [12.74, 22.74]\n'
+        '[uncertainty]\nsamples = 2\nseed = 5\n[uncertainty.parameters.N0_N_per_bar]\n'
+        'distribution = "normal"\nmean = 6.87\nstd = 0.3\nlower = 6.0\nupper = 7.5\n')
+    pamsim.sweep(tmp_path / "s.toml").write(tmp_path / "one")
+    dask = _cli("sweep", tmp_path / "s.toml", "-o", tmp_path / "dask", "--dask-local", "2", "--chunk-size", "2",
+                "--no-progress")
+    assert dask.returncode == 0, dask.stderr
+    assert "Dask LocalCluster of 2 worker process(es)" in dask.stdout
+    for name in ("summary.csv", "uncertainty_samples.csv", "uncertainty_summary.csv"):
+        assert (tmp_path / "dask" / name).read_bytes() == (tmp_path / "one" / name).read_bytes(), name
