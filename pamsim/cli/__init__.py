@@ -22,6 +22,7 @@ COMMANDS = (
     "pamsim.cli.linearize",
     "pamsim.cli.control_example",
     "pamsim.cli.params",
+    "pamsim.cli.fit",
 )
 
 
