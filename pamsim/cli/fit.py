@@ -5,13 +5,18 @@ from __future__ import annotations
 
 import argparse
 import os
+from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 from ..atomic import OutputError, ensure_output_dir
 from ..identification import compare, muscle_file, report, static_fit
-from ..identification.columns import read_static_data
+from ..identification import dynamic_fit
+from ..identification.columns import read_static_data, read_trace
 from ..identification.crossval import CV_CHOICES
+from ..identification.pressure_input import KNOT_TOLERANCE_PA
+from ..scenario import load_scenario
 from . import finite_float
+from .sweep import _workers
 
 
 def _names(text: str) -> list[str]:
@@ -39,6 +44,27 @@ def _count(text: str) -> int:
     if n < 0:
         raise argparse.ArgumentTypeError(f"{text!r}: must not be negative")
     return n
+
+
+def _window(text: str) -> tuple[float, float]:
+    a, sep, b = text.partition(":")
+    try:
+        t0, t1 = float(a), float(b)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: write T0:T1 in seconds, e.g. 1.4:6") from None
+    if not sep or not t1 > t0:
+        raise argparse.ArgumentTypeError(f"{text!r}: need T0:T1 with T1 > T0")
+    return t0, t1
+
+
+def _loads(text: str) -> list[float]:
+    try:
+        values = [float(v) for v in text.split(",")]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: give one weight in N per trace, comma-separated") from None
+    if not all(v > 0 for v in values):
+        raise argparse.ArgumentTypeError(f"{text!r}: weights must be positive")
+    return values
 
 
 def check_output_dir(directory: str) -> None:
@@ -86,6 +112,32 @@ def register(sub) -> None:
     s.add_argument("--json", action="store_true", help="print fit.json to stdout")
     s.set_defaults(func=run_static)
 
+    d = fsub.add_parser("dynamic", help="fit friction and damping to step responses (eq. 13)",
+                        description="Fit coefficients to measured step responses with the hybrid simulator inside "
+                                    "(the paper's eq. 13) and write fit.json, muscle.toml, scenario.toml, report.md "
+                                    "and figures.")
+    d.add_argument("traces", nargs="+", help="CSV traces with t_s, x_m (or x_mm) and optionally p_gauge_Pa, weight_N")
+    d.add_argument("--scenario", required=True, help="scenario TOML: parameter set, elements, valve, solver")
+    d.add_argument("--free", type=_names, default=list(dynamic_fit.DYNAMIC_DEFAULT_FREE),
+                   help="comma-separated coefficients to fit (default: D1, D2, N2, N1, N0 of the paper)")
+    d.add_argument("--window", type=_window, help="time window T0:T1 [s] of the residuals (default: whole trace)")
+    d.add_argument("--load-N", type=_loads, help="hung weight [N] per trace, comma-separated")
+    d.add_argument("--columns", type=_columns, default={}, help="map quantities to other column names")
+    d.add_argument("--per-trace", action="store_true", help="also fit every trace alone (Table 4 layout)")
+    d.add_argument("--global", dest="global_search", action="store_true",
+                   help="differential evolution over start +- 50 %% before the local fit")
+    d.add_argument("--workers", type=_workers, default=os.cpu_count() or 1,
+                   help="worker processes for the simulations (default: number of CPUs)")
+    d.add_argument("--max-iterations", type=_count, default=30, help="residual evaluations of the local fit")
+    d.add_argument("--fd-step", type=finite_float, default=dynamic_fit.FD_RELATIVE_STEP,
+                   help="relative finite-difference step (default 1e-3)")
+    d.add_argument("--knot-tolerance-Pa", type=finite_float, default=KNOT_TOLERANCE_PA,
+                   help="largest deviation of the thinned measured pressure [Pa] (default 10)")
+    d.add_argument("--seed", type=_count, default=0, help="seed of --global (default 0)")
+    d.add_argument("-o", "--output", required=True, help="output directory")
+    d.add_argument("--json", action="store_true", help="print fit.json to stdout")
+    d.set_defaults(func=run_dynamic)
+
 
 def run_static(args: argparse.Namespace) -> int:
     params, muscle_model = muscle_file.load_muscle_parameters(args.muscle)
@@ -110,6 +162,32 @@ def run_static(args: argparse.Namespace) -> int:
     print(f"{model} on {args.data}: RMS contraction {fit.rms_contraction_mm:.3f} mm "
           f"(cross-validated {fit.cv_rms_contraction_mm:.3f} mm, {fit.cv_kind}), "
           f"{fit.n_points} tests, {fit.n_censored} censored")
+    for a, b, r in fit.uncertainty.inseparable_pairs():
+        print(f"  warning: {a} and {b} are correlated (r = {r:+.3f}): the data do not separate them")
+    print(f"wrote {', '.join(str(Path(args.output) / n) for n in names)}")
+    return 0
+
+
+def run_dynamic(args: argparse.Namespace) -> int:
+    scenario = load_scenario(args.scenario)
+    traces = [read_trace(t, args.columns) for t in args.traces]
+    check_output_dir(args.output)
+    options = dict(free=args.free, window_s=args.window, loads_N=args.load_N, global_search=args.global_search,
+                   per_trace=args.per_trace, seed=args.seed, fd_step=args.fd_step,
+                   max_iterations=args.max_iterations, knot_tolerance_Pa=args.knot_tolerance_Pa)
+    if args.workers == 1:
+        fit = dynamic_fit.fit_dynamic(scenario, traces, executor=None, **options)
+    else:
+        with ProcessPoolExecutor(max_workers=args.workers) as pool:
+            fit = dynamic_fit.fit_dynamic(scenario, traces, executor=pool, **options)
+    names = report.write_dynamic_fit(fit, args.output)
+    if args.json:
+        print(report.json_text(fit.to_json()), end="")
+        return 0
+    print(f"{len(traces)} trace(s): pooled RMS {fit.rms_pooled_mm:.4f} mm, {fit.n_simulations} simulations in "
+          f"{fit.wall_time_s:.2f} s on {args.workers} worker(s)")
+    for name, value in fit.parameters.items():
+        print(f"  {name} = {value:.6g}")
     for a, b, r in fit.uncertainty.inseparable_pairs():
         print(f"  warning: {a} and {b} are correlated (r = {r:+.3f}): the data do not separate them")
     print(f"wrote {', '.join(str(Path(args.output) / n) for n in names)}")

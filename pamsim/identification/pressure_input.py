@@ -2,10 +2,11 @@
 also breakpoints of the simulation.
 
 A measured trace sampled at 1 kHz makes the simulator cap its step while the load is held at the
-sample spacing (it must not step over a rise and fall of the input).  Thinning the trace to the
-knots of a piecewise-linear approximation within a tolerance (Ramer-Douglas-Peucker), and
-declaring every knot a breakpoint, makes the input monotonic between breakpoints, so the cap is
-not needed: the same input to within the tolerance, several times fewer steps.
+sample spacing (it must not step over a rise and fall of the input, or it could miss a release).
+Thinning the trace to the knots of a piecewise-linear approximation within a tolerance
+(Ramer-Douglas-Peucker) and declaring the knots where the polyline turns (rising to falling or
+back) breakpoints makes the input monotonic between breakpoints, so the cap is not needed: the same
+input to within the tolerance, a few restarts of the integrator instead of one step per sample.
 """
 
 from __future__ import annotations
@@ -38,7 +39,10 @@ class PiecewiseLinearInput:
 
     @property
     def breakpoints(self) -> tuple[float, ...]:
-        return tuple(float(t) for t in self.t_s[1:-1])
+        """Interior knots where the polyline turns; between them it is monotonic."""
+        s = np.sign(np.diff(self.values))
+        turns = np.flatnonzero(s[1:] != s[:-1]) + 1
+        return tuple(float(t) for t in self.t_s[turns])
 
     @property
     def final_value(self) -> float:

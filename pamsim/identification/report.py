@@ -3,6 +3,7 @@ nothing (pamsim.atomic)."""
 
 from __future__ import annotations
 
+import csv
 import datetime
 import json
 import math
@@ -13,9 +14,10 @@ from typing import TYPE_CHECKING, Sequence
 from ..atomic import atomic_outputs
 from .compare import comparison_rows, write_comparison_csv
 from .muscle_file import muscle_toml
-from .plots import plot_comparison, plot_correlation, plot_static_fit, plot_static_residuals
+from .plots import plot_comparison, plot_correlation, plot_dynamic_fit, plot_static_fit, plot_static_residuals
 
 if TYPE_CHECKING:
+    from .dynamic_fit import DynamicFit
     from .static_fit import StaticFit
 
 
@@ -122,3 +124,93 @@ def _clean(v):
     if isinstance(v, float) and not math.isfinite(v):
         return None
     return v
+
+
+def _toml_value(v) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, (int, float)):
+        return repr(v)
+    if isinstance(v, str):
+        return json.dumps(v, ensure_ascii=False)
+    if isinstance(v, dict):
+        return "{ " + ", ".join(f"{k} = {_toml_value(x)}" for k, x in v.items()) + " }"
+    raise TypeError(f"cannot write {type(v).__name__} to TOML")
+
+
+def scenario_toml(spec: dict, header: Sequence[str]) -> str:
+    """A scenario spec (as validated by :class:`pamsim.Scenario`) as TOML text; sub-tables inline."""
+    lines = [f"# {h}" for h in header]
+    lines += [f"{k} = {_toml_value(v)}" for k, v in spec.items() if not isinstance(v, dict)]
+    for section, table in spec.items():
+        if isinstance(table, dict):
+            lines += ["", f"[{section}]"] + [f"{k} = {_toml_value(v)}" for k, v in table.items()]
+    return "\n".join(lines) + "\n"
+
+
+def _absolute_files(value, base_dir: Path):
+    """Trace file names made absolute, so the written scenario works from the output folder."""
+    if isinstance(value, dict):
+        return {k: (str((base_dir / v).resolve()) if k == "file" and isinstance(v, str) else _absolute_files(v, base_dir))
+                for k, v in value.items()}
+    return value
+
+
+def dynamic_report_md(fit: "DynamicFit") -> str:
+    p = fit.problem
+    errs = dict(zip(fit.uncertainty.names, map(float, fit.uncertainty.standard_errors)))
+    start = dict(zip(p.free, map(float, fit.start)))
+    out = [f"# Dynamic fit (eq. 13) on {len(p.traces)} trace(s), scenario {p.scenario.name}", "",
+           f"- pooled RMS contraction error in the window: **{fit.rms_pooled_mm:.4f} mm**",
+           f"- {fit.n_simulations} simulations in {fit.wall_time_s:.2f} s; optimiser: {fit.message}", "",
+           "| trace | load [N] | pressure | RMS [mm] |", "|---|---|---|---|"]
+    out += [f"| {tr.origin} | {w:g} | {'recorded' if tr.p_gauge_Pa is not None else 'scenario valve'} | {r:.4f} |"
+            for tr, w, r in zip(p.traces, p.loads_N, fit.rms_contraction_mm)]
+    out += ["", "## Coefficients", ""] + parameter_table(p.free, start, fit.parameters, errs) + [""]
+    out += correlation_lines(fit.uncertainty)
+    if fit.per_trace:
+        out += ["## Each trace alone (the layout of the paper's Table 4)", "",
+                "| trace | final pressure [bar] | load [N] | " + " | ".join(p.free) + " | RMS [mm] |",
+                "|---|---|---|" + "---|" * len(p.free) + "---|"]
+        out += [f"| {row['trace']} | {row['pressure_final_bar']:.3f} | {row['load_N']:g} | "
+                + " | ".join(f"{row[n]:.4g}" for n in p.free) + f" | {row['rms_contraction_mm']:.4f} |"
+                for row in fit.per_trace]
+        out += [""]
+    out += ["![measured and fitted](fit.png)", "", "![correlation](correlation.png)", ""]
+    return "\n".join(out)
+
+
+def write_dynamic_fit(fit: "DynamicFit", directory) -> list[str]:
+    """Write fit.json, muscle.toml, scenario.toml (the scenario with the fitted coefficients),
+    report.md, fit.png (overlays and residuals) and correlation.png; per_trace.csv with a per-trace fit."""
+    p = fit.problem
+    names = ["fit.json", "muscle.toml", "scenario.toml", "report.md", "fit.png", "correlation.png"]
+    if fit.per_trace:
+        names.append("per_trace.csv")
+    rms = f"pooled RMS contraction {fit.rms_pooled_mm:.4f} mm over {len(p.traces)} trace(s)"
+    prov = {"fitted by": "pamsim fit dynamic (eq. 13)",
+            "traces": ", ".join(f"{Path(t.origin).name} (sha256 {t.sha256})" for t in p.traces),
+            "date (UTC)": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M"),
+            "objective": "sum of squared contraction residuals in the window", "fit quality": rms}
+    source = f"fitted: pamsim fit dynamic on {', '.join(Path(t.origin).name for t in p.traces)}"
+    fitted = p.scenario.parameters.with_overrides(fit.parameters, source=source)
+    spec = _absolute_files(dict(p.scenario.spec), p.scenario.base_dir)
+    spec["parameters"] = {**spec.get("parameters", {}), **fit.parameters}
+    spec["name"] = f"{p.scenario.name}_fitted"
+    with atomic_outputs(directory, names) as out:
+        out["fit.json"].write_text(json_text(fit.to_json()))
+        out["muscle.toml"].write_text(muscle_toml(
+            fitted, name=f"{fitted.name}_dynamic_fit",
+            description=f"{fitted.name} with {', '.join(p.free)} fitted by pamsim fit dynamic ({rms})",
+            citation=fitted.citation, static_force=p.scenario.spec["model"]["static_force"], provenance=prov))
+        out["scenario.toml"].write_text(scenario_toml(spec, [f"{k}: {v}" for k, v in prov.items()]))
+        out["report.md"].write_text(dynamic_report_md(fit))
+        plot_dynamic_fit(fit, out["fit.png"])
+        plot_correlation(p.free, fit.uncertainty.correlation, out["correlation.png"])
+        if fit.per_trace:
+            cols = list(fit.per_trace[0])
+            with open(out["per_trace.csv"], "w", newline="") as fh:
+                w = csv.DictWriter(fh, fieldnames=cols)
+                w.writeheader()
+                w.writerows(fit.per_trace)
+    return names

@@ -42,6 +42,36 @@ class Uncertainty:
         tied = {n for a, b, _ in self.inseparable_pairs(limit) for n in (a, b)}
         return tuple(n for n in self.names if n not in tied)
 
+    def groups(self, limit: float = CORRELATION_LIMIT) -> list[tuple[str, ...]]:
+        """Sets of coefficients linked by correlations beyond ``limit`` (connected components)."""
+        out: list[set[str]] = []
+        for a, b, _ in self.inseparable_pairs(limit):
+            hit = [g for g in out if a in g or b in g]
+            merged = set().union({a, b}, *hit)
+            out = [g for g in out if g not in hit] + [merged]
+        return [tuple(n for n in self.names if n in g) for g in out]
+
+    def best_combination(self, group: tuple[str, ...]) -> tuple[np.ndarray, float]:
+        """The combination of ``group`` the data determine best, and its standard error.
+
+        In coefficients measured in their standard errors (``theta_i / se_i``) it is the
+        eigenvector of the group's correlation matrix with the smallest eigenvalue.  Returns the
+        weights ``w`` (per unit of each coefficient; the combination is ``w . theta``) and the
+        standard error of ``w . theta``.
+        """
+        idx = [self.names.index(n) for n in group]
+        R = self.correlation[np.ix_(idx, idx)]
+        vals, vecs = np.linalg.eigh(R)
+        e = vecs[:, 0] * (1.0 if vecs[np.argmax(np.abs(vecs[:, 0])), 0] > 0 else -1.0)
+        return e / self.standard_errors[idx], float(math.sqrt(max(vals[0], 0.0)))
+
+    def identifiable(self, theta: np.ndarray, relative: float = 0.05, limit: float = CORRELATION_LIMIT) -> tuple[str, ...]:
+        """Coefficients separable from all others whose standard error is at most ``relative`` of
+        their value (so a two-sigma interval is within twice that)."""
+        sep = set(self.separable(limit))
+        return tuple(n for n, v, s in zip(self.names, theta, self.standard_errors)
+                     if n in sep and math.isfinite(s) and s <= relative * abs(v))
+
     def correlation_table(self) -> dict:
         """``{"names": [...], "matrix": [[...]]}`` for JSON."""
         return {"names": list(self.names), "matrix": [[_num(v) for v in row] for row in self.correlation]}
