@@ -1,6 +1,6 @@
 """Wall time of the 66-case ACRA 2012 sweep with 1 and 2 worker processes, and the speed-up.
 
-    /work/venv/bin/python benchmarks/bench_sweep.py [--repeat N]
+    python benchmarks/bench_sweep.py [--repeat N]
 
 Two sweeps are timed: the 66 cases alone (default valve, load-dependent friction; the issue's
 target is <= 3 s on 2 workers) and the whole ``scenarios/acra2012_grid.toml`` (66 cases x 2

@@ -11,7 +11,7 @@ from .parameters import PARAMETER_SETS, ParameterSet, get_parameter_set
 from .result import Result
 from .scenario import Scenario, ScenarioError, load_scenario
 from .simulator import SolverFailure, SolverOptions, simulate_model
-from .sweep import sweep  # the function pamsim.sweep(...); the module stays importable as pamsim.sweep
+from . import sweep  # a callable package: pamsim.sweep(spec, executor) runs a sweep
 
 __all__ = ["simulate", "load_scenario", "Scenario", "ScenarioError", "Result", "Mode", "MuscleModel",
            "PARAMETER_SETS", "ParameterSet", "get_parameter_set", "SolverFailure", "SolverOptions",

@@ -23,6 +23,7 @@ import math
 
 import numpy as np
 
+from .elements.contracts import Damping, Friction, PressureSource, StaticForce
 from .elements.load import HangingLoad
 from .elements.stops import EndStops
 from .signals import max_step_hint_s
@@ -61,14 +62,15 @@ class FitRange:
 
 @dataclass(frozen=True)
 class MuscleModel:
-    """The composed model.  Every element is swappable."""
+    """The composed model.  Every element is swappable: any object meeting its
+    :mod:`pamsim.elements.contracts` protocol will do."""
 
-    static_force: object
-    friction: object
-    damping: object
+    static_force: StaticForce
+    friction: Friction
+    damping: Damping
     load: HangingLoad
     stops: EndStops
-    source: object
+    source: PressureSource
     fit_range: FitRange
 
     @property

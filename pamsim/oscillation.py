@@ -5,7 +5,10 @@ viscous oscillator: its swings shrink linearly and it usually sticks at a
 turning point.  Both cases share one property that this estimator relies on:
 successive turning points (where the velocity is zero) are half a period apart
 (``pi / omega_d`` for viscous damping, ``pi / omega_n`` for Coulomb friction).
-So the frequency comes from the spacing of turning points, and the damping from
+So the frequency comes from the spacing of turning points, over whole periods
+only: the swing up and the swing down need not last as long (with a
+load-dependent friction they do not), and averaging an odd number of
+half-periods would weight one direction more.  The damping comes from
 the ratio of successive swings (peak-to-peak excursions), which needs no
 estimate of the centre the trace oscillates about.
 
@@ -37,8 +40,9 @@ class Oscillation:
     Attributes
     ----------
     frequency_Hz : float
-        Damped oscillation frequency, ``1 / (2 * mean half-period)``; NaN with
-        fewer half-periods than asked for.
+        Damped oscillation frequency: whole periods counted, divided by the time
+        they span (the last half-period is left out when their number is odd);
+        NaN with fewer half-periods than asked for.
     damping_ratio : float
         Equivalent viscous damping ratio from the mean logarithmic decrement of
         successive swings; NaN with fewer than three turning points.
@@ -46,12 +50,16 @@ class Oscillation:
         Number of half-periods (intervals between turning points) measured.
     turning_times_s : tuple of float
         Times of the accepted turning points.
+    half_period_asymmetry : float
+        ``(mean rising half-period - mean falling half-period) / mean half-period``:
+        how much longer the swing up lasts than the swing down; NaN without one of each.
     """
 
     frequency_Hz: float
     damping_ratio: float
     n_half_cycles: int
     turning_times_s: tuple[float, ...]
+    half_period_asymmetry: float = math.nan
 
 
 def estimate_oscillation(t_s, x, t_start_s: float | None = None, hysteresis: float | None = None,
@@ -71,8 +79,9 @@ def estimate_oscillation(t_s, x, t_start_s: float | None = None, hysteresis: flo
         Reversal that confirms a turning point.  Default: ``HYSTERESIS_FRACTION``
         of the range of ``x`` after ``t_start_s``, at least ``MIN_HYSTERESIS_M``.
     min_half_cycles : int
-        Fewest half-periods that give a frequency (default 2: one lone swing that
-        ends in a stick is too easily shaped by the still-changing input).
+        Fewest half-periods that give a frequency (default 2, one whole period: one
+        lone swing that ends in a stick is too easily shaped by the still-changing
+        input).  With 1, a lone half-period T gives ``1 / (2 T)``.
 
     Returns
     -------
@@ -94,14 +103,25 @@ def estimate_oscillation(t_s, x, t_start_s: float | None = None, hysteresis: flo
     idx = _turning_indices(y, hysteresis)
     times = np.array([_refine_time(t, y, i) for i in idx])
     n_half = max(len(idx) - 1, 0)
-    frequency = 1.0 / (2.0 * float(np.mean(np.diff(times)))) if n_half >= max(min_half_cycles, 1) else math.nan
+    frequency = math.nan
+    if n_half >= max(min_half_cycles, 2):
+        n_full = n_half // 2
+        frequency = n_full / float(times[2 * n_full] - times[0])
+    elif n_half == 1 and min_half_cycles <= 1:
+        frequency = 1.0 / (2.0 * float(times[1] - times[0]))
+    asymmetry = math.nan
+    if n_half >= 2:
+        halves = np.diff(times)
+        rising = y[idx[1:]] > y[idx[:-1]]  # the half-period ends on a maximum: the swing went up
+        if rising.any() and (~rising).any():
+            asymmetry = float((halves[rising].mean() - halves[~rising].mean()) / halves.mean())
     damping = math.nan
     if len(idx) >= 3:
         swings = np.abs(np.diff(y[idx]))
         # Each swing spans half a period; the full-period log decrement is twice the half-period one.
         delta = 2.0 * float(np.mean(np.log(swings[:-1] / swings[1:])))
         damping = delta / math.sqrt(4.0 * math.pi ** 2 + delta ** 2)
-    return Oscillation(frequency, damping, n_half, tuple(float(v) for v in times))
+    return Oscillation(frequency, damping, n_half, tuple(float(v) for v in times), asymmetry)
 
 
 def _turning_indices(y: np.ndarray, hysteresis: float) -> list[int]:

@@ -13,7 +13,9 @@ from dataclasses import dataclass, replace
 from types import MappingProxyType
 from typing import Mapping
 
-ACRA2012 = "ACRA 2012 (acra2012_dynamic_force_model_small_soft_pm)"
+from .references import REFERENCES
+
+ACRA2012 = REFERENCES["acra2012"].short
 BRAID_LOCK_DEG = math.degrees(math.acos(1.0 / math.sqrt(3.0)))
 """Braid angle at which a McKibben braid locks (54.7356 deg): the muscle cannot shorten further."""
 
@@ -147,7 +149,7 @@ def _shadow_6x300_acra2012() -> ParameterSet:
         # End stops (MODEL_NOTES sec. 5).
         "stop_restitution": P(0.0, "1", "assumed: inelastic contact; Table 2 shows the loaded muscle resting on a very stiff stop", "coefficient of restitution of both stops", lower=0.0, upper=1.0),
     }
-    return ParameterSet("shadow_6x300_acra2012", "Shadow Robot 6 mm x 300 mm muscle, " + ACRA2012, e)
+    return ParameterSet("shadow_6x300_acra2012", "Shadow Robot 6 mm x 300 mm muscle, " + REFERENCES["acra2012"].full(), e)
 
 
 PARAMETER_SETS: Mapping[str, ParameterSet] = MappingProxyType({

@@ -1,8 +1,10 @@
-"""Plots of results.  Kept apart from the model and the Result class."""
+"""Plots of results.  Kept apart from the model and the Result class.
+
+The functions take a :class:`pamsim.Result` without importing it: ``Result.plot``
+imports this module, and one direction of dependency is enough.
+"""
 
 from __future__ import annotations
-
-from typing import TYPE_CHECKING
 
 import numpy as np
 from matplotlib.figure import Figure
@@ -10,8 +12,6 @@ from matplotlib.figure import Figure
 from .atomic import atomic_path
 from .constants import PA_PER_BAR
 
-if TYPE_CHECKING:
-    from .result import Result
 
 _FORCES = (("F_static_N", "static"), ("F_gravity_N", "gravity"), ("F_friction_N", "friction"),
            ("F_damping_N", "damping"), ("F_stop_N", "stop contact"), ("F_external_N", "external"))

@@ -22,7 +22,7 @@ from .constants import PA_PER_BAR
 from .errors import InputError
 from .elements.chamber import MuscleChamber
 from .elements.damping import DAMPING_MODELS
-from .elements.friction import FRICTION_MODELS, NEGATIVE_LEVEL_CHOICES, build_friction
+from .elements.friction import FRICTION_MODELS, NEGATIVE_LEVEL_CHOICES
 from .elements.load import HangingLoad
 from .elements.pressure_source import PrescribedPressure, ValveChamberSource
 from .elements.static_force import STATIC_FORCE_MODELS
@@ -244,9 +244,9 @@ class Scenario:
         p = self.parameters
         m = self.spec["model"]
         return MuscleModel(
-            static_force=STATIC_FORCE_MODELS[m["static_force"]](p),
-            friction=build_friction(m["friction"], p, m["friction_negative_level"]),
-            damping=DAMPING_MODELS[m["damping"]](p),
+            static_force=STATIC_FORCE_MODELS[m["static_force"]](p, m),
+            friction=FRICTION_MODELS[m["friction"]](p, m),
+            damping=DAMPING_MODELS[m["damping"]](p, m),
             load=HangingLoad(self.mass_kg, p["g_m_s2"], self._external_force),
             stops=EndStops.from_parameters(p),
             source=self._source,

@@ -41,7 +41,7 @@ def test_nlsys_names_and_rhs_are_the_models(fig4):
     sys_nl = muscle_nlsys(model, FrictionTreatment("sliding", direction=1.0))
     assert list(sys_nl.state_labels) == ["x_m", "v_m_s", "p_abs_Pa", "air_mass_kg"]
     assert list(sys_nl.input_labels) == ["valve_command", "supply_gauge_Pa", "F_ext_N"]
-    assert list(sys_nl.output_labels) == ["contraction_m", "p_gauge_Pa", "F_muscle_N"]
+    assert list(sys_nl.output_labels) == ["contraction_m", "p_gauge_Pa", "F_tendon_N"]
     x = np.array([0.03, 0.01, 3.0e5, 2.0e-5])
     u = np.array([0.4, 3.6e5, 1.5])
     y = np.concatenate([x, np.zeros(4)])
@@ -393,3 +393,58 @@ def test_cli_load_beyond_capability_exits_2(tmp_path):
         proc = _cli("linearize", heavy, *extra, "-o", tmp_path)
         assert proc.returncode == 2, proc.stderr
         assert ("force capability" in proc.stderr) and "Traceback" not in proc.stderr
+
+
+def test_loop_margins_agree_with_a_direct_frequency_scan_and_the_closed_loop_poles():
+    """Margins of the design loop against L(jw) evaluated from its matrices, and against the
+    closed-loop poles when the loop gain is scaled just past the gain margin."""
+    import control as ct
+    from scipy.optimize import brentq
+
+    from pamsim.control.margins import loop_margins, loop_transfer
+
+    sc = pamsim.load_scenario(ROOT / "scenarios" / "closed_loop_position.toml")
+    m = loop_margins(sc)
+    L = loop_transfer(sc)
+    A, B, C, D = (np.asarray(M) for M in (L.A, L.B, L.C, L.D))
+
+    def Ljw(f_Hz):
+        s = 2j * np.pi * f_Hz
+        return (C @ np.linalg.solve(s * np.eye(A.shape[0]) - A, B) + D)[0, 0]
+
+    def crossings(g, grid):
+        vals = [g(f) for f in grid]
+        return [brentq(g, a, b) for a, b, ga, gb in zip(grid, grid[1:], vals, vals[1:]) if ga * gb < 0]
+
+    grid = np.geomspace(0.1, 1000.0, 2001)
+    gain_x = crossings(lambda f: abs(Ljw(f)) - 1.0, grid)
+    # Phase -180 deg: L real and negative (the integrators' crossing at f -> 0 lies below the grid).
+    phase_x = [f for f in crossings(lambda f: np.imag(Ljw(f)), grid) if np.real(Ljw(f)) < 0]
+    assert len(gain_x) == 1 and len(phase_x) == 1, (gain_x, phase_x)
+    f_gc, f_pc = gain_x[0], phase_x[0]
+    pm = 180.0 + np.degrees(np.angle(Ljw(f_gc)))
+    assert m.gain_crossover_Hz == pytest.approx(f_gc, rel=1e-4)
+    assert m.phase_margin_deg == pytest.approx(pm, abs=0.05)
+    assert m.phase_crossover_Hz == pytest.approx(f_pc, rel=1e-4)
+    assert m.gain_margin == pytest.approx(1.0 / abs(Ljw(f_pc)), rel=1e-4)
+    # The crossovers the docs state (gain crossover above the phase crossover) ...
+    assert m.gain_crossover_Hz > m.phase_crossover_Hz
+    # ... and the meaning of a lower gain margin: the loop is stable as designed and just above
+    # the margin, and unstable just below it.
+    for factor, stable in ((1.0, True), (1.05 * m.gain_margin, True), (0.95 * m.gain_margin, False)):
+        poles = ct.feedback(factor * L, 1).poles()  # u = C P u = -L u: negative feedback around L
+        assert (np.max(np.real(poles)) < 0) == stable, factor
+
+
+def test_bode_phase_is_unwrapped():
+    sc = pamsim.load_scenario(FIG4)
+    model = sc.build_model()
+    lin = linearize(model, open_valve_equilibrium(model, sc.final_pressure_gauge_Pa))
+    for inp, out in (("F_ext_N", "contraction_m"), ("supply_gauge_Pa", "contraction_m")):
+        phase = np.asarray(lin.bode(inp, out, lin.frequency_grid_rad_s())["phase_deg"])
+        assert np.max(np.abs(np.diff(phase))) < 180.0, (inp, out)
+        # Both channels are a lightly damped mass-spring seen from its input: 0 deg at DC,
+        # -180 deg just past the resonance, with no jump of 360 deg on the way.
+        assert phase[0] == pytest.approx(0.0, abs=5.0)
+        assert phase[np.searchsorted(lin.frequency_grid_rad_s(), 1.5 * lin.mechanical_mode().omega_n_rad_s)] \
+            == pytest.approx(-180.0, abs=20.0)

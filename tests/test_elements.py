@@ -47,13 +47,13 @@ def test_load_dependent_friction_eq7_and_clamp():
     # 2.0 bar with 22.74 N: P - m = -0.318 < 0 -> clamped to zero, or its magnitude with "abs".
     m2 = 22.74 / 9.81
     assert fr.level_N(x, 2.0e5, m2) == 0.0
-    fr_abs = LoadDependentCoulomb.from_parameters(P, "abs")
+    fr_abs = LoadDependentCoulomb.from_parameters(P, {"friction_negative_level": "abs"})
     assert fr_abs.level_N(x, 2.0e5, m2) == pytest.approx(abs((2.0 - m2) * (228.93 * x * x - 90.43 * x + 6.87)))
     # Works on arrays too (used to rebuild the force breakdown of a trace).
     arr = fr.level_N(np.array([x, x]), np.array([3.6e5, 2.0e5]), m2)
     assert arr[1] == 0.0 and arr[0] > 0.0
     with pytest.raises(ValueError):
-        LoadDependentCoulomb.from_parameters(P, "signed")
+        LoadDependentCoulomb.from_parameters(P, {"friction_negative_level": "signed"})
 
 
 def test_friction_polynomial_stays_positive_below_102_mm():
@@ -162,3 +162,33 @@ def test_signal_breakpoints_and_final_values():
     assert Step(1.0, 0.0, 2.0).breakpoints == (1.0,) and Step(1.0, 0.0, 2.0).final_value == 2.0
     assert Ramp(0.5, 1.5, 0.0, 3.0).breakpoints == (0.5, 1.5) and Ramp(0.5, 1.5, 0.0, 3.0).final_value == 3.0
     assert FirstOrderLag(1.0, 0.0, 4.0, 0.1).final_value == 4.0
+
+
+@pytest.mark.parametrize("registry, protocol", [
+    ("pamsim.elements.static_force:STATIC_FORCE_MODELS", "StaticForce"),
+    ("pamsim.elements.friction:FRICTION_MODELS", "Friction"),
+    ("pamsim.elements.damping:DAMPING_MODELS", "Damping"),
+])
+def test_every_registry_entry_builds_from_params_and_options_into_its_protocol(registry, protocol):
+    """One builder shape for every registry: ``builder(params, options)``, no special case per entry."""
+    import importlib
+
+    from pamsim.elements import contracts
+
+    module, name = registry.split(":")
+    entries = getattr(importlib.import_module(module), name)
+    proto = getattr(contracts, protocol)
+    for key, builder in entries.items():
+        element = builder(P, {"friction_negative_level": "abs"})
+        assert isinstance(element, proto), key
+        assert element.name == key
+
+
+def test_the_negative_level_option_reaches_the_friction_through_the_registry():
+    from pamsim.elements.friction import FRICTION_MODELS
+
+    x, p, m = 0.02, 1.0e5, 3.0  # P - m = 1 - 3 bar < 0: clamped to zero, or its magnitude
+    raw = (1.0 - P["phi_bar_per_kg"] * m) * (P["N2_N_per_bar_m2"] * x * x + P["N1_N_per_bar_m"] * x + P["N0_N_per_bar"])
+    assert raw < 0
+    assert FRICTION_MODELS["load_dependent"](P, {"friction_negative_level": "clamp"}).level_N(x, p, m) == 0.0
+    assert FRICTION_MODELS["load_dependent"](P, {"friction_negative_level": "abs"}).level_N(x, p, m) == pytest.approx(-raw)

@@ -134,6 +134,11 @@ def test_rest_at_the_end(serial):
             assert r["at_rest"], r["case"]
     not_at_rest = [r for r in serial.rows if not r["at_rest"]]
     assert len(not_at_rest) > 0  # honest: the issue's "every case ends at rest" fails, see below
+    # The motion left in the last second: a load still moving covers some distance; a load held
+    # still since before the last second covers none (its contraction is frozen while stuck).
+    assert all(r["last_second_peak_to_peak_m"] > 1e-6 for r in not_at_rest)
+    for r in serial.rows:
+        assert 0.0 <= r["constant_last_second_peak_to_peak_m"] <= r["constant_peak_contraction_m"]
 
 
 @pytest.mark.xfail(strict=True, reason="with the paper's load-dependent friction clamped to zero for P_bar < m_kg "
@@ -267,3 +272,42 @@ def test_bad_sweep_files_exit_2_naming_the_problem(tmp_path, label):
 
 def test_sweep_error_is_an_input_error():
     assert issubclass(SweepError, pamsim.errors.InputError)
+
+
+def test_pamsim_sweep_is_the_package_and_runs_a_sweep(tmp_path):
+    """``pamsim.sweep`` must be both: ``pamsim.sweep.load_sweep`` (the package) and ``pamsim.sweep(spec)``."""
+    import importlib
+    import subprocess
+    import sys
+
+    mod = importlib.import_module("pamsim.sweep")
+    assert mod is pamsim.sweep and mod.load_sweep is load_sweep
+    spec = sweep_from_dict({"base_scenario": "acra2012_fig5.toml", "case": [{"weight_N": 12.74, "pressure_bar": 3.6}]},
+                           base_dir=Path(__file__).resolve().parents[1] / "scenarios")
+    direct = pamsim.sweep.run_sweep(spec)
+    via_call = pamsim.sweep(spec)
+    assert via_call.rows[0]["final_contraction_m"] == direct.rows[0]["final_contraction_m"]
+    # A fresh interpreter that imports the submodule by name sees the package, not a function.
+    code = "import pamsim.sweep; print(pamsim.sweep.load_sweep.__module__)"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.strip() == "pamsim.sweep.spec"
+
+
+@pytest.mark.parametrize("n_half", [4, 5, 6, 7])
+def test_estimator_uses_whole_periods_when_up_and_down_swings_differ(n_half):
+    """A swing up of 0.15 s and a swing down of 0.10 s: the period is 0.25 s (4 Hz) whatever the
+    number of half-periods; averaging half-periods would give 4.17 Hz for 5 of them (three short)."""
+    t_up, t_down = 0.15, 0.10
+    knots_t, knots_x, now = [0.0], [0.0], 0.0
+    for i in range(n_half + 1):  # the first swing up leaves the start, which is not a turning point
+        now += t_up if i % 2 == 0 else t_down
+        knots_t.append(now)
+        knots_x.append(0.01 if i % 2 == 0 else 0.0)
+    t = np.arange(0.0, now + 0.5, 1e-4)
+    phase = np.interp(t, knots_t, np.arange(len(knots_t)))  # half-cosine swings between the knots
+    x = 0.005 * (1 - np.cos(np.pi * phase))
+    osc = estimate_oscillation(t, x)
+    assert osc.n_half_cycles == n_half
+    assert osc.frequency_Hz == pytest.approx(1.0 / (t_up + t_down), rel=1e-3)
+    mean_half = (t_up + t_down) / 2
+    assert osc.half_period_asymmetry == pytest.approx((t_up - t_down) / mean_half, rel=0.05)

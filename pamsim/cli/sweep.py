@@ -9,7 +9,7 @@ from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 from ..atomic import ensure_output_dir
-from ..sweep import load_sweep, sweep
+from ..sweep import load_sweep, run_sweep
 
 
 def _workers(text: str) -> int:
@@ -38,10 +38,10 @@ def run(args: argparse.Namespace) -> int:
     spec = load_sweep(args.sweep_file)
     ensure_output_dir(args.output)  # before the runs, not after them
     if args.workers == 1:
-        result = sweep(spec, None, progress=not args.no_progress)
+        result = run_sweep(spec, None, progress=not args.no_progress)
     else:
         with ProcessPoolExecutor(max_workers=args.workers) as pool:
-            result = sweep(spec, pool, progress=not args.no_progress)
+            result = run_sweep(spec, pool, progress=not args.no_progress)
     names = result.write(args.output)
     for failure in result.failures:
         print(f"pamsim: warning: failed run {failure}", file=sys.stderr)

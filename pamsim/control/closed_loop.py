@@ -277,6 +277,31 @@ def step_metrics(t_s: np.ndarray, x_m: np.ndarray, step_time_s: float, x0_m: flo
             "tail_peak_to_peak_mm": float(np.ptp(x[tail]) * 1e3)}
 
 
+def controller_system(design: LqrDesign, config: ControllerConfig) -> ct.StateSpace:
+    """The linear controller, velocity filter included, as a python-control system.
+
+    Inputs ``contraction_m``, ``p_gauge_Pa`` (deviations from the design point) and
+    the reference ``r_m``; output ``valve_command``; no saturation or deadband.
+    """
+    Kx, Kv, Kp, Kz = design.K
+    tau = config.velocity_filter_time_s
+    # Holding-pressure slope dp_ff/dr at the design point, for the reference feedforward.
+    h = 1e-5
+    lin = design.linear
+    supply = float(lin.op.inputs[1])
+    model = design.model
+    load = model.load.weight_N - float(lin.op.inputs[2])
+    g_ff = (holding_pressure_Pa(model, config.design_contraction_m + h, load, supply)
+            - holding_pressure_Pa(model, config.design_contraction_m - h, load, supply)) / (2 * h)
+    # Controller states z (error integral), x_f (filter); inputs contraction, pressure, reference.
+    return ct.ss([[0.0, 0.0], [0.0, -1.0 / tau]],
+                 [[1.0, 0.0, -1.0], [1.0 / tau, 0.0, 0.0]],
+                 [[-Kz, Kv / tau]],
+                 [[-(Kx + Kv / tau), -Kp, Kx + Kp * g_ff]],
+                 states=["z_error_integral_m_s", "x_filter_m"], inputs=["contraction_m", "p_gauge_Pa", "r_m"],
+                 outputs=["valve_command"], name="lqr")
+
+
 def linear_step_prediction(design: LqrDesign, config: ControllerConfig, x0_m: float,
                            duration_s: float) -> tuple[np.ndarray, np.ndarray]:
     """Contraction [m] of the linear loop (no saturation, deadband or friction) for the same step.
@@ -284,24 +309,8 @@ def linear_step_prediction(design: LqrDesign, config: ControllerConfig, x0_m: fl
     The controller, with its velocity filter, is built as a python-control
     system and closed around the plant linearisation by signal name.
     """
-    lin = design.linear
-    model_plant = lin.sys[["contraction_m", "p_gauge_Pa"], :]
-    Kx, Kv, Kp, Kz = design.K
-    tau = config.velocity_filter_time_s
-    # Holding-pressure slope dp_ff/dr at the design point, for the reference feedforward.
-    h = 1e-5
-    supply = float(lin.op.inputs[1])
-    model = design.model
-    load = model.load.weight_N - float(lin.op.inputs[2])
-    g_ff = (holding_pressure_Pa(model, config.design_contraction_m + h, load, supply)
-            - holding_pressure_Pa(model, config.design_contraction_m - h, load, supply)) / (2 * h)
-    # Controller states z (error integral), x_f (filter); inputs contraction, pressure, reference.
-    ctrl = ct.ss([[0.0, 0.0], [0.0, -1.0 / tau]],
-                 [[1.0, 0.0, -1.0], [1.0 / tau, 0.0, 0.0]],
-                 [[-Kz, Kv / tau]],
-                 [[-(Kx + Kv / tau), -Kp, Kx + Kp * g_ff]],
-                 states=["z_error_integral_m_s", "x_filter_m"], inputs=["contraction_m", "p_gauge_Pa", "r_m"],
-                 outputs=["valve_command"], name="lqr")
+    model_plant = design.linear.sys[["contraction_m", "p_gauge_Pa"], :]
+    ctrl = controller_system(design, config)
     loop = ct.interconnect([model_plant, ctrl], inplist=["r_m", "supply_gauge_Pa", "F_ext_N"],
                            outlist=["contraction_m", "valve_command"], inputs=["r_m", "supply_gauge_Pa", "F_ext_N"],
                            outputs=["contraction_m", "valve_command"], name="linear_loop")

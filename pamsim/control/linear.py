@@ -170,11 +170,15 @@ class LinearModel:
         return g0, 0.0
 
     def bode(self, input_name: str, output_name: str, omega_rad_s: np.ndarray) -> dict[str, list[float]]:
-        """Bode data of one channel: frequency [Hz], magnitude [output unit per input unit], phase [deg]."""
+        """Bode data of one channel: frequency [Hz], magnitude [output unit per input unit], phase [deg].
+
+        The phase is unwrapped along the grid (no 360 deg jumps between neighbouring frequencies).
+        """
         resp = ct.frequency_response(self.sys[output_name, input_name], omega_rad_s)
+        phase = np.unwrap(np.atleast_1d(np.squeeze(resp.phase)))
         return {"frequency_Hz": [float(w / (2 * math.pi)) for w in omega_rad_s],
                 "magnitude": [float(m) for m in np.atleast_1d(np.squeeze(resp.magnitude))],
-                "phase_deg": [float(np.degrees(ph)) for ph in np.atleast_1d(np.squeeze(resp.phase))]}
+                "phase_deg": [float(np.degrees(ph)) for ph in phase]}
 
     def frequency_grid_rad_s(self, n: int = 200) -> np.ndarray:
         """Logarithmic grid two decades either side of the mechanical mode."""

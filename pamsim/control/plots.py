@@ -47,14 +47,18 @@ def pole_zero_figure(lin: LinearModel) -> Figure:
     ax.plot(poles.real, poles.imag, "x", ms=9, mew=2, label="poles")
     if zeros.size:
         ax.plot(zeros.real, zeros.imag, "o", mfc="none", ms=9, label="zeros valve -> contraction")
+    else:
+        ax.plot([], [], " ", label="valve -> contraction: no finite zeros")
     reals = np.concatenate([poles.real, zeros.real, [0.0]])
-    span = max(np.max(np.abs(reals)), 1.0)
-    ax.set_xlim(min(reals.min(), -0.1 * span) * 1.5, max(reals.max(), 0.1 * span) * 1.5)
+    span = max(np.max(np.abs(reals)), 1e-3)
+    ax.set_xlim(min(reals.min(), -0.1 * span) * 1.3, max(reals.max(), 0.1 * span) * 1.3)
     ax.axhline(0, color="k", lw=0.5)
     ax.axvline(0, color="k", lw=0.5)
-    # Pressure poles can sit a decade beyond the mechanical pair; symlog keeps both readable.
+    # Pressure poles can sit a decade beyond the mechanical pair: then symlog keeps both readable;
+    # when every real part is small a linear axis reads better.
     w = max(lin.mechanical_mode().omega_n_rad_s, 1.0)
-    ax.set_xscale("symlog", linthresh=max(w / 10.0, 1e-3))
+    if np.max(np.abs(reals)) > w / 10.0:
+        ax.set_xscale("symlog", linthresh=w / 10.0)
     ax.set_xlabel("real [1/s]")
     ax.set_ylabel("imaginary [rad/s]")
     ax.grid(alpha=0.3)

@@ -26,8 +26,9 @@ STATES = ("x_m", "v_m_s", "p_abs_Pa", "air_mass_kg")
 """State names of the control model (contraction, velocity, absolute chamber pressure, air mass)."""
 INPUTS = ("valve_command", "supply_gauge_Pa", "F_ext_N")
 """Input names: valve command (dimensionless, -1 exhaust .. +1 supply), supply gauge pressure, external force."""
-OUTPUTS = ("contraction_m", "p_gauge_Pa", "F_muscle_N")
-"""Output names: contraction, chamber gauge pressure, force of the muscle on the load."""
+OUTPUTS = ("contraction_m", "p_gauge_Pa", "F_tendon_N")
+"""Output names: contraction, chamber gauge pressure, tendon force (static minus damping minus friction;
+not the static force alone, which the simulator and the FMU call ``F_static_N``)."""
 
 STATE_SCALES = (1e-2, 1e-1, 1e5, 1e-5)
 """Typical magnitude of each state (10 mm, 0.1 m/s, 1 bar, 10 mg), as the simulator's tolerances use."""

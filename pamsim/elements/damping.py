@@ -6,7 +6,9 @@ Every law here is zero at v = 0, which the stick/slip logic relies on.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable, Mapping
+from typing import Mapping
+
+from .contracts import NO_OPTIONS, Builder, Damping, ElementOptions
 
 
 @dataclass(frozen=True)
@@ -22,7 +24,7 @@ class PaperDamping:
     name: str = "paper"
 
     @classmethod
-    def from_parameters(cls, p: Mapping[str, float]) -> "PaperDamping":
+    def from_parameters(cls, p: Mapping[str, float], options: ElementOptions = NO_OPTIONS) -> "PaperDamping":
         return cls(p["D1_N_s_per_m"], p["D2_N_s2_per_m2"])
 
     def force_N(self, v_m_s):
@@ -37,7 +39,7 @@ class LinearDamping:
     name: str = "linear"
 
     @classmethod
-    def from_parameters(cls, p: Mapping[str, float]) -> "LinearDamping":
+    def from_parameters(cls, p: Mapping[str, float], options: ElementOptions = NO_OPTIONS) -> "LinearDamping":
         return cls(abs(p["D1_N_s_per_m"]))
 
     def force_N(self, v_m_s):
@@ -51,14 +53,14 @@ class NoDamping:
     name: str = "none"
 
     @classmethod
-    def from_parameters(cls, p: Mapping[str, float]) -> "NoDamping":
+    def from_parameters(cls, p: Mapping[str, float], options: ElementOptions = NO_OPTIONS) -> "NoDamping":
         return cls()
 
     def force_N(self, v_m_s):
         return 0.0 * v_m_s
 
 
-DAMPING_MODELS: dict[str, Callable[[Mapping[str, float]], object]] = {
+DAMPING_MODELS: dict[str, Builder[Damping]] = {
     "paper": PaperDamping.from_parameters,
     "linear": LinearDamping.from_parameters,
     "none": NoDamping.from_parameters,

@@ -7,9 +7,10 @@ stick/slip logic belong to the simulator.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable, Mapping
+from typing import Mapping
 
 from ..constants import PA_PER_BAR
+from .contracts import NO_OPTIONS, Builder, ElementOptions, Friction
 
 NEGATIVE_LEVEL_CHOICES = ("clamp", "abs")
 
@@ -32,7 +33,9 @@ class LoadDependentCoulomb:
     name: str = "load_dependent"
 
     @classmethod
-    def from_parameters(cls, p: Mapping[str, float], negative_level: str = "clamp") -> "LoadDependentCoulomb":
+    def from_parameters(cls, p: Mapping[str, float], options: ElementOptions = NO_OPTIONS) -> "LoadDependentCoulomb":
+        """Build from the parameters; ``options["friction_negative_level"]`` picks the treatment (default clamp)."""
+        negative_level = options.get("friction_negative_level", "clamp")
         if negative_level not in NEGATIVE_LEVEL_CHOICES:
             raise ValueError(f"negative_level must be one of {NEGATIVE_LEVEL_CHOICES}, not {negative_level!r}")
         return cls(p["N2_N_per_bar_m2"], p["N1_N_per_bar_m"], p["N0_N_per_bar"], p["phi_bar_per_kg"], negative_level)
@@ -53,7 +56,7 @@ class ConstantCoulomb:
     name: str = "constant"
 
     @classmethod
-    def from_parameters(cls, p: Mapping[str, float]) -> "ConstantCoulomb":
+    def from_parameters(cls, p: Mapping[str, float], options: ElementOptions = NO_OPTIONS) -> "ConstantCoulomb":
         return cls(p["coulomb_constant_N"])
 
     def level_N(self, x_m, p_gauge_Pa, mass_kg):
@@ -67,22 +70,15 @@ class NoCoulomb:
     name: str = "none"
 
     @classmethod
-    def from_parameters(cls, p: Mapping[str, float]) -> "NoCoulomb":
+    def from_parameters(cls, p: Mapping[str, float], options: ElementOptions = NO_OPTIONS) -> "NoCoulomb":
         return cls()
 
     def level_N(self, x_m, p_gauge_Pa, mass_kg):
         return 0.0 * x_m
 
 
-FRICTION_MODELS: dict[str, Callable[[Mapping[str, float]], object]] = {
+FRICTION_MODELS: dict[str, Builder[Friction]] = {
     "load_dependent": LoadDependentCoulomb.from_parameters,
     "constant": ConstantCoulomb.from_parameters,
     "none": NoCoulomb.from_parameters,
 }
-
-
-def build_friction(name: str, params: Mapping[str, float], negative_level: str = "clamp"):
-    """The friction element a scenario names; ``negative_level`` applies to the load-dependent law only."""
-    if name == "load_dependent":
-        return LoadDependentCoulomb.from_parameters(params, negative_level)
-    return FRICTION_MODELS[name](params)

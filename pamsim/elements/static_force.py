@@ -1,25 +1,17 @@
 """Static (quasi-static) force of the muscle, F_static(x, p).
 
 Positive force contracts the muscle (lifts the load).  Other static models
-plug in by providing ``force_N(x_m, p_gauge_Pa)`` and ``name``; the registry
+plug in by meeting :class:`pamsim.elements.contracts.StaticForce`; the registry
 ``STATIC_FORCE_MODELS`` maps a scenario's ``static_force`` key to a builder.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable, Mapping, Protocol
+from typing import Mapping
 
 from ..constants import PA_PER_BAR
-
-
-class StaticForceModel(Protocol):
-    """What the simulator needs of a static force model."""
-
-    name: str
-
-    def force_N(self, x_m, p_gauge_Pa):
-        """Static force [N] at contraction ``x_m`` [m] and gauge pressure [Pa]."""
+from .contracts import NO_OPTIONS, Builder, ElementOptions, StaticForce
 
 
 @dataclass(frozen=True)
@@ -35,7 +27,7 @@ class Acra2012Polynomial:
     name: str = "acra2012_polynomial"
 
     @classmethod
-    def from_parameters(cls, p: Mapping[str, float]) -> "Acra2012Polynomial":
+    def from_parameters(cls, p: Mapping[str, float], options: ElementOptions = NO_OPTIONS) -> "Acra2012Polynomial":
         return cls(p["K1_N_per_bar_m2"], p["K2_N_per_bar_m"], p["C1_N_per_bar"],
                    p["S1_N_per_m2"], p["S2_N_per_m"], p["S3_N"])
 
@@ -45,6 +37,6 @@ class Acra2012Polynomial:
                 + (self.S1_N_per_m2 * x_m + self.S2_N_per_m) * x_m + self.S3_N)
 
 
-STATIC_FORCE_MODELS: dict[str, Callable[[Mapping[str, float]], StaticForceModel]] = {
+STATIC_FORCE_MODELS: dict[str, Builder[StaticForce]] = {
     "acra2012_polynomial": Acra2012Polynomial.from_parameters,
 }

@@ -2,21 +2,22 @@
 
 Each ``*_figure`` function returns a Figure; :func:`write_figures` saves them
 as PNG to the paths it is given (the caller stages them atomically).
+
+The functions take a :class:`pamsim.sweep.SweepResult` but do not import it:
+the result imports this module to write itself, and one direction is enough.
 """
 
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, Mapping
+from typing import Mapping
 
 import numpy as np
 from matplotlib.colors import TwoSlopeNorm
 from matplotlib.figure import Figure
 
-from .constants import PA_PER_BAR
+from ..constants import PA_PER_BAR
 
-if TYPE_CHECKING:
-    from .sweep import SweepResult
 
 _DPI = 110
 

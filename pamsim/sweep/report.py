@@ -1,14 +1,14 @@
-"""``report.md`` of a sweep: error statistics, cases not at rest, frequencies, failures."""
+"""``report.md`` of a sweep: error statistics, cases not at rest, frequencies, failures.
+
+Takes a :class:`pamsim.sweep.SweepResult` without importing it (the result imports this module).
+"""
 
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
 
 import numpy as np
 
-if TYPE_CHECKING:
-    from .sweep import SweepResult
 
 
 def error_stats_mm(errors_m: np.ndarray) -> tuple[float, float, int]:
@@ -71,8 +71,11 @@ def write_report(result: "SweepResult") -> str:
         out.append(f"- {f}: {len(result.rows) - len(moving)} of {len(result.rows)} cases at rest at the end"
                    + (":" if moving else "."))
         if moving:
+            ptp = [r[prefixes[f] + "last_second_peak_to_peak_m"] for r in moving]
             out.append("  not at rest: " + ", ".join(
                 f"{r['weight_N']:g} N / {r['pressure_bar']:.3f} bar ({r[prefixes[f] + 'final_mode']})" for r in moving))
+            out.append(f"  motion over the last second of the run, peak to peak: {min(ptp) * 1e3:.3f} to "
+                       f"{max(ptp) * 1e3:.3f} mm")
     out.append("")
     if result.frequency_rows:
         study = spec.frequency
@@ -80,13 +83,16 @@ def write_report(result: "SweepResult") -> str:
         out += [f"## Oscillation frequency against load at {study.pressure_bar:g} bar", "",
                 f"Pressure source for this study: `{_inline(source)}`. Frequency and damping ratio are estimated "
                 "from the turning points of the contraction after the pressure has settled "
-                "(`pamsim.oscillation`); n = number of half-cycles seen, n/a = fewer than two half-cycles.", "",
-                "| weight [N] | " + " | ".join(f"{f} f [Hz] | {f} zeta | {f} n" for f in models) + " |",
-                "|---|" + "---|---|---|" * len(models)]
+                "(`pamsim.oscillation`) over whole periods; n = number of half-cycles seen, n/a = fewer than two "
+                "half-cycles; up/down = how much longer the swing up lasts than the swing down, in % of the mean "
+                "half-period.", "",
+                "| weight [N] | " + " | ".join(f"{f} f [Hz] | {f} zeta | {f} n | {f} up/down [%]" for f in models)
+                + " |", "|---|" + "---|---|---|---|" * len(models)]
         for r in result.frequency_rows:
             out.append(f"| {r['weight_N']:g} | " + " | ".join(
                 f"{_num(r[f + '_frequency_Hz'], '.3f')} | {_num(r[f + '_damping_ratio'], '.3f')} | "
-                f"{r[f + '_n_half_cycles']}" for f in models) + " |")
+                f"{r[f + '_n_half_cycles']} | {_num(100 * r[f + '_half_period_asymmetry'], '+.1f')}"
+                for f in models) + " |")
         out.append("")
     if result.responses:
         out += ["## Time responses", "", "| scenario | " + " | ".join(
