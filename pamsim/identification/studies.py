@@ -93,9 +93,9 @@ def _recovery(sc: Scenario, loads, duration_s, pool) -> None:
         idx = [fit.problem.free.index(n) for n in g]
         print(f"- best-determined combination of {', '.join(g)}: fitted {wts @ fit.theta[idx]:.4g}, "
               f"truth {wts @ truth[idx]:.4g}, standard error {se:.3g}")
-    for (n, c), sim in zip(pairs, fit.simulated_m):
+    for (_, c), sim, start in zip(pairs, fit.simulated_m, fit.start_simulated_m):
         print(f"- {c.weight_N:g} N: fitted trajectory vs noise-free truth RMS {_rms(sim - c.x_m):.4f} mm "
-              f"(start: {_rms(fit.start_simulated_m[pairs.index((n, c))] - c.x_m):.3f} mm)")
+              f"(start: {_rms(start - c.x_m):.3f} mm)")
 
 
 def _fd_steps(sc: Scenario) -> None:
