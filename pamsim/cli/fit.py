@@ -150,8 +150,11 @@ def run_static(args: argparse.Namespace) -> int:
     fit = static_fit.fit_static(data, params, model=model, free=args.free, muscle_label=args.muscle, **options)
     compared = None
     if args.compare:
-        compared = compare.compare_models(data, params, args.compare,
-                                          **{**options, "muscle_label": args.muscle})
+        # The main fit is one of the compared ones when it uses the model's own free coefficients.
+        others = [m for m in args.compare if args.free or m != model]
+        fits = dict(zip(others, compare.compare_models(data, params, others,
+                                                       **{**options, "muscle_label": args.muscle})))
+        compared = [fits.get(m, fit) for m in args.compare]
     names = report.write_static_fit(fit, args.output, compared)
     if args.json:
         body = fit.to_json()
