@@ -180,3 +180,39 @@ def test_bad_choices_are_input_errors(scenario, single):
         fit_dynamic(scenario, [tr], window_s=(10.0, 11.0))
     with pytest.raises(InputError, match="--load-N"):
         fit_dynamic(scenario, [tr], loads_N=[1.0, 2.0])
+
+
+@pytest.fixture(scope="module")
+def short_pair(scenario):
+    """Two 2 s traces with N0 = 6.0 only changed (12.74 and 22.74 N)."""
+    from pamsim.identification.synthetic import synthetic_trace
+
+    return [synthetic_trace(scenario, {"N0_N_per_bar": 6.0}, w, NOISE_M, seed=10 + i, duration_s=2.0)
+            for i, w in enumerate((12.74, 22.74))]
+
+
+def test_global_search_then_local_fit(scenario, short_pair):
+    noisy, _ = short_pair[1]
+    fit = fit_dynamic(scenario, [noisy], free=["N0_N_per_bar"], global_search=True, global_iterations=2, seed=1)
+    assert fit.parameters["N0_N_per_bar"] == pytest.approx(6.0, rel=0.02)
+    # popsize 6 x 1 coefficient, initial population and 2 generations: at least 18 evaluations, 1 trace each
+    assert fit.n_simulations >= 18
+
+
+def test_per_trace_table_beside_the_pooled_fit(scenario, short_pair):
+    fit = fit_dynamic(scenario, [n for n, _ in short_pair], free=["N0_N_per_bar"], per_trace=True)
+    assert [row["load_N"] for row in fit.per_trace] == [12.74, 22.74]
+    for row in fit.per_trace:
+        assert row["N0_N_per_bar"] == pytest.approx(6.0, rel=0.03)
+        assert row["pressure_final_bar"] == pytest.approx(3.6, rel=1e-3)
+        assert row["rms_contraction_mm"] == pytest.approx(NOISE_M * 1e3, rel=0.2)
+    assert fit.parameters["N0_N_per_bar"] == pytest.approx(6.0, rel=0.02)
+
+
+def test_without_recorded_pressure_the_scenario_valve_drives_the_fit(scenario, short_pair):
+    noisy, clean = short_pair[1]
+    no_p = TraceData(noisy.t_s, noisy.x_m, None, None, "no pressure")
+    fit = fit_dynamic(scenario, [no_p], free=["N0_N_per_bar"], loads_N=[22.74])
+    assert fit.problem.inputs == (None,)
+    assert fit.parameters["N0_N_per_bar"] == pytest.approx(6.0, rel=0.02)
+    assert np.sqrt(np.mean((fit.simulated_m[0] - clean.x_m) ** 2)) < 0.02e-3

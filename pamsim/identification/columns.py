@@ -229,10 +229,5 @@ def write_trace_csv(trace: TraceData, path: str | Path) -> None:
     Path(path).write_text(buf.getvalue())
 
 
-def sha256_of(path: str | Path) -> str:
-    """SHA-256 of a file (provenance of fitted muscles)."""
-    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
-
-
 __all__ = ["StaticData", "TraceData", "DataError", "read_static_data", "read_trace", "write_trace_csv",
            "PRESSURE_UNITS_PA", "LENGTH_UNITS_M"]

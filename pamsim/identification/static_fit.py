@@ -17,6 +17,7 @@ with bounds from the parameter ranges, an optional robust loss and an optional s
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass, field
 from typing import Mapping, Sequence
 
@@ -239,8 +240,6 @@ def fit_static(data: StaticData, params: ParameterSet, model: str = "acra2012_po
     cv : {"auto", "loo", "kfold", None}
         Cross-validation: leave-one-out, ``k_folds``-fold, or ``auto`` (leave-one-out up to 100 tests).
     """
-    import time
-
     start = time.perf_counter()
     if loss not in LOSSES:
         raise InputError(f"--loss = {loss!r}: choose from {', '.join(LOSSES)}")
@@ -260,13 +259,12 @@ def fit_static(data: StaticData, params: ParameterSet, model: str = "acra2012_po
             theta, res = t, r
     residuals = problem.residuals(theta)
     unc = linearised_uncertainty(problem.free, problem.jacobian(theta), residuals)
-    fit_theta = theta
     predicted = problem.predict_m(theta)
     err_mm = (predicted - data.contraction_m) * 1e3
     force_err = problem.force(theta).force_N(data.contraction_m, data.pressure_gauge_Pa) - data.load_N
     lifted = ~problem.censored
     rms_force = float(np.sqrt(np.mean(force_err[lifted] ** 2))) if lifted.any() else math.nan
-    cv_kind, cv_err = cross_validate(lambda train: _solve(_restrict(problem, train), fit_theta, loss, f_scale)[0],
+    cv_kind, cv_err = cross_validate(lambda train: _solve(_restrict(problem, train), theta, loss, f_scale)[0],
                                      lambda th, test: problem.predict_m(th, data.subset(test)) - data.contraction_m[test],
                                      len(data), len(theta), cv, k_folds, seed)
     aic, bic = information_criteria(float(residuals @ residuals), len(data), len(theta))
