@@ -241,3 +241,16 @@ def test_muscle_file_round_trip(tmp_path, robust_fit):
     path.write_text(text.replace("[parameters.S3_N]", "[parameters.S3_Nx]"))
     with pytest.raises(MuscleFileError, match="parameters.S3_Nx: unknown parameter"):
         load_muscle_parameters(str(path))
+
+
+def test_a_failed_write_leaves_no_folder(tmp_path, robust_fit, monkeypatch):
+    from pamsim.identification import report
+
+    def broken(*args, **kwargs):
+        raise RuntimeError("plotting failed")
+
+    monkeypatch.setattr(report, "plot_correlation", broken)
+    out = tmp_path / "new"
+    with pytest.raises(RuntimeError):
+        report.write_static_fit(robust_fit, out)
+    assert not out.exists()

@@ -3,6 +3,7 @@ nothing (pamsim.atomic)."""
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import datetime
 import json
@@ -19,6 +20,21 @@ from .plots import plot_comparison, plot_correlation, plot_dynamic_fit, plot_sta
 if TYPE_CHECKING:
     from .dynamic_fit import DynamicFit
     from .static_fit import StaticFit
+
+
+@contextlib.contextmanager
+def _outputs(directory, names: list[str]):
+    """:func:`pamsim.atomic.atomic_outputs`, and a folder it had to create is removed again on failure."""
+    directory = Path(directory)
+    existed = directory.exists()
+    try:
+        with atomic_outputs(directory, names) as out:
+            yield out
+    except BaseException:
+        if not existed:
+            with contextlib.suppress(OSError):
+                directory.rmdir()  # only if empty: never remove what someone else put there
+        raise
 
 
 def _f(v: float, fmt: str = ".4g") -> str:
@@ -89,7 +105,7 @@ def write_static_fit(fit: "StaticFit", directory, compare: Sequence["StaticFit"]
     body = fit.to_json()
     if rows:
         body["compare"] = rows
-    with atomic_outputs(directory, names) as out:
+    with _outputs(directory, names) as out:
         out["fit.json"].write_text(json_text(body))
         out["muscle.toml"].write_text(muscle_toml(
             fit.fitted, name=f"{fit.fitted.name}_fitted",
@@ -197,7 +213,7 @@ def write_dynamic_fit(fit: "DynamicFit", directory) -> list[str]:
     spec = _absolute_files(dict(p.scenario.spec), p.scenario.base_dir)
     spec["parameters"] = {**spec.get("parameters", {}), **fit.parameters}
     spec["name"] = f"{p.scenario.name}_fitted"
-    with atomic_outputs(directory, names) as out:
+    with _outputs(directory, names) as out:
         out["fit.json"].write_text(json_text(fit.to_json()))
         out["muscle.toml"].write_text(muscle_toml(
             fitted, name=f"{fitted.name}_dynamic_fit",
