@@ -18,8 +18,8 @@ import numpy as np
 
 KNOT_TOLERANCE_PA = 10.0
 """Default largest deviation of the thinned pressure from the measured one: 0.1 mbar, 0.003 % of a
-3.6 bar step.  At 100 Pa the synthetic recovery study biased the damping coefficients by 15 %
-(docs/identification.md); a noisy measured pressure needs a tolerance near its noise level, or
+3.6 bar step; the motion it drives differs by about a micrometre from the full trace's
+(docs/identification.md).  A noisy measured pressure needs a tolerance near its noise level, or
 every sample becomes a knot."""
 
 

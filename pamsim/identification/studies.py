@@ -2,6 +2,7 @@
 
     python -m pamsim.identification.studies static    # ACRA 2012 refit, a few seconds
     python -m pamsim.identification.studies dynamic   # synthetic recovery and FD steps, minutes
+    python -m pamsim.identification.studies inputs    # thinning of a recorded pressure, seconds
 
 Run from the repository root (the dynamic study reads scenarios/acra2012_fig4.toml; ``--scenario``
 names another).
@@ -110,6 +111,45 @@ def _fd_steps(sc: Scenario) -> None:
         print(f"| {h:g} | {np.linalg.norm(J - ref) / np.linalg.norm(ref):.3g} |")
 
 
+def inputs_study(scenario_path: str) -> None:
+    """Thinned pressure against the full 1 kHz trace, and the forces a 3.6 bar trace excites."""
+    import time
+    from dataclasses import replace
+
+    from ..elements.pressure_source import PrescribedPressure
+    from ..scenario import load_scenario
+    from ..signals import Trace
+    from ..simulator import simulate_model
+    from .pressure_input import thinned_input
+
+    sc = load_scenario(scenario_path).with_changes({"parameters": TRUTH})
+    res = simulate(sc)
+    model = sc.build_model()
+    opts = replace(sc.solver, rtol=1e-8)
+
+    def run(signal):
+        best = np.inf
+        for _ in range(3):
+            start = time.perf_counter()
+            out = simulate_model(replace(model, source=PrescribedPressure(signal)), sc.duration_s, opts)
+            best = min(best, time.perf_counter() - start)
+        return out, best
+
+    full, t_full = run(Trace(res.t_s, res.p_gauge_Pa))
+    print(f"8 s trace, rtol 1e-8: full 1 kHz pressure trace {t_full:.3f} s per simulation\n")
+    print("| knot tolerance [Pa] | knots | breakpoints | s per simulation | largest contraction difference [mm] |")
+    print("|---|---|---|---|---|")
+    for tol in (1.0, 10.0, 100.0, 1000.0):
+        sig = thinned_input(res.t_s, res.p_gauge_Pa, tol)
+        out, t = run(sig)
+        print(f"| {tol:g} | {len(sig.t_s)} | {len(sig.breakpoints)} | {t:.3f} | "
+              f"{np.max(np.abs(out.x_m - full.x_m)) * 1e3:.4f} |")
+    moving = np.abs(res.mode) == 1
+    print(f"\nalong the truth trace (22.74 N): largest |damping force| {np.max(np.abs(res.signals['F_damping_N'])):.3f} N, "
+          f"largest Coulomb level while sliding {np.max(res.signals['F_coulomb_level_N'][moving]):.2f} N, "
+          f"largest speed {np.max(np.abs(res.v_m_s)):.3f} m/s")
+
+
 def dynamic_study(scenario_path: str) -> None:
     from ..scenario import load_scenario
 
@@ -122,11 +162,13 @@ def dynamic_study(scenario_path: str) -> None:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("which", choices=("static", "dynamic"))
+    parser.add_argument("which", choices=("static", "dynamic", "inputs"))
     parser.add_argument("--scenario", default="scenarios/acra2012_fig4.toml")
     args = parser.parse_args()
     if args.which == "static":
         static_study()
+    elif args.which == "inputs":
+        inputs_study(args.scenario)
     else:
         dynamic_study(args.scenario)
 
