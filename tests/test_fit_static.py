@@ -254,3 +254,20 @@ def test_a_failed_write_leaves_no_folder(tmp_path, robust_fit, monkeypatch):
     with pytest.raises(RuntimeError):
         report.write_static_fit(robust_fit, out)
     assert not out.exists()
+
+
+def test_force_gauge_data_fit_by_the_force_objective():
+    # A force gauge at fixed lengths: the paper's polynomial plus 0.05 N of seeded noise.
+    rng = np.random.default_rng(7)
+    p_bar = np.repeat(np.linspace(0.5, 4.0, 8), 10)
+    x = np.tile(np.linspace(0.0, 0.05, 10), 8)
+    K1, K2, C1, S1, S2, S3 = PRINTED
+    F = (K1 * x ** 2 + K2 * x + C1) * p_bar + S1 * x ** 2 + S2 * x + S3 + rng.normal(0.0, 0.05, x.size)
+    data = StaticData(p_bar * 1e5, x, F, "force")
+    start = PAPER.with_overrides({n: 0.8 * v for n, v in zip(COEFFS, PRINTED)})
+    fit = fit_static(data, start, cv="loo")
+    assert fit.problem.objective == "force" and fit.n_censored == 0
+    assert fit.uncertainty.sigma == pytest.approx(0.05, rel=0.2)
+    for n, true, se in zip(COEFFS, PRINTED, fit.uncertainty.standard_errors):
+        assert abs(fit.parameters[n] - true) < 4 * se, n
+    assert fit.cv_kind == "leave-one-out" and np.isfinite(fit.cv_rms_contraction_mm)
