@@ -7,13 +7,15 @@
 
 from .api import simulate
 from .model import Mode, MuscleModel
-from .parameters import PARAMETER_SETS, ParameterSet, get_parameter_set
+from .muscles import load_muscle
+from .parameters import ParameterSet, get_parameter_set
 from .result import Result
 from .scenario import Scenario, ScenarioError, load_scenario
 from .simulator import SolverFailure, SolverOptions, simulate_model
+from . import static_models
 from . import sweep  # a callable package: pamsim.sweep(spec, executor) runs a sweep
 
 __all__ = ["simulate", "load_scenario", "Scenario", "ScenarioError", "Result", "Mode", "MuscleModel",
-           "PARAMETER_SETS", "ParameterSet", "get_parameter_set", "SolverFailure", "SolverOptions",
-           "simulate_model"]
+           "ParameterSet", "get_parameter_set", "SolverFailure", "SolverOptions",
+           "simulate_model", "load_muscle", "static_models"]
 __version__ = "0.1.0"

@@ -1,5 +1,5 @@
-"""Scenarios: a TOML file (or a dict) that names a parameter set, overrides,
-the element choices, the load, the pressure source, the duration and the
+"""Scenarios: a TOML file (or a dict) that names a muscle, overrides of its
+parameters, the static force model and the other element choices, the load, the pressure source, the duration and the
 solver settings.  The schema is documented in ``docs/scenarios.md``.
 
 Every mistake raises :class:`ScenarioError` naming the file, the key and the
@@ -25,11 +25,15 @@ from .elements.damping import DAMPING_MODELS
 from .elements.friction import FRICTION_MODELS, NEGATIVE_LEVEL_CHOICES
 from .elements.load import HangingLoad
 from .elements.pressure_source import PrescribedPressure, ValveChamberSource
+from .elements.force_clip import NEGATIVE_FORCE_CHOICES
 from .elements.static_force import STATIC_FORCE_MODELS
 from .elements.stops import EndStops
 from .elements.valve import Iso6358Orifice, ProportionalValve33
 from .model import FitRange, MuscleModel
-from .parameters import PARAMETER_SETS, ParameterSet
+from .muscle_setup import applicable_model, with_overrides
+from .muscles import Muscle, load_muscle, shipped_names
+from .parameters import ParameterSet, dynamics_parameters
+from .static_models import REGISTRY
 from .signals import Constant, FirstOrderLag, Ramp, Step, Trace
 from .simulator import SolverOptions
 
@@ -46,8 +50,8 @@ _SIGNAL_KINDS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
 _SCHEMA: dict[str, dict[str, Any]] = {
     "": {"name": str, "description": str, "model": dict, "parameters": dict, "load": dict, "pressure": dict,
          "simulation": dict, "solver": dict, "controller": dict},
-    "model": {"parameter_set": str, "static_force": str, "friction": str, "damping": str,
-              "friction_negative_level": str},
+    "model": {"muscle": str, "parameter_set": str, "static_force": str, "static_force_variant": str,
+              "static_force_negative": str, "friction": str, "damping": str, "friction_negative_level": str},
     "load": {"weight_N": float, "mass_kg": float, "external_force": dict},
     "pressure": {"source": str, "supply_gauge_bar": float, "supply_gauge_Pa": float, "valve_open_time_s": float,
                  "command": dict, "prescribed": dict, "initial_gauge_bar": float},
@@ -66,8 +70,9 @@ class ScenarioError(InputError):
 class Scenario:
     """A validated scenario.  Build one with :func:`load_scenario` or :meth:`from_dict`.
 
-    ``spec`` is the validated dict (the TOML content); ``parameters`` the
-    parameter set with the scenario's overrides applied.
+    ``spec`` is the validated dict (the TOML content); ``muscle`` the muscle it
+    names; ``parameters`` the muscle's parameters completed with the dynamics'
+    defaults, with the scenario's overrides applied.
     """
 
     name: str
@@ -77,6 +82,7 @@ class Scenario:
     solver: SolverOptions
     base_dir: Path = field(default=Path("."), repr=False)
     origin: str = "<dict>"
+    muscle: Muscle | None = field(default=None, repr=False)
 
     # ------------------------------------------------------------ construction
     @classmethod
@@ -93,27 +99,18 @@ class Scenario:
             if section not in spec:
                 raise ScenarioError(f"{origin}: missing section [{section}]")
         model = spec.setdefault("model", {})
-        set_name = model.setdefault("parameter_set", "shadow_6x300_acra2012")
-        if set_name not in PARAMETER_SETS:
-            v.fail("model.parameter_set", set_name, "unknown parameter set", choices=PARAMETER_SETS)
-        for key, registry, default in (("static_force", STATIC_FORCE_MODELS, "acra2012_polynomial"),
-                                       ("friction", FRICTION_MODELS, "load_dependent"),
-                                       ("damping", DAMPING_MODELS, "paper")):
+        muscle = _muscle(v, model)
+        for key, registry, default in (("friction", FRICTION_MODELS, "load_dependent"),
+                                       ("damping", DAMPING_MODELS, "paper"),
+                                       ("friction_negative_level", NEGATIVE_LEVEL_CHOICES, "clamp"),
+                                       ("static_force_negative", NEGATIVE_FORCE_CHOICES, "clip")):
             choice = model.setdefault(key, default)
             if choice not in registry:
                 v.fail(f"model.{key}", choice, "unknown choice", choices=registry)
-        negative = model.setdefault("friction_negative_level", "clamp")
-        if negative not in NEGATIVE_LEVEL_CHOICES:
-            v.fail("model.friction_negative_level", negative, "unknown choice", choices=NEGATIVE_LEVEL_CHOICES)
-        params = PARAMETER_SETS[set_name]
-        overrides = spec.get("parameters", {})
-        for key, value in overrides.items():
-            if key not in params:
-                v.fail(f"parameters.{key}", value, "unknown parameter", choices=params)
-            v.number(f"parameters.{key}", value)
-        params = params.with_overrides(overrides, source=f"override in {origin}")
-        for key, value, why in params.violations():
-            v.fail(f"parameters.{key}", value, why)
+        params = with_overrides(dynamics_parameters(muscle.parameters), spec.get("parameters", {}), v.fail, _key,
+                                f"override in {origin}")
+        applicable_model(model.setdefault("static_force", muscle.default_static_force),
+                         model.get("static_force_variant"), muscle, params, v.fail, _key)
         sim = spec["simulation"]
         duration = v.positive("simulation.duration_s", v.required(sim, "simulation", "duration_s"))
         sample_rate = v.positive("simulation.sample_rate_Hz", sim.get("sample_rate_Hz", 1000.0))
@@ -131,7 +128,8 @@ class Scenario:
         max_step = v.positive("solver.max_step_s", solver.get("max_step_s", math.inf))
         opts = SolverOptions(method=method, rtol=rtol, sample_rate_Hz=sample_rate, max_events=int(max_events),
                              max_step_s=max_step)
-        scenario = cls(name or spec.get("name") or "scenario", spec, params, duration, opts, Path(base_dir), origin)
+        scenario = cls(name or spec.get("name") or "scenario", spec, params, duration, opts, Path(base_dir), origin,
+                       muscle)
         if duration * sample_rate > _MAX_SAMPLES:
             v.fail("simulation.sample_rate_Hz", sample_rate,
                    f"with duration_s = {duration:g} this asks for more than {_MAX_SAMPLES:.0e} output samples")
@@ -144,6 +142,10 @@ class Scenario:
         stops = EndStops.from_parameters(params)
         if not stops.x_low_m <= x0 <= stops.x_high_m:
             v.fail("simulation.initial_contraction_m", x0, f"must lie between the stops, 0 and {stops.x_high_m:.4f} m")
+        try:
+            object.__setattr__(scenario, "_static_force", scenario._build_static_force())
+        except ValueError as exc:  # an implicit model that cannot be tabulated over the muscle's range
+            v.fail("model.static_force", model["static_force"], str(exc))
         return scenario
 
     def with_changes(self, changes: Mapping[str, Mapping[str, Any]], name: str | None = None) -> "Scenario":
@@ -239,18 +241,28 @@ class Scenario:
             return PrescribedPressure(sig)
         v.fail("pressure.source", source, "unknown source", choices=("valve", "prescribed"))
 
+    def static_model(self):
+        """The library model the scenario names, built for its muscle, raw (unclipped, untabulated)."""
+        m = self.spec["model"]
+        return REGISTRY[m["static_force"]].build(self.parameters, m.get("static_force_variant"))
+
+    def _build_static_force(self):
+        m = self.spec["model"]
+        return STATIC_FORCE_MODELS[m["static_force"]](self.parameters, m)
+
     def build_model(self) -> MuscleModel:
         """Compose the elements this scenario names into a :class:`MuscleModel`."""
         p = self.parameters
         m = self.spec["model"]
+        domain = self._static_force.domain
         return MuscleModel(
-            static_force=STATIC_FORCE_MODELS[m["static_force"]](p, m),
+            static_force=self._static_force,
             friction=FRICTION_MODELS[m["friction"]](p, m),
             damping=DAMPING_MODELS[m["damping"]](p, m),
             load=HangingLoad(self.mass_kg, p["g_m_s2"], self._external_force),
             stops=EndStops.from_parameters(p),
             source=self._source,
-            fit_range=FitRange(p["fit_x_min_m"], p["fit_x_max_m"], p["fit_p_max_Pa"]),
+            fit_range=FitRange(domain.x_min_m, domain.x_max_m, domain.p_max_Pa),
         )
 
     @property
@@ -281,6 +293,31 @@ def load_scenario(path: str | Path) -> Scenario:
     path = Path(path)
     spec = read_toml(path, "scenario", ScenarioError)
     return Scenario.from_dict(spec, name=spec.get("name") or path.stem, base_dir=path.parent, origin=str(path))
+
+
+# ---------------------------------------------------------------- model section
+def _muscle(v: "_Validator", model: dict) -> Muscle:
+    """The muscle ``[model]`` names: ``muscle`` (a shipped name or a path relative to the scenario)
+    or the older ``parameter_set`` (a shipped name); the Shadow muscle by default."""
+    if "muscle" in model and "parameter_set" in model:
+        v.fail("model.parameter_set", model["parameter_set"], "give either muscle or parameter_set, not both")
+    key = "muscle" if "muscle" in model else "parameter_set"
+    name = model.get(key, "shadow_6x300_acra2012")
+    is_path = "/" in name or name.endswith(".toml")
+    if key == "parameter_set" and is_path or not is_path and name not in shipped_names():
+        v.fail(f"model.{key}", name, "unknown muscle (`pamsim muscles` lists them)", choices=shipped_names())
+    try:
+        muscle = load_muscle(v.base_dir / name if is_path else name)
+    except InputError as exc:
+        v.fail(f"model.{key}", name, f"invalid muscle file: {exc}")
+    model["muscle"] = name
+    model.pop("parameter_set", None)
+    return muscle
+
+
+def _key(kind: str, name: str) -> str:
+    return {"parameter": f"parameters.{name}", "model": "model.static_force",
+            "variant": "model.static_force_variant"}[kind]
 
 
 # ---------------------------------------------------------------- validation

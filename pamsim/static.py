@@ -62,11 +62,17 @@ def friction_band_m(static_force, friction, p_gauge_Pa: float, mass_kg: float, g
 
 
 def static_report(params: Mapping[str, float], static_force, p_gauge_Pa: float, load_N: float) -> dict:
-    """The figures ``pamsim static`` prints."""
+    """The figures ``pamsim static`` prints.
+
+    ``static_force`` is a library model (:mod:`pamsim.static_models`): its
+    valid domain bounds the force capability (beyond it a fitted model
+    extrapolates and says nothing about what the muscle can hold) and decides
+    ``within_fit_range``.
+    """
     x_hi = EndStops.from_parameters(params).x_high_m
     x_eq = equilibrium_contraction_m(static_force, p_gauge_Pa, load_N, x_hi)
+    d = static_force.domain
     return {"pressure_gauge_Pa": p_gauge_Pa, "load_N": load_N, "equilibrium_contraction_m": x_eq,
-            "max_load_N": max_load_N(static_force, p_gauge_Pa, min(x_hi, params["fit_x_max_m"])), "lifts_load": x_eq > 0.0,
+            "max_load_N": max_load_N(static_force, p_gauge_Pa, min(x_hi, d.x_max_m)), "lifts_load": x_eq > 0.0,
             "upper_stop_m": x_hi,
-            "within_fit_range": bool(params["fit_x_min_m"] <= x_eq <= params["fit_x_max_m"]
-                                     and p_gauge_Pa <= params["fit_p_max_Pa"])}
+            "within_fit_range": bool(d.x_min_m <= x_eq <= d.x_max_m and d.p_min_Pa <= p_gauge_Pa <= d.p_max_Pa)}

@@ -87,7 +87,7 @@ BAD_SCENARIOS = [
     ("missing trace", lambda s: s.replace('source = "valve"\nsupply_gauge_bar = 3.6\nvalve_open_time_s = 1.0',
                                           'source = "prescribed"\n[pressure.prescribed]\nkind = "trace"\nfile = "nope.csv"'),
      ["nope.csv", "not found"]),
-    ("parameter out of range", lambda s: s + "\n[parameters]\nD0_m = 0.0\n", ["D0_m", "0.0", "> 0"]),
+    ("parameter out of range", lambda s: s + "\n[parameters]\nr0_m = 0.0\n", ["r0_m", "0.0", "> 0"]),
     ("inconsistent parameters", lambda s: s + "\n[parameters]\nvalve_b = 0.9995\n", ["valve_b", "valve_laminar_ratio"]),
     ("key of another signal kind", lambda s: s.replace("valve_open_time_s = 1.0",
                                                        '[pressure.command]\nkind = "step"\ntime_s = 1.0\nfinal = 1.0\ntau_s = 0.5'),

@@ -131,9 +131,9 @@ def _hand_stiffness_N_m(params, x_m, p_gauge_Pa):
     dF_dx = (2 * params["K1_N_per_bar_m2"] * x_m + params["K2_N_per_bar_m"]) * P + 2 * params["S1_N_per_m2"] * x_m \
         + params["S2_N_per_m"]
     dF_dp = (params["K1_N_per_bar_m2"] * x_m ** 2 + params["K2_N_per_bar_m"] * x_m + params["C1_N_per_bar"]) / 1e5
-    theta = math.radians(params["braid_angle_rest_deg"])
+    theta = math.radians(params["theta0_deg"])
     b = params["L0_m"] / math.cos(theta)
-    n = b * math.sin(theta) / (math.pi * params["D0_m"])
+    n = b * math.sin(theta) / (2.0 * math.pi * params["r0_m"])
     L = params["L0_m"] - x_m
     V = L * (b * b - L * L) / (4 * math.pi * n * n) + params["dead_volume_m3"]
     dV_dx = (3 * L * L - b * b) / (4 * math.pi * n * n)  # V grows as the muscle shortens

@@ -33,8 +33,9 @@ def test_docs_name_no_source_files_issues_or_outside_paths(path):
 
 
 def test_parameter_provenance_uses_the_short_labels_not_file_keys():
-    from pamsim.parameters import PARAMETER_SETS
+    from pamsim.muscles import shipped_names
+    from pamsim.parameters import get_parameter_set
 
-    for pset in PARAMETER_SETS.values():
+    for pset in map(get_parameter_set, shipped_names()):
         for name, entry in pset.entries.items():
             assert "acra2012_dynamic" not in entry.source and ".txt" not in entry.source, name

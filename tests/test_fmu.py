@@ -373,9 +373,9 @@ def _python_reason(name, value):
 
 @pytest.mark.parametrize("version", [2, 3])
 @pytest.mark.parametrize("name,value", [
-    ("D0_m", 0.0),
+    ("r0_m", 0.0),
     ("L0_m", -0.3),
-    ("braid_angle_rest_deg", 60.0),
+    ("theta0_deg", 60.0),
     ("valve_b", 0.9995),  # inside its own range [0, 1), above valve_laminar_ratio
     ("polytropic_index", 0.5),
     ("stop_restitution", 1.5),

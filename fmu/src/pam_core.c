@@ -45,11 +45,11 @@ void pam_reset(PamCore *c) {
 
 /* ------------------------------------------------------------ elements */
 
-/* pamsim.parameters.braid_geometry */
+/* pamsim.static_models.geometry.Braid (b, N) */
 static void braid_geometry(const double *r, double *b, double *n) {
-    double theta = r[R_braid_angle_rest_deg] * PI / 180.0;
+    double theta = r[R_theta0_deg] * PI / 180.0;
     *b = r[R_L0_m] / cos(theta);
-    *n = *b * sin(theta) / (PI * r[R_D0_m]);
+    *n = *b * sin(theta) / (2.0 * PI * r[R_r0_m]);
 }
 
 /* elements.chamber.MuscleChamber.volume_m3 / dvolume_dx_m2 */
@@ -68,11 +68,12 @@ static double pressure_gauge_Pa(const PamCore *c, const double *y) {
     return y[P] - c->r[R_p_atm_Pa];
 }
 
-/* elements.static_force.Acra2012Polynomial */
+/* static_models.acra2012.Acra2012Polynomial, clipped at zero (elements.force_clip: a muscle cannot push) */
 static double static_force_N(const double *r, double x, double p_gauge) {
     double p_bar = p_gauge / PA_PER_BAR;
-    return ((r[R_K1_N_per_bar_m2] * x + r[R_K2_N_per_bar_m]) * x + r[R_C1_N_per_bar]) * p_bar
-           + (r[R_S1_N_per_m2] * x + r[R_S2_N_per_m]) * x + r[R_S3_N];
+    double f = ((r[R_K1_N_per_bar_m2] * x + r[R_K2_N_per_bar_m]) * x + r[R_C1_N_per_bar]) * p_bar
+               + (r[R_S1_N_per_m2] * x + r[R_S2_N_per_m]) * x + r[R_S3_N];
+    return f > 0.0 ? f : 0.0;
 }
 
 /* elements.friction: load-dependent (a negative level clamped at zero, or its magnitude:

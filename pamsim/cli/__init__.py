@@ -22,6 +22,10 @@ COMMANDS = (
     "pamsim.cli.linearize",
     "pamsim.cli.control_example",
     "pamsim.cli.params",
+    "pamsim.cli.models",
+    "pamsim.cli.muscles",
+    "pamsim.cli.force",
+    "pamsim.cli.atlas",
     "pamsim.cli.fit",
 )
 

@@ -1,4 +1,4 @@
-"""``pamsim params``: the parameter set with units and provenance."""
+"""``pamsim params``: a muscle's parameters as the dynamics use them, with units and provenance."""
 
 from __future__ import annotations
 
@@ -6,22 +6,21 @@ import argparse
 import json
 import math
 
-from ..errors import InputError
-from ..parameters import PARAMETER_SETS
+from . import muscle_args
 
 
 def register(sub) -> None:
-    p = sub.add_parser("params", help="list a parameter set with units and provenance")
-    p.add_argument("--set", default="shadow_6x300_acra2012", help="parameter set name")
+    p = sub.add_parser("params", help="list a muscle's parameters with units and provenance",
+                       description="A muscle's parameters with the dynamics' assumed defaults for what its "
+                                   "file does not give, each with unit, range and source.")
+    muscle_args.add_arguments(p, model=False)
     p.add_argument("--json", action="store_true", help="print JSON")
     p.add_argument("--markdown", action="store_true", help="print a Markdown table (as in docs/model.md)")
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
-    if args.set not in PARAMETER_SETS:
-        raise InputError(f"--set = {args.set!r}: unknown parameter set (choose from {', '.join(PARAMETER_SETS)})")
-    ps = PARAMETER_SETS[args.set]
+    _, ps, _ = muscle_args.resolve(args)
     rows = ps.table()
     if args.json:
         print(json.dumps({"name": ps.name, "citation": ps.citation,

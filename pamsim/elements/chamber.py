@@ -22,7 +22,7 @@ import math
 from dataclasses import dataclass
 from typing import Mapping
 
-from ..parameters import braid_geometry
+from ..static_models.geometry import Braid
 
 
 @dataclass(frozen=True)
@@ -38,8 +38,8 @@ class MuscleChamber:
 
     @classmethod
     def from_parameters(cls, p: Mapping[str, float]) -> "MuscleChamber":
-        b, n = braid_geometry(p)
-        return cls(p["L0_m"], b, n, p["dead_volume_m3"], p["polytropic_index"], p["R_J_per_kg_K"])
+        braid = Braid.from_parameters(p)
+        return cls(p["L0_m"], braid.b, braid.N, p["dead_volume_m3"], p["polytropic_index"], p["R_J_per_kg_K"])
 
     def volume_m3(self, x_m):
         L = self.L0_m - x_m

@@ -1,42 +1,48 @@
 """Static (quasi-static) force of the muscle, F_static(x, p).
 
-Positive force contracts the muscle (lifts the load).  Other static models
-plug in by meeting :class:`pamsim.elements.contracts.StaticForce`; the registry
-``STATIC_FORCE_MODELS`` maps a scenario's ``static_force`` key to a builder.
+Positive force contracts the muscle (lifts the load).  The models live in the
+static-model library :mod:`pamsim.static_models` (one registry); any of them
+meets :class:`pamsim.elements.contracts.StaticForce`.  ``STATIC_FORCE_MODELS``
+is a read-only view of that registry which maps a scenario's ``static_force``
+key to a builder ``builder(params, options)`` of the force as the dynamics
+apply it (:func:`pamsim.elements.muscle_force.dynamics_static_force`: tabulated
+if implicit, clipped at zero unless ``static_force_negative = "keep"``).
+Whether a model applies to a muscle is checked where the muscle is known
+(:func:`pamsim.muscle_setup.applicable_model`).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Mapping
+from collections.abc import Mapping
+from typing import Iterator
 
-from ..constants import PA_PER_BAR
+from ..static_models import REGISTRY
+from ..static_models.acra2012 import Acra2012Polynomial
 from .contracts import NO_OPTIONS, Builder, ElementOptions, StaticForce
+from .muscle_force import dynamics_static_force
+from .stops import EndStops
+
+__all__ = ["Acra2012Polynomial", "STATIC_FORCE_MODELS"]
 
 
-@dataclass(frozen=True)
-class Acra2012Polynomial:
-    """Paper eq. (3)/(11): ``(K1 x^2 + K2 x + C1) P + S1 x^2 + S2 x + S3``, P in bar."""
+class _Builders(Mapping[str, Builder[StaticForce]]):
+    """name -> ``builder(params, options)`` for every library model."""
 
-    K1_N_per_bar_m2: float
-    K2_N_per_bar_m: float
-    C1_N_per_bar: float
-    S1_N_per_m2: float
-    S2_N_per_m: float
-    S3_N: float
-    name: str = "acra2012_polynomial"
+    def __getitem__(self, name: str) -> Builder[StaticForce]:
+        if name not in REGISTRY:
+            raise KeyError(name)
 
-    @classmethod
-    def from_parameters(cls, p: Mapping[str, float], options: ElementOptions = NO_OPTIONS) -> "Acra2012Polynomial":
-        return cls(p["K1_N_per_bar_m2"], p["K2_N_per_bar_m"], p["C1_N_per_bar"],
-                   p["S1_N_per_m2"], p["S2_N_per_m"], p["S3_N"])
+        def build(params: Mapping[str, float], options: ElementOptions = NO_OPTIONS) -> StaticForce:
+            return dynamics_static_force(name, params, (0.0, EndStops.from_parameters(params).x_high_m),
+                                         options.get("static_force_variant"),
+                                         options.get("static_force_negative", "clip"))
+        return build
 
-    def force_N(self, x_m, p_gauge_Pa):
-        p_bar = p_gauge_Pa / PA_PER_BAR
-        return (((self.K1_N_per_bar_m2 * x_m + self.K2_N_per_bar_m) * x_m + self.C1_N_per_bar) * p_bar
-                + (self.S1_N_per_m2 * x_m + self.S2_N_per_m) * x_m + self.S3_N)
+    def __iter__(self) -> Iterator[str]:
+        return iter(REGISTRY)
+
+    def __len__(self) -> int:
+        return len(REGISTRY)
 
 
-STATIC_FORCE_MODELS: dict[str, Builder[StaticForce]] = {
-    "acra2012_polynomial": Acra2012Polynomial.from_parameters,
-}
+STATIC_FORCE_MODELS: Mapping[str, Builder[StaticForce]] = _Builders()

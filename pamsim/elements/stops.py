@@ -8,11 +8,10 @@ reported in the results.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Mapping
 
-from ..parameters import braid_geometry
+from ..static_models.geometry import Braid
 
 
 @dataclass(frozen=True)
@@ -26,9 +25,8 @@ class EndStops:
 
     @classmethod
     def from_parameters(cls, p: Mapping[str, float]) -> "EndStops":
-        b, _ = braid_geometry(p)
         # Braid lock at 54.7 deg (cos^2 = 1/3): L_lock = b / sqrt(3), MODEL_NOTES sec. 5.
-        return cls(0.0, p["L0_m"] - b / math.sqrt(3.0), p["stop_restitution"])
+        return cls(0.0, Braid.from_parameters(p).x_lock_m, p["stop_restitution"])
 
     def rebound_speed_m_s(self, impact_speed_m_s: float) -> float:
         """Speed after an impact; below ``min_rebound_speed_m_s`` the load stays on the stop."""

@@ -54,7 +54,8 @@ def cached_fmu(fmi_version: int = 2) -> Path:
 # the python backend.
 REPRESENTED = {
     "": {"name", "description", "model", "parameters", "load", "pressure", "simulation", "solver", "controller"},
-    "model": {"parameter_set", "static_force", "friction", "damping", "friction_negative_level"},
+    "model": {"muscle", "parameter_set", "static_force", "static_force_negative", "friction", "damping",
+              "friction_negative_level"},
     "load": {"weight_N", "mass_kg", "external_force"},
     "pressure": {"source", "supply_gauge_bar", "supply_gauge_Pa", "valve_open_time_s", "command", "prescribed",
                  "initial_gauge_bar"},
@@ -76,11 +77,14 @@ def _refuse_unrepresented(scenario: Scenario) -> None:
     if model["static_force"] != "acra2012_polynomial":
         raise InputError(f"{scenario.origin}: the FMU implements only the acra2012_polynomial static force, "
                          f"not model.static_force = {model['static_force']!r}")
+    if model["static_force_negative"] != "clip":
+        raise InputError(f"{scenario.origin}: the FMU clips a negative static force at zero, "
+                         f"not model.static_force_negative = {model['static_force_negative']!r}")
     names = {v.name for v in VARIABLES if v.causality == "parameter" and v.kind == "real"}
     missing = [k for k in scenario.parameters if k not in names]
     if missing:
         raise InputError(f"{scenario.origin}: the FMU has no parameter {missing[0]!r} "
-                         f"(parameter set {model['parameter_set']!r})")
+                         f"(muscle {model['muscle']!r})")
 
 
 def start_values(scenario: Scenario) -> dict[str, float | int]:

@@ -1,0 +1,192 @@
+"""Static-model atlas of one muscle: isobaric force-contraction curves of every
+applicable model, blocked force and free contraction per model and pressure,
+and the muscle's measured points.
+
+:func:`build_atlas` computes an :class:`Atlas`; :meth:`Atlas.write` writes its
+CSV files, a Markdown table and the figures (:mod:`pamsim.atlas_plots`)
+together or not at all.  ``pamsim atlas`` is the command-line face.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Mapping, Sequence
+
+import numpy as np
+
+from .atomic import atomic_outputs
+from .constants import PA_PER_BAR
+from .elements.stops import EndStops
+from .errors import InputError
+from .muscle_setup import muscle_parameters, prepare
+from .muscles import Muscle
+from .static_models import REGISTRY
+
+N_POINTS = 201
+"""Points per curve along the contraction."""
+RATING_FRACTIONS = (0.25, 0.5, 0.75, 1.0)
+"""Default pressures as fractions of the rating, for a muscle without measured points."""
+MATCH_FRACTION = 0.1
+"""A measured point is drawn on the figure of the nearest atlas pressure within 10 % of it."""
+
+# Column sets of the measured-point files shipped with muscles: (pressure column, its scale to Pa,
+# contraction column, its scale to m, force column).
+_DATA_FORMATS = (
+    ("pressure_stable_bar", PA_PER_BAR, "contraction_stable_mm", 1e-3, "weight_N"),
+    ("pressure_gauge_Pa", 1.0, "contraction_mm", 1e-3, "load_N"),
+)
+
+
+@dataclass(frozen=True)
+class Curve:
+    """One model at one pressure: force [N] along contraction [m] over the model's domain."""
+
+    model: str
+    pressure_Pa: float
+    x_m: np.ndarray = field(repr=False)
+    F_N: np.ndarray = field(repr=False)
+    blocked_force_N: float
+    free_contraction_m: float
+
+
+@dataclass(frozen=True)
+class Atlas:
+    """Curves, summary table and measured points of one muscle."""
+
+    muscle: Muscle
+    pressures_Pa: tuple[float, ...]
+    curves: tuple[Curve, ...]
+    measured: np.ndarray = field(repr=False)  # rows (p_Pa, x_m, F_N)
+    skipped: Mapping[str, str] = field(default_factory=dict)
+
+    @property
+    def models(self) -> list[str]:
+        return list(dict.fromkeys(c.model for c in self.curves))
+
+    def measured_near(self, p_Pa: float) -> np.ndarray:
+        """Measured points whose pressure is nearest to ``p_Pa`` among the atlas pressures (within 10 %)."""
+        if not len(self.measured):
+            return self.measured
+        ps = np.array(self.pressures_Pa)
+        nearest = ps[np.argmin(np.abs(self.measured[:, :1] - ps[None, :]), axis=1)]
+        keep = (nearest == p_Pa) & (np.abs(self.measured[:, 0] - p_Pa) <= MATCH_FRACTION * p_Pa)
+        return self.measured[keep]
+
+    def table_rows(self) -> list[dict]:
+        return [{"model": c.model, "pressure_bar": c.pressure_Pa / PA_PER_BAR, "blocked_force_N": c.blocked_force_N,
+                 "free_contraction_mm": c.free_contraction_m * 1e3} for c in self.curves]
+
+    def markdown_table(self) -> str:
+        """Blocked force and free contraction per model (rows) and pressure (columns)."""
+        head = " | ".join(f"{p / PA_PER_BAR:g} bar" for p in self.pressures_Pa)
+        lines = [f"Blocked force [N] / free contraction [mm] of `{self.muscle.name}`", "",
+                 f"| model | {head} |", "| --- |" + " --- |" * len(self.pressures_Pa)]
+        by = {(c.model, c.pressure_Pa): c for c in self.curves}
+        for m in self.models:
+            cells = []
+            for p in self.pressures_Pa:
+                c = by.get((m, p))
+                cells.append("-" if c is None else f"{c.blocked_force_N:.4g} / {c.free_contraction_m * 1e3:.3g}")
+            lines.append(f"| `{m}` | " + " | ".join(cells) + " |")
+        for m, why in self.skipped.items():
+            lines.append(f"\nNot drawn: `{m}`: {why}")
+        return "\n".join(lines) + "\n"
+
+    def figure_names(self) -> list[str]:
+        return [f"atlas_{p / PA_PER_BAR:g}bar.png" for p in self.pressures_Pa] + ["atlas_all.png"]
+
+    def write(self, directory: str | Path) -> list[Path]:
+        """Write ``atlas_curves.csv``, ``atlas_table.csv``, ``atlas_table.md`` and the figures."""
+        from .atlas_plots import plot_all, plot_pressure
+
+        names = ["atlas_curves.csv", "atlas_table.csv", "atlas_table.md"] + self.figure_names()
+        with atomic_outputs(directory, names) as tmp:
+            with open(tmp["atlas_curves.csv"], "w", newline="") as fh:
+                w = csv.writer(fh)
+                w.writerow(["model", "pressure_bar", "contraction_mm", "force_N"])
+                for c in self.curves:
+                    for x, F in zip(c.x_m, c.F_N):
+                        w.writerow([c.model, f"{c.pressure_Pa / PA_PER_BAR:g}", f"{x * 1e3:.6g}", f"{F:.6g}"])
+            with open(tmp["atlas_table.csv"], "w", newline="") as fh:
+                w = csv.DictWriter(fh, ["model", "pressure_bar", "blocked_force_N", "free_contraction_mm"])
+                w.writeheader()
+                w.writerows(self.table_rows())
+            tmp["atlas_table.md"].write_text(self.markdown_table())
+            for p, name in zip(self.pressures_Pa, self.figure_names()):
+                plot_pressure(self, p, tmp[name])
+            plot_all(self, tmp["atlas_all.png"])
+        return [Path(directory) / n for n in names]
+
+
+def measured_points(path: Path | None) -> np.ndarray:
+    """Rows ``(p_Pa, x_m, F_N)`` of a muscle's measured-point file (empty if it has none).
+
+    Raises
+    ------
+    InputError
+        A file in none of the known column layouts.
+    """
+    if path is None:
+        return np.empty((0, 3))
+    lines = [ln for ln in Path(path).read_text().splitlines() if ln.strip() and not ln.startswith("#")]
+    rows = list(csv.DictReader(lines))
+    header = set(rows[0]) if rows else set()
+    for p_col, p_scale, x_col, x_scale, f_col in _DATA_FORMATS:
+        if {p_col, x_col, f_col} <= header:
+            return np.array([(float(r[p_col]) * p_scale, float(r[x_col]) * x_scale, float(r[f_col])) for r in rows])
+    raise InputError(f"{path}: no known columns for measured points (expected one of "
+                     f"{'; '.join(', '.join((a, c, e)) for a, _, c, _, e in _DATA_FORMATS)})")
+
+
+def default_pressures_Pa(measured: np.ndarray, rating_Pa: float) -> tuple[float, ...]:
+    """The measured points' distinct pressures rounded to 0.01 bar (at most six, spread), else fractions
+    of the rating."""
+    if len(measured):
+        ps = np.unique(np.round(measured[:, 0] / PA_PER_BAR, 2))
+        ps = ps[ps > 0]
+        if len(ps) > 6:
+            ps = ps[np.round(np.linspace(0, len(ps) - 1, 6)).astype(int)]
+        return tuple(float(p) * PA_PER_BAR for p in ps)
+    return tuple(f * rating_Pa for f in RATING_FRACTIONS)
+
+
+def build_atlas(muscle: str, models: Sequence[str] | None = None, pressures_bar: Sequence[float] | None = None,
+                overrides: Mapping[str, float] | None = None, n_points: int = N_POINTS) -> Atlas:
+    """Curves of ``models`` (default: every model whose parameters the muscle gives) at ``pressures_bar``.
+
+    A model named explicitly that does not apply raises :class:`InputError`;
+    a pressure above a model's domain leaves that curve out.
+    """
+    m, params = muscle_parameters(muscle, overrides)
+    names = list(models) if models else m.applicable_models()
+    for name in names:  # the same checks and messages as a scenario or `pamsim force`
+        prepare(muscle, name, overrides)
+    measured = measured_points(m.data_file)
+    rating = params["rated_pressure_gauge_Pa"]
+    if pressures_bar:
+        for p in pressures_bar:
+            if not 0.0 < p * PA_PER_BAR <= rating:
+                raise InputError(f"pressure {p:g} bar: must lie in (0, {rating / PA_PER_BAR:g}] bar (the muscle's rating)")
+        pressures = tuple(float(p) * PA_PER_BAR for p in pressures_bar)
+    else:
+        pressures = default_pressures_Pa(measured, rating)
+    x_stop = EndStops.from_parameters(params).x_high_m if {"L0_m", "r0_m", "theta0_deg"} <= set(params) else math.inf
+    curves, skipped = [], {}
+    for name in names:
+        model = REGISTRY[name].build(params)
+        d = model.domain
+        x_lo, x_hi = max(d.x_min_m, 0.0), min(d.x_max_m, x_stop)
+        if not math.isfinite(x_hi) or x_hi <= x_lo:
+            skipped[name] = f"no finite contraction range (domain {d.x_min_m:g} .. {d.x_max_m:g} m)"
+            continue
+        x = np.linspace(x_lo, x_hi, n_points)
+        for p in pressures:
+            if not d.p_min_Pa <= p <= d.p_max_Pa:
+                continue
+            F = np.asarray(model.force_N(x, p), dtype=float)
+            free = model.free_contraction_m(p, 0.0)
+            curves.append(Curve(name, p, x, F, float(F[0]) if x_lo == 0.0 else math.nan, float(free)))
+    return Atlas(m, pressures, tuple(curves), measured, skipped)

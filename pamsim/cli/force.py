@@ -1,0 +1,32 @@
+"""``pamsim force``: the raw static force of one model at one point."""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+from ..constants import PA_PER_BAR
+from . import finite_float, muscle_args
+
+
+def register(sub) -> None:
+    p = sub.add_parser("force", help="static force of a model at one contraction and pressure",
+                       description="The raw static force (positive pulls; may be negative) of a library model "
+                                   "for a muscle, after checking the point against the model's valid domain.")
+    p.add_argument("--pressure-bar", type=finite_float, required=True, help="gauge pressure [bar]")
+    p.add_argument("--contraction-mm", type=finite_float, required=True, help="contraction L0 - L [mm]")
+    muscle_args.add_arguments(p)
+    p.add_argument("--json", action="store_true", help="print JSON (key force_N)")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    muscle, _, model = muscle_args.resolve(args)
+    x_m, p_Pa = args.contraction_mm * 1e-3, args.pressure_bar * PA_PER_BAR
+    force = float(model.evaluate_N(x_m, p_Pa))
+    if args.json:
+        print(json.dumps({"muscle": muscle.name, "model": model.name, "contraction_m": x_m,
+                          "pressure_gauge_Pa": p_Pa, "force_N": force}, indent=2))
+        return 0
+    print(f"{model.name} on {muscle.name}: {force:.6g} N at {args.contraction_mm:g} mm, {args.pressure_bar:g} bar")
+    return 0

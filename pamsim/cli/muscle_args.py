@@ -1,0 +1,53 @@
+"""Options shared by the commands that query a muscle's static model:
+``--muscle``, ``--model``, ``--variant`` and ``--set NAME=VALUE``."""
+
+from __future__ import annotations
+
+import argparse
+import difflib
+
+from ..errors import InputError
+from ..muscle_setup import prepare
+
+
+def add_arguments(parser: argparse.ArgumentParser, model: bool = True) -> None:
+    parser.add_argument("--muscle", default="shadow_6x300_acra2012",
+                        help="shipped muscle name (`pamsim muscles`) or a muscle TOML file (default: the Shadow muscle)")
+    if model:
+        parser.add_argument("--model", "--static-force", dest="model", default=None,
+                            help="static force model (`pamsim models`; default: the muscle's own)")
+        parser.add_argument("--variant", default=None, help="the model's variant (default: its first)")
+    parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="NAME=VALUE",
+                        help="override a muscle parameter, in the unit of its name (repeatable)")
+
+
+def _fail(key: str, value, why: str, choices=None):
+    hint = ""
+    if choices:
+        close = difflib.get_close_matches(str(value), [str(c) for c in choices], n=1)
+        hint = f" (did you mean {close[0]!r}?)" if close else ""
+    raise InputError(f"{key} = {value!r}: {why}{hint}")
+
+
+def _key(kind: str, name: str) -> str:
+    return {"parameter": f"--set {name}", "model": "--model", "variant": "--variant"}[kind]
+
+
+def overrides(pairs: list[str]) -> dict[str, float]:
+    """``["NAME=VALUE", ...]`` -> ``{NAME: VALUE}``; a malformed pair raises InputError naming it."""
+    out = {}
+    for pair in pairs:
+        name, sep, text = pair.partition("=")
+        if not sep or not name.strip():
+            raise InputError(f"--set {pair!r}: expected NAME=VALUE (for example --set E_bladder_Pa=1.2e6)")
+        try:
+            out[name.strip()] = float(text)
+        except ValueError:
+            raise InputError(f"--set {name.strip()} = {text!r}: not a number") from None
+    return out
+
+
+def resolve(args: argparse.Namespace):
+    """``(muscle, parameters, built model)`` from the parsed options."""
+    return prepare(args.muscle, getattr(args, "model", None), overrides(args.overrides),
+                   getattr(args, "variant", None), fail=_fail, key=_key)

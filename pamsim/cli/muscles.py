@@ -1,0 +1,32 @@
+"""``pamsim muscles``: the muscles shipped with pamsim."""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+from ..muscles import load_muscle, shipped_names
+
+
+def register(sub) -> None:
+    p = sub.add_parser("muscles", help="list the shipped muscles",
+                       description="Every shipped muscle with its citation, default static model and the "
+                                   "models whose parameters it gives.")
+    p.add_argument("--json", action="store_true", help="print JSON")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    rows = []
+    for name in shipped_names():
+        m = load_muscle(name)
+        rows.append({"name": m.name, "description": m.description, "citation": m.citation,
+                     "default_static_force": m.default_static_force, "applicable_models": m.applicable_models(),
+                     "parameters": list(m.parameters)})
+    if args.json:
+        print(json.dumps(rows, indent=2))
+        return 0
+    for r in rows:
+        print(f"{r['name']:28s} default model {r['default_static_force']}; {len(r['applicable_models'])} models apply")
+        print(f"{'':28s} {r['description']}")
+    return 0

@@ -1,0 +1,162 @@
+"""Static models that need a numerical solve, tabulated once for the dynamics.
+
+An implicit library model (kind ``"implicit"``) solves an equation at every
+point, far too slow for the ODE's inner loop.  :func:`tabulate` samples it once
+on a uniform grid over contraction and pressure and returns a
+:class:`TabulatedStaticForce` that interpolates bilinearly: exact where the
+force is affine in pressure (every membrane model in the library), second
+order in the grid spacing along the contraction.  Outside the grid the edge
+cells are extended linearly.  Tables are cached in memory per model, variant,
+parameter values and grid, so a sweep builds each one once per process.
+
+The table error is measured by :func:`table_error` (at the cell centres,
+where bilinear interpolation is worst) and documented in docs/model.md.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Mapping
+
+import numpy as np
+
+N_X = 401
+"""Default grid points along the contraction (a pamsim choice: table error below 0.1 % of the
+blocked force at the rated pressure for every implicit model shipped, docs/model.md)."""
+N_P = 41
+"""Default grid points along the pressure."""
+_CACHE_SIZE = 64
+_CACHE: dict[tuple, "TabulatedStaticForce"] = {}
+
+
+@dataclass(frozen=True, eq=False)
+class TabulatedStaticForce:
+    """Bilinear interpolation of ``F[i, j] = F(x_i, p_j)`` on a uniform grid [m, Pa, N].
+
+    ``name`` and ``domain`` are those of the tabulated model.
+    """
+
+    name: str
+    domain: object
+    x_grid_m: np.ndarray = field(repr=False)
+    p_grid_Pa: np.ndarray = field(repr=False)
+    F_N: np.ndarray = field(repr=False)
+
+    def __post_init__(self):
+        x, p = self.x_grid_m, self.p_grid_Pa
+        # Plain Python floats for the scalar path the ODE calls (numpy scalars cost several times more).
+        object.__setattr__(self, "_x0", float(x[0]))
+        object.__setattr__(self, "_p0", float(p[0]))
+        object.__setattr__(self, "_inv_dx", (len(x) - 1) / float(x[-1] - x[0]))
+        object.__setattr__(self, "_inv_dp", (len(p) - 1) / float(p[-1] - p[0]))
+        object.__setattr__(self, "_nx", len(x))
+        object.__setattr__(self, "_np", len(p))
+        object.__setattr__(self, "_flat", self.F_N.ravel().tolist())
+
+    def force_N(self, x_m, p_gauge_Pa):
+        """Interpolated force [N] at contraction ``x_m`` [m] and gauge pressure [Pa]."""
+        if type(x_m) is float and type(p_gauge_Pa) is float:
+            return self._scalar(x_m, p_gauge_Pa)
+        return self._array(np.asarray(x_m, dtype=float), np.asarray(p_gauge_Pa, dtype=float))
+
+    def _scalar(self, x: float, p: float) -> float:
+        u = (x - self._x0) * self._inv_dx
+        i = min(max(int(math.floor(u)), 0), self._nx - 2)
+        t = u - i
+        v = (p - self._p0) * self._inv_dp
+        j = min(max(int(math.floor(v)), 0), self._np - 2)
+        s = v - j
+        F = self._flat
+        k = i * self._np + j
+        a = F[k] + s * (F[k + 1] - F[k])
+        k += self._np
+        b = F[k] + s * (F[k + 1] - F[k])
+        return a + t * (b - a)
+
+    def _array(self, x: np.ndarray, p: np.ndarray):
+        x, p = np.broadcast_arrays(x, p)
+        u = (x - self._x0) * self._inv_dx
+        i = np.clip(np.floor(u).astype(int), 0, self._nx - 2)
+        t = u - i
+        v = (p - self._p0) * self._inv_dp
+        j = np.clip(np.floor(v).astype(int), 0, self._np - 2)
+        s = v - j
+        F = self.F_N
+        a = F[i, j] + s * (F[i, j + 1] - F[i, j])
+        b = F[i + 1, j] + s * (F[i + 1, j + 1] - F[i + 1, j])
+        out = a + t * (b - a)
+        return out if out.ndim else float(out)
+
+
+def grid_limits(domain, x_range_m: tuple[float, float], p_range_Pa: tuple[float, float]):
+    """The part of ``x_range_m`` x ``p_range_Pa`` inside the model's domain: ``(x_lo, x_hi, p_lo, p_hi)``."""
+    x_lo, x_hi = max(domain.x_min_m, x_range_m[0]), min(domain.x_max_m, x_range_m[1])
+    p_lo, p_hi = max(domain.p_min_Pa, p_range_Pa[0]), min(domain.p_max_Pa, p_range_Pa[1])
+    if not (x_lo < x_hi and p_lo < p_hi and all(map(math.isfinite, (x_lo, x_hi, p_lo, p_hi)))):
+        raise ValueError(f"no finite grid: contraction [{x_lo:g}, {x_hi:g}] m, pressure [{p_lo:g}, {p_hi:g}] Pa")
+    return x_lo, x_hi, p_lo, p_hi
+
+
+def _sample(model, X: np.ndarray, P: np.ndarray) -> np.ndarray:
+    """The model on a grid: one vectorised call, or point by point when it only takes floats."""
+    try:
+        F = np.asarray(model.force_N(X, P), dtype=float)
+        if F.shape == X.shape:
+            return F
+    except (TypeError, ValueError):
+        pass
+    return np.array([float(model.force_N(float(x), float(p))) for x, p in zip(X.ravel(), P.ravel())]).reshape(X.shape)
+
+
+def tabulate(model, x_range_m: tuple[float, float], p_range_Pa: tuple[float, float], n_x: int = N_X,
+             n_p: int = N_P, key: tuple | None = None) -> TabulatedStaticForce:
+    """Tabulate ``model.force_N`` on an ``n_x`` x ``n_p`` grid over the ranges clipped to its domain.
+
+    Parameters
+    ----------
+    model : a built static model (``force_N``, ``name``, ``domain``).
+    x_range_m, p_range_Pa : the region the dynamics can reach (stops, 0 .. rating).
+    n_x, n_p : grid points.
+    key : identifies the model for the in-memory cache (for example the model
+        name, variant and parameter values); None disables the cache.
+
+    Raises
+    ------
+    ValueError
+        If the model gives a non-finite value on the grid.
+    """
+    limits = grid_limits(model.domain, x_range_m, p_range_Pa)
+    full_key = None if key is None else (key, limits, n_x, n_p)
+    if full_key is not None and full_key in _CACHE:
+        return _CACHE[full_key]
+    x = np.linspace(limits[0], limits[1], n_x)
+    p = np.linspace(limits[2], limits[3], n_p)
+    X, P = np.meshgrid(x, p, indexing="ij")
+    F = _sample(model, X, P)
+    if not np.all(np.isfinite(F)):
+        i, j = np.argwhere(~np.isfinite(F))[0]
+        raise ValueError(f"static model {model.name!r} is not finite at x = {x[i]:g} m, p = {p[j]:g} Pa")
+    table = TabulatedStaticForce(model.name, model.domain, x, p, F)
+    if full_key is not None:
+        if len(_CACHE) >= _CACHE_SIZE:
+            _CACHE.pop(next(iter(_CACHE)))
+        _CACHE[full_key] = table
+    return table
+
+
+def table_error(model, table: TabulatedStaticForce) -> float:
+    """Largest ``|table - model|`` [N] at the centres of the table's cells."""
+    x, p = table.x_grid_m, table.p_grid_Pa
+    X, P = np.meshgrid(0.5 * (x[1:] + x[:-1]), 0.5 * (p[1:] + p[:-1]), indexing="ij")
+    return float(np.max(np.abs(_sample(model, X, P) - table.force_N(X, P))))
+
+
+def clear_cache() -> None:
+    """Forget every cached table."""
+    _CACHE.clear()
+
+
+def cache_key(model_name: str, variant: str | None, params: Mapping[str, float]) -> tuple:
+    """Cache key of a model built from ``params``: the muscle is its parameter values."""
+    return (model_name, variant, tuple(sorted((k, float(v)) for k, v in params.items())))

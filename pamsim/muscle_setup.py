@@ -1,0 +1,99 @@
+"""A muscle ready for a run or a static query: its parameters with the dynamics'
+defaults and the user's overrides, and a static model that applies to it.
+
+Scenarios (``[parameters]``, ``[model] static_force``) and the command line
+(``--set NAME=VALUE``, ``--model``) share these checks; each passes a ``fail``
+callback ``fail(key, value, why, choices=None)`` that raises its own error
+naming its own file or option, and ``key`` maps a kind (``"parameter"``,
+``"model"``, ``"variant"``) and a name to the key the user wrote.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Callable, Mapping
+
+from .errors import InputError
+from .muscles import Muscle, load_muscle
+from .muscles.schema import KNOWN
+from .parameters import ParameterSet, dynamics_parameters, known_parameter
+from .static_models import REGISTRY, StaticModelSpec
+from .static_models.base import did_you_mean
+
+Fail = Callable[..., None]
+Key = Callable[[str, str], str]
+
+
+def with_overrides(params: ParameterSet, overrides: Mapping[str, Any], fail: Fail, key: Key,
+                   source: str) -> ParameterSet:
+    """``params`` with ``overrides`` applied; a known parameter name the muscle lacks is added.
+
+    Every value is checked for type and range, and the result for consistency
+    (:meth:`ParameterSet.violations`).
+    """
+    values, added = {}, {}
+    for name, value in overrides.items():
+        if name not in params and name not in KNOWN:
+            fail(key("parameter", name), value, "unknown parameter" + _suggest(name, sorted(set(params) | set(KNOWN))))
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            fail(key("parameter", name), value, f"must be a number, not {type(value).__name__}")
+        (values if name in params else added)[name] = float(value)
+    params = params.with_overrides(values, source=source)
+    if added:
+        entries = dict(params.entries)
+        entries.update({k: known_parameter(k, x, source) for k, x in added.items()})
+        params = ParameterSet(params.name, params.citation, entries)
+    for name, value, why in params.violations():
+        fail(key("parameter", name), value, why)
+    return params
+
+
+def _suggest(name: str, names: list[str]) -> str:
+    """The names that extend ``name`` by a unit suffix (``valve_C`` -> ``valve_C_m3_per_s_Pa``), else the closest."""
+    longer = [n for n in names if n.startswith(name + "_")]
+    if longer:
+        return f" (did you mean {' or '.join(repr(n) for n in longer[:3])}?)"
+    return did_you_mean(name, names) or " (`pamsim params` lists a muscle's parameters)"
+
+
+def applicable_model(name: str, variant: str | None, muscle: Muscle, params: Mapping[str, float], fail: Fail,
+                     key: Key) -> StaticModelSpec:
+    """The spec of library model ``name``: known, with every parameter it needs, and the variant known."""
+    if name not in REGISTRY:
+        fail(key("model", name), name, "unknown static force model (`pamsim models` lists them)", list(REGISTRY))
+    spec = REGISTRY[name]
+    missing = spec.missing(params)
+    if missing:
+        fail(key("model", name), name, f"needs parameter(s) {', '.join(missing)}, which muscle {muscle.name!r} "
+             "does not give (set them or choose another model)")
+    if variant is not None and variant not in spec.variants:
+        fail(key("variant", variant), variant, f"not a variant of {name!r}", list(spec.variants))
+    return spec
+
+
+def _defaults(fail: Fail | None, key: Key | None) -> tuple[Fail, Key]:
+    def default_fail(k, value, why, choices=None):
+        raise InputError(f"{k} = {value!r}: {why}" + (did_you_mean(value, choices) if choices else ""))
+
+    return (fail or default_fail,
+            key or (lambda kind, name: {"parameter": name, "model": "model", "variant": "variant"}[kind]))
+
+
+def muscle_parameters(muscle: str, overrides: Mapping[str, Any] | None = None, fail: Fail | None = None,
+                      key: Key | None = None) -> tuple[Muscle, ParameterSet]:
+    """Load ``muscle`` (name or path): ``(muscle, its parameters with the dynamics' defaults and overrides)``."""
+    fail, key = _defaults(fail, key)
+    m = load_muscle(muscle)
+    return m, with_overrides(dynamics_parameters(m.parameters), overrides or {}, fail, key, "override")
+
+
+def prepare(muscle: str, model: str | None = None, overrides: Mapping[str, Any] | None = None,
+            variant: str | None = None, fail: Fail | None = None, key: Key | None = None):
+    """Load ``muscle`` and return ``(muscle, parameters, built static model)`` for static queries.
+
+    The Python face of ``pamsim force`` / ``pamsim static``: without ``fail``
+    every mistake raises :class:`~pamsim.errors.InputError`.
+    """
+    fail, key = _defaults(fail, key)
+    m, params = muscle_parameters(muscle, overrides, fail, key)
+    spec = applicable_model(model or m.default_static_force, variant, m, params, fail, key)
+    return m, params, spec.build(params, variant)

@@ -1,0 +1,256 @@
+"""Muscles as data: TOML files with every value's unit (from its key) and provenance.
+
+``load_muscle("kothera2009_5a")`` loads a shipped muscle; a name containing
+``/`` or ending in ``.toml`` is a path.  Any mistake in a file raises
+:class:`MuscleError` with one line ``FILE: KEY = VALUE: why``.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+from typing import Any, Mapping
+
+from ..errors import InputError
+from ..parameters import Parameter, ParameterSet
+from ..static_models import REGISTRY, StaticForce
+from ..static_models import get as get_model
+from ..static_models.base import did_you_mean
+from .schema import KNOWN, LOCK_DEG, unit_of
+
+
+class MuscleError(InputError):
+    """A muscle file or name that cannot be used; the message names file, key and value."""
+
+
+TOP_KEYS = ("name", "description", "citation", "default_static_force", "rated_pressure_gauge_Pa", "gaps",
+            "force_map", "parameters", "data")
+ENTRY_KEYS = ("value", "source", "description", "unit")
+
+
+@dataclass(frozen=True)
+class Muscle:
+    """A validated muscle: metadata and its :class:`~pamsim.parameters.ParameterSet`.
+
+    Attributes
+    ----------
+    name, description, citation : from the file.
+    default_static_force : registry name of the model to use when none is chosen.
+    parameters : values (SI, unit in the name) with unit, source, description and range.
+    origin : the file it was read from.
+    gaps : values the source does not give (said, not invented).
+    data_file : measured points shipped with the muscle, or None.
+    force_map_file : measured F(x, p) table for the ``force_map`` model, or None.
+    """
+
+    name: str
+    description: str
+    citation: str
+    default_static_force: str
+    parameters: ParameterSet
+    origin: Path
+    gaps: tuple[str, ...] = ()
+    data_file: Path | None = field(default=None)
+    force_map_file: Path | None = field(default=None)
+
+    def model_inputs(self) -> dict:
+        """What a static model is built from: the parameter values and, if any, the force-map file."""
+        inputs: dict = dict(self.parameters)
+        if self.force_map_file is not None:
+            inputs["force_map_file"] = self.force_map_file
+        return inputs
+
+    def applicable_models(self) -> list[str]:
+        """Names of the library models whose required inputs this muscle gives."""
+        inputs = self.model_inputs()
+        return [name for name, spec in REGISTRY.items() if not spec.missing(inputs)]
+
+    def static_force(self, model: str | None = None, variant: str | None = None,
+                     overrides: Mapping[str, float] | None = None) -> StaticForce:
+        """Build a library model (default: the muscle's own) for this muscle."""
+        params = self.model_inputs()
+        params.update(overrides or {})
+        return get_model(model or self.default_static_force).build(params, variant)
+
+
+def shipped_names() -> list[str]:
+    """Names of the muscles shipped with pamsim."""
+    return sorted(p.name[:-5] for p in resources.files(__name__).iterdir() if p.name.endswith(".toml"))
+
+
+def load_muscle(name_or_path: str | Path) -> Muscle:
+    """Load and validate a shipped muscle (by name) or a muscle file (by path).
+
+    Raises
+    ------
+    MuscleError
+        Unknown name, unreadable file, or any invalid key or value.
+    """
+    text = str(name_or_path)
+    if isinstance(name_or_path, Path) or "/" in text or text.endswith(".toml"):
+        path = Path(name_or_path)
+        if not path.is_file():
+            raise MuscleError(f"{path}: no such muscle file")
+    else:
+        names = shipped_names()
+        if text not in names:
+            raise MuscleError(f"muscle = {text!r}: unknown muscle{did_you_mean(text, names)} "
+                              f"(shipped: {', '.join(names)})")
+        path = Path(str(resources.files(__name__).joinpath(text + ".toml")))
+    try:
+        raw = tomllib.loads(path.read_text(encoding="utf-8"))
+    except tomllib.TOMLDecodeError as exc:
+        raise MuscleError(f"{path}: invalid TOML: {exc}") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise MuscleError(f"{path}: cannot read: {exc}") from None
+    return muscle_from_dict(raw, path)
+
+
+def muscle_from_dict(raw: Mapping[str, Any], origin: str | Path = "<dict>") -> Muscle:
+    """Validate the structure of a muscle file (already parsed) and build the :class:`Muscle`."""
+    origin = Path(origin)
+
+    def fail(key: str, value: Any, why: str) -> MuscleError:
+        return MuscleError(f"{origin}: {key} = {value!r}: {why}")
+
+    for key in raw:
+        if key not in TOP_KEYS:
+            raise fail(key, raw[key], "unknown key" + did_you_mean(key, TOP_KEYS))
+    strings = {}
+    for key in ("name", "description", "citation", "default_static_force"):
+        value = raw.get(key)
+        if not isinstance(value, str) or not value.strip():
+            raise fail(key, value, "required, a non-empty string")
+        strings[key] = value
+    model = strings["default_static_force"]
+    if model not in REGISTRY:
+        raise fail("default_static_force", model, "unknown static model" + did_you_mean(model, REGISTRY))
+    gaps = raw.get("gaps", [])
+    if not isinstance(gaps, list) or not all(isinstance(g, str) for g in gaps):
+        raise fail("gaps", gaps, "must be a list of strings")
+    tables = raw.get("parameters", {})
+    if not isinstance(tables, dict):
+        raise fail("parameters", tables, "must be a table of [parameters.NAME] tables")
+    entries = {name: _entry(fail, name, table) for name, table in tables.items()}
+    if "rated_pressure_gauge_Pa" in raw:
+        if "rated_pressure_gauge_Pa" in entries:
+            raise fail("rated_pressure_gauge_Pa", raw["rated_pressure_gauge_Pa"],
+                       "given both at the top level and under [parameters]")
+        entries["rated_pressure_gauge_Pa"] = _entry(
+            fail, "rated_pressure_gauge_Pa",
+            {"value": raw["rated_pressure_gauge_Pa"], "source": f"{origin.name}: top-level rating (no source given)"})
+    _convert_radial_angle(fail, entries)
+    _complete_wall(fail, entries)
+    _check_geometry(fail, entries)
+    force_map_file = None
+    if "force_map" in raw:
+        fm = raw["force_map"]
+        if not isinstance(fm, str) or not (origin.parent / fm).is_file():
+            raise fail("force_map", fm, "must name a CSV file next to the muscle file")
+        force_map_file = (origin.parent / fm).resolve()
+    data_file = None
+    if "data" in raw:
+        data = raw["data"]
+        if not isinstance(data, dict) or set(data) != {"file"} or not isinstance(data["file"], str):
+            raise fail("data", data, 'must be a table with one key, file = "NAME.csv"')
+        data_file = (origin.parent / data["file"]).resolve()
+        if not data_file.is_file():
+            raise fail("data.file", data["file"], f"no such file next to the muscle file ({data_file})")
+    params = ParameterSet(strings["name"], strings["citation"], entries)
+    return Muscle(strings["name"], strings["description"], strings["citation"], model, params, origin,
+                  tuple(gaps), data_file, force_map_file)
+
+
+def _entry(fail, name: str, table: Any) -> Parameter:
+    """One ``[parameters.NAME]`` table -> :class:`Parameter` with the known unit and bounds."""
+    key = f"parameters.{name}"
+    if name not in KNOWN and name != "alpha_radial_deg":
+        raise fail(key, table, "unknown parameter" + did_you_mean(name, list(KNOWN) + ["alpha_radial_deg"]))
+    if not isinstance(table, dict):
+        raise fail(key, table, "must be a table with value and source")
+    for k in table:
+        if k not in ENTRY_KEYS:
+            raise fail(f"{key}.{k}", table[k], "unknown key" + did_you_mean(k, ENTRY_KEYS))
+    value = table.get("value")
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise fail(f"{key}.value", value, "required, a number")
+    value = float(value)
+    if not math.isfinite(value):
+        raise fail(f"{key}.value", value, "must be a finite number")
+    source = table.get("source")
+    if not isinstance(source, str) or not source.strip():
+        raise fail(f"{key}.source", source, 'required: where the value comes from (paper + table/equation, or "assumed: <reason>")')
+    unit = unit_of(name)
+    if "unit" in table and table["unit"] != unit:
+        raise fail(f"{key}.unit", table["unit"], f"does not match the unit of the name's suffix ({unit!r})")
+    description = table.get("description", "")
+    if not isinstance(description, str):
+        raise fail(f"{key}.description", description, "must be a string")
+    if name == "alpha_radial_deg":
+        known = KNOWN["theta0_deg"]
+        description = description or "braid angle from the plane normal to the axis (Kothera's convention)"
+    else:
+        known = KNOWN[name]
+        description = description or known.description
+    param = Parameter(value, unit, source, description, known.lower, known.upper, known.lower_open, known.upper_open)
+    why = param.violation(value)
+    if why:
+        raise fail(key, value, why)
+    return param
+
+
+def _convert_radial_angle(fail, entries: dict[str, Parameter]) -> None:
+    """Turn a radial-plane braid angle into ``theta0_deg = 90 - alpha_radial_deg`` at the edge."""
+    if "alpha_radial_deg" not in entries:
+        return
+    alpha = entries.pop("alpha_radial_deg")
+    if "theta0_deg" in entries:
+        raise fail("parameters.alpha_radial_deg", alpha.value,
+                   "give either theta0_deg (from the axis) or alpha_radial_deg (from the radial plane), not both")
+    known = KNOWN["theta0_deg"]
+    entries["theta0_deg"] = Parameter(90.0 - alpha.value, "deg", f"{alpha.source}; converted: theta0 = 90 deg - "
+                                      f"alpha_radial ({alpha.value:g} deg)", known.description,
+                                      known.lower, known.upper, known.lower_open, known.upper_open)
+
+
+def _complete_wall(fail, entries: dict[str, Parameter]) -> None:
+    """Derive the wall thickness from the inner radius or the reverse; check them if both are given."""
+    r0, ri0, t = entries.get("r0_m"), entries.get("ri0_m"), entries.get("wall_thickness_m")
+    if r0 is None:
+        return
+    if ri0 is not None and t is not None:
+        if abs(r0.value - ri0.value - t.value) > 1e-9 * r0.value:
+            raise fail("parameters.wall_thickness_m", t.value,
+                       f"inconsistent with r0_m - ri0_m = {r0.value - ri0.value:g} m")
+    elif ri0 is not None:
+        k = KNOWN["wall_thickness_m"]
+        entries["wall_thickness_m"] = Parameter(r0.value - ri0.value, "m", "derived: r0_m - ri0_m", k.description,
+                                                k.lower, k.upper, k.lower_open)
+    elif t is not None:
+        k = KNOWN["ri0_m"]
+        entries["ri0_m"] = Parameter(r0.value - t.value, "m", "derived: r0_m - wall_thickness_m", k.description,
+                                     k.lower, k.upper, k.lower_open)
+
+
+def _check_geometry(fail, entries: dict[str, Parameter]) -> None:
+    """Consistency checks between geometry values."""
+    v = {k: p.value for k, p in entries.items()}
+    if "r0_m" in v and "wall_thickness_m" in v and not v["r0_m"] > v["wall_thickness_m"]:
+        raise fail("parameters.r0_m", v["r0_m"],
+                   f"braid radius must exceed the bladder wall thickness ({v['wall_thickness_m']:g} m): "
+                   "the bladder would have no bore")
+    if "theta0_deg" in v and v["theta0_deg"] >= LOCK_DEG:
+        raise fail("parameters.theta0_deg", v["theta0_deg"],
+                   f"at or beyond the braid locking angle {LOCK_DEG:.4f} deg: the muscle would not contract")
+    if "fit_x_min_m" in v and "fit_x_max_m" in v and not v["fit_x_min_m"] < v["fit_x_max_m"]:
+        raise fail("parameters.fit_x_min_m", v["fit_x_min_m"], f"must be below fit_x_max_m = {v['fit_x_max_m']:g}")
+    if "valve_b" in v and "valve_laminar_ratio" in v and not v["valve_b"] < v["valve_laminar_ratio"]:
+        raise fail("parameters.valve_b", v["valve_b"], f"must be below valve_laminar_ratio = {v['valve_laminar_ratio']:g}")
+    if "L0_m" in v and "r0_m" in v and not v["r0_m"] < v["L0_m"]:
+        raise fail("parameters.r0_m", v["r0_m"], f"braid radius must be below the rest length ({v['L0_m']:g} m)")
+
+
+__all__ = ["Muscle", "MuscleError", "load_muscle", "muscle_from_dict", "shipped_names"]

@@ -1,0 +1,103 @@
+"""A measured (or tabulated) static force map ``F(x, p)`` read from a CSV file.
+
+File format: comment lines start with ``#``; a header row names three columns
+``contraction_m`` (x = L0 - L [m]), ``pressure_gauge_Pa`` [Pa] and ``force_N``
+[N]; one row per point of a full rectangular grid (every contraction with every
+pressure, any order, at least two values of each).  The force is interpolated by
+a bicubic interpolating spline (``scipy.interpolate.RectBivariateSpline``,
+``s = 0``; degree lowered to ``n - 1`` along an axis with fewer than four values),
+which is exact for data that are cubic in each variable and smooth (C2) in
+between.  The domain is the table's extent: no extrapolation.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from pathlib import Path
+
+import numpy as np
+from scipy.interpolate import RectBivariateSpline
+
+from ..errors import InputError
+from .base import Domain, StaticForce, StaticModelSpec
+
+COLUMNS = ("contraction_m", "pressure_gauge_Pa", "force_N")
+
+
+class ForceMapError(InputError):
+    """A force-map file that cannot be used; the message names file, row/column and value."""
+
+
+def read_force_map(path: str | Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Read and check a force-map CSV: ``(x_m [nx], p_Pa [np], F_N [nx, np])``.
+
+    Raises
+    ------
+    ForceMapError
+        Missing file or column, a non-numeric or non-finite value, a duplicate
+        point, or points that do not form a full grid.
+    """
+    path = Path(path)
+    try:
+        lines = [ln for ln in path.read_text(encoding="utf-8").splitlines() if ln.strip() and not ln.startswith("#")]
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ForceMapError(f"{path}: cannot read the force map: {exc}") from None
+    reader = csv.DictReader(lines)
+    missing = [c for c in COLUMNS if c not in (reader.fieldnames or [])]
+    if missing:
+        raise ForceMapError(f"{path}: header = {reader.fieldnames!r}: missing column(s) {', '.join(missing)} "
+                            f"(need {', '.join(COLUMNS)})")
+    points = {}
+    for n, row in enumerate(reader, start=2):
+        values = []
+        for c in COLUMNS:
+            try:
+                v = float(row[c])
+            except (TypeError, ValueError):
+                raise ForceMapError(f"{path}: row {n}: {c} = {row[c]!r}: not a number") from None
+            if not math.isfinite(v):
+                raise ForceMapError(f"{path}: row {n}: {c} = {row[c]!r}: must be finite")
+            values.append(v)
+        key = (values[0], values[1])
+        if key in points:
+            raise ForceMapError(f"{path}: row {n}: (contraction_m, pressure_gauge_Pa) = {key}: duplicate point")
+        points[key] = values[2]
+    xs = np.unique([k[0] for k in points])
+    ps = np.unique([k[1] for k in points])
+    if len(xs) < 2 or len(ps) < 2:
+        raise ForceMapError(f"{path}: grid = {len(xs)} x {len(ps)}: needs at least two contractions and two pressures")
+    if len(points) != len(xs) * len(ps):
+        absent = next((x, p) for x in xs for p in ps if (x, p) not in points)
+        raise ForceMapError(f"{path}: (contraction_m, pressure_gauge_Pa) = ({absent[0]:g}, {absent[1]:g}): "
+                            f"missing point (the table must be a full {len(xs)} x {len(ps)} grid)")
+    F = np.array([[points[(x, p)] for p in ps] for x in xs])
+    return xs, ps, F
+
+
+class ForceMap(StaticForce):
+    """Smooth interpolation of a tabulated ``F(x, p)``; see the module docstring."""
+
+    name = "force_map"
+
+    def __init__(self, x_m: np.ndarray, p_Pa: np.ndarray, F_N: np.ndarray, origin: str = "<table>"):
+        self.origin = origin
+        self.spline = RectBivariateSpline(x_m, p_Pa, F_N, kx=min(3, len(x_m) - 1), ky=min(3, len(p_Pa) - 1), s=0)
+        self.domain = Domain(float(x_m[0]), float(x_m[-1]), float(p_Pa[0]), float(p_Pa[-1]))
+
+    @classmethod
+    def from_csv(cls, path: str | Path) -> "ForceMap":
+        return cls(*read_force_map(path), origin=str(path))
+
+    def force_N(self, x_m, p_gauge_Pa):
+        if isinstance(x_m, float) and isinstance(p_gauge_Pa, float):
+            return float(self.spline.ev(x_m, p_gauge_Pa))
+        x, p = np.broadcast_arrays(np.asarray(x_m, dtype=float), np.asarray(p_gauge_Pa, dtype=float))
+        return self.spline.ev(x, p)
+
+
+SPECS = (
+    StaticModelSpec("force_map", "table", "a measured F(x, p) table given by the user (CSV, see docs/static_models.md)",
+                    ("force_map_file",), lambda p, v: ForceMap.from_csv(p["force_map_file"]),
+                    summary="bicubic interpolation of a measured force table; domain = the table's extent"),
+)

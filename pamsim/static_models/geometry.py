@@ -1,0 +1,96 @@
+"""Braid and bladder geometry shared by the physical models.
+
+Conventions (STATIC_MODELS.md sec. 1): ``theta`` is the braid angle from the
+muscle axis; the fibre length ``b`` and number of turns ``N`` follow from the
+rest length ``L0``, the braid radius at rest ``r0`` and ``theta0``:
+``L = b cos(theta)``, ``2 pi r N = b sin(theta)``.  The bladder volume
+``V_b = pi L0 (r0^2 - ri0^2)`` is constant (incompressible rubber).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Mapping
+
+from scipy.optimize import brentq
+
+
+
+@dataclass(frozen=True)
+class Braid:
+    """Rest geometry of a braided muscle, SI units.
+
+    Attributes
+    ----------
+    L0 : rest length [m].  r0 : braid (= bladder outer) radius at rest [m].
+    theta0 : rest braid angle from the axis [rad].  t0 : bladder wall thickness at rest [m]
+    (0 when the muscle gives none).  b : fibre length [m].  N : turns of one fibre [-].
+    Vb : bladder wall volume [m^3].
+    """
+
+    L0: float
+    r0: float
+    theta0: float
+    t0: float
+    b: float
+    N: float
+    Vb: float
+
+    @classmethod
+    def from_parameters(cls, p: Mapping[str, float]) -> "Braid":
+        L0, r0 = p["L0_m"], p["r0_m"]
+        theta0 = math.radians(p["theta0_deg"])
+        t0 = p.get("wall_thickness_m", 0.0)
+        b = L0 / math.cos(theta0)
+        N = b * math.sin(theta0) / (2.0 * math.pi * r0)
+        Vb = math.pi * L0 * (r0 ** 2 - (r0 - t0) ** 2)
+        return cls(L0, r0, theta0, t0, b, N, Vb)
+
+    @property
+    def ri0(self) -> float:
+        """Bladder inner radius at rest [m]."""
+        return self.r0 - self.t0
+
+    @property
+    def gaylord_area_m2(self) -> float:
+        """``b^2 / (4 pi N^2)``: Gaylord's force per pressure is this times ``3 cos^2(theta) - 1``."""
+        return self.b ** 2 / (4.0 * math.pi * self.N ** 2)
+
+    @property
+    def x_lock_m(self) -> float:
+        """Contraction at the Gaylord kinematic limit, where ``3 cos^2(theta) = 1``."""
+        return self.L0 - self.b / math.sqrt(3.0)
+
+    @property
+    def q1(self) -> float:
+        return 3.0 / math.tan(self.theta0) ** 2
+
+    @property
+    def q2(self) -> float:
+        return 1.0 / math.sin(self.theta0) ** 2
+
+    def radius_m(self, L):
+        """Braid radius [m] at length ``L`` [m]: ``sqrt(b^2 - L^2) / (2 pi N)``."""
+        return (self.b * self.b - L * L) ** 0.5 / (2.0 * math.pi * self.N)
+
+    def thickness_m(self, L, R=None):
+        """Wall thickness [m] at length ``L`` from constant bladder volume (Kothera eq. 16)."""
+        R = self.radius_m(L) if R is None else R
+        return R - (R * R - self.Vb / (math.pi * L)) ** 0.5
+
+    def x_fill_m(self) -> float:
+        """Contraction [m] at which a constant-volume bladder fills the braid (``R^2 = V_b/(pi L)``).
+
+        Beyond it the wall-thickness formula has no real value.  Without a
+        bladder nothing fills the braid and ``L0`` (zero length) is returned.
+        """
+        if self.Vb <= 0.0:
+            return self.L0
+        def g(L):
+            return self.radius_m(L) ** 2 - self.Vb / (math.pi * L)
+        L_lo = 1e-9 * self.L0
+        L_peak = self.b / math.sqrt(3.0)  # R^2 L is largest here, so g's root lies below it
+        if g(L_peak) <= 0.0:
+            return 0.0
+        return self.L0 - brentq(g, L_lo, L_peak, xtol=1e-15)

@@ -1,0 +1,372 @@
+"""The static-model library in the dynamics: muscles in scenarios, clipping, tables, CLI, sweeps."""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import pamsim
+from pamsim.elements.force_clip import ClippedStaticForce
+from pamsim.elements.force_table import clear_cache, table_error, tabulate
+from pamsim.muscles import load_muscle
+from pamsim.parameters import DYNAMICS_DEFAULTS, dynamics_parameters, get_parameter_set
+from pamsim.scenario import ScenarioError
+from pamsim.static_models import REGISTRY, Domain, StaticForce
+from pamsim.sweep import sweep, sweep_from_dict
+
+from conftest import run_cli
+
+ROOT = Path(__file__).resolve().parents[1]
+SCENARIOS = ROOT / "scenarios"
+SHADOW = get_parameter_set("shadow_6x300_acra2012")
+
+# Three muscles of different size and source, each with a supply pressure it was tested at and a load
+# (None: 30 % of its default model's blocked force there).
+MUSCLES = {"shadow_6x300_acra2012": (3.6, 22.74), "kothera2009_5a": (4.0, None), "mpam_survey_45mm": (7.58, 0.05)}
+
+
+def _spec(muscle: str, model: str | None = None, **model_keys) -> dict:
+    pbar, weight = MUSCLES.get(muscle, (3.0, 10.0))
+    if weight is None:
+        weight = 0.3 * float(load_muscle(muscle).static_force().force_N(0.0, pbar * 1e5))
+    m = {"muscle": muscle, **model_keys}
+    if model:
+        m["static_force"] = model
+    return {"model": m, "load": {"weight_N": weight},
+            "pressure": {"source": "valve", "supply_gauge_bar": pbar, "valve_open_time_s": 0.1},
+            "simulation": {"duration_s": 1.0, "sample_rate_Hz": 200.0}}
+
+
+# ---------------------------------------------------------------- scenarios name a muscle
+def test_parameter_set_and_muscle_name_the_same_muscle():
+    a = pamsim.Scenario.from_dict({**_spec("shadow_6x300_acra2012"), "model": {"parameter_set": "shadow_6x300_acra2012"}})
+    b = pamsim.Scenario.from_dict(_spec("shadow_6x300_acra2012"))
+    assert dict(a.parameters) == dict(b.parameters)
+    assert a.spec["model"]["static_force"] == "acra2012_polynomial"  # the muscle's default model
+
+
+def test_shadow_parameters_come_from_its_muscle_file_only():
+    m = load_muscle("shadow_6x300_acra2012")
+    # The file gives every dynamics value itself: no assumed default is added to the Shadow muscle.
+    assert set(SHADOW) == set(m.parameters)
+    assert all(SHADOW.entries[k].source == m.parameters.entries[k].source for k in SHADOW)
+
+
+def test_other_muscles_take_the_assumed_dynamics_defaults_and_the_file_wins():
+    m = load_muscle("mpam_survey_45mm")
+    p = dynamics_parameters(m.parameters)
+    for name, (value, source) in DYNAMICS_DEFAULTS.items():
+        if name in m.parameters:
+            assert p[name] == m.parameters[name]
+        else:
+            assert p[name] == value and p.entries[name].source == source
+            assert source.startswith("assumed") or "ISO" in source or "standard" in source or "gas constant" in source \
+                or "ACRA" in source
+
+
+def test_muscle_path_is_relative_to_the_scenario(tmp_path):
+    text = "\n".join(line for line in (ROOT / "pamsim" / "muscles" / "mpam_survey_45mm.toml").read_text().splitlines()
+                     if not line.startswith("[data]") and not line.startswith("file ="))
+    (tmp_path / "my").mkdir()
+    (tmp_path / "my" / "mini.toml").write_text(text.replace('name = "mpam_survey_45mm"', 'name = "mini"'))
+    sc = tmp_path / "s.toml"
+    sc.write_text('[model]\nmuscle = "my/mini.toml"\nstatic_force = "gaylord"\n[load]\nweight_N = 0.05\n'
+                  '[pressure]\nsource = "valve"\nsupply_gauge_bar = 7.58\nvalve_open_time_s = 0.1\n'
+                  '[simulation]\nduration_s = 0.5\n')
+    s = pamsim.load_scenario(sc)
+    assert s.muscle.name == "mini"
+    # Gaylord's free contraction at 0.05 N, from its own formula (second implementation: brentq on the
+    # closed form F = p (3 L^2 - b^2) / (4 pi N^2) - W).
+    g = s.static_model()
+    res = pamsim.simulate(s)
+    assert res.x_m[-1] == pytest.approx(g.free_contraction_m(7.58e5, 0.05), abs=1e-4)
+
+
+@pytest.mark.parametrize("model, extra, words", [
+    ("gaylrd", {}, ["model.static_force", "gaylrd", "gaylord"]),
+    ("chou_hannaford", {}, ["model.static_force", "chou_hannaford", "wall_thickness_m", "shadow_6x300_acra2012"]),
+    ("gaylord", {"static_force_negative": "push"}, ["static_force_negative", "push"]),
+    ("gaylord", {"static_force_variant": "nope"}, ["static_force_variant", "nope"]),
+])
+def test_bad_model_choices_name_key_and_value(model, extra, words):
+    with pytest.raises(ScenarioError) as exc:
+        pamsim.Scenario.from_dict(_spec("shadow_6x300_acra2012", model, **extra), origin="x.toml")
+    msg = str(exc.value)
+    assert msg.startswith("x.toml: ") and "\n" not in msg
+    for w in words:
+        assert w in msg
+
+
+def test_unknown_muscle_and_both_keys_are_refused():
+    with pytest.raises(ScenarioError, match="model.muscle = 'kothera2009_5x'.*kothera2009_5"):
+        pamsim.Scenario.from_dict(_spec("kothera2009_5x"))
+    spec = _spec("shadow_6x300_acra2012")
+    spec["model"]["parameter_set"] = "shadow_6x300_acra2012"
+    with pytest.raises(ScenarioError, match="either muscle or parameter_set"):
+        pamsim.Scenario.from_dict(spec)
+
+
+def test_overrides_apply_to_muscle_parameters_and_add_known_ones():
+    spec = _spec("shadow_6x300_acra2012", "chou_hannaford")
+    spec["parameters"] = {"wall_thickness_m": 5e-4, "r0_m": 0.0031}
+    s = pamsim.Scenario.from_dict(spec)
+    assert s.parameters["wall_thickness_m"] == 5e-4 and s.parameters["r0_m"] == 0.0031
+    spec["parameters"] = {"wall_thickness_m": 0.004}
+    with pytest.raises(ScenarioError, match="parameters.r0_m = 0.003: must exceed the bladder wall thickness"):
+        pamsim.Scenario.from_dict(spec)
+    spec["parameters"] = {"theta0_deg": 60.0}
+    with pytest.raises(ScenarioError, match="parameters.theta0_deg = 60.0"):
+        pamsim.Scenario.from_dict(spec)
+
+
+def test_chamber_volume_follows_the_muscle_geometry():
+    """V(0) is the cylinder pi r0^2 L0 plus the dead volume, for every muscle (hand calculation)."""
+    for name in MUSCLES:
+        s = pamsim.Scenario.from_dict(_spec(name))
+        p = s.parameters
+        V0 = s.build_model().source.chamber.volume_m3(0.0)
+        assert V0 == pytest.approx(math.pi * p["r0_m"] ** 2 * p["L0_m"] + p["dead_volume_m3"], rel=1e-12)
+
+
+# ---------------------------------------------------------------- clipping
+def test_negative_force_is_clipped_unless_kept():
+    raw = REGISTRY["acra2012_polynomial"].build(SHADOW)
+    assert raw.force_N(0.0, 0.0) == pytest.approx(-11.56)  # the paper's S3: a push at zero pressure
+    clipped = pamsim.Scenario.from_dict(_spec("shadow_6x300_acra2012")).build_model().static_force
+    kept = pamsim.Scenario.from_dict(_spec("shadow_6x300_acra2012", static_force_negative="keep")).build_model()
+    assert clipped.force_N(0.0, 0.0) == 0.0 and kept.static_force.force_N(0.0, 0.0) == pytest.approx(-11.56)
+    x = np.linspace(0, 0.07, 50)
+    p = np.linspace(0, 4e5, 50)
+    assert np.array_equal(clipped.force_N(x, p), np.maximum(raw.force_N(x, p), 0.0))
+    assert all(clipped.force_N(float(a), float(b)) == max(raw.force_N(float(a), float(b)), 0.0) for a, b in zip(x, p))
+
+
+def test_clipping_changes_a_fall_under_exhaust():
+    """A fast exhaust under a light load: the raw polynomial goes negative and pushes the load down,
+    the clipped force only stops pulling, so the load reaches the lower stop later (never above it)."""
+    spec = _spec("shadow_6x300_acra2012")
+    spec["load"] = {"weight_N": 2.74}
+    spec["pressure"] = {"source": "prescribed", "prescribed": {"kind": "ramp", "start_s": 0.0, "end_s": 0.02,
+                                                               "initial_gauge_bar": 3.0, "final_gauge_bar": 0.0}}
+    spec["simulation"] = {"duration_s": 0.5, "sample_rate_Hz": 1000.0, "initial_contraction_m": 0.04}
+    spec["model"]["friction"] = "none"
+    clip = pamsim.simulate(pamsim.Scenario.from_dict(spec))
+    spec["model"]["static_force_negative"] = "keep"
+    keep = pamsim.simulate(pamsim.Scenario.from_dict(spec))
+    assert np.all(clip.x_m >= keep.x_m - 1e-9)
+    assert np.argmax(clip.x_m <= 0.0) > np.argmax(keep.x_m <= 0.0) + 50  # 50 ms later at 1 kHz
+    assert np.min(clip.signals["F_static_N"]) >= 0.0 and np.min(keep.signals["F_static_N"]) < -1.0
+
+
+# ---------------------------------------------------------------- tables for implicit models
+class _Affine(StaticForce):
+    """F = (a x^2 + c) p + e x: affine in p, quadratic in x (known second derivative 2 a p)."""
+
+    name = "affine_test"
+
+    def __init__(self, a, c, e):
+        self.a, self.c, self.e = a, c, e
+        self.domain = Domain(0.0, 0.05, 0.0, 5e5)
+
+    def force_N(self, x_m, p_gauge_Pa):
+        return (self.a * x_m * x_m + self.c) * p_gauge_Pa + self.e * x_m
+
+
+def test_table_error_is_the_bilinear_bound():
+    """Bilinear interpolation of an affine-in-p function: the cell-centre error is h^2/8 |F_xx| exactly."""
+    m = _Affine(-400.0, 2e-4, -300.0)
+    t = tabulate(m, (0.0, 0.1), (0.0, 1e6), n_x=51, n_p=6)
+    h = 0.05 / 50
+    # Largest at the last cell centre in p, 4.5e5 Pa.
+    assert table_error(m, t) == pytest.approx(h * h / 8 * abs(2 * m.a) * 4.5e5, rel=1e-6)
+    # Exact on the grid nodes, and scalar and array paths agree off them.
+    X, P = np.meshgrid(t.x_grid_m, t.p_grid_Pa, indexing="ij")
+    assert np.allclose(t.force_N(X, P), m.force_N(X, P), rtol=1e-12, atol=1e-9)
+    xs, ps = np.linspace(-0.01, 0.06, 37), np.linspace(-1e4, 5.5e5, 37)
+    assert np.allclose([t.force_N(float(a), float(b)) for a, b in zip(xs, ps)], t.force_N(xs, ps), rtol=1e-12, atol=1e-9)
+
+
+@pytest.mark.parametrize("muscle, model", [("kothera2009_5a", "kothera_energy"), ("mpam_survey_45mm", "chou_hannaford"),
+                                           ("kothera2009_5a", "kothera_force_balance_thickness")])
+def test_default_table_is_within_0p1_percent_of_the_blocked_force(muscle, model):
+    p = dynamics_parameters(load_muscle(muscle).parameters)
+    m = REGISTRY[model].build(p)
+    x_hi = pamsim.Scenario.from_dict(_spec(muscle, model)).build_model().stops.x_high_m
+    t = tabulate(m, (0.0, x_hi), (0.0, p["rated_pressure_gauge_Pa"]))
+    assert table_error(m, t) <= 1e-3 * float(m.force_N(0.0, p["rated_pressure_gauge_Pa"]))
+
+
+def test_tables_are_cached_per_model_and_parameters(monkeypatch):
+    clear_cache()
+    m = _Affine(-400.0, 2e-4, -300.0)
+    a = tabulate(m, (0.0, 0.1), (0.0, 1e6), key=("affine", 1))
+    assert tabulate(m, (0.0, 0.1), (0.0, 1e6), key=("affine", 1)) is a
+    assert tabulate(m, (0.0, 0.1), (0.0, 1e6), key=("affine", 2)) is not a
+
+
+def test_implicit_models_are_tabulated_for_the_dynamics(monkeypatch):
+    """A model of kind "implicit" reaches the ODE as a table that agrees with it."""
+    import dataclasses
+
+    import pamsim.elements.muscle_force as mf
+
+    spec = REGISTRY["kothera_energy"]  # closed-form; marked implicit here, as no shipped model is yet
+    implicit = dataclasses.replace(spec, kind="implicit")
+    monkeypatch.setattr(mf, "get", lambda name: implicit)
+    s = pamsim.Scenario.from_dict(_spec("kothera2009_5a", "kothera_energy"))
+    f = s.build_model().static_force
+    assert type(f.inner).__name__ == "TabulatedStaticForce"
+    raw = s.static_model()
+    assert f.force_N(0.01, 3e5) == pytest.approx(raw.force_N(0.01, 3e5), rel=1e-3)
+
+
+# ---------------------------------------------------------------- runs and sweeps
+def test_chou_hannaford_paper_scenario_ends_at_rest_and_balances_energy():
+    poly = pamsim.simulate(pamsim.load_scenario(SCENARIOS / "acra2012_fig4.toml"))
+    ch = pamsim.simulate(pamsim.load_scenario(SCENARIOS / "acra2012_fig4_chou_hannaford.toml"))
+    for res in (poly, ch):
+        assert res.at_rest_at_end
+        assert res.energy_balance()["relative"] <= 1e-3
+    s = pamsim.load_scenario(SCENARIOS / "acra2012_fig4_chou_hannaford.toml")
+    # At rest the static force holds the weight within the friction band: equilibrium of the model itself.
+    net, level = ch.final_rest_forces_N
+    assert abs(net) <= level + 1e-6
+    assert s.static_model().force_N(ch.x_m[-1], ch.p_gauge_Pa[-1]) == pytest.approx(22.74, abs=level + 1e-6)
+
+
+def _every_model_sweep(tmp_path: Path, muscle: str):
+    m = load_muscle(muscle)
+    for model in m.applicable_models():
+        base = tmp_path / f"{muscle}_{model}.toml"
+        spec = _spec(muscle, model)
+        lines = [f'[model]\nmuscle = "{muscle}"\nstatic_force = "{model}"\n',
+                 f"[load]\nweight_N = {spec['load']['weight_N']!r}\n",
+                 '[pressure]\nsource = "valve"\nsupply_gauge_bar = 1.0\nvalve_open_time_s = 0.1\n',
+                 "[simulation]\nduration_s = 0.6\nsample_rate_Hz = 200.0\n"]
+        base.write_text("\n".join(lines))
+        pbar, weight = spec["pressure"]["supply_gauge_bar"], spec["load"]["weight_N"]
+        yield model, sweep_from_dict({"base_scenario": base.name, "friction_models": ["load_dependent", "none"],
+                                      "case": [{"pressure_bar": pbar, "weight_N": weight},
+                                               {"pressure_bar": 0.5 * pbar, "weight_N": 0.5 * weight}]},
+                                     base_dir=tmp_path, origin=f"{muscle}-{model}")
+
+
+@pytest.mark.parametrize("muscle", list(MUSCLES))
+def test_a_sweep_of_every_model_over_three_muscles_has_no_failed_case(tmp_path, muscle):
+    n = 0
+    for model, spec in _every_model_sweep(tmp_path, muscle):
+        res = sweep(spec)
+        for row in res.rows:
+            for f in ("", "none_"):
+                assert not row[f + "failure"], (muscle, model, row[f + "failure"])
+                assert math.isfinite(row[f + "final_contraction_m"])
+        n += 1
+    assert n == len(load_muscle(muscle).applicable_models()) >= 5
+
+
+def test_linearize_works_with_another_muscle_and_model(tmp_path):
+    sc = tmp_path / "k.toml"
+    spec = _spec("kothera2009_5a", "kothera_energy")
+    sc.write_text('[model]\nmuscle = "kothera2009_5a"\nstatic_force = "kothera_energy"\nfriction = "none"\n'
+                  f"[load]\nweight_N = {spec['load']['weight_N']!r}\n"
+                  '[pressure]\nsource = "valve"\nsupply_gauge_bar = 3.0\nvalve_open_time_s = 0.1\n'
+                  "[simulation]\nduration_s = 2.0\n")
+    r = run_cli("linearize", sc, "-o", tmp_path / "lin")
+    assert r.returncode == 0, r.stderr
+
+
+# ---------------------------------------------------------------- command line
+def test_models_json_lists_every_registry_entry():
+    r = run_cli("models", "--json")
+    assert r.returncode == 0, r.stderr
+    rows = json.loads(r.stdout)
+    assert [x["name"] for x in rows] == list(REGISTRY)
+    assert all({"name", "kind", "source", "parameters"} <= set(x) for x in rows)
+
+
+def test_muscles_json_lists_the_shipped_muscles():
+    r = run_cli("muscles", "--json")
+    assert r.returncode == 0, r.stderr
+    names = [x["name"] for x in json.loads(r.stdout)]
+    assert {"shadow_6x300_acra2012", "kothera2009_5a", "mpam_survey_45mm", "festo_dmsp_20_120"} <= set(names)
+
+
+def test_force_json_is_gaylords_formula():
+    """Hand calculation: F = p (3 L^2 - b^2) / (4 pi N^2), b = L0 / cos(theta0), N = b sin(theta0) / (2 pi r0)."""
+    r = run_cli("force", "--model", "gaylord", "--muscle", "mpam_survey_45mm", "--pressure-bar", "7.58",
+                   "--contraction-mm", "5", "--set", "r0_m=0.0006", "--json")
+    assert r.returncode == 0, r.stderr
+    p = dynamics_parameters(load_muscle("mpam_survey_45mm").parameters)
+    th = math.radians(p["theta0_deg"])
+    b = p["L0_m"] / math.cos(th)
+    N = b * math.sin(th) / (2 * math.pi * 0.0006)
+    L = p["L0_m"] - 0.005
+    assert json.loads(r.stdout)["force_N"] == pytest.approx(7.58e5 * (3 * L * L - b * b) / (4 * math.pi * N * N), rel=1e-12)
+
+
+def test_static_with_another_model_solves_its_equilibrium():
+    r = run_cli("static", "--model", "gaylord", "--muscle", "kothera2009_5a", "--pressure-bar", "3",
+                   "--load-N", "50", "--json")
+    assert r.returncode == 0, r.stderr
+    out = json.loads(r.stdout)
+    g = load_muscle("kothera2009_5a").static_force("gaylord")
+    assert float(g.force_N(out["equilibrium_contraction_m"], 3e5)) == pytest.approx(50.0, abs=1e-6)
+    assert out["max_load_N"] == pytest.approx(float(g.force_N(0.0, 3e5)), rel=1e-9)  # Gaylord falls with x
+
+
+@pytest.mark.parametrize("args, words", [
+    (["force", "--model", "gaylord", "--pressure-bar", "3", "--contraction-mm", "1", "--set", "L0_m=abc"],
+     ["--set L0_m", "abc"]),
+    (["force", "--model", "gaylord", "--pressure-bar", "3", "--contraction-mm", "1", "--set", "L0=0.1"],
+     ["--set L0", "L0_m"]),
+    (["force", "--model", "gaylord", "--pressure-bar", "3", "--contraction-mm", "1", "--set", "L0_m=-1"],
+     ["--set L0_m", "-1"]),
+    (["force", "--model", "chou_hannaford", "--pressure-bar", "3", "--contraction-mm", "1"],
+     ["chou_hannaford", "wall_thickness_m"]),
+    (["force", "--model", "gaylord", "--pressure-bar", "3", "--contraction-mm", "500"], ["x_m", "0.5", "domain"]),
+    (["force", "--model", "gaylord", "--muscle", "nosuch", "--pressure-bar", "3", "--contraction-mm", "1"],
+     ["nosuch"]),
+    (["static", "--model", "gaylord", "--pressure-bar", "3", "--load-N", "5", "--set", "festo"], ["festo"]),
+])
+def test_bad_cli_values_exit_2_naming_them(args, words):
+    r = run_cli(*args)
+    assert r.returncode == 2
+    line = r.stderr.strip()
+    assert "\n" not in line and "Traceback" not in line
+    for w in words:
+        assert w in line
+
+
+# ---------------------------------------------------------------- atlas
+def test_atlas_writes_curves_table_and_figures_of_every_applicable_model(tmp_path):
+    out = tmp_path / "atlas"
+    r = run_cli("atlas", "--muscle", "mpam_survey_45mm", "-o", out)
+    assert r.returncode == 0, r.stderr
+    m = load_muscle("mpam_survey_45mm")
+    rows = list(csv.DictReader((out / "atlas_table.csv").open()))
+    assert [row["model"] for row in rows] == m.applicable_models()
+    p = dynamics_parameters(m.parameters)
+    for row in rows:  # each row from the model itself (its own blocked force and free contraction)
+        model = REGISTRY[row["model"]].build(p)
+        P = float(row["pressure_bar"]) * 1e5
+        assert float(row["blocked_force_N"]) == pytest.approx(float(model.force_N(0.0, P)), rel=1e-5)
+        free = float(row["free_contraction_mm"])
+        assert free == pytest.approx(model.free_contraction_m(P) * 1e3, rel=1e-5, nan_ok=True)
+    # The survey's measured point (758 kPa, 13 mm) sets the pressure and is overlaid.
+    assert [float(r["pressure_bar"]) for r in rows][:1] == [7.58]
+    curves = list(csv.DictReader((out / "atlas_curves.csv").open()))
+    assert len(curves) == len(rows) * 201
+    for name in ("atlas_7.58bar.png", "atlas_all.png", "atlas_table.md"):
+        assert (out / name).stat().st_size > 0
+
+
+def test_atlas_refuses_a_model_that_does_not_apply_and_writes_nothing(tmp_path):
+    out = tmp_path / "atlas"
+    r = run_cli("atlas", "--muscle", "shadow_6x300_acra2012", "--models", "gaylord,chou_hannaford", "-o", out)
+    assert r.returncode == 2 and "chou_hannaford" in r.stderr and "wall_thickness_m" in r.stderr
+    assert not out.exists()
