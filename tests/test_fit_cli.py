@@ -107,3 +107,20 @@ def test_fit_dynamic_bad_input(tmp_path, args, message):
     assert proc.returncode == 2, proc.stderr
     assert message in proc.stderr and "Traceback" not in proc.stderr
     assert not out.exists()
+
+
+def test_fitted_muscle_works_as_muscle_everywhere(static_out):
+    out, body = static_out
+    c = body["parameters"]
+    p_bar, w = 3.6, 22.74
+    a = c["K1_N_per_bar_m2"] * p_bar + c["S1_N_per_m2"]
+    b = c["K2_N_per_bar_m"] * p_bar + c["S2_N_per_m"]
+    c0 = c["C1_N_per_bar"] * p_bar + c["S3_N"] - w
+    x_expected = 2 * c0 / (-b + np.sqrt(b * b - 4 * a * c0))  # smaller root of the fitted quadratic
+    proc = pamsim_cli("static", "--muscle", out / "muscle.toml", "--pressure-bar", p_bar, "--load-N", w, "--json")
+    assert proc.returncode == 0, proc.stderr
+    assert json.loads(proc.stdout)["equilibrium_contraction_m"] == pytest.approx(x_expected, abs=1e-9)
+    sc = pamsim.Scenario.from_dict({"model": {"muscle": str(out / "muscle.toml")}, "load": {"weight_N": w},
+                                    "pressure": {"source": "valve", "supply_gauge_bar": p_bar, "valve_open_time_s": 1.0},
+                                    "simulation": {"duration_s": 1.0}})
+    assert sc.parameters["C1_N_per_bar"] == c["C1_N_per_bar"]

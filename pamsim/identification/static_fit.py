@@ -30,7 +30,7 @@ from ..parameters import ParameterSet
 from .columns import StaticData
 from .crossval import cross_validate
 from .equilibrium import equilibrium_m, slope_N_per_m
-from .models import build_static, check_model, default_free
+from .models import build_static, check_model, default_free, missing_inputs
 from .uncertainty import Uncertainty, information_criteria, linearised_uncertainty
 
 OBJECTIVES = ("force", "contraction")
@@ -182,6 +182,9 @@ def make_problem(data: StaticData, params: ParameterSet, model: str = "acra2012_
     The search for the equilibrium ends at the muscle's upper stop (braid lock).
     """
     check_model(model)
+    missing = missing_inputs(model, params)
+    if missing:
+        raise InputError(f"--model = {model!r}: muscle {params.name!r} does not give {', '.join(missing)}")
     free = tuple(free) if free else default_free(model)
     for name in free:
         if name not in params:
