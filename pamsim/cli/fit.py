@@ -162,8 +162,9 @@ def run_static(args: argparse.Namespace) -> int:
             body["compare"] = compare.comparison_rows(compared)
         print(report.json_text(body), end="")
         return 0
+    cv = "n/a" if fit.cv_kind.startswith("none") else f"{fit.cv_rms_contraction_mm:.3f} mm"
     print(f"{model} on {args.data}: RMS contraction {fit.rms_contraction_mm:.3f} mm "
-          f"(cross-validated {fit.cv_rms_contraction_mm:.3f} mm, {fit.cv_kind}), "
+          f"(cross-validated {cv}, {fit.cv_kind}), "
           f"{fit.n_points} tests, {fit.n_censored} censored")
     for a, b, r in fit.uncertainty.inseparable_pairs():
         print(f"  warning: {a} and {b} are correlated (r = {r:+.3f}): the data do not separate them")

@@ -50,3 +50,8 @@ def default_free(name: str) -> tuple[str, ...]:
 def missing_inputs(name: str, params: Mapping[str, float]) -> list[str]:
     """Parameters model ``name`` needs that ``params`` does not give."""
     return static_models.REGISTRY[name].missing(params)
+
+
+def optional_defaults(name: str) -> dict[str, float]:
+    """The model's optional coefficients and their defaults (free-able with ``--free``)."""
+    return dict(static_models.REGISTRY[name].optional)

@@ -19,6 +19,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Mapping, Sequence
 
 import numpy as np
@@ -26,11 +27,11 @@ from scipy.optimize import least_squares
 
 from ..elements.stops import EndStops
 from ..errors import InputError
-from ..parameters import ParameterSet
+from ..parameters import ParameterSet, known_parameter
 from .columns import StaticData
 from .crossval import cross_validate
 from .equilibrium import equilibrium_m, slope_N_per_m
-from .models import build_static, check_model, default_free, missing_inputs
+from .models import build_static, check_model, default_free, missing_inputs, optional_defaults
 from .uncertainty import Uncertainty, information_criteria, linearised_uncertainty
 
 OBJECTIVES = ("force", "contraction")
@@ -47,7 +48,7 @@ class StaticProblem:
 
     data: StaticData
     model: str
-    base: Mapping[str, float]
+    base: ParameterSet
     free: tuple[str, ...]
     objective: str
     censor_threshold_m: float
@@ -62,7 +63,11 @@ class StaticProblem:
         return self.data.contraction_m <= self.censor_threshold_m
 
     def params(self, theta: np.ndarray) -> dict[str, float]:
-        return {**self.base, **dict(zip(self.free, map(float, theta)))}
+        return {**self.base_values, **dict(zip(self.free, map(float, theta)))}
+
+    @cached_property
+    def base_values(self) -> dict[str, float]:
+        return dict(self.base)
 
     def force(self, theta: np.ndarray):
         return build_static(self.model, self.params(theta))
@@ -186,9 +191,13 @@ def make_problem(data: StaticData, params: ParameterSet, model: str = "acra2012_
     if missing:
         raise InputError(f"--model = {model!r}: muscle {params.name!r} does not give {', '.join(missing)}")
     free = tuple(free) if free else default_free(model)
+    optional = optional_defaults(model)
     for name in free:
-        if name not in params:
-            raise InputError(f"--free: {name!r} is not a parameter of muscle {params.name!r}")
+        if name not in params and name not in optional:
+            raise InputError(f"--free: {name!r} is not a parameter of muscle {params.name!r} nor an optional "
+                             f"coefficient of {model!r}")
+        if name in optional and not math.isfinite(optional[name]):
+            raise InputError(f"--free: {name!r} of {model!r} has no finite default to start from")
     if len(set(free)) != len(free):
         raise InputError(f"--free = {','.join(free)}: a name appears twice")
     objective = objective or ("contraction" if data.kind == "weight" else "force")
@@ -196,10 +205,18 @@ def make_problem(data: StaticData, params: ParameterSet, model: str = "acra2012_
         raise InputError(f"--objective = {objective!r}: choose from {', '.join(OBJECTIVES)}")
     if not censor_threshold_m >= 0.0:
         raise InputError(f"--censor-threshold-mm = {censor_threshold_m * 1e3:g}: must not be negative")
+    x_max = EndStops.from_parameters(params).x_high_m
+    params = with_optional(params, {k: v for k, v in optional.items() if k in free}, model)
     lower = np.array([params.entries[n].lower for n in free], dtype=float)
     upper = np.array([params.entries[n].upper for n in free], dtype=float)
-    x_max = EndStops.from_parameters(params).x_high_m
-    return StaticProblem(data, model, dict(params), free, objective, censor_threshold_m, x_max, (lower, upper))
+    return StaticProblem(data, model, params, free, objective, censor_threshold_m, x_max, (lower, upper))
+
+
+def with_optional(params: ParameterSet, optional: Mapping[str, float], model: str) -> ParameterSet:
+    """``params`` plus a model's optional coefficients at their defaults (ranges from the muscle schema),
+    so they can be fitted and written to the fitted muscle."""
+    extra = {k: known_parameter(k, v, f"default of {model}") for k, v in optional.items() if k not in params}
+    return ParameterSet(params.name, params.citation, {**params.entries, **extra}) if extra else params
 
 
 def _solve(problem: StaticProblem, theta0: np.ndarray, loss: str, f_scale: float, max_nfev: int | None = None):
@@ -251,7 +268,7 @@ def fit_static(data: StaticData, params: ParameterSet, model: str = "acra2012_po
     if n_starts < 0:
         raise InputError(f"--starts = {n_starts}: must not be negative")
     problem = make_problem(data, params, model, free, objective, censor_threshold_m)
-    theta0 = np.array([params[n] for n in problem.free], dtype=float)
+    theta0 = np.array([problem.base[n] for n in problem.free], dtype=float)
     theta, res = _solve(problem, theta0, loss, f_scale)
     nfev = res.nfev
     rng = np.random.default_rng(seed)
@@ -271,7 +288,7 @@ def fit_static(data: StaticData, params: ParameterSet, model: str = "acra2012_po
                                      lambda th, test: problem.predict_m(th, data.subset(test)) - data.contraction_m[test],
                                      len(data), len(theta), cv, k_folds, seed)
     aic, bic = information_criteria(float(residuals @ residuals), len(data), len(theta))
-    fitted = params.with_overrides(dict(zip(problem.free, map(float, theta))),
+    fitted = problem.base.with_overrides(dict(zip(problem.free, map(float, theta))),
                                    source=f"fitted: pamsim fit static ({problem.objective} objective) on "
                                           f"{data.origin}")
     return StaticFit(problem, theta, fitted, unc, predicted, residuals, rms_force,

@@ -65,6 +65,16 @@ def static_study() -> None:
     for label, c, r66, r28, cv in rows:
         print(f"| {label} | " + " | ".join(f"{c[n]:.5g}" for n in coeffs) + f" | {r66:.3f} | {r28:.3f} | "
               + (f"{cv:.3f}" if cv is not None else "-") + " |")
+    print("\nModel comparison (soft_l1 loss, 1 mm; leave-one-out; default free coefficients unless listed):\n")
+    print("| model | free coefficients | RMS [mm] | leave-one-out RMS [mm] | AIC | BIC |\n|---|---|---|---|---|---|")
+    from ..muscles import load_muscle
+
+    for name in load_muscle("shadow_6x300_acra2012").applicable_models() + ["tondu_lopez+kappa"]:
+        model, free = (("tondu_lopez", ["r0_m", "theta0_deg", "tondu_kappa1", "tondu_kappa2"])
+                       if name.endswith("+kappa") else (name, None))
+        f = fit_static(data, P, model=model, free=free, loss="soft_l1", cv="loo")
+        print(f"| {model} | {', '.join(f.problem.free)} | {f.rms_contraction_mm:.3f} | {f.cv_rms_contraction_mm:.3f} | "
+              f"{f.aic:.1f} | {f.bic:.1f} |")
     w = data.subset(train)
     F = f6.problem.force(f6.theta).force_N(w.contraction_m, w.pressure_gauge_Pa)
     Fp = build_static("acra2012_polynomial", P).force_N(w.contraction_m, w.pressure_gauge_Pa)
