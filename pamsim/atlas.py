@@ -21,7 +21,7 @@ from .atomic import atomic_outputs
 from .constants import PA_PER_BAR
 from .elements.stops import EndStops
 from .errors import InputError
-from .muscle_setup import muscle_parameters, prepare
+from .muscle_setup import model_inputs, muscle_parameters, prepare
 from .muscles import Muscle
 from .static_models import REGISTRY
 
@@ -161,7 +161,7 @@ def build_atlas(muscle: str, models: Sequence[str] | None = None, pressures_bar:
     a pressure above a model's domain leaves that curve out.
     """
     m, params = muscle_parameters(muscle, overrides)
-    names = list(models) if models else m.applicable_models()
+    names = list(models) if models else [n for n, s in REGISTRY.items() if not s.missing(model_inputs(m, params))]
     for name in names:  # the same checks and messages as a scenario or `pamsim force`
         prepare(muscle, name, overrides)
     measured = measured_points(m.data_file)
@@ -176,7 +176,7 @@ def build_atlas(muscle: str, models: Sequence[str] | None = None, pressures_bar:
     x_stop = EndStops.from_parameters(params).x_high_m if {"L0_m", "r0_m", "theta0_deg"} <= set(params) else math.inf
     curves, skipped = [], {}
     for name in names:
-        model = REGISTRY[name].build(params)
+        model = REGISTRY[name].build(model_inputs(m, params))
         d = model.domain
         x_lo, x_hi = max(d.x_min_m, 0.0), min(d.x_max_m, x_stop)
         if not math.isfinite(x_hi) or x_hi <= x_lo:

@@ -47,6 +47,14 @@ def with_overrides(params: ParameterSet, overrides: Mapping[str, Any], fail: Fai
     return params
 
 
+def model_inputs(muscle: Muscle, params: Mapping[str, float]) -> dict:
+    """What a static model is built from: ``params`` and, if the muscle has one, its force-map file."""
+    inputs = dict(params)
+    if muscle.force_map_file is not None:
+        inputs["force_map_file"] = muscle.force_map_file
+    return inputs
+
+
 def _suggest(name: str, names: list[str]) -> str:
     """The names that extend ``name`` by a unit suffix (``valve_C`` -> ``valve_C_m3_per_s_Pa``), else the closest."""
     longer = [n for n in names if n.startswith(name + "_")]
@@ -95,5 +103,6 @@ def prepare(muscle: str, model: str | None = None, overrides: Mapping[str, Any] 
     """
     fail, key = _defaults(fail, key)
     m, params = muscle_parameters(muscle, overrides, fail, key)
-    spec = applicable_model(model or m.default_static_force, variant, m, params, fail, key)
-    return m, params, spec.build(params, variant)
+    inputs = model_inputs(m, params)
+    spec = applicable_model(model or m.default_static_force, variant, m, inputs, fail, key)
+    return m, params, spec.build(inputs, variant)

@@ -30,7 +30,7 @@ from .elements.static_force import STATIC_FORCE_MODELS
 from .elements.stops import EndStops
 from .elements.valve import Iso6358Orifice, ProportionalValve33
 from .model import FitRange, MuscleModel
-from .muscle_setup import applicable_model, with_overrides
+from .muscle_setup import applicable_model, model_inputs, with_overrides
 from .muscles import Muscle, load_muscle, shipped_names
 from .parameters import ParameterSet, dynamics_parameters
 from .static_models import REGISTRY
@@ -110,7 +110,7 @@ class Scenario:
         params = with_overrides(dynamics_parameters(muscle.parameters), spec.get("parameters", {}), v.fail, _key,
                                 f"override in {origin}")
         applicable_model(model.setdefault("static_force", muscle.default_static_force),
-                         model.get("static_force_variant"), muscle, params, v.fail, _key)
+                         model.get("static_force_variant"), muscle, model_inputs(muscle, params), v.fail, _key)
         sim = spec["simulation"]
         duration = v.positive("simulation.duration_s", v.required(sim, "simulation", "duration_s"))
         sample_rate = v.positive("simulation.sample_rate_Hz", sim.get("sample_rate_Hz", 1000.0))
@@ -244,11 +244,12 @@ class Scenario:
     def static_model(self):
         """The library model the scenario names, built for its muscle, raw (unclipped, untabulated)."""
         m = self.spec["model"]
-        return REGISTRY[m["static_force"]].build(self.parameters, m.get("static_force_variant"))
+        return REGISTRY[m["static_force"]].build(model_inputs(self.muscle, self.parameters),
+                                                 m.get("static_force_variant"))
 
     def _build_static_force(self):
         m = self.spec["model"]
-        return STATIC_FORCE_MODELS[m["static_force"]](self.parameters, m)
+        return STATIC_FORCE_MODELS[m["static_force"]](model_inputs(self.muscle, self.parameters), m)
 
     def build_model(self) -> MuscleModel:
         """Compose the elements this scenario names into a :class:`MuscleModel`."""

@@ -17,7 +17,7 @@ from pamsim.muscles import load_muscle
 from pamsim.parameters import DYNAMICS_DEFAULTS, dynamics_parameters, get_parameter_set
 from pamsim.scenario import ScenarioError
 from pamsim.static_models import REGISTRY, Domain, StaticForce
-from pamsim.sweep import sweep, sweep_from_dict
+from pamsim.sweep import run_sweep, sweep_from_dict
 
 from conftest import run_cli
 
@@ -256,17 +256,55 @@ def _every_model_sweep(tmp_path: Path, muscle: str):
                                      base_dir=tmp_path, origin=f"{muscle}-{model}")
 
 
+def _assert_no_failed_case(res, what):
+    for row in res.rows:
+        for f in ("", "none_"):
+            assert not row[f + "failure"], (what, row[f + "failure"])
+            assert math.isfinite(row[f + "final_contraction_m"])
+
+
 @pytest.mark.parametrize("muscle", list(MUSCLES))
 def test_a_sweep_of_every_model_over_three_muscles_has_no_failed_case(tmp_path, muscle):
     n = 0
     for model, spec in _every_model_sweep(tmp_path, muscle):
-        res = sweep(spec)
-        for row in res.rows:
-            for f in ("", "none_"):
-                assert not row[f + "failure"], (muscle, model, row[f + "failure"])
-                assert math.isfinite(row[f + "final_contraction_m"])
+        _assert_no_failed_case(run_sweep(spec), (muscle, model))
         n += 1
     assert n == len(load_muscle(muscle).applicable_models()) >= 5
+
+
+def test_models_no_shipped_muscle_gives_run_with_assumed_constants(tmp_path):
+    """The fitted-coefficient models no paper gives constants for run on the miniature muscle with the
+    constants the sanity tests assume (their Gaylord-equivalent expansions), added under [parameters]."""
+    from test_static_models_sanity import ASSUMED
+
+    for model, constants in ASSUMED.items():
+        base = tmp_path / f"{model}.toml"
+        base.write_text(f'[model]\nmuscle = "mpam_survey_45mm"\nstatic_force = "{model}"\n[parameters]\n'
+                        + "".join(f"{k} = {v!r}\n" for k, v in constants.items())
+                        + '[load]\nweight_N = 0.05\n[pressure]\nsource = "valve"\nsupply_gauge_bar = 1.0\n'
+                        'valve_open_time_s = 0.1\n[simulation]\nduration_s = 0.6\nsample_rate_Hz = 200.0\n')
+        spec = sweep_from_dict({"base_scenario": base.name, "friction_models": ["load_dependent", "none"],
+                                "case": [{"pressure_bar": 7.58, "weight_N": 0.05}, {"pressure_bar": 3.0, "weight_N": 0.02}]},
+                               base_dir=tmp_path, origin=model)
+        _assert_no_failed_case(run_sweep(spec), model)
+
+
+def test_force_map_muscle_runs_in_the_dynamics(tmp_path):
+    """A muscle with a measured F(x, p) table: the force_map model drives the run and the equilibrium
+    matches the table's own free contraction at the load."""
+    g = load_muscle("mpam_survey_45mm").static_force("gaylord")
+    xs, ps = np.linspace(0.0, g.domain.x_max_m, 12), np.linspace(0.0, 8e5, 9)
+    (tmp_path / "map.csv").write_text("contraction_m,pressure_gauge_Pa,force_N\n" + "".join(
+        f"{float(x)!r},{float(p)!r},{float(g.force_N(x, p))!r}\n" for x in xs for p in ps))
+    text = "\n".join(line for line in (ROOT / "pamsim" / "muscles" / "mpam_survey_45mm.toml").read_text().splitlines()
+                     if not line.startswith("[data]") and not line.startswith("file ="))
+    (tmp_path / "m.toml").write_text(text.replace('name = "mpam_survey_45mm"', 'name = "mapped"\nforce_map = "map.csv"', 1))
+    spec = _spec("mpam_survey_45mm", "force_map")
+    spec["model"]["muscle"] = "m.toml"
+    spec["simulation"]["duration_s"] = 2.0
+    s = pamsim.Scenario.from_dict(spec, base_dir=tmp_path)
+    res = pamsim.simulate(s)
+    assert res.x_m[-1] == pytest.approx(s.static_model().free_contraction_m(7.58e5, 0.05), abs=2e-4)
 
 
 def test_linearize_works_with_another_muscle_and_model(tmp_path):
@@ -370,3 +408,9 @@ def test_atlas_refuses_a_model_that_does_not_apply_and_writes_nothing(tmp_path):
     r = run_cli("atlas", "--muscle", "shadow_6x300_acra2012", "--models", "gaylord,chou_hannaford", "-o", out)
     assert r.returncode == 2 and "chou_hannaford" in r.stderr and "wall_thickness_m" in r.stderr
     assert not out.exists()
+
+
+def test_docs_list_the_dynamics_defaults():
+    from pamsim.cli.params import defaults_table
+
+    assert defaults_table() in (ROOT / "docs" / "model.md").read_text()

@@ -7,7 +7,7 @@ import argparse
 import difflib
 
 from ..errors import InputError
-from ..muscle_setup import prepare
+from ..muscle_setup import muscle_parameters, prepare
 
 
 def add_arguments(parser: argparse.ArgumentParser, model: bool = True) -> None:
@@ -51,3 +51,8 @@ def resolve(args: argparse.Namespace):
     """``(muscle, parameters, built model)`` from the parsed options."""
     return prepare(args.muscle, getattr(args, "model", None), overrides(args.overrides),
                    getattr(args, "variant", None), fail=_fail, key=_key)
+
+
+def resolve_parameters(args: argparse.Namespace):
+    """``(muscle, parameters)`` from the parsed options (no static model)."""
+    return muscle_parameters(args.muscle, overrides(args.overrides), fail=_fail, key=_key)

@@ -6,6 +6,8 @@ import argparse
 import json
 import math
 
+from ..muscles.schema import unit_of
+from ..parameters import DYNAMICS_DEFAULTS
 from . import muscle_args
 
 
@@ -16,11 +18,16 @@ def register(sub) -> None:
     muscle_args.add_arguments(p, model=False)
     p.add_argument("--json", action="store_true", help="print JSON")
     p.add_argument("--markdown", action="store_true", help="print a Markdown table (as in docs/model.md)")
+    p.add_argument("--defaults", action="store_true",
+                   help="the dynamics' assumed defaults instead (a Markdown table, as in docs/model.md)")
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
-    _, ps, _ = muscle_args.resolve(args)
+    if args.defaults:
+        print(defaults_table())
+        return 0
+    _, ps = muscle_args.resolve_parameters(args)
     rows = ps.table()
     if args.json:
         print(json.dumps({"name": ps.name, "citation": ps.citation,
@@ -41,6 +48,14 @@ def markdown_table(ps) -> str:
     lines = ["| name | value | unit | range | source | meaning |", "| --- | --- | --- | --- | --- | --- |"]
     for name, p in ps.entries.items():
         lines.append(f"| `{name}` | {p.value:.6g} | {p.unit} | {_range(p)} | {p.source} | {p.description} |")
+    return "\n".join(lines)
+
+
+def defaults_table() -> str:
+    """The dynamics defaults of ``docs/model.md``; a test keeps the two identical."""
+    lines = ["| name | value | unit | source |", "| --- | --- | --- | --- |"]
+    for name, (value, source) in DYNAMICS_DEFAULTS.items():
+        lines.append(f"| `{name}` | {value:.6g} | {unit_of(name)} | {source} |")
     return "\n".join(lines)
 
 

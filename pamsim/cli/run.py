@@ -36,7 +36,7 @@ def run(args: argparse.Namespace) -> int:
         if not args.no_plot:
             result.plot(tmp[names[2]])
     for warning in result.fit_range_violations:
-        print(f"pamsim: warning: left the polynomial's fitted range: {warning}", file=sys.stderr)
+        print(f"pamsim: warning: left the static model's valid (fitted) range: {warning}", file=sys.stderr)
     s = summary
     print(f"{scenario.name}: final contraction {s['final_contraction_m'] * 1e3:.2f} mm "
           f"(peak {s['peak_contraction_m'] * 1e3:.2f} mm), final pressure {s['final_pressure_gauge_Pa'] / 1e5:.3f} bar, "

@@ -159,4 +159,4 @@ def clear_cache() -> None:
 
 def cache_key(model_name: str, variant: str | None, params: Mapping[str, float]) -> tuple:
     """Cache key of a model built from ``params``: the muscle is its parameter values."""
-    return (model_name, variant, tuple(sorted((k, float(v)) for k, v in params.items())))
+    return (model_name, variant, tuple(sorted((k, v if isinstance(v, float) else str(v)) for k, v in params.items())))

@@ -1,5 +1,6 @@
 """The static force as the dynamics apply it: a library model, tabulated if it
-needs a numerical solve, with a negative force clipped at zero.
+needs a numerical solve, held inside its domain where it has no value outside
+it, with a negative force clipped at zero.
 
 Every choice here is a scenario key (docs/scenarios.md): ``static_force``
 (any model of :mod:`pamsim.static_models`), ``static_force_variant`` and
@@ -12,6 +13,7 @@ from typing import Mapping
 
 from ..static_models import get
 from .force_clip import with_negative_force
+from .force_domain import within_domain_if_needed
 from .force_table import cache_key, tabulate
 
 
@@ -31,7 +33,9 @@ def dynamics_static_force(model: str, params: Mapping[str, float], x_range_m: tu
     """
     spec = get(model)
     built = spec.build(params, variant)
+    p_range = (0.0, params["rated_pressure_gauge_Pa"])
     if spec.kind == "implicit":
-        built = tabulate(built, x_range_m, (0.0, params["rated_pressure_gauge_Pa"]),
-                         key=cache_key(model, variant, params))
+        built = tabulate(built, x_range_m, p_range, key=cache_key(model, variant, params))
+    else:
+        built = within_domain_if_needed(built, x_range_m, p_range)
     return with_negative_force(built, negative)

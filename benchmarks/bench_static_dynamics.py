@@ -1,0 +1,118 @@
+"""Benchmark: the fig4 scenario with every static force model, time relative to the polynomial.
+
+The fig4 scenario (ACRA 2012 Figure 4: valve step to 3.6 bar at 1 s, 8 s, LSODA at rtol 1e-6) is
+run with each library model on the Shadow muscle where the model applies to it; a model that needs
+values the Shadow muscle does not give (wall thickness, bladder constants, fibres) runs the same
+scenario on Kothera's actuator 5a (friction and damping: the assumed defaults), with the load at
+30 % of that model's blocked force at 3.6 bar.  One more row forces Kothera's energy model through
+the table the dynamics use for implicit models, to show what a tabulated model costs.
+
+Target (issue): a paper scenario with an implicit (tabulated) model costs at most 3x the
+polynomial's run.  Each figure is the median of --repeats runs (default 3), wall time of
+``pamsim.simulate`` only (the table is built when the scenario is validated and cached).
+
+Run on one core:  taskset -c 0 python benchmarks/bench_static_dynamics.py [--repeats N]
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import os
+import statistics
+import time
+from pathlib import Path
+
+for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(var, "1")
+
+import pamsim  # noqa: E402
+import pamsim.elements.muscle_force as muscle_force  # noqa: E402
+from pamsim.muscles import load_muscle  # noqa: E402
+from pamsim.parameters import dynamics_parameters  # noqa: E402
+from pamsim.static_models import REGISTRY  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[1]
+TARGET_RATIO_IMPLICIT = 3.0
+
+
+def _time(scenario: pamsim.Scenario, repeats: int) -> tuple[float, pamsim.Result]:
+    times, res = [], None
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        res = pamsim.simulate(scenario)
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times), res
+
+
+def _scenario(base: pamsim.Scenario, model: str) -> pamsim.Scenario:
+    shadow = dynamics_parameters(load_muscle("shadow_6x300_acra2012").parameters)
+    if not REGISTRY[model].missing(shadow):
+        return base.with_changes({"model": {"static_force": model}}, name=f"fig4_{model}")
+    kothera = dynamics_parameters(load_muscle("kothera2009_5a").parameters)
+    blocked = float(REGISTRY[model].build(kothera).force_N(0.0, 3.6e5))
+    return base.with_changes({"model": {"muscle": "kothera2009_5a", "static_force": model},
+                              "load": {"weight_N": 0.3 * blocked}}, name=f"fig4_{model}_kothera5a")
+
+
+def table_errors() -> None:
+    """Largest table error (cell centres) of every model the three muscles give, relative to its
+    blocked force at the muscle's rating: what the dynamics would use if the model were implicit."""
+    from pamsim.elements.force_table import table_error, tabulate
+    from pamsim.elements.stops import EndStops
+
+    print("table error, 401 x 41 grid, max |table - model| / blocked force at the rating:")
+    for muscle in ("shadow_6x300_acra2012", "kothera2009_5a", "mpam_survey_45mm"):
+        m = load_muscle(muscle)
+        p = dynamics_parameters(m.parameters)
+        worst = (0.0, "")
+        for name in m.applicable_models():
+            model = REGISTRY[name].build(p)
+            t = tabulate(model, (0.0, EndStops.from_parameters(p).x_high_m), (0.0, p["rated_pressure_gauge_Pa"]))
+            rel = table_error(model, t) / abs(float(model.force_N(0.0, p["rated_pressure_gauge_Pa"])))
+            worst = max(worst, (rel, name))
+        print(f"  {muscle:24s} worst {worst[0] * 100:.4f} % ({worst[1]}) over {len(m.applicable_models())} models "
+              f"(target <= 0.1 %)")
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeats", type=int, default=3)
+    args = ap.parse_args()
+    base = pamsim.load_scenario(ROOT / "scenarios" / "acra2012_fig4.toml")
+    t_poly, _ = _time(base, args.repeats)
+    print(f"fig4 with acra2012_polynomial: {t_poly * 1e3:.1f} ms (median of {args.repeats})")
+    print(f"{'model':38s} {'muscle':24s} {'kind':12s} {'time [ms]':>10s} {'ratio':>7s} {'final x [mm]':>12s}")
+    models = [m for m, s in REGISTRY.items() if s.kind != "table"]
+    kothera = dynamics_parameters(load_muscle("kothera2009_5a").parameters)
+    shadow = dynamics_parameters(load_muscle("shadow_6x300_acra2012").parameters)
+    for model in models:
+        if REGISTRY[model].missing(shadow) and REGISTRY[model].missing(kothera):
+            print(f"{model:38s} (needs parameters neither muscle gives: {', '.join(REGISTRY[model].missing(kothera))})")
+            continue
+        sc = _scenario(base, model)
+        t, res = _time(sc, args.repeats)
+        print(f"{model:38s} {sc.muscle.name:24s} {REGISTRY[model].kind:12s} {t * 1e3:10.1f} {t / t_poly:7.2f} "
+              f"{res.x_m[-1] * 1e3:12.3f}")
+    # The table path: kothera_energy marked implicit, so the dynamics tabulate it.
+    implicit = dataclasses.replace(REGISTRY["kothera_energy"], kind="implicit")
+    original = muscle_force.get
+    muscle_force.get = lambda name: implicit if name == "kothera_energy" else original(name)
+    try:
+        t_build = time.perf_counter()
+        sc = _scenario(base, "kothera_energy")
+        t_build = time.perf_counter() - t_build
+        t, res = _time(sc, args.repeats)
+    finally:
+        muscle_force.get = original
+    ratio = t / t_poly
+    print(f"{'kothera_energy as a table':38s} {sc.muscle.name:24s} {'(tabulated)':12s} {t * 1e3:10.1f} {ratio:7.2f} "
+          f"{res.x_m[-1] * 1e3:12.3f}")
+    print(f"table build (401 x 41 points, once per muscle and model): {t_build * 1e3:.0f} ms")
+    print(f"tabulated model vs polynomial: {ratio:.2f}x (target <= {TARGET_RATIO_IMPLICIT:g}x: "
+          f"{'met' if ratio <= TARGET_RATIO_IMPLICIT else 'NOT met'})")
+    table_errors()
+
+
+if __name__ == "__main__":
+    main()
