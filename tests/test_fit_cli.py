@@ -124,3 +124,14 @@ def test_fitted_muscle_works_as_muscle_everywhere(static_out):
                                     "pressure": {"source": "valve", "supply_gauge_bar": p_bar, "valve_open_time_s": 1.0},
                                     "simulation": {"duration_s": 1.0}})
     assert sc.parameters["C1_N_per_bar"] == c["C1_N_per_bar"]
+
+
+def test_the_fit_command_module_imports_no_numerical_code():
+    import subprocess
+    import sys
+
+    probe = ("import sys, pamsim.atomic\nbefore = set(sys.modules)\nimport pamsim.cli.fit\n"
+             "new = [m for m in set(sys.modules) - before if m.startswith(('numpy', 'scipy', 'matplotlib'))]\n"
+             "print(sorted(new))")
+    r = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=120)
+    assert r.stdout.strip() == "[]", r.stdout + r.stderr

@@ -5,18 +5,14 @@ from __future__ import annotations
 
 import argparse
 import os
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 from ..atomic import OutputError, ensure_output_dir
-from ..identification import compare, muscle_file, report, static_fit
-from ..identification import dynamic_fit
-from ..identification.columns import read_static_data, read_trace
-from ..identification.crossval import CV_CHOICES
-from ..identification.pressure_input import KNOT_TOLERANCE_PA
-from ..scenario import load_scenario
+from ..identification import choices
 from . import finite_float
-from .sweep import _workers
+
+# The numerical modules (numpy, scipy, matplotlib) are imported by the run functions, not here:
+# `pamsim --help` must not load them.
 
 
 def _names(text: str) -> list[str]:
@@ -36,14 +32,21 @@ def _columns(text: str) -> dict[str, str]:
     return out
 
 
-def _count(text: str) -> int:
-    try:
-        n = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
-    if n < 0:
-        raise argparse.ArgumentTypeError(f"{text!r}: must not be negative")
-    return n
+def _int_at_least(minimum: int):
+    """argparse type: an integer of at least ``minimum``."""
+    def parse(text: str) -> int:
+        try:
+            n = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
+        if n < minimum:
+            raise argparse.ArgumentTypeError(f"{text!r}: must be at least {minimum}")
+        return n
+    return parse
+
+
+_count = _int_at_least(0)
+_workers = _int_at_least(1)
 
 
 def _window(text: str) -> tuple[float, float]:
@@ -93,20 +96,20 @@ def register(sub) -> None:
                    help="starting muscle: a parameter set name or a muscle.toml path")
     s.add_argument("--model", help="static force model (default: the muscle's own)")
     s.add_argument("--free", type=_names, help="comma-separated coefficients to fit (default: the model's own)")
-    s.add_argument("--objective", choices=static_fit.OBJECTIVES,
+    s.add_argument("--objective", choices=choices.OBJECTIVES,
                    help="force or contraction (default: contraction for hung weights, force for measured forces)")
     s.add_argument("--compare", type=_names, help="comma-separated models to compare on the same data")
     s.add_argument("--columns", type=_columns, default={},
                    help="map quantities to other column names: pressure=NAME,contraction=NAME,force=NAME,weight=NAME")
-    s.add_argument("--loss", default="linear", choices=static_fit.LOSSES, help="robust loss (default linear)")
+    s.add_argument("--loss", default="linear", choices=choices.LOSSES, help="robust loss (default linear)")
     s.add_argument("--f-scale", type=finite_float, default=1.0,
                    help="scale of the robust loss, in the residual's unit (mm or N; default 1)")
     s.add_argument("--starts", type=_count, default=0, help="extra seeded random starts (default 0)")
     s.add_argument("--seed", type=_count, default=0, help="seed of the starts and of k-fold splits (default 0)")
-    s.add_argument("--cv", default="auto", choices=CV_CHOICES,
+    s.add_argument("--cv", default="auto", choices=choices.CV_CHOICES,
                    help="cross-validation: auto (leave-one-out up to 100 tests), loo, kfold or none")
     s.add_argument("--folds", type=_count, default=10, help="folds of --cv kfold (default 10)")
-    s.add_argument("--censor-threshold-mm", type=finite_float, default=static_fit.CENSOR_THRESHOLD_M * 1e3,
+    s.add_argument("--censor-threshold-mm", type=finite_float, default=choices.CENSOR_THRESHOLD_M * 1e3,
                    help="measured contraction at or below which a hung load counts as not lifted (default 0.5)")
     s.add_argument("-o", "--output", required=True, help="output directory")
     s.add_argument("--json", action="store_true", help="print fit.json to stdout")
@@ -118,7 +121,7 @@ def register(sub) -> None:
                                     "and figures.")
     d.add_argument("traces", nargs="+", help="CSV traces with t_s, x_m (or x_mm) and optionally p_gauge_Pa, weight_N")
     d.add_argument("--scenario", required=True, help="scenario TOML: parameter set, elements, valve, solver")
-    d.add_argument("--free", type=_names, default=list(dynamic_fit.DYNAMIC_DEFAULT_FREE),
+    d.add_argument("--free", type=_names, default=list(choices.DYNAMIC_DEFAULT_FREE),
                    help="comma-separated coefficients to fit (default: D1, D2, N2, N1, N0 of the paper)")
     d.add_argument("--window", type=_window, help="time window T0:T1 [s] of the residuals (default: whole trace)")
     d.add_argument("--load-N", type=_loads, help="hung weight [N] per trace, comma-separated")
@@ -129,9 +132,9 @@ def register(sub) -> None:
     d.add_argument("--workers", type=_workers, default=os.cpu_count() or 1,
                    help="worker processes for the simulations (default: number of CPUs)")
     d.add_argument("--max-iterations", type=_count, default=30, help="residual evaluations of the local fit")
-    d.add_argument("--fd-step", type=finite_float, default=dynamic_fit.FD_RELATIVE_STEP,
+    d.add_argument("--fd-step", type=finite_float, default=choices.FD_RELATIVE_STEP,
                    help="relative finite-difference step (default 1e-3)")
-    d.add_argument("--knot-tolerance-Pa", type=finite_float, default=KNOT_TOLERANCE_PA,
+    d.add_argument("--knot-tolerance-Pa", type=finite_float, default=choices.KNOT_TOLERANCE_PA,
                    help="largest deviation of the thinned measured pressure [Pa] (default 10)")
     d.add_argument("--seed", type=_count, default=0, help="seed of --global (default 0)")
     d.add_argument("-o", "--output", required=True, help="output directory")
@@ -140,6 +143,9 @@ def register(sub) -> None:
 
 
 def run_static(args: argparse.Namespace) -> int:
+    from ..identification import compare, muscle_file, report, static_fit
+    from ..identification.columns import read_static_data
+
     params, muscle_model = muscle_file.load_muscle_parameters(args.muscle)
     model = args.model or muscle_model
     check_output_dir(args.output)
@@ -173,6 +179,12 @@ def run_static(args: argparse.Namespace) -> int:
 
 
 def run_dynamic(args: argparse.Namespace) -> int:
+    from concurrent.futures import ProcessPoolExecutor
+
+    from ..identification import dynamic_fit, report
+    from ..identification.columns import read_trace
+    from ..scenario import load_scenario
+
     scenario = load_scenario(args.scenario)
     traces = [read_trace(t, args.columns) for t in args.traces]
     check_output_dir(args.output)

@@ -7,8 +7,8 @@ from typing import Callable
 import numpy as np
 
 from ..errors import InputError
+from .choices import CV_CHOICES
 
-CV_CHOICES = ("auto", "loo", "kfold", "none")
 LOO_MAX_POINTS = 100
 """``auto`` uses leave-one-out up to this many tests, k-fold above (each refit costs a fit)."""
 

@@ -30,17 +30,15 @@ from ..elements.pressure_source import PrescribedPressure
 from ..errors import InputError
 from ..scenario import Scenario
 from ..simulator import simulate_model
+from .choices import DYNAMIC_DEFAULT_FREE, FD_RELATIVE_STEP
 from .columns import TraceData
 from .pressure_input import KNOT_TOLERANCE_PA, PiecewiseLinearInput, thinned_input
 from .uncertainty import Uncertainty, linearised_uncertainty
 
-FD_RELATIVE_STEP = 1e-3
-"""Forward-difference step relative to each coefficient (absolute for coefficients below 1)."""
 FIT_RTOL = 1e-8
 """Integrator tolerance of the fit's simulations: the trajectory noise it leaves (about 1e-10 m)
 is far below what a step of FD_RELATIVE_STEP changes."""
-DYNAMIC_DEFAULT_FREE = ("D1_N_s_per_m", "D2_N_s2_per_m2", "N2_N_per_bar_m2", "N1_N_per_bar_m", "N0_N_per_bar")
-"""The paper's eq. (13) coefficients (its Table 4)."""
+
 
 
 @dataclass(frozen=True)

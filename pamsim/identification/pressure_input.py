@@ -16,11 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-KNOT_TOLERANCE_PA = 10.0
-"""Default largest deviation of the thinned pressure from the measured one: 0.1 mbar, 0.003 % of a
-3.6 bar step; the motion it drives differs by about a micrometre from the full trace's
-(docs/identification.md).  A noisy measured pressure needs a tolerance near its noise level, or
-every sample becomes a knot."""
+from .choices import KNOT_TOLERANCE_PA
 
 
 @dataclass(frozen=True)

@@ -28,16 +28,13 @@ from scipy.optimize import least_squares
 from ..elements.stops import EndStops
 from ..errors import InputError
 from ..parameters import ParameterSet, known_parameter
+from .choices import CENSOR_THRESHOLD_M, LOSSES, OBJECTIVES
 from .columns import StaticData
 from .crossval import cross_validate
 from .equilibrium import equilibrium_m, slope_N_per_m
 from .models import build_static, check_model, default_free, missing_inputs, optional_defaults
 from .uncertainty import Uncertainty, information_criteria, linearised_uncertainty
 
-OBJECTIVES = ("force", "contraction")
-LOSSES = ("linear", "soft_l1", "huber", "cauchy", "arctan")
-CENSOR_THRESHOLD_M = 0.5e-3
-"""Measured contraction at or below which a hung load counts as not lifted (issue default, 0.5 mm)."""
 _FD_REL = 1e-6
 """Relative step of the force sensitivities dF/dtheta (the force is a smooth, cheap function)."""
 
