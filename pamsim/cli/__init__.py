@@ -25,6 +25,7 @@ COMMANDS = (
     "pamsim.cli.muscles",
     "pamsim.cli.force",
     "pamsim.cli.atlas",
+    "pamsim.cli.fit",
 )
 
 

@@ -1,0 +1,210 @@
+"""``pamsim fit static`` and ``pamsim fit dynamic``: identify a muscle from measurements
+(docs/identification.md)."""
+
+from __future__ import annotations
+
+import argparse
+import os
+from pathlib import Path
+
+from ..atomic import OutputError, ensure_output_dir
+from ..identification import choices
+from . import finite_float
+
+# The numerical modules (numpy, scipy, matplotlib) are imported by the run functions, not here:
+# `pamsim --help` must not load them.
+
+
+def _names(text: str) -> list[str]:
+    names = [n.strip() for n in text.split(",") if n.strip()]
+    if not names:
+        raise argparse.ArgumentTypeError(f"{text!r}: give comma-separated names")
+    return names
+
+
+def _columns(text: str) -> dict[str, str]:
+    out = {}
+    for item in text.split(","):
+        key, sep, value = item.partition("=")
+        if not sep or not key.strip() or not value.strip():
+            raise argparse.ArgumentTypeError(f"{item!r}: write QUANTITY=COLUMN, e.g. pressure=p_meas_kPa")
+        out[key.strip()] = value.strip()
+    return out
+
+
+def _int_at_least(minimum: int):
+    """argparse type: an integer of at least ``minimum``."""
+    def parse(text: str) -> int:
+        try:
+            n = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
+        if n < minimum:
+            raise argparse.ArgumentTypeError(f"{text!r}: must be at least {minimum}")
+        return n
+    return parse
+
+
+_count = _int_at_least(0)
+_workers = _int_at_least(1)
+
+
+def _window(text: str) -> tuple[float, float]:
+    a, sep, b = text.partition(":")
+    try:
+        t0, t1 = float(a), float(b)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: write T0:T1 in seconds, e.g. 1.4:6") from None
+    if not sep or not t1 > t0:
+        raise argparse.ArgumentTypeError(f"{text!r}: need T0:T1 with T1 > T0")
+    return t0, t1
+
+
+def _loads(text: str) -> list[float]:
+    try:
+        values = [float(v) for v in text.split(",")]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: give one weight in N per trace, comma-separated") from None
+    if not all(v > 0 for v in values):
+        raise argparse.ArgumentTypeError(f"{text!r}: weights must be positive")
+    return values
+
+
+def check_output_dir(directory: str) -> None:
+    """Refuse an output folder that cannot be written, before any work, without creating it."""
+    path = Path(directory)
+    if path.exists():
+        ensure_output_dir(path)
+        return
+    parent = path.parent
+    while not parent.exists():
+        parent = parent.parent
+    if not (parent.is_dir() and os.access(parent, os.W_OK | os.X_OK)):
+        raise OutputError(f"{directory}: cannot create the output folder ({parent} is not writable)")
+
+
+def register(sub) -> None:
+    p = sub.add_parser("fit", help="identify a muscle from static tests or step responses",
+                       description="Fit static force coefficients to static tests (fit static) or friction and "
+                                   "damping coefficients to step responses (fit dynamic).")
+    fsub = p.add_subparsers(dest="fit_kind", required=True, metavar="KIND")
+    s = fsub.add_parser("static", help="fit a static force model to static tests",
+                        description="Fit a static force model to static tests (pressure, contraction, hung weight "
+                                    "or measured force) and write fit.json, muscle.toml, report.md and figures.")
+    s.add_argument("data", help="CSV with unit-suffixed columns (e.g. pamsim/data/acra2012_steady_state.csv)")
+    s.add_argument("--muscle", default="shadow_6x300_acra2012",
+                   help="starting muscle: a parameter set name or a muscle.toml path")
+    s.add_argument("--model", help="static force model (default: the muscle's own)")
+    s.add_argument("--free", type=_names, help="comma-separated coefficients to fit (default: the model's own)")
+    s.add_argument("--objective", choices=choices.OBJECTIVES,
+                   help="force or contraction (default: contraction for hung weights, force for measured forces)")
+    s.add_argument("--compare", type=_names, help="comma-separated models to compare on the same data")
+    s.add_argument("--columns", type=_columns, default={},
+                   help="map quantities to other column names: pressure=NAME,contraction=NAME,force=NAME,weight=NAME")
+    s.add_argument("--loss", default="linear", choices=choices.LOSSES, help="robust loss (default linear)")
+    s.add_argument("--f-scale", type=finite_float, default=1.0,
+                   help="scale of the robust loss, in the residual's unit (mm or N; default 1)")
+    s.add_argument("--starts", type=_count, default=0, help="extra seeded random starts (default 0)")
+    s.add_argument("--seed", type=_count, default=0, help="seed of the starts and of k-fold splits (default 0)")
+    s.add_argument("--cv", default="auto", choices=choices.CV_CHOICES,
+                   help="cross-validation: auto (leave-one-out up to 100 tests), loo, kfold or none")
+    s.add_argument("--folds", type=_count, default=10, help="folds of --cv kfold (default 10)")
+    s.add_argument("--censor-threshold-mm", type=finite_float, default=choices.CENSOR_THRESHOLD_M * 1e3,
+                   help="measured contraction at or below which a hung load counts as not lifted (default 0.5)")
+    s.add_argument("-o", "--output", required=True, help="output directory")
+    s.add_argument("--json", action="store_true", help="print fit.json to stdout")
+    s.set_defaults(func=run_static)
+
+    d = fsub.add_parser("dynamic", help="fit friction and damping to step responses (eq. 13)",
+                        description="Fit coefficients to measured step responses with the hybrid simulator inside "
+                                    "(the paper's eq. 13) and write fit.json, muscle.toml, scenario.toml, report.md "
+                                    "and figures.")
+    d.add_argument("traces", nargs="+", help="CSV traces with t_s, x_m (or x_mm) and optionally p_gauge_Pa, weight_N")
+    d.add_argument("--scenario", required=True, help="scenario TOML: parameter set, elements, valve, solver")
+    d.add_argument("--free", type=_names, default=list(choices.DYNAMIC_DEFAULT_FREE),
+                   help="comma-separated coefficients to fit (default: D1, D2, N2, N1, N0 of the paper)")
+    d.add_argument("--window", type=_window, help="time window T0:T1 [s] of the residuals (default: whole trace)")
+    d.add_argument("--load-N", type=_loads, help="hung weight [N] per trace, comma-separated")
+    d.add_argument("--columns", type=_columns, default={}, help="map quantities to other column names")
+    d.add_argument("--per-trace", action="store_true", help="also fit every trace alone (Table 4 layout)")
+    d.add_argument("--global", dest="global_search", action="store_true",
+                   help="differential evolution over start +- 50 %% before the local fit")
+    d.add_argument("--workers", type=_workers, default=os.cpu_count() or 1,
+                   help="worker processes for the simulations (default: number of CPUs)")
+    d.add_argument("--max-iterations", type=_count, default=30, help="residual evaluations of the local fit")
+    d.add_argument("--fd-step", type=finite_float, default=choices.FD_RELATIVE_STEP,
+                   help="relative finite-difference step (default 1e-3)")
+    d.add_argument("--knot-tolerance-Pa", type=finite_float, default=choices.KNOT_TOLERANCE_PA,
+                   help="largest deviation of the thinned measured pressure [Pa] (default 10)")
+    d.add_argument("--seed", type=_count, default=0, help="seed of --global (default 0)")
+    d.add_argument("-o", "--output", required=True, help="output directory")
+    d.add_argument("--json", action="store_true", help="print fit.json to stdout")
+    d.set_defaults(func=run_dynamic)
+
+
+def run_static(args: argparse.Namespace) -> int:
+    from ..identification import compare, muscle_file, report, static_fit
+    from ..identification.columns import read_static_data
+
+    params, muscle_model = muscle_file.load_muscle_parameters(args.muscle)
+    model = args.model or muscle_model
+    check_output_dir(args.output)
+    data = read_static_data(args.data, args.columns)
+    options = dict(objective=args.objective, loss=args.loss, f_scale=args.f_scale, n_starts=args.starts,
+                   seed=args.seed, censor_threshold_m=args.censor_threshold_mm * 1e-3, cv=args.cv,
+                   k_folds=args.folds)
+    fit = static_fit.fit_static(data, params, model=model, free=args.free, muscle_label=args.muscle, **options)
+    compared = None
+    if args.compare:
+        # The main fit is one of the compared ones when it uses the model's own free coefficients.
+        others = [m for m in args.compare if args.free or m != model]
+        fits = dict(zip(others, compare.compare_models(data, params, others,
+                                                       **{**options, "muscle_label": args.muscle})))
+        compared = [fits.get(m, fit) for m in args.compare]
+    names = report.write_static_fit(fit, args.output, compared)
+    if args.json:
+        body = fit.to_json()
+        if compared:
+            body["compare"] = compare.comparison_rows(compared)
+        print(report.json_text(body), end="")
+        return 0
+    cv = "n/a" if fit.cv_kind.startswith("none") else f"{fit.cv_rms_contraction_mm:.3f} mm"
+    print(f"{model} on {args.data}: RMS contraction {fit.rms_contraction_mm:.3f} mm "
+          f"(cross-validated {cv}, {fit.cv_kind}), "
+          f"{fit.n_points} tests, {fit.n_censored} censored")
+    for a, b, r in fit.uncertainty.inseparable_pairs():
+        print(f"  warning: {a} and {b} are correlated (r = {r:+.3f}): the data do not separate them")
+    print(f"wrote {', '.join(str(Path(args.output) / n) for n in names)}")
+    return 0
+
+
+def run_dynamic(args: argparse.Namespace) -> int:
+    from concurrent.futures import ProcessPoolExecutor
+
+    from ..identification import dynamic_fit, report
+    from ..identification.columns import read_trace
+    from ..scenario import load_scenario
+
+    scenario = load_scenario(args.scenario)
+    traces = [read_trace(t, args.columns) for t in args.traces]
+    check_output_dir(args.output)
+    options = dict(free=args.free, window_s=args.window, loads_N=args.load_N, global_search=args.global_search,
+                   per_trace=args.per_trace, seed=args.seed, fd_step=args.fd_step,
+                   max_iterations=args.max_iterations, knot_tolerance_Pa=args.knot_tolerance_Pa)
+    if args.workers == 1:
+        fit = dynamic_fit.fit_dynamic(scenario, traces, executor=None, **options)
+    else:
+        with ProcessPoolExecutor(max_workers=args.workers) as pool:
+            fit = dynamic_fit.fit_dynamic(scenario, traces, executor=pool, **options)
+    names = report.write_dynamic_fit(fit, args.output)
+    if args.json:
+        print(report.json_text(fit.to_json()), end="")
+        return 0
+    print(f"{len(traces)} trace(s): pooled RMS {fit.rms_pooled_mm:.4f} mm, {fit.n_simulations} simulations in "
+          f"{fit.wall_time_s:.2f} s on {args.workers} worker(s)")
+    for name, value in fit.parameters.items():
+        print(f"  {name} = {value:.6g}")
+    for a, b, r in fit.uncertainty.inseparable_pairs():
+        print(f"  warning: {a} and {b} are correlated (r = {r:+.3f}): the data do not separate them")
+    print(f"wrote {', '.join(str(Path(args.output) / n) for n in names)}")
+    return 0

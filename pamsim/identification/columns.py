@@ -1,0 +1,233 @@
+"""Measurement files for identification: CSV with a header row, ``#`` comment lines, and
+columns that carry their unit in their name.
+
+Static data need a pressure (``_bar``, ``_Pa``, ``_kPa`` or ``_psi``, gauge), a contraction
+(``_mm`` or ``_m``) and a force (``force_N``, measured pull) or a hung weight (``weight_N``).
+Traces need ``t_s``, a contraction and optionally a pressure and a ``weight_N``.
+Other column names are mapped with ``columns={"pressure": "my_column_bar", ...}``; the mapped
+column must still end in a unit suffix.  Everything is converted to SI here, at the edge.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import io
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Mapping
+
+import numpy as np
+
+from ..errors import InputError
+
+PRESSURE_UNITS_PA = {"_gauge_Pa": 1.0, "_Pa": 1.0, "_kPa": 1e3, "_gauge_bar": 1e5, "_bar": 1e5, "_psi": 6894.757293168}
+"""Gauge pressure suffixes and their factor to Pa (psi: 0.45359237 kg * 9.80665 / 0.0254^2)."""
+LENGTH_UNITS_M = {"_mm": 1e-3, "_m": 1.0}
+"""Contraction suffixes and their factor to metres."""
+QUANTITIES = ("pressure", "contraction", "force", "weight", "time")
+
+
+class DataError(InputError):
+    """A measurement file that cannot be used; the message names the file, the column and the value."""
+
+
+@dataclass(frozen=True)
+class StaticData:
+    """Static tests: one row per test, SI units.
+
+    ``load_N`` is the measured pull (``kind == "force"``) or the hung weight (``kind == "weight"``).
+    """
+
+    pressure_gauge_Pa: np.ndarray
+    contraction_m: np.ndarray
+    load_N: np.ndarray
+    kind: str
+    origin: str = "<arrays>"
+    sha256: str = ""
+
+    def __len__(self) -> int:
+        return len(self.load_N)
+
+    def subset(self, rows) -> "StaticData":
+        """The tests at ``rows`` (indices or a boolean mask)."""
+        return StaticData(self.pressure_gauge_Pa[rows], self.contraction_m[rows], self.load_N[rows], self.kind,
+                          self.origin, self.sha256)
+
+
+@dataclass(frozen=True)
+class TraceData:
+    """One step response: time [s], contraction [m], gauge pressure [Pa] if recorded, hung weight [N] if given."""
+
+    t_s: np.ndarray
+    x_m: np.ndarray
+    p_gauge_Pa: np.ndarray | None
+    weight_N: float | None
+    origin: str = "<arrays>"
+    sha256: str = ""
+
+    def window(self, t0_s: float, t1_s: float) -> np.ndarray:
+        """Boolean mask of the samples inside ``[t0_s, t1_s]``."""
+        return (self.t_s >= t0_s) & (self.t_s <= t1_s)
+
+
+def _table(path: Path) -> tuple[list[str], np.ndarray, str]:
+    """Header names, the numeric rows and the SHA-256 of the file."""
+    try:
+        raw = path.read_bytes()
+    except OSError as exc:
+        raise DataError(f"{path}: cannot read it: {exc.strerror or exc}") from None
+    try:
+        text = raw.decode()
+    except UnicodeDecodeError:
+        raise DataError(f"{path}: not a text (UTF-8) CSV file") from None
+    lines = [(n, line) for n, line in enumerate(text.splitlines(), start=1) if line.strip() and not line.startswith("#")]
+    if not lines:
+        raise DataError(f"{path}: no header row (the file is empty or only comments)")
+    header = [h.strip() for h in lines[0][1].split(",")]
+    rows = []
+    for n, line in lines[1:]:
+        cells = line.split(",")
+        if len(cells) != len(header):
+            raise DataError(f"{path}: line {n} has {len(cells)} fields, the header has {len(header)}")
+        try:
+            rows.append([float(c) for c in cells])
+        except ValueError:
+            bad = next(c for c in cells if not _is_number(c))
+            raise DataError(f"{path}: line {n}: value {bad.strip()!r} is not a number") from None
+    if not rows:
+        raise DataError(f"{path}: no data rows below the header")
+    return header, np.array(rows, dtype=float), hashlib.sha256(raw).hexdigest()
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def _unit_column(path: Path, header: list[str], quantity: str, units: Mapping[str, float], stems: tuple[str, ...],
+                 columns: Mapping[str, str], required: bool = True) -> tuple[str, float] | None:
+    """The column holding ``quantity`` and its factor to SI: the mapped name, or the first column whose
+    name starts with one of ``stems`` and ends with one of ``units``."""
+    if quantity in columns:
+        name = columns[quantity]
+        if name not in header:
+            raise DataError(f"{path}: --columns {quantity}={name}: no such column (columns: {', '.join(header)})")
+        suffix = next((s for s in sorted(units, key=len, reverse=True) if name.endswith(s)), None)
+        if suffix is None:
+            raise DataError(f"{path}: --columns {quantity}={name}: the name must end in a unit "
+                            f"({', '.join(units)})")
+        return name, units[suffix]
+    for name in header:
+        if name.startswith(stems):
+            suffix = next((s for s in sorted(units, key=len, reverse=True) if name.endswith(s)), None)
+            if suffix is not None:
+                return name, units[suffix]
+    if required:
+        want = " or ".join(f"{s}*" for s in stems)
+        raise DataError(f"{path}: no {quantity} column: need {want} ending in {' / '.join(units)} "
+                        f"(columns: {', '.join(header)}; map another with --columns {quantity}=NAME)")
+    return None
+
+
+def _check_columns_map(columns: Mapping[str, str], path: Path) -> None:
+    for key in columns:
+        if key not in QUANTITIES:
+            raise DataError(f"{path}: --columns {key}=...: unknown quantity (choose from {', '.join(QUANTITIES)})")
+
+
+def _finite(path: Path, name: str, values: np.ndarray) -> np.ndarray:
+    bad = np.flatnonzero(~np.isfinite(values))
+    if bad.size:
+        raise DataError(f"{path}: column {name}, data row {int(bad[0]) + 1}: value {values[bad[0]]} is not finite")
+    return values
+
+
+def read_static_data(path: str | Path, columns: Mapping[str, str] | None = None) -> StaticData:
+    """Read static tests (pressure, contraction, force or weight) from a CSV file.
+
+    Parameters
+    ----------
+    path : str or Path
+        CSV file with a header row; ``#`` lines are comments.
+    columns : mapping, optional
+        ``{"pressure" | "contraction" | "force" | "weight": column name}`` for columns that are not
+        found by their standard names.  A pressure column named ``pressure_stable_bar`` is
+        preferred over other pressure columns (the ACRA tables record the stable pressure).
+
+    Returns
+    -------
+    StaticData
+    """
+    path = Path(path)
+    columns = dict(columns or {})
+    _check_columns_map(columns, path)
+    header, rows, digest = _table(path)
+    if "pressure" not in columns and "pressure_stable_bar" in header:
+        columns["pressure"] = "pressure_stable_bar"
+    p_col, p_k = _unit_column(path, header, "pressure", PRESSURE_UNITS_PA, ("pressure", "p_"), columns)
+    x_col, x_k = _unit_column(path, header, "contraction", LENGTH_UNITS_M, ("contraction", "x_"), columns)
+    force = _unit_column(path, header, "force", {"_N": 1.0}, ("force",), columns, required=False)
+    weight = _unit_column(path, header, "weight", {"_N": 1.0}, ("weight",), columns, required=False)
+    if (force is None) == (weight is None):
+        raise DataError(f"{path}: need exactly one of a force_N column (measured pull) or a weight_N column "
+                        f"(hung weight); columns: {', '.join(header)}")
+    (l_col, _), kind = (force, "force") if force is not None else (weight, "weight")
+    p = _finite(path, p_col, rows[:, header.index(p_col)] * p_k)
+    x = _finite(path, x_col, rows[:, header.index(x_col)] * x_k)
+    load = _finite(path, l_col, rows[:, header.index(l_col)])
+    if kind == "weight" and np.any(load <= 0):
+        i = int(np.flatnonzero(load <= 0)[0])
+        raise DataError(f"{path}: column {l_col}, data row {i + 1}: value {load[i]:g} must be positive")
+    return StaticData(p, x, load, kind, str(path), digest)
+
+
+def read_trace(path: str | Path, columns: Mapping[str, str] | None = None) -> TraceData:
+    """Read one step response: ``t_s``, a contraction, optionally a gauge pressure and ``weight_N``.
+
+    The weight column, if present, must hold one value (the load of the whole trace).
+    """
+    path = Path(path)
+    columns = dict(columns or {})
+    _check_columns_map(columns, path)
+    header, rows, digest = _table(path)
+    t_col, _ = _unit_column(path, header, "time", {"_s": 1.0}, ("t_", "time"), columns)
+    x_col, x_k = _unit_column(path, header, "contraction", LENGTH_UNITS_M, ("x_", "contraction"), columns)
+    p = _unit_column(path, header, "pressure", PRESSURE_UNITS_PA, ("p_", "pressure"), columns, required=False)
+    w = _unit_column(path, header, "weight", {"_N": 1.0}, ("weight",), columns, required=False)
+    t = _finite(path, t_col, rows[:, header.index(t_col)])
+    x = _finite(path, x_col, rows[:, header.index(x_col)] * x_k)
+    if len(t) < 3:
+        raise DataError(f"{path}: a trace needs at least three rows, got {len(t)}")
+    bad = np.flatnonzero(np.diff(t) <= 0)
+    if bad.size:
+        raise DataError(f"{path}: column {t_col}, data row {int(bad[0]) + 2}: time {t[bad[0] + 1]:g} does not "
+                        f"increase (previous {t[bad[0]]:g})")
+    p_Pa = None if p is None else _finite(path, p[0], rows[:, header.index(p[0])] * p[1])
+    weight = None
+    if w is not None:
+        values = _finite(path, w[0], rows[:, header.index(w[0])])
+        if not np.all(values == values[0]) or not values[0] > 0:
+            raise DataError(f"{path}: column {w[0]}: value {values[0]:g}: the hung weight must be one positive "
+                            "value for the whole trace")
+        weight = float(values[0])
+    return TraceData(t, x, p_Pa, weight, str(path), digest)
+
+
+def write_trace_csv(trace: TraceData, path: str | Path) -> None:
+    """Write a trace in the format :func:`read_trace` reads (SI columns)."""
+    cols = {"t_s": trace.t_s, "x_m": trace.x_m}
+    if trace.p_gauge_Pa is not None:
+        cols["p_gauge_Pa"] = trace.p_gauge_Pa
+    if trace.weight_N is not None:
+        cols["weight_N"] = np.full_like(trace.t_s, trace.weight_N)
+    buf = io.StringIO()
+    np.savetxt(buf, np.column_stack(list(cols.values())), delimiter=",", header=",".join(cols), comments="",
+               fmt="%.10g")
+    Path(path).write_text(buf.getvalue())
+
+
+__all__ = ["StaticData", "TraceData", "DataError", "read_static_data", "read_trace", "write_trace_csv",
+           "PRESSURE_UNITS_PA", "LENGTH_UNITS_M"]

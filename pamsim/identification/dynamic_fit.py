@@ -1,0 +1,362 @@
+"""Dynamic identification, the ACRA 2012 paper's eq. (13): find the coefficients that minimise the
+sum of squared differences between simulated and measured contraction over a time window, summed
+over traces, with the exact hybrid stick/slip simulator inside.
+
+Each trace is simulated from rest at its first sample.  With a recorded pressure the simulation is
+driven by it (thinned to knots, :mod:`.pressure_input`), as the paper did; without one, by the
+scenario's own pressure source (its valve).  The load of a trace is its ``weight_N`` column, a
+value given by the caller, or the scenario's.
+
+The simulations of one optimiser iteration (every trace, and every finite-difference column of the
+Jacobian) are independent tasks sent to a :class:`concurrent.futures.Executor`, as sweeps do.
+
+Finite differences: the residuals are exact simulations, but each carries integration error of
+about ``rtol`` times the state scale and event times located to the solver's tolerance.  A step of
+``fd_relative_step`` (default 1e-3) times the coefficient changes the trajectory by orders of
+magnitude more than that noise, while staying small enough for a linear model of the response
+(docs/identification.md has the measured figures).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, replace
+from typing import Mapping, Sequence
+
+import numpy as np
+from scipy.optimize import differential_evolution, least_squares
+
+from ..elements.pressure_source import PrescribedPressure
+from ..errors import InputError
+from ..scenario import Scenario
+from ..simulator import simulate_model
+from .choices import DYNAMIC_DEFAULT_FREE, FD_RELATIVE_STEP
+from .columns import TraceData
+from .pressure_input import KNOT_TOLERANCE_PA, PiecewiseLinearInput, thinned_input
+from .uncertainty import Uncertainty, linearised_uncertainty
+
+FIT_RTOL = 1e-8
+"""Integrator tolerance of the fit's simulations: the trajectory noise it leaves (about 1e-10 m)
+is far below what a step of FD_RELATIVE_STEP changes."""
+
+
+
+@dataclass(frozen=True)
+class SimulationTask:
+    """One simulation of one trace with some coefficients (pickles to a worker process)."""
+
+    scenario: Scenario
+    overrides: Mapping[str, float]
+    weight_N: float
+    duration_s: float
+    pressure_t_s: np.ndarray | None
+    pressure_Pa: np.ndarray | None
+    sample_t_s: np.ndarray
+
+
+def run_simulation(task: SimulationTask) -> np.ndarray:
+    """Contraction [m] at the trace's sample times (relative to its first sample); NaN if it fails.
+
+    A failed simulation (solver failure) returns NaNs rather than raising, so one bad trial point
+    of the optimiser does not end the fit; the residuals turn it into a large cost.
+    """
+    try:
+        changes = {"parameters": dict(task.overrides), "load": {"weight_N": task.weight_N},
+                   "simulation": {"duration_s": task.duration_s}, "solver": {"rtol": FIT_RTOL}}
+        sc = task.scenario.with_changes(changes)
+        model = sc.build_model()
+        p0 = sc.initial_pressure_gauge_Pa
+        if task.pressure_t_s is not None:
+            model = replace(model, source=PrescribedPressure(PiecewiseLinearInput(task.pressure_t_s, task.pressure_Pa)))
+            p0 = None
+        res = simulate_model(model, sc.duration_s, sc.solver, x0_m=sc.initial_contraction_m, p0_gauge_Pa=p0)
+        return np.interp(task.sample_t_s, res.t_s, res.x_m)
+    except Exception:  # noqa: BLE001 -- a trial point that cannot be simulated is a bad point, not an error
+        return np.full(task.sample_t_s.shape, np.nan)
+
+
+def _map(executor, tasks: Sequence[SimulationTask]) -> list[np.ndarray]:
+    if executor is None:
+        return [run_simulation(t) for t in tasks]
+    return list(executor.map(run_simulation, tasks))
+
+
+@dataclass(frozen=True)
+class DynamicProblem:
+    """Traces, scenario, free coefficients and windows of a dynamic fit."""
+
+    scenario: Scenario
+    traces: tuple[TraceData, ...]
+    loads_N: tuple[float, ...]
+    windows: tuple[np.ndarray, ...]
+    free: tuple[str, ...]
+    bounds: tuple[np.ndarray, np.ndarray]
+    inputs: tuple[PiecewiseLinearInput | None, ...]
+
+    def tasks(self, theta: np.ndarray) -> list[SimulationTask]:
+        overrides = dict(zip(self.free, map(float, theta)))
+        out = []
+        for tr, w, sig in zip(self.traces, self.loads_N, self.inputs):
+            t_rel = tr.t_s - tr.t_s[0]
+            pt, pv = (sig.t_s, sig.values) if sig is not None else (None, None)
+            out.append(SimulationTask(self.scenario, overrides, w, float(t_rel[-1]), pt, pv, t_rel))
+        return out
+
+    def residuals_from(self, simulated: Sequence[np.ndarray]) -> np.ndarray:
+        """Window residuals [mm] of every trace, concatenated (eq. 13 in mm^2)."""
+        parts = [(x - tr.x_m)[m] * 1e3 for x, tr, m in zip(simulated, self.traces, self.windows)]
+        r = np.concatenate(parts)
+        return np.where(np.isfinite(r), r, 1e3)  # a failed simulation: 1 m off at every sample
+
+
+class _Objective:
+    """Residuals and Jacobian with one batch of parallel simulations each; counts simulations."""
+
+    def __init__(self, problem: DynamicProblem, executor, fd_step: float):
+        self.problem = problem
+        self.executor = executor
+        self.fd_step = fd_step
+        self.n_simulations = 0
+        self._cache: tuple[bytes, list[np.ndarray]] | None = None
+
+    def simulate(self, theta: np.ndarray) -> list[np.ndarray]:
+        key = np.asarray(theta, dtype=float).tobytes()
+        if self._cache is None or self._cache[0] != key:
+            tasks = self.problem.tasks(theta)
+            self.n_simulations += len(tasks)
+            self._cache = (key, _map(self.executor, tasks))
+        return self._cache[1]
+
+    def residuals(self, theta: np.ndarray) -> np.ndarray:
+        return self.problem.residuals_from(self.simulate(theta))
+
+    def steps(self, theta: np.ndarray) -> np.ndarray:
+        return self.fd_step * np.maximum(np.abs(theta), 1.0)
+
+    def jacobian(self, theta: np.ndarray) -> np.ndarray:
+        """Forward differences, every column's simulations in one parallel batch."""
+        r0 = self.residuals(theta)
+        h = self.steps(theta)
+        lo, hi = self.problem.bounds
+        h = np.where(theta + h > hi, -h, h)  # step inward at an upper bound
+        thetas = []
+        for j in range(len(theta)):
+            t = np.array(theta, dtype=float)
+            t[j] += h[j]
+            thetas.append(t)
+        tasks = [task for t in thetas for task in self.problem.tasks(t)]
+        self.n_simulations += len(tasks)
+        sims = _map(self.executor, tasks)
+        n_tr = len(self.problem.traces)
+        J = np.empty((r0.size, len(theta)))
+        for j in range(len(theta)):
+            J[:, j] = (self.problem.residuals_from(sims[j * n_tr:(j + 1) * n_tr]) - r0) / h[j]
+        return J
+
+
+class _SumOfSquares:
+    """Scalar eq. (13) cost for differential evolution (picklable; simulations run in this process)."""
+
+    def __init__(self, problem: DynamicProblem):
+        self.problem = problem
+
+    def __call__(self, theta: np.ndarray) -> float:
+        r = self.problem.residuals_from([run_simulation(t) for t in self.problem.tasks(theta)])
+        return float(r @ r)
+
+
+@dataclass
+class DynamicFit:
+    """Result of a dynamic fit; ``to_json()`` gives ``fit.json``."""
+
+    problem: DynamicProblem
+    theta: np.ndarray
+    start: np.ndarray
+    uncertainty: Uncertainty
+    simulated_m: list[np.ndarray]
+    start_simulated_m: list[np.ndarray]
+    rms_contraction_mm: list[float]
+    rms_pooled_mm: float
+    n_simulations: int
+    wall_time_s: float
+    success: bool
+    message: str
+    per_trace: list[dict] | None = None
+
+    @property
+    def traces(self) -> tuple[TraceData, ...]:
+        return self.problem.traces
+
+    @property
+    def windows(self) -> tuple[np.ndarray, ...]:
+        return self.problem.windows
+
+    @property
+    def loads_N(self) -> tuple[float, ...]:
+        return self.problem.loads_N
+
+    @property
+    def parameters(self) -> dict[str, float]:
+        return dict(zip(self.problem.free, map(float, self.theta)))
+
+    def to_json(self) -> dict:
+        u = self.uncertainty
+        names = [tr.origin for tr in self.traces]
+        body = {"scenario": self.problem.scenario.origin, "traces": names,
+                "traces_sha256": [tr.sha256 for tr in self.traces], "loads_N": list(self.loads_N),
+                "pressure_recorded": [tr.p_gauge_Pa is not None for tr in self.traces],
+                "parameters": self.parameters,
+                "start": dict(zip(self.problem.free, map(float, self.start))),
+                "standard_errors": dict(zip(u.names, map(float, u.standard_errors))),
+                "correlation": u.correlation_table(),
+                "inseparable_pairs": [[a, b, r] for a, b, r in u.inseparable_pairs()],
+                "rms_contraction_mm": {"per_trace": dict(zip(names, self.rms_contraction_mm)),
+                                       "pooled": self.rms_pooled_mm},
+                "n_simulations": self.n_simulations, "wall_time_s": self.wall_time_s,
+                "success": self.success, "message": self.message}
+        if self.per_trace is not None:
+            body["per_trace"] = self.per_trace
+        return body
+
+
+def make_problem(scenario: Scenario, traces: Sequence[TraceData], free: Sequence[str] | None = None,
+                 window_s: tuple[float, float] | None = None, loads_N: Sequence[float | None] | None = None,
+                 knot_tolerance_Pa: float = KNOT_TOLERANCE_PA) -> DynamicProblem:
+    """Check the choices of a dynamic fit and bundle them.
+
+    The load of trace i is ``loads_N[i]`` if given, else its ``weight_N`` column, else the
+    scenario's load.  ``window_s`` (times of the traces' own clock) defaults to the whole trace.
+    """
+    if not traces:
+        raise InputError("fit dynamic: give at least one trace")
+    free = tuple(free) if free else DYNAMIC_DEFAULT_FREE
+    params = scenario.parameters
+    for n in free:
+        if n not in params:
+            raise InputError(f"--free: {n!r} is not a parameter of the scenario's parameter set {params.name!r}")
+    if len(set(free)) != len(free):
+        raise InputError(f"--free = {','.join(free)}: a name appears twice")
+    if loads_N is not None and len(loads_N) != len(traces):
+        raise InputError(f"--load-N: {len(loads_N)} values for {len(traces)} traces")
+    loads = []
+    for i, tr in enumerate(traces):
+        given = loads_N[i] if loads_N is not None else None
+        w = given if given is not None else tr.weight_N
+        if w is None:
+            w = scenario.mass_kg * params["g_m_s2"]
+        if not w > 0:
+            raise InputError(f"--load-N = {w!r}: must be positive")
+        loads.append(float(w))
+    windows = []
+    for tr in traces:
+        t0, t1 = window_s if window_s is not None else (tr.t_s[0], tr.t_s[-1])
+        mask = tr.window(t0, t1)
+        if mask.sum() < len(free) + 1:
+            raise InputError(f"--window = {t0:g}:{t1:g}: only {int(mask.sum())} samples of {tr.origin} inside "
+                             f"(trace spans {tr.t_s[0]:g}..{tr.t_s[-1]:g} s)")
+        windows.append(mask)
+    if not knot_tolerance_Pa > 0:
+        raise InputError(f"--knot-tolerance-Pa = {knot_tolerance_Pa!r}: must be positive")
+    lower = np.array([params.entries[n].lower for n in free], dtype=float)
+    upper = np.array([params.entries[n].upper for n in free], dtype=float)
+    inputs = tuple(None if tr.p_gauge_Pa is None else thinned_input(tr.t_s, tr.p_gauge_Pa, knot_tolerance_Pa)
+                   for tr in traces)
+    return DynamicProblem(scenario, tuple(traces), tuple(loads), tuple(windows), free, (lower, upper), inputs)
+
+
+def _rms_per_trace(problem: DynamicProblem, sims: Sequence[np.ndarray]) -> list[float]:
+    return [float(np.sqrt(np.mean(((x - tr.x_m)[m] * 1e3) ** 2))) for x, tr, m in
+            zip(sims, problem.traces, problem.windows)]
+
+
+def _local(problem: DynamicProblem, theta0: np.ndarray, executor, fd_step: float, max_iterations: int):
+    obj = _Objective(problem, executor, fd_step)
+    scale = np.where(np.abs(theta0) > 0, np.abs(theta0), 1.0)
+    lo, hi = problem.bounds
+    res = least_squares(lambda z: obj.residuals(z * scale), np.clip(theta0, lo, hi) / scale,
+                        jac=lambda z: obj.jacobian(z * scale) * scale, bounds=(lo / scale, hi / scale),
+                        method="trf", x_scale=1.0, max_nfev=max_iterations, xtol=1e-8, ftol=1e-10, gtol=1e-10)
+    theta = res.x * scale
+    J = obj.jacobian(theta)
+    return theta, res, obj, J
+
+
+def fit_dynamic(scenario: Scenario, traces: Sequence[TraceData], free: Sequence[str] | None = None,
+                window_s: tuple[float, float] | None = None, loads_N: Sequence[float | None] | None = None,
+                executor=None, global_search: bool = False, global_span: float = 0.5,
+                global_iterations: int = 10, per_trace: bool = False, seed: int = 0,
+                fd_step: float = FD_RELATIVE_STEP, max_iterations: int = 30,
+                knot_tolerance_Pa: float = KNOT_TOLERANCE_PA) -> DynamicFit:
+    """Fit coefficients (default the paper's D1, D2, N2, N1, N0) to step responses, eq. (13).
+
+    Parameters
+    ----------
+    scenario : Scenario
+        Everything that is not fitted: parameter set, element choices, pressure source (used for
+        traces without a recorded pressure), solver.
+    traces : sequence of TraceData
+    free : sequence of str, optional
+        Coefficients to fit; start values are the scenario's.
+    window_s : (float, float), optional
+        Time window of the residuals, on the traces' clock.
+    loads_N : sequence, optional
+        Hung weight per trace [N] (None entries: the trace's column or the scenario's load).
+    executor : concurrent.futures.Executor, optional
+        Runs each iteration's simulations in parallel; None runs them here.
+    global_search : bool
+        First run differential evolution over ``start * (1 -+ global_span)`` (within the parameter
+        ranges), seeded with ``seed``, then the local fit from its best point.
+    per_trace : bool
+        Also fit every trace alone (the paper's Table 4 layout).
+    fd_step : float
+        Relative forward-difference step of the Jacobian.
+    max_iterations : int
+        Residual evaluations allowed to the local optimiser.
+    """
+    start_time = time.perf_counter()
+    if not (0 < fd_step < 0.1):
+        raise InputError(f"--fd-step = {fd_step!r}: must lie in (0, 0.1)")
+    if max_iterations < 1:
+        raise InputError(f"--max-iterations = {max_iterations}: must be at least 1")
+    problem = make_problem(scenario, traces, free, window_s, loads_N, knot_tolerance_Pa)
+    theta0 = np.array([scenario.parameters[n] for n in problem.free], dtype=float)
+    n_sim = 0
+    start = theta0
+    if global_search:
+        lo, hi = problem.bounds
+        span = global_span * np.maximum(np.abs(theta0), 1e-3)
+        de_bounds = list(zip(np.maximum(theta0 - span, lo), np.minimum(theta0 + span, hi)))
+        de_workers = executor.map if executor is not None else 1
+        de = differential_evolution(_SumOfSquares(problem), de_bounds, maxiter=global_iterations, popsize=6,
+                                    seed=seed, polish=False, workers=de_workers, updating="deferred", tol=1e-6,
+                                    x0=theta0)
+        n_sim += de.nfev * len(problem.traces)
+        start = de.x
+    theta, res, obj, J = _local(problem, start, executor, fd_step, max_iterations)
+    n_sim += obj.n_simulations
+    sims = obj.simulate(theta)
+    r = problem.residuals_from(sims)
+    unc = linearised_uncertainty(problem.free, J, r)
+    start_sims = _map(executor, problem.tasks(theta0))
+    n_sim += len(problem.traces)
+    rms = _rms_per_trace(problem, sims)
+    table = None
+    if per_trace and len(problem.traces) > 1:
+        table = []
+        for i, tr in enumerate(problem.traces):
+            sub = replace(problem, traces=(tr,), loads_N=(problem.loads_N[i],), windows=(problem.windows[i],),
+                          inputs=(problem.inputs[i],))
+            th_i, res_i, obj_i, _ = _local(sub, theta, executor, fd_step, max_iterations)
+            n_sim += obj_i.n_simulations
+            table.append({"trace": tr.origin, "load_N": problem.loads_N[i],
+                          "pressure_final_bar": (float(tr.p_gauge_Pa[-1]) / 1e5 if tr.p_gauge_Pa is not None
+                                                 else scenario.final_pressure_gauge_Pa / 1e5),
+                          **dict(zip(problem.free, map(float, th_i))),
+                          "rms_contraction_mm": _rms_per_trace(sub, obj_i.simulate(th_i))[0]})
+    pooled = float(np.sqrt(np.mean(r ** 2)))
+    return DynamicFit(problem, theta, theta0, unc, sims, start_sims, rms, pooled, n_sim,
+                      time.perf_counter() - start_time, bool(res.success), str(res.message), table)
+
+
+__all__ = ["fit_dynamic", "DynamicFit", "DynamicProblem", "make_problem", "run_simulation", "SimulationTask",
+           "DYNAMIC_DEFAULT_FREE", "FD_RELATIVE_STEP"]

@@ -1,0 +1,232 @@
+"""Writing a fit's folder: ``fit.json``, the fitted ``muscle.toml``, ``report.md`` and figures, all or
+nothing (pamsim.atomic)."""
+
+from __future__ import annotations
+
+import contextlib
+import csv
+import datetime
+import json
+import math
+import shutil
+from pathlib import Path
+from typing import TYPE_CHECKING, Sequence
+
+from ..atomic import atomic_outputs
+from .compare import comparison_rows, write_comparison_csv
+from .muscle_file import muscle_toml
+from .plots import plot_comparison, plot_correlation, plot_dynamic_fit, plot_static_fit, plot_static_residuals
+
+if TYPE_CHECKING:
+    from .dynamic_fit import DynamicFit
+    from .static_fit import StaticFit
+
+
+@contextlib.contextmanager
+def _outputs(directory, names: list[str]):
+    """:func:`pamsim.atomic.atomic_outputs`, and a folder it had to create is removed again on failure."""
+    directory = Path(directory)
+    existed = directory.exists()
+    try:
+        with atomic_outputs(directory, names) as out:
+            yield out
+    except BaseException:
+        if not existed:
+            with contextlib.suppress(OSError):
+                directory.rmdir()  # only if empty: never remove what someone else put there
+        raise
+
+
+def _f(v: float, fmt: str = ".4g") -> str:
+    return "n/a" if v is None or not math.isfinite(v) else format(v, fmt)
+
+
+def provenance(origin: str, sha256: str, objective: str, rms_text: str) -> dict:
+    """The provenance lines of a fitted muscle file."""
+    return {"fitted by": "pamsim fit", "data file": Path(origin).name, "data sha256": sha256,
+            "date (UTC)": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M"),
+            "objective": objective, "fit quality": rms_text}
+
+
+def parameter_table(names: Sequence[str], start: dict, fitted: dict, errors: dict) -> list[str]:
+    """Markdown rows: coefficient, start value, fitted value, standard error."""
+    out = ["| coefficient | start | fitted | standard error |", "|---|---|---|---|"]
+    out += [f"| {n} | {_f(start[n])} | {_f(fitted[n])} | {_f(errors[n])} |" for n in names]
+    return out
+
+
+def correlation_lines(fit_unc) -> list[str]:
+    pairs = fit_unc.inseparable_pairs()
+    if not pairs:
+        return ["No two coefficients are correlated beyond |r| = 0.95: the data separate them.", ""]
+    return ["**Coefficients the data cannot separate** (|r| > 0.95); trust their combination, not each alone:",
+            ""] + [f"- {a} and {b}: r = {r:+.3f}" for a, b, r in pairs] + [""]
+
+
+def static_report_md(fit: "StaticFit", compare: Sequence[dict] | None) -> str:
+    p = fit.problem
+    start = {n: p.base[n] for n in p.free}
+    errs = dict(zip(fit.uncertainty.names, map(float, fit.uncertainty.standard_errors)))
+    out = [f"# Static fit: {p.model} on {Path(p.data.origin).name}", "",
+           f"- muscle: {fit.muscle}; objective: **{p.objective}**; loss: {fit.loss}; extra starts: {fit.n_starts}",
+           f"- tests: {fit.n_points}, censored (not lifted, <= {p.censor_threshold_m * 1e3:g} mm): {fit.n_censored}",
+           f"- RMS equilibrium contraction error over all tests: **{_f(fit.rms_contraction_mm, '.3f')} mm**; "
+           f"cross-validated ({fit.cv_kind}): **{_f(fit.cv_rms_contraction_mm, '.3f')} mm**",
+           f"- RMS force error over the lifted tests: {_f(fit.rms_force_N, '.3f')} N",
+           f"- AIC {_f(fit.aic, '.2f')}, BIC {_f(fit.bic, '.2f')}; optimiser: {fit.message} ({fit.nfev} evaluations)",
+           "", "## Coefficients", ""]
+    out += parameter_table(p.free, start, fit.parameters, errs) + [""]
+    out += ["Standard errors come from the Jacobian at the optimum (linearised, residual variance from the fit).",
+            ""] + correlation_lines(fit.uncertainty)
+    out += ["## Figures", "", "![measured and fitted](fit.png)", "", "![residuals](residuals.png)", "",
+            "![correlation](correlation.png)", ""]
+    if compare:
+        out += ["## Model comparison", "", "| model | free | RMS [mm] | CV RMS [mm] | AIC | BIC |", "|---|---|---|---|---|---|"]
+        out += [f"| {r['model']} | {r['n_free']} | {_f(r['rms_contraction_mm'], '.3f')} | "
+                f"{_f(r['cv_rms_contraction_mm'], '.3f')} | {_f(r['aic'], '.2f')} | {_f(r['bic'], '.2f')} |"
+                for r in compare]
+        out += ["", "![comparison](compare.png)", ""]
+    return "\n".join(out)
+
+
+def write_static_fit(fit: "StaticFit", directory, compare: Sequence["StaticFit"] | None = None) -> list[str]:
+    """Write fit.json, muscle.toml (with a copy of the data beside it), report.md and figures into
+    ``directory``; with ``compare``, also compare.csv and compare.png.  Returns the file names."""
+    p = fit.problem
+    rows = comparison_rows(compare) if compare else None
+    has_file = Path(p.data.origin).is_file()
+    names = ["fit.json", "muscle.toml"] + (["data.csv"] if has_file else []) + \
+        ["report.md", "fit.png", "residuals.png", "correlation.png"]
+    if rows:
+        names += ["compare.csv", "compare.png"]
+    rms = (f"RMS contraction {fit.rms_contraction_mm:.3f} mm, cross-validated "
+           f"{_f(fit.cv_rms_contraction_mm, '.3f')} mm ({fit.cv_kind})")
+    prov = provenance(p.data.origin, p.data.sha256, p.objective, rms)
+    body = fit.to_json()
+    if rows:
+        body["compare"] = rows
+    with _outputs(directory, names) as out:
+        out["fit.json"].write_text(json_text(body))
+        out["muscle.toml"].write_text(muscle_toml(
+            fit.fitted, name=f"{fit.fitted.name}_fitted",
+            description=f"{fit.fitted.name} with {', '.join(p.free)} fitted by pamsim fit static "
+                        f"({p.objective} objective, {rms}) on {Path(p.data.origin).name} "
+                        f"(sha256 {p.data.sha256})",
+            citation=fit.fitted.citation, static_force=p.model, provenance=prov, data_file="data.csv" if has_file else None))
+        if has_file:
+            shutil.copyfile(p.data.origin, out["data.csv"])
+        out["report.md"].write_text(static_report_md(fit, rows))
+        plot_static_fit(fit, out["fit.png"])
+        plot_static_residuals(fit, out["residuals.png"])
+        plot_correlation(p.free, fit.uncertainty.correlation, out["correlation.png"])
+        if rows:
+            write_comparison_csv(rows, out["compare.csv"])
+            plot_comparison(rows, out["compare.png"])
+    return names
+
+
+def json_text(body) -> str:
+    """JSON with non-finite numbers written as null (strict JSON has no NaN)."""
+    return json.dumps(_clean(body), indent=2, allow_nan=False) + "\n"
+
+
+def _clean(v):
+    if isinstance(v, dict):
+        return {k: _clean(x) for k, x in v.items()}
+    if isinstance(v, (list, tuple)):
+        return [_clean(x) for x in v]
+    if hasattr(v, "tolist"):
+        return _clean(v.tolist())
+    if isinstance(v, float) and not math.isfinite(v):
+        return None
+    return v
+
+
+def _toml_value(v) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, (int, float)):
+        return repr(v)
+    if isinstance(v, str):
+        return json.dumps(v, ensure_ascii=False)
+    if isinstance(v, dict):
+        return "{ " + ", ".join(f"{k} = {_toml_value(x)}" for k, x in v.items()) + " }"
+    raise TypeError(f"cannot write {type(v).__name__} to TOML")
+
+
+def scenario_toml(spec: dict, header: Sequence[str]) -> str:
+    """A scenario spec (as validated by :class:`pamsim.Scenario`) as TOML text; sub-tables inline."""
+    lines = [f"# {h}" for h in header]
+    lines += [f"{k} = {_toml_value(v)}" for k, v in spec.items() if not isinstance(v, dict)]
+    for section, table in spec.items():
+        if isinstance(table, dict):
+            lines += ["", f"[{section}]"] + [f"{k} = {_toml_value(v)}" for k, v in table.items()]
+    return "\n".join(lines) + "\n"
+
+
+def _absolute_files(value, base_dir: Path):
+    """Trace file names made absolute, so the written scenario works from the output folder."""
+    if isinstance(value, dict):
+        return {k: (str((base_dir / v).resolve()) if k == "file" and isinstance(v, str) else _absolute_files(v, base_dir))
+                for k, v in value.items()}
+    return value
+
+
+def dynamic_report_md(fit: "DynamicFit") -> str:
+    p = fit.problem
+    errs = dict(zip(fit.uncertainty.names, map(float, fit.uncertainty.standard_errors)))
+    start = dict(zip(p.free, map(float, fit.start)))
+    out = [f"# Dynamic fit (eq. 13) on {len(p.traces)} trace(s), scenario {p.scenario.name}", "",
+           f"- pooled RMS contraction error in the window: **{fit.rms_pooled_mm:.4f} mm**",
+           f"- {fit.n_simulations} simulations in {fit.wall_time_s:.2f} s; optimiser: {fit.message}", "",
+           "| trace | load [N] | pressure | RMS [mm] |", "|---|---|---|---|"]
+    out += [f"| {tr.origin} | {w:g} | {'recorded' if tr.p_gauge_Pa is not None else 'scenario valve'} | {r:.4f} |"
+            for tr, w, r in zip(p.traces, p.loads_N, fit.rms_contraction_mm)]
+    out += ["", "## Coefficients", ""] + parameter_table(p.free, start, fit.parameters, errs) + [""]
+    out += correlation_lines(fit.uncertainty)
+    if fit.per_trace:
+        out += ["## Each trace alone (the layout of the paper's Table 4)", "",
+                "| trace | final pressure [bar] | load [N] | " + " | ".join(p.free) + " | RMS [mm] |",
+                "|---|---|---|" + "---|" * len(p.free) + "---|"]
+        out += [f"| {row['trace']} | {row['pressure_final_bar']:.3f} | {row['load_N']:g} | "
+                + " | ".join(f"{row[n]:.4g}" for n in p.free) + f" | {row['rms_contraction_mm']:.4f} |"
+                for row in fit.per_trace]
+        out += [""]
+    out += ["![measured and fitted](fit.png)", "", "![correlation](correlation.png)", ""]
+    return "\n".join(out)
+
+
+def write_dynamic_fit(fit: "DynamicFit", directory) -> list[str]:
+    """Write fit.json, muscle.toml, scenario.toml (the scenario with the fitted coefficients),
+    report.md, fit.png (overlays and residuals) and correlation.png; per_trace.csv with a per-trace fit."""
+    p = fit.problem
+    names = ["fit.json", "muscle.toml", "scenario.toml", "report.md", "fit.png", "correlation.png"]
+    if fit.per_trace:
+        names.append("per_trace.csv")
+    rms = f"pooled RMS contraction {fit.rms_pooled_mm:.4f} mm over {len(p.traces)} trace(s)"
+    prov = {"fitted by": "pamsim fit dynamic (eq. 13)",
+            "traces": ", ".join(f"{Path(t.origin).name} (sha256 {t.sha256})" for t in p.traces),
+            "date (UTC)": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M"),
+            "objective": "sum of squared contraction residuals in the window", "fit quality": rms}
+    source = f"fitted: pamsim fit dynamic on {', '.join(Path(t.origin).name for t in p.traces)}"
+    fitted = p.scenario.parameters.with_overrides(fit.parameters, source=source)
+    spec = _absolute_files(dict(p.scenario.spec), p.scenario.base_dir)
+    spec["parameters"] = {**spec.get("parameters", {}), **fit.parameters}
+    spec["name"] = f"{p.scenario.name}_fitted"
+    with _outputs(directory, names) as out:
+        out["fit.json"].write_text(json_text(fit.to_json()))
+        out["muscle.toml"].write_text(muscle_toml(
+            fitted, name=f"{fitted.name}_dynamic_fit",
+            description=f"{fitted.name} with {', '.join(p.free)} fitted by pamsim fit dynamic ({rms})",
+            citation=fitted.citation, static_force=p.scenario.spec["model"]["static_force"], provenance=prov))
+        out["scenario.toml"].write_text(scenario_toml(spec, [f"{k}: {v}" for k, v in prov.items()]))
+        out["report.md"].write_text(dynamic_report_md(fit))
+        plot_dynamic_fit(fit, out["fit.png"])
+        plot_correlation(p.free, fit.uncertainty.correlation, out["correlation.png"])
+        if fit.per_trace:
+            cols = list(fit.per_trace[0])
+            with open(out["per_trace.csv"], "w", newline="") as fh:
+                w = csv.DictWriter(fh, fieldnames=cols)
+                w.writeheader()
+                w.writerows(fit.per_trace)
+    return names

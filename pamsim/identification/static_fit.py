@@ -1,0 +1,300 @@
+"""Static identification: fit a static force model's coefficients to static tests.
+
+Two objectives (docs/identification.md):
+
+``force``
+    the model's force at the measured pressure and contraction minus the measured force or hung
+    weight [N] (the ACRA 2012 paper's training approach, its eq. 10);
+``contraction``
+    the model's static equilibrium under the load minus the measured contraction [mm].  Tests
+    where the load was not lifted (measured contraction at or below ``censor_threshold_m``) are
+    censored: they only add a residual when the model predicts a lift above the threshold.
+
+Both go to :func:`scipy.optimize.least_squares` in coefficients scaled by their starting values,
+with bounds from the parameter ranges, an optional robust loss and an optional seeded multi-start.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from functools import cached_property
+from typing import Mapping, Sequence
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from ..elements.stops import EndStops
+from ..errors import InputError
+from ..parameters import ParameterSet, known_parameter
+from .choices import CENSOR_THRESHOLD_M, LOSSES, OBJECTIVES
+from .columns import StaticData
+from .crossval import cross_validate
+from .equilibrium import equilibrium_m, slope_N_per_m
+from .models import build_static, check_model, default_free, missing_inputs, optional_defaults
+from .uncertainty import Uncertainty, information_criteria, linearised_uncertainty
+
+_FD_REL = 1e-6
+"""Relative step of the force sensitivities dF/dtheta (the force is a smooth, cheap function)."""
+
+
+@dataclass(frozen=True)
+class StaticProblem:
+    """The data, the model and the free coefficients of one static fit (everything but the values)."""
+
+    data: StaticData
+    model: str
+    base: ParameterSet
+    free: tuple[str, ...]
+    objective: str
+    censor_threshold_m: float
+    x_max_m: float
+    bounds: tuple[np.ndarray, np.ndarray]
+
+    @property
+    def censored(self) -> np.ndarray:
+        """Tests where a hung load was not lifted (only hanging-weight data are censored)."""
+        if self.data.kind != "weight":
+            return np.zeros(len(self.data), dtype=bool)
+        return self.data.contraction_m <= self.censor_threshold_m
+
+    def params(self, theta: np.ndarray) -> dict[str, float]:
+        return {**self.base_values, **dict(zip(self.free, map(float, theta)))}
+
+    @cached_property
+    def base_values(self) -> dict[str, float]:
+        return dict(self.base)
+
+    def force(self, theta: np.ndarray):
+        return build_static(self.model, self.params(theta))
+
+    def predict_m(self, theta: np.ndarray, data: StaticData | None = None) -> np.ndarray:
+        """Equilibrium contraction [m] of each test under its load."""
+        d = self.data if data is None else data
+        return equilibrium_m(self.force(theta).force_N, d.pressure_gauge_Pa, d.load_N, self.x_max_m)
+
+    def residuals(self, theta: np.ndarray) -> np.ndarray:
+        """The objective's residuals (contraction in mm, force in N)."""
+        d = self.data
+        cens = self.censored
+        if self.objective == "force":
+            r = self.force(theta).force_N(d.contraction_m, d.pressure_gauge_Pa) - d.load_N
+            return np.where(cens, np.maximum(r, 0.0), r)
+        x = self.predict_m(theta)
+        return 1e3 * np.where(cens, np.maximum(x - self.censor_threshold_m, 0.0), x - d.contraction_m)
+
+    def jacobian(self, theta: np.ndarray) -> np.ndarray:
+        """d residual / d theta (physical units).
+
+        Force: forward differences of the force.  Contraction: the implicit-function derivative
+        ``dx*/dtheta = -(dF/dtheta) / (dF/dx)`` at the equilibrium, zero where the equilibrium sits
+        on a stop, so no root finding enters a difference quotient.
+        """
+        d = self.data
+        if self.objective == "force":
+            x, base_x = d.contraction_m, None
+        else:
+            base_x = self.predict_m(theta)
+            x = base_x
+        f0 = self.force(theta).force_N(x, d.pressure_gauge_Pa)
+        J = np.empty((len(d), len(theta)))
+        for j in range(len(theta)):
+            h = _FD_REL * max(abs(theta[j]), 1.0)
+            t = theta.copy()
+            t[j] += h
+            J[:, j] = (self.force(t).force_N(x, d.pressure_gauge_Pa) - f0) / h
+        cens = self.censored
+        if self.objective == "force":
+            active = ~cens | (f0 - d.load_N > 0.0)
+            return J * active[:, None]
+        inside = (base_x > 0.0) & (base_x < self.x_max_m)
+        slope = slope_N_per_m(self.force(theta).force_N, base_x, d.pressure_gauge_Pa)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            dx = np.where(inside[:, None], -J / slope[:, None], 0.0)
+        active = ~cens | (base_x > self.censor_threshold_m)
+        return 1e3 * dx * active[:, None]
+
+
+@dataclass
+class StaticFit:
+    """Result of a static fit; ``to_json()`` gives the ``fit.json`` content."""
+
+    problem: StaticProblem
+    theta: np.ndarray
+    fitted: ParameterSet
+    uncertainty: Uncertainty
+    predicted_m: np.ndarray
+    residuals: np.ndarray
+    rms_force_N: float
+    rms_contraction_mm: float
+    cv_rms_contraction_mm: float
+    cv_kind: str
+    cv_errors_mm: np.ndarray
+    aic: float
+    bic: float
+    loss: str
+    n_starts: int
+    success: bool
+    message: str
+    nfev: int
+    wall_time_s: float
+    muscle: str = ""
+    extra: dict = field(default_factory=dict)
+
+    @property
+    def parameters(self) -> dict[str, float]:
+        return dict(zip(self.problem.free, map(float, self.theta)))
+
+    @property
+    def n_points(self) -> int:
+        return len(self.problem.data)
+
+    @property
+    def n_censored(self) -> int:
+        return int(self.problem.censored.sum())
+
+    def to_json(self) -> dict:
+        u = self.uncertainty
+        return {"model": self.problem.model, "muscle": self.muscle, "objective": self.problem.objective,
+                "data": self.problem.data.origin, "data_sha256": self.problem.data.sha256,
+                "parameters": self.parameters,
+                "standard_errors": {n: _num(v) for n, v in zip(u.names, u.standard_errors)},
+                "correlation": u.correlation_table(),
+                "inseparable_pairs": [[a, b, r] for a, b, r in u.inseparable_pairs()],
+                "rms_force_N": _num(self.rms_force_N), "rms_contraction_mm": _num(self.rms_contraction_mm),
+                "cv_rms_contraction_mm": _num(self.cv_rms_contraction_mm), "cv_kind": self.cv_kind,
+                "n_points": self.n_points, "n_censored": self.n_censored,
+                "censor_threshold_mm": self.problem.censor_threshold_m * 1e3,
+                "aic": _num(self.aic), "bic": _num(self.bic), "loss": self.loss, "n_starts": self.n_starts,
+                "success": self.success, "message": self.message, "nfev": self.nfev,
+                "wall_time_s": self.wall_time_s, **self.extra}
+
+
+def _num(v: float):
+    return None if not math.isfinite(v) else float(v)
+
+
+def make_problem(data: StaticData, params: ParameterSet, model: str = "acra2012_polynomial",
+                 free: Sequence[str] | None = None, objective: str | None = None,
+                 censor_threshold_m: float = CENSOR_THRESHOLD_M) -> StaticProblem:
+    """Check the choices of a static fit and bundle them.
+
+    ``objective`` defaults to ``contraction`` for hanging-weight data and ``force`` for force data.
+    The search for the equilibrium ends at the muscle's upper stop (braid lock).
+    """
+    check_model(model)
+    missing = missing_inputs(model, params)
+    if missing:
+        raise InputError(f"--model = {model!r}: muscle {params.name!r} does not give {', '.join(missing)}")
+    free = tuple(free) if free else default_free(model)
+    optional = optional_defaults(model)
+    for name in free:
+        if name not in params and name not in optional:
+            raise InputError(f"--free: {name!r} is not a parameter of muscle {params.name!r} nor an optional "
+                             f"coefficient of {model!r}")
+        if name in optional and not math.isfinite(optional[name]):
+            raise InputError(f"--free: {name!r} of {model!r} has no finite default to start from")
+    if len(set(free)) != len(free):
+        raise InputError(f"--free = {','.join(free)}: a name appears twice")
+    objective = objective or ("contraction" if data.kind == "weight" else "force")
+    if objective not in OBJECTIVES:
+        raise InputError(f"--objective = {objective!r}: choose from {', '.join(OBJECTIVES)}")
+    if not censor_threshold_m >= 0.0:
+        raise InputError(f"--censor-threshold-mm = {censor_threshold_m * 1e3:g}: must not be negative")
+    x_max = EndStops.from_parameters(params).x_high_m
+    params = with_optional(params, {k: v for k, v in optional.items() if k in free}, model)
+    lower = np.array([params.entries[n].lower for n in free], dtype=float)
+    upper = np.array([params.entries[n].upper for n in free], dtype=float)
+    return StaticProblem(data, model, params, free, objective, censor_threshold_m, x_max, (lower, upper))
+
+
+def with_optional(params: ParameterSet, optional: Mapping[str, float], model: str) -> ParameterSet:
+    """``params`` plus a model's optional coefficients at their defaults (ranges from the muscle schema),
+    so they can be fitted and written to the fitted muscle."""
+    extra = {k: known_parameter(k, v, f"default of {model}") for k, v in optional.items() if k not in params}
+    return ParameterSet(params.name, params.citation, {**params.entries, **extra}) if extra else params
+
+
+def _solve(problem: StaticProblem, theta0: np.ndarray, loss: str, f_scale: float, max_nfev: int | None = None):
+    scale = np.where(np.abs(theta0) > 0, np.abs(theta0), 1.0)
+    lo, hi = problem.bounds
+    z0 = np.clip(theta0, lo, hi) / scale
+    res = least_squares(lambda z: problem.residuals(z * scale), z0,
+                        jac=lambda z: problem.jacobian(z * scale) * scale,
+                        bounds=(lo / scale, hi / scale), loss=loss, f_scale=f_scale, method="trf",
+                        x_scale=1.0, max_nfev=max_nfev, xtol=1e-12, ftol=1e-12, gtol=1e-12)
+    return res.x * scale, res
+
+
+def fit_static(data: StaticData, params: ParameterSet, model: str = "acra2012_polynomial",
+               free: Sequence[str] | None = None, objective: str | None = None, loss: str = "linear",
+               f_scale: float = 1.0, n_starts: int = 0, seed: int = 0,
+               censor_threshold_m: float = CENSOR_THRESHOLD_M, cv: str | None = "auto", k_folds: int = 10,
+               muscle_label: str = "") -> StaticFit:
+    """Fit the free coefficients of a static force model to static tests.
+
+    Parameters
+    ----------
+    data : StaticData
+        Pressures, contractions and loads (see :func:`~pamsim.identification.read_static_data`).
+    params : ParameterSet
+        The muscle: starting values, ranges (bounds) and every fixed parameter.
+    model : str
+        Static force model name.
+    free : sequence of str, optional
+        Coefficients to fit; default: the model's own fitted coefficients.
+    objective : {"force", "contraction"}, optional
+        Default ``contraction`` for hung weights, ``force`` for measured forces.
+    loss, f_scale : str, float
+        Robust loss of :func:`scipy.optimize.least_squares` and its scale (mm or N, as the residuals).
+    n_starts : int
+        Extra starts, each from the starting values times ``1 + 0.3 N(0, 1)`` (seeded); the best wins.
+    seed : int
+        Seed of the multi-start and of the k-fold split.
+    censor_threshold_m : float
+        Contraction [m] at or below which a hung load counts as not lifted.
+    cv : {"auto", "loo", "kfold", None}
+        Cross-validation: leave-one-out, ``k_folds``-fold, or ``auto`` (leave-one-out up to 100 tests).
+    """
+    start = time.perf_counter()
+    if loss not in LOSSES:
+        raise InputError(f"--loss = {loss!r}: choose from {', '.join(LOSSES)}")
+    if not (math.isfinite(f_scale) and f_scale > 0):
+        raise InputError(f"--f-scale = {f_scale!r}: must be a positive number")
+    if n_starts < 0:
+        raise InputError(f"--starts = {n_starts}: must not be negative")
+    problem = make_problem(data, params, model, free, objective, censor_threshold_m)
+    theta0 = np.array([problem.base[n] for n in problem.free], dtype=float)
+    theta, res = _solve(problem, theta0, loss, f_scale)
+    nfev = res.nfev
+    rng = np.random.default_rng(seed)
+    for _ in range(n_starts):
+        t, r = _solve(problem, theta0 * (1.0 + 0.3 * rng.standard_normal(theta0.size)), loss, f_scale)
+        nfev += r.nfev
+        if r.cost < res.cost:
+            theta, res = t, r
+    residuals = problem.residuals(theta)
+    unc = linearised_uncertainty(problem.free, problem.jacobian(theta), residuals)
+    predicted = problem.predict_m(theta)
+    err_mm = (predicted - data.contraction_m) * 1e3
+    force_err = problem.force(theta).force_N(data.contraction_m, data.pressure_gauge_Pa) - data.load_N
+    lifted = ~problem.censored
+    rms_force = float(np.sqrt(np.mean(force_err[lifted] ** 2))) if lifted.any() else math.nan
+    cv_kind, cv_err = cross_validate(lambda train: _solve(_restrict(problem, train), theta, loss, f_scale)[0],
+                                     lambda th, test: problem.predict_m(th, data.subset(test)) - data.contraction_m[test],
+                                     len(data), len(theta), cv, k_folds, seed)
+    aic, bic = information_criteria(float(residuals @ residuals), len(data), len(theta))
+    fitted = problem.base.with_overrides(dict(zip(problem.free, map(float, theta))),
+                                   source=f"fitted: pamsim fit static ({problem.objective} objective) on "
+                                          f"{data.origin}")
+    return StaticFit(problem, theta, fitted, unc, predicted, residuals, rms_force,
+                     float(np.sqrt(np.mean(err_mm ** 2))),
+                     float(np.sqrt(np.mean(cv_err ** 2))) * 1e3 if cv_err.size else math.nan, cv_kind,
+                     cv_err * 1e3, aic, bic, loss, n_starts, bool(res.success), str(res.message), int(nfev),
+                     time.perf_counter() - start, muscle_label)
+
+
+def _restrict(problem: StaticProblem, rows: np.ndarray) -> StaticProblem:
+    return StaticProblem(problem.data.subset(rows), problem.model, problem.base, problem.free, problem.objective,
+                         problem.censor_threshold_m, problem.x_max_m, problem.bounds)

@@ -1,0 +1,112 @@
+"""How far to trust fitted coefficients: standard errors and correlations from the Jacobian at the
+optimum, the pairs the data cannot separate, and information criteria for model comparison.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+CORRELATION_LIMIT = 0.95
+"""Above this absolute correlation two coefficients are reported as not separable by the data."""
+
+
+@dataclass(frozen=True)
+class Uncertainty:
+    """Linearised uncertainty of a least-squares fit.
+
+    ``covariance = s^2 (J^T J)^+`` with ``s^2 = SSR / (n - k)``; with no degrees of freedom left
+    (``n <= k``) the standard errors are NaN but the correlations (which do not depend on
+    ``s^2``) are still given.
+    """
+
+    names: tuple[str, ...]
+    standard_errors: np.ndarray
+    correlation: np.ndarray
+    sigma: float
+
+    def inseparable_pairs(self, limit: float = CORRELATION_LIMIT) -> list[tuple[str, str, float]]:
+        """``(a, b, r)`` for every pair with ``|r| > limit``, strongest first."""
+        out = []
+        for i in range(len(self.names)):
+            for j in range(i + 1, len(self.names)):
+                r = float(self.correlation[i, j])
+                if abs(r) > limit:
+                    out.append((self.names[i], self.names[j], r))
+        return sorted(out, key=lambda t: -abs(t[2]))
+
+    def separable(self, limit: float = CORRELATION_LIMIT) -> tuple[str, ...]:
+        """Coefficients correlated with no other beyond ``limit``."""
+        tied = {n for a, b, _ in self.inseparable_pairs(limit) for n in (a, b)}
+        return tuple(n for n in self.names if n not in tied)
+
+    def groups(self, limit: float = CORRELATION_LIMIT) -> list[tuple[str, ...]]:
+        """Sets of coefficients linked by correlations beyond ``limit`` (connected components)."""
+        out: list[set[str]] = []
+        for a, b, _ in self.inseparable_pairs(limit):
+            hit = [g for g in out if a in g or b in g]
+            merged = set().union({a, b}, *hit)
+            out = [g for g in out if g not in hit] + [merged]
+        return [tuple(n for n in self.names if n in g) for g in out]
+
+    def best_combination(self, group: tuple[str, ...]) -> tuple[np.ndarray, float]:
+        """The combination of ``group`` the data determine best, and its standard error.
+
+        In coefficients measured in their standard errors (``theta_i / se_i``) it is the
+        eigenvector of the group's correlation matrix with the smallest eigenvalue.  Returns the
+        weights ``w`` (per unit of each coefficient; the combination is ``w . theta``) and the
+        standard error of ``w . theta``.
+        """
+        idx = [self.names.index(n) for n in group]
+        R = self.correlation[np.ix_(idx, idx)]
+        vals, vecs = np.linalg.eigh(R)
+        e = vecs[:, 0] * (1.0 if vecs[np.argmax(np.abs(vecs[:, 0])), 0] > 0 else -1.0)
+        return e / self.standard_errors[idx], float(math.sqrt(max(vals[0], 0.0)))
+
+    def identifiable(self, theta: np.ndarray, relative: float = 0.05, limit: float = CORRELATION_LIMIT) -> tuple[str, ...]:
+        """Coefficients separable from all others whose standard error is at most ``relative`` of
+        their value (so a two-sigma interval is within twice that)."""
+        sep = set(self.separable(limit))
+        return tuple(n for n, v, s in zip(self.names, theta, self.standard_errors)
+                     if n in sep and math.isfinite(s) and s <= relative * abs(v))
+
+    def correlation_table(self) -> dict:
+        """``{"names": [...], "matrix": [[...]]}`` for JSON."""
+        return {"names": list(self.names), "matrix": [[_num(v) for v in row] for row in self.correlation]}
+
+
+def linearised_uncertainty(names, jacobian: np.ndarray, residuals: np.ndarray) -> Uncertainty:
+    """Standard errors and correlation of the coefficients ``names`` from the Jacobian of the residuals
+    with respect to them (physical units) at the optimum."""
+    J = np.asarray(jacobian, dtype=float)
+    r = np.asarray(residuals, dtype=float)
+    n, k = J.shape
+    dof = n - k
+    sigma2 = float(r @ r) / dof if dof > 0 else math.nan
+    # Scale the columns before inverting: the coefficients differ by orders of magnitude.
+    col = np.linalg.norm(J, axis=0)
+    col[col == 0.0] = 1.0
+    Js = J / col
+    cov_s = np.linalg.pinv(Js.T @ Js)
+    cov_unit = cov_s / np.outer(col, col)
+    d = np.sqrt(np.clip(np.diag(cov_unit), 0.0, None))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        corr = cov_unit / np.outer(d, d)
+    corr = np.where(np.outer(d, d) > 0, corr, np.nan)
+    np.fill_diagonal(corr, 1.0)
+    return Uncertainty(tuple(names), d * math.sqrt(sigma2) if dof > 0 else np.full(k, math.nan),
+                       np.clip(corr, -1.0, 1.0), math.sqrt(sigma2) if dof > 0 else math.nan)
+
+
+def information_criteria(ssr: float, n: int, k: int) -> tuple[float, float]:
+    """(AIC, BIC) of a least-squares fit with Gaussian residuals: ``n ln(SSR/n) + 2k`` and ``+ k ln n``."""
+    if n == 0 or ssr <= 0.0:
+        return -math.inf, -math.inf
+    base = n * math.log(ssr / n)
+    return base + 2 * k, base + k * math.log(n)
+
+
+def _num(v: float):
+    return None if not math.isfinite(v) else float(v)
