@@ -103,7 +103,7 @@ static double static_force_N(const PamCore *c, double x, double p_gauge) {
     if (c->i[I_static_force_model] == PAM_STATIC_FORCE_MODEL_TABLE) f = table_force_N(x, p_gauge);
     else f = ((r[R_K1_N_per_bar_m2] * x + r[R_K2_N_per_bar_m]) * x + r[R_C1_N_per_bar]) * p_bar
              + (r[R_S1_N_per_m2] * x + r[R_S2_N_per_m]) * x + r[R_S3_N];
-    return f > 0.0 ? f : 0.0;
+    return f < 0.0 ? 0.0 : f;  /* NaN (a table choice without a table) stays NaN */
 }
 
 /* elements.friction: load-dependent (a negative level clamped at zero, or its magnitude:
