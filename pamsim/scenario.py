@@ -16,7 +16,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping
 
-import numpy as np
 
 from .constants import PA_PER_BAR
 from .errors import InputError
@@ -34,19 +33,12 @@ from .muscle_setup import applicable_model, model_inputs, with_overrides
 from .muscles import Muscle, load_muscle, shipped_names
 from .parameters import LOAD_MASS, ParameterSet, dynamics_parameters
 from .static_models import REGISTRY
-from .signals import Constant, FirstOrderLag, Ramp, Step, Trace
+from .signal_tables import signal_from_table, signal_range
+from .signals import Constant, Step
 from .simulator import SolverOptions
 
 
 # Schema: section -> {key: (type, required)}; a nested dict is a sub-table.
-# Signal kind -> (keys without a unit, value keys that take the unit suffix of where the signal is used).
-_SIGNAL_KINDS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
-    "constant": ((), ("value",)),
-    "step": (("time_s",), ("initial", "final")),
-    "ramp": (("start_s", "end_s"), ("initial", "final")),
-    "lag": (("time_s", "tau_s"), ("initial", "final")),
-    "trace": (("file", "time_column", "value_column"), ()),
-}
 _SCHEMA: dict[str, dict[str, Any]] = {
     "": {"name": str, "description": str, "model": dict, "parameters": dict, "load": dict, "pressure": dict,
          "simulation": dict, "solver": dict, "controller": dict},
@@ -150,7 +142,7 @@ class Scenario:
         ext = spec["load"].get("external_force")
         object.__setattr__(scenario, "_source", scenario._build_source(v))
         object.__setattr__(scenario, "_external_force",
-                           _signal(v, "load.external_force", ext, "_N", 1.0, Path(base_dir)) if ext else None)
+                           signal_from_table(v, "load.external_force", ext, "_N", 1.0, Path(base_dir)) if ext else None)
         stops = EndStops.from_parameters(params)
         if not stops.x_low_m <= x0 <= stops.x_high_m:
             v.fail("simulation.initial_contraction_m", x0, f"must lie between the stops, 0 and {stops.x_high_m:.4f} m")
@@ -240,8 +232,8 @@ class Scenario:
             if ("command" in pr) == ("valve_open_time_s" in pr):
                 raise ScenarioError(f"{self.origin}: [pressure] needs exactly one of valve_open_time_s or [pressure.command]")
             if "command" in pr:
-                command = _signal(v, "pressure.command", pr["command"], "", 1.0, self.base_dir)
-                lo, hi = _signal_range(command)
+                command = signal_from_table(v, "pressure.command", pr["command"], "", 1.0, self.base_dir)
+                lo, hi = signal_range(command)
                 if lo < -1 or hi > 1:
                     v.fail("pressure.command", f"{lo:g}..{hi:g}", "valve command must stay within [-1, 1]")
             else:
@@ -254,9 +246,9 @@ class Scenario:
                                       p["T_supply_K"], p["p_atm_Pa"])
         if source == "prescribed":
             v.allowed("pressure", pr, {"source", "prescribed"})
-            sig = _signal(v, "pressure.prescribed", v.required(pr, "pressure", "prescribed"), "_gauge_bar",
+            sig = signal_from_table(v, "pressure.prescribed", v.required(pr, "pressure", "prescribed"), "_gauge_bar",
                           PA_PER_BAR, self.base_dir, alt_suffix=("_gauge_Pa", 1.0))
-            lo, hi = _signal_range(sig)
+            lo, hi = signal_range(sig)
             if hi > rating:
                 v.fail("pressure.prescribed", f"{hi / PA_PER_BAR:g} bar", f"exceeds the muscle's rating of {rating / PA_PER_BAR:g} bar")
             if lo < -p["p_atm_Pa"]:
@@ -350,6 +342,11 @@ class _Validator:
         self.origin = origin
         self.base_dir = base_dir
 
+    @staticmethod
+    def error(message: str) -> ScenarioError:
+        """The exception a mistake in this file raises (for helpers such as :mod:`pamsim.signal_tables`)."""
+        return ScenarioError(message)
+
     def fail(self, key: str, value: Any, why: str, choices=None):
         msg = f"{self.origin}: {key} = {value!r}: {why}"
         if choices is not None:
@@ -402,94 +399,3 @@ class _Validator:
         if key not in table:
             raise ScenarioError(f"{self.origin}: missing key {section}.{key}")
         return table[key]
-
-
-def _signal(v: _Validator, where: str, spec: Any, suffix: str, scale: float, base_dir: Path,
-            alt_suffix: tuple[str, float] | None = None):
-    """Build a signal from a table ``{kind = ..., ...}``; values are named ``initial<suffix>``, ``final<suffix>``."""
-    if not isinstance(spec, dict):
-        v.fail(where, spec, "must be a table with a 'kind'")
-    kind = v.required(spec, where, "kind")
-    if not isinstance(kind, str) or kind not in _SIGNAL_KINDS:
-        v.fail(f"{where}.kind", kind, "unknown signal kind", choices=_SIGNAL_KINDS)
-    suffixes = [(suffix, scale)] + ([alt_suffix] if alt_suffix else [])
-    times, values = _SIGNAL_KINDS[kind]
-    known = ["kind", *times, *(f"{n}{s}" for n in values for s, _ in suffixes)]
-    for key in spec:
-        if key not in known:
-            close = difflib.get_close_matches(key, known, n=1)
-            hint = f" (did you mean {close[0]!r}?)" if close else f" (known: {', '.join(known)})"
-            raise ScenarioError(f"{v.origin}: unknown key {where}.{key} for kind = {kind!r}{hint}")
-
-    def val(name: str, default: float | None = None) -> float:
-        for s, k in suffixes:
-            if f"{name}{s}" in spec:
-                return v.number(f"{where}.{name}{s}", spec[f"{name}{s}"]) * k
-        if default is None:
-            raise ScenarioError(f"{v.origin}: missing key {where}.{name}{suffixes[0][0]}")
-        return default
-
-    def t(name: str) -> float:
-        value = v.number(f"{where}.{name}", v.required(spec, where, name))
-        if value < 0:
-            v.fail(f"{where}.{name}", value, "must not be negative")
-        return value
-
-    if kind == "constant":
-        return Constant(val("value"))
-    if kind == "step":
-        return Step(t("time_s"), val("initial", 0.0), val("final"))
-    if kind == "ramp":
-        start, end = t("start_s"), t("end_s")
-        if end <= start:
-            v.fail(f"{where}.end_s", end, f"must be after start_s = {start}")
-        return Ramp(start, end, val("initial", 0.0), val("final"))
-    if kind == "lag":
-        tau = t("tau_s")
-        if tau <= 0:
-            v.fail(f"{where}.tau_s", tau, "must be positive")
-        return FirstOrderLag(t("time_s"), val("initial", 0.0), val("final"), tau)
-    return _trace(v, where, spec, suffixes, base_dir)
-
-
-def _trace(v: _Validator, where: str, spec: Mapping, suffixes, base_dir: Path) -> Trace:
-    name = v.required(spec, where, "file")
-    if not isinstance(name, str):
-        v.fail(f"{where}.file", name, "must be a string (a CSV path)")
-    path = (base_dir / name) if not Path(name).is_absolute() else Path(name)
-    if not path.is_file():
-        v.fail(f"{where}.file", name, f"trace file not found at {path}")
-    time_col = spec.get("time_column", "t_s")
-    try:
-        with open(path) as fh:
-            header = fh.readline().strip().split(",")
-        data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
-    except (ValueError, OSError) as exc:
-        v.fail(f"{where}.file", name, f"cannot read as CSV with a header row: {exc}")
-    value_cols = [spec["value_column"]] if "value_column" in spec else [c for c in header if c != time_col]
-    if time_col not in header:
-        v.fail(f"{where}.time_column", time_col, f"no such column in {name} (columns: {', '.join(header)})")
-    col = next((c for c in value_cols if c in header), None)
-    unit = next((k for s, k in suffixes if col and col.endswith(s)), None)
-    if col is None or unit is None:
-        want = " or ".join(f"a column ending in {s}" for s, _ in suffixes)
-        v.fail(f"{where}.value_column", spec.get("value_column", col), f"{name} needs {want}")
-    t = data[:, header.index(time_col)]
-    y = data[:, header.index(col)] * unit
-    if len(t) < 2:
-        v.fail(f"{where}.file", name, "a trace needs at least two rows")
-    if not (np.all(np.isfinite(t)) and np.all(np.isfinite(y))):
-        row = int(np.flatnonzero(~(np.isfinite(t) & np.isfinite(y)))[0]) + 2
-        v.fail(f"{where}.file", name, f"non-finite value on line {row}")
-    bad = np.flatnonzero(np.diff(t) <= 0)
-    if bad.size:
-        v.fail(f"{where}.file", name, f"time must increase strictly; line {int(bad[0]) + 3} has t = {t[bad[0] + 1]:g} "
-               f"after {t[bad[0]]:g}")
-    return Trace(t, y, str(path))
-
-
-def _signal_range(sig) -> tuple[float, float]:
-    if isinstance(sig, Trace):
-        return float(sig.values.min()), float(sig.values.max())
-    vals = [getattr(sig, a) for a in ("value", "initial", "final") if hasattr(sig, a)]
-    return min(vals), max(vals)

@@ -1,0 +1,117 @@
+"""Signals given as TOML tables (``{kind = "step", time_s = 1.0, final_gauge_bar = 3.6}``).
+
+Scenario files use these tables for the prescribed pressure, the valve command
+and the external force.  The functions take a validator ``v`` of the file they
+read (its ``origin``, ``fail``, ``number``, ``required`` and ``error``), so every
+mistake names that file, the key and the value.
+"""
+
+from __future__ import annotations
+
+import difflib
+from pathlib import Path
+from typing import Any, Mapping
+
+import numpy as np
+
+from .signals import Constant, FirstOrderLag, Ramp, Step, Trace
+
+# Signal kind -> (keys without a unit, value keys that take the unit suffix of where the signal is used).
+SIGNAL_KINDS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
+    "constant": ((), ("value",)),
+    "step": (("time_s",), ("initial", "final")),
+    "ramp": (("start_s", "end_s"), ("initial", "final")),
+    "lag": (("time_s", "tau_s"), ("initial", "final")),
+    "trace": (("file", "time_column", "value_column"), ()),
+}
+
+
+def signal_from_table(v, where: str, spec: Any, suffix: str, scale: float, base_dir: Path,
+            alt_suffix: tuple[str, float] | None = None):
+    """Build a signal from a table ``{kind = ..., ...}``; values are named ``initial<suffix>``, ``final<suffix>``."""
+    if not isinstance(spec, dict):
+        v.fail(where, spec, "must be a table with a 'kind'")
+    kind = v.required(spec, where, "kind")
+    if not isinstance(kind, str) or kind not in SIGNAL_KINDS:
+        v.fail(f"{where}.kind", kind, "unknown signal kind", choices=SIGNAL_KINDS)
+    suffixes = [(suffix, scale)] + ([alt_suffix] if alt_suffix else [])
+    times, values = SIGNAL_KINDS[kind]
+    known = ["kind", *times, *(f"{n}{s}" for n in values for s, _ in suffixes)]
+    for key in spec:
+        if key not in known:
+            close = difflib.get_close_matches(key, known, n=1)
+            hint = f" (did you mean {close[0]!r}?)" if close else f" (known: {', '.join(known)})"
+            raise v.error(f"{v.origin}: unknown key {where}.{key} for kind = {kind!r}{hint}")
+
+    def val(name: str, default: float | None = None) -> float:
+        for s, k in suffixes:
+            if f"{name}{s}" in spec:
+                return v.number(f"{where}.{name}{s}", spec[f"{name}{s}"]) * k
+        if default is None:
+            raise v.error(f"{v.origin}: missing key {where}.{name}{suffixes[0][0]}")
+        return default
+
+    def t(name: str) -> float:
+        value = v.number(f"{where}.{name}", v.required(spec, where, name))
+        if value < 0:
+            v.fail(f"{where}.{name}", value, "must not be negative")
+        return value
+
+    if kind == "constant":
+        return Constant(val("value"))
+    if kind == "step":
+        return Step(t("time_s"), val("initial", 0.0), val("final"))
+    if kind == "ramp":
+        start, end = t("start_s"), t("end_s")
+        if end <= start:
+            v.fail(f"{where}.end_s", end, f"must be after start_s = {start}")
+        return Ramp(start, end, val("initial", 0.0), val("final"))
+    if kind == "lag":
+        tau = t("tau_s")
+        if tau <= 0:
+            v.fail(f"{where}.tau_s", tau, "must be positive")
+        return FirstOrderLag(t("time_s"), val("initial", 0.0), val("final"), tau)
+    return _trace(v, where, spec, suffixes, base_dir)
+
+
+def _trace(v, where: str, spec: Mapping, suffixes, base_dir: Path) -> Trace:
+    name = v.required(spec, where, "file")
+    if not isinstance(name, str):
+        v.fail(f"{where}.file", name, "must be a string (a CSV path)")
+    path = (base_dir / name) if not Path(name).is_absolute() else Path(name)
+    if not path.is_file():
+        v.fail(f"{where}.file", name, f"trace file not found at {path}")
+    time_col = spec.get("time_column", "t_s")
+    try:
+        with open(path) as fh:
+            header = fh.readline().strip().split(",")
+        data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+    except (ValueError, OSError) as exc:
+        v.fail(f"{where}.file", name, f"cannot read as CSV with a header row: {exc}")
+    value_cols = [spec["value_column"]] if "value_column" in spec else [c for c in header if c != time_col]
+    if time_col not in header:
+        v.fail(f"{where}.time_column", time_col, f"no such column in {name} (columns: {', '.join(header)})")
+    col = next((c for c in value_cols if c in header), None)
+    unit = next((k for s, k in suffixes if col and col.endswith(s)), None)
+    if col is None or unit is None:
+        want = " or ".join(f"a column ending in {s}" for s, _ in suffixes)
+        v.fail(f"{where}.value_column", spec.get("value_column", col), f"{name} needs {want}")
+    t = data[:, header.index(time_col)]
+    y = data[:, header.index(col)] * unit
+    if len(t) < 2:
+        v.fail(f"{where}.file", name, "a trace needs at least two rows")
+    if not (np.all(np.isfinite(t)) and np.all(np.isfinite(y))):
+        row = int(np.flatnonzero(~(np.isfinite(t) & np.isfinite(y)))[0]) + 2
+        v.fail(f"{where}.file", name, f"non-finite value on line {row}")
+    bad = np.flatnonzero(np.diff(t) <= 0)
+    if bad.size:
+        v.fail(f"{where}.file", name, f"time must increase strictly; line {int(bad[0]) + 3} has t = {t[bad[0] + 1]:g} "
+               f"after {t[bad[0]]:g}")
+    return Trace(t, y, str(path))
+
+
+def signal_range(sig) -> tuple[float, float]:
+    if isinstance(sig, Trace):
+        return float(sig.values.min()), float(sig.values.max())
+    vals = [getattr(sig, a) for a in ("value", "initial", "final") if hasattr(sig, a)]
+    return min(vals), max(vals)
