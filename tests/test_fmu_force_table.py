@@ -113,16 +113,25 @@ def test_fmu_without_a_table_refuses_the_table_choice(unzipped, version, choice,
     assert message in capfd.readouterr().out
 
 
+def _kothera_energy_scenario():
+    """Kothera's actuator 5a with its energy model (K-4), 10 N stepped to 3.6 bar, 3 s."""
+    return pamsim.load_scenario(SCENARIOS / "acra2012_fig4.toml").with_changes(
+        {"model": {"muscle": "kothera2009_5a", "static_force": "kothera_energy"}, "load": {"weight_N": 10.0},
+         "simulation": {"duration_s": 3.0}}, name="kothera_5a_energy")
+
+
 @pytest.mark.parametrize("interface", ["cs", "me"])
-def test_scenario_with_another_static_model_runs_on_its_table_like_python(interface):
+@pytest.mark.parametrize("model", ["chou_hannaford", "kothera_energy"])
+def test_scenario_with_another_static_model_runs_on_its_table_like_python(interface, model):
     """The runner tabulates a scenario's non-polynomial static force, builds the FMU with the table
     and starts it on the table; the run matches pamsim.simulate within 0.2 mm."""
-    sc = pamsim.load_scenario(SCENARIOS / "acra2012_fig4_chou_hannaford.toml")
+    sc = (pamsim.load_scenario(SCENARIOS / "acra2012_fig4_chou_hannaford.toml") if model == "chou_hannaford"
+          else _kothera_energy_scenario())
     table = force_table_for(sc)
-    assert table is not None and table.model_name == "chou_hannaford"
+    assert table is not None and table.model_name == model
     assert force_table_for(pamsim.load_scenario(SCENARIOS / "acra2012_fig4.toml")) is None
     ref = pamsim.simulate(sc)
-    assert ref.x_m.max() > 0.02  # the load moved
+    assert ref.x_m.max() > 0.005  # the load moved (11.6 mm on Kothera 5a, 95 mm on the Shadow)
     tr = run_cs(sc, 2) if interface == "cs" else run_me(sc, 2)
     assert np.allclose(tr["t_s"], ref.t_s, atol=1e-9)
     d = np.abs(tr["contraction_m"] - ref.x_m)
@@ -141,6 +150,24 @@ def test_cli_builds_a_table_fmu_from_a_scenario(tmp_path):
     start = {v.name: v.start for v in md.modelVariables}
     assert start["static_force_model"] == "1"
     assert value_reference("static_force_model") == 63
+
+
+def test_cli_builds_a_table_fmu_from_a_muscle_and_model(tmp_path):
+    from conftest import run_cli
+
+    out = run_cli("fmu", "build", "--muscle", "kothera2009_5a", "--static-force", "kothera_energy",
+                  "-o", tmp_path / "k.fmu")
+    assert out.returncode == 0, out.stderr
+    assert "table of kothera_energy" in out.stdout
+    # The baked table has the shape of the one the runner makes for a scenario with that muscle and model.
+    runner_table = force_table_for(_kothera_energy_scenario())
+    assert f"{runner_table.shape[0]} x {runner_table.shape[1]} table" in out.stdout
+    bad = run_cli("fmu", "build", "--muscle", "kothera2009_5a", "--static-force", "kothera_enrgy",
+                  "-o", tmp_path / "bad.fmu")
+    assert bad.returncode == 2 and "kothera_enrgy" in bad.stderr and "Traceback" not in bad.stderr
+    assert not (tmp_path / "bad.fmu").exists()
+    lone = run_cli("fmu", "build", "--static-force", "kothera_energy", "-o", tmp_path / "lone.fmu")
+    assert lone.returncode == 2 and "--muscle" in lone.stderr
 
 
 @pytest.mark.parametrize("version", [2, 3])
