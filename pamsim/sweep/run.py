@@ -239,7 +239,8 @@ def run_sweep(spec: SweepSpec | str | Path, executor: Executor | None = None, pr
     by_key = {(t.kind, t.key): o for t, o in zip(tasks, outputs)}
     failures = [f"{t.scenario.name}{f' sample {t.key[0]}' if t.kind == 'sample' else ''}: {o['error']}"
                 for t, o in zip(tasks, outputs) if o["error"]]
-    rows = [_case_row(spec, i, case, by_key) for i, case in enumerate(spec.cases)]
+    case_scenarios = {t.key: t.scenario for t in tasks if t.kind == "case"}
+    rows = [_case_row(spec, i, case, by_key, case_scenarios) for i, case in enumerate(spec.cases)]
     freq_rows = []
     if spec.frequency is not None:
         for w in spec.frequency.weights_N:
@@ -307,10 +308,15 @@ _RUN_COLUMNS = ("final_contraction_m", "peak_contraction_m", "error_m", "at_rest
                 "last_second_peak_to_peak_m", "frequency_Hz", "damping_ratio", "n_half_cycles", "failure")
 
 
-def _case_row(spec: SweepSpec, i: int, case: SweepCase, by_key: Mapping) -> dict:
-    """One summary row: inputs, static analysis, measurement, and each friction model's run."""
+def _case_row(spec: SweepSpec, i: int, case: SweepCase, by_key: Mapping, scenarios: Mapping) -> dict:
+    """One summary row: inputs, static analysis, measurement, and each friction model's run.
+
+    ``scenarios`` maps ``(i, friction)`` to the case scenarios the runs used (built once, in
+    :func:`run_sweep`), so the row's static analysis describes the very model that ran.
+    """
     params = spec.base.parameters
-    model = spec.case_scenario(case, spec.friction_models[0]).build_model()
+    models = {f: scenarios[(i, f)].build_model() for f in spec.friction_models}
+    model = models[spec.friction_models[0]]
     p_Pa = case.pressure_bar * PA_PER_BAR
     x_eq = static_report(params, model.static_force, p_Pa, case.weight_N)["equilibrium_contraction_m"]
     row = {"case": case.name, "weight_N": case.weight_N, "pressure_bar": case.pressure_bar,
@@ -319,8 +325,7 @@ def _case_row(spec: SweepSpec, i: int, case: SweepCase, by_key: Mapping) -> dict
            "equilibrium_error_m": x_eq - case.measured_contraction_m,
            "within_capability": bool(x_eq >= spec.capability_min_equilibrium_m)}
     for n, f in enumerate(spec.friction_models):
-        friction = spec.case_scenario(case, f).build_model().friction
-        lo, hi = friction_band_m(model.static_force, friction, p_Pa, model.load.mass_kg, model.load.g_m_s2,
+        lo, hi = friction_band_m(model.static_force, models[f].friction, p_Pa, model.load.mass_kg, model.load.g_m_s2,
                                  model.stops.x_high_m)
         o = by_key[("case", (i, f))]
         # The first model's columns carry the plain names; the others are prefixed with the model name.
