@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import contextlib
+import io
 import subprocess
 import sys
 from pathlib import Path
@@ -54,21 +56,25 @@ def run_cli(*args, cwd=None):
                           cwd=cwd, timeout=300)
 
 
-@pytest.fixture
-def cli(capsys):
+def run_main(*args):
     """Run ``pamsim ARGS`` in this process (the console script's ``main()``); returns a CompletedProcess.
 
-    Most CLI tests use this: a subprocess costs an interpreter and the imports every time.  A few
-    representative tests still go through :func:`run_cli`.
+    Most CLI tests use this (through the :func:`cli` fixture, or directly from module fixtures): a
+    subprocess costs an interpreter and the imports every time.  A few representative tests still go
+    through :func:`run_cli`.
     """
     from pamsim.cli import main
 
-    def run(*args):
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
         try:
             code = main([str(a) for a in args])
         except SystemExit as exc:  # argparse's own errors
             code = exc.code if isinstance(exc.code, int) else 1
-        out = capsys.readouterr()
-        return subprocess.CompletedProcess(args, code, out.out, out.err)
+    return subprocess.CompletedProcess(args, code, out.getvalue(), err.getvalue())
 
-    return run
+
+@pytest.fixture
+def cli():
+    """:func:`run_main`, for tests that take the command line as a fixture."""
+    return run_main

@@ -1,4 +1,9 @@
-"""``pamsim fit static`` and ``pamsim fit dynamic`` as a user runs them."""
+"""``pamsim fit static`` and ``pamsim fit dynamic`` as a user runs them.
+
+The commands run in this process (``main(argv)``); one bad-input case per command goes through a
+real ``python -m pamsim`` subprocess, for the exit code and the absence of a traceback as a user
+sees them.
+"""
 
 from __future__ import annotations
 
@@ -13,7 +18,7 @@ from pamsim.identification.columns import write_trace_csv
 from pamsim.identification.synthetic import synthetic_trace
 
 from conftest import ROOT, SCENARIOS
-from conftest import run_cli as pamsim_cli
+from conftest import run_cli, run_main as pamsim_cli
 
 DATA = ROOT / "pamsim" / "data" / "acra2012_steady_state.csv"
 FIT_KEYS = {"model", "muscle", "objective", "parameters", "standard_errors", "correlation", "rms_force_N",
@@ -60,14 +65,14 @@ def test_fitted_muscle_file_carries_provenance_and_is_reusable(static_out, tmp_p
         assert again["parameters"][k] == pytest.approx(v, rel=1e-4)
 
 
-@pytest.mark.parametrize("args, message", [
-    (["--columns", "pressure=nope_bar"], "--columns pressure=nope_bar: no such column"),
-    (["--model", "acra2012_polynomal"], "did you mean 'acra2012_polynomial'"),
-    (["--muscle", "no/such/muscle.toml"], "no/such/muscle.toml: no such muscle file"),
-])
-def test_fit_static_bad_input_is_one_line_and_leaves_nothing(tmp_path, args, message):
+@pytest.mark.parametrize("args, message, run", [
+    (["--columns", "pressure=nope_bar"], "--columns pressure=nope_bar: no such column", run_cli),
+    (["--model", "acra2012_polynomal"], "did you mean 'acra2012_polynomial'", pamsim_cli),
+    (["--muscle", "no/such/muscle.toml"], "no/such/muscle.toml: no such muscle file", pamsim_cli),
+], ids=["columns-subprocess", "model", "muscle"])
+def test_fit_static_bad_input_is_one_line_and_leaves_nothing(tmp_path, args, message, run):
     out = tmp_path / "never"
-    proc = pamsim_cli("fit", "static", DATA, *args, "-o", out)
+    proc = run("fit", "static", DATA, *args, "-o", out)
     assert proc.returncode == 2
     assert message in proc.stderr and proc.stderr.count("\n") == 1 and "Traceback" not in proc.stderr
     assert not out.exists()
@@ -95,15 +100,15 @@ def test_fit_dynamic_cli_recovers_friction_from_a_recorded_trace(tmp_path):
     assert np.sqrt(np.mean((res.x_m - clean.x_m) ** 2)) < 0.1e-3
 
 
-@pytest.mark.parametrize("args, message", [
-    (["--load-N", "1,2"], "--load-N: 2 values for 1 traces"),
-    (["--free", "N9"], "--free: 'N9'"),
-])
-def test_fit_dynamic_bad_input(tmp_path, args, message):
+@pytest.mark.parametrize("args, message, run", [
+    (["--load-N", "1,2"], "--load-N: 2 values for 1 traces", run_cli),
+    (["--free", "N9"], "--free: 'N9'", pamsim_cli),
+], ids=["load-subprocess", "free"])
+def test_fit_dynamic_bad_input(tmp_path, args, message, run):
     trace = tmp_path / "t.csv"
     trace.write_text("t_s,x_mm\n0,0\n0.1,1\n0.2,2\n")
     out = tmp_path / "never"
-    proc = pamsim_cli("fit", "dynamic", trace, "--scenario", SCENARIOS / "acra2012_fig4.toml", *args, "-o", out)
+    proc = run("fit", "dynamic", trace, "--scenario", SCENARIOS / "acra2012_fig4.toml", *args, "-o", out)
     assert proc.returncode == 2, proc.stderr
     assert message in proc.stderr and "Traceback" not in proc.stderr
     assert not out.exists()
