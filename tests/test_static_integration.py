@@ -19,7 +19,7 @@ from pamsim.scenario import ScenarioError
 from pamsim.static_models import REGISTRY, Domain, StaticForce
 from pamsim.sweep import run_sweep, sweep_from_dict
 
-from conftest import run_cli
+from conftest import run_cli, run_main
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENARIOS = ROOT / "scenarios"
@@ -314,13 +314,13 @@ def test_linearize_works_with_another_muscle_and_model(tmp_path):
                   f"[load]\nweight_N = {spec['load']['weight_N']!r}\n"
                   '[pressure]\nsource = "valve"\nsupply_gauge_bar = 3.0\nvalve_open_time_s = 0.1\n'
                   "[simulation]\nduration_s = 2.0\n")
-    r = run_cli("linearize", sc, "-o", tmp_path / "lin")
+    r = run_main("linearize", sc, "-o", tmp_path / "lin")
     assert r.returncode == 0, r.stderr
 
 
 # ---------------------------------------------------------------- command line
 def test_models_json_lists_every_registry_entry():
-    r = run_cli("models", "--json")
+    r = run_main("models", "--json")
     assert r.returncode == 0, r.stderr
     rows = json.loads(r.stdout)
     assert [x["name"] for x in rows] == list(REGISTRY)
@@ -328,7 +328,7 @@ def test_models_json_lists_every_registry_entry():
 
 
 def test_muscles_json_lists_the_shipped_muscles():
-    r = run_cli("muscles", "--json")
+    r = run_main("muscles", "--json")
     assert r.returncode == 0, r.stderr
     names = [x["name"] for x in json.loads(r.stdout)]
     assert {"shadow_6x300_acra2012", "kothera2009_5a", "mpam_survey_45mm", "festo_dmsp_20_120"} <= set(names)
@@ -336,7 +336,7 @@ def test_muscles_json_lists_the_shipped_muscles():
 
 def test_force_json_is_gaylords_formula():
     """Hand calculation: F = p (3 L^2 - b^2) / (4 pi N^2), b = L0 / cos(theta0), N = b sin(theta0) / (2 pi r0)."""
-    r = run_cli("force", "--model", "gaylord", "--muscle", "mpam_survey_45mm", "--pressure-bar", "7.58",
+    r = run_main("force", "--model", "gaylord", "--muscle", "mpam_survey_45mm", "--pressure-bar", "7.58",
                    "--contraction-mm", "5", "--set", "r0_m=0.0006", "--json")
     assert r.returncode == 0, r.stderr
     p = dynamics_parameters(load_muscle("mpam_survey_45mm").parameters)
@@ -348,7 +348,7 @@ def test_force_json_is_gaylords_formula():
 
 
 def test_static_with_another_model_solves_its_equilibrium():
-    r = run_cli("static", "--model", "gaylord", "--muscle", "kothera2009_5a", "--pressure-bar", "3",
+    r = run_main("static", "--model", "gaylord", "--muscle", "kothera2009_5a", "--pressure-bar", "3",
                    "--load-N", "50", "--json")
     assert r.returncode == 0, r.stderr
     out = json.loads(r.stdout)
@@ -372,7 +372,11 @@ def test_static_with_another_model_solves_its_equilibrium():
     (["static", "--model", "gaylord", "--pressure-bar", "3", "--load-N", "5", "--set", "festo"], ["festo"]),
 ])
 def test_bad_cli_values_exit_2_naming_them(args, words):
-    r = run_cli(*args)
+    # The commands run in this process; the first case also through a real subprocess, as a user sees it.
+    r = run_main(*args)
+    if args[-1] == "L0_m=abc":
+        sub = run_cli(*args)
+        assert (sub.returncode, sub.stderr) == (r.returncode, r.stderr)
     assert r.returncode == 2
     line = r.stderr.strip()
     assert "\n" not in line and "Traceback" not in line
@@ -383,7 +387,7 @@ def test_bad_cli_values_exit_2_naming_them(args, words):
 # ---------------------------------------------------------------- atlas
 def test_atlas_writes_curves_table_and_figures_of_every_applicable_model(tmp_path):
     out = tmp_path / "atlas"
-    r = run_cli("atlas", "--muscle", "mpam_survey_45mm", "-o", out)
+    r = run_main("atlas", "--muscle", "mpam_survey_45mm", "-o", out)
     assert r.returncode == 0, r.stderr
     m = load_muscle("mpam_survey_45mm")
     rows = list(csv.DictReader((out / "atlas_table.csv").open()))
@@ -405,7 +409,7 @@ def test_atlas_writes_curves_table_and_figures_of_every_applicable_model(tmp_pat
 
 def test_atlas_refuses_a_model_that_does_not_apply_and_writes_nothing(tmp_path):
     out = tmp_path / "atlas"
-    r = run_cli("atlas", "--muscle", "shadow_6x300_acra2012", "--models", "gaylord,chou_hannaford", "-o", out)
+    r = run_main("atlas", "--muscle", "shadow_6x300_acra2012", "--models", "gaylord,chou_hannaford", "-o", out)
     assert r.returncode == 2 and "chou_hannaford" in r.stderr and "wall_thickness_m" in r.stderr
     assert not out.exists()
 

@@ -10,8 +10,6 @@ from __future__ import annotations
 
 import json
 import math
-import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -201,17 +199,13 @@ def test_stiffness_at_758_kPa_is_the_surveys_0_94_N_per_mm():
 
 
 # ------------------------------------------------------------------------------------ command line
-def _pamsim(*args):
-    return subprocess.run([sys.executable, "-m", "pamsim", *args], capture_output=True, text=True)
-
-
-def test_cli_refuses_without_the_nylon_modulus_and_computes_with_it():
+def test_cli_refuses_without_the_nylon_modulus_and_computes_with_it(cli):
     point = ("force", "--model", "mpam_two_phase", "--muscle", "mpam_survey_45mm", "--pressure-bar", "7.58",
              "--contraction-mm", "5")
-    r = _pamsim(*point)
+    r = cli(*point)
     assert r.returncode == 2 and "E_nylon_Pa" in r.stderr and "Traceback" not in r.stderr
-    r = _pamsim(*point, "--set", f"E_nylon_Pa={E_NYLON_ASSUMED_PA:g}", "--json")
+    r = cli(*point, "--set", f"E_nylon_Pa={E_NYLON_ASSUMED_PA:g}", "--json")
     assert r.returncode == 0
     assert json.loads(r.stdout)["force_N"] == pytest.approx(CORRECTED.force_N(5e-3, 7.58e5), rel=1e-12)
-    r = _pamsim(*point, "--set", f"E_nylon_Pa={E_NYLON_ASSUMED_PA:g}", "--variant", "printed")
+    r = cli(*point, "--set", f"E_nylon_Pa={E_NYLON_ASSUMED_PA:g}", "--variant", "printed")
     assert r.returncode == 2 and "p_gauge_Pa = 758000" in r.stderr and "Traceback" not in r.stderr
