@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 import pamsim
+from pamsim.elements.static_force import Acra2012Polynomial
 from pamsim.errors import InputError
 from pamsim.identification import fit_static, read_static_data
 from pamsim.identification.columns import DataError, StaticData
@@ -84,7 +85,7 @@ def test_vectorised_equilibrium_matches_the_closed_form(measured):
     rng = np.random.default_rng(1)
     p_bar = rng.uniform(0.3, 4.1, 500)
     w = rng.uniform(5.0, 80.0, 500)
-    force = pamsim.elements.static_force.Acra2012Polynomial(*PRINTED).force_N
+    force = Acra2012Polynomial(*PRINTED).force_N
     got = equilibrium_m(force, p_bar * 1e5, w, X_MAX_M)
     np.testing.assert_allclose(got, quadratic_equilibrium_m(PRINTED, p_bar, w), atol=1e-12)
     assert (got == 0).any() and (got > 0).any()
