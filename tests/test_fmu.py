@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 
 import pamsim
-from conftest import PAPER_SCENARIOS, SCENARIOS, run_cli
+from conftest import PAPER_SCENARIOS, SCENARIOS, run_cli, run_main
 from pamsim.fmu import build
 from pamsim.fmu.generate import c_header, token
 from pamsim.fmu.runner import ScenarioInputs, run_cs, run_me, set_values, start_values
@@ -580,14 +580,14 @@ def test_model_exchange_events_protocol(fmus, version):
 
 
 def test_cli_build_and_run_with_fmu_backends(tmp_path):
-    out = run_cli("fmu", "build", "-o", tmp_path / "m.fmu", "--fmi", "3")
+    out = run_main("fmu", "build", "-o", tmp_path / "m.fmu", "--fmi", "3")
     assert out.returncode == 0 and (tmp_path / "m.fmu").is_file(), out.stderr
-    bad = run_cli("fmu", "build", "--fmi", "4")
+    bad = run_cli("fmu", "build", "--fmi", "4")  # the one real subprocess here: exit code and line as a user sees them
     assert bad.returncode == 2 and bad.stderr.count("\n") == 1 and "must be 2 or 3" in bad.stderr
     scenario = SCENARIOS / "acra2012_fig6b.toml"
     csvs = {}
     for backend in ("python", "fmu-cs", "fmu-me"):
-        r = run_cli("run", scenario, "-o", tmp_path / backend, "--backend", backend, "--no-plot")
+        r = run_main("run", scenario, "-o", tmp_path / backend, "--backend", backend, "--no-plot")
         assert r.returncode == 0, r.stderr
         with open(tmp_path / backend / "acra2012_fig6b.csv") as fh:
             header = fh.readline()

@@ -139,9 +139,9 @@ def test_scenario_with_another_static_model_runs_on_its_table_like_python(interf
 
 
 def test_cli_builds_a_table_fmu_from_a_scenario(tmp_path):
-    from conftest import run_cli
+    from conftest import run_main
 
-    out = run_cli("fmu", "build", "--scenario", SCENARIOS / "acra2012_fig4.toml", "-o", tmp_path / "t.fmu")
+    out = run_main("fmu", "build", "--scenario", SCENARIOS / "acra2012_fig4.toml", "-o", tmp_path / "t.fmu")
     assert out.returncode == 0, out.stderr
     assert "table of acra2012_polynomial" in out.stdout
     from fmpy import read_model_description
@@ -153,20 +153,20 @@ def test_cli_builds_a_table_fmu_from_a_scenario(tmp_path):
 
 
 def test_cli_builds_a_table_fmu_from_a_muscle_and_model(tmp_path):
-    from conftest import run_cli
+    from conftest import run_main
 
-    out = run_cli("fmu", "build", "--muscle", "kothera2009_5a", "--static-force", "kothera_energy",
+    out = run_main("fmu", "build", "--muscle", "kothera2009_5a", "--static-force", "kothera_energy",
                   "-o", tmp_path / "k.fmu")
     assert out.returncode == 0, out.stderr
     assert "table of kothera_energy" in out.stdout
     # The baked table has the shape of the one the runner makes for a scenario with that muscle and model.
     runner_table = force_table_for(_kothera_energy_scenario())
     assert f"{runner_table.shape[0]} x {runner_table.shape[1]} table" in out.stdout
-    bad = run_cli("fmu", "build", "--muscle", "kothera2009_5a", "--static-force", "kothera_enrgy",
+    bad = run_main("fmu", "build", "--muscle", "kothera2009_5a", "--static-force", "kothera_enrgy",
                   "-o", tmp_path / "bad.fmu")
     assert bad.returncode == 2 and "kothera_enrgy" in bad.stderr and "Traceback" not in bad.stderr
     assert not (tmp_path / "bad.fmu").exists()
-    lone = run_cli("fmu", "build", "--static-force", "kothera_energy", "-o", tmp_path / "lone.fmu")
+    lone = run_main("fmu", "build", "--static-force", "kothera_energy", "-o", tmp_path / "lone.fmu")
     assert lone.returncode == 2 and "--muscle" in lone.stderr
 
 

@@ -16,7 +16,7 @@ from pamsim.native.backend import hold_interval_s
 from pamsim.sweep import sweep_from_dict
 from pamsim.sweep.spec import SweepError
 
-from conftest import PAPER_SCENARIOS, SCENARIOS, run_cli
+from conftest import PAPER_SCENARIOS, SCENARIOS, run_cli, run_main
 
 # Both backends integrate to rtol 1e-6 (LSODA and Dormand-Prince 5(4), absolute tolerances rtol x
 # 10 mm on the contraction), so they agree to a few multiples of 1e-8 m per unit error; 5 um is
@@ -133,7 +133,7 @@ def test_unknown_backend_is_an_input_error():
 
 
 def test_cli_run_native_writes_the_python_backends_files(tmp_path):
-    proc = run_cli("run", SCENARIOS / "acra2012_fig4.toml", "--backend", "native", "-o", tmp_path, "--no-plot")
+    proc = run_main("run", SCENARIOS / "acra2012_fig4.toml", "--backend", "native", "-o", tmp_path, "--no-plot")
     assert proc.returncode == 0, proc.stderr
     summary = json.loads((tmp_path / "acra2012_fig4.json").read_text())
     assert summary["backend"] == "native"
@@ -171,7 +171,7 @@ def test_sweep_refuses_unknown_backend_and_unsupported_settings_before_running(t
     spec = sweep_from_dict({"base_scenario": str(base), "case": [{"weight_N": 12.74, "pressure_bar": 3.6}]})
     with pytest.raises(InputError, match="solver.method"):
         pamsim.sweep(spec, backend="native")
-    proc = run_cli("sweep", _write_sweep(tmp_path, base), "--backend", "native", "--workers", "1", "-o",
+    proc = run_main("sweep", _write_sweep(tmp_path, base), "--backend", "native", "--workers", "1", "-o",
                    tmp_path / "out")
     assert proc.returncode == 2 and "solver.method" in proc.stderr and not (tmp_path / "out").exists()
 
