@@ -17,8 +17,8 @@ import pytest
 import pamsim
 from pamsim.cli import main as cli_main
 from pamsim.sweep import dask_cluster, sweep_from_dict
-from pamsim.sweep.run import auto_chunk_size
-from conftest import run_cli as _cli
+from pamsim.sweep.run import UNCERTAINTY_TABLES, auto_chunk_size
+from conftest import run_main as _cli
 
 distributed = pytest.importorskip("distributed", reason="Dask is the optional extra pamsim[dask] (in [test])")
 
@@ -149,10 +149,15 @@ def test_cli_dask_local_writes_the_same_tables_as_the_serial_api(tmp_path):
         f'base_scenario = "{FIG4}"\n[axes]\npressure_bar = [3.6]\nweight_N = [12.74, 22.74]\n'
         '[uncertainty]\nsamples = 2\nseed = 5\n[uncertainty.parameters.N0_N_per_bar]\n'
         'distribution = "normal"\nmean = 6.87\nstd = 0.3\nlower = 6.0\nupper = 7.5\n')
-    pamsim.sweep(tmp_path / "s.toml").write(tmp_path / "one")
+    # The reference: the serial run's tables, written by the same writers as SweepResult.write (its
+    # figures are not compared, so not drawn).
+    one = pamsim.sweep(tmp_path / "s.toml")
+    (tmp_path / "one").mkdir()
+    one.to_csv(tmp_path / "one" / "summary.csv")
+    one.uncertainty.write_tables(*(tmp_path / "one" / n for n in UNCERTAINTY_TABLES))
     dask = _cli("sweep", tmp_path / "s.toml", "-o", tmp_path / "dask", "--dask-local", "2", "--chunk-size", "2",
                 "--no-progress")
     assert dask.returncode == 0, dask.stderr
     assert "Dask LocalCluster of 2 worker process(es)" in dask.stdout
-    for name in ("summary.csv", "uncertainty_samples.csv", "uncertainty_summary.csv"):
+    for name in ("summary.csv", *UNCERTAINTY_TABLES):
         assert (tmp_path / "dask" / name).read_bytes() == (tmp_path / "one" / name).read_bytes(), name
