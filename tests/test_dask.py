@@ -144,6 +144,8 @@ def test_unreachable_scheduler_is_one_line_exit_2(tmp_path, monkeypatch, capsys)
     assert not (tmp_path / "out").exists()
 
 
+# The CLI's LocalCluster asks for the default dashboard port; another Dask on the machine may hold it.
+@pytest.mark.filterwarnings("ignore:Port 8787 is already in use")
 def test_cli_dask_local_writes_the_same_tables_as_the_serial_api(tmp_path):
     (tmp_path / "s.toml").write_text(
         f'base_scenario = "{FIG4}"\n[axes]\npressure_bar = [3.6]\nweight_N = [12.74, 22.74]\n'
