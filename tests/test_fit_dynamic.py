@@ -140,14 +140,18 @@ def test_parallel_and_in_process_simulations_agree(single):
     np.testing.assert_array_equal(run_simulation(task), fit.simulated_m[0])
 
 
-def test_fd_step_is_far_above_the_simulation_noise(scenario):
+def test_fd_step_is_far_above_the_simulation_noise(scenario, single):
     # A short trace: the Jacobian columns at steps 1e-3 and 3e-3 agree, so neither is dominated by
     # integration or event-timing noise; at 1e-9 they do not.
-    noisy, _ = _traces(scenario, [22.74])[0]
+    (noisy, _), = single[0]
     short = TraceData(noisy.t_s[:1801], noisy.x_m[:1801], noisy.p_gauge_Pa[:1801], 22.74)
     prob = make_problem(scenario, [short], free=FREE)
     theta = np.array([scenario.parameters[n] for n in FREE])
-    J = {h: _Objective(prob, None, h).jacobian(theta) for h in (1e-3, 3e-3, 1e-9)}
+    objective = _Objective(prob, None, 1e-3)  # one objective: the unperturbed simulation is shared
+    J = {}
+    for h in (1e-3, 3e-3, 1e-9):
+        objective.fd_step = h
+        J[h] = objective.jacobian(theta)
     rel = lambda a, b: np.linalg.norm(a - b) / np.linalg.norm(b)  # noqa: E731
     assert rel(J[1e-3], J[3e-3]) < 0.05
     assert rel(J[1e-9], J[1e-3]) > 0.05

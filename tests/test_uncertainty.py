@@ -18,7 +18,7 @@ from scipy import integrate, stats
 
 import pamsim
 from pamsim.sweep import SweepError, load_sweep, sweep_from_dict
-from conftest import run_cli as _cli
+from conftest import run_main as _cli
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENARIOS = ROOT / "scenarios"
