@@ -46,11 +46,23 @@ def _finite(model, x: float, p: float) -> bool:
         return False
 
 
+def _finite_on_grid(model, xs: np.ndarray, ps: np.ndarray) -> bool:
+    """True if one vectorised call finds the force finite at every grid point.  False decides nothing:
+    the caller then asks point by point, as a model written for scalars needs."""
+    X, P = np.meshgrid(xs, ps)
+    try:
+        with np.errstate(all="ignore"):
+            F = np.asarray(model.force_N(X, P), dtype=float)
+    except (ValueError, TypeError, ZeroDivisionError, OverflowError):
+        return False
+    return F.shape == X.shape and bool(np.isfinite(F).all())
+
+
 def within_domain_if_needed(model, x_range_m: tuple[float, float], p_range_Pa: tuple[float, float]):
     """``model`` itself if it is finite over the reachable region, else it clamped to its domain."""
     xs = np.linspace(x_range_m[0], x_range_m[1], _PROBE)
     ps = np.linspace(p_range_Pa[0], p_range_Pa[1], _PROBE)
-    if all(_finite(model, float(x), float(p)) for x in xs for p in ps):
+    if _finite_on_grid(model, xs, ps) or all(_finite(model, float(x), float(p)) for x in xs for p in ps):
         return model
     d = model.domain
     return DomainClampedForce(model, d.x_min_m, d.x_max_m, d.p_min_Pa, d.p_max_Pa)
