@@ -196,14 +196,17 @@ class _SumOfSquares:
 
 class _PopulationSumOfSquares:
     """Eq. (13) cost of a whole population at once (differential evolution's ``vectorized`` form):
-    one batch of simulations per generation, for the native backend."""
+    one batch of simulations per generation, for the native backend; counts its simulations (scipy's
+    ``nfev`` counts calls when vectorized)."""
 
     def __init__(self, problem: DynamicProblem, trials, executor):
         self.problem, self.trials, self.executor = problem, trials, executor
+        self.n_simulations = 0
 
     def __call__(self, thetas: np.ndarray) -> np.ndarray:
         thetas = np.atleast_2d(np.asarray(thetas, dtype=float).T)  # scipy passes (n_coefficients, S)
         sims = self.trials(thetas, self.executor)
+        self.n_simulations += len(sims)
         n_tr = len(self.problem.traces)
         costs = [self.problem.residuals_from(sims[k * n_tr:(k + 1) * n_tr]) for k in range(len(thetas))]
         return np.array([r @ r for r in costs])
@@ -386,7 +389,7 @@ def fit_dynamic(scenario: Scenario, traces: Sequence[TraceData], free: Sequence[
         de = differential_evolution(cost, de_bounds, maxiter=global_iterations, popsize=6, seed=seed, polish=False,
                                     workers=de_workers, updating="deferred", tol=1e-6, x0=theta0,
                                     vectorized=vectorized)
-        n_sim += de.nfev * len(problem.traces)
+        n_sim += cost.n_simulations if vectorized else de.nfev * len(problem.traces)
         start = de.x
     theta, res, obj, J = _local(problem, start, executor, fd_step, max_iterations, trials)
     n_sim += obj.n_simulations
