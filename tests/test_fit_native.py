@@ -17,7 +17,7 @@ import pytest
 import pamsim
 from pamsim.errors import InputError
 from pamsim.identification.columns import TraceData, write_trace_csv
-from pamsim.identification.dynamic_fit import FIT_RTOL, fit_dynamic, make_problem, make_trials, trace_scenario
+from pamsim.identification.dynamic_fit import FIT_RTOL, _Objective, fit_dynamic, make_problem, make_trials, trace_scenario
 from pamsim.identification.native_fit import NativeTrials
 from pamsim.identification.synthetic import synthetic_trace
 from pamsim.native.backend import case_inputs
@@ -147,6 +147,22 @@ def test_trial_cases_are_the_native_backends_own_cases_with_the_coefficients_cha
         np.testing.assert_array_equal(chunk.segment_t_s[offset:offset + n], ref.segment_t_s)
         np.testing.assert_allclose(chunk.segment_u[offset:offset + n], ref.segment_u, rtol=1e-15)
         offset += n
+
+
+def test_fd_step_is_far_above_the_native_simulation_noise(scenario):
+    """The Python test's check of the finite-difference step, on the native backend: the Jacobian
+    columns at steps 1e-3 and 3e-3 agree.  Unlike the Python backend's, the native trajectories are
+    smooth in the coefficients down to steps of about 1e-10 (docs/identification.md), so the
+    Jacobian at 1e-9 agrees too: the default step suits both."""
+    noisy, _ = _traces(scenario, [22.74])[0]
+    short = TraceData(noisy.t_s[:1801], noisy.x_m[:1801], noisy.p_gauge_Pa[:1801], 22.74)
+    prob = make_problem(scenario, [short], free=FREE)
+    trials = make_trials(prob, "native")
+    theta = np.array([scenario.parameters[n] for n in FREE])
+    J = {h: _Objective(prob, None, h, trials).jacobian(theta) for h in (1e-3, 3e-3, 1e-9)}
+    rel = lambda a, b: np.linalg.norm(a - b) / np.linalg.norm(b)  # noqa: E731
+    assert rel(J[1e-3], J[3e-3]) < 0.05
+    assert rel(J[1e-9], J[1e-3]) < 0.005
 
 
 class _CountingExecutor(ThreadPoolExecutor):
