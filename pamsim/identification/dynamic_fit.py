@@ -383,8 +383,10 @@ def fit_dynamic(scenario: Scenario, traces: Sequence[TraceData], free: Sequence[
         span = global_span * np.maximum(np.abs(theta0), 1e-3)
         de_bounds = list(zip(np.maximum(theta0 - span, lo), np.minimum(theta0 + span, hi)))
         if backend == "python":
-            cost, vectorized, de_workers = _SumOfSquares(problem), False, executor.map if executor else 1
+            de_workers = executor.map if executor is not None else 1
+            cost, vectorized = _SumOfSquares(problem), False
         else:
+            # a whole generation per call, one batch (scipy then evaluates in this process)
             cost, vectorized, de_workers = _PopulationSumOfSquares(problem, trials, executor), True, 1
         de = differential_evolution(cost, de_bounds, maxiter=global_iterations, popsize=6, seed=seed, polish=False,
                                     workers=de_workers, updating="deferred", tol=1e-6, x0=theta0,
