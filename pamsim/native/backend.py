@@ -161,8 +161,16 @@ def _run(cases: Sequence[CaseInputs], capacity: Sequence[int]) -> dict:
                          np.asarray(capacity))
 
 
-def _result(scenario: Scenario, case: CaseInputs, out: dict, i: int, wall_time_s: float) -> Result:
-    """Case ``i`` of a batch's output as a :class:`Result`, or the error it ended with."""
+_MODE_LABELS = {int(m): m.label for m in Mode}
+_IMPACTS_ROW = lib.SAMPLE_COLUMNS.index("E_impacts_J")
+
+
+def _result(scenario: Scenario, case: CaseInputs, out: dict, i: int, wall_time_s: float,
+            t: np.ndarray | None = None) -> Result:
+    """Case ``i`` of a batch's output as a :class:`Result`, or the error it ended with.
+
+    ``t`` is the sample grid if the caller has it already (cases of one batch share equal grids).
+    """
     status = int(out["status"][i])
     message = out["messages"][i]
     if status == 1:
@@ -173,19 +181,31 @@ def _result(scenario: Scenario, case: CaseInputs, out: dict, i: int, wall_time_s
         raise SolverFailure(f"more than {case.max_events} events (raise [solver] max_events if this is expected)")
     model = case.model
     first, n = int(out["sample_offset"][i]), case.n_samples
-    rows = slice(first, first + n)
     S = out["samples"][len(lib.SAMPLE_COLUMNS) * first:len(lib.SAMPLE_COLUMNS) * (first + n)].reshape(-1, n)
     Y = S[_STATE_ROWS[model.n_source]]
-    events = out["events"][out["event_offset"][i]:out["event_offset"][i] + out["n_events"][i]]
-    transitions = [TransitionEvent(float(e[0]), lib.EVENT_KINDS[int(e[1])], Mode(int(e[2])).label,
-                                   Mode(int(e[3])).label, float(e[4])) for e in events]
-    losses = [(float(e[0]), float(e[5])) for e in events]
+    events = out["events"][out["event_offset"][i]:out["event_offset"][i] + out["n_events"][i]].tolist()
+    kinds, labels = lib.EVENT_KINDS, _MODE_LABELS
+    transitions = [TransitionEvent(e[0], kinds[int(e[1])], labels[int(e[2])], labels[int(e[3])], e[4])
+                   for e in events]
+    losses = [(e[0], e[5]) for e in events]
     n_rhs, _, segments = (int(v) for v in out["stats"][i])
     stats = {"rhs_evaluations": n_rhs, "events": len(transitions), "segments": segments, "method": METHOD_LABEL,
              "rtol": scenario.solver.rtol}
-    t = np.linspace(0.0, case.duration_s, case.n_samples)
-    return Result.from_trace(model, scenario.name, t, Y, out["modes"][rows].astype(int), transitions, losses,
-                             stats, wall_time_s)
+    if t is None:
+        t = np.linspace(0.0, case.duration_s, case.n_samples)
+    return Result.from_trace(model, scenario.name, t, Y, out["modes"][first:first + n].astype(int), transitions,
+                             losses, stats, wall_time_s, impacts_J=S[_IMPACTS_ROW])
+
+
+def _sample_grids(cases: Sequence[CaseInputs]) -> list[np.ndarray]:
+    """Each case's sample times [s]; cases with the same grid share one read-only array."""
+    grids: dict[tuple[float, int], np.ndarray] = {}
+    for c in cases:
+        key = (c.duration_s, c.n_samples)
+        if key not in grids:
+            grids[key] = np.linspace(0.0, c.duration_s, c.n_samples)
+            grids[key].flags.writeable = False
+    return [grids[(c.duration_s, c.n_samples)] for c in cases]
 
 
 def simulate_batch(scenarios: Sequence[Scenario], return_exceptions: bool = False) -> list:
@@ -204,14 +224,14 @@ def simulate_batch(scenarios: Sequence[Scenario], return_exceptions: bool = Fals
     out = _run(cases, [min(c.max_events + 1, BATCH_EVENT_CAPACITY) for c in cases])
     wall = (time.perf_counter() - wall0) / max(len(cases), 1)
     results = []
-    for i, (scenario, case) in enumerate(zip(scenarios, cases)):
+    for i, (scenario, case, t) in enumerate(zip(scenarios, cases, _sample_grids(cases))):
         try:
             if out["status"][i] == 3 and case.max_events + 1 > BATCH_EVENT_CAPACITY:
                 again = time.perf_counter()
                 alone = _run([case], [case.max_events + 1])
-                results.append(_result(scenario, case, alone, 0, time.perf_counter() - again))
+                results.append(_result(scenario, case, alone, 0, time.perf_counter() - again, t))
             else:
-                results.append(_result(scenario, case, out, i, wall))
+                results.append(_result(scenario, case, out, i, wall, t))
         except (InputError, SolverFailure) as exc:
             if not return_exceptions:
                 raise
