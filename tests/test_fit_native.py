@@ -17,7 +17,8 @@ import pytest
 import pamsim
 from pamsim.errors import InputError
 from pamsim.identification.columns import TraceData, write_trace_csv
-from pamsim.identification.dynamic_fit import FIT_RTOL, _Objective, fit_dynamic, make_problem, make_trials, trace_scenario
+from pamsim.identification.dynamic_fit import (FIT_RTOL, _Objective, fit_dynamic, make_problem, make_trials,
+                                               trace_scenario)
 from pamsim.identification.native_fit import NativeTrials
 from pamsim.identification.synthetic import synthetic_trace
 from pamsim.native.backend import case_inputs
