@@ -109,10 +109,14 @@ def hold_interval_s(signals, sample_interval_s: float) -> float:
     return hold
 
 
-def case_inputs(scenario: Scenario) -> CaseInputs:
-    """The library's inputs for ``scenario``; refuses (``InputError``) what the backend cannot honour."""
+def case_inputs(scenario: Scenario, model: MuscleModel | None = None) -> CaseInputs:
+    """The library's inputs for ``scenario``; refuses (``InputError``) what the backend cannot honour.
+
+    ``model`` is ``scenario.build_model()`` (built here if not given), or that model with its pressure
+    source replaced (a fit drives it with a recorded pressure): the source choice follows the model.
+    """
     refuse_unsupported(scenario)
-    model = scenario.build_model()
+    model = scenario.build_model() if model is None else model
     spec = scenario.spec
     opts = scenario.solver
     T = scenario.duration_s
@@ -130,7 +134,7 @@ def case_inputs(scenario: Scenario) -> CaseInputs:
     ints = lib.INT_DEFAULTS.copy()
     choices = {"friction_model": ("friction", spec["model"]["friction"]),
                "damping_model": ("damping", spec["model"]["damping"]),
-               "pressure_source": ("source", spec["pressure"]["source"]),
+               "pressure_source": ("source", "valve" if isinstance(model.source, ValveChamberSource) else "prescribed"),
                "friction_negative_level": ("friction_negative_level", spec["model"]["friction_negative_level"])}
     for name, (key, value) in choices.items():
         ints[lib.INT_INDEX[name]] = C_CHOICES[key].index(value)
