@@ -28,7 +28,15 @@ typedef struct {
     double sample_step_s, duration_s;
     double work[N_WORK], impacts_J;
     double gauss[GL_N][GL_N];
+    double x_max, x_min, p_max; /* over every step end and event (simulator: Result.peaks) */
 } Run;
+
+static void note_peaks(Run *run, const double *y) {
+    double p = pressure_gauge_Pa(&run->core, y);
+    if (y[X] > run->x_max) run->x_max = y[X];
+    if (y[X] < run->x_min) run->x_min = y[X];
+    if (p > run->p_max) run->p_max = p;
+}
 
 static void keep_first_error(void *env, int level, const char *message) {
     Run *run = (Run *)env;
@@ -162,6 +170,8 @@ static void on_step(void *env, double t0, double t1, double h, const double *y0,
         record(run, y, work);
     }
     work_at(&w, t1, run->work, run->work);
+    state_at(&d, t1, y);
+    note_peaks(run, y);
 }
 
 static int event_kind(int from, int to, const PamCore *c, const double *y_after) {
@@ -179,6 +189,8 @@ static void on_event(void *env, double t, int from, int to, const double *y_befo
     double m = run->core.r[R_load_mass_kg], loss;
     loss = 0.5 * m * (y_before[V] * y_before[V] - y_after[V] * y_after[V]);
     run->impacts_J += loss;
+    note_peaks(run, y_before);
+    note_peaks(run, y_after);
     if (run->n_events < run->capacity) {
         double *e = run->events + PAM_NATIVE_NEV * run->n_events;
         e[0] = t;
@@ -234,6 +246,8 @@ static int run_case(const PamBatch *b, int64_t i) {
     c->on_step = on_step;
     c->step_env = &run;
     get_states(c, y);
+    run.x_max = run.x_min = y[X];
+    run.p_max = pressure_gauge_Pa(c, y);
     record(&run, y, run.work);
     for (j = 1; j <= n_seg; j++) {
         double t_next = j < n_seg ? seg_t[j] : run.duration_s;
@@ -253,6 +267,9 @@ static int run_case(const PamBatch *b, int64_t i) {
     b->stats[3 * i + 1] = c->n_steps;
     b->stats[3 * i + 2] = n_seg + run.n_events;
     b->n_events[i] = run.n_events;
+    b->peaks[3 * i] = run.x_max;
+    b->peaks[3 * i + 1] = run.x_min;
+    b->peaks[3 * i + 2] = run.p_max;
     return PAM_OK;
 }
 

@@ -59,6 +59,8 @@ typedef struct {
     int64_t *n_events;            /* out: n_cases */
     int64_t *stats;               /* out: n_cases x 3: RHS evaluations, accepted steps, integration segments */
     int32_t *status;              /* out: n_cases, PamStatus */
+    double *peaks;                /* out: n_cases x 3: largest x, smallest x, largest gauge pressure of the
+                                     solution at every step end and event (samples may miss a peak) */
     char *messages;               /* out: n_cases x PAM_NATIVE_MSG, the first error */
 } PamBatch;
 

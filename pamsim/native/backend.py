@@ -193,8 +193,10 @@ def _result(scenario: Scenario, case: CaseInputs, out: dict, i: int, wall_time_s
              "rtol": scenario.solver.rtol}
     if t is None:
         t = np.linspace(0.0, case.duration_s, case.n_samples)
+    x_max, x_min, p_max = (float(v) for v in out["peaks"][i])
     return Result.from_trace(model, scenario.name, t, Y, out["modes"][first:first + n].astype(int), transitions,
-                             losses, stats, wall_time_s, impacts_J=S[_IMPACTS_ROW])
+                             losses, stats, wall_time_s, peaks={"x_m": x_max, "x_min_m": x_min, "p_gauge_Pa": p_max},
+                             impacts_J=S[_IMPACTS_ROW])
 
 
 def _sample_grids(cases: Sequence[CaseInputs]) -> list[np.ndarray]:

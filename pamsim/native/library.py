@@ -53,7 +53,7 @@ class PamBatch(ctypes.Structure):
                 ("n_samples", _I64), ("sample_offset", _I64), ("n_segments", _I64), ("segment_offset", _I64),
                 ("segment_t_s", _D), ("segment_u", _D), ("event_capacity", _I64), ("event_offset", _I64),
                 ("samples", _D), ("modes", _I32), ("events", _D), ("n_events", _I64), ("stats", _I64),
-                ("status", _I32), ("messages", ctypes.c_char_p)]
+                ("status", _I32), ("peaks", _D), ("messages", ctypes.c_char_p)]
 
 
 @lru_cache(maxsize=1)
@@ -99,6 +99,7 @@ def run_batch(reals, ints, duration_s, n_samples, segment_counts, segment_t_s, s
     dict
         ``samples`` (per case a block of :data:`SAMPLE_COLUMNS` x its samples, flattened), ``modes``, ``sample_offset``, ``events``,
         ``event_offset``, ``n_events``, ``stats`` (RHS evaluations, steps, segments), ``status``,
+        ``peaks`` (per case: largest and smallest x [m], largest gauge pressure [Pa] at every step end and event),
         ``messages``.
     """
     lib = load()
@@ -113,7 +114,8 @@ def run_batch(reals, ints, duration_s, n_samples, segment_counts, segment_t_s, s
            "samples": np.empty(int(n_samples.sum()) * len(SAMPLE_COLUMNS)),
            "modes": np.empty(int(n_samples.sum()), dtype=np.int32),
            "events": np.empty((int(event_capacity.sum()), 6)), "n_events": np.zeros(n, dtype=np.int64),
-           "stats": np.zeros((n, 3), dtype=np.int64), "status": np.zeros(n, dtype=np.int32)}
+           "stats": np.zeros((n, 3), dtype=np.int64), "status": np.zeros(n, dtype=np.int32),
+           "peaks": np.full((n, 3), np.nan)}
     messages = ctypes.create_string_buffer(MESSAGE_BYTES * n)
     segment_offset = offsets(segment_counts)
     batch = PamBatch(n, _ptr(reals, _D), _ptr(ints, _I32), _ptr(duration_s, _D), _ptr(n_samples, _I64),
@@ -121,7 +123,7 @@ def run_batch(reals, ints, duration_s, n_samples, segment_counts, segment_t_s, s
                      _ptr(segment_t_s, _D), _ptr(segment_u, _D), _ptr(event_capacity, _I64),
                      _ptr(out["event_offset"], _I64), _ptr(out["samples"], _D), _ptr(out["modes"], _I32),
                      _ptr(out["events"], _D), _ptr(out["n_events"], _I64), _ptr(out["stats"], _I64),
-                     _ptr(out["status"], _I32), ctypes.cast(messages, ctypes.c_char_p))
+                     _ptr(out["status"], _I32), _ptr(out["peaks"], _D), ctypes.cast(messages, ctypes.c_char_p))
     lib.pam_native_run_batch(ctypes.byref(batch))
     raw = messages.raw
     out["messages"] = [raw[MESSAGE_BYTES * i:MESSAGE_BYTES * (i + 1)].split(b"\0", 1)[0].decode(errors="replace")
