@@ -230,12 +230,17 @@ def test_per_trace_table_on_the_native_backend(scenario, short_pair):
 
 @pytest.mark.parametrize("changes, key", [
     ({"solver": {"method": "Radau"}}, "solver.method"),
-    ({"model": {"static_force": "gaylord"}}, "model.static_force"),
+    ({"model": {"static_force_negative": "keep"}}, "model.static_force_negative"),
 ])
 def test_settings_the_native_backend_cannot_honour_are_refused_before_the_fit(scenario, short_pair, changes, key):
     noisy, _ = short_pair[0]
     with pytest.raises(InputError, match=key.replace(".", r"\.")):
         fit_dynamic(scenario.with_changes(changes), [noisy], free=["N0_N_per_bar"], backend="native")
+    # A library static force runs as a force table built once per fit: a free coefficient that
+    # shapes the table is refused by name.
+    gaylord = scenario.with_changes({"model": {"static_force": "gaylord"}})
+    with pytest.raises(InputError, match="'r0_m' shapes the force table of static model 'gaylord'"):
+        fit_dynamic(gaylord, [noisy], free=["r0_m"], backend="native")
     with pytest.raises(InputError, match="--backend = 'c'"):
         fit_dynamic(scenario, [noisy], free=["N0_N_per_bar"], backend="c")
 

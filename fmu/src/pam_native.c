@@ -29,6 +29,7 @@ typedef struct {
     double work[N_WORK], impacts_J;
     double gauss[GL_N][GL_N];
     double x_max, x_min, p_max; /* over every step end and event (simulator: Result.peaks) */
+    PamTable table;             /* the case's static force table, if it has one */
 } Run;
 
 static void note_peaks(Run *run, const double *y) {
@@ -46,7 +47,7 @@ static void keep_first_error(void *env, int level, const char *message) {
 /* MuscleModel.slip_rhs: the powers whose integrals are the work states (zero while held, v = 0). */
 static void powers_W(const PamCore *c, const double *y, double *P) {
     double p = pressure_gauge_Pa(c, y), v = y[V];
-    P[W_MUSCLE] = static_force_N(c->r, y[X], p) * v;
+    P[W_MUSCLE] = static_force_N(c, y[X], p) * v;
     P[E_FRICTION] = coulomb_level_N(c, y[X], p) * fabs(v);
     P[E_DAMPING] = damping_force_N(c, v) * v;
     P[W_EXTERNAL] = c->r[R_external_force_N] * v;
@@ -239,6 +240,17 @@ static int run_case(const PamBatch *b, int64_t i) {
     memcpy(c->i, b->ints + PAM_NI * i, sizeof c->i);
     c->log = keep_first_error;
     c->log_env = &run;
+    if (b->table_index[i] >= 0) {
+        const double *g = b->table_grid + 6 * b->table_index[i];
+        run.table.nx = (int)g[0];
+        run.table.np = (int)g[1];
+        run.table.x0 = g[2];
+        run.table.dx = g[3];
+        run.table.p0 = g[4];
+        run.table.dp = g[5];
+        run.table.nodes = (const double(*)[4])(b->table_nodes + 4 * b->table_offset[b->table_index[i]]);
+        c->table = &run.table;
+    }
     if (set_inputs(c, seg_u) || pam_check_parameters(c)) return PAM_BAD_INPUT;
     pam_initialize(c);
     c->on_event = on_event;
@@ -300,7 +312,7 @@ PAM_EXPORT void pam_native_evaluate(int64_t n, const double *reals, const int32_
         c.x_high_m = c.r[R_L0_m] - c.braid_b_m / sqrt(PAM_BRAID_LOCK_SEC2);
         p = pressure_gauge_Pa(&c, y);
         q[Q_PRESSURE_GAUGE] = p;
-        q[Q_STATIC_FORCE] = static_force_N(c.r, y[X], p);
+        q[Q_STATIC_FORCE] = static_force_N(&c, y[X], p);
         q[Q_COULOMB_LEVEL] = coulomb_level_N(&c, y[X], p);
         q[Q_DAMPING_FORCE] = damping_force_N(&c, y[V]);
         chamber_derivatives(&c, y, y[V], &q[Q_PRESSURE_RATE], &q[Q_VALVE_FLOW]);

@@ -27,8 +27,10 @@ from typing import Sequence
 import numpy as np
 
 from ..elements.pressure_source import PrescribedPressure
+from ..errors import InputError
 from ..native import library as lib
 from ..native.backend import BATCH_EVENT_CAPACITY, CaseInputs, case_inputs
+from ..static_models import get as get_static_model
 from .dynamic_fit import trace_scenario
 
 _X_ROW = lib.SAMPLE_COLUMNS.index("x_m")
@@ -98,6 +100,24 @@ def _stack(cases: Sequence[CaseInputs], reals: np.ndarray, samples: Sequence[np.
                  np.array([c.max_events for c in cases], dtype=np.int64), tuple(samples))
 
 
+TABLE_SHAPERS = ("rated_pressure_gauge_Pa", "L0_m", "r0_m", "theta0_deg")
+"""Parameters that set a force table's domain (the pressure rating and the stops) for any model."""
+
+
+def _refuse_free_table_parameters(problem) -> None:
+    """A static force other than the polynomial runs as a force table built once per fit: a free
+    coefficient that shapes it (a parameter of the model, or of the table's domain) is refused."""
+    m = problem.scenario.spec["model"]
+    if m["static_force"] == "acra2012_polynomial":
+        return
+    spec = get_static_model(m["static_force"])
+    shapers = set(spec.parameters) | set(spec.optional) | set(TABLE_SHAPERS)
+    for name in problem.free:
+        if name in shapers:
+            raise InputError(f"--free: {name!r} shapes the force table of static model {m['static_force']!r}, "
+                             "which the native backend builds once per fit; fit it with --backend python")
+
+
 def executor_workers(executor) -> int:
     """Worker count of ``executor``: ``concurrent.futures`` pools keep it as ``_max_workers`` (there is
     no public attribute); for other executors, the machine's CPU count."""
@@ -109,6 +129,7 @@ class NativeTrials:
     at its sample times for every row of ``thetas``, theta-major (the Python backend's task order)."""
 
     def __init__(self, problem, rtol: float):
+        _refuse_free_table_parameters(problem)
         self.cases = []
         for tr, w, sig in zip(problem.traces, problem.loads_N, problem.inputs):
             sc = trace_scenario(problem.scenario, {}, w, float(tr.t_s[-1] - tr.t_s[0]), rtol)

@@ -10,8 +10,10 @@ Differences from the Python backend, all documented in ``docs/scaling.md``:
 - the integrator is the core's Dormand-Prince 5(4) at the scenario's ``rtol``
   (``solver.method`` may be ``LSODA``, the automatic choice, or ``RK45``, the
   same method; the implicit ones are refused);
-- the work integrals are trapezoid sums over the sample grid with every event
-  as a node (the Python backend integrates them as states);
+- a static force other than the ACRA 2012 polynomial is the FMU's bicubic force
+  table of the model (:func:`force_table`), not the model itself;
+- the work integrals are Gauss-Legendre quadratures of each step's dense output
+  (the Python backend integrates them as states);
 - a signal that is neither constant nor a step (ramp, lag, trace, external
   force) is held at its midpoint value over intervals of at most
   :func:`hold_interval_s`, a second-order approximation.
@@ -21,6 +23,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections import OrderedDict
 from dataclasses import dataclass
 from typing import Sequence
 
@@ -29,7 +32,8 @@ import numpy as np
 from ..core_table import C_CHOICES, SCENARIO_KEYS, unimplemented_choice
 from ..elements.pressure_source import ValveChamberSource
 from ..errors import InputError, SolverFailure
-from ..fmu.runner import REPRESENTED
+from ..fmu.force_table import ForceTable
+from ..fmu.runner import REPRESENTED, tabulate_model
 from ..model import Mode, MuscleModel
 from ..result import Result, TransitionEvent
 from ..scenario import Scenario
@@ -61,6 +65,7 @@ class CaseInputs:
     segment_u: np.ndarray
     max_events: int
     model: MuscleModel
+    table: ForceTable | None = None
 
 
 def refuse_unsupported(scenario: Scenario) -> None:
@@ -73,7 +78,10 @@ def refuse_unsupported(scenario: Scenario) -> None:
             name = f"{section}.{key}" if section else key
             raise InputError(f"{where}: {name}: the native backend cannot honour this key; "
                              "run it with the python backend")
-    lacking = unimplemented_choice(spec)
+    if spec["model"]["static_force_negative"] != "clip":
+        raise InputError(f"{where}: model.static_force_negative = {spec['model']['static_force_negative']!r}: "
+                         "the C core clips a negative static force at zero; run it with the python backend")
+    lacking = unimplemented_choice(spec, skip=("static_force",))  # any static force: through a force table
     if lacking:
         key = next(k for k, w in SCENARIO_KEYS.items() if w == lacking[0])
         raise InputError(f"{where}: {lacking[0]} = {lacking[1]!r}: the C core implements only "
@@ -82,10 +90,33 @@ def refuse_unsupported(scenario: Scenario) -> None:
     if method not in METHODS:
         raise InputError(f"{where}: solver.method = {method!r}: the native backend integrates with Dormand-Prince "
                          f"5(4) and honours only {', '.join(METHODS)}; run it with the python backend")
+    if spec["model"]["static_force"] != "acra2012_polynomial":
+        return  # a parameter the core lacks (wall_thickness_m, E_bladder_Pa, ...) only shapes the force table
     for name in scenario.parameters.entries:
         if name not in lib.REAL_INDEX:
             raise InputError(f"{where}: parameters.{name}: the C core has no such parameter "
-                             f"(parameter set {spec['model']['parameter_set']!r}); run it with the python backend")
+                             f"(muscle {spec['model']['muscle']!r}); run it with the python backend")
+
+
+TABLE_CACHE_SIZE = 32
+"""Force tables kept per process: a sweep's cases share their muscle's table."""
+_tables: "OrderedDict[tuple, ForceTable]" = OrderedDict()
+
+
+def force_table(scenario: Scenario) -> ForceTable | None:
+    """The static force table of ``scenario`` as the FMU would bake it (:func:`pamsim.fmu.runner.tabulate_model`),
+    or None for the ACRA 2012 polynomial, which the core computes exactly.  Tables are cached by the
+    model, its variant, the parameters and the force-map file, so the cases of a sweep tabulate once."""
+    m = scenario.spec["model"]
+    if m["static_force"] == "acra2012_polynomial":
+        return None
+    key = (m["static_force"], m.get("static_force_variant"), tuple(sorted(scenario.parameters.items())),
+           scenario.muscle.force_map_file if scenario.muscle is not None else None)
+    if key not in _tables:
+        _tables[key] = tabulate_model(scenario)
+        if len(_tables) > TABLE_CACHE_SIZE:
+            _tables.popitem(last=False)
+    return _tables[key]
 
 
 def _signals(model: MuscleModel) -> tuple:
@@ -123,7 +154,8 @@ def case_inputs(scenario: Scenario, model: MuscleModel | None = None) -> CaseInp
     n_samples = int(round(T * opts.sample_rate_Hz)) + 1
     reals = lib.REAL_DEFAULTS.copy()
     for name, value in scenario.parameters.items():
-        reals[lib.REAL_INDEX[name]] = value
+        if name in lib.REAL_INDEX:  # the others shape the force table (refuse_unsupported)
+            reals[lib.REAL_INDEX[name]] = value
     fmu_own = {"initial_contraction_m": scenario.initial_contraction_m,
                "initial_pressure_gauge_Pa": scenario.initial_pressure_gauge_Pa or 0.0,
                "stick_margin_N": opts.stick_margin_N, "release_margin_N": opts.release_margin_N,
@@ -138,6 +170,9 @@ def case_inputs(scenario: Scenario, model: MuscleModel | None = None) -> CaseInp
                "friction_negative_level": ("friction_negative_level", spec["model"]["friction_negative_level"])}
     for name, (key, value) in choices.items():
         ints[lib.INT_INDEX[name]] = C_CHOICES[key].index(value)
+    table = force_table(scenario)
+    ints[lib.INT_INDEX["static_force_model"]] = C_CHOICES["static_force_model"].index(
+        "acra2012_polynomial" if table is None else "table")
     signals = _signals(model)
     hold = hold_interval_s(signals, T / max(n_samples - 1, 1))
     bounds = {0.0} | {float(b) for b in model.breakpoints if 0.0 < b < T}
@@ -150,15 +185,22 @@ def case_inputs(scenario: Scenario, model: MuscleModel | None = None) -> CaseInp
         if sig is not None:
             u[:, k] = sig(mid)
     u[:, lib.INPUTS.index("load_mass_kg")] = model.load.mass_kg
-    return CaseInputs(reals, ints, T, n_samples, starts, u, opts.max_events, model)
+    return CaseInputs(reals, ints, T, n_samples, starts, u, opts.max_events, model, table)
 
 
 def _run(cases: Sequence[CaseInputs], capacity: Sequence[int]) -> dict:
+    tables: list[ForceTable] = []
+    index: dict[int, int] = {}  # id(table) -> its place in tables: the cases of one muscle share one table
+    for c in cases:
+        if c.table is not None and id(c.table) not in index:
+            index[id(c.table)] = len(tables)
+            tables.append(c.table)
     return lib.run_batch(np.array([c.reals for c in cases]), np.array([c.ints for c in cases]),
                          np.array([c.duration_s for c in cases]), np.array([c.n_samples for c in cases]),
                          np.array([len(c.segment_t_s) for c in cases]),
                          np.concatenate([c.segment_t_s for c in cases]), np.concatenate([c.segment_u for c in cases]),
-                         np.asarray(capacity))
+                         np.asarray(capacity), tables,
+                         np.array([-1 if c.table is None else index[id(c.table)] for c in cases]))
 
 
 _MODE_LABELS = {int(m): m.label for m in Mode}
