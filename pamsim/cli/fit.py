@@ -129,8 +129,9 @@ def register(sub) -> None:
     d.add_argument("--per-trace", action="store_true", help="also fit every trace alone (Table 4 layout)")
     d.add_argument("--global", dest="global_search", action="store_true",
                    help="differential evolution over start +- 50 %% before the local fit")
-    d.add_argument("--workers", type=_workers, default=os.cpu_count() or 1,
-                   help="worker processes for the simulations (default: number of CPUs)")
+    d.add_argument("--workers", type=_workers, default=None,
+                   help="worker processes for the simulations (default: number of CPUs with the python backend; "
+                        "1 with native, whose optimiser steps are too few cases to gain from workers)")
     d.add_argument("--max-iterations", type=_count, default=30, help="residual evaluations of the local fit")
     d.add_argument("--fd-step", type=finite_float, default=choices.FD_RELATIVE_STEP,
                    help="relative finite-difference step (default 1e-3)")
@@ -194,6 +195,8 @@ def run_dynamic(args: argparse.Namespace) -> int:
                    per_trace=args.per_trace, seed=args.seed, fd_step=args.fd_step,
                    max_iterations=args.max_iterations, knot_tolerance_Pa=args.knot_tolerance_Pa,
                    backend=args.backend)
+    if args.workers is None:
+        args.workers = 1 if args.backend == "native" else os.cpu_count() or 1
     if args.workers == 1:
         fit = dynamic_fit.fit_dynamic(scenario, traces, executor=None, **options)
     else:
