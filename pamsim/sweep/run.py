@@ -335,11 +335,13 @@ def _execute(tasks: list[_Task], executor: Executor | None, bar, chunk_size: int
     outputs: list[dict | None] = [None] * len(tasks)
     failed = 0
     if executor is None:
-        for i, task in enumerate(tasks):
-            outputs[i] = run_task(task)
-            failed += bool(outputs[i]["error"])
+        # In batches of NATIVE_BATCH, as a worker runs its chunk (the native backend's runs share library calls).
+        for i in range(0, len(tasks), NATIVE_BATCH):
+            chunk = run_chunk(tasks[i:i + NATIVE_BATCH])
+            outputs[i:i + len(chunk)] = chunk
+            failed += sum(bool(o["error"]) for o in chunk)
             bar.set_postfix(failed=failed, refresh=False)
-            bar.update(1)
+            bar.update(len(chunk))
         return outputs
     starts = range(0, len(tasks), chunk_size)
     futures = {executor.submit(run_chunk, tasks[i:i + chunk_size]): i for i in starts}
