@@ -102,16 +102,21 @@ def load_muscle(name_or_path: str | Path) -> Muscle:
         if not path.is_file():
             raise MuscleError(f"{path}: no such muscle file")
     else:
-        names = shipped_names()
+        names = _shipped_names()
         if text not in names:
             raise MuscleError(f"muscle = {text!r}: unknown muscle{did_you_mean(text, names)} "
                               f"(shipped: {', '.join(names)})")
-        path = Path(str(resources.files(__name__).joinpath(text + ".toml")))
+        path = _shipped_path(text)
     try:
         stat = path.stat()
     except OSError as exc:
         raise MuscleError(f"{path}: cannot read: {exc}") from None
     return _load_file(path, stat.st_mtime_ns, stat.st_size)
+
+
+@lru_cache(maxsize=None)
+def _shipped_path(name: str) -> Path:
+    return Path(str(resources.files(__name__).joinpath(name + ".toml")))
 
 
 @lru_cache(maxsize=64)
