@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -46,23 +47,25 @@ def _finite(model, x: float, p: float) -> bool:
         return False
 
 
-def _finite_on_grid(model, xs: np.ndarray, ps: np.ndarray) -> bool:
-    """True if one vectorised call finds the force finite at every grid point.  False decides nothing:
-    the caller then asks point by point, as a model written for scalars needs."""
-    X, P = np.meshgrid(xs, ps)
-    try:
-        with np.errstate(all="ignore"):
-            F = np.asarray(model.force_N(X, P), dtype=float)
-    except (ValueError, TypeError, ZeroDivisionError, OverflowError):
-        return False
-    return F.shape == X.shape and bool(np.isfinite(F).all())
-
-
 def within_domain_if_needed(model, x_range_m: tuple[float, float], p_range_Pa: tuple[float, float]):
     """``model`` itself if it is finite over the reachable region, else it clamped to its domain."""
+    try:
+        return _within_domain_cached(model, tuple(x_range_m), tuple(p_range_Pa))
+    except TypeError:  # a model that cannot be hashed (it holds arrays): decided afresh
+        return _within_domain(model, x_range_m, p_range_Pa)
+
+
+@lru_cache(maxsize=256)
+def _within_domain_cached(model, x_range_m: tuple[float, float], p_range_Pa: tuple[float, float]):
+    # Models are immutable values: a sweep that builds the same model thousands of times probes it once.
+    return _within_domain(model, x_range_m, p_range_Pa)
+
+
+def _within_domain(model, x_range_m, p_range_Pa):
+    # Point by point, as the dynamics evaluate it: a model's array form may guard what its scalar form does not.
     xs = np.linspace(x_range_m[0], x_range_m[1], _PROBE)
     ps = np.linspace(p_range_Pa[0], p_range_Pa[1], _PROBE)
-    if _finite_on_grid(model, xs, ps) or all(_finite(model, float(x), float(p)) for x in xs for p in ps):
+    if all(_finite(model, float(x), float(p)) for x in xs for p in ps):
         return model
     d = model.domain
     return DomainClampedForce(model, d.x_min_m, d.x_max_m, d.p_min_Pa, d.p_max_Pa)
