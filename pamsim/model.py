@@ -139,8 +139,7 @@ class MuscleModel:
 
     def pressure_trace_Pa(self, t, Y) -> np.ndarray:
         """Gauge pressure [Pa] the mechanics see at times ``t`` of a trace ``Y`` (one column per time)."""
-        S = Y[2:2 + self.n_source]
-        return np.asarray(self.source.pressure_gauge_Pa(S, self.source.inputs(t)), dtype=float) + 0.0 * t
+        return self.source.pressure_trace_Pa(t, Y[2:2 + self.n_source])
 
     def breakdown(self, t, Y, modes) -> dict[str, np.ndarray]:
         """Force components [N] along x (positive contracts) and source outputs for a trace.

@@ -128,14 +128,17 @@ def _turning_indices(y: np.ndarray, hysteresis: float) -> list[int]:
     """Indices of turning points confirmed by a reversal larger than ``hysteresis``.
 
     A zig-zag filter: follow the running extreme in the current direction and
-    record it once the trace has come back by more than ``hysteresis``.
+    record it once the trace has come back by more than ``hysteresis``.  It visits
+    only :func:`_candidates` (the first sample of every local extremum and the ends),
+    which gives the same points as visiting every sample.
     """
     found: list[int] = []
     direction = 0
     extreme = 0
     n = y.size
+    idx = _candidates(y).tolist()
     y = y.tolist()  # Python floats: indexing a numpy array per sample costs several times more
-    for i in range(1, n):
+    for i in idx[1:]:
         if direction == 0:
             # The first motion away from the start sets the direction; the start itself is not
             # a turning point (the response to a step begins there, not an oscillation).
@@ -153,6 +156,24 @@ def _turning_indices(y: np.ndarray, hysteresis: float) -> list[int]:
     if direction != 0 and extreme <= n - 3:
         found.append(extreme)
     return found
+
+
+def _candidates(y: np.ndarray) -> np.ndarray:
+    """The samples the zig-zag filter can stop at: the first sample, the first sample of every local
+    extremum and of the last value (a plateau counts from its first sample).
+
+    A sample equal to its predecessor changes nothing in the filter (it neither passes the running
+    extreme nor reverses further), and inside a strictly monotone run the running extreme moves on to
+    the run's end whether or not the filter turned inside it; so the filter's turning points are among
+    these samples.  A flat (stuck) stretch of a trace costs nothing.
+    """
+    n = y.size
+    if n < 3:
+        return np.arange(n)
+    new = np.concatenate(([0], np.flatnonzero(np.diff(y) != 0.0) + 1))  # first sample of each new value
+    rising = np.diff(y[new]) > 0.0
+    turns = new[1:-1][rising[1:] != rising[:-1]]
+    return np.unique(np.concatenate(([0], turns, new[-1:])))
 
 
 def _refine_time(t: np.ndarray, y: np.ndarray, i: int) -> float:

@@ -95,12 +95,19 @@ class Result:
 
     @classmethod
     def from_trace(cls, model: "MuscleModel", name, t, Y, modes, transitions, impact_losses, stats, wall_time_s,
-                   peaks: dict[str, float] | None = None):
+                   peaks: dict[str, float] | None = None, impacts_J: np.ndarray | None = None):
+        """A Result from a sampled trace ``Y`` (one row per model state, one column per time ``t`` [s]).
+
+        ``impact_losses`` lists ``(t_s, loss_J)`` of every event; ``impacts_J`` is their running sum
+        at the samples [J] where the backend has it, else it is summed here.
+        """
         work = {key: Y[-N_WORK + i] for i, key in enumerate(model.state_names[-N_WORK:])}
-        loss_t = np.array([a for a, _ in impact_losses])
         loss_J = np.array([b for _, b in impact_losses])
-        cum = np.concatenate([[0.0], np.cumsum(loss_J)])
-        work["E_impacts_J"] = cum[np.searchsorted(loss_t, t, side="right")]
+        if impacts_J is None:
+            loss_t = np.array([a for a, _ in impact_losses])
+            cum = np.concatenate([[0.0], np.cumsum(loss_J)])
+            impacts_J = cum[np.searchsorted(loss_t, t, side="right")]
+        work["E_impacts_J"] = impacts_J
         sig = Signals(work, model, t, Y, modes)
         p = model.pressure_trace_Pa(t, Y)
         fr = model.fit_range
@@ -116,7 +123,7 @@ class Result:
         if p_hi > fr.p_max_gauge_Pa:
             violations.append(f"pressure up to {p_hi / 1e5:.3f} bar, above the fitted {fr.p_max_gauge_Pa / 1e5:.2f} bar")
         final = model.rest_forces(float(t[-1]), Y[:, -1])
-        return cls(name, t, Y[0].copy(), Y[1].copy(), p, modes, sig, transitions, stats, wall_time_s,
+        return cls(name, t, Y[0], Y[1], p, modes, sig, transitions, stats, wall_time_s,
                    model.load.mass_kg, model.load.g_m_s2, float(loss_J.sum()), final, violations, peaks=peaks, model=model)
 
     # ------------------------------------------------------------------ queries

@@ -86,8 +86,12 @@ class Scenario:
     def from_dict(cls, spec: Mapping[str, Any], name: str | None = None, base_dir: str | Path = ".",
                   origin: str = "<dict>") -> "Scenario":
         """Validate ``spec`` (the same structure as a TOML file) and return a Scenario."""
+        return cls._from_own_dict(copy.deepcopy(dict(spec)), name, base_dir, origin)
+
+    @classmethod
+    def _from_own_dict(cls, spec: dict, name: str | None, base_dir: str | Path, origin: str) -> "Scenario":
+        """:meth:`from_dict` of a dict nobody else holds (it is completed in place and kept)."""
         v = _Validator(origin, Path(base_dir))
-        spec = copy.deepcopy(dict(spec))
         v.check_table("", spec)
         for section in ("model", "load", "pressure", "simulation", "solver"):
             if section in spec:
@@ -178,7 +182,7 @@ class Scenario:
                 for k in pair:
                     if given and k not in given:
                         spec[section].pop(k, None)
-        return Scenario.from_dict(spec, name or self.name, self.base_dir, self.origin)
+        return Scenario._from_own_dict(spec, name or self.name, self.base_dir, self.origin)
 
     # ------------------------------------------------------------ model build
     @property

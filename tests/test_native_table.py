@@ -18,6 +18,8 @@ from pamsim.errors import InputError
 from pamsim.fmu.generate import c_source_dir, shared_header
 from pamsim.fmu.runner import start_values
 from pamsim.model import Mode
+from pamsim.native import library
+from pamsim.native.backend import case_inputs
 from pamsim.parameters import get_parameter_set
 from pamsim.static_models.geometry import Braid
 
@@ -81,15 +83,22 @@ def _scenario(key: str, value: str) -> pamsim.Scenario:
 
 
 def _assert_refused_by_the_c_backends(scenario: pamsim.Scenario, key: str, value: str) -> None:
-    """Native refuses the choice naming it; so does the FMU, except a static force, which the FMU runs
-    through its force table (a C counterpart for any static model)."""
+    """Native and FMU refuse the choice naming it, except a static force, which both run through the
+    force table (the C counterpart of any static model): its nodes hold the model's own force."""
     where = core_table.SCENARIO_KEYS[key]
-    with pytest.raises(InputError, match=rf"{re.escape(where)} = {value!r}"):
-        pamsim.simulate(scenario, backend="native")
     if key == "static_force":
         table = core_table.C_CHOICES["static_force_model"].index("table")
         assert start_values(scenario)["static_force_model"] == table
+        case = case_inputs(scenario)
+        assert case.ints[library.INT_INDEX["static_force_model"]] == table
+        t = case.table
+        i, j = t.shape[0] // 2, t.shape[1] // 2
+        x = t.x_min_m + i * (t.x_max_m - t.x_min_m) / (t.shape[0] - 1)
+        p = t.p_min_Pa + j * (t.p_max_Pa - t.p_min_Pa) / (t.shape[1] - 1)
+        assert t.values[i, j, 0] == pytest.approx(float(scenario.static_model().force_N(x, p)), rel=1e-12, abs=1e-9)
         return
+    with pytest.raises(InputError, match=rf"{re.escape(where)} = {value!r}"):
+        pamsim.simulate(scenario, backend="native")
     with pytest.raises(InputError, match=rf"{re.escape(where)} = {value!r}"):
         start_values(scenario)
 

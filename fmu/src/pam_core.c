@@ -30,8 +30,11 @@ void pam_logf(PamCore *c, int level, const char *fmt, ...) {
     c->log(c->log_env, level, buf);
 }
 
+static const PamTable BUILT_IN_TABLE = {PAM_FT_NX, PAM_FT_NP, PAM_FT_X0, PAM_FT_DX, PAM_FT_P0, PAM_FT_DP, PAM_FT};
+
 void pam_reset(PamCore *c) {
     int k;
+    c->table = &BUILT_IN_TABLE;
     for (k = 0; k < PAM_NVARS; k++) {
         if (PAM_VARS[k].kind == 'r') c->r[PAM_VARS[k].index] = PAM_VARS[k].start;
         else if (PAM_VARS[k].kind) c->i[PAM_VARS[k].index] = (int32_t)PAM_VARS[k].start;
@@ -68,17 +71,24 @@ static double pressure_gauge_Pa(const PamCore *c, const double *y) {
     return y[P] - c->r[R_p_atm_Pa];
 }
 
-/* The force table baked in at build time (pamsim.fmu.force_table): bicubic Hermite interpolation
- * of the value and the derivatives F_x, F_p, F_xp at the four corners of the cell holding (x, p).
- * Outside the grid the edge cell's cubic extrapolates. */
-static double table_force_N(double x, double p) {
-    double u = (x - PAM_FT_X0) / PAM_FT_DX, w = (p - PAM_FT_P0) / PAM_FT_DP, s, t, f = 0.0;
+static int has_table(const PamCore *c) {
+    return c->table != NULL && c->table->nx >= 2 && c->table->np >= 2;
+}
+
+/* The force table (pamsim.fmu.force_table; the FMU's baked in at build time, the native library's
+ * given per case): bicubic Hermite interpolation of the value and the derivatives F_x, F_p, F_xp at
+ * the four corners of the cell holding (x, p).  Outside the grid the edge cell's cubic extrapolates. */
+static double table_force_N(const PamCore *c, double x, double p) {
+    const PamTable *T = c->table;
+    double u, w, s, t, f = 0.0;
     int i, j, a, b;
     /* No table (the parameter check refuses the choice; an initialisation-mode read may still get here). */
-    if (PAM_FT_NX < 2 || PAM_FT_NP < 2) return NAN;
+    if (!has_table(c)) return NAN;
+    u = (x - T->x0) / T->dx;
+    w = (p - T->p0) / T->dp;
     /* Clamped as doubles, so that a non-finite argument cannot make an out-of-range index. */
-    i = (int)fmin(fmax(floor(u), 0.0), PAM_FT_NX - 2.0);
-    j = (int)fmin(fmax(floor(w), 0.0), PAM_FT_NP - 2.0);
+    i = (int)fmin(fmax(floor(u), 0.0), T->nx - 2.0);
+    j = (int)fmin(fmax(floor(w), 0.0), T->np - 2.0);
     s = u - i;
     t = w - j;
     {
@@ -87,9 +97,9 @@ static double table_force_N(double x, double p) {
         double vt[2] = {(2 * t - 3) * t * t + 1, (3 - 2 * t) * t * t}, dt[2] = {((t - 2) * t + 1) * t, (t - 1) * t * t};
         for (a = 0; a < 2; a++)
             for (b = 0; b < 2; b++) {
-                const double *n = PAM_FT[(i + a) * PAM_FT_NP + (j + b)];
-                f += vs[a] * vt[b] * n[0] + ds[a] * PAM_FT_DX * vt[b] * n[1] + vs[a] * dt[b] * PAM_FT_DP * n[2]
-                     + ds[a] * PAM_FT_DX * dt[b] * PAM_FT_DP * n[3];
+                const double *n = T->nodes[(i + a) * T->np + (j + b)];
+                f += vs[a] * vt[b] * n[0] + ds[a] * T->dx * vt[b] * n[1] + vs[a] * dt[b] * T->dp * n[2]
+                     + ds[a] * T->dx * dt[b] * T->dp * n[3];
             }
     }
     return f;
@@ -100,7 +110,7 @@ static double table_force_N(double x, double p) {
 static double static_force_N(const PamCore *c, double x, double p_gauge) {
     const double *r = c->r;
     double p_bar = p_gauge / PA_PER_BAR, f;
-    if (c->i[I_static_force_model] == PAM_STATIC_FORCE_MODEL_TABLE) f = table_force_N(x, p_gauge);
+    if (c->i[I_static_force_model] == PAM_STATIC_FORCE_MODEL_TABLE) f = table_force_N(c, x, p_gauge);
     else f = ((r[R_K1_N_per_bar_m2] * x + r[R_K2_N_per_bar_m]) * x + r[R_C1_N_per_bar]) * p_bar
              + (r[R_S1_N_per_m2] * x + r[R_S2_N_per_m]) * x + r[R_S3_N];
     return f < 0.0 ? 0.0 : f;  /* NaN (a table choice without a table) stays NaN */
@@ -307,7 +317,7 @@ int pam_check_parameters(PamCore *c) {
                  r[R_release_margin_N], r[R_stick_margin_N]);
         bad = -1;
     }
-    if (c->i[I_static_force_model] == PAM_STATIC_FORCE_MODEL_TABLE && PAM_FT_NX < 2) {
+    if (c->i[I_static_force_model] == PAM_STATIC_FORCE_MODEL_TABLE && !has_table(c)) {
         pam_logf(c, PAM_LOG_ERROR, "invalid parameters: static_force_model = 1 (table): this FMU was built without "
                  "a force table (build it with pamsim fmu build --scenario)");
         bad = -1;

@@ -34,6 +34,15 @@ typedef void (*PamStepFn)(void *env, double t0_s, double t1_s, double h_s, const
 typedef void (*PamEventFn)(void *env, double t_s, int from_mode, int to_mode, const double *y_before,
                            const double *y_after);
 
+/* A static force table (pamsim.fmu.force_table): (F, F_x, F_p, F_xp) at the nodes of a uniform grid,
+ * node (i, j) at index i * np + j.  The FMU's is baked in at build time; the native library passes
+ * one per case. */
+typedef struct {
+    int nx, np;
+    double x0, dx, p0, dp;
+    const double (*nodes)[4];
+} PamTable;
+
 typedef struct PamCore {
     double r[PAM_NR];
     int32_t i[PAM_NI];
@@ -50,6 +59,7 @@ typedef struct PamCore {
     void *event_env;
     PamStepFn on_step;
     void *step_env;
+    const PamTable *table; /* static_force_model = table; pam_reset points it at the built-in one */
 } PamCore;
 
 void pam_reset(PamCore *c);

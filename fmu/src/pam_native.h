@@ -53,12 +53,18 @@ typedef struct {
     const double *segment_u;      /* PAM_NATIVE_NU values held over each segment */
     const int64_t *event_capacity; /* n_cases: rows available in events */
     const int64_t *event_offset;
+    const int64_t *table_index;   /* n_cases: the case's static force table, or -1 (the core's built-in, none) */
+    const double *table_grid;     /* per table: nx, np, x0 [m], dx [m], p0 [Pa], dp [Pa] */
+    const int64_t *table_offset;  /* per table: its first node in table_nodes */
+    const double *table_nodes;    /* every table's nodes x 4: F [N], F_x [N/m], F_p [N/Pa], F_xp [N/(m Pa)] */
     double *samples;              /* out: per case a PAM_NATIVE_NOUT x n_samples block (column-major) */
     int32_t *modes;               /* out: rows */
     double *events;               /* out: event rows x PAM_NATIVE_NEV */
     int64_t *n_events;            /* out: n_cases */
     int64_t *stats;               /* out: n_cases x 3: RHS evaluations, accepted steps, integration segments */
     int32_t *status;              /* out: n_cases, PamStatus */
+    double *peaks;                /* out: n_cases x 3: largest x, smallest x, largest gauge pressure of the
+                                     solution at every step end and event (samples may miss a peak) */
     char *messages;               /* out: n_cases x PAM_NATIVE_MSG, the first error */
 } PamBatch;
 

@@ -129,13 +129,16 @@ def register(sub) -> None:
     d.add_argument("--per-trace", action="store_true", help="also fit every trace alone (Table 4 layout)")
     d.add_argument("--global", dest="global_search", action="store_true",
                    help="differential evolution over start +- 50 %% before the local fit")
-    d.add_argument("--workers", type=_workers, default=os.cpu_count() or 1,
-                   help="worker processes for the simulations (default: number of CPUs)")
+    d.add_argument("--workers", type=_workers, default=None,
+                   help="worker processes for the simulations (default: number of CPUs with the python backend; "
+                        "1 with native, whose optimiser steps are too few cases to gain from workers)")
     d.add_argument("--max-iterations", type=_count, default=30, help="residual evaluations of the local fit")
     d.add_argument("--fd-step", type=finite_float, default=choices.FD_RELATIVE_STEP,
                    help="relative finite-difference step (default 1e-3)")
     d.add_argument("--knot-tolerance-Pa", type=finite_float, default=choices.KNOT_TOLERANCE_PA,
                    help="largest deviation of the thinned measured pressure [Pa] (default 10)")
+    d.add_argument("--backend", choices=choices.DYNAMIC_BACKENDS, default="python",
+                   help="simulator of the fit: python (default) or native (the C core, one batch per step)")
     d.add_argument("--seed", type=_count, default=0, help="seed of --global (default 0)")
     d.add_argument("-o", "--output", required=True, help="output directory")
     d.add_argument("--json", action="store_true", help="print fit.json to stdout")
@@ -190,7 +193,10 @@ def run_dynamic(args: argparse.Namespace) -> int:
     check_output_dir(args.output)
     options = dict(free=args.free, window_s=args.window, loads_N=args.load_N, global_search=args.global_search,
                    per_trace=args.per_trace, seed=args.seed, fd_step=args.fd_step,
-                   max_iterations=args.max_iterations, knot_tolerance_Pa=args.knot_tolerance_Pa)
+                   max_iterations=args.max_iterations, knot_tolerance_Pa=args.knot_tolerance_Pa,
+                   backend=args.backend)
+    if args.workers is None:
+        args.workers = 1 if args.backend == "native" else os.cpu_count() or 1
     if args.workers == 1:
         fit = dynamic_fit.fit_dynamic(scenario, traces, executor=None, **options)
     else:
@@ -201,7 +207,7 @@ def run_dynamic(args: argparse.Namespace) -> int:
         print(report.json_text(fit.to_json()), end="")
         return 0
     print(f"{len(traces)} trace(s): pooled RMS {fit.rms_pooled_mm:.4f} mm, {fit.n_simulations} simulations in "
-          f"{fit.wall_time_s:.2f} s on {args.workers} worker(s)")
+          f"{fit.wall_time_s:.2f} s on {args.workers} worker(s), {args.backend} backend")
     for name, value in fit.parameters.items():
         print(f"  {name} = {value:.6g}")
     for a, b, r in fit.uncertainty.inseparable_pairs():

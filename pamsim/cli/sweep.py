@@ -65,7 +65,7 @@ def run(args: argparse.Namespace) -> int:
         with output_folder(args.output) as out:  # checked before the runs; removed again if nothing gets written
             result = run_sweep(spec, executor, progress=not args.no_progress, backend=args.backend,
                                chunk_size=args.chunk_size)
-            names = result.write(out)
+            names = result.write(out, executor)
     for failure in result.failures:
         print(f"pamsim: warning: failed run {failure}", file=sys.stderr)
     samples = f", {spec.uncertainty.samples} uncertainty samples" if spec.uncertainty is not None else ""

@@ -199,6 +199,9 @@ class ClosedLoopValveSource:
     def pressure_gauge_Pa(self, s, inputs):
         return s[0] - self.p_atm_Pa
 
+    def pressure_trace_Pa(self, t_s, S):
+        return self.plant.pressure_trace_Pa(t_s, S)
+
     def command(self, s, x_m, inputs):
         """(clipped, unclipped) valve command for source states ``s`` at contraction ``x_m``."""
         r, p_ff, _ = inputs

@@ -68,6 +68,9 @@ class PressureSource(Protocol):
     def pressure_gauge_Pa(self, s: Sequence[float], inputs: tuple):
         """Gauge pressure [Pa] the mechanics see, from the source's states and inputs."""
 
+    def pressure_trace_Pa(self, t_s, S):
+        """Gauge pressure [Pa] along a trace: times ``t_s`` [s], states ``S`` of shape (n_states, n_times)."""
+
     def derivatives(self, s: Sequence[float], x_m: float, v_m_s: float, inputs: tuple) -> tuple:
         """Time derivatives of the source's states."""
 

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -48,6 +49,20 @@ def _finite(model, x: float, p: float) -> bool:
 
 def within_domain_if_needed(model, x_range_m: tuple[float, float], p_range_Pa: tuple[float, float]):
     """``model`` itself if it is finite over the reachable region, else it clamped to its domain."""
+    try:
+        return _within_domain_cached(model, tuple(x_range_m), tuple(p_range_Pa))
+    except TypeError:  # a model that cannot be hashed (it holds arrays): decided afresh
+        return _within_domain(model, x_range_m, p_range_Pa)
+
+
+@lru_cache(maxsize=256)
+def _within_domain_cached(model, x_range_m: tuple[float, float], p_range_Pa: tuple[float, float]):
+    # Models are immutable values: a sweep that builds the same model thousands of times probes it once.
+    return _within_domain(model, x_range_m, p_range_Pa)
+
+
+def _within_domain(model, x_range_m, p_range_Pa):
+    # Point by point, as the dynamics evaluate it: a model's array form may guard what its scalar form does not.
     xs = np.linspace(x_range_m[0], x_range_m[1], _PROBE)
     ps = np.linspace(p_range_Pa[0], p_range_Pa[1], _PROBE)
     if all(_finite(model, float(x), float(p)) for x in xs for p in ps):

@@ -46,6 +46,9 @@ class ValveChamberSource:
     def pressure_gauge_Pa(self, s, inputs):
         return s[0] - self.p_atm_Pa
 
+    def pressure_trace_Pa(self, t_s, S):
+        return np.asarray(S[0], dtype=float) - self.p_atm_Pa  # a state: the inputs are not needed
+
     def inflow_kg_s(self, s, V, inputs):
         """Valve mass flow into the chamber [kg/s] and the chamber gas temperature [K] at volume V [m^3]."""
         p, m = s[0], s[1]
@@ -98,6 +101,9 @@ class PrescribedPressure:
 
     def pressure_gauge_Pa(self, s, inputs):
         return inputs[0]
+
+    def pressure_trace_Pa(self, t_s, S):
+        return np.asarray(self.p_gauge_Pa(t_s), dtype=float) + 0.0 * t_s
 
     def derivatives(self, s, x_m, v_m_s, inputs) -> tuple[()]:
         return ()

@@ -16,3 +16,6 @@ FD_RELATIVE_STEP = 1e-3
 coefficients below 1)."""
 DYNAMIC_DEFAULT_FREE = ("D1_N_s_per_m", "D2_N_s2_per_m2", "N2_N_per_bar_m2", "N1_N_per_bar_m", "N0_N_per_bar")
 """The paper's eq. (13) coefficients (its Table 4)."""
+DYNAMIC_BACKENDS = ("python", "native")
+"""Simulators of the dynamic fit (``fit_dynamic(backend=...)``, ``pamsim fit dynamic --backend``); python
+is the default."""

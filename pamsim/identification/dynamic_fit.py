@@ -8,7 +8,9 @@ scenario's own pressure source (its valve).  The load of a trace is its ``weight
 value given by the caller, or the scenario's.
 
 The simulations of one optimiser iteration (every trace, and every finite-difference column of the
-Jacobian) are independent tasks sent to a :class:`concurrent.futures.Executor`, as sweeps do.
+Jacobian) are independent tasks sent to a :class:`concurrent.futures.Executor`, as sweeps do.  On
+the native backend (``backend="native"``, :mod:`.native_fit`) they are one call of the C core's
+batch entry point instead, split into one chunk per worker when there is an executor.
 
 Finite differences: the residuals are exact simulations, but each carries integration error of
 about ``rtol`` times the state scale and event times located to the solver's tolerance.  A step of
@@ -30,7 +32,7 @@ from ..elements.pressure_source import PrescribedPressure
 from ..errors import InputError
 from ..scenario import Scenario
 from ..simulator import simulate_model
-from .choices import DYNAMIC_DEFAULT_FREE, FD_RELATIVE_STEP
+from .choices import DYNAMIC_BACKENDS, DYNAMIC_DEFAULT_FREE, FD_RELATIVE_STEP
 from .columns import TraceData
 from .pressure_input import KNOT_TOLERANCE_PA, PiecewiseLinearInput, thinned_input
 from .uncertainty import Uncertainty, linearised_uncertainty
@@ -38,7 +40,6 @@ from .uncertainty import Uncertainty, linearised_uncertainty
 FIT_RTOL = 1e-8
 """Integrator tolerance of the fit's simulations: the trajectory noise it leaves (about 1e-10 m)
 is far below what a step of FD_RELATIVE_STEP changes."""
-
 
 
 @dataclass(frozen=True)
@@ -61,9 +62,7 @@ def run_simulation(task: SimulationTask) -> np.ndarray:
     of the optimiser does not end the fit; the residuals turn it into a large cost.
     """
     try:
-        changes = {"parameters": dict(task.overrides), "load": {"weight_N": task.weight_N},
-                   "simulation": {"duration_s": task.duration_s}, "solver": {"rtol": FIT_RTOL}}
-        sc = task.scenario.with_changes(changes)
+        sc = trace_scenario(task.scenario, task.overrides, task.weight_N, task.duration_s)
         model = sc.build_model()
         p0 = sc.initial_pressure_gauge_Pa
         if task.pressure_t_s is not None:
@@ -75,10 +74,41 @@ def run_simulation(task: SimulationTask) -> np.ndarray:
         return np.full(task.sample_t_s.shape, np.nan)
 
 
+def trace_scenario(scenario: Scenario, overrides: Mapping[str, float], weight_N: float, duration_s: float,
+                   rtol: float = FIT_RTOL) -> Scenario:
+    """The scenario one trace is simulated with: ``overrides`` of its parameters, the trace's load
+    [N] and duration [s], the fit's integrator tolerance."""
+    return scenario.with_changes({"parameters": dict(overrides), "load": {"weight_N": weight_N},
+                                  "simulation": {"duration_s": duration_s}, "solver": {"rtol": rtol}})
+
+
 def _map(executor, tasks: Sequence[SimulationTask]) -> list[np.ndarray]:
     if executor is None:
         return [run_simulation(t) for t in tasks]
     return list(executor.map(run_simulation, tasks))
+
+
+class PythonTrials:
+    """The fit's simulations on the Python backend: ``trials(thetas, executor)`` gives every trace's
+    contraction at its sample times for every row of ``thetas``, theta-major; one task per simulation."""
+
+    def __init__(self, problem: "DynamicProblem"):
+        self.problem = problem
+
+    def __call__(self, thetas: np.ndarray, executor=None) -> list[np.ndarray]:
+        return _map(executor, [task for t in np.atleast_2d(thetas) for task in self.problem.tasks(t)])
+
+
+def make_trials(problem: "DynamicProblem", backend: str):
+    """The simulations of ``problem`` on ``backend``; refuses (``InputError``) a backend name or a
+    scenario setting the backend cannot honour, before anything runs."""
+    if backend == "python":
+        return PythonTrials(problem)
+    if backend == "native":
+        from .native_fit import NativeTrials  # the C library only when asked for
+
+        return NativeTrials(problem, FIT_RTOL)
+    raise InputError(f"--backend = {backend!r}: choose from {', '.join(DYNAMIC_BACKENDS)}")
 
 
 @dataclass(frozen=True)
@@ -112,8 +142,9 @@ class DynamicProblem:
 class _Objective:
     """Residuals and Jacobian with one batch of parallel simulations each; counts simulations."""
 
-    def __init__(self, problem: DynamicProblem, executor, fd_step: float):
+    def __init__(self, problem: DynamicProblem, executor, fd_step: float, trials=None):
         self.problem = problem
+        self.trials = trials if trials is not None else PythonTrials(problem)
         self.executor = executor
         self.fd_step = fd_step
         self.n_simulations = 0
@@ -122,9 +153,8 @@ class _Objective:
     def simulate(self, theta: np.ndarray) -> list[np.ndarray]:
         key = np.asarray(theta, dtype=float).tobytes()
         if self._cache is None or self._cache[0] != key:
-            tasks = self.problem.tasks(theta)
-            self.n_simulations += len(tasks)
-            self._cache = (key, _map(self.executor, tasks))
+            self.n_simulations += len(self.problem.traces)
+            self._cache = (key, self.trials(np.asarray(theta, dtype=float), self.executor))
         return self._cache[1]
 
     def residuals(self, theta: np.ndarray) -> np.ndarray:
@@ -144,10 +174,9 @@ class _Objective:
             t = np.array(theta, dtype=float)
             t[j] += h[j]
             thetas.append(t)
-        tasks = [task for t in thetas for task in self.problem.tasks(t)]
-        self.n_simulations += len(tasks)
-        sims = _map(self.executor, tasks)
         n_tr = len(self.problem.traces)
+        self.n_simulations += len(thetas) * n_tr
+        sims = self.trials(np.array(thetas), self.executor)
         J = np.empty((r0.size, len(theta)))
         for j in range(len(theta)):
             J[:, j] = (self.problem.residuals_from(sims[j * n_tr:(j + 1) * n_tr]) - r0) / h[j]
@@ -163,6 +192,24 @@ class _SumOfSquares:
     def __call__(self, theta: np.ndarray) -> float:
         r = self.problem.residuals_from([run_simulation(t) for t in self.problem.tasks(theta)])
         return float(r @ r)
+
+
+class _PopulationSumOfSquares:
+    """Eq. (13) cost of a whole population at once (differential evolution's ``vectorized`` form):
+    one batch of simulations per generation, for the native backend; counts its simulations (scipy's
+    ``nfev`` counts calls when vectorized)."""
+
+    def __init__(self, problem: DynamicProblem, trials, executor):
+        self.problem, self.trials, self.executor = problem, trials, executor
+        self.n_simulations = 0
+
+    def __call__(self, thetas: np.ndarray) -> np.ndarray:
+        thetas = np.atleast_2d(np.asarray(thetas, dtype=float).T)  # scipy passes (n_coefficients, S)
+        sims = self.trials(thetas, self.executor)
+        self.n_simulations += len(sims)
+        n_tr = len(self.problem.traces)
+        costs = [self.problem.residuals_from(sims[k * n_tr:(k + 1) * n_tr]) for k in range(len(thetas))]
+        return np.array([r @ r for r in costs])
 
 
 @dataclass
@@ -182,6 +229,7 @@ class DynamicFit:
     success: bool
     message: str
     per_trace: list[dict] | None = None
+    backend: str = "python"
 
     @property
     def traces(self) -> tuple[TraceData, ...]:
@@ -212,7 +260,7 @@ class DynamicFit:
                 "inseparable_pairs": [[a, b, r] for a, b, r in u.inseparable_pairs()],
                 "rms_contraction_mm": {"per_trace": dict(zip(names, self.rms_contraction_mm)),
                                        "pooled": self.rms_pooled_mm},
-                "n_simulations": self.n_simulations, "wall_time_s": self.wall_time_s,
+                "n_simulations": self.n_simulations, "wall_time_s": self.wall_time_s, "backend": self.backend,
                 "success": self.success, "message": self.message}
         if self.per_trace is not None:
             body["per_trace"] = self.per_trace
@@ -269,8 +317,8 @@ def _rms_per_trace(problem: DynamicProblem, sims: Sequence[np.ndarray]) -> list[
             zip(sims, problem.traces, problem.windows)]
 
 
-def _local(problem: DynamicProblem, theta0: np.ndarray, executor, fd_step: float, max_iterations: int):
-    obj = _Objective(problem, executor, fd_step)
+def _local(problem: DynamicProblem, theta0: np.ndarray, executor, fd_step: float, max_iterations: int, trials):
+    obj = _Objective(problem, executor, fd_step, trials)
     scale = np.where(np.abs(theta0) > 0, np.abs(theta0), 1.0)
     lo, hi = problem.bounds
     res = least_squares(lambda z: obj.residuals(z * scale), np.clip(theta0, lo, hi) / scale,
@@ -286,7 +334,7 @@ def fit_dynamic(scenario: Scenario, traces: Sequence[TraceData], free: Sequence[
                 executor=None, global_search: bool = False, global_span: float = 0.5,
                 global_iterations: int = 10, per_trace: bool = False, seed: int = 0,
                 fd_step: float = FD_RELATIVE_STEP, max_iterations: int = 30,
-                knot_tolerance_Pa: float = KNOT_TOLERANCE_PA) -> DynamicFit:
+                knot_tolerance_Pa: float = KNOT_TOLERANCE_PA, backend: str = "python") -> DynamicFit:
     """Fit coefficients (default the paper's D1, D2, N2, N1, N0) to step responses, eq. (13).
 
     Parameters
@@ -312,6 +360,13 @@ def fit_dynamic(scenario: Scenario, traces: Sequence[TraceData], free: Sequence[
         Relative forward-difference step of the Jacobian.
     max_iterations : int
         Residual evaluations allowed to the local optimiser.
+    knot_tolerance_Pa : float
+        Largest deviation [Pa] of the thinned recorded pressure from the recorded one.
+    backend : {"python", "native"}
+        Simulator of the fit.  ``native`` runs each optimiser step's simulations (each
+        differential-evolution generation's too) in one call of the C core, one per worker with an
+        executor; it holds a recorded pressure at its midpoint over every output sample (see
+        :mod:`.native_fit`) and refuses, before anything runs, a scenario setting it cannot honour.
     """
     start_time = time.perf_counter()
     if not (0 < fd_step < 0.1):
@@ -319,6 +374,7 @@ def fit_dynamic(scenario: Scenario, traces: Sequence[TraceData], free: Sequence[
     if max_iterations < 1:
         raise InputError(f"--max-iterations = {max_iterations}: must be at least 1")
     problem = make_problem(scenario, traces, free, window_s, loads_N, knot_tolerance_Pa)
+    trials = make_trials(problem, backend)
     theta0 = np.array([scenario.parameters[n] for n in problem.free], dtype=float)
     n_sim = 0
     start = theta0
@@ -326,18 +382,23 @@ def fit_dynamic(scenario: Scenario, traces: Sequence[TraceData], free: Sequence[
         lo, hi = problem.bounds
         span = global_span * np.maximum(np.abs(theta0), 1e-3)
         de_bounds = list(zip(np.maximum(theta0 - span, lo), np.minimum(theta0 + span, hi)))
-        de_workers = executor.map if executor is not None else 1
-        de = differential_evolution(_SumOfSquares(problem), de_bounds, maxiter=global_iterations, popsize=6,
-                                    seed=seed, polish=False, workers=de_workers, updating="deferred", tol=1e-6,
-                                    x0=theta0)
-        n_sim += de.nfev * len(problem.traces)
+        if backend == "python":
+            de_workers = executor.map if executor is not None else 1
+            cost, vectorized = _SumOfSquares(problem), False
+        else:
+            # a whole generation per call, one batch (scipy then evaluates in this process)
+            cost, vectorized, de_workers = _PopulationSumOfSquares(problem, trials, executor), True, 1
+        de = differential_evolution(cost, de_bounds, maxiter=global_iterations, popsize=6, seed=seed, polish=False,
+                                    workers=de_workers, updating="deferred", tol=1e-6, x0=theta0,
+                                    vectorized=vectorized)
+        n_sim += cost.n_simulations if vectorized else de.nfev * len(problem.traces)
         start = de.x
-    theta, res, obj, J = _local(problem, start, executor, fd_step, max_iterations)
+    theta, res, obj, J = _local(problem, start, executor, fd_step, max_iterations, trials)
     n_sim += obj.n_simulations
     sims = obj.simulate(theta)
     r = problem.residuals_from(sims)
     unc = linearised_uncertainty(problem.free, J, r)
-    start_sims = _map(executor, problem.tasks(theta0))
+    start_sims = trials(theta0, executor)
     n_sim += len(problem.traces)
     rms = _rms_per_trace(problem, sims)
     table = None
@@ -346,7 +407,7 @@ def fit_dynamic(scenario: Scenario, traces: Sequence[TraceData], free: Sequence[
         for i, tr in enumerate(problem.traces):
             sub = replace(problem, traces=(tr,), loads_N=(problem.loads_N[i],), windows=(problem.windows[i],),
                           inputs=(problem.inputs[i],))
-            th_i, res_i, obj_i, _ = _local(sub, theta, executor, fd_step, max_iterations)
+            th_i, res_i, obj_i, _ = _local(sub, theta, executor, fd_step, max_iterations, make_trials(sub, backend))
             n_sim += obj_i.n_simulations
             table.append({"trace": tr.origin, "load_N": problem.loads_N[i],
                           "pressure_final_bar": (float(tr.p_gauge_Pa[-1]) / 1e5 if tr.p_gauge_Pa is not None
@@ -355,8 +416,8 @@ def fit_dynamic(scenario: Scenario, traces: Sequence[TraceData], free: Sequence[
                           "rms_contraction_mm": _rms_per_trace(sub, obj_i.simulate(th_i))[0]})
     pooled = float(np.sqrt(np.mean(r ** 2)))
     return DynamicFit(problem, theta, theta0, unc, sims, start_sims, rms, pooled, n_sim,
-                      time.perf_counter() - start_time, bool(res.success), str(res.message), table)
+                      time.perf_counter() - start_time, bool(res.success), str(res.message), table, backend)
 
 
-__all__ = ["fit_dynamic", "DynamicFit", "DynamicProblem", "make_problem", "run_simulation", "SimulationTask",
-           "DYNAMIC_DEFAULT_FREE", "FD_RELATIVE_STEP"]
+__all__ = ["fit_dynamic", "DynamicFit", "DynamicProblem", "make_problem", "make_trials", "run_simulation",
+           "SimulationTask", "trace_scenario", "DYNAMIC_BACKENDS", "DYNAMIC_DEFAULT_FREE", "FD_RELATIVE_STEP"]

@@ -3,6 +3,7 @@
     python -m pamsim.identification.studies static    # ACRA 2012 refit, a few seconds
     python -m pamsim.identification.studies dynamic   # synthetic recovery and FD steps, minutes
     python -m pamsim.identification.studies inputs    # thinning of a recorded pressure, seconds
+    python -m pamsim.identification.studies native    # the fits on the native backend, seconds
 
 Run from the repository root (the dynamic study reads scenarios/acra2012_fig4.toml; ``--scenario``
 names another).
@@ -21,7 +22,7 @@ from ..api import simulate
 from ..parameters import get_parameter_set
 from ..scenario import Scenario
 from .columns import TraceData, read_static_data
-from .dynamic_fit import _Objective, fit_dynamic, make_problem
+from .dynamic_fit import _Objective, fit_dynamic, make_problem, make_trials
 from .equilibrium import equilibrium_m
 from .models import build_static
 from .static_fit import fit_static
@@ -82,13 +83,13 @@ def static_study() -> None:
           f"{np.max(np.abs(Fp - w.load_N)):.3f} N (printed coefficients); within-capability tests: {int(within.sum())}")
 
 
-def _recovery(sc: Scenario, loads, duration_s, pool) -> None:
+def _recovery(sc: Scenario, loads, duration_s, pool, backend: str = "python") -> None:
     pairs = [synthetic_trace(sc, TRUTH, w, seed=i, duration_s=duration_s) for i, w in enumerate(loads)]
-    fit = fit_dynamic(sc, [n for n, _ in pairs], free=tuple(TRUTH), executor=pool)
+    fit = fit_dynamic(sc, [n for n, _ in pairs], free=tuple(TRUTH), executor=pool, backend=backend)
     truth = np.array(list(TRUTH.values()))
     u = fit.uncertainty
     print(f"\n{len(loads)} trace(s) at {', '.join(f'{w:g}' for w in loads)} N, {duration_s:g} s, 3.6 bar: "
-          f"{fit.n_simulations} simulations, {fit.wall_time_s:.1f} s")
+          f"{fit.n_simulations} simulations, {fit.wall_time_s:.1f} s ({backend} backend)")
     print("\n| coefficient | truth | start | fitted | error | standard error | identifiable |")
     print("|---|---|---|---|---|---|---|")
     ident = u.identifiable(fit.theta)
@@ -109,15 +110,18 @@ def _recovery(sc: Scenario, loads, duration_s, pool) -> None:
               f"(start: {_rms(start - c.x_m):.3f} mm)")
 
 
-def _fd_steps(sc: Scenario) -> None:
+def _fd_steps(sc: Scenario, backend: str = "python") -> None:
     res = simulate(sc.with_changes({"parameters": TRUTH, "simulation": {"duration_s": 2.5}}))
     tr = TraceData(res.t_s, res.x_m, res.p_gauge_Pa, 22.74)
     prob = make_problem(sc, [tr], free=tuple(TRUTH))
+    trials = make_trials(prob, backend)
     theta = np.array([sc.parameters[n] for n in prob.free])
-    ref = _Objective(prob, None, 1e-3).jacobian(theta)
-    print("\n| relative FD step | Jacobian change against step 1e-3 (relative Frobenius norm) |\n|---|---|")
-    for h in (1e-9, 1e-7, 1e-5, 1e-4, 3e-3, 1e-2, 3e-2):
-        J = _Objective(prob, None, h).jacobian(theta)
+    ref = _Objective(prob, None, 1e-3, trials).jacobian(theta)
+    print(f"\n| relative FD step | Jacobian change against step 1e-3 (relative Frobenius norm), {backend} backend |"
+          "\n|---|---|")
+    steps = (1e-12, 1e-11, 1e-10, 1e-9) if backend == "native" else (1e-9,)
+    for h in (*steps, 1e-7, 1e-5, 1e-4, 3e-3, 1e-2, 3e-2):
+        J = _Objective(prob, None, h, trials).jacobian(theta)
         print(f"| {h:g} | {np.linalg.norm(J - ref) / np.linalg.norm(ref):.3g} |")
 
 
@@ -170,15 +174,47 @@ def dynamic_study(scenario_path: str) -> None:
         _recovery(sc, [12.74, 22.74, 32.74], 8.0, pool)
 
 
+def _input_hold(sc: Scenario) -> None:
+    """Native against Python contraction at the truth, recorded pressure (held per output sample on the
+    native backend) and valve (held exactly, a step), at several output sample rates."""
+    noisy, _ = synthetic_trace(sc, TRUTH, 22.74, seed=0)
+    by_valve = TraceData(noisy.t_s, noisy.x_m, None, 22.74)
+    theta = np.array(list(TRUTH.values()))
+    print("\n| output sample rate [Hz] (hold interval) | largest contraction difference, recorded pressure [mm] | "
+          "same, valve [mm] |\n|---|---|---|")
+    for rate in (500.0, 1000.0, 2000.0, 4000.0):
+        rated = sc.with_changes({"simulation": {"sample_rate_Hz": rate}})
+        diff = []
+        for tr in (noisy, by_valve):
+            prob = make_problem(rated, [tr], free=tuple(TRUTH), loads_N=[22.74])
+            x_py, = make_trials(prob, "python")(theta)
+            x_nat, = make_trials(prob, "native")(theta)
+            diff.append(np.max(np.abs(x_nat - x_py)) * 1e3)
+        print(f"| {rate:g} ({1e3 / rate:g} ms) | {diff[0]:.2e} | {diff[1]:.2e} |")
+
+
+def native_study(scenario_path: str) -> None:
+    """The dynamic study on the native backend: input hold, FD steps, recovery (in this process)."""
+    from ..scenario import load_scenario
+
+    sc = load_scenario(scenario_path)
+    _input_hold(sc)
+    _fd_steps(sc, "native")
+    _recovery(sc, [22.74], 8.0, None, "native")
+    _recovery(sc, [12.74, 22.74, 32.74], 8.0, None, "native")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("which", choices=("static", "dynamic", "inputs"))
+    parser.add_argument("which", choices=("static", "dynamic", "inputs", "native"))
     parser.add_argument("--scenario", default="scenarios/acra2012_fig4.toml")
     args = parser.parse_args()
     if args.which == "static":
         static_study()
     elif args.which == "inputs":
         inputs_study(args.scenario)
+    elif args.which == "native":
+        native_study(args.scenario)
     else:
         dynamic_study(args.scenario)
 

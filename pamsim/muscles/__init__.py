@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 import tomllib
 from dataclasses import dataclass, field
+from functools import lru_cache
 from importlib import resources
 from pathlib import Path
 from typing import Any, Mapping
@@ -78,7 +79,13 @@ class Muscle:
 
 def shipped_names() -> list[str]:
     """Names of the muscles shipped with pamsim."""
-    return sorted(p.name[:-5] for p in resources.files(__name__).iterdir() if p.name.endswith(".toml"))
+    return list(_shipped_names())
+
+
+@lru_cache(maxsize=1)
+def _shipped_names() -> tuple[str, ...]:
+    # The package's files do not change while it runs; listing them costs more than a native run.
+    return tuple(sorted(p.name[:-5] for p in resources.files(__name__).iterdir() if p.name.endswith(".toml")))
 
 
 def load_muscle(name_or_path: str | Path) -> Muscle:
@@ -95,11 +102,27 @@ def load_muscle(name_or_path: str | Path) -> Muscle:
         if not path.is_file():
             raise MuscleError(f"{path}: no such muscle file")
     else:
-        names = shipped_names()
+        names = _shipped_names()
         if text not in names:
             raise MuscleError(f"muscle = {text!r}: unknown muscle{did_you_mean(text, names)} "
                               f"(shipped: {', '.join(names)})")
-        path = Path(str(resources.files(__name__).joinpath(text + ".toml")))
+        path = _shipped_path(text)
+    try:
+        stat = path.stat()
+    except OSError as exc:
+        raise MuscleError(f"{path}: cannot read: {exc}") from None
+    return _load_file(path, stat.st_mtime_ns, stat.st_size)
+
+
+@lru_cache(maxsize=None)
+def _shipped_path(name: str) -> Path:
+    return Path(str(resources.files(__name__).joinpath(name + ".toml")))
+
+
+@lru_cache(maxsize=64)
+def _load_file(path: Path, mtime_ns: int, size: int) -> Muscle:
+    """A muscle file read and validated once per version (its modification time and size are in the key):
+    every scenario built from it (thousands in a sweep) shares the immutable :class:`Muscle`."""
     try:
         raw = tomllib.loads(path.read_text(encoding="utf-8"))
     except tomllib.TOMLDecodeError as exc:

@@ -10,8 +10,10 @@ Differences from the Python backend, all documented in ``docs/scaling.md``:
 - the integrator is the core's Dormand-Prince 5(4) at the scenario's ``rtol``
   (``solver.method`` may be ``LSODA``, the automatic choice, or ``RK45``, the
   same method; the implicit ones are refused);
-- the work integrals are trapezoid sums over the sample grid with every event
-  as a node (the Python backend integrates them as states);
+- a static force other than the ACRA 2012 polynomial is the FMU's bicubic force
+  table of the model (:func:`force_table`), not the model itself;
+- the work integrals are Gauss-Legendre quadratures of each step's dense output
+  (the Python backend integrates them as states);
 - a signal that is neither constant nor a step (ramp, lag, trace, external
   force) is held at its midpoint value over intervals of at most
   :func:`hold_interval_s`, a second-order approximation.
@@ -21,6 +23,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections import OrderedDict
 from dataclasses import dataclass
 from typing import Sequence
 
@@ -29,7 +32,8 @@ import numpy as np
 from ..core_table import C_CHOICES, SCENARIO_KEYS, unimplemented_choice
 from ..elements.pressure_source import ValveChamberSource
 from ..errors import InputError, SolverFailure
-from ..fmu.runner import REPRESENTED
+from ..fmu.force_table import ForceTable
+from ..fmu.runner import REPRESENTED, tabulate_model
 from ..model import Mode, MuscleModel
 from ..result import Result, TransitionEvent
 from ..scenario import Scenario
@@ -61,6 +65,7 @@ class CaseInputs:
     segment_u: np.ndarray
     max_events: int
     model: MuscleModel
+    table: ForceTable | None = None
 
 
 def refuse_unsupported(scenario: Scenario) -> None:
@@ -73,7 +78,10 @@ def refuse_unsupported(scenario: Scenario) -> None:
             name = f"{section}.{key}" if section else key
             raise InputError(f"{where}: {name}: the native backend cannot honour this key; "
                              "run it with the python backend")
-    lacking = unimplemented_choice(spec)
+    if spec["model"]["static_force_negative"] != "clip":
+        raise InputError(f"{where}: model.static_force_negative = {spec['model']['static_force_negative']!r}: "
+                         "the C core clips a negative static force at zero; run it with the python backend")
+    lacking = unimplemented_choice(spec, skip=("static_force",))  # any static force: through a force table
     if lacking:
         key = next(k for k, w in SCENARIO_KEYS.items() if w == lacking[0])
         raise InputError(f"{where}: {lacking[0]} = {lacking[1]!r}: the C core implements only "
@@ -82,10 +90,33 @@ def refuse_unsupported(scenario: Scenario) -> None:
     if method not in METHODS:
         raise InputError(f"{where}: solver.method = {method!r}: the native backend integrates with Dormand-Prince "
                          f"5(4) and honours only {', '.join(METHODS)}; run it with the python backend")
+    if spec["model"]["static_force"] != "acra2012_polynomial":
+        return  # a parameter the core lacks (wall_thickness_m, E_bladder_Pa, ...) only shapes the force table
     for name in scenario.parameters.entries:
         if name not in lib.REAL_INDEX:
             raise InputError(f"{where}: parameters.{name}: the C core has no such parameter "
-                             f"(parameter set {spec['model']['parameter_set']!r}); run it with the python backend")
+                             f"(muscle {spec['model']['muscle']!r}); run it with the python backend")
+
+
+TABLE_CACHE_SIZE = 32
+"""Force tables kept per process: a sweep's cases share their muscle's table."""
+_tables: "OrderedDict[tuple, ForceTable]" = OrderedDict()
+
+
+def force_table(scenario: Scenario) -> ForceTable | None:
+    """The static force table of ``scenario`` as the FMU would bake it (:func:`pamsim.fmu.runner.tabulate_model`),
+    or None for the ACRA 2012 polynomial, which the core computes exactly.  Tables are cached by the
+    model, its variant, the parameters and the force-map file, so the cases of a sweep tabulate once."""
+    m = scenario.spec["model"]
+    if m["static_force"] == "acra2012_polynomial":
+        return None
+    key = (m["static_force"], m.get("static_force_variant"), tuple(sorted(scenario.parameters.items())),
+           scenario.muscle.force_map_file if scenario.muscle is not None else None)
+    if key not in _tables:
+        _tables[key] = tabulate_model(scenario)
+        if len(_tables) > TABLE_CACHE_SIZE:
+            _tables.popitem(last=False)
+    return _tables[key]
 
 
 def _signals(model: MuscleModel) -> tuple:
@@ -109,17 +140,22 @@ def hold_interval_s(signals, sample_interval_s: float) -> float:
     return hold
 
 
-def case_inputs(scenario: Scenario) -> CaseInputs:
-    """The library's inputs for ``scenario``; refuses (``InputError``) what the backend cannot honour."""
+def case_inputs(scenario: Scenario, model: MuscleModel | None = None) -> CaseInputs:
+    """The library's inputs for ``scenario``; refuses (``InputError``) what the backend cannot honour.
+
+    ``model`` is ``scenario.build_model()`` (built here if not given), or that model with its pressure
+    source replaced (a fit drives it with a recorded pressure): the source choice follows the model.
+    """
     refuse_unsupported(scenario)
-    model = scenario.build_model()
+    model = scenario.build_model() if model is None else model
     spec = scenario.spec
     opts = scenario.solver
     T = scenario.duration_s
     n_samples = int(round(T * opts.sample_rate_Hz)) + 1
     reals = lib.REAL_DEFAULTS.copy()
     for name, value in scenario.parameters.items():
-        reals[lib.REAL_INDEX[name]] = value
+        if name in lib.REAL_INDEX:  # the others shape the force table (refuse_unsupported)
+            reals[lib.REAL_INDEX[name]] = value
     fmu_own = {"initial_contraction_m": scenario.initial_contraction_m,
                "initial_pressure_gauge_Pa": scenario.initial_pressure_gauge_Pa or 0.0,
                "stick_margin_N": opts.stick_margin_N, "release_margin_N": opts.release_margin_N,
@@ -130,10 +166,13 @@ def case_inputs(scenario: Scenario) -> CaseInputs:
     ints = lib.INT_DEFAULTS.copy()
     choices = {"friction_model": ("friction", spec["model"]["friction"]),
                "damping_model": ("damping", spec["model"]["damping"]),
-               "pressure_source": ("source", spec["pressure"]["source"]),
+               "pressure_source": ("source", "valve" if isinstance(model.source, ValveChamberSource) else "prescribed"),
                "friction_negative_level": ("friction_negative_level", spec["model"]["friction_negative_level"])}
     for name, (key, value) in choices.items():
         ints[lib.INT_INDEX[name]] = C_CHOICES[key].index(value)
+    table = force_table(scenario)
+    ints[lib.INT_INDEX["static_force_model"]] = C_CHOICES["static_force_model"].index(
+        "acra2012_polynomial" if table is None else "table")
     signals = _signals(model)
     hold = hold_interval_s(signals, T / max(n_samples - 1, 1))
     bounds = {0.0} | {float(b) for b in model.breakpoints if 0.0 < b < T}
@@ -146,19 +185,34 @@ def case_inputs(scenario: Scenario) -> CaseInputs:
         if sig is not None:
             u[:, k] = sig(mid)
     u[:, lib.INPUTS.index("load_mass_kg")] = model.load.mass_kg
-    return CaseInputs(reals, ints, T, n_samples, starts, u, opts.max_events, model)
+    return CaseInputs(reals, ints, T, n_samples, starts, u, opts.max_events, model, table)
 
 
 def _run(cases: Sequence[CaseInputs], capacity: Sequence[int]) -> dict:
+    tables: list[ForceTable] = []
+    index: dict[int, int] = {}  # id(table) -> its place in tables: the cases of one muscle share one table
+    for c in cases:
+        if c.table is not None and id(c.table) not in index:
+            index[id(c.table)] = len(tables)
+            tables.append(c.table)
     return lib.run_batch(np.array([c.reals for c in cases]), np.array([c.ints for c in cases]),
                          np.array([c.duration_s for c in cases]), np.array([c.n_samples for c in cases]),
                          np.array([len(c.segment_t_s) for c in cases]),
                          np.concatenate([c.segment_t_s for c in cases]), np.concatenate([c.segment_u for c in cases]),
-                         np.asarray(capacity))
+                         np.asarray(capacity), tables,
+                         np.array([-1 if c.table is None else index[id(c.table)] for c in cases]))
 
 
-def _result(scenario: Scenario, case: CaseInputs, out: dict, i: int, wall_time_s: float) -> Result:
-    """Case ``i`` of a batch's output as a :class:`Result`, or the error it ended with."""
+_MODE_LABELS = {int(m): m.label for m in Mode}
+_IMPACTS_ROW = lib.SAMPLE_COLUMNS.index("E_impacts_J")
+
+
+def _result(scenario: Scenario, case: CaseInputs, out: dict, i: int, wall_time_s: float,
+            t: np.ndarray | None = None) -> Result:
+    """Case ``i`` of a batch's output as a :class:`Result`, or the error it ended with.
+
+    ``t`` is the sample grid if the caller has it already (cases of one batch share equal grids).
+    """
     status = int(out["status"][i])
     message = out["messages"][i]
     if status == 1:
@@ -169,19 +223,33 @@ def _result(scenario: Scenario, case: CaseInputs, out: dict, i: int, wall_time_s
         raise SolverFailure(f"more than {case.max_events} events (raise [solver] max_events if this is expected)")
     model = case.model
     first, n = int(out["sample_offset"][i]), case.n_samples
-    rows = slice(first, first + n)
     S = out["samples"][len(lib.SAMPLE_COLUMNS) * first:len(lib.SAMPLE_COLUMNS) * (first + n)].reshape(-1, n)
     Y = S[_STATE_ROWS[model.n_source]]
-    events = out["events"][out["event_offset"][i]:out["event_offset"][i] + out["n_events"][i]]
-    transitions = [TransitionEvent(float(e[0]), lib.EVENT_KINDS[int(e[1])], Mode(int(e[2])).label,
-                                   Mode(int(e[3])).label, float(e[4])) for e in events]
-    losses = [(float(e[0]), float(e[5])) for e in events]
+    events = out["events"][out["event_offset"][i]:out["event_offset"][i] + out["n_events"][i]].tolist()
+    kinds, labels = lib.EVENT_KINDS, _MODE_LABELS
+    transitions = [TransitionEvent(e[0], kinds[int(e[1])], labels[int(e[2])], labels[int(e[3])], e[4])
+                   for e in events]
+    losses = [(e[0], e[5]) for e in events]
     n_rhs, _, segments = (int(v) for v in out["stats"][i])
     stats = {"rhs_evaluations": n_rhs, "events": len(transitions), "segments": segments, "method": METHOD_LABEL,
              "rtol": scenario.solver.rtol}
-    t = np.linspace(0.0, case.duration_s, case.n_samples)
-    return Result.from_trace(model, scenario.name, t, Y, out["modes"][rows].astype(int), transitions, losses,
-                             stats, wall_time_s)
+    if t is None:
+        t = np.linspace(0.0, case.duration_s, case.n_samples)
+    x_max, x_min, p_max = (float(v) for v in out["peaks"][i])
+    return Result.from_trace(model, scenario.name, t, Y, out["modes"][first:first + n].astype(int), transitions,
+                             losses, stats, wall_time_s, peaks={"x_m": x_max, "x_min_m": x_min, "p_gauge_Pa": p_max},
+                             impacts_J=S[_IMPACTS_ROW])
+
+
+def _sample_grids(cases: Sequence[CaseInputs]) -> list[np.ndarray]:
+    """Each case's sample times [s]; cases with the same grid share one read-only array."""
+    grids: dict[tuple[float, int], np.ndarray] = {}
+    for c in cases:
+        key = (c.duration_s, c.n_samples)
+        if key not in grids:
+            grids[key] = np.linspace(0.0, c.duration_s, c.n_samples)
+            grids[key].flags.writeable = False
+    return [grids[(c.duration_s, c.n_samples)] for c in cases]
 
 
 def simulate_batch(scenarios: Sequence[Scenario], return_exceptions: bool = False) -> list:
@@ -200,14 +268,14 @@ def simulate_batch(scenarios: Sequence[Scenario], return_exceptions: bool = Fals
     out = _run(cases, [min(c.max_events + 1, BATCH_EVENT_CAPACITY) for c in cases])
     wall = (time.perf_counter() - wall0) / max(len(cases), 1)
     results = []
-    for i, (scenario, case) in enumerate(zip(scenarios, cases)):
+    for i, (scenario, case, t) in enumerate(zip(scenarios, cases, _sample_grids(cases))):
         try:
             if out["status"][i] == 3 and case.max_events + 1 > BATCH_EVENT_CAPACITY:
                 again = time.perf_counter()
                 alone = _run([case], [case.max_events + 1])
-                results.append(_result(scenario, case, alone, 0, time.perf_counter() - again))
+                results.append(_result(scenario, case, alone, 0, time.perf_counter() - again, t))
             else:
-                results.append(_result(scenario, case, out, i, wall))
+                results.append(_result(scenario, case, out, i, wall, t))
         except (InputError, SolverFailure) as exc:
             if not return_exceptions:
                 raise

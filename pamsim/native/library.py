@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import ctypes
 from functools import lru_cache
+from typing import Sequence
 
 import numpy as np
 
@@ -52,8 +53,9 @@ class PamBatch(ctypes.Structure):
     _fields_ = [("n_cases", ctypes.c_int64), ("reals", _D), ("ints", _I32), ("duration_s", _D),
                 ("n_samples", _I64), ("sample_offset", _I64), ("n_segments", _I64), ("segment_offset", _I64),
                 ("segment_t_s", _D), ("segment_u", _D), ("event_capacity", _I64), ("event_offset", _I64),
+                ("table_index", _I64), ("table_grid", _D), ("table_offset", _I64), ("table_nodes", _D),
                 ("samples", _D), ("modes", _I32), ("events", _D), ("n_events", _I64), ("stats", _I64),
-                ("status", _I32), ("messages", ctypes.c_char_p)]
+                ("status", _I32), ("peaks", _D), ("messages", ctypes.c_char_p)]
 
 
 @lru_cache(maxsize=1)
@@ -78,7 +80,8 @@ def _ptr(array: np.ndarray, kind):
     return array.ctypes.data_as(kind)
 
 
-def run_batch(reals, ints, duration_s, n_samples, segment_counts, segment_t_s, segment_u, event_capacity) -> dict:
+def run_batch(reals, ints, duration_s, n_samples, segment_counts, segment_t_s, segment_u, event_capacity,
+              tables: Sequence = (), table_index=None) -> dict:
     """Run cases in one library call.
 
     Parameters
@@ -93,12 +96,17 @@ def run_batch(reals, ints, duration_s, n_samples, segment_counts, segment_t_s, s
         All cases' segments, concatenated: start time [s] and the :data:`INPUTS` held over it.
     event_capacity : ndarray
         Per case: how many events to keep.
+    tables : sequence of pamsim.fmu.force_table.ForceTable
+        The static force tables the cases use (``static_force_model = table``).
+    table_index : ndarray, optional
+        Per case: its table in ``tables``, or -1 (none; the default for every case).
 
     Returns
     -------
     dict
         ``samples`` (per case a block of :data:`SAMPLE_COLUMNS` x its samples, flattened), ``modes``, ``sample_offset``, ``events``,
         ``event_offset``, ``n_events``, ``stats`` (RHS evaluations, steps, segments), ``status``,
+        ``peaks`` (per case: largest and smallest x [m], largest gauge pressure [Pa] at every step end and event),
         ``messages``.
     """
     lib = load()
@@ -113,15 +121,23 @@ def run_batch(reals, ints, duration_s, n_samples, segment_counts, segment_t_s, s
            "samples": np.empty(int(n_samples.sum()) * len(SAMPLE_COLUMNS)),
            "modes": np.empty(int(n_samples.sum()), dtype=np.int32),
            "events": np.empty((int(event_capacity.sum()), 6)), "n_events": np.zeros(n, dtype=np.int64),
-           "stats": np.zeros((n, 3), dtype=np.int64), "status": np.zeros(n, dtype=np.int32)}
+           "stats": np.zeros((n, 3), dtype=np.int64), "status": np.zeros(n, dtype=np.int32),
+           "peaks": np.full((n, 3), np.nan)}
     messages = ctypes.create_string_buffer(MESSAGE_BYTES * n)
+    table_index = c(np.full(n, -1) if table_index is None else table_index, np.int64)
+    grid = c([[*t.shape, t.x_min_m, (t.x_max_m - t.x_min_m) / (t.shape[0] - 1), t.p_min_Pa,
+               (t.p_max_Pa - t.p_min_Pa) / (t.shape[1] - 1)] for t in tables] or np.zeros((1, 6)), np.float64)
+    nodes = c(np.concatenate([t.values.reshape(-1, 4) for t in tables]) if tables else np.zeros((1, 4)), np.float64)
+    table_offset = c(np.concatenate([[0], np.cumsum([t.shape[0] * t.shape[1] for t in tables])[:-1]])
+                     if tables else np.zeros(1), np.int64)
     segment_offset = offsets(segment_counts)
     batch = PamBatch(n, _ptr(reals, _D), _ptr(ints, _I32), _ptr(duration_s, _D), _ptr(n_samples, _I64),
                      _ptr(out["sample_offset"], _I64), _ptr(segment_counts, _I64), _ptr(segment_offset, _I64),
                      _ptr(segment_t_s, _D), _ptr(segment_u, _D), _ptr(event_capacity, _I64),
-                     _ptr(out["event_offset"], _I64), _ptr(out["samples"], _D), _ptr(out["modes"], _I32),
+                     _ptr(out["event_offset"], _I64), _ptr(table_index, _I64), _ptr(grid, _D),
+                     _ptr(table_offset, _I64), _ptr(nodes, _D), _ptr(out["samples"], _D), _ptr(out["modes"], _I32),
                      _ptr(out["events"], _D), _ptr(out["n_events"], _I64), _ptr(out["stats"], _I64),
-                     _ptr(out["status"], _I32), ctypes.cast(messages, ctypes.c_char_p))
+                     _ptr(out["status"], _I32), _ptr(out["peaks"], _D), ctypes.cast(messages, ctypes.c_char_p))
     lib.pam_native_run_batch(ctypes.byref(batch))
     raw = messages.raw
     out["messages"] = [raw[MESSAGE_BYTES * i:MESSAGE_BYTES * (i + 1)].split(b"\0", 1)[0].decode(errors="replace")

@@ -1,7 +1,7 @@
 """Figures of a sweep, as matplotlib ``Figure`` objects (no pyplot global state).
 
-Each ``*_figure`` function returns a Figure; :func:`write_figures` saves them
-as PNG to the paths it is given (the caller stages them atomically).
+Each ``*_figure`` function returns a Figure; :func:`figure_jobs` lists them for
+:mod:`.figures`, which renders them (the caller stages the files atomically).
 
 The functions take a :class:`pamsim.sweep.SweepResult` but do not import it:
 the result imports this module to write itself, and one direction is enough.
@@ -19,15 +19,13 @@ from matplotlib.figure import Figure
 from ..constants import PA_PER_BAR
 
 
-_DPI = 110
-
-
-def write_figures(result: "SweepResult", paths: Mapping[str, object]) -> None:
-    """Save the four sweep figures to ``paths`` (keys are the names in ``pamsim.sweep.FIGURES``)."""
-    makers = {"error_heatmap.png": error_heatmap_figure, "steady_state_vs_pressure.png": steady_state_figure,
-              "time_responses.png": time_responses_figure, "frequency_vs_load.png": frequency_figure}
-    for name, path in paths.items():
-        makers[name](result).savefig(path, format="png", dpi=_DPI)
+def figure_jobs(result: "SweepResult") -> dict:
+    """``{file name: (figure function, its argument)}`` of the four sweep figures (the names of
+    ``pamsim.sweep.FIGURES``), slowest first, for :func:`pamsim.sweep.figures.render_all`."""
+    return {"time_responses.png": (time_responses_figure, result),
+            "error_heatmap.png": (error_heatmap_figure, result),
+            "steady_state_vs_pressure.png": (steady_state_figure, result),
+            "frequency_vs_load.png": (frequency_figure, result)}
 
 
 def _grid_pressure(row: Mapping) -> float:
@@ -46,7 +44,7 @@ def _empty(fig: Figure, text: str) -> Figure:
 def error_heatmap_figure(result: "SweepResult") -> Figure:
     """Contraction error (model minus measured, mm) over pressure x load, one panel per quantity."""
     rows = [r for r in result.rows if math.isfinite(r["measured_contraction_m"])]
-    fig = Figure(figsize=(13, 6), constrained_layout=True)
+    fig = Figure(figsize=(13, 6))
     if not rows:
         return _empty(fig, "no measured data to compare with")
     pressures = sorted({_grid_pressure(r) for r in rows})
@@ -62,7 +60,8 @@ def error_heatmap_figure(result: "SweepResult") -> Figure:
         grids.append(g)
     limit = max(float(np.nanmax(np.abs(g))) for g in grids) if any(np.isfinite(g).any() for g in grids) else 1.0
     norm = TwoSlopeNorm(vcenter=0.0, vmin=-limit, vmax=limit)
-    axes = fig.subplots(1, 2, sharey=True)
+    # Fixed margins rather than a layout engine: its extra layout pass is a third of a figure's time.
+    axes = fig.subplots(1, 2, sharey=True, gridspec_kw=dict(left=0.05, right=0.9, top=0.89, bottom=0.09, wspace=0.05))
     for ax, g, (col, title) in zip(axes, grids, panels):
         im = ax.imshow(g, origin="lower", cmap="RdBu_r", norm=norm, aspect="auto")
         ax.set_facecolor("0.85")  # missing tests show grey
@@ -82,7 +81,7 @@ def error_heatmap_figure(result: "SweepResult") -> Figure:
         ax.set_xlabel("hanging weight [N]")
         ax.set_title(title, fontsize=10)
     axes[0].set_ylabel("pressure step [bar]")
-    fig.colorbar(im, ax=axes, label="contraction error [mm]", shrink=0.9)
+    fig.colorbar(im, cax=fig.add_axes((0.915, 0.09, 0.012, 0.8)), label="contraction error [mm]")
     thr = result.spec.capability_min_equilibrium_m * 1e3
     fig.suptitle(f"{result.spec.name}: contraction error; hatched = beyond force capability "
                  f"(static equilibrium < {thr:g} mm), bold = within")
@@ -97,12 +96,12 @@ def _hatch(j: int, i: int):
 
 def steady_state_figure(result: "SweepResult") -> Figure:
     """Measured against modelled steady-state contraction versus pressure, one colour per load."""
-    fig = Figure(figsize=(13, 6), constrained_layout=True)
+    fig = Figure(figsize=(13, 6))
     rows = result.rows
     if not rows:
         return _empty(fig, "no cases")
     first = result.spec.friction_models[0]
-    axes = fig.subplots(1, 2, sharey=True)
+    axes = fig.subplots(1, 2, sharey=True, gridspec_kw=dict(left=0.05, right=0.99, top=0.9, bottom=0.09, wspace=0.04))
     panels = [("equilibrium_contraction_m", "static equilibrium (paper polynomial)"),
               ("final_contraction_m", f"simulated final contraction ({first} friction, 8 s run)")]
     weights = sorted({r["weight_N"] for r in rows})
@@ -130,12 +129,14 @@ def steady_state_figure(result: "SweepResult") -> Figure:
 def time_responses_figure(result: "SweepResult") -> Figure:
     """Contraction against time for each response scenario, one line style per friction model."""
     names = list(result.responses)
-    fig = Figure(figsize=(13, 3.2 * max(1, math.ceil(len(names) / 2))), constrained_layout=True)
+    height_in = 3.2 * max(1, math.ceil(len(names) / 2))
+    fig = Figure(figsize=(13, height_in))
     if not names:
         return _empty(fig, "no [time_responses] in the sweep file")
     ncols = 2 if len(names) > 1 else 1
     nrows = math.ceil(len(names) / ncols)
-    axes = np.atleast_1d(fig.subplots(nrows, ncols, squeeze=False).ravel())
+    margins = dict(left=0.05, right=0.95, top=1 - 0.75 / height_in, bottom=0.5 / height_in, wspace=0.2, hspace=0.42)
+    axes = np.atleast_1d(fig.subplots(nrows, ncols, squeeze=False, gridspec_kw=margins).ravel())
     styles = ["-", "--", ":", "-."]
     for ax, name in zip(axes, names):
         runs = result.responses[name]
@@ -165,14 +166,15 @@ def time_responses_figure(result: "SweepResult") -> Figure:
 
 def frequency_figure(result: "SweepResult") -> Figure:
     """Estimated oscillation frequency against load for each friction model."""
-    fig = Figure(figsize=(8, 5.5), constrained_layout=True)
+    fig = Figure(figsize=(8, 5.5))
     rows = result.frequency_rows
     if not rows:
         return _empty(fig, "no [frequency] study in the sweep file")
     models = result.spec.friction_models
     # The half-cycle counts go in a strip of their own under the plot, one row per friction model,
     # so that no label can sit on a marker.
-    ax, strip = fig.subplots(2, 1, sharex=True, height_ratios=[5, 0.35 * len(models) + 0.3])
+    ax, strip = fig.subplots(2, 1, sharex=True, height_ratios=[5, 0.35 * len(models) + 0.3],
+                             gridspec_kw=dict(left=0.16, right=0.98, top=0.92, bottom=0.09, hspace=0.08))
     w = np.array([r["weight_N"] for r in rows])
     for k, f in enumerate(models):
         freq = np.array([r[f"{f}_frequency_Hz"] for r in rows], dtype=float)

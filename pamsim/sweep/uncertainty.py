@@ -22,8 +22,6 @@ from dataclasses import dataclass
 from typing import Any, Mapping
 
 import numpy as np
-from scipy import stats
-from scipy.stats import qmc
 
 from ..scenario import Scenario
 
@@ -70,6 +68,8 @@ class ParameterDistribution:
 
     def frozen(self):
         """The untruncated scipy distribution (of the factor when ``relative``)."""
+        from scipy import stats  # imported when a study samples: it costs every sweep half a second
+
         if self.distribution == "normal":
             return stats.norm(loc=self.shape[0], scale=self.shape[1])
         if self.distribution == "lognormal":
@@ -120,6 +120,8 @@ class UncertaintySpec:
         rng = np.random.default_rng(self.seed)
         if self.sampling == "random":
             return rng.random((self.samples, d))
+        from scipy.stats import qmc
+
         # scipy >= 1.15 names the generator ``rng``; older versions call it ``seed``.
         kw = "rng" if "rng" in inspect.signature(qmc.LatinHypercube).parameters else "seed"
         return qmc.LatinHypercube(d=d, **{kw: rng}).random(self.samples)

@@ -11,13 +11,12 @@ from matplotlib.figure import Figure
 
 from .uncertainty import QUANTITIES, UncertaintyResult
 
-_DPI = 110
 FIGURES = ("uncertainty_histograms.png", "uncertainty_ecdf.png")
 
 
 def _panels(result: UncertaintyResult, title: str):
-    fig = Figure(figsize=(13, 4), constrained_layout=True)
-    axes = fig.subplots(1, len(QUANTITIES))
+    fig = Figure(figsize=(13, 4))  # fixed margins: a layout engine's extra pass costs a third of the time
+    axes = fig.subplots(1, len(QUANTITIES), gridspec_kw=dict(left=0.05, right=0.99, top=0.88, bottom=0.13, wspace=0.25))
     fig.suptitle(f"{title}: {result.spec.samples} samples, seed {result.spec.seed}")
     for ax, (q, label) in zip(axes, QUANTITIES.items()):
         scale = 1e3 if q.endswith("_m") else 1.0
@@ -52,8 +51,7 @@ def ecdf_figure(result: UncertaintyResult) -> Figure:
     return fig
 
 
-def write_uncertainty_figures(result: UncertaintyResult, paths) -> None:
-    """Save the two figures to ``paths`` (keys are the names in :data:`FIGURES`)."""
-    makers = {"uncertainty_histograms.png": histogram_figure, "uncertainty_ecdf.png": ecdf_figure}
-    for name, path in paths.items():
-        makers[name](result).savefig(path, format="png", dpi=_DPI)
+def figure_jobs(result: UncertaintyResult) -> dict:
+    """``{file name: (figure function, its argument)}`` of the two figures (:data:`FIGURES`), for
+    :func:`pamsim.sweep.figures.render_all`."""
+    return {"uncertainty_histograms.png": (histogram_figure, result), "uncertainty_ecdf.png": (ecdf_figure, result)}
