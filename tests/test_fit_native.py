@@ -1,5 +1,5 @@
 """The dynamic fit (eq. 13) on the native backend, against the Python backend's fit on the same
-synthetic traces (those of tests/test_fit_dynamic.py: 2.5 s, 3.6 bar valve step recorded, 0.05 mm
+synthetic traces (those of tests/synthetic_fit.py: 2.5 s, 3.6 bar valve step recorded, 0.05 mm
 noise), against the truth with the Python tests' own bounds, and from the command line.
 
 The native path differs from the Python one by its input hold: the recorded pressure, linear between
@@ -23,12 +23,14 @@ from pamsim.identification.native_fit import NativeTrials
 from pamsim.identification.synthetic import synthetic_trace
 from pamsim.native.backend import case_inputs
 
-from conftest import SCENARIOS, run_cli
-from test_fit_dynamic import FREE, NOISE_M, TRUTH, _traces, _truth_vector
+from conftest import SCENARIOS, run_cli, run_main
+from synthetic_fit import FREE, NOISE_M
+from synthetic_fit import traces as _traces
+from synthetic_fit import truth_vector as _truth_vector
 from test_fit_dynamic import test_single_trace_identifiable_coefficients_within_10_percent as check_single_ident
 from test_fit_dynamic import test_single_trace_recovers_the_noise_free_trajectory as check_single_trajectory
 from test_fit_dynamic import test_single_trace_says_which_coefficients_it_cannot_separate as check_single_pairs
-from test_fit_dynamic import test_three_loads_pooled as check_three_loads_pooled
+from test_fit_dynamic_pooled import test_three_loads_pooled as check_three_loads_pooled
 
 LOADS_N = (12.74, 22.74, 32.74)
 HOLD_TOL_MM = 0.005
@@ -250,8 +252,8 @@ def test_cli_fit_dynamic_backend_native(tmp_path, scenario, short_pair):
     trace = tmp_path / "step.csv"
     write_trace_csv(noisy, trace)
     out = tmp_path / "dyn"
-    proc = run_cli("fit", "dynamic", trace, "--scenario", SCENARIOS / "acra2012_fig4.toml", "--free",
-                   "N0_N_per_bar", "--backend", "native", "--workers", "2", "-o", out, "--json")
+    proc = run_main("fit", "dynamic", trace, "--scenario", SCENARIOS / "acra2012_fig4.toml", "--free",
+                    "N0_N_per_bar", "--backend", "native", "--workers", "2", "-o", out, "--json")
     assert proc.returncode == 0, proc.stderr
     body = json.loads(proc.stdout)
     assert body["backend"] == "native"
