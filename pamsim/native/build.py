@@ -25,7 +25,7 @@ from ..fmu.generate import c_header, c_source_dir
 
 SOURCES = ("pam_native.c", "pam_native.h", "pam_core.c", "pam_core.h", "pam_shared.h")
 """The C files the library is built from (pam_native.c includes pam_core.c: one translation unit)."""
-FLAGS = ("-shared", "-fPIC", "-O2", "-std=c99", "-Wall", "-fvisibility=hidden")
+FLAGS = ("-shared", "-fPIC", "-O3", "-std=c99", "-Wall", "-fvisibility=hidden")
 LIBRARY_NAME = "libpamsim_native"
 CACHE_ENV = "PAMSIM_NATIVE_CACHE"
 
