@@ -137,7 +137,8 @@ def _turning_indices(y: np.ndarray, hysteresis: float) -> list[int]:
     extreme = 0
     n = y.size
     idx = _candidates(y).tolist()
-    y = y.tolist()  # Python floats: indexing a numpy array per sample costs several times more
+    # Python floats of the candidates only: indexing a numpy array per sample costs several times more.
+    y = dict(zip(idx, y[idx].tolist()))
     for i in idx[1:]:
         if direction == 0:
             # The first motion away from the start sets the direction; the start itself is not
@@ -173,7 +174,7 @@ def _candidates(y: np.ndarray) -> np.ndarray:
     new = np.concatenate(([0], np.flatnonzero(np.diff(y) != 0.0) + 1))  # first sample of each new value
     rising = np.diff(y[new]) > 0.0
     turns = new[1:-1][rising[1:] != rising[:-1]]
-    return np.unique(np.concatenate(([0], turns, new[-1:])))
+    return np.concatenate(([0], turns, new[-1:] if new[-1] > 0 else [])).astype(np.intp)  # increasing
 
 
 def _refine_time(t: np.ndarray, y: np.ndarray, i: int) -> float:
