@@ -57,18 +57,21 @@ def _task(kind: str, key: tuple, scenario: Scenario, keep_trace: bool = False, b
     return _Task(kind, key, scenario, keep_trace, backend, parameters)
 
 
-MAX_AUTO_CHUNK = 50
-"""Largest chunk chosen automatically: big enough to amortise the per-task overhead of a scheduler
-(milliseconds) against runs of about 20 ms, small enough to balance the load and lose little work
-when a worker dies."""
+MAX_AUTO_CHUNK = {"python": 50, "native": 1000}
+"""Largest chunk chosen automatically, by backend: about a second of runs (the Python backend's take
+about 20 ms, the native backend's about 1 ms), big enough to amortise the per-task overhead of a
+scheduler (milliseconds), small enough to balance the load and lose little work when a worker dies.
+A backend not listed (an FMU) takes the Python backend's."""
 
 AUTO_CHUNKS = 64
 """Chunks the automatic size aims at (fewer when capped by :data:`MAX_AUTO_CHUNK`)."""
 
 
-def auto_chunk_size(n_tasks: int) -> int:
-    """Runs per executor task when none is given: ``ceil(n / 64)``, between 1 and 50."""
-    return max(1, min(MAX_AUTO_CHUNK, math.ceil(n_tasks / AUTO_CHUNKS)))
+def auto_chunk_size(n_tasks: int, backend: str = "python") -> int:
+    """Runs per executor task when none is given: ``ceil(n / 64)``, between 1 and the backend's
+    :data:`MAX_AUTO_CHUNK` (50 for the Python backend, 1000 for the native one)."""
+    cap = MAX_AUTO_CHUNK.get(backend, MAX_AUTO_CHUNK["python"])
+    return max(1, min(cap, math.ceil(n_tasks / AUTO_CHUNKS)))
 
 
 NATIVE_BATCH = 16
@@ -287,7 +290,7 @@ def run_sweep(spec: SweepSpec | str | Path, executor: Executor | None = None, pr
 
     with tqdm(total=len(tasks), unit="run", desc=spec.name, file=sys.stderr, disable=not progress,
               dynamic_ncols=True) as bar:
-        outputs = _execute(tasks, executor, bar, chunk_size or auto_chunk_size(len(tasks)))
+        outputs = _execute(tasks, executor, bar, chunk_size or auto_chunk_size(len(tasks), backend))
     wall = time.perf_counter() - start
     by_key = {(t.kind, t.key): o for t, o in zip(tasks, outputs)}
     failures = [f"{t.scenario.name}{f' sample {t.key[0]}' if t.kind == 'sample' else ''}: {o['error']}"
