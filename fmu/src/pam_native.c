@@ -88,6 +88,7 @@ static void state_at(const DensePoly *d, double t, double *y) {
  * powers are evaluated 5 times a step instead of 3 times a sample. */
 typedef struct {
     double t0, span, c[N_WORK][GL_N]; /* W(t) - W(t0) = sum_j c[k][j] phi^(j+1) */
+    int moving;                       /* 0: no work in this step (c is zero) */
 } WorkPoly;
 
 /* A[k][j]: coefficient of phi^(j+1) in the integral from 0 to phi of node k's Lagrange polynomial. */
@@ -114,8 +115,9 @@ static void work_poly(const PamCore *c, const DensePoly *d, double A[GL_N][GL_N]
     int q, k, j;
     w->t0 = ta;
     w->span = tb - ta;
+    w->moving = moving && w->span > 0.0;
     memset(w->c, 0, sizeof w->c);
-    if (!moving || !(w->span > 0.0)) return; /* a held load does no work */
+    if (!w->moving) return; /* a held load does no work */
     for (q = 0; q < GL_N; q++) {
         state_at(d, ta + GL_NODE[q] * w->span, y);
         powers_W(c, y, P[q]);
@@ -131,6 +133,10 @@ static void work_poly(const PamCore *c, const DensePoly *d, double A[GL_N][GL_N]
 static void work_at(const WorkPoly *w, double t, const double *base, double *work) {
     double phi = w->span > 0.0 ? (t - w->t0) / w->span : 0.0;
     int k, j;
+    if (!w->moving) { /* most samples of a run: the load is held; + 0.0 as the polynomial's sum gives */
+        for (k = 0; k < N_WORK; k++) work[k] = base[k] + 0.0;
+        return;
+    }
     for (k = 0; k < N_WORK; k++) {
         double acc = 0.0;
         for (j = GL_N - 1; j >= 0; j--) acc = (acc + w->c[k][j]) * phi;
