@@ -112,7 +112,9 @@ def force_table(scenario: Scenario) -> ForceTable | None:
         return None
     key = (m["static_force"], m.get("static_force_variant"), tuple(sorted(scenario.parameters.items())),
            scenario.muscle.force_map_file if scenario.muscle is not None else None)
-    if key not in _tables:
+    if key in _tables:
+        _tables.move_to_end(key)  # least recently used goes first
+    else:
         _tables[key] = tabulate_model(scenario)
         if len(_tables) > TABLE_CACHE_SIZE:
             _tables.popitem(last=False)
