@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import contextlib
+import fcntl
 import io
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -35,11 +37,22 @@ def paper_results():
 
 @pytest.fixture(scope="session")
 def fmus(tmp_path_factory):
-    """{FMI version: path} of the FMU built once per session from the current sources."""
+    """{FMI version: path} of the FMU built once per test session from the current sources.
+
+    The test processes of one ``pytest -n`` session share one build: the first to take the lock
+    builds into the session's common temporary folder, the others wait and reuse it.
+    """
     from pamsim.fmu import build
 
-    folder = tmp_path_factory.mktemp("fmu")
-    return {v: build(folder / f"pamsim_muscle_fmi{v}.fmu", v) for v in (2, 3)}
+    root = tmp_path_factory.getbasetemp()
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        root = root.parent  # shared by the session's workers, fresh for every session
+    folder = root / "session-fmus"
+    folder.mkdir(exist_ok=True)
+    with open(folder / ".lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        paths = {v: folder / f"pamsim_muscle_fmi{v}.fmu" for v in (2, 3)}
+        return {v: p if p.exists() else build(p, v) for v, p in paths.items()}
 
 
 @pytest.fixture(scope="session")
