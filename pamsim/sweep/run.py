@@ -23,6 +23,7 @@ from ..errors import InputError
 from ..oscillation import estimate_oscillation
 from ..scenario import Scenario
 from ..static import friction_band_m, static_report
+from .figures import SWEEP_FIGURES, UNCERTAINTY_FIGURES
 from .spec import SweepCase, SweepSpec, load_sweep
 from .uncertainty import UncertaintyResult
 
@@ -35,7 +36,8 @@ LAST_WINDOW_S = 1.0
 
 UNCERTAINTY_TABLES = ("uncertainty_samples.csv", "uncertainty_summary.csv")
 
-FIGURES = ("error_heatmap.png", "steady_state_vs_pressure.png", "time_responses.png", "frequency_vs_load.png")
+FIGURES = tuple(SWEEP_FIGURES)
+"""File names of a sweep's figures."""
 
 
 @dataclass(frozen=True)
@@ -198,17 +200,18 @@ class SweepResult:
         list of str
             The names written.
         """
-        from . import plots, uncertainty_plots
         from .figures import render_all
         from .report import write_report
 
         study = self.uncertainty
+        jobs = {}
         # A pure uncertainty study (no cases) writes only its own outputs.
-        jobs = plots.figure_jobs(self) if self.spec.cases or study is None else {}
+        if self.spec.cases or study is None:
+            jobs = {name: (maker, self) for name, maker in SWEEP_FIGURES.items()}
         names = ["summary.csv", "report.md", *FIGURES] if jobs else []
         if study is not None:
-            jobs.update(uncertainty_plots.figure_jobs(study))
-            names += [*UNCERTAINTY_TABLES, "uncertainty.md", *uncertainty_plots.FIGURES]
+            jobs.update({name: (maker, study) for name, maker in UNCERTAINTY_FIGURES.items()})
+            names += [*UNCERTAINTY_TABLES, "uncertainty.md", *UNCERTAINTY_FIGURES]
         figures = render_all(jobs, executor)
         with atomic_outputs(directory, names) as tmp:
             if "summary.csv" in names:

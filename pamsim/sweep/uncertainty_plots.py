@@ -1,7 +1,8 @@
 """Figures of an uncertainty study: histograms and empirical CDFs of the summarised outputs.
 
 Each function returns a matplotlib ``Figure`` (no pyplot state) for a
-:class:`pamsim.sweep.uncertainty.UncertaintyResult`; the caller saves it.
+:class:`pamsim.sweep.uncertainty.UncertaintyResult`;
+:data:`pamsim.sweep.figures.UNCERTAINTY_FIGURES` names them.
 """
 
 from __future__ import annotations
@@ -10,9 +11,6 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from .uncertainty import QUANTITIES, UncertaintyResult
-
-FIGURES = ("uncertainty_histograms.png", "uncertainty_ecdf.png")
-
 
 def _panels(result: UncertaintyResult, title: str):
     fig = Figure(figsize=(13, 4))  # fixed margins: a layout engine's extra pass costs a third of the time
@@ -50,8 +48,3 @@ def ecdf_figure(result: UncertaintyResult) -> Figure:
         ax.legend(fontsize=8)
     return fig
 
-
-def figure_jobs(result: UncertaintyResult) -> dict:
-    """``{file name: (figure function, its argument)}`` of the two figures (:data:`FIGURES`), for
-    :func:`pamsim.sweep.figures.render_all`."""
-    return {"uncertainty_histograms.png": (histogram_figure, result), "uncertainty_ecdf.png": (ecdf_figure, result)}
