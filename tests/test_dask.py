@@ -58,8 +58,8 @@ def serial(spec):
 
 @pytest.fixture(scope="module")
 def client():
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                  dashboard_address=None) as cluster, distributed.Client(cluster) as c:
+    """The LocalCluster that ``--dask-local 2`` starts (pamsim's settings; workers from the fork server)."""
+    with dask_cluster.local_client(2) as c:
         yield c
 
 
@@ -118,7 +118,8 @@ def test_a_process_pool_worker_killed_mid_sweep_fails_its_chunks_and_the_sweep_c
         deadline = time.monotonic() + 60
         while not pool._processes and time.monotonic() < deadline:  # CPython's pool keeps {pid: process}
             time.sleep(0.02)
-        time.sleep(0.2)  # the workers hold their first chunks (starting a worker takes longer)
+        # Killed at once: the 14 runs take about 0.2 s on 2 workers, and a worker that dies at any
+        # moment before the last result breaks the pool (an earlier 0.2 s wait sometimes missed it).
         os.kill(next(iter(pool._processes)), signal.SIGKILL)
         result = running.result(timeout=240)
     assert len(result.rows) == len(serial.rows)
@@ -168,16 +169,26 @@ def test_cli_dask_local_writes_the_same_tables_as_the_serial_api(tmp_path):
         assert (tmp_path / "dask" / name).read_bytes() == (tmp_path / "one" / name).read_bytes(), name
 
 
-def test_local_workers_keep_the_malloc_defaults():
+def _worker_state():
+    return os.environ.get("MALLOC_TRIM_THRESHOLD_"), "pamsim.native" in sys.modules
+
+
+def test_local_workers_keep_the_malloc_defaults_and_use_the_preloaded_fork_server(client):
     """Dask starts its workers with MALLOC_TRIM_THRESHOLD_ (which also turns off glibc's adaptive heap
     threshold, costing the native backend's millisecond runs a quarter of their time); the clusters
-    pamsim starts leave it out, and only those."""
+    pamsim starts leave it out, fork their workers (a restarted one too: this runs after the
+    killed-worker test) from a server that has imported pamsim, and give Dask's configuration back
+    as it was."""
     import dask
 
+    states = client.run(_worker_state)
+    assert len(states) == 2 and all(s == (None, True) for s in states.values()), states
     key = "distributed.nanny.pre-spawn-environ"
-    assert "MALLOC_TRIM_THRESHOLD_" in dask.config.get(key)
-    with dask_cluster._keep_malloc_defaults():
+    before = {k: dask.config.get(k) for k in (*dask_cluster.LOCAL_CLUSTER_CONFIG, key)}
+    with dask_cluster._local_cluster_settings():
         environ = dask.config.get(key)
         assert "MALLOC_TRIM_THRESHOLD_" not in environ
         assert environ.get("OMP_NUM_THREADS") == 1  # the rest of Dask's worker environment stays
-    assert "MALLOC_TRIM_THRESHOLD_" in dask.config.get(key)
+        for k, v in dask_cluster.LOCAL_CLUSTER_CONFIG.items():
+            assert dask.config.get(k) == v, k
+    assert {k: dask.config.get(k) for k in before} == before

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import contextlib
 import logging
+import os
 from concurrent.futures import Executor
 from typing import Iterator
 
@@ -45,23 +46,85 @@ def _distributed():
     return distributed
 
 
-@contextlib.contextmanager
-def _keep_malloc_defaults() -> Iterator[None]:
-    """Start local workers without the ``MALLOC_TRIM_THRESHOLD_`` Dask sets for them.
+LOCAL_CLUSTER_CONFIG = {
+    # Workers forked from a single-threaded server that has imported Dask, numpy and pamsim once,
+    # instead of spawned fresh interpreters that each import them again (a worker's import of
+    # distributed and pamsim takes about 0.8 s of CPU; with 2 cores that is the run's time).
+    "distributed.worker.multiprocessing-method": "forkserver",
+    # The statistical profiler samples each task thread every 10 ms for the dashboard, which the
+    # clusters pamsim starts do not serve.
+    "distributed.worker.profile.enabled": False,
+    # Resource and memory polling every 2 s and 1 s instead of 0.5 s and 0.1 s: the polling shares
+    # the CPUs with the runs, and a runaway worker is still stopped within a second.
+    "distributed.admin.system-monitor.interval": "2s",
+    "distributed.worker.memory.monitor-interval": "1s",
+}
+"""Dask settings of the ``LocalCluster`` that ``--dask-local`` starts (a pamsim choice; a cluster
+of your own keeps its configuration).  With runs of about a millisecond (the native backend),
+Dask's own work shows; ``benchmarks/bench_dask.py`` measures the cluster against a process pool
+(figures in ``docs/scaling.md``)."""
 
-    Dask sets it to hand freed memory back to the system sooner.  Setting it also turns off glibc's
-    adaptive threshold for serving large allocations from the heap, so every run's traces (about
-    0.6 MB per 8 s run at 1 kHz) come from fresh pages: with the native backend's runs of about a
-    millisecond that made each run a quarter slower.  A pamsim choice for the clusters it starts;
-    a cluster of your own keeps its configuration.
+FORKSERVER_PRELOAD = ("distributed", "numpy", "pamsim.sweep.run", "pamsim.native")
+"""Modules the fork server imports once, before it forks the workers."""
+
+
+def _start_fork_server() -> None:
+    """Start the fork server of the local workers, which imports :data:`FORKSERVER_PRELOAD`.
+
+    Called before this process imports Dask, so that on 2 cores the two imports overlap.  A fork
+    server already running (an earlier local cluster of this process) is reused as it is.
+    """
+    import multiprocessing
+    import multiprocessing.forkserver
+
+    multiprocessing.get_context("forkserver").set_forkserver_preload(list(FORKSERVER_PRELOAD))
+    # The workers are forked from the server, so they keep the malloc settings of the server's
+    # start; a Dask cluster started earlier in this process may have left MALLOC_TRIM_THRESHOLD_ in
+    # its environment.
+    trim = os.environ.pop("MALLOC_TRIM_THRESHOLD_", None)
+    try:
+        multiprocessing.forkserver.ensure_running()
+    finally:
+        if trim is not None:
+            os.environ["MALLOC_TRIM_THRESHOLD_"] = trim
+
+
+@contextlib.contextmanager
+def _local_cluster_settings() -> Iterator[None]:
+    """:data:`LOCAL_CLUSTER_CONFIG`, the fork server's preload, and the workers' environment
+    without ``MALLOC_TRIM_THRESHOLD_``, for the lifetime of a local cluster (a restarted worker is
+    started the same way).
+
+    Dask sets ``MALLOC_TRIM_THRESHOLD_`` to hand freed memory back to the system sooner.  Setting
+    it also turns off glibc's adaptive threshold for serving large allocations from the heap, so
+    every run's traces (about 0.6 MB per 8 s run at 1 kHz) come from fresh pages: with the native
+    backend's runs of about a millisecond that made each run a quarter slower.
     """
     import dask
+    from distributed.utils import get_mp_context
 
     key = "distributed.nanny.pre-spawn-environ"
     environ = dict(dask.config.get(key, default={}) or {})
     environ.pop("MALLOC_TRIM_THRESHOLD_", None)
-    with dask.config.set({key: environ}):
+    with dask.config.set({**LOCAL_CLUSTER_CONFIG, key: environ}):
+        get_mp_context()  # Dask's own preload list, set on first use, no longer reaches the running server
         yield
+
+
+@contextlib.contextmanager
+def local_client(workers: int) -> Iterator:
+    """Yield a ``distributed.Client`` of a new ``LocalCluster`` of ``workers`` single-threaded worker
+    processes, started with pamsim's settings (:func:`_local_cluster_settings`); closed on exit.
+
+    Raises :class:`DaskUnavailable` without the extra.
+    """
+    _start_fork_server()  # first, so that its imports overlap this process's import of Dask
+    distributed = _distributed()
+    with _local_cluster_settings(), distributed.LocalCluster(
+            n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
+            # Workers log a lost heartbeat as an error while the cluster shuts down; not the user's concern.
+            silence_logs=logging.CRITICAL) as cluster, distributed.Client(cluster) as client:
+        yield client
 
 
 @contextlib.contextmanager
@@ -75,24 +138,19 @@ def dask_executor(address: str | None = None, local_workers: int | None = None) 
         need the same pamsim installed.
     local_workers : int, optional
         Instead of ``address``: start a ``LocalCluster`` of this many single-threaded
-        worker processes (the simulations hold the GIL, so threads would not help).
+        worker processes (the simulations hold the GIL, so threads would not help), with
+        :func:`local_client`.
     """
     if (address is None) == (local_workers is None):
         raise InputError("give exactly one of a scheduler address (--dask) and a local worker count (--dask-local)")
+    if local_workers is not None:
+        with local_client(local_workers) as client:
+            yield client.get_executor(pure=False), f"Dask LocalCluster of {local_workers} worker process(es)"
+        return
     distributed = _distributed()
-    with contextlib.ExitStack() as stack:
-        if address is not None:
-            try:
-                client = stack.enter_context(distributed.Client(address, timeout=CONNECT_TIMEOUT_S))
-            except (OSError, TimeoutError, ValueError) as exc:
-                raise DaskConnectionError(f"--dask {address}: cannot reach the scheduler: {exc}") from None
-            where = f"Dask scheduler {address}"
-        else:
-            stack.enter_context(_keep_malloc_defaults())
-            cluster = stack.enter_context(distributed.LocalCluster(
-                n_workers=local_workers, threads_per_worker=1, processes=True, dashboard_address=None,
-                # Workers log a lost heartbeat as an error while the cluster shuts down; not the user's concern.
-                silence_logs=logging.CRITICAL))
-            client = stack.enter_context(distributed.Client(cluster))
-            where = f"Dask LocalCluster of {local_workers} worker process(es)"
-        yield client.get_executor(pure=False), where
+    try:
+        client = distributed.Client(address, timeout=CONNECT_TIMEOUT_S)
+    except (OSError, TimeoutError, ValueError) as exc:
+        raise DaskConnectionError(f"--dask {address}: cannot reach the scheduler: {exc}") from None
+    with client:
+        yield client.get_executor(pure=False), f"Dask scheduler {address}"
