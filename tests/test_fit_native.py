@@ -275,3 +275,23 @@ def test_cli_fit_dynamic_native_refuses_with_one_line_and_exit_2(tmp_path, short
     assert len(lines) == 1 and key in lines[0] and "refused.toml" in lines[0], lines
     assert "Traceback" not in proc.stderr
     assert not out.exists()
+
+
+def test_trials_that_outgrow_the_batch_event_room_run_again_alone(pooled, monkeypatch):
+    """The fit's batch keeps as many events per case as a scenario's batch does; with room for 2, each
+    trial (these have more) is run again alone, with the same contraction as with room enough."""
+    from pamsim.identification import native_fit
+    from pamsim.native import backend
+
+    _, fit = pooled
+    thetas = np.array([_truth_vector(), 1.01 * _truth_vector()])
+    reference = make_trials(fit.problem, "native")(thetas)
+    capacities = []
+    run = native_fit._run
+    monkeypatch.setattr(native_fit, "_run", lambda chunk, capacity: capacities.append(list(capacity)) or run(chunk, capacity))
+    monkeypatch.setattr(backend, "BATCH_EVENT_CAPACITY", 2)
+    again = make_trials(fit.problem, "native")(thetas)
+    limit = fit.problem.scenario.solver.max_events + 1
+    assert capacities[0] == [2] * len(reference) and capacities[1:] == [[limit]] * len(reference)
+    for a, r in zip(again, reference):
+        assert np.array_equal(a, r)

@@ -116,6 +116,29 @@ def test_too_many_events_is_a_solver_failure_on_both_backends():
             pamsim.simulate(sc, backend=backend)
 
 
+def test_a_case_that_outgrows_the_batch_event_room_runs_again_alone(monkeypatch):
+    """With room for 3 events per case, cases with more are run again alone with room for their own
+    max_events, and give the numbers of a batch with room enough; a case over its own limit still
+    fails as on its own."""
+    from pamsim.native import backend, simulate_batch
+
+    fig6b = pamsim.load_scenario(SCENARIOS / "acra2012_fig6b.toml")
+    fig4 = pamsim.load_scenario(SCENARIOS / "acra2012_fig4.toml")
+    few = fig6b.with_changes({"solver": {"max_events": 2}})
+    reference = simulate_batch([fig6b, fig4])
+    assert len(reference[0].transitions) > 3
+    calls = []
+    run = backend._run
+    monkeypatch.setattr(backend, "_run", lambda cases, capacity: calls.append(list(capacity)) or run(cases, capacity))
+    monkeypatch.setattr(backend, "BATCH_EVENT_CAPACITY", 3)
+    again = simulate_batch([fig6b, fig4, few], return_exceptions=True)
+    # fig6b (34 events) and fig4 (4) outgrow the room; `few` stops on its own limit of 2, not run again
+    assert calls[0] == [3, 3, 3] and calls[1:] == [[fig6b.solver.max_events + 1], [fig4.solver.max_events + 1]]
+    for a, r in zip(again, reference):
+        assert np.array_equal(a.x_m, r.x_m) and a.transitions == r.transitions
+    assert isinstance(again[2], SolverFailure) and "more than 2 events" in str(again[2])
+
+
 @pytest.mark.parametrize("changes, key", [
     ({"solver": {"method": "Radau"}}, "solver.method"),
     ({"solver": {"method": "DOP853"}}, "solver.method"),

@@ -29,7 +29,7 @@ import numpy as np
 from ..elements.pressure_source import PrescribedPressure
 from ..errors import InputError
 from ..native import library as lib
-from ..native.backend import BATCH_EVENT_CAPACITY, CaseInputs, case_inputs
+from ..native.backend import CaseInputs, case_inputs, event_capacity, outgrew_batch
 from ..static_models import get as get_static_model
 from .dynamic_fit import trace_scenario
 
@@ -69,17 +69,16 @@ def _sub(chunk: Chunk, a: int, b: int) -> Chunk:
 def run_chunk(chunk: Chunk) -> list[np.ndarray]:
     """Contraction [m] of every case of ``chunk`` at its sample times; NaN for a case that failed.
 
-    One library call for the chunk.  Events are kept up to :data:`BATCH_EVENT_CAPACITY` per case;
+    One library call for the chunk.  Events are kept up to :data:`pamsim.native.backend.BATCH_EVENT_CAPACITY` per case;
     a case that had more is run again alone with room for its ``max_events``, as
     :func:`pamsim.native.simulate_batch` does, so the event limit is the scenario's, as on the
     Python backend.
     """
-    capacity = np.minimum(chunk.max_events + 1, BATCH_EVENT_CAPACITY)
-    out = _run(chunk, capacity)
+    out = _run(chunk, event_capacity(chunk.max_events))
     xs = []
     for i in range(len(chunk.duration_s)):
         status, found, k = int(out["status"][i]), out, i
-        if status == 3 and capacity[i] < chunk.max_events[i] + 1:
+        if outgrew_batch(status, int(chunk.max_events[i])):
             found, k = _run(_sub(chunk, i, i + 1), chunk.max_events[i:i + 1] + 1), 0
             status = int(found["status"][0])
         if status != 0:  # bad input, solver failure or too many events: a bad trial point, as in Python

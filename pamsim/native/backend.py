@@ -45,6 +45,18 @@ METHODS = ("LSODA", "RK45")
 LSODA is the automatic choice of a non-stiff method for this non-stiff model.  Others are refused."""
 BATCH_EVENT_CAPACITY = 1024
 """Events kept per case in a batch; a case with more is run again alone, with room for ``max_events``."""
+
+
+def event_capacity(max_events):
+    """Events kept per case in a batch call (``max_events``: one case's limit, or an array of them)."""
+    return np.minimum(np.asarray(max_events) + 1, BATCH_EVENT_CAPACITY)
+
+
+def outgrew_batch(status: int, max_events: int) -> bool:
+    """Whether a case stopped on the batch's event room (status 3) below its own ``max_events``,
+    and so is to be run again alone with room for ``max_events + 1`` events."""
+    return status == 3 and max_events + 1 > BATCH_EVENT_CAPACITY
+
 HOLD_STEPS_PER_TAU = 10
 """A first-order lag is held over at most tau / 10 (and never longer than one output sample)."""
 METHOD_LABEL = "native DOPRI5(4)"
@@ -267,12 +279,12 @@ def simulate_batch(scenarios: Sequence[Scenario], return_exceptions: bool = Fals
     """
     cases = [case_inputs(s) for s in scenarios]
     wall0 = time.perf_counter()
-    out = _run(cases, [min(c.max_events + 1, BATCH_EVENT_CAPACITY) for c in cases])
+    out = _run(cases, [event_capacity(c.max_events) for c in cases])
     wall = (time.perf_counter() - wall0) / max(len(cases), 1)
     results = []
     for i, (scenario, case, t) in enumerate(zip(scenarios, cases, _sample_grids(cases))):
         try:
-            if out["status"][i] == 3 and case.max_events + 1 > BATCH_EVENT_CAPACITY:
+            if outgrew_batch(int(out["status"][i]), case.max_events):
                 again = time.perf_counter()
                 alone = _run([case], [case.max_events + 1])
                 results.append(_result(scenario, case, alone, 0, time.perf_counter() - again, t))
