@@ -139,6 +139,18 @@ def test_dask_without_the_extra_is_one_line_naming_it(tmp_path, monkeypatch, cap
     assert not (tmp_path / "out").exists()
 
 
+def test_dask_local_without_the_extra_is_one_line_and_starts_nothing(tmp_path, monkeypatch, capsys):
+    import multiprocessing.forkserver
+
+    (tmp_path / "s.toml").write_text(f'base_scenario = "{FIG4}"\n[axes]\npressure_bar = [3.6]\nweight_N = [22.74]\n')
+    monkeypatch.setitem(sys.modules, "distributed", None)
+    monkeypatch.setattr(multiprocessing.forkserver, "ensure_running", lambda: pytest.fail("fork server started"))
+    code = cli_main(["sweep", str(tmp_path / "s.toml"), "-o", str(tmp_path / "out"), "--dask-local", "2"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and "pamsim[dask]" in err[0]
+    assert not (tmp_path / "out").exists()
+
+
 def test_unreachable_scheduler_is_one_line_exit_2(tmp_path, monkeypatch, capsys):
     (tmp_path / "s.toml").write_text(f'base_scenario = "{FIG4}"\n[axes]\npressure_bar = [3.6]\nweight_N = [22.74]\n')
     monkeypatch.setattr(dask_cluster, "CONNECT_TIMEOUT_S", 1.0)

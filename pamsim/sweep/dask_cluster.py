@@ -17,6 +17,7 @@ cases become failed rows (``KilledWorker``) while the sweep completes.
 from __future__ import annotations
 
 import contextlib
+import importlib.util
 import logging
 import os
 from concurrent.futures import Executor
@@ -118,7 +119,8 @@ def local_client(workers: int) -> Iterator:
 
     Raises :class:`DaskUnavailable` without the extra.
     """
-    _start_fork_server()  # first, so that its imports overlap this process's import of Dask
+    if importlib.util.find_spec("distributed") is not None:  # else _distributed() says what to install
+        _start_fork_server()  # first, so that its imports overlap this process's import of Dask
     distributed = _distributed()
     with _local_cluster_settings(), distributed.LocalCluster(
             n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
