@@ -81,16 +81,30 @@ NATIVE_BATCH = 16
 batch's traces (about 0.6 MB per 8 s run at 1 kHz) stay in cache while they are reduced."""
 
 
-def run_chunk(tasks: list[_Task]) -> list[dict]:
+class ChunkOutputs(tuple):
+    """The outputs of a chunk's runs, in order: a tuple that a Dask worker sends in one piece.
+
+    Dask sends the items of a plain list or tuple result one by one (each run's small dict
+    pickled and unpickled on its own: ten thousand of them for the uncertainty study); a subclass
+    is pickled whole, as a process pool does anyway.
+    """
+
+    __slots__ = ()
+
+
+def run_chunk(tasks: list[_Task]) -> ChunkOutputs:
     """Run a chunk of tasks in one worker (one executor task, one round trip).
 
     The native backend's runs go to the library in batch calls of :data:`NATIVE_BATCH`; the
     Python backend's run one after the other.  The numbers are the same either way.
     """
     if not tasks or any(t.backend != "native" for t in tasks):
-        return [run_task(task) for task in tasks]
-    if len(tasks) > NATIVE_BATCH:
-        return [o for i in range(0, len(tasks), NATIVE_BATCH) for o in run_chunk(tasks[i:i + NATIVE_BATCH])]
+        return ChunkOutputs(run_task(task) for task in tasks)
+    return ChunkOutputs(o for i in range(0, len(tasks), NATIVE_BATCH) for o in _run_native_batch(tasks[i:i + NATIVE_BATCH]))
+
+
+def _run_native_batch(tasks: list[_Task]) -> list[dict]:
+    """:func:`run_chunk` of at most :data:`NATIVE_BATCH` native tasks: one library call."""
     from ..native import simulate_batch
 
     out: list[dict | None] = [None] * len(tasks)
