@@ -65,16 +65,12 @@ about 20 ms, the native backend's about 1 ms), big enough to amortise the per-ta
 scheduler (milliseconds), small enough to balance the load and lose little work when a worker dies.
 A backend not listed (an FMU) takes the Python backend's."""
 
-AUTO_CHUNKS = 32
-"""Chunks the automatic size aims at (more when capped by :data:`MAX_AUTO_CHUNK`): 16 per worker of
-a 2-process pool, enough to balance the load.  Each chunk costs a Dask client a round trip to fetch
-its outputs (milliseconds of CPU that, on a small machine, the workers' runs wait for); 64 chunks
-made a 2-worker Dask cluster measurably slower than 32 against the process pool
-(``benchmarks/bench_dask.py --chunk-size N``, figures in docs/scaling.md)."""
+AUTO_CHUNKS = 64
+"""Chunks the automatic size aims at (fewer when capped by :data:`MAX_AUTO_CHUNK`)."""
 
 
 def auto_chunk_size(n_tasks: int, backend: str = "python") -> int:
-    """Runs per executor task when none is given: ``ceil(n / 32)``, between 1 and the backend's
+    """Runs per executor task when none is given: ``ceil(n / 64)``, between 1 and the backend's
     :data:`MAX_AUTO_CHUNK` (50 for the Python backend, 1000 for the native one)."""
     cap = MAX_AUTO_CHUNK.get(backend, MAX_AUTO_CHUNK["python"])
     return max(1, min(cap, math.ceil(n_tasks / AUTO_CHUNKS)))
