@@ -182,25 +182,37 @@ def test_cli_dask_local_writes_the_same_tables_as_the_serial_api(tmp_path):
 
 
 def _worker_state():
-    return os.environ.get("MALLOC_TRIM_THRESHOLD_"), "pamsim.native" in sys.modules
+    """(MALLOC_TRIM_THRESHOLD_ in the worker, pamsim.native imported, the environment its parent
+    process, the fork server, started with)."""
+    with open(f"/proc/{os.getppid()}/environ", "rb") as fh:
+        parent = dict(v.decode().split("=", 1) for v in fh.read().split(b"\0") if b"=" in v)
+    return os.environ.get("MALLOC_TRIM_THRESHOLD_"), "pamsim.native" in sys.modules, parent
 
 
 def test_local_workers_keep_the_malloc_defaults_and_use_the_preloaded_fork_server(client):
     """Dask starts its workers with MALLOC_TRIM_THRESHOLD_ (which also turns off glibc's adaptive heap
     threshold, costing the native backend's millisecond runs a quarter of their time); the clusters
     pamsim starts leave it out, fork their workers (a restarted one too: this runs after the
-    killed-worker test) from a server that has imported pamsim, and give Dask's configuration back
-    as it was."""
+    killed-worker test) from a server that has imported pamsim and started with one BLAS thread per
+    worker (numpy's BLAS reads that when the server loads it), and give Dask's configuration and this
+    process's environment back as they were."""
     import dask
 
     states = client.run(_worker_state)
-    assert len(states) == 2 and all(s == (None, True) for s in states.values()), states
+    assert len(states) == 2
+    for trim, preloaded, server in states.values():
+        assert trim is None and preloaded
+        assert "MALLOC_TRIM_THRESHOLD_" not in server
+        assert all(server.get(k) == v for k, v in dask_cluster.FORKSERVER_ENVIRON.items()), server
     key = "distributed.nanny.pre-spawn-environ"
     before = {k: dask.config.get(k) for k in (*dask_cluster.LOCAL_CLUSTER_CONFIG, key)}
+    environ = dict(os.environ)
     with dask_cluster._local_cluster_settings():
-        environ = dask.config.get(key)
-        assert "MALLOC_TRIM_THRESHOLD_" not in environ
-        assert environ.get("OMP_NUM_THREADS") == 1  # the rest of Dask's worker environment stays
+        pre_spawn = dask.config.get(key)
+        assert "MALLOC_TRIM_THRESHOLD_" not in pre_spawn
+        assert pre_spawn.get("OMP_NUM_THREADS") == 1  # the rest of Dask's worker environment stays
         for k, v in dask_cluster.LOCAL_CLUSTER_CONFIG.items():
             assert dask.config.get(k) == v, k
+        os.environ.update({"PAMSIM_TEST_ADDED": "1", "PATH": "changed"})  # as Dask's nanny does
     assert {k: dask.config.get(k) for k in before} == before
+    assert dict(os.environ) == environ

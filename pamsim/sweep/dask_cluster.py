@@ -68,26 +68,41 @@ Dask's own work shows; ``benchmarks/bench_dask.py`` measures the cluster against
 FORKSERVER_PRELOAD = ("distributed", "numpy", "pamsim.sweep.run", "pamsim.native")
 """Modules the fork server imports once, before it forks the workers."""
 
+FORKSERVER_ENVIRON = {"OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"}
+"""Environment the fork server starts with: one thread for numpy's linear algebra in each worker,
+as Dask's own ``pre-spawn-environ`` gives a worker it spawns.  The libraries read these when they
+load, which is in the server (the preload), before Dask could set them in a worker."""
+
+
+@contextlib.contextmanager
+def _restored_environ() -> Iterator[None]:
+    """``os.environ`` put back on exit as it was on entry (variables added meanwhile removed)."""
+    saved = dict(os.environ)
+    try:
+        yield
+    finally:
+        for k in set(os.environ) - set(saved):
+            del os.environ[k]
+        os.environ.update(saved)
+
 
 def _start_fork_server() -> None:
     """Start the fork server of the local workers, which imports :data:`FORKSERVER_PRELOAD`.
 
-    Called before this process imports Dask, so that on 2 cores the two imports overlap.  A fork
-    server already running (an earlier local cluster of this process) is reused as it is.
+    Called before this process imports Dask, so that on 2 cores the two imports overlap.  The server
+    lives until this process exits; a later local cluster of this process reuses it as it is.
     """
     import multiprocessing
     import multiprocessing.forkserver
 
     multiprocessing.get_context("forkserver").set_forkserver_preload(list(FORKSERVER_PRELOAD))
-    # The workers are forked from the server, so they keep the malloc settings of the server's
-    # start; a Dask cluster started earlier in this process may have left MALLOC_TRIM_THRESHOLD_ in
-    # its environment.
-    trim = os.environ.pop("MALLOC_TRIM_THRESHOLD_", None)
-    try:
+    # The workers are forked from the server, so they keep the environment of its start: the thread
+    # limits, and no MALLOC_TRIM_THRESHOLD_ (which a Dask cluster started earlier in this process
+    # leaves in its environment).
+    with _restored_environ():
+        os.environ.update(FORKSERVER_ENVIRON)
+        os.environ.pop("MALLOC_TRIM_THRESHOLD_", None)
         multiprocessing.forkserver.ensure_running()
-    finally:
-        if trim is not None:
-            os.environ["MALLOC_TRIM_THRESHOLD_"] = trim
 
 
 @contextlib.contextmanager
@@ -107,8 +122,12 @@ def _local_cluster_settings() -> Iterator[None]:
     key = "distributed.nanny.pre-spawn-environ"
     environ = dict(dask.config.get(key, default={}) or {})
     environ.pop("MALLOC_TRIM_THRESHOLD_", None)
-    with dask.config.set({**LOCAL_CLUSTER_CONFIG, key: environ}):
-        get_mp_context()  # Dask's own preload list, set on first use, no longer reaches the running server
+    # Dask's nanny writes the workers' pre-spawn variables into this process's environment and leaves
+    # them there; they are put back when the cluster closes.
+    with dask.config.set({**LOCAL_CLUSTER_CONFIG, key: environ}), _restored_environ():
+        # Dask names its own preload the first time it makes the context; pamsim's is named again, for
+        # a server restarted after this one (the running one has its preload already).
+        get_mp_context().set_forkserver_preload(list(FORKSERVER_PRELOAD))
         yield
 
 
