@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import contextlib
-import fcntl
 import io
 import os
 import subprocess
@@ -13,6 +12,11 @@ from pathlib import Path
 import pytest
 
 import pamsim
+
+try:
+    import fcntl
+except ImportError:  # not on Windows: each test process then builds its own FMUs
+    fcntl = None
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENARIOS = ROOT / "scenarios"
@@ -45,12 +49,13 @@ def fmus(tmp_path_factory):
     from pamsim.fmu import build
 
     root = tmp_path_factory.getbasetemp()
-    if os.environ.get("PYTEST_XDIST_WORKER"):
+    if os.environ.get("PYTEST_XDIST_WORKER") and fcntl is not None:
         root = root.parent  # shared by the session's workers, fresh for every session
     folder = root / "session-fmus"
     folder.mkdir(exist_ok=True)
     with open(folder / ".lock", "w") as lock:
-        fcntl.flock(lock, fcntl.LOCK_EX)
+        if fcntl is not None:
+            fcntl.flock(lock, fcntl.LOCK_EX)
         paths = {v: folder / f"pamsim_muscle_fmi{v}.fmu" for v in (2, 3)}
         return {v: p if p.exists() else build(p, v) for v, p in paths.items()}
 

@@ -10,6 +10,7 @@ from __future__ import annotations
 from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
+import pytest
 
 from pamsim.identification.dynamic_fit import fit_dynamic
 from pamsim.identification.synthetic import synthetic_trace
@@ -42,3 +43,22 @@ def friction_polynomial_error(theta, clean_traces):
     true = TRUTH["N2_N_per_bar_m2"] * x ** 2 + TRUTH["N1_N_per_bar_m"] * x + TRUTH["N0_N_per_bar"]
     fit = theta[2] * x ** 2 + theta[3] * x + theta[4]
     return float(np.sqrt(np.mean(((fit - true) / true) ** 2)))
+
+
+def check_three_loads_pooled(pooled):
+    """Three loads pooled separate what one trace cannot: ``pooled`` is ``(pairs, fit)`` of the three
+    loads 12.74, 22.74 and 32.74 N with every coefficient of FREE free."""
+    pairs, fit = pooled
+    for sim, (_, clean) in zip(fit.simulated_m, pairs):
+        assert np.sqrt(np.mean((sim - clean.x_m) ** 2)) < 0.1e-3
+    truth = dict(zip(FREE, truth_vector()))
+    ident = fit.uncertainty.identifiable(fit.theta)
+    assert {"D1_N_s_per_m", "D2_N_s2_per_m2"} <= set(ident)  # three loads separate the damping terms
+    for name in ident:
+        assert fit.parameters[name] == pytest.approx(truth[name], rel=0.10), name
+    for group in fit.uncertainty.groups():
+        w, se = fit.uncertainty.best_combination(group)
+        idx = [FREE.index(n) for n in group]
+        assert w @ fit.theta[idx] == pytest.approx(w @ truth_vector()[idx], rel=0.10)
+    assert friction_polynomial_error(fit.theta, [c for _, c in pairs]) < 0.02
+    assert fit.n_simulations > 3 * (len(FREE) + 1)

@@ -24,13 +24,12 @@ from pamsim.identification.synthetic import synthetic_trace
 from pamsim.native.backend import case_inputs
 
 from conftest import SCENARIOS, run_cli, run_main
-from synthetic_fit import FREE, NOISE_M
+from synthetic_fit import FREE, NOISE_M, check_three_loads_pooled
 from synthetic_fit import traces as _traces
 from synthetic_fit import truth_vector as _truth_vector
 from test_fit_dynamic import test_single_trace_identifiable_coefficients_within_10_percent as check_single_ident
 from test_fit_dynamic import test_single_trace_recovers_the_noise_free_trajectory as check_single_trajectory
 from test_fit_dynamic import test_single_trace_says_which_coefficients_it_cannot_separate as check_single_pairs
-from test_fit_dynamic_pooled import test_three_loads_pooled as check_three_loads_pooled
 
 LOADS_N = (12.74, 22.74, 32.74)
 HOLD_TOL_MM = 0.005
@@ -222,12 +221,16 @@ def test_global_search_then_local_fit_on_the_native_backend(scenario, short_pair
     assert fit.n_simulations >= 18
 
 
-def test_per_trace_table_on_the_native_backend(scenario, short_pair):
+def test_per_trace_table_beside_the_pooled_fit_on_the_native_backend(scenario, short_pair):
+    # The per-trace refits are the same code on both backends (the Python backend's pooled fit of
+    # these traces is in test_fit_dynamic.py); on the Python backend the three fits take 8 s.
     fit = fit_dynamic(scenario, [n for n, _ in short_pair], free=["N0_N_per_bar"], per_trace=True, backend="native")
     assert [row["load_N"] for row in fit.per_trace] == [12.74, 22.74]
     for row in fit.per_trace:
         assert row["N0_N_per_bar"] == pytest.approx(6.0, rel=0.03)
+        assert row["pressure_final_bar"] == pytest.approx(3.6, rel=1e-3)
         assert row["rms_contraction_mm"] == pytest.approx(NOISE_M * 1e3, rel=0.2)
+    assert fit.parameters["N0_N_per_bar"] == pytest.approx(6.0, rel=0.02)
 
 
 @pytest.mark.parametrize("changes, key", [

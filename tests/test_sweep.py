@@ -75,6 +75,14 @@ def _rms_mm(values_m) -> float:
 
 
 # ---------------------------------------------------------------- the 66-case grid
+def test_the_written_figures_are_the_named_ones(written):
+    from pamsim.sweep.figures import SWEEP_FIGURES
+
+    assert sorted(pamsim.sweep.FIGURES) == sorted(SWEEP_FIGURES)
+    for name in pamsim.sweep.FIGURES:
+        assert (written / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n", name
+
+
 def test_grid_has_one_row_per_measured_test(serial, written):
     with open(DATA) as fh:
         measured = list(csv.DictReader(line for line in fh if not line.startswith("#")))

@@ -36,8 +36,8 @@ LAST_WINDOW_S = 1.0
 
 UNCERTAINTY_TABLES = ("uncertainty_samples.csv", "uncertainty_summary.csv")
 
-FIGURES = tuple(SWEEP_FIGURES)
-"""File names of a sweep's figures."""
+FIGURES = ("error_heatmap.png", "steady_state_vs_pressure.png", "time_responses.png", "frequency_vs_load.png")
+"""File names of a sweep's figures, in the order of the report (:data:`.figures.SWEEP_FIGURES` renders them)."""
 
 
 @dataclass(frozen=True)
