@@ -59,9 +59,6 @@ LOCAL_CLUSTER_CONFIG = {
     # the CPUs with the runs, and a runaway worker is still stopped within a second.
     "distributed.admin.system-monitor.interval": "2s",
     "distributed.worker.memory.monitor-interval": "1s",
-    # The workers start while the sweep prepares its tasks (local_client); should none arrive, the
-    # tasks fail after this long (their runs become failed rows) instead of waiting for ever.
-    "distributed.scheduler.no-workers-timeout": "60s",
 }
 """Dask settings of the ``LocalCluster`` that ``--dask-local`` starts (a pamsim choice; a cluster
 of your own keeps its configuration).  With runs of about a millisecond (the native backend),
@@ -145,12 +142,9 @@ def local_client(workers: int) -> Iterator:
         _start_fork_server()  # first, so that its imports overlap this process's import of Dask
     distributed = _distributed()
     with _local_cluster_settings(), distributed.LocalCluster(
-            n_workers=0, threads_per_worker=1, processes=True, dashboard_address=None,
+            n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
             # Workers log a lost heartbeat as an error while the cluster shuts down; not the user's concern.
             silence_logs=logging.CRITICAL) as cluster, distributed.Client(cluster) as client:
-        # The workers start while the caller prepares its tasks (the scheduler holds the tasks until
-        # they arrive), instead of before.
-        cluster.scale(workers)
         yield client
 
 
