@@ -112,7 +112,7 @@ def test_a_worker_killed_mid_sweep_is_retried_and_the_sweep_completes(spec, seri
     client.wait_for_workers(2, timeout=60)  # the nanny restarts it for the tests that follow
 
 
-def test_a_process_pool_worker_killed_mid_sweep_fails_its_chunks_and_the_sweep_completes(spec, serial):
+def test_a_process_pool_worker_killed_mid_sweep_fails_its_chunks_and_the_sweep_completes(spec, serial, tmp_path):
     with ProcessPoolExecutor(max_workers=2) as pool, ThreadPoolExecutor(1) as outer:
         running = outer.submit(pamsim.sweep, spec, pool, chunk_size=1)
         deadline = time.monotonic() + 60
@@ -122,6 +122,10 @@ def test_a_process_pool_worker_killed_mid_sweep_fails_its_chunks_and_the_sweep_c
         # moment before the last result breaks the pool (an earlier 0.2 s wait sometimes missed it).
         os.kill(next(iter(pool._processes)), signal.SIGKILL)
         result = running.result(timeout=240)
+        # The broken pool cannot draw the figures either: they are drawn here, and everything is written.
+        names = result.write(tmp_path / "out", pool)
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == sorted(names)
+    assert all((tmp_path / "out" / n).stat().st_size > 0 for n in names)
     assert len(result.rows) == len(serial.rows)
     errors = [r["failure"] + r["constant_failure"] for r in result.rows]
     assert any("BrokenProcessPool" in e for e in errors)

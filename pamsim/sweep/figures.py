@@ -52,9 +52,25 @@ def render_all(jobs: Mapping[str, tuple[str, object]], executor: Executor | None
     """Render ``{file name: (maker name, data)}``, in this process or on ``executor``; return ``{file name: png}``.
 
     Jobs are submitted in the order given (put the slowest first so the workers finish together).
-    A figure that fails raises here, before the caller writes anything.
+    A figure the executor cannot give (a pool broken by a worker killed during the sweep, a cluster
+    that lost its workers) is drawn in this process; a figure that fails there raises, before the
+    caller writes anything.
     """
     if executor is None:
         return {name: render_png(maker_name, data) for name, (maker_name, data) in jobs.items()}
-    futures = {name: executor.submit(render_png, maker_name, data) for name, (maker_name, data) in jobs.items()}
-    return {name: future.result() for name, future in futures.items()}
+    futures = {}
+    for name, (maker_name, data) in jobs.items():
+        try:
+            futures[name] = executor.submit(render_png, maker_name, data)
+        except Exception:  # noqa: BLE001 -- a broken pool (a worker killed during the sweep): drawn here
+            futures[name] = None
+    pngs = {}
+    for name, future in futures.items():
+        if future is not None:
+            try:
+                pngs[name] = future.result()
+                continue
+            except Exception:  # noqa: BLE001 -- the executor failed, or the figure did: drawn here,
+                pass  # which gives the figure or raises the figure's own error
+        pngs[name] = render_png(*jobs[name])
+    return pngs

@@ -31,7 +31,8 @@ def histogram_figure(result: UncertaintyResult) -> Figure:
             _, _, patches = ax.hist(v, bins=min(50, max(5, int(np.sqrt(v.size)))), histtype="step", label=f)
             ax.axvline(np.median(v), ls="--", lw=0.8, color=patches[0].get_edgecolor())
         ax.set_ylabel("runs")
-        ax.legend(fontsize=8)
+        if ax.get_legend_handles_labels()[0]:  # none when every run of the study failed
+            ax.legend(fontsize=8)
     return fig
 
 
@@ -45,6 +46,7 @@ def ecdf_figure(result: UncertaintyResult) -> Figure:
             ax.axhline(p, lw=0.5, color="0.7")
         ax.set_ylabel("fraction of runs <= value")
         ax.set_ylim(0, 1)
-        ax.legend(fontsize=8)
+        if ax.get_legend_handles_labels()[0]:  # none when every run of the study failed
+            ax.legend(fontsize=8)
     return fig
 
