@@ -5,8 +5,9 @@
 Runs ``scenarios/acra2012_fig4_uncertainty.toml`` (10,000 Latin hypercube samples unless
 ``--samples`` says fewer) with the chosen backend (default native) on a ``ProcessPoolExecutor`` and
 on a ``distributed.LocalCluster`` of single-threaded worker processes, both with the same chunking.
-Times include starting the pool or the cluster; the two alternate, and the best of ``--repeat`` of
-each is kept.  Targets: Dask
+Each measurement runs in a fresh Python process, as ``pamsim sweep`` does: its time includes
+importing Dask (or not) and starting the pool or the cluster, with nothing left warm by an earlier
+one.  The two alternate, and the best of ``--repeat`` of each is kept.  Targets: Dask
 within 1.3x of the process pool; with the native backend, the 10,000 samples in <= 15 s on the
 pool.  The two results are also checked to be identical.
 """
@@ -17,6 +18,10 @@ import argparse
 import dataclasses
 import math
 import os
+import pickle
+import subprocess
+import sys
+import tempfile
 import time
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
@@ -49,6 +54,23 @@ def _same(a: dict, b: dict) -> bool:
                for k in b if k != "wall_time_s")
 
 
+def _arguments(args) -> list[str]:
+    out = ["--backend", args.backend, "--workers", str(args.workers)]
+    if args.samples:
+        out += ["--samples", str(args.samples)]
+    if args.chunk_size:
+        out += ["--chunk-size", str(args.chunk_size)]
+    return out
+
+
+def _in_fresh_process(kind: str, args) -> tuple[float, object]:
+    """(seconds, result) of one measurement, in a new Python process."""
+    with tempfile.TemporaryDirectory() as tmp:
+        out = Path(tmp) / "result.pickle"
+        subprocess.run([sys.executable, __file__, "--one", kind, "--out", str(out), *_arguments(args)], check=True)
+        return pickle.loads(out.read_bytes())
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--backend", choices=("native", "python"), default="native",
@@ -57,19 +79,26 @@ def main() -> None:
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--chunk-size", type=int, default=None, help="runs per task (default: automatic)")
     parser.add_argument("--repeat", type=int, default=1, help="repeats per configuration (best is kept)")
+    parser.add_argument("--one", choices=("pool", "dask"), help=argparse.SUPPRESS)  # one measurement, here
+    parser.add_argument("--out", help=argparse.SUPPRESS)
     args = parser.parse_args()
     spec = load_sweep(STUDY)
     if args.samples:
         spec = dataclasses.replace(spec, uncertainty=dataclasses.replace(spec.uncertainty, samples=args.samples))
     n = spec.uncertainty.samples
-    print(f"{os.cpu_count()} CPUs; {n} samples of {STUDY.name}; {args.workers} workers; "
-          f"chunk size {args.chunk_size or 'automatic'}; best of {args.repeat}")
     spec = dataclasses.replace(spec, backend=args.backend)
+    if args.one:
+        timed = timed_pool if args.one == "pool" else timed_dask
+        seconds, result = timed(spec, args.workers, args.chunk_size)
+        Path(args.out).write_bytes(pickle.dumps((seconds, result)))
+        return
+    print(f"{os.cpu_count()} CPUs; {n} samples of {STUDY.name}; {args.workers} workers; "
+          f"chunk size {args.chunk_size or 'automatic'}; best of {args.repeat}, each in a fresh process")
     # Alternated, so that a drift of the machine's speed during the benchmark does not favour either.
     pools, dasks = [], []
     for _ in range(args.repeat):
-        pools.append(timed_pool(spec, args.workers, args.chunk_size))
-        dasks.append(timed_dask(spec, args.workers, args.chunk_size))
+        pools.append(_in_fresh_process("pool", args))
+        dasks.append(_in_fresh_process("dask", args))
     (pool_s, pool_result), (dask_s, dask_result) = (min(runs, key=lambda r: r[0]) for runs in (pools, dasks))
     identical = all(_same(a, b) for f in pool_result.uncertainty.outputs
                     for a, b in zip(dask_result.uncertainty.outputs[f], pool_result.uncertainty.outputs[f]))
