@@ -217,6 +217,8 @@ def test_local_workers_keep_the_malloc_defaults_and_use_the_preloaded_fork_serve
         assert pre_spawn.get("OMP_NUM_THREADS") == 1  # the rest of Dask's worker environment stays
         for k, v in dask_cluster.LOCAL_CLUSTER_CONFIG.items():
             assert dask.config.get(k) == v, k
-        os.environ.update({"PAMSIM_TEST_ADDED": "1", "PATH": "changed"})  # as Dask's nanny does
+        os.environ.update({k: "changed" for k in (*pre_spawn, "PYTHONHASHSEED")})  # as Dask's nanny does
+        os.environ["PAMSIM_TEST_OTHER"] = "kept"  # a variable Dask does not write is not undone
     assert {k: dask.config.get(k) for k in before} == before
-    assert dict(os.environ) == environ
+    assert dict(os.environ) == {**environ, "PAMSIM_TEST_OTHER": "kept"}
+    del os.environ["PAMSIM_TEST_OTHER"]

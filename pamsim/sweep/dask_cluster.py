@@ -75,15 +75,18 @@ load, which is in the server (the preload), before Dask could set them in a work
 
 
 @contextlib.contextmanager
-def _restored_environ() -> Iterator[None]:
-    """``os.environ`` put back on exit as it was on entry (variables added meanwhile removed)."""
-    saved = dict(os.environ)
+def _restored_environ(keys) -> Iterator[None]:
+    """The variables ``keys`` of ``os.environ`` put back on exit as they were on entry (removed if
+    they were not set); the others are left alone."""
+    saved = {k: os.environ.get(k) for k in keys}
     try:
         yield
     finally:
-        for k in set(os.environ) - set(saved):
-            del os.environ[k]
-        os.environ.update(saved)
+        for k, v in saved.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
 
 
 def _start_fork_server() -> None:
@@ -99,7 +102,7 @@ def _start_fork_server() -> None:
     # The workers are forked from the server, so they keep the environment of its start: the thread
     # limits, and no MALLOC_TRIM_THRESHOLD_ (which a Dask cluster started earlier in this process
     # leaves in its environment).
-    with _restored_environ():
+    with _restored_environ([*FORKSERVER_ENVIRON, "MALLOC_TRIM_THRESHOLD_"]):
         os.environ.update(FORKSERVER_ENVIRON)
         os.environ.pop("MALLOC_TRIM_THRESHOLD_", None)
         multiprocessing.forkserver.ensure_running()
@@ -122,9 +125,9 @@ def _local_cluster_settings() -> Iterator[None]:
     key = "distributed.nanny.pre-spawn-environ"
     environ = dict(dask.config.get(key, default={}) or {})
     environ.pop("MALLOC_TRIM_THRESHOLD_", None)
-    # Dask's nanny writes the workers' pre-spawn variables into this process's environment and leaves
-    # them there; they are put back when the cluster closes.
-    with dask.config.set({**LOCAL_CLUSTER_CONFIG, key: environ}), _restored_environ():
+    # Dask's nanny writes the workers' pre-spawn variables (and PYTHONHASHSEED) into this process's
+    # environment and leaves them there; they are put back when the cluster closes.
+    with dask.config.set({**LOCAL_CLUSTER_CONFIG, key: environ}), _restored_environ([*environ, "PYTHONHASHSEED"]):
         # Dask names its own preload the first time it makes the context; pamsim's is named again, for
         # a server restarted after this one (the running one has its preload already).
         get_mp_context().set_forkserver_preload(list(FORKSERVER_PRELOAD))
