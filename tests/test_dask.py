@@ -8,6 +8,7 @@ import math
 import os
 import signal
 import sys
+import threading
 import time
 from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 from pathlib import Path
@@ -60,6 +61,7 @@ def serial(spec):
 def client():
     """The LocalCluster that ``--dask-local 2`` starts (pamsim's settings; workers from the fork server)."""
     with dask_cluster.local_client(2) as c:
+        c.wait_for_workers(2, timeout=60)  # local_client does not wait: the tests below count them
         yield c
 
 
@@ -132,6 +134,40 @@ def test_a_process_pool_worker_killed_mid_sweep_fails_its_chunks_and_the_sweep_c
     for row, ref, e in zip(result.rows, serial.rows, errors):
         if not e:
             assert all(_same(row[k], ref[k]) for k in ref)
+
+
+@pytest.mark.filterwarnings("ignore:Port 8787 is already in use")  # the module's cluster holds it
+@pytest.mark.parametrize("preload", [None, "/nonexistent/pamsim_test_preload.py", "hang"],
+                         ids=["no worker", "failed start", "hung start"])
+def test_a_local_cluster_whose_workers_never_start_fails_the_runs_instead_of_waiting(spec, monkeypatch, tmp_path,
+                                                                                   preload):
+    """local_client returns before its workers have started; should none start (none asked for, a
+    worker whose start fails, one whose start hangs), the runs fail after
+    distributed.scheduler.no-workers-timeout (30 s; 2 s here), the sweep completes, and the cluster
+    closes (a hung worker gives up after WORKER_START_TIMEOUT_S: 30 s; 3 s here)."""
+    import dask
+
+    monkeypatch.setitem(dask_cluster.LOCAL_CLUSTER_CONFIG, "distributed.scheduler.no-workers-timeout", "2s")
+    monkeypatch.setattr(dask_cluster, "WORKER_START_TIMEOUT_S", 3.0)
+    if preload == "hang":
+        preload = tmp_path / "hang.py"
+        preload.write_text("import time\ntime.sleep(600)\n")
+        preload = str(preload)
+    out = {}
+
+    def sweep():
+        with dask.config.set({"distributed.worker.preload": [preload] if preload else []}):
+            with dask_cluster.local_client(0 if preload is None else 2) as c:
+                out["result"] = pamsim.sweep(spec, c.get_executor(pure=False))
+        out["closed"] = True
+
+    # In a daemon thread, so that a hang fails this test instead of stopping the suite.
+    thread = threading.Thread(target=sweep, daemon=True)
+    thread.start()
+    thread.join(timeout=30)
+    assert out.get("closed"), "the sweep or the cluster's close hung"
+    errors = [r["failure"] + r["constant_failure"] for r in out["result"].rows]
+    assert len(errors) == 4 and all("NoWorkerError" in e for e in errors), errors
 
 
 def test_dask_without_the_extra_is_one_line_naming_it(tmp_path, monkeypatch, capsys):

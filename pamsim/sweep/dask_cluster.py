@@ -59,11 +59,17 @@ LOCAL_CLUSTER_CONFIG = {
     # the CPUs with the runs, and a runaway worker is still stopped within a second.
     "distributed.admin.system-monitor.interval": "2s",
     "distributed.worker.memory.monitor-interval": "1s",
+    # The workers start while the sweep prepares its tasks (local_client): should none start, the
+    # tasks fail after this long (failed rows, the sweep completes) instead of waiting for ever.
+    "distributed.scheduler.no-workers-timeout": "30s",
 }
 """Dask settings of the ``LocalCluster`` that ``--dask-local`` starts (a pamsim choice; a cluster
 of your own keeps its configuration).  With runs of about a millisecond (the native backend),
 Dask's own work shows; ``benchmarks/bench_dask.py`` measures the cluster against a process pool
 (figures in ``docs/scaling.md``)."""
+
+WORKER_START_TIMEOUT_S = 30.0
+"""How long a local worker may take to start and reach the scheduler before it gives up [s]."""
 
 FORKSERVER_PRELOAD = ("distributed", "numpy", "pamsim.sweep.run", "pamsim.native")
 """Modules the fork server imports once, before it forks the workers."""
@@ -145,9 +151,15 @@ def local_client(workers: int) -> Iterator:
         _start_fork_server()  # first, so that its imports overlap this process's import of Dask
     distributed = _distributed()
     with _local_cluster_settings(), distributed.LocalCluster(
-            n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
+            n_workers=0, threads_per_worker=1, processes=True, dashboard_address=None,
+            # A worker whose start hangs gives up after this long, so closing the cluster cannot hang.
+            death_timeout=WORKER_START_TIMEOUT_S,
             # Workers log a lost heartbeat as an error while the cluster shuts down; not the user's concern.
             silence_logs=logging.CRITICAL) as cluster, distributed.Client(cluster) as client:
+        # The workers start while the caller prepares its tasks, instead of before: the scheduler holds
+        # the tasks until they arrive.  A worker that cannot start fails its tasks after
+        # distributed.scheduler.no-workers-timeout (LOCAL_CLUSTER_CONFIG).
+        cluster.scale(workers)
         yield client
 
 
