@@ -108,7 +108,8 @@ def main() -> None:
     print(f"{'process pool ' + label:<34} {pool_s:>9.1f} {1e3 * pool_s / n:>13.2f} {1.0:>14.2f} {pool_target:>10}")
     print(f"{'Dask LocalCluster ' + label:<34} {dask_s:>9.1f} {1e3 * dask_s / n:>13.2f} "
           f"{dask_s / pool_s:>14.2f} {'<= ' + format(DASK_RATIO_TARGET, 'g') + 'x':>10}")
-    print(f"every run [s]: pool {' '.join(f'{t:.2f}' for t, _ in pools)}; Dask {' '.join(f'{t:.2f}' for t, _ in dasks)}")
+    pool_runs, dask_runs = (" ".join(f"{t:.2f}" for t, _ in runs) for runs in (pools, dasks))
+    print(f"every run [s]: pool {pool_runs}; Dask {dask_runs}")
     print(f"Dask results identical to the process pool's: {identical}; failed runs: pool "
           f"{len(pool_result.failures)}, Dask {len(dask_result.failures)}")
 

@@ -291,7 +291,8 @@ def test_trials_that_outgrow_the_batch_event_room_run_again_alone(pooled, monkey
     reference = make_trials(fit.problem, "native")(thetas)
     capacities = []
     run = native_fit._run
-    monkeypatch.setattr(native_fit, "_run", lambda chunk, capacity: capacities.append(list(capacity)) or run(chunk, capacity))
+    monkeypatch.setattr(native_fit, "_run",
+                        lambda chunk, capacity: capacities.append(list(capacity)) or run(chunk, capacity))
     monkeypatch.setattr(backend, "BATCH_EVENT_CAPACITY", 2)
     again = make_trials(fit.problem, "native")(thetas)
     limit = fit.problem.scenario.solver.max_events + 1

@@ -100,7 +100,8 @@ def run_chunk(tasks: list[_Task]) -> ChunkOutputs:
     """
     if not tasks or any(t.backend != "native" for t in tasks):
         return ChunkOutputs(run_task(task) for task in tasks)
-    return ChunkOutputs(o for i in range(0, len(tasks), NATIVE_BATCH) for o in _run_native_batch(tasks[i:i + NATIVE_BATCH]))
+    batches = (tasks[i:i + NATIVE_BATCH] for i in range(0, len(tasks), NATIVE_BATCH))
+    return ChunkOutputs(o for batch in batches for o in _run_native_batch(batch))
 
 
 def _run_native_batch(tasks: list[_Task]) -> list[dict]:
