@@ -223,25 +223,31 @@ def test_cli_dask_local_writes_the_same_tables_as_the_serial_api(tmp_path):
 
 def _worker_state():
     """(MALLOC_TRIM_THRESHOLD_ in the worker, pamsim.native imported, the environment its parent
-    process, the fork server, started with)."""
+    process, the fork server, started with, (objects frozen out of the garbage collector, collector on))."""
+    import gc
+
     with open(f"/proc/{os.getppid()}/environ", "rb") as fh:
         parent = dict(v.decode().split("=", 1) for v in fh.read().split(b"\0") if b"=" in v)
-    return os.environ.get("MALLOC_TRIM_THRESHOLD_"), "pamsim.native" in sys.modules, parent
+    return (os.environ.get("MALLOC_TRIM_THRESHOLD_"), "pamsim.native" in sys.modules, parent,
+            (gc.get_freeze_count(), gc.isenabled()))
 
 
 def test_local_workers_keep_the_malloc_defaults_and_use_the_preloaded_fork_server(client):
     """Dask starts its workers with MALLOC_TRIM_THRESHOLD_ (which also turns off glibc's adaptive heap
     threshold, costing the native backend's millisecond runs a quarter of their time); the clusters
     pamsim starts leave it out, fork their workers (a restarted one too: this runs after the
-    killed-worker test) from a server that has imported pamsim and started with one BLAS thread per
-    worker (numpy's BLAS reads that when the server loads it), and give Dask's configuration and this
-    process's environment back as they were."""
+    killed-worker test) from a server that has imported pamsim, frozen those imports out of the
+    workers' garbage collection and started with one BLAS thread per worker (numpy's BLAS reads that
+    when the server loads it), and give Dask's configuration and this process's environment back as
+    they were."""
     import dask
 
     states = client.run(_worker_state)
     assert len(states) == 2
-    for trim, preloaded, server in states.values():
+    for trim, preloaded, server, (frozen, collecting) in states.values():
         assert trim is None and preloaded
+        # The server's imports are frozen out of the worker's garbage collection, which is on.
+        assert frozen > 10_000 and collecting
         assert "MALLOC_TRIM_THRESHOLD_" not in server
         assert all(server.get(k) == v for k, v in dask_cluster.FORKSERVER_ENVIRON.items()), server
     key = "distributed.nanny.pre-spawn-environ"

@@ -47,8 +47,12 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..sweep.dask_cluster import dask_executor, start_worker_server
+
+    if args.dask_local is not None:
+        # The local workers' fork server imports Dask and pamsim while this process reads the sweep.
+        start_worker_server()
     from ..sweep import load_sweep, run_sweep
-    from ..sweep.dask_cluster import dask_executor
     from ..sweep.run import check_backend
 
     spec = load_sweep(args.sweep_file)

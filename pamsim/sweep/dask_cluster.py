@@ -24,6 +24,7 @@ from concurrent.futures import Executor
 from typing import Iterator
 
 from ..errors import InputError
+from .gc_control import paused_gc
 
 EXTRA = "pamsim[dask]"
 CONNECT_TIMEOUT_S = 10.0
@@ -71,8 +72,9 @@ Dask's own work shows; ``benchmarks/bench_dask.py`` measures the cluster against
 WORKER_START_TIMEOUT_S = 30.0
 """How long a local worker may take to start and reach the scheduler before it gives up [s]."""
 
-FORKSERVER_PRELOAD = ("distributed", "numpy", "pamsim.sweep.run", "pamsim.native")
-"""Modules the fork server imports once, before it forks the workers."""
+FORKSERVER_PRELOAD = ("pamsim.sweep.worker_preload",)
+"""What the fork server imports once, before it forks the workers: Dask, numpy and pamsim's runner,
+with their objects frozen out of the workers' garbage collection (:mod:`.worker_preload`)."""
 
 FORKSERVER_ENVIRON = {"OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"}
 """Environment the fork server starts with: one thread for numpy's linear algebra in each worker,
@@ -95,12 +97,17 @@ def _restored_environ(keys) -> Iterator[None]:
                 os.environ[k] = v
 
 
-def _start_fork_server() -> None:
-    """Start the fork server of the local workers, which imports :data:`FORKSERVER_PRELOAD`.
+def start_worker_server() -> None:
+    """Start the fork server that local workers are forked from, if Dask is installed.
 
-    Called before this process imports Dask, so that on 2 cores the two imports overlap.  The server
-    lives until this process exits; a later local cluster of this process reuses it as it is.
+    The server imports :data:`FORKSERVER_PRELOAD` (Dask, numpy, pamsim) in its own process, so the
+    earlier it starts, the more of that overlaps this process's own work: ``pamsim sweep
+    --dask-local`` starts it before reading the sweep file.  :func:`local_client` starts it too
+    (before this process imports Dask); a server already running is reused as it is, and lives until
+    this process exits.  Without Dask this does nothing (:func:`local_client` then says what to install).
     """
+    if importlib.util.find_spec("distributed") is None:
+        return
     import multiprocessing
     import multiprocessing.forkserver
 
@@ -147,19 +154,24 @@ def local_client(workers: int) -> Iterator:
 
     Raises :class:`DaskUnavailable` without the extra.
     """
-    if importlib.util.find_spec("distributed") is not None:  # else _distributed() says what to install
-        _start_fork_server()  # first, so that its imports overlap this process's import of Dask
-    distributed = _distributed()
-    with _local_cluster_settings(), distributed.LocalCluster(
-            n_workers=0, threads_per_worker=1, processes=True, dashboard_address=None,
-            # A worker whose start hangs gives up after this long, so closing the cluster cannot hang.
-            death_timeout=WORKER_START_TIMEOUT_S,
-            # Workers log a lost heartbeat as an error while the cluster shuts down; not the user's concern.
-            silence_logs=logging.CRITICAL) as cluster, distributed.Client(cluster) as client:
-        # The workers start while the caller prepares its tasks, instead of before: the scheduler holds
-        # the tasks until they arrive.  A worker that cannot start fails its tasks after
-        # distributed.scheduler.no-workers-timeout (LOCAL_CLUSTER_CONFIG).
-        cluster.scale(workers)
+    start_worker_server()  # first, so that its imports overlap this process's import of Dask
+    with contextlib.ExitStack() as stack:
+        # Importing Dask and starting the cluster make objects in a burst that would set off several
+        # full passes of the garbage collector (gc_control); it runs again once they are made.
+        with paused_gc():
+            distributed = _distributed()
+            stack.enter_context(_local_cluster_settings())
+            cluster = stack.enter_context(distributed.LocalCluster(
+                n_workers=0, threads_per_worker=1, processes=True, dashboard_address=None,
+                # A worker whose start hangs gives up after this long, so closing the cluster cannot hang.
+                death_timeout=WORKER_START_TIMEOUT_S,
+                # Workers log a lost heartbeat as an error while the cluster shuts down; not the user's concern.
+                silence_logs=logging.CRITICAL))
+            client = stack.enter_context(distributed.Client(cluster))
+            # The workers start while the caller prepares its tasks, instead of before: the scheduler
+            # holds the tasks until they arrive.  A worker that cannot start fails its tasks after
+            # distributed.scheduler.no-workers-timeout (LOCAL_CLUSTER_CONFIG).
+            cluster.scale(workers)
         yield client
 
 

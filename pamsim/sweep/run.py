@@ -24,6 +24,7 @@ from ..oscillation import estimate_oscillation
 from ..scenario import Scenario
 from ..static import friction_band_m, static_report
 from .figures import SWEEP_FIGURES, UNCERTAINTY_FIGURES
+from .gc_control import frozen_gc, paused_gc
 from .spec import SweepCase, SweepSpec, load_sweep
 from .uncertainty import UncertaintyResult
 
@@ -40,7 +41,7 @@ FIGURES = ("error_heatmap.png", "steady_state_vs_pressure.png", "time_responses.
 """File names of a sweep's figures, in the order of the report (:data:`.figures.SWEEP_FIGURES` renders them)."""
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class _Task:
     """One scenario to run in a worker (it pickles to a process or a distributed worker)."""
 
@@ -298,10 +299,13 @@ def run_sweep(spec: SweepSpec | str | Path, executor: Executor | None = None, pr
     start = time.perf_counter()
     samples = spec.uncertainty.draw() if spec.uncertainty is not None else None
     if samples is not None:
-        for f in spec.friction_models:
-            base = spec.base.with_changes({"model": {"friction": f}})
-            tasks += [_task("sample", (k, f), base, backend=backend, parameters=tuple(zip(samples.names, map(float, values))))
-                      for k, values in enumerate(samples.values)]
+        # Thousands of small objects that live until the end: no garbage for the collector to find.
+        with paused_gc():
+            for f in spec.friction_models:
+                base = spec.base.with_changes({"model": {"friction": f}})
+                tasks += [_task("sample", (k, f), base, backend=backend,
+                                parameters=tuple(zip(samples.names, map(float, values))))
+                          for k, values in enumerate(samples.values)]
     if chunk_size is not None and (isinstance(chunk_size, bool) or not isinstance(chunk_size, int) or chunk_size < 1):
         raise InputError(f"chunk_size = {chunk_size!r}: must be a positive integer")
     from tqdm import tqdm
@@ -364,6 +368,15 @@ def _execute(tasks: list[_Task], executor: Executor | None, bar, chunk_size: int
             bar.set_postfix(failed=failed, refresh=False)
             bar.update(len(chunk))
         return outputs
+    # The tasks, the imported modules and a local cluster's scheduler stay out of the collector's
+    # passes while this process waits on the workers and serves the scheduler.
+    with frozen_gc():
+        return _collect(tasks, executor, bar, chunk_size, outputs)
+
+
+def _collect(tasks: list[_Task], executor: Executor, bar, chunk_size: int, outputs: list) -> list[dict]:
+    """:func:`_execute` on an executor: submit the chunks and fill ``outputs`` as they finish."""
+    failed = 0
     starts = range(0, len(tasks), chunk_size)
     futures = {executor.submit(run_chunk, tasks[i:i + chunk_size]): i for i in starts}
     for fut in as_completed(futures):
