@@ -4,12 +4,20 @@
 
 Runs ``scenarios/acra2012_fig4_uncertainty.toml`` (10,000 Latin hypercube samples unless
 ``--samples`` says fewer) with the chosen backend (default native) on a ``ProcessPoolExecutor`` and
-on a ``distributed.LocalCluster`` of single-threaded worker processes, both with the same chunking.
-Each measurement runs in a fresh Python process, as ``pamsim sweep`` does: its time includes
-importing Dask (or not) and starting the pool or the cluster, with nothing left warm by an earlier
-one.  The two alternate, and the best of ``--repeat`` of each is kept.  Targets: Dask
-within 1.3x of the process pool; with the native backend, the 10,000 samples in <= 15 s on the
-pool.  The two results are also checked to be identical.
+on a ``distributed.LocalCluster`` of single-threaded worker processes, both with the same chunking,
+measured two ways:
+
+- **the command**: ``pamsim sweep STUDY --backend B --workers 2 -o DIR`` against the same with
+  ``--dask-local 2``, end to end (the process's start, reading the file, the runs, the tables and
+  the two figures), as ``benchmarks/bench_native.py`` measures the pool's 10,000-sample study;
+- **the sweep call**: ``pamsim.sweep(spec, executor)`` in a fresh Python process, timed from before
+  the pool or the cluster is made until it is closed (importing Dask and starting the cluster
+  included; reading the file, the figures and the tables not).
+
+Each measurement runs in a fresh process, with nothing left warm by an earlier one.  The pool and
+the cluster alternate, and the best of ``--repeat`` of each is kept.  Targets: Dask within 1.3x of
+the process pool; with the native backend, the 10,000 samples in <= 15 s on the pool.  The results
+are also checked to be identical (the command's tables byte for byte).
 """
 
 from __future__ import annotations
@@ -19,6 +27,8 @@ import dataclasses
 import math
 import os
 import pickle
+import re
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -29,6 +39,7 @@ from pathlib import Path
 import pamsim
 from pamsim.sweep import load_sweep
 from pamsim.sweep.dask_cluster import dask_executor
+from pamsim.sweep.run import UNCERTAINTY_TABLES
 
 STUDY = Path(__file__).resolve().parents[1] / "scenarios" / "acra2012_fig4_uncertainty.toml"
 DASK_RATIO_TARGET = 1.3
@@ -71,6 +82,43 @@ def _in_fresh_process(kind: str, args) -> tuple[float, object]:
         return pickle.loads(out.read_bytes())
 
 
+def _study_file(directory: Path, samples: int | None) -> Path:
+    """The study's sweep file, with ``samples`` samples if given (a copy in ``directory``)."""
+    if not samples:
+        return STUDY
+    text = STUDY.read_text()
+    text = re.sub(r"(?m)^samples = \d+", f"samples = {samples}", text)
+    text = re.sub(r'(?m)^base_scenario = "(.*)"', lambda m: f'base_scenario = "{(STUDY.parent / m[1]).as_posix()}"', text)
+    path = directory / STUDY.name
+    path.write_text(text)
+    return path
+
+
+def _command(kind: str, study: Path, out: Path, args) -> float:
+    """Wall seconds of ``pamsim sweep`` on the pool or the cluster, from its start to its exit."""
+    where = ["--workers", str(args.workers)] if kind == "pool" else ["--dask-local", str(args.workers)]
+    chunk = ["--chunk-size", str(args.chunk_size)] if args.chunk_size else []
+    shutil.rmtree(out, ignore_errors=True)
+    start = time.perf_counter()
+    subprocess.run([str(Path(sys.executable).with_name("pamsim")), "sweep", str(study), "--backend", args.backend,
+                    *where, *chunk, "-o", str(out), "--no-progress"], check=True, stdout=subprocess.DEVNULL)
+    return time.perf_counter() - start
+
+
+def _table(label: str, n: int, backend: str, pools: list[float], dasks: list[float]) -> float:
+    """Print one comparison; return the ratio of the best times."""
+    pool_s, dask_s = min(pools), min(dasks)
+    pool_target = f"<= {NATIVE_TARGET_S:g} s" if backend == "native" and n == 10000 else ""
+    print(f"\n{label} ({backend} backend)")
+    print(f"{'executor':<20} {'wall [s]':>9} {'per run [ms]':>13} {'ratio to pool':>14} {'target':>10}   every run [s]")
+    for name, best, runs, ratio, target in (
+            ("process pool", pool_s, pools, 1.0, pool_target),
+            ("Dask LocalCluster", dask_s, dasks, dask_s / pool_s, f"<= {DASK_RATIO_TARGET:g}x")):
+        print(f"{name:<20} {best:>9.2f} {1e3 * best / n:>13.2f} {ratio:>14.2f} {target:>10}   "
+              + " ".join(f"{t:.2f}" for t in runs))
+    return dask_s / pool_s
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--backend", choices=("native", "python"), default="native",
@@ -95,23 +143,27 @@ def main() -> None:
     print(f"{os.cpu_count()} CPUs; {n} samples of {STUDY.name}; {args.workers} workers; "
           f"chunk size {args.chunk_size or 'automatic'}; best of {args.repeat}, each in a fresh process")
     # Alternated, so that a drift of the machine's speed during the benchmark does not favour either.
-    pools, dasks = [], []
-    for _ in range(args.repeat):
-        pools.append(_in_fresh_process("pool", args))
-        dasks.append(_in_fresh_process("dask", args))
-    (pool_s, pool_result), (dask_s, dask_result) = (min(runs, key=lambda r: r[0]) for runs in (pools, dasks))
+    pools, dasks, command = [], [], {"pool": [], "dask": []}
+    with tempfile.TemporaryDirectory() as tmp:
+        study = _study_file(Path(tmp), args.samples)
+        for _ in range(args.repeat):
+            for kind in ("pool", "dask"):
+                command[kind].append(_command(kind, study, Path(tmp) / kind, args))
+            pools.append(_in_fresh_process("pool", args))
+            dasks.append(_in_fresh_process("dask", args))
+        same_tables = all((Path(tmp) / "pool" / t).read_bytes() == (Path(tmp) / "dask" / t).read_bytes()
+                          for t in UNCERTAINTY_TABLES)
+    (_, pool_result), (_, dask_result) = (min(runs, key=lambda r: r[0]) for runs in (pools, dasks))
     identical = all(_same(a, b) for f in pool_result.uncertainty.outputs
                     for a, b in zip(dask_result.uncertainty.outputs[f], pool_result.uncertainty.outputs[f]))
-    pool_target = f"<= {NATIVE_TARGET_S * n / 10000:g} s" if args.backend == "native" else ""
-    label = f"({args.backend} backend)"
-    print(f"{'executor':<34} {'wall [s]':>9} {'per run [ms]':>13} {'ratio to pool':>14} {'target':>10}")
-    print(f"{'process pool ' + label:<34} {pool_s:>9.1f} {1e3 * pool_s / n:>13.2f} {1.0:>14.2f} {pool_target:>10}")
-    print(f"{'Dask LocalCluster ' + label:<34} {dask_s:>9.1f} {1e3 * dask_s / n:>13.2f} "
-          f"{dask_s / pool_s:>14.2f} {'<= ' + format(DASK_RATIO_TARGET, 'g') + 'x':>10}")
-    pool_runs, dask_runs = (" ".join(f"{t:.2f}" for t, _ in runs) for runs in (pools, dasks))
-    print(f"every run [s]: pool {pool_runs}; Dask {dask_runs}")
-    print(f"Dask results identical to the process pool's: {identical}; failed runs: pool "
-          f"{len(pool_result.failures)}, Dask {len(dask_result.failures)}")
+    _table(f"the command, pamsim sweep {STUDY.name} -o DIR, end to end", n, args.backend,
+           command["pool"], command["dask"])
+    _table("the sweep call, pamsim.sweep(spec, executor), executor start included", n, args.backend,
+           [t for t, _ in pools], [t for t, _ in dasks])
+    print(f"\ncommand's tables ({', '.join(UNCERTAINTY_TABLES)}) byte-identical: {same_tables}; sweep call's "
+          f"results identical: {identical}; failed runs: pool {len(pool_result.failures)}, "
+          f"Dask {len(dask_result.failures)}")
+
 
 if __name__ == "__main__":
     main()
