@@ -79,9 +79,9 @@ def test_chunked_process_pool_gives_the_serial_numbers(spec, serial):
 
 def test_automatic_chunk_size_amortises_large_sweeps():
     assert auto_chunk_size(14) == 1
-    assert auto_chunk_size(156) == 3           # the grid: 52 tasks
+    assert auto_chunk_size(156) == 5           # the grid: 32 tasks
     assert auto_chunk_size(10_000) == 50       # capped: 200 tasks
-    assert auto_chunk_size(10_000, "native") == 157  # runs of a millisecond: 64 tasks
+    assert auto_chunk_size(10_000, "native") == 313  # runs of a millisecond: 32 tasks
     assert auto_chunk_size(100_000, "native") == 1000
     assert auto_chunk_size(10_000, "fmu-cs") == 50
     with pytest.raises(pamsim.errors.InputError, match="chunk_size = 0"):

@@ -38,7 +38,7 @@ def register(sub) -> None:
     where.add_argument("--dask-local", metavar="N", type=_workers,
                        help="start a Dask LocalCluster of N worker processes (needs pamsim[dask])")
     p.add_argument("--chunk-size", metavar="N", type=_workers, default=None,
-                   help="runs per executor task (default: about 64 chunks, at most 50 runs each with the python "
+                   help="runs per executor task (default: about 32 chunks, at most 50 runs each with the python "
                         "backend, 1000 with native)")
     p.add_argument("--backend", choices=sorted(BACKENDS), default=None,
                    help="backend of every run (default: the sweep file's backend key, else python)")

@@ -66,12 +66,15 @@ about 20 ms, the native backend's about 1 ms), big enough to amortise the per-ta
 scheduler (milliseconds), small enough to balance the load and lose little work when a worker dies.
 A backend not listed (an FMU) takes the Python backend's."""
 
-AUTO_CHUNKS = 64
-"""Chunks the automatic size aims at (fewer when capped by :data:`MAX_AUTO_CHUNK`)."""
+AUTO_CHUNKS = 32
+"""Chunks the automatic size aims at (more when capped by :data:`MAX_AUTO_CHUNK`): 16 per worker on
+2 workers, enough to balance the load, while a Dask task costs the sweep's process (which serves a
+local cluster's scheduler and client) milliseconds of CPU each.  On a cluster of more than 32
+workers, give a smaller ``chunk_size`` so that every worker gets chunks."""
 
 
 def auto_chunk_size(n_tasks: int, backend: str = "python") -> int:
-    """Runs per executor task when none is given: ``ceil(n / 64)``, between 1 and the backend's
+    """Runs per executor task when none is given: ``ceil(n / 32)``, between 1 and the backend's
     :data:`MAX_AUTO_CHUNK` (50 for the Python backend, 1000 for the native one)."""
     cap = MAX_AUTO_CHUNK.get(backend, MAX_AUTO_CHUNK["python"])
     return max(1, min(cap, math.ceil(n_tasks / AUTO_CHUNKS)))
