@@ -60,6 +60,10 @@ LOCAL_CLUSTER_CONFIG = {
     # the CPUs with the runs, and a runaway worker is still stopped within a second.
     "distributed.admin.system-monitor.interval": "2s",
     "distributed.worker.memory.monitor-interval": "1s",
+    # Every Dask server (the scheduler, each nanny, each worker) times its event loop every 20 ms, to
+    # warn when it stalls for seconds; each tick wakes a thread that takes the GIL from the runs (in a
+    # worker) or from the scheduler (in the sweep's process).  Once a second still catches a stall.
+    "distributed.admin.tick.interval": "1s",
     # The workers start while the sweep prepares its tasks (local_client): should none start, the
     # tasks fail after this long (failed rows, the sweep completes) instead of waiting for ever.
     "distributed.scheduler.no-workers-timeout": "30s",
