@@ -41,7 +41,7 @@ FIGURES = ("error_heatmap.png", "steady_state_vs_pressure.png", "time_responses.
 """File names of a sweep's figures, in the order of the report (:data:`.figures.SWEEP_FIGURES` renders them)."""
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True)
 class _Task:
     """One scenario to run in a worker (it pickles to a process or a distributed worker)."""
 
@@ -69,8 +69,9 @@ A backend not listed (an FMU) takes the Python backend's."""
 AUTO_CHUNKS = 32
 """Chunks the automatic size aims at (more when capped by :data:`MAX_AUTO_CHUNK`): 16 per worker on
 2 workers, enough to balance the load, while a Dask task costs the sweep's process (which serves a
-local cluster's scheduler and client) milliseconds of CPU each.  On a cluster of more than 32
-workers, give a smaller ``chunk_size`` so that every worker gets chunks."""
+local cluster's scheduler and client) milliseconds of CPU each.  With more than 32 workers (a
+large cluster, or a process pool on a machine with more CPUs), a sweep small enough to get only
+32 chunks leaves some idle: give a smaller ``chunk_size``."""
 
 
 def auto_chunk_size(n_tasks: int, backend: str = "python") -> int:
