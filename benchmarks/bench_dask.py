@@ -105,8 +105,8 @@ def _command(kind: str, study: Path, out: Path, args) -> float:
     return time.perf_counter() - start
 
 
-def _table(label: str, n: int, backend: str, pools: list[float], dasks: list[float]) -> float:
-    """Print one comparison; return the ratio of the best times."""
+def _table(label: str, n: int, backend: str, pools: list[float], dasks: list[float]) -> None:
+    """Print one comparison: the best times, their ratio and every run."""
     pool_s, dask_s = min(pools), min(dasks)
     pool_target = f"<= {NATIVE_TARGET_S:g} s" if backend == "native" and n == 10000 else ""
     print(f"\n{label} ({backend} backend)")
@@ -116,7 +116,6 @@ def _table(label: str, n: int, backend: str, pools: list[float], dasks: list[flo
             ("Dask LocalCluster", dask_s, dasks, dask_s / pool_s, f"<= {DASK_RATIO_TARGET:g}x")):
         print(f"{name:<20} {best:>9.2f} {1e3 * best / n:>13.2f} {ratio:>14.2f} {target:>10}   "
               + " ".join(f"{t:.2f}" for t in runs))
-    return dask_s / pool_s
 
 
 def main() -> None:

@@ -372,28 +372,22 @@ def _execute(tasks: list[_Task], executor: Executor | None, bar, chunk_size: int
             bar.set_postfix(failed=failed, refresh=False)
             bar.update(len(chunk))
         return outputs
+    starts = range(0, len(tasks), chunk_size)
     # The tasks, the imported modules and a local cluster's scheduler stay out of the collector's
     # passes while this process waits on the workers and serves the scheduler.
     with frozen_gc():
-        return _collect(tasks, executor, bar, chunk_size, outputs)
-
-
-def _collect(tasks: list[_Task], executor: Executor, bar, chunk_size: int, outputs: list) -> list[dict]:
-    """:func:`_execute` on an executor: submit the chunks and fill ``outputs`` as they finish."""
-    failed = 0
-    starts = range(0, len(tasks), chunk_size)
-    futures = {executor.submit(run_chunk, tasks[i:i + chunk_size]): i for i in starts}
-    for fut in as_completed(futures):
-        i = futures[fut]
-        n = min(chunk_size, len(tasks) - i)
-        try:
-            chunk = fut.result()
-        except Exception as exc:  # noqa: BLE001 -- a dead worker fails its chunk's cases, not the sweep
-            chunk = [{"error": f"{type(exc).__name__}: {exc}"}] * n
-        outputs[i:i + n] = chunk
-        failed += sum(bool(o["error"]) for o in chunk)
-        bar.set_postfix(failed=failed, refresh=False)
-        bar.update(n)
+        futures = {executor.submit(run_chunk, tasks[i:i + chunk_size]): i for i in starts}
+        for fut in as_completed(futures):
+            i = futures[fut]
+            n = min(chunk_size, len(tasks) - i)
+            try:
+                chunk = fut.result()
+            except Exception as exc:  # noqa: BLE001 -- a dead worker fails its chunk's cases, not the sweep
+                chunk = [{"error": f"{type(exc).__name__}: {exc}"}] * n
+            outputs[i:i + n] = chunk
+            failed += sum(bool(o["error"]) for o in chunk)
+            bar.set_postfix(failed=failed, refresh=False)
+            bar.update(n)
     return outputs
 
 
