@@ -1,0 +1,19 @@
+"""Physical components: each element of a muscle system, its variables and ports, written once.
+
+Each module holds one component.  The physics stays in the elements (:mod:`pamsim.elements`) and the
+static force library (:mod:`pamsim.static_models`): a component declares the variables and ports
+around an element and calls the element's own functions with symbols, so the equations exist in one
+place and every generated form comes from them.
+"""
+
+from .chamber import PolytropicChamber
+from .damping import ViscousDamping
+from .external_force import ExternalForce
+from .friction import CoulombFriction
+from .hanging_load import HangingLoad, LoadMode
+from .pressure import PressureSignal
+from .static_force import MuscleStaticForce
+from .valve import ProportionalValve
+
+__all__ = ["CoulombFriction", "ExternalForce", "HangingLoad", "LoadMode", "MuscleStaticForce",
+           "PolytropicChamber", "PressureSignal", "ProportionalValve", "ViscousDamping"]

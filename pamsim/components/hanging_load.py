@@ -1,0 +1,115 @@
+"""The hanging load: a mass on the muscle's flange, with its own stick/slip and end-stop modes.
+
+The mode machine that the simulator and the C core each held is written here once: the equations of
+each mode, the event indicators that end it, the jump at an event and the decision of a load at rest
+(MODEL_NOTES sec. 4; docs/model.md).  The Coulomb level comes in as a signal; this component decides
+its direction (against the motion when sliding, whatever holds the load when it is held).
+"""
+
+from __future__ import annotations
+
+from enum import IntEnum
+
+from ..core_table import EVENT_V_TOL_M_S, EVENT_X_TOL_M, MIN_REBOUND_SPEED_M_S
+from ..modeling import TRANSLATIONAL, Component, Equations, Port, Symbols, Var
+from ..modeling.smath import if_else
+
+
+class LoadMode(IntEnum):
+    """Friction / contact mode of the load."""
+
+    SLIP_DOWN = -1
+    STICK = 0
+    SLIP_UP = 1
+    STOP_LOW = 2
+    STOP_HIGH = 3
+
+    @property
+    def is_slip(self) -> bool:
+        return self in (LoadMode.SLIP_UP, LoadMode.SLIP_DOWN)
+
+    @property
+    def label(self) -> str:
+        return self.name.lower()
+
+
+class HangingLoad(Component):
+    """A mass under gravity between two rigid stops, driven by the forces on its flange.
+
+    Sliding (``SLIP_UP``/``SLIP_DOWN``): ``m a = F - q F_c - m g`` with ``F`` the sum of the forces
+    on the flange and ``q`` = +1 or -1.  Held (``STICK`` or on a stop): x and v are constant and the
+    flange reports zero velocity, so every velocity-dependent branch sees the load at rest.
+
+    Event indicators, positive inside the mode (a crossing to zero ends it): sliding, the velocity
+    (shifted by ``EVENT_V_TOL_M_S``, so that a release from rest is not an event) and the distance to
+    the stop ahead (shifted by ``EVENT_X_TOL_M``); held, the margins ``F_c + release_margin -+ net``
+    by which friction still holds the load up and down.  At an event: a stop reached takes the load
+    to it, with a rebound of ``restitution |v|`` if that exceeds ``MIN_REBOUND_SPEED_M_S``, else at
+    rest on it; a velocity reaching zero stops the load; then :attr:`Equations.rest_mode` decides a
+    held load's mode from its forces (slip if the net force beats friction by ``stick_margin_N``).
+    """
+
+    modes = LoadMode
+    n_indicators = 2
+    parameters = (Var("mass_kg", "kg", "hanging mass, holder included"),
+                  Var("g_m_s2", "m/s^2", "gravitational acceleration"),
+                  Var("x_low_m", "m", "lower stop"), Var("x_high_m", "m", "upper stop"),
+                  Var("restitution", "1", "coefficient of restitution at the stops"),
+                  Var("stick_margin_N", "N", "a stopping load is held unless the net force beats friction by more"),
+                  Var("release_margin_N", "N", "a held load is released when the net force beats friction by this"),
+                  Var("initial_contraction_m", "m", "contraction at the start, load at rest"))
+    ports = (Port("flange", TRANSLATIONAL, "node"),)
+    inputs = (Var("friction_level_N", "N", "Coulomb friction level"),)
+    states = (Var("x_m", "m", "contraction x = L0 - L", 1e-2), Var("v_m_s", "m/s", "contraction velocity", 1e-1))
+    outputs = (Var("x_m", "m", "contraction"), Var("v_m_s", "m/s", "contraction velocity (zero when held)"),
+               Var("mass_kg", "kg", "hanging mass"), Var("F_gravity_N", "N", "weight along x"),
+               Var("F_friction_N", "N", "friction on the load along x; when held, whatever holds it"),
+               Var("F_stop_N", "N", "reaction of a stop along x"),
+               Var("F_coulomb_level_N", "N", "Coulomb friction level"))
+
+    def equations(self, s: Symbols) -> Equations:
+        P = s.p
+        q, x, v = s.mode, s.x["x_m"], s.x["v_m_s"]
+        M = LoadMode
+        slip = q * q == 1
+        up = q == M.SLIP_UP
+        low, high = q == M.STOP_LOW, q == M.STOP_HIGH
+        v_flange = if_else(slip, v, 0.0)
+        weight = P["mass_kg"] * P["g_m_s2"]
+        F, level = s.port["flange"]["F_N"], s.u["friction_level_N"]
+        net = F - weight  # at rest the flange's velocity is zero, so F holds no damping
+        accel = if_else(slip, (F - q * level - weight) / P["mass_kg"], 0.0)
+
+        eps = P["release_margin_N"]
+        z_slip = (if_else(up, v + EVENT_V_TOL_M_S, EVENT_V_TOL_M_S - v),
+                  if_else(up, P["x_high_m"] + EVENT_X_TOL_M - x, x - P["x_low_m"] + EVENT_X_TOL_M))
+        z_held = (if_else(high, 1.0, level + eps - net), if_else(low, 1.0, level + eps + net))
+        indicators = tuple(if_else(slip, a, b) for a, b in zip(z_slip, z_held))
+
+        margin = P["stick_margin_N"]
+        rest = if_else(slip, q, if_else((1 - high) * (net - level > margin), float(M.SLIP_UP),
+                                        if_else((1 - low) * (-net - level > margin), float(M.SLIP_DOWN), q)))
+        at_stop = slip * if_else(up, x >= P["x_high_m"], x <= P["x_low_m"])
+        stopped = slip * (1 - at_stop) * if_else(up, v <= 0.0, v >= 0.0)
+        rebound = P["restitution"] * abs(v)
+        bounces = rebound > MIN_REBOUND_SPEED_M_S
+        transition = {
+            "x_m": if_else(at_stop, if_else(up, P["x_high_m"], P["x_low_m"]), x),
+            "v_m_s": if_else(at_stop, if_else(bounces, if_else(up, -rebound, rebound), 0.0),
+                             if_else(stopped, 0.0, v)),
+            "mode": if_else(at_stop, if_else(bounces, -q, if_else(up, float(M.STOP_HIGH), float(M.STOP_LOW))),
+                            if_else(stopped, float(M.STICK), q)),
+        }
+        held_by_friction = (q == M.STICK) + low * (net > 0.0) + high * (net < 0.0)
+        on_stop = low * (net <= 0.0) + high * (net >= 0.0)
+        x0 = P["initial_contraction_m"]
+        return Equations(
+            der={"x_m": v_flange, "v_m_s": accel},
+            outputs={"x_m": x, "v_m_s": v_flange, "mass_kg": P["mass_kg"], "F_gravity_N": -weight,
+                     "F_friction_N": if_else(slip, -q * level, if_else(held_by_friction, -net, 0.0)),
+                     "F_stop_N": if_else(on_stop, -net, 0.0), "F_coulomb_level_N": level},
+            port={"flange": {"x_m": x, "v_m_s": v_flange}},
+            indicators=indicators, transition=transition, rest_mode=rest,
+            initial={"x_m": x0, "v_m_s": 0.0,
+                     "mode": if_else(x0 <= P["x_low_m"], float(M.STOP_LOW),
+                                     if_else(x0 >= P["x_high_m"], float(M.STOP_HIGH), float(M.STICK)))})

@@ -1,0 +1,39 @@
+"""The proportional 3/3 valve between a supply, the exhaust and a pneumatic port."""
+
+from __future__ import annotations
+
+from ..modeling import PNEUMATIC, Component, Equations, Port, Symbols, Var
+from ..modeling.smath import if_else
+from .chamber import CP_OVER_R_AIR
+from .element import ElementParameters, element_parameters
+
+
+class ProportionalValve(ElementParameters, Component):
+    """:class:`pamsim.elements.valve.ProportionalValve33` on an ISO 6358 orifice: a pneumatic branch.
+
+    Inputs: the command in [-1, 1] (1 open to supply, -1 open to exhaust) and the supply gauge
+    pressure.  Inflow carries the supply temperature, outflow the volume's gas temperature.
+    """
+
+    ports = (Port("port", PNEUMATIC, "branch"),)
+    inputs = (Var("command", "1", "valve command in [-1, 1]"),
+              Var("supply_gauge_Pa", "Pa", "supply gauge pressure"))
+    outputs = (Var("mass_flow_kg_s", "kg/s", "mass flow into the port"),)
+    extra_parameters = (Var("T_supply_K", "K", "supply air temperature"),
+                        Var("p_atm_Pa", "Pa", "ambient (exhaust) pressure"),
+                        Var("cp_J_per_kg_K", "J/(kg K)", "specific heat of air at constant pressure"))
+
+    def __init__(self, name: str, element, T_supply_K: float, p_atm_Pa: float, R_J_per_kg_K: float):
+        self.element = element
+        values = element_parameters(element)
+        values.update(T_supply_K=T_supply_K, p_atm_Pa=p_atm_Pa, cp_J_per_kg_K=CP_OVER_R_AIR * R_J_per_kg_K)
+        super().__init__(name, values)
+
+    def equations(self, s: Symbols) -> Equations:
+        valve = self.symbolic_element(s.p)
+        p, T = s.port["port"]["p_abs_Pa"], s.port["port"]["T_K"]
+        T_supply, p_atm = s.p["T_supply_K"], s.p["p_atm_Pa"]
+        mdot = valve.inflow_kg_s(s.u["command"], p, T, s.u["supply_gauge_Pa"] + p_atm, T_supply, p_atm)
+        T_in = if_else(mdot >= 0.0, T_supply, T)
+        return Equations(outputs={"mass_flow_kg_s": mdot},
+                         port={"port": {"mdot_kg_s": mdot, "Hdot_W": s.p["cp_J_per_kg_K"] * T_in * mdot}})

@@ -1,0 +1,17 @@
+"""The modelling layer: components with declared variables and ports, assemblies of them, the flat
+model they make, and the code generated from it (Python, C, exact Jacobians).
+
+This layer knows nothing about muscles.  Components (:mod:`pamsim.components`) write their equations
+once, with operations that work on CasADi symbols; :class:`Assembly` connects them into one
+:class:`FlatModel`, whose right-hand side, outputs, event indicators and mode transitions are CasADi
+expressions of the states, inputs, parameters and modes.  From those come the generated Python
+(:mod:`pamsim.modeling.pygen`), the C (:mod:`pamsim.modeling.cgen`) and the Jacobians.
+"""
+
+from .assembly import Assembly, AssemblyError
+from .component import Component, Equations, Symbols
+from .flat import FlatModel
+from .variables import PNEUMATIC, SIGNAL, TRANSLATIONAL, Port, PortKind, Var
+
+__all__ = ["Assembly", "AssemblyError", "Component", "Equations", "FlatModel", "PNEUMATIC", "Port", "PortKind",
+           "SIGNAL", "Symbols", "TRANSLATIONAL", "Var"]

@@ -1,0 +1,331 @@
+"""Connecting components into one flat model.
+
+An :class:`Assembly` takes components, connections between their ports and signals, and the
+component inputs that the model exposes as its own inputs.  :meth:`Assembly.flatten` checks the
+wiring (names given twice, unconnected ports and inputs, ports of different kinds, signals of
+different units, two nodes on one net, algebraic loops) and returns a :class:`~.flat.FlatModel`
+whose equations are CasADi expressions of the states, inputs, parameters and modes only.
+"""
+
+from __future__ import annotations
+
+from collections import defaultdict
+from dataclasses import dataclass
+from typing import Mapping, Sequence
+
+from .component import Component, Equations, Symbols, quiet_numpy_on_symbols
+from .flat import FlatModel, FlatVar
+from .variables import Var
+
+
+class AssemblyError(ValueError):
+    """A wiring mistake; the message names the component and the port or signal."""
+
+
+@dataclass(frozen=True)
+class _Endpoint:
+    component: Component
+    name: str
+    kind: str  # "port", "output" or "input"
+
+    @property
+    def label(self) -> str:
+        return f"{self.component.name}.{self.name}"
+
+
+class Assembly:
+    """Components, their connections and the model's inputs.
+
+    Parameters
+    ----------
+    components : the components, each with a name unique in the assembly.
+    connections : pairs ``("a.port", "b.port")`` of ports of one kind (a node and a branch, or two
+        branches of one net), or ``("a.output", "b.input")`` of signals with one unit.
+    inputs : ``{model input name: "component.input"}`` (a string or a tuple of them, for one model
+        input that drives several component inputs).
+    name : the assembly's name (used in generated code).
+    """
+
+    def __init__(self, components: Sequence[Component], connections: Sequence[tuple[str, str]] = (),
+                 inputs: Mapping[str, str | Sequence[str]] | None = None, name: str = "model"):
+        self.name = name
+        self.components = tuple(components)
+        self.connections = tuple(tuple(c) for c in connections)
+        self.inputs = {k: (v,) if isinstance(v, str) else tuple(v) for k, v in (inputs or {}).items()}
+        by_name: dict[str, Component] = {}
+        for c in self.components:
+            if c.name in by_name:
+                raise AssemblyError(f"component name {c.name!r} is given twice "
+                                    f"({type(by_name[c.name]).__name__} and {type(c).__name__})")
+            if not c.name.isidentifier():
+                raise AssemblyError(f"component name {c.name!r} is not an identifier")
+            by_name[c.name] = c
+        self.by_name = by_name
+
+    # ------------------------------------------------------------------ wiring
+    def _endpoint(self, ref: str) -> _Endpoint:
+        comp_name, _, local = ref.partition(".")
+        comp = self.by_name.get(comp_name)
+        if comp is None or not local:
+            raise AssemblyError(f"connection end {ref!r}: no component {comp_name!r} "
+                                f"(components: {', '.join(self.by_name)})")
+        if any(p.name == local for p in comp.ports):
+            return _Endpoint(comp, local, "port")
+        if any(v.name == local for v in comp.outputs):
+            return _Endpoint(comp, local, "output")
+        if any(v.name == local for v in comp.inputs):
+            return _Endpoint(comp, local, "input")
+        raise AssemblyError(f"connection end {ref!r}: component {comp_name!r} ({type(comp).__name__}) has no port, "
+                            f"output or input {local!r}")
+
+    def _nets(self) -> list[list[_Endpoint]]:
+        """Connected ports grouped into nets, each checked for one kind and exactly one node."""
+        parent: dict[str, str] = {}
+        ends: dict[str, _Endpoint] = {}
+
+        def find(k):
+            while parent[k] != k:
+                parent[k] = parent[parent[k]]
+                k = parent[k]
+            return k
+
+        for c in self.components:
+            for p in c.ports:
+                ep = _Endpoint(c, p.name, "port")
+                parent[ep.label] = ep.label
+                ends[ep.label] = ep
+        for a_ref, b_ref in self.connections:
+            a, b = self._endpoint(a_ref), self._endpoint(b_ref)
+            if (a.kind == "port") != (b.kind == "port"):
+                raise AssemblyError(f"cannot connect {a.label} ({a.kind}) to {b.label} ({b.kind}): "
+                                    "a port connects to a port, a signal to a signal")
+            if a.kind != "port":
+                continue
+            ka, kb = a.component.port(a.name).kind, b.component.port(b.name).kind
+            if ka != kb:
+                raise AssemblyError(f"cannot connect port {a.label} ({ka.name}) to port {b.label} ({kb.name}): "
+                                    "the kinds differ")
+            parent[find(a.label)] = find(b.label)
+        groups: dict[str, list[_Endpoint]] = defaultdict(list)
+        for label, ep in ends.items():
+            groups[find(label)].append(ep)
+        nets, unconnected = [], []
+        for members in groups.values():
+            nodes = [e for e in members if e.component.port(e.name).role == "node"]
+            if len(members) == 1:
+                port = members[0].component.port(members[0].name)
+                if port.role == "branch" or not port.optional:
+                    unconnected.append(f"{members[0].label} ({port.kind.name} {port.role})")
+                    continue
+            if len(nodes) != 1:
+                labels = ", ".join(e.label for e in members)
+                raise AssemblyError(f"ports {labels} form a net with {len(nodes)} nodes; it needs exactly one "
+                                    "(a body or a volume that the others act on)")
+            nets.append(members)
+        if unconnected:
+            raise AssemblyError(f"port{'s' if len(unconnected) > 1 else ''} {', '.join(unconnected)} "
+                                f"{'are' if len(unconnected) > 1 else 'is'} not connected")
+        return nets
+
+    def _signal_sources(self) -> dict[str, tuple[str, str]]:
+        """``{"comp.input": ("output", "comp.output") or ("input", model input name)}``, every input bound once."""
+        bound: dict[str, tuple[str, str]] = {}
+
+        def bind(ep: _Endpoint, source: tuple[str, str]):
+            if ep.label in bound:
+                raise AssemblyError(f"input {ep.label} is connected twice ({bound[ep.label][1]} and {source[1]})")
+            bound[ep.label] = source
+
+        for a_ref, b_ref in self.connections:
+            a, b = self._endpoint(a_ref), self._endpoint(b_ref)
+            if a.kind == "port":
+                continue
+            if a.kind == "input" and b.kind == "output":
+                a, b = b, a
+            if not (a.kind == "output" and b.kind == "input"):
+                raise AssemblyError(f"cannot connect {a.label} ({a.kind}) to {b.label} ({b.kind}): "
+                                    "a signal connects an output to an input")
+            ua, ub = _var(a.component.outputs, a.name).unit, _var(b.component.inputs, b.name).unit
+            if ua != ub:
+                raise AssemblyError(f"cannot connect {a.label} [{ua}] to {b.label} [{ub}]: the units differ")
+            bind(b, ("output", a.label))
+        for model_input, refs in self.inputs.items():
+            units = set()
+            for ref in refs:
+                ep = self._endpoint(ref)
+                if ep.kind != "input":
+                    raise AssemblyError(f"model input {model_input!r}: {ep.label} is a {ep.kind}, not an input")
+                units.add(_var(ep.component.inputs, ep.name).unit)
+                bind(ep, ("input", model_input))
+            if len(units) > 1:
+                raise AssemblyError(f"model input {model_input!r} drives inputs of different units {sorted(units)}")
+        for c in self.components:
+            for v in c.inputs:
+                if f"{c.name}.{v.name}" not in bound:
+                    raise AssemblyError(f"input {c.name}.{v.name} [{v.unit}] is not connected")
+        return bound
+
+    # ------------------------------------------------------------------ flattening
+    def flatten(self) -> FlatModel:
+        """Check the wiring and return the flat model."""
+        import casadi as ca
+
+        nets = self._nets()
+        signal_sources = self._signal_sources()
+        model_inputs = {name: ca.SX.sym(name) for name in self.inputs}
+        params, states, placeholders = [], [], {}
+        symbols: dict[str, Symbols] = {}
+        mode_syms = {}
+        for c in self.components:
+            p = {v.name: ca.SX.sym(f"{c.name}.{v.name}") for v in c.parameter_vars()}
+            x = {v.name: ca.SX.sym(f"{c.name}.{v.name}") for v in c.states}
+            u = {v.name: ca.SX.sym(f"{c.name}.{v.name}") for v in c.inputs}
+            port = {}
+            for pt in c.ports:
+                read = pt.kind.through if pt.role == "node" else pt.kind.across
+                port[pt.name] = {v.name: ca.SX.sym(f"{c.name}.{pt.name}.{v.name}") for v in read}
+            mode = None
+            if c.modes is not None:
+                mode = mode_syms[c.name] = ca.SX.sym(f"{c.name}.mode")
+            symbols[c.name] = Symbols(p, x, u, port, mode)
+            params += [(c, v, p[v.name]) for v in c.parameter_vars()]
+            states += [(c, v, x[v.name]) for v in c.states]
+            placeholders.update({f"{c.name}.{k}": s for k, s in u.items()})
+            for pt_name, vs in port.items():
+                placeholders.update({f"{c.name}.{pt_name}.{k}": s for k, s in vs.items()})
+        with quiet_numpy_on_symbols():
+            equations = {c.name: _checked(c, c.equations(symbols[c.name])) for c in self.components}
+
+        bindings: dict[str, object] = {}
+        for label, (kind, source) in signal_sources.items():
+            if kind == "input":
+                bindings[label] = model_inputs[source]
+            else:
+                comp, out = source.split(".", 1)
+                bindings[label] = equations[comp].outputs[out]
+        for members in nets:
+            node = next(e for e in members if e.component.port(e.name).role == "node")
+            kind = node.component.port(node.name).kind
+            branches = [e for e in members if e is not node]
+            for v in kind.across:
+                for b in branches:
+                    bindings[f"{b.label}.{v.name}"] = equations[node.component.name].port[node.name][v.name]
+            for v in kind.through:
+                total = ca.SX(0.0)
+                for b in branches:
+                    total = total + equations[b.component.name].port[b.name][v.name]
+                bindings[f"{node.label}.{v.name}"] = total
+        resolved = _resolve(placeholders, bindings)
+
+        def flat(expr):
+            return ca.substitute([ca.SX(expr)], list(resolved), list(resolved.values()))[0] if resolved else ca.SX(expr)
+
+        comps = self.components
+        fv = lambda c, v: FlatVar(f"{c.name}.{v.name}", v.unit, v.description, v.nominal)  # noqa: E731
+        out_vars = [fv(c, v) for c in comps for v in c.outputs]
+        hybrid = [c for c in comps if c.modes is not None]
+        initial = _initial_states(states, {c.name: equations[c.name].initial for c in comps}, flat)
+        transition_x = []
+        for c, v, sym in states:
+            eq = equations[c.name]
+            transition_x.append(flat(eq.transition.get(v.name, sym)))
+        return FlatModel(
+            name=self.name,
+            states=[fv(c, v) for c, v, _ in states],
+            inputs=[FlatVar(n, _var(self._endpoint(refs[0]).component.inputs, self._endpoint(refs[0]).name).unit)
+                    for n, refs in self.inputs.items()],
+            outputs=out_vars,
+            parameters=[fv(c, v) for c, v, _ in params],
+            parameter_values=[float(c.values[v.name]) for c, v, _ in params],
+            modes=[(c.name, c.modes) for c in hybrid],
+            x=[s for _, _, s in states], u=list(model_inputs.values()), p=[s for _, _, s in params],
+            q=[mode_syms[c.name] for c in hybrid],
+            f=[flat(equations[c.name].der[v.name]) for c, v, _ in states],
+            y=[flat(equations[c.name].outputs[v.name]) for c in comps for v in c.outputs],
+            z=[flat(z) for c in hybrid for z in equations[c.name].indicators],
+            transition_x=transition_x,
+            transition_q=[flat(equations[c.name].transition.get("mode", mode_syms[c.name])) for c in hybrid],
+            rest_q=[flat(equations[c.name].rest_mode) for c in hybrid],
+            x0=initial,
+            q0=[flat(ca.substitute([ca.SX(equations[c.name].initial.get("mode", 0.0))],
+                                   [sym for _, _, sym in states], initial)[0]) for c in hybrid],
+        )
+
+
+def _var(vs: Sequence[Var], name: str) -> Var:
+    return next(v for v in vs if v.name == name)
+
+
+def _checked(c: Component, eq: Equations) -> Equations:
+    """The component's equations, refused if they leave out a state, an output or a port variable."""
+    def need(what, have, names):
+        lacking = [n for n in names if n not in have]
+        if lacking:
+            raise AssemblyError(f"component {c.name} ({type(c).__name__}) gives no {what} for {', '.join(lacking)}")
+
+    need("derivative", eq.der, [v.name for v in c.states])
+    need("value", eq.outputs, [v.name for v in c.outputs])
+    for pt in c.ports:
+        given = pt.kind.across if pt.role == "node" else pt.kind.through
+        need(f"port {pt.name} variable", eq.port.get(pt.name, {}), [v.name for v in given])
+    if c.modes is not None:
+        if len(eq.indicators) != c.n_indicators or eq.rest_mode is None:
+            raise AssemblyError(f"component {c.name} ({type(c).__name__}) has modes but gives "
+                                f"{len(eq.indicators)} of {c.n_indicators} indicators or no rest mode")
+    return eq
+
+
+def _resolve(placeholders: dict, bindings: dict) -> dict:
+    """Each placeholder symbol -> its expression free of placeholders, in dependency order.
+
+    A placeholder whose expression depends on itself through others is an algebraic loop: the message
+    lists the inputs and ports around it.
+    """
+    import casadi as ca
+
+    names = list(placeholders)
+    index = {placeholders[n].name(): n for n in names}
+    deps = {}
+    for n in names:
+        expr = ca.SX(bindings[n])
+        deps[n] = {index[s.name()] for s in ca.symvar(expr) if s.name() in index}
+    order, state = [], {}
+
+    def visit(n, path):
+        if state.get(n) == "done":
+            return
+        if state.get(n) == "active":
+            loop = path[path.index(n):] + [n]
+            raise AssemblyError("algebraic loop: " + " -> ".join(loop))
+        state[n] = "active"
+        for d in sorted(deps[n]):
+            visit(d, path + [n])
+        state[n] = "done"
+        order.append(n)
+
+    for n in names:
+        visit(n, [])
+    resolved: dict = {}
+    for n in order:
+        expr = ca.SX(bindings[n])
+        if resolved:
+            expr = ca.substitute([expr], list(resolved), list(resolved.values()))[0]
+        resolved[placeholders[n]] = expr
+    return resolved
+
+
+def _initial_states(states, initial_by_component, flat) -> list:
+    """Initial state expressions in the parameters and model inputs only.
+
+    A component's initial value may read other states (a chamber's air mass reads the load's
+    position); they are substituted until none is left.  A state with no initial expression starts at 0.
+    """
+    import casadi as ca
+
+    syms = [s for _, _, s in states]
+    exprs = [flat(initial_by_component[c.name].get(v.name, 0.0)) for c, v, _ in states]
+    for _ in range(len(syms) + 1):
+        if not any(ca.depends_on(e, ca.vertcat(*syms)) for e in exprs if syms):
+            return exprs
+        exprs = list(ca.substitute(exprs, syms, exprs))
+    raise AssemblyError("the initial states depend on each other in a loop")

@@ -1,0 +1,144 @@
+"""The flat model: one hybrid ODE in states x, inputs u, parameters p and modes q.
+
+Everything downstream is sized from its counts and named from its lists: the generated Python and C,
+the Jacobians and their sparsity (the FMU's ``ModelStructure``), and python-control's named signals.
+Names are namespaced by component (``chamber.p_abs_Pa``); model inputs keep the names the assembly
+gives them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+
+@dataclass(frozen=True)
+class FlatVar:
+    """A variable of the flat model: its namespaced name, unit, meaning and nominal scale."""
+
+    name: str
+    unit: str
+    description: str = ""
+    nominal: float = 1.0
+
+
+FUNCTION_SIGNATURES = {
+    "f": (("x", "u", "p", "q"), ("xdot",)),
+    "y": (("x", "u", "p", "q"), ("y",)),
+    "z": (("x", "u", "p", "q"), ("z",)),
+    "transition": (("x", "u", "p", "q"), ("x_next", "q_next")),
+    "rest_mode": (("x", "u", "p", "q"), ("q_rest",)),
+    "x0": (("u", "p"), ("x0", "q0")),
+    "jacobian": (("x", "u", "p", "q"), ("A", "B", "C", "D")),
+}
+"""The generated functions, their arguments and results, in the order every backend uses."""
+
+
+@dataclass(eq=False)
+class FlatModel:
+    """Counts, names and CasADi expressions of an assembled model (built by :meth:`Assembly.flatten`).
+
+    ``f``: state derivatives; ``y``: outputs; ``z``: event indicators, positive inside the current
+    modes; ``transition_x``/``transition_q``: states and modes after an event; ``rest_q``: the modes
+    decided afresh from the forces at rest; ``x0``/``q0``: the initial states and the modes where the
+    hybrid components start, before :attr:`rest_q` decides them (of ``u`` and ``p``).
+    """
+
+    name: str
+    states: list[FlatVar]
+    inputs: list[FlatVar]
+    outputs: list[FlatVar]
+    parameters: list[FlatVar]
+    parameter_values: list[float]
+    modes: list[tuple[str, Any]]
+    x: list[Any]
+    u: list[Any]
+    p: list[Any]
+    q: list[Any]
+    f: list[Any]
+    y: list[Any]
+    z: list[Any]
+    transition_x: list[Any]
+    transition_q: list[Any]
+    rest_q: list[Any]
+    x0: list[Any]
+    q0: list[Any]
+    _cache: dict = field(default_factory=dict, repr=False)
+
+    # ------------------------------------------------------------------ names
+    @property
+    def counts(self) -> dict[str, int]:
+        return {"states": len(self.states), "inputs": len(self.inputs), "outputs": len(self.outputs),
+                "parameters": len(self.parameters), "modes": len(self.modes), "indicators": len(self.z)}
+
+    def index(self, kind: str, name: str) -> int:
+        """Position of ``name`` among the model's ``kind`` (``states``, ``inputs``, ``outputs``, ``parameters``)."""
+        names = [v.name for v in getattr(self, kind)]
+        try:
+            return names.index(name)
+        except ValueError:
+            raise KeyError(f"{self.name} has no {kind[:-1]} {name!r}; it has {', '.join(names)}") from None
+
+    # ------------------------------------------------------------------ CasADi
+    def _vectors(self):
+        import casadi as ca
+        return tuple(ca.vertcat(*v) if v else ca.SX(0, 1) for v in (self.x, self.u, self.p, self.q))
+
+    def function(self, name: str):
+        """One of the model's CasADi ``Function`` s, by its name in :data:`FUNCTION_SIGNATURES`."""
+        import casadi as ca
+
+        key = ("function", name)
+        if key not in self._cache:
+            x, u, p, q = self._vectors()
+            col = lambda es: ca.vertcat(*es) if es else ca.SX(0, 1)  # noqa: E731
+            if name == "jacobian":
+                f, y = col(self.f), col(self.y)
+                exprs = [ca.jacobian(f, x), ca.jacobian(f, u), ca.jacobian(y, x), ca.jacobian(y, u)]
+            else:
+                exprs = {"f": [self.f], "y": [self.y], "z": [self.z], "transition": [self.transition_x, self.transition_q],
+                         "rest_mode": [self.rest_q], "x0": [self.x0, self.q0]}[name]
+                exprs = [col(e) for e in exprs]
+            ins, outs = FUNCTION_SIGNATURES[name]
+            args = {"x": x, "u": u, "p": p, "q": q}
+            self._cache[key] = ca.Function(f"{self.name}_{name}", [args[a] for a in ins], exprs, list(ins), list(outs))
+        return self._cache[key]
+
+    @property
+    def functions(self) -> dict[str, Any]:
+        """The model as CasADi ``Function`` s, by the names of :data:`FUNCTION_SIGNATURES`."""
+        return {name: self.function(name) for name in FUNCTION_SIGNATURES}
+
+    def sparsity(self) -> dict[str, list[list[int]]]:
+        """Structural dependencies: for each Jacobian block, the column indices each row depends on.
+
+        ``A``: derivatives on states, ``B``: derivatives on inputs, ``C``: outputs on states,
+        ``D``: outputs on inputs (an FMU's ``ModelStructure`` is written from these).
+        """
+        jac = self.function("jacobian")
+        out = {}
+        for k, name in enumerate(("A", "B", "C", "D")):
+            sp = jac.sparsity_out(k)
+            rows = [[] for _ in range(sp.size1())]
+            for r, c in zip(*sp.get_triplet()):
+                rows[r].append(c)
+            out[name] = [sorted(r) for r in rows]
+        return out
+
+    # ------------------------------------------------------------------ generated code
+    def python_source(self) -> str:
+        """Python source of every function (:mod:`pamsim.modeling.pygen`): byte-identical for one model."""
+        from .pygen import module_source
+        return module_source(self)
+
+    def compile_python(self):
+        """The generated Python functions, compiled (:class:`pamsim.modeling.pygen.GeneratedModel`)."""
+        if "python" not in self._cache:
+            from .pygen import GeneratedModel
+            self._cache["python"] = GeneratedModel(self)
+        return self._cache["python"]
+
+    def c_sources(self, prefix: str | None = None) -> dict[str, str]:
+        """C sources of every function (:mod:`pamsim.modeling.cgen`): ``{file name: text}``."""
+        from .cgen import c_sources
+        return c_sources(self, prefix or self.name)

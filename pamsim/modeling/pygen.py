@@ -1,0 +1,216 @@
+"""Python source from the flat model's CasADi functions: straight-line code, one line per operation.
+
+CasADi evaluates a function from Python in tens of microseconds (argument conversion); the
+right-hand side of a one-muscle model costs a few microseconds as plain Python arithmetic.  So the
+Python backend runs code printed from CasADi's own instruction list: the common subexpressions it
+found, in its order, with C's meaning kept where Python's differs (a division by zero, the square
+root or logarithm of a negative number give inf or NaN instead of raising, as in the generated C).
+The printed text depends only on the model: generating it twice gives the same bytes.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from .flat import FUNCTION_SIGNATURES, FlatModel
+
+RUNTIME = '''\
+import math as _math
+
+_nan = float("nan")
+_inf = float("inf")
+
+
+def _div0(a, b):
+    # a / 0 as C computes it (b is +0.0 or -0.0)
+    if a != a or a == 0.0:
+        return _nan
+    return _math.copysign(_inf, a) * _math.copysign(1.0, b)
+
+
+def _pow(a, b):
+    try:
+        r = a ** b
+    except ZeroDivisionError:
+        return _inf
+    except OverflowError:
+        return _inf
+    return _nan if isinstance(r, complex) else r
+
+
+def _exp(a):
+    try:
+        return _math.exp(a)
+    except OverflowError:
+        return _inf
+
+
+def _log(a):
+    if a > 0.0:
+        return _math.log(a)
+    return -_inf if a == 0.0 else _nan
+
+
+def _asin(a):
+    return _math.asin(a) if -1.0 <= a <= 1.0 else _nan
+
+
+def _acos(a):
+    return _math.acos(a) if -1.0 <= a <= 1.0 else _nan
+
+
+def _sign(a):
+    return 1.0 if a > 0.0 else (-1.0 if a < 0.0 else (0.0 if a == 0.0 else _nan))
+
+
+def _fmin(a, b):
+    return b if a != a else (a if b != b or a <= b else b)
+
+
+def _fmax(a, b):
+    return b if a != a else (a if b != b or a >= b else b)
+
+
+def _fmod(a, b):
+    return _math.fmod(a, b) if b != 0.0 and abs(a) != _inf else _nan
+
+
+def _sinh(a):
+    try:
+        return _math.sinh(a)
+    except OverflowError:
+        return _math.copysign(_inf, a)
+
+
+def _cosh(a):
+    try:
+        return _math.cosh(a)
+    except OverflowError:
+        return _inf
+
+
+def _acosh(a):
+    return _math.acosh(a) if a >= 1.0 else _nan
+
+
+def _atanh(a):
+    if -1.0 < a < 1.0:
+        return _math.atanh(a)
+    return _math.copysign(_inf, a) if abs(a) == 1.0 else _nan
+
+
+def _floor(a):
+    return float(_math.floor(a)) if a == a and abs(a) != _inf else a
+
+
+def _ceil(a):
+    return float(_math.ceil(a)) if a == a and abs(a) != _inf else a
+'''
+
+
+
+def _op_table() -> dict[int, str]:
+    import casadi as ca
+
+    t = {
+        "ASSIGN": "{0}", "ADD": "{0} + {1}", "SUB": "{0} - {1}", "MUL": "{0} * {1}",
+        "DIV": "({0} / {1} if {1} else _div0({0}, {1}))", "NEG": "-{0}", "EXP": "_exp({0})",
+        "LOG": "_log({0})", "POW": "_pow({0}, {1})", "CONSTPOW": "_pow({0}, {1})",
+        "SQRT": "(_math.sqrt({0}) if {0} >= 0.0 else _nan)", "SQ": "{0} * {0}", "TWICE": "{0} + {0}",
+        "SIN": "_math.sin({0})", "COS": "_math.cos({0})", "TAN": "_math.tan({0})", "ASIN": "_asin({0})",
+        "ACOS": "_acos({0})", "ATAN": "_math.atan({0})",
+        "LT": "(1.0 if {0} < {1} else 0.0)", "LE": "(1.0 if {0} <= {1} else 0.0)",
+        "EQ": "(1.0 if {0} == {1} else 0.0)", "NE": "(1.0 if {0} != {1} else 0.0)",
+        "NOT": "(0.0 if {0} else 1.0)", "AND": "(1.0 if {0} and {1} else 0.0)",
+        "OR": "(1.0 if {0} or {1} else 0.0)", "FLOOR": "_floor({0})", "CEIL": "_ceil({0})",
+        "FMOD": "_fmod({0}, {1})", "FABS": "abs({0})", "SIGN": "_sign({0})",
+        "COPYSIGN": "_math.copysign({0}, {1})", "IF_ELSE_ZERO": "({1} if {0} else 0.0)", "ERF": "_math.erf({0})",
+        "FMIN": "_fmin({0}, {1})", "FMAX": "_fmax({0}, {1})", "INV": "(1.0 / {0} if {0} else _div0(1.0, {0}))",
+        "SINH": "_sinh({0})", "COSH": "_cosh({0})", "TANH": "_math.tanh({0})",
+        "ASINH": "_math.asinh({0})", "ACOSH": "_acosh({0})", "ATANH": "_atanh({0})",
+        "ATAN2": "_math.atan2({0}, {1})",
+    }
+    return {getattr(ca, "OP_" + k): v for k, v in t.items()}
+
+
+def _literal(value: float) -> str:
+    if math.isnan(value):
+        return "_nan"
+    if math.isinf(value):
+        return "_inf" if value > 0 else "-_inf"
+    return repr(float(value))
+
+
+def function_source(fn, py_name: str) -> str:
+    """One CasADi SX ``Function`` as a Python ``def``: dense vector arguments (sequences of floats), each
+    result a list of floats (a matrix column by column)."""
+    import casadi as ca
+
+    ops = _op_table()
+    args = [fn.name_in(i) for i in range(fn.n_in())]
+    lines = [f"def {py_name}({', '.join(args)}):"]
+    dense_index = []
+    results = []
+    for i in range(fn.n_out()):
+        sp = fn.sparsity_out(i)
+        dense_index.append(sp.find())
+        results.append(["0.0"] * sp.numel())
+    for k in range(fn.n_instructions()):
+        op = fn.instruction_id(k)
+        ins = fn.instruction_input(k)
+        outs = fn.instruction_output(k)
+        if op == ca.OP_INPUT:
+            lines.append(f"    w{outs[0]} = {args[ins[0]]}[{ins[1]}]")
+        elif op == ca.OP_OUTPUT:
+            name = f"r{outs[0]}_{outs[1]}"
+            lines.append(f"    {name} = w{ins[0]}")
+            results[outs[0]][dense_index[outs[0]][outs[1]]] = name
+        elif op == ca.OP_CONST:
+            lines.append(f"    w{outs[0]} = {_literal(fn.instruction_constant(k))}")
+        elif op in ops:
+            operands = [f"w{j}" for j in ins]
+            lines.append(f"    w{outs[0]} = {ops[op].format(*operands)}")
+        else:
+            raise NotImplementedError(f"{fn.name()}: CasADi operation {op} has no Python form")
+    returned = ", ".join("[" + ", ".join(r) + "]" for r in results)
+    lines.append(f"    return {returned}" + ("," if len(results) == 1 else ""))
+    return "\n".join(lines) + "\n"
+
+
+def module_source(model: FlatModel) -> str:
+    """The whole module: the runtime helpers, then one ``def`` per function of :data:`FUNCTION_SIGNATURES`."""
+    parts = [f'"""Generated by pamsim.modeling.pygen from the flat model {model.name!r}.  Do not edit."""\n',
+             RUNTIME]
+    for name, fn in model.functions.items():
+        parts.append(function_source(fn, name))
+    return "\n\n".join(parts)
+
+
+class GeneratedModel:
+    """The compiled functions of a flat model, each taking sequences and returning lists of floats.
+
+    ``f(x, u, p, q)`` returns ``(xdot,)``, ``transition(x, u, p, q)`` returns ``(x_next, q_next)`` and
+    so on (:data:`pamsim.modeling.flat.FUNCTION_SIGNATURES`); :meth:`jacobian` gives numpy matrices.
+    """
+
+    def __init__(self, model: FlatModel):
+        self.source = model.python_source()
+        namespace: dict[str, Any] = {"__name__": f"pamsim_generated_{model.name}"}
+        exec(compile(self.source, f"<pamsim generated {model.name}>", "exec"), namespace)
+        self.f = namespace["f"]
+        self.y = namespace["y"]
+        self.z = namespace["z"]
+        self.transition = namespace["transition"]
+        self.rest_mode = namespace["rest_mode"]
+        self.x0 = namespace["x0"]
+        self._jacobian = namespace["jacobian"]
+        fn = model.functions["jacobian"]
+        self._jacobian_shapes = [(fn.size1_out(i), fn.size2_out(i)) for i in range(fn.n_out())]
+
+    def jacobian(self, x, u, p, q):
+        """``(A, B, C, D)`` as numpy arrays: df/dx, df/du, dy/dx, dy/du."""
+        import numpy as np
+
+        return tuple(np.array(b, dtype=float).reshape(shape, order="F")
+                     for b, shape in zip(self._jacobian(x, u, p, q), self._jacobian_shapes))

@@ -1,0 +1,75 @@
+"""Declared variables and typed ports.
+
+A port is a pair of across and through variables, in the manner of Modelica's connectors.  pamsim's
+models are explicit ODEs, so each connection is causal: a port has a role, ``node`` or ``branch``.
+The node (a moving body, a gas volume) owns the across variables and receives the sum of the through
+variables of every branch connected to it; a branch (a force element, a valve) reads the across
+variables and gives its through variables.  The assembly writes the sums; nothing else is written
+by hand.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class Var:
+    """A named variable with its unit, meaning and nominal scale (the integrator's absolute scale)."""
+
+    name: str
+    unit: str
+    description: str = ""
+    nominal: float = 1.0
+
+
+@dataclass(frozen=True)
+class PortKind:
+    """A kind of connection: its across variables (equal at a node) and through variables (summed)."""
+
+    name: str
+    across: tuple[Var, ...]
+    through: tuple[Var, ...]
+
+    @property
+    def variables(self) -> tuple[Var, ...]:
+        return self.across + self.through
+
+
+TRANSLATIONAL = PortKind(
+    "translational",
+    across=(Var("x_m", "m", "position along the line of action (contraction for a muscle)"),
+            Var("v_m_s", "m/s", "velocity along the line of action")),
+    through=(Var("F_N", "N", "force on the node along the line of action"),))
+"""A mechanical flange along one line: position and velocity, force."""
+
+PNEUMATIC = PortKind(
+    "pneumatic",
+    across=(Var("p_abs_Pa", "Pa", "absolute pressure of the volume"),
+            Var("T_K", "K", "gas temperature of the volume")),
+    through=(Var("mdot_kg_s", "kg/s", "mass flow into the volume"),
+             Var("Hdot_W", "W", "enthalpy flow into the volume, cp T_in mdot")))
+"""A gas port: pressure and temperature, mass and enthalpy flow."""
+
+SIGNAL = PortKind("signal", across=(), through=())
+"""Plain inputs and outputs connect one to one; this kind only names them in messages."""
+
+ROLES = ("node", "branch")
+
+
+@dataclass(frozen=True)
+class Port:
+    """A component's port: a name, a kind and a role (``node`` or ``branch``).
+
+    A node port left unconnected receives no through flow (a body on which nothing pulls, a closed
+    volume) only if ``optional``; a branch port must always be connected, or it has nothing to read.
+    """
+
+    name: str
+    kind: PortKind
+    role: str
+    optional: bool = False
+
+    def __post_init__(self):
+        if self.role not in ROLES:
+            raise ValueError(f"port {self.name!r}: role must be one of {ROLES}, not {self.role!r}")
