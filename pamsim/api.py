@@ -1,4 +1,9 @@
-"""The three-line path: ``load_scenario``, ``simulate``, ``result.plot()``."""
+"""The three-line path: ``load_scenario``, ``simulate``, ``result.plot()``.
+
+``simulate`` and ``as_scenario`` live in :mod:`pamsim.backends` and ``simulate_python`` in
+:mod:`pamsim.simulator`, so that sweeps, fits and the control tools, which this module's
+:func:`run` calls, can run scenarios without importing it; they are re-exported here.
+"""
 
 from __future__ import annotations
 
@@ -6,59 +11,14 @@ import os
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Callable
 
+from .backends import BACKENDS, as_scenario, simulate
 from .errors import InputError
 from .result import Result
-from .scenario import Scenario, load_scenario
-from .simulator import simulate_model
+from .scenario import Scenario, load_scenario  # noqa: F401 -- re-exported
+from .simulator import simulate_python  # noqa: F401 -- re-exported
 
 if TYPE_CHECKING:
     from .control.closed_loop import ClosedLoopRun
-
-
-def as_scenario(scenario: "Scenario | str | os.PathLike") -> Scenario:
-    """``scenario`` itself, or the scenario file it names (read and validated).
-
-    Raises
-    ------
-    TypeError
-        For anything else, saying what is expected.
-    """
-    if isinstance(scenario, Scenario):
-        return scenario
-    if isinstance(scenario, (str, os.PathLike)):
-        return load_scenario(scenario)
-    raise TypeError(f"expected a pamsim.Scenario or the path of a scenario TOML file, "
-                    f"not {type(scenario).__name__}")
-
-
-def simulate(scenario: "Scenario | str | os.PathLike", backend: str = "python",
-             progress: "Callable[[float], None] | None" = None) -> Result:
-    """Run ``scenario`` (a :class:`Scenario` or a scenario file's path) and return its :class:`Result`.
-
-    Parameters
-    ----------
-    scenario : Scenario, str or PathLike
-        The scenario, or the path of its file.
-    backend : str
-        ``"python"`` (solve_ivp, the default), ``"native"`` (the C core as a shared library), or an
-        FMU importer (``"fmu-cs"``, ``"fmu-me"``); see :data:`pamsim.backends.BACKENDS`.  A setting a
-        backend cannot honour raises :class:`~pamsim.errors.InputError` naming it.
-    progress : callable, optional
-        Called with the simulated time reached (python backend; the others do not report it).
-    """
-    scenario = as_scenario(scenario)
-    if backend == "python":
-        return simulate_python(scenario, progress)
-    from .backends import get_backend
-
-    return get_backend(backend)(scenario)
-
-
-def simulate_python(scenario: Scenario, progress: "Callable[[float], None] | None" = None) -> Result:
-    """Backend ``python``: integrate ``scenario`` with ``scipy.integrate.solve_ivp``."""
-    return simulate_model(scenario.build_model(), scenario.duration_s, scenario.solver,
-                          x0_m=scenario.initial_contraction_m, name=scenario.name,
-                          p0_gauge_Pa=scenario.initial_pressure_gauge_Pa, progress=progress)
 
 
 @dataclass
@@ -105,8 +65,6 @@ def run(scenario: "Scenario | str | os.PathLike", backend: str = "python",
     loop would silently give a different system).  ``progress`` receives the
     simulated time reached (python backend; the FMU backends do not report it).
     """
-    from .backends import BACKENDS
-
     scenario = as_scenario(scenario)
     if backend not in BACKENDS:
         raise InputError(f"unknown backend {backend!r} (choose from {', '.join(sorted(BACKENDS))})")
@@ -119,3 +77,4 @@ def run(scenario: "Scenario | str | os.PathLike", backend: str = "python",
         loop = run_closed_loop(scenario, progress=progress)
         return ScenarioRun(loop.result, backend, loop)
     return ScenarioRun(simulate(scenario, backend, progress), backend)
+

@@ -1,18 +1,26 @@
-"""Simulation backends selectable with ``pamsim run --backend``.
+"""Simulation backends selectable with ``pamsim run --backend``, and :func:`simulate`, which runs a
+scenario on one of them.
 
 Each maps a :class:`~pamsim.scenario.Scenario` to a :class:`~pamsim.result.Result`.
 Backends that need optional machinery (a C compiler for the FMU) are
-imported only when chosen.
+imported only when chosen.  Sweeps, fits and the control tools run their
+scenarios through :func:`simulate` here, below :mod:`pamsim.api`, which
+re-exports it.
 """
 
 from __future__ import annotations
 
 import importlib
-from typing import Callable
+import os
+from typing import TYPE_CHECKING, Callable
+
+if TYPE_CHECKING:
+    from .result import Result
+    from .scenario import Scenario
 
 # name -> "module:function"
 BACKENDS: dict[str, str] = {
-    "python": "pamsim.api:simulate_python",
+    "python": "pamsim.simulator:simulate_python",
     "native": "pamsim.native:simulate",
     "fmu-cs": "pamsim.fmu.runner:simulate_cs",
     "fmu-me": "pamsim.fmu.runner:simulate_me",
@@ -43,3 +51,45 @@ def get_backend(name: str) -> Callable:
         raise InputError(f"unknown backend {name!r} (choose from {', '.join(BACKENDS)})")
     module, func = BACKENDS[name].split(":")
     return getattr(importlib.import_module(module), func)
+
+
+def as_scenario(scenario: "Scenario | str | os.PathLike") -> "Scenario":
+    """``scenario`` itself, or the scenario file it names (read and validated).
+
+    Raises
+    ------
+    TypeError
+        For anything else, saying what is expected.
+    """
+    # Imported here: the command line reads BACKENDS for its options and must not pay for numpy then.
+    from .scenario import Scenario, load_scenario
+
+    if isinstance(scenario, Scenario):
+        return scenario
+    if isinstance(scenario, (str, os.PathLike)):
+        return load_scenario(scenario)
+    raise TypeError(f"expected a pamsim.Scenario or the path of a scenario TOML file, "
+                    f"not {type(scenario).__name__}")
+
+
+def simulate(scenario: "Scenario | str | os.PathLike", backend: str = "python",
+             progress: "Callable[[float], None] | None" = None) -> "Result":
+    """Run ``scenario`` (a :class:`Scenario` or a scenario file's path) and return its :class:`Result`.
+
+    Parameters
+    ----------
+    scenario : Scenario, str or PathLike
+        The scenario, or the path of its file.
+    backend : str
+        ``"python"`` (solve_ivp, the default), ``"native"`` (the C core as a shared library), or an
+        FMU importer (``"fmu-cs"``, ``"fmu-me"``); see :data:`pamsim.backends.BACKENDS`.  A setting a
+        backend cannot honour raises :class:`~pamsim.errors.InputError` naming it.
+    progress : callable, optional
+        Called with the simulated time reached (python backend; the others do not report it).
+    """
+    scenario = as_scenario(scenario)
+    if backend == "python":
+        from .simulator import simulate_python
+
+        return simulate_python(scenario, progress)
+    return get_backend(backend)(scenario)

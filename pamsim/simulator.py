@@ -73,6 +73,13 @@ _MAX_ZERO_LENGTH = 30
 """Zero-length segments in a row (the last hold is then 2**29 ns, about 0.5 s) before it is a solver failure."""
 
 
+def simulate_python(scenario, progress: Callable[[float], None] | None = None) -> Result:
+    """Backend ``python``: integrate a :class:`~pamsim.scenario.Scenario` with ``scipy.integrate.solve_ivp``."""
+    return simulate_model(scenario.build_model(), scenario.duration_s, scenario.solver,
+                          x0_m=scenario.initial_contraction_m, name=scenario.name,
+                          p0_gauge_Pa=scenario.initial_pressure_gauge_Pa, progress=progress)
+
+
 def n_samples(duration_s: float, sample_rate_Hz: float) -> int:
     """Number of output samples: round(duration x rate) + 1, evenly spaced, at least the start and the end."""
     return max(2, int(round(duration_s * sample_rate_Hz)) + 1)

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq
 
-from ..api import simulate
+from ..backends import simulate
 from ..constants import PA_PER_BAR
 from ..errors import InputError
 from ..model import Mode, MuscleModel

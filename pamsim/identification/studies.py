@@ -18,7 +18,7 @@ from importlib import resources
 
 import numpy as np
 
-from ..api import simulate
+from ..backends import simulate
 from ..parameters import get_parameter_set
 from ..scenario import Scenario
 from .columns import TraceData, read_static_data

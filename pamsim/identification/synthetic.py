@@ -7,7 +7,7 @@ from typing import Mapping
 
 import numpy as np
 
-from ..api import simulate
+from ..backends import simulate
 from ..scenario import Scenario
 from .columns import TraceData
 

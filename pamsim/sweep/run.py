@@ -148,7 +148,7 @@ def run_task(task: _Task) -> dict:
 
     Any exception is returned as ``{"error": ...}`` so one failing case does not end the sweep.
     """
-    from ..api import simulate
+    from ..backends import simulate
 
     try:
         return _reduce(task, simulate(_scenario(task), task.backend))
