@@ -31,7 +31,7 @@ from ..errors import InputError
 from ..native import library as lib
 from ..native.backend import CaseInputs, case_inputs, event_capacity, outgrew_batch
 from ..static_models import get as get_static_model
-from .dynamic_fit import trace_scenario
+from .trials import trace_scenario
 
 _X_ROW = lib.SAMPLE_COLUMNS.index("x_m")
 _MASS = lib.INPUTS.index("load_mass_kg")
