@@ -14,8 +14,8 @@ from typing import Any, Callable, Mapping
 
 from .errors import InputError
 from .muscles import Muscle, load_muscle
-from .muscles.schema import KNOWN
-from .parameters import ParameterSet, dynamics_parameters, known_parameter
+from .parameter_schema import KNOWN, ParameterSet, known_parameter
+from .parameters import dynamics_parameters
 from .static_models import REGISTRY, StaticModelSpec
 from .static_models.base import did_you_mean
 

@@ -15,101 +15,12 @@ them all, from its paper.
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from types import MappingProxyType
 from typing import Mapping
 
-from .core_table import ORDER_CHECKS
-
-
-@dataclass(frozen=True)
-class Parameter:
-    """One parameter value with its unit, provenance, meaning and physical range.
-
-    ``lower``/``upper`` bound the value; ``*_open`` excludes the bound itself.
-    The FMU's C parameter check is generated from the same bounds.
-    """
-
-    value: float
-    unit: str
-    source: str
-    description: str
-    lower: float = -math.inf
-    upper: float = math.inf
-    lower_open: bool = False
-    upper_open: bool = False
-
-    def violation(self, value: float) -> str | None:
-        """Why ``value`` is out of range, or None."""
-        if not math.isfinite(value):
-            return "must be a finite number"
-        low_bad = value <= self.lower if self.lower_open else value < self.lower
-        high_bad = value >= self.upper if self.upper_open else value > self.upper
-        if not (low_bad or high_bad):
-            return None
-        if not math.isfinite(self.upper):
-            return f"must be {'>' if self.lower_open else '>='} {self.lower:g}"
-        if not math.isfinite(self.lower):
-            return f"must be {'<' if self.upper_open else '<='} {self.upper:g}"
-        lo = ("(" if self.lower_open else "[") + f"{self.lower:g}"
-        hi = f"{self.upper:g}" + (")" if self.upper_open else "]")
-        return f"must lie in {lo}, {hi}"
-
-
-class ParameterSet(Mapping[str, float]):
-    """An immutable, named set of parameters; reads as ``{name: value}``.
-
-    ``with_overrides`` returns a new set, so scenarios never mutate the
-    registered sets.
-    """
-
-    def __init__(self, name: str, citation: str, entries: Mapping[str, Parameter]):
-        self.name = name
-        self.citation = citation
-        self.entries: Mapping[str, Parameter] = MappingProxyType(dict(entries))
-
-    def __reduce__(self):
-        # A read-only mapping proxy does not pickle; a plain dict rebuilds it (process pools).
-        return ParameterSet, (self.name, self.citation, dict(self.entries))
-
-    def __getitem__(self, key: str) -> float:
-        return self.entries[key].value
-
-    def __iter__(self):
-        return iter(self.entries)
-
-    def __len__(self) -> int:
-        return len(self.entries)
-
-    def with_overrides(self, overrides: Mapping[str, float], source: str = "override") -> "ParameterSet":
-        """Return a copy with some values replaced; unknown names raise KeyError."""
-        entries = dict(self.entries)
-        for key, value in overrides.items():
-            if key not in entries:
-                raise KeyError(key)
-            entries[key] = replace(entries[key], value=float(value), source=source)
-        return ParameterSet(self.name, self.citation, entries)
-
-    def violations(self) -> list[tuple[str, float, str]]:
-        """``(name, value, reason)`` for every value outside its range or inconsistent with another."""
-        out = [(k, p.value, why) for k, p in self.entries.items() if (why := p.violation(p.value))]
-        if out:
-            return out
-        v = self
-        for a, b in ORDER_CHECKS:
-            if a in v and b in v and not v[a] < v[b]:
-                out.append((a, v[a], f"must be below {b} = {v[b]:g}"))
-        if "wall_thickness_m" in v and "r0_m" in v and not v["r0_m"] > v["wall_thickness_m"]:
-            out.append(("r0_m", v["r0_m"], f"must exceed the bladder wall thickness wall_thickness_m = "
-                        f"{v['wall_thickness_m']:g}"))
-        return out
-
-    def table(self) -> list[tuple[str, float, str, str, str]]:
-        """Rows ``(name, value, unit, source, description)`` for docs and CLI."""
-        return [(k, p.value, p.unit, p.source, p.description) for k, p in self.entries.items()]
-
-
+from .muscles import load_muscle
+from .parameter_schema import LOCK_DEG, Parameter, ParameterSet, known_parameter
 
 
 LOAD_MASS = Parameter(
@@ -155,8 +66,6 @@ def dynamics_parameters(muscle: ParameterSet) -> ParameterSet:
     The rest braid angle is bounded by the locking angle: the dynamics model a
     contracting muscle, whose upper stop is the braid lock.
     """
-    from .muscles.schema import LOCK_DEG  # pamsim.muscles imports this module: imported late
-
     entries = dict(muscle.entries)
     for name, (value, source) in DYNAMICS_DEFAULTS.items():
         if name not in entries:
@@ -167,14 +76,6 @@ def dynamics_parameters(muscle: ParameterSet) -> ParameterSet:
     return ParameterSet(muscle.name, muscle.citation, entries)
 
 
-def known_parameter(name: str, value: float, source: str) -> Parameter:
-    """A :class:`Parameter` of a known name (unit, range and meaning from the muscle schema)."""
-    from .muscles.schema import KNOWN, unit_of
-
-    k = KNOWN[name]
-    return Parameter(float(value), unit_of(name), source, k.description, k.lower, k.upper, k.lower_open, k.upper_open)
-
-
 def get_parameter_set(name: str) -> ParameterSet:
     """The dynamics' parameter set of a shipped muscle (or muscle file): its values, then the defaults.
 
@@ -183,6 +84,4 @@ def get_parameter_set(name: str) -> ParameterSet:
     pamsim.muscles.MuscleError
         For an unknown muscle.
     """
-    from .muscles import load_muscle  # the muscle loader builds ParameterSets: imported late
-
     return dynamics_parameters(load_muscle(name).parameters)

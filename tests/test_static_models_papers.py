@@ -278,7 +278,7 @@ def test_two_phase_phase2_has_no_compressive_contact_solution(c1_sign):
 
 def test_report_prints_every_table_the_docs_quote(capsys):
     from pamsim.static_models import REGISTRY
-    from pamsim.static_models.report import main
+    from pamsim.muscles.report import main
     main([])
     out = capsys.readouterr().out
     assert all(f"| `{name}` |" in out for name in REGISTRY)

@@ -51,7 +51,7 @@ def markdown_table(ps) -> str:
 
 def defaults_table() -> str:
     """The dynamics defaults of ``docs/model.md``; a test keeps the two identical."""
-    from ..muscles.schema import unit_of
+    from ..parameter_schema import unit_of
     from ..parameters import DYNAMICS_DEFAULTS
 
     lines = ["| name | value | unit | source |", "| --- | --- | --- | --- |"]

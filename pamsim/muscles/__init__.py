@@ -16,11 +16,10 @@ from pathlib import Path
 from typing import Any, Mapping
 
 from ..errors import InputError
-from ..parameters import Parameter, ParameterSet
+from ..parameter_schema import KNOWN, LOCK_DEG, Parameter, ParameterSet, unit_of
 from ..static_models import REGISTRY, StaticForce
 from ..static_models import get as get_model
 from ..static_models.base import did_you_mean
-from .schema import KNOWN, LOCK_DEG, unit_of
 
 
 class MuscleError(InputError):

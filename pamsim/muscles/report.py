@@ -1,15 +1,16 @@
-"""Paper numbers reproduced by the static-model library, as Markdown tables.
+"""Paper numbers reproduced by the static-model library on the shipped muscles, as Markdown tables.
 
-Run ``python -m pamsim.static_models.report`` (``--models`` for the model table
+Run ``python -m pamsim.muscles.report`` (``--models`` for the model table
 only, ``--muscles`` for the shipped muscles); ``docs/static_models.md`` quotes its output.
+It lives with the muscles, above the models, because every table but the first is of a muscle file.
 """
 
 from __future__ import annotations
 
 import argparse
 
-from ..muscles import load_muscle, shipped_names
-from . import REGISTRY, get
+from ..static_models import REGISTRY, get
+from . import load_muscle, shipped_names
 
 PSI_PA = 6894.757293168361
 """Pascals per psi (Kothera's pressures are psi gauge; the exact conversion)."""
@@ -85,8 +86,8 @@ def miniature_table() -> str:
 
 def claims_table() -> str:
     """Paper claims and the numbers pamsim computes for them (reproduced or not)."""
-    from .reference import acra_point, is_acra_point, reference_points, table3_estimate_N
-    from .two_phase import TwoPhaseTube
+    from ..static_models.reference import acra_point, is_acra_point, reference_points, table3_estimate_N
+    from ..static_models.two_phase import TwoPhaseTube
 
     rows = ["| claim (source) | pamsim | verdict |", "|---|---|---|"]
     k5a = load_muscle("kothera2009_5a")
