@@ -10,18 +10,16 @@ in ``docs/validation.md`` and ``scenarios/acra2012_grid.toml``.
 from __future__ import annotations
 
 import csv
-import difflib
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Mapping
+from typing import Any, Mapping
 
 from ..elements.friction import FRICTION_MODELS
 from ..errors import InputError
 from ..scenario import Scenario, load_scenario, read_toml
-
-if TYPE_CHECKING:
-    from .uncertainty import UncertaintySpec
+from ..table_checks import TableChecker
+from .uncertainty import UncertaintySpec, parse_uncertainty
 
 _TOP_KEYS = {"name", "description", "base_scenario", "friction_models", "capability_min_equilibrium_mm",
              "backend", "measured", "cases", "axes", "case", "frequency", "time_responses", "uncertainty"}
@@ -74,7 +72,7 @@ class SweepSpec:
     time_responses: tuple[Scenario, ...] = ()
     backend: str = "python"
     """The backend that runs every case (:data:`pamsim.backends.BACKENDS`); ``pamsim sweep --backend`` overrides it."""
-    uncertainty: "UncertaintySpec | None" = None
+    uncertainty: UncertaintySpec | None = None
 
     def case_scenario(self, case: SweepCase, friction: str) -> Scenario:
         """The base scenario with the case's load and pressure and the given friction model."""
@@ -116,38 +114,35 @@ def sweep_from_dict(spec: Mapping[str, Any], base_dir: str | Path = ".", origin:
                     default_name: str = "sweep") -> SweepSpec:
     """Validate a sweep given as a dict (the structure of the TOML file)."""
     base_dir = Path(base_dir)
-    _check_keys(origin, "the top level", "", spec, _TOP_KEYS)
-    base_name = _required(origin, spec, "base_scenario", str)
+    check = TableChecker(origin, SweepError, "sweep")
+    check.check_keys("the top level", "", spec, _TOP_KEYS)
+    base_name = check.required(spec, "base_scenario", str)
     base = load_scenario(_resolve(base_dir, base_name))
-    frictions = tuple(_typed(origin, "friction_models", spec.get("friction_models", [base.spec["model"]["friction"]]),
-                             list))
+    frictions = tuple(check.typed("friction_models", spec.get("friction_models", [base.spec["model"]["friction"]]),
+                                  list))
     if not frictions:
         raise SweepError(f"{origin}: friction_models = []: name at least one friction model")
     for f in frictions:
         if not isinstance(f, str) or f not in FRICTION_MODELS:
-            _fail(origin, "friction_models", f, "unknown friction model", FRICTION_MODELS)
-    threshold_mm = _number(origin, "capability_min_equilibrium_mm", spec.get("capability_min_equilibrium_mm", 5.0))
-    measured = _read_measured(origin, base_dir, spec["measured"]) if "measured" in spec else None
-    uncertainty = None
-    if "uncertainty" in spec:
-        from .uncertainty import parse_uncertainty  # it uses this module's checks
-
-        uncertainty = parse_uncertainty(origin, spec["uncertainty"], base)
+            check.fail("friction_models", f, "unknown friction model", FRICTION_MODELS)
+    threshold_mm = check.number("capability_min_equilibrium_mm", spec.get("capability_min_equilibrium_mm", 5.0))
+    measured = _read_measured(check, base_dir, spec["measured"]) if "measured" in spec else None
+    uncertainty = parse_uncertainty(check, spec["uncertainty"], base) if "uncertainty" in spec else None
     # An uncertainty study samples the base scenario itself and needs no cases.
     no_cases = uncertainty is not None and not any(k in spec for k in ("cases", "axes", "case"))
-    cases = () if no_cases else _cases(origin, spec, measured)
-    frequency = _frequency(origin, spec["frequency"]) if "frequency" in spec else None
+    cases = () if no_cases else _cases(check, spec, measured)
+    frequency = _frequency(check, spec["frequency"]) if "frequency" in spec else None
     responses = ()
     if "time_responses" in spec:
         table = spec["time_responses"]
-        _check_keys(origin, "[time_responses]", "time_responses.", table, {"scenarios"})
-        names = _required(origin, table, "scenarios", list, "time_responses.")
-        responses = tuple(load_scenario(_resolve(base_dir, _typed(origin, "time_responses.scenarios", n, str)))
+        check.check_keys("[time_responses]", "time_responses.", table, {"scenarios"})
+        names = check.required(table, "scenarios", list, "time_responses.")
+        responses = tuple(load_scenario(_resolve(base_dir, check.typed("time_responses.scenarios", n, str)))
                           for n in names)
-    result = SweepSpec(_typed(origin, "name", spec.get("name", default_name), str),
-                       _typed(origin, "description", spec.get("description", ""), str), origin, base, cases,
+    result = SweepSpec(check.typed("name", spec.get("name", default_name), str),
+                       check.typed("description", spec.get("description", ""), str), origin, base, cases,
                        frictions, threshold_mm * 1e-3, frequency, responses,
-                       _backend(origin, spec.get("backend", "python")), uncertainty)
+                       _backend(check, spec.get("backend", "python")), uncertainty)
     # Build every scenario once so a bad value (a pressure above the rating...) fails before the run.
     try:
         for case in cases:
@@ -162,51 +157,51 @@ def sweep_from_dict(spec: Mapping[str, Any], base_dir: str | Path = ".", origin:
     return result
 
 
-def _backend(origin: str, name: Any) -> str:
+def _backend(check: TableChecker, name: Any) -> str:
     from ..backends import BACKENDS
 
     if name not in BACKENDS:
-        _fail(origin, "backend", name, "unknown backend", BACKENDS)
+        check.fail("backend", name, "unknown backend", BACKENDS)
     return name
 
 
-def _cases(origin: str, spec: Mapping[str, Any], measured: list[dict] | None) -> tuple[SweepCase, ...]:
+def _cases(check: TableChecker, spec: Mapping[str, Any], measured: list[dict] | None) -> tuple[SweepCase, ...]:
     given = [k for k in ("cases", "axes", "case") if k in spec]
     if len(given) != 1:
-        raise SweepError(f"{origin}: give exactly one of [cases] from_measured = true, [axes] or [[case]] "
+        raise SweepError(f"{check.origin}: give exactly one of [cases] from_measured = true, [axes] or [[case]] "
                          f"(found {', '.join(given) or 'none'})")
     if "cases" in spec:
         table = spec["cases"]
-        _check_keys(origin, "[cases]", "cases.", table, {"from_measured"})
+        check.check_keys("[cases]", "cases.", table, {"from_measured"})
         if table.get("from_measured") is not True:
-            _fail(origin, "cases.from_measured", table.get("from_measured"), "must be true (or use [axes] / [[case]])")
+            check.fail("cases.from_measured", table.get("from_measured"), "must be true (or use [axes] / [[case]])")
         if measured is None:
-            raise SweepError(f"{origin}: cases.from_measured = true needs a [measured] file")
+            raise SweepError(f"{check.origin}: cases.from_measured = true needs a [measured] file")
         return tuple(_named(row["weight_N"], row["pressure_stable_bar"], measured) for row in measured)
     if "axes" in spec:
         axes = spec["axes"]
-        _check_keys(origin, "[axes]", "axes.", axes, _AXES, what="axis")
+        check.check_keys("[axes]", "axes.", axes, _AXES, what="axis")
         values = {}
         for axis in sorted(_AXES):
             if axis not in axes:
-                raise SweepError(f"{origin}: missing axis axes.{axis} (the sweep varies both pressure_bar and weight_N)")
-            values[axis] = _number_list(origin, f"axes.{axis}", axes[axis])
+                raise SweepError(f"{check.origin}: missing axis axes.{axis} (the sweep varies both pressure_bar and weight_N)")
+            values[axis] = check.number_list(f"axes.{axis}", axes[axis])
         pairs = [(w, p) for p in values["pressure_bar"] for w in values["weight_N"]]
     else:
         rows = spec["case"]
         if not isinstance(rows, list) or not rows:
-            _fail(origin, "case", rows, "must be a non-empty array of tables [[case]]")
+            check.fail("case", rows, "must be a non-empty array of tables [[case]]")
         pairs = []
         for i, row in enumerate(rows):
             where = f"case[{i}]."
-            _check_keys(origin, f"[[case]] number {i + 1}", where, row, _AXES)
-            pairs.append((_positive(origin, where + "weight_N", _required(origin, row, "weight_N", float, where)),
-                          _number(origin, where + "pressure_bar", _required(origin, row, "pressure_bar", float, where))))
+            check.check_keys(f"[[case]] number {i + 1}", where, row, _AXES)
+            pairs.append((check.positive(where + "weight_N", check.required(row, "weight_N", float, where)),
+                          check.number(where + "pressure_bar", check.required(row, "pressure_bar", float, where))))
     for w, p in pairs:
         if w <= 0:
-            _fail(origin, "weight_N", w, "must be positive")
+            check.fail("weight_N", w, "must be positive")
         if p < 0:
-            _fail(origin, "pressure_bar", p, "must not be negative")
+            check.fail("pressure_bar", p, "must not be negative")
     return tuple(_named(w, p, measured or []) for w, p in pairs)
 
 
@@ -221,39 +216,39 @@ def _named(weight_N: float, pressure_bar: float, measured: list[dict]) -> SweepC
                      row.get("pressure_step_bar", math.nan))
 
 
-def _frequency(origin: str, table: Any) -> FrequencyStudy:
-    _check_keys(origin, "[frequency]", "frequency.", table, _FREQUENCY_KEYS)
-    pressure = _number(origin, "frequency.pressure_bar", _required(origin, table, "pressure_bar", float, "frequency."))
-    weights = _number_list(origin, "frequency.weight_N", _required(origin, table, "weight_N", list, "frequency."))
+def _frequency(check: TableChecker, table: Any) -> FrequencyStudy:
+    check.check_keys("[frequency]", "frequency.", table, _FREQUENCY_KEYS)
+    pressure = check.number("frequency.pressure_bar", check.required(table, "pressure_bar", float, "frequency."))
+    weights = check.number_list("frequency.weight_N", check.required(table, "weight_N", list, "frequency."))
     for w in weights:
         if w <= 0:
-            _fail(origin, "frequency.weight_N", w, "must be positive")
+            check.fail("frequency.weight_N", w, "must be positive")
     ptable = table.get("pressure")
     if ptable is not None and not isinstance(ptable, dict):
-        _fail(origin, "frequency.pressure", ptable, "must be a table (it replaces the base scenario's [pressure])")
+        check.fail("frequency.pressure", ptable, "must be a table (it replaces the base scenario's [pressure])")
     return FrequencyStudy(pressure, tuple(weights), ptable)
 
 
-def _read_measured(origin: str, base_dir: Path, table: Any) -> list[dict]:
+def _read_measured(check: TableChecker, base_dir: Path, table: Any) -> list[dict]:
     """Rows ``{weight_N, pressure_stable_bar, contraction_mm[, pressure_step_bar]}`` of the measured CSV."""
-    _check_keys(origin, "[measured]", "measured.", table, _MEASURED_KEYS)
-    name = _required(origin, table, "file", str, "measured.")
+    check.check_keys("[measured]", "measured.", table, _MEASURED_KEYS)
+    name = check.required(table, "file", str, "measured.")
     path = _resolve(base_dir, name)
     if not path.is_file():
-        _fail(origin, "measured.file", name, f"no such file ({path})")
-    cols = {k: _typed(origin, f"measured.{k}", table.get(k, d), str) for k, d in _MEASURED_DEFAULTS.items()}
+        check.fail("measured.file", name, f"no such file ({path})")
+    cols = {k: check.typed(f"measured.{k}", table.get(k, d), str) for k, d in _MEASURED_DEFAULTS.items()}
     try:
         lines = [ln for ln in path.read_text().splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
     except (OSError, UnicodeDecodeError) as exc:
-        _fail(origin, "measured.file", name, f"cannot read: {exc}")
+        check.fail("measured.file", name, f"cannot read: {exc}")
     if not lines:
-        _fail(origin, "measured.file", name, "has no header row")
+        check.fail("measured.file", name, "has no header row")
     reader = csv.DictReader(lines)
     header = reader.fieldnames or []
     required = [cols["weight_column"], cols["pressure_column"], cols["contraction_column"]]
     missing = [c for c in required if c not in header]
     if missing:
-        raise SweepError(f"{origin}: measured.file = {name!r}: columns {', '.join(missing)} not found "
+        raise SweepError(f"{check.origin}: measured.file = {name!r}: columns {', '.join(missing)} not found "
                          f"(its columns: {', '.join(header)}; set measured.weight_column, pressure_column, "
                          "contraction_column)")
     rows = []
@@ -265,13 +260,13 @@ def _read_measured(origin: str, base_dir: Path, table: Any) -> list[dict]:
             if cols["nominal_pressure_column"] in header:
                 row["pressure_step_bar"] = float(raw[cols["nominal_pressure_column"]])
         except (TypeError, ValueError):
-            raise SweepError(f"{origin}: measured.file = {name!r}: data row {line_no - 1} is not numeric: "
+            raise SweepError(f"{check.origin}: measured.file = {name!r}: data row {line_no - 1} is not numeric: "
                              f"{dict(raw)}") from None
         if not all(math.isfinite(v) for v in row.values()):
-            raise SweepError(f"{origin}: measured.file = {name!r}: data row {line_no - 1} has a non-finite value")
+            raise SweepError(f"{check.origin}: measured.file = {name!r}: data row {line_no - 1} has a non-finite value")
         rows.append(row)
     if not rows:
-        _fail(origin, "measured.file", name, "has no data rows")
+        check.fail("measured.file", name, "has no data rows")
     return rows
 
 
@@ -293,59 +288,6 @@ def _with_case(base: Scenario, weight_N: float, pressure_bar: float, friction: s
         pressure_change = {"prescribed": signal}
     return base.with_changes({"load": {"weight_N": weight_N}, "pressure": pressure_change,
                               "model": {"friction": friction}}, name=name)
-
-
-# ---------------------------------------------------------------- validation helpers
-def _fail(origin: str, key: str, value: Any, why: str, choices=None):
-    msg = f"{origin}: {key} = {value!r}: {why}"
-    if choices is not None:
-        close = difflib.get_close_matches(str(value), [str(c) for c in choices], n=1)
-        msg += f" (did you mean {close[0]!r}?)" if close else f" (choose from {', '.join(map(str, choices))})"
-    raise SweepError(msg)
-
-
-def _check_keys(origin: str, where: str, prefix: str, table: Any, known: set[str], what: str = "key"):
-    if not isinstance(table, dict):
-        _fail(origin, prefix.rstrip(".") or "sweep", table, "must be a table")
-    for key in table:
-        if key not in known:
-            close = difflib.get_close_matches(key, sorted(known), n=1)
-            hint = f" (did you mean {close[0]!r}?)" if close else f" (known: {', '.join(sorted(known))})"
-            raise SweepError(f"{origin}: unknown {what} {prefix}{key!s} in {where}{hint}")
-
-
-def _required(origin: str, table: Mapping, key: str, kind: type, prefix: str = ""):
-    if key not in table:
-        raise SweepError(f"{origin}: missing key {prefix}{key}")
-    return _typed(origin, prefix + key, table[key], kind)
-
-
-def _typed(origin: str, key: str, value: Any, kind: type):
-    if kind is float:
-        return _number(origin, key, value)
-    if not isinstance(value, kind):
-        _fail(origin, key, value, f"must be a {kind.__name__}, not {type(value).__name__}")
-    return value
-
-
-def _number(origin: str, key: str, value: Any) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        _fail(origin, key, value, "must be a finite number")
-    return float(value)
-
-
-def _positive(origin: str, key: str, value: float) -> float:
-    if value <= 0:
-        _fail(origin, key, value, "must be positive")
-    return value
-
-
-def _number_list(origin: str, key: str, value: Any) -> list[float]:
-    if not isinstance(value, list):
-        _fail(origin, key, value, "must be a list of numbers")
-    if not value:
-        _fail(origin, key, value, "is empty: give at least one value")
-    return [_number(origin, key, v) for v in value]
 
 
 def _resolve(base_dir: Path, name: str) -> Path:

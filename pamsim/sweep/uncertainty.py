@@ -24,6 +24,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from ..scenario import Scenario
+from ..table_checks import TableChecker
 
 DISTRIBUTIONS = {
     "normal": ("mean", "std"),
@@ -134,76 +135,73 @@ class UncertaintySpec:
 
 
 # ---------------------------------------------------------------- reading the table
-def parse_uncertainty(origin: str, table: Any, base: Scenario) -> UncertaintySpec:
+def parse_uncertainty(check: TableChecker, table: Any, base: Scenario) -> UncertaintySpec:
     """Validate an ``[uncertainty]`` table against the base scenario's parameter set.
 
-    Every mistake raises :class:`pamsim.sweep.SweepError` naming the file, the key and the value.
+    Every mistake raises ``check.error`` (:class:`pamsim.sweep.SweepError` in a sweep file) naming
+    the file, the key and the value.
     """
-    from .spec import SweepError, _check_keys, _fail, _number, _required, _typed
-
-    _check_keys(origin, "[uncertainty]", "uncertainty.", table, _TABLE_KEYS)
-    n = _required(origin, table, "samples", int, "uncertainty.")
+    check.check_keys("[uncertainty]", "uncertainty.", table, _TABLE_KEYS)
+    n = check.required(table, "samples", int, "uncertainty.")
     if isinstance(n, bool) or n < 1:
-        _fail(origin, "uncertainty.samples", n, "must be a positive integer")
-    seed = _required(origin, table, "seed", int, "uncertainty.")
+        check.fail("uncertainty.samples", n, "must be a positive integer")
+    seed = check.required(table, "seed", int, "uncertainty.")
     if isinstance(seed, bool) or seed < 0:
-        _fail(origin, "uncertainty.seed", seed, "must be a non-negative integer")
-    sampling = _typed(origin, "uncertainty.sampling", table.get("sampling", "latin_hypercube"), str)
+        check.fail("uncertainty.seed", seed, "must be a non-negative integer")
+    sampling = check.typed("uncertainty.sampling", table.get("sampling", "latin_hypercube"), str)
     if sampling not in SAMPLING:
-        _fail(origin, "uncertainty.sampling", sampling, "unknown sampling", SAMPLING)
+        check.fail("uncertainty.sampling", sampling, "unknown sampling", SAMPLING)
     quantiles = table.get("quantiles", list(DEFAULT_QUANTILES))
     if not isinstance(quantiles, list) or not quantiles:
-        _fail(origin, "uncertainty.quantiles", quantiles, "must be a non-empty list of numbers in [0, 1]")
+        check.fail("uncertainty.quantiles", quantiles, "must be a non-empty list of numbers in [0, 1]")
     for q in quantiles:
-        if not 0.0 <= _number(origin, "uncertainty.quantiles", q) <= 1.0:
-            _fail(origin, "uncertainty.quantiles", q, "must lie in [0, 1]")
-    params = _required(origin, table, "parameters", dict, "uncertainty.")
+        if not 0.0 <= check.number("uncertainty.quantiles", q) <= 1.0:
+            check.fail("uncertainty.quantiles", q, "must lie in [0, 1]")
+    params = check.required(table, "parameters", dict, "uncertainty.")
     if not params:
-        raise SweepError(f"{origin}: uncertainty.parameters is empty: name at least one parameter to sample")
+        raise check.error(f"{check.origin}: uncertainty.parameters is empty: name at least one parameter to sample")
     dists = []
     for name, entry in params.items():
         if name not in base.parameters.entries:
-            _fail(origin, f"uncertainty.parameters.{name}", entry, "unknown parameter", base.parameters.entries)
-        dists.append(_distribution(origin, f"uncertainty.parameters.{name}", name, entry, base))
+            check.fail(f"uncertainty.parameters.{name}", entry, "unknown parameter", base.parameters.entries)
+        dists.append(_distribution(check, f"uncertainty.parameters.{name}", name, entry, base))
     return UncertaintySpec(tuple(dists), n, seed, sampling, tuple(float(q) for q in quantiles))
 
 
-def _distribution(origin: str, where: str, name: str, entry: Any, base: Scenario) -> ParameterDistribution:
-    from .spec import _check_keys, _fail, _number, _required, _typed
-
-    _check_keys(origin, f"[{where}]", where + ".", entry, _PARAM_KEYS)
-    kind = _required(origin, entry, "distribution", str, where + ".")
+def _distribution(check: TableChecker, where: str, name: str, entry: Any, base: Scenario) -> ParameterDistribution:
+    check.check_keys(f"[{where}]", where + ".", entry, _PARAM_KEYS)
+    kind = check.required(entry, "distribution", str, where + ".")
     if kind not in DISTRIBUTIONS:
-        _fail(origin, f"{where}.distribution", kind, "unknown distribution", DISTRIBUTIONS)
+        check.fail(f"{where}.distribution", kind, "unknown distribution", DISTRIBUTIONS)
     allowed = {"distribution", "relative", "lower", "upper", *DISTRIBUTIONS[kind]}
     for key in entry:
         if key not in allowed:
-            _fail(origin, f"{where}.{key}", entry[key], f"does not apply to a {kind} distribution "
-                  f"(it takes {', '.join(sorted(allowed - {'distribution'}))})")
-    relative = _typed(origin, f"{where}.relative", entry.get("relative", False), bool)
-    lower = _required(origin, entry, "lower", float, where + ".")
-    upper = _required(origin, entry, "upper", float, where + ".")
+            check.fail(f"{where}.{key}", entry[key], f"does not apply to a {kind} distribution "
+                       f"(it takes {', '.join(sorted(allowed - {'distribution'}))})")
+    relative = check.typed(f"{where}.relative", entry.get("relative", False), bool)
+    lower = check.required(entry, "lower", float, where + ".")
+    upper = check.required(entry, "upper", float, where + ".")
     if not lower < upper:
-        _fail(origin, f"{where}.upper", upper, f"must be above lower = {lower:g}")
-    shape = tuple(_required(origin, entry, k, float, where + ".") for k in DISTRIBUTIONS[kind])
+        check.fail(f"{where}.upper", upper, f"must be above lower = {lower:g}")
+    shape = tuple(check.required(entry, k, float, where + ".") for k in DISTRIBUTIONS[kind])
     if kind in ("normal", "lognormal") and not shape[1] > 0:
-        _fail(origin, f"{where}.{DISTRIBUTIONS[kind][1]}", shape[1], "must be positive")
+        check.fail(f"{where}.{DISTRIBUTIONS[kind][1]}", shape[1], "must be positive")
     if kind == "lognormal" and not shape[0] > 0:
-        _fail(origin, f"{where}.median", shape[0], "must be positive")
+        check.fail(f"{where}.median", shape[0], "must be positive")
     nominal = float(base.parameters[name])
     if relative and nominal == 0.0:
-        _fail(origin, f"{where}.relative", True, "the base value is 0, so a factor cannot vary it")
+        check.fail(f"{where}.relative", True, "the base value is 0, so a factor cannot vary it")
     dist = ParameterDistribution(name, kind, lower, upper, shape, relative, nominal)
     mass = dist.bound_mass()
     if not mass >= MIN_BOUND_MASS:
-        _fail(origin, f"{where}.lower", lower, f"the bounds [{lower:g}, {upper:g}] exclude the {kind} "
-              f"distribution (probability inside {mass:.3g})")
+        check.fail(f"{where}.lower", lower, f"the bounds [{lower:g}, {upper:g}] exclude the {kind} "
+                   f"distribution (probability inside {mass:.3g})")
     rule = base.parameters.entries[name]
     for key, bound in (("lower", lower), ("upper", upper)):
         value = bound * nominal if relative else bound
         why = rule.violation(value)
         if why is not None:
-            _fail(origin, f"{where}.{key}", bound, f"gives {name} = {value:g}, which {why}")
+            check.fail(f"{where}.{key}", bound, f"gives {name} = {value:g}, which {why}")
     return dist
 
 

@@ -1,0 +1,95 @@
+"""Checks of what a user writes: scenario, sweep and muscle files, and command-line options.
+
+Every mistake raises one line that names the file (where there is one), the key and the value,
+with the closest valid name when one is close: the readers of scenarios, signal tables, sweeps,
+uncertainty studies and muscle files, and the command line, build their messages here so that a
+typo reads the same wherever it is made.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+from typing import Any, Mapping, NoReturn
+
+from .errors import InputError
+
+
+def did_you_mean(value: Any, choices) -> str:
+    """`` (did you mean 'x'?)`` for the choice closest to ``value``, or an empty string."""
+    close = difflib.get_close_matches(str(value), [str(c) for c in choices], n=1)
+    return f" (did you mean {close[0]!r}?)" if close else ""
+
+
+def choices_hint(value: Any, choices, listing: str = "choose from") -> str:
+    """:func:`did_you_mean`, or, when no choice is close, `` (LISTING a, b, c)``."""
+    return did_you_mean(value, choices) or f" ({listing} {', '.join(map(str, choices))})"
+
+
+def option_error(key: str, value: Any, why: str, choices=None) -> NoReturn:
+    """Raise :class:`InputError` ``KEY = VALUE: WHY`` for a value that no file holds (an option, an argument)."""
+    raise InputError(f"{key} = {value!r}: {why}" + (did_you_mean(value, choices) if choices else ""))
+
+
+class TableChecker:
+    """The checks of the tables of one file: a mistake raises ``error`` naming ``origin``, the key and the value.
+
+    ``prefix`` arguments are the dotted path of the table a key is in (``"measured."``), so that
+    the message shows the key as the user would write it in full; ``document`` names the top level
+    (prefix ``""``) when it is not a table.
+    """
+
+    def __init__(self, origin: str, error: type[InputError] = InputError, document: str = "file"):
+        self.origin = origin
+        self.error = error
+        self.document = document
+
+    def fail(self, key: str, value: Any, why: str, choices=None) -> NoReturn:
+        """Raise ``ORIGIN: KEY = VALUE: WHY``, with the closest of ``choices`` or all of them."""
+        msg = f"{self.origin}: {key} = {value!r}: {why}"
+        if choices is not None:
+            msg += choices_hint(value, choices)
+        raise self.error(msg)
+
+    def check_keys(self, where: str, prefix: str, table: Any, known: set[str], what: str = "key") -> None:
+        """``table`` must be a table whose keys are all in ``known``; ``where`` names it in the message."""
+        if not isinstance(table, dict):
+            self.fail(prefix.rstrip(".") or self.document, table, "must be a table")
+        for key in table:
+            if key not in known:
+                raise self.error(f"{self.origin}: unknown {what} {prefix}{key!s} in {where}"
+                                 + choices_hint(key, sorted(known), "known:"))
+
+    def required(self, table: Mapping, key: str, kind: type | None = None, prefix: str = ""):
+        """``table[key]``, of type ``kind`` when one is given (see :meth:`typed`); missing, an error."""
+        if key not in table:
+            raise self.error(f"{self.origin}: missing key {prefix}{key}")
+        return table[key] if kind is None else self.typed(prefix + key, table[key], kind)
+
+    def typed(self, key: str, value: Any, kind: type):
+        """``value`` if it is a ``kind``; ``float`` means any finite number (:meth:`number`)."""
+        if kind is float:
+            return self.number(key, value)
+        if not isinstance(value, kind):
+            self.fail(key, value, f"must be a {kind.__name__}, not {type(value).__name__}")
+        return value
+
+    def number(self, key: str, value: Any) -> float:
+        """``value`` as a float; a boolean, a non-number or a non-finite number is an error."""
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+            self.fail(key, value, "must be a finite number")
+        return float(value)
+
+    def positive(self, key: str, value: float) -> float:
+        """``value`` if it is above zero."""
+        if value <= 0:
+            self.fail(key, value, "must be positive")
+        return value
+
+    def number_list(self, key: str, value: Any) -> list[float]:
+        """A non-empty list of finite numbers, as floats."""
+        if not isinstance(value, list):
+            self.fail(key, value, "must be a list of numbers")
+        if not value:
+            self.fail(key, value, "is empty: give at least one value")
+        return [self.number(key, v) for v in value]
