@@ -2,22 +2,22 @@
 defaults and the user's overrides, and a static model that applies to it.
 
 Scenarios (``[parameters]``, ``[model] static_force``) and the command line
-(``--set NAME=VALUE``, ``--model``) share these checks; each passes a ``fail``
-callback ``fail(key, value, why, choices=None)`` that raises its own error
-naming its own file or option, and ``key`` maps a kind (``"parameter"``,
-``"model"``, ``"variant"``) and a name to the key the user wrote.
+(``--set NAME=VALUE``, ``--model``) share these checks.  ``key`` maps a kind
+(``"parameter"``, ``"model"``, ``"variant"``) and a name to the key the user
+wrote; a ``fail(key, value, why, choices=None)`` callback raises the error,
+by default :func:`pamsim.table_checks.option_error` (``KEY = VALUE: WHY``, as
+the command line reports it), a scenario's naming its file.
 """
 
 from __future__ import annotations
 
 from typing import Any, Callable, Mapping
 
-from .errors import InputError
 from .muscles import Muscle, load_muscle
 from .parameter_schema import KNOWN, ParameterSet, known_parameter
 from .parameters import dynamics_parameters
 from .static_models import REGISTRY, StaticModelSpec
-from .static_models.base import did_you_mean
+from .table_checks import did_you_mean, option_error
 
 Fail = Callable[..., None]
 Key = Callable[[str, str], str]
@@ -79,10 +79,7 @@ def applicable_model(name: str, variant: str | None, muscle: Muscle, params: Map
 
 
 def _defaults(fail: Fail | None, key: Key | None) -> tuple[Fail, Key]:
-    def default_fail(k, value, why, choices=None):
-        raise InputError(f"{k} = {value!r}: {why}" + (did_you_mean(value, choices) if choices else ""))
-
-    return (fail or default_fail,
+    return (fail or option_error,
             key or (lambda kind, name: {"parameter": name, "model": "model", "variant": "variant"}[kind]))
 
 

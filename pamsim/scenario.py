@@ -9,7 +9,6 @@ offending value; the CLI turns it into a one-line message and exit code 2.
 from __future__ import annotations
 
 import copy
-import difflib
 import math
 import tomllib
 from dataclasses import dataclass, field
@@ -36,6 +35,7 @@ from .static_models import REGISTRY
 from .signal_tables import signal_from_table, signal_range
 from .signals import Constant, Step
 from .simulator import SolverOptions
+from .table_checks import TableChecker, choices_hint, did_you_mean
 
 
 # Schema: section -> {key: (type, required)}; a nested dict is a sub-table.
@@ -113,7 +113,7 @@ class Scenario:
         applicable_model(model.setdefault("static_force", muscle.default_static_force),
                          model.get("static_force_variant"), muscle, model_inputs(muscle, params), v.fail, _key)
         sim = spec["simulation"]
-        duration = v.positive("simulation.duration_s", v.required(sim, "simulation", "duration_s"))
+        duration = v.positive("simulation.duration_s", v.required(sim, "duration_s", prefix="simulation."))
         sample_rate = v.positive("simulation.sample_rate_Hz", sim.get("sample_rate_Hz", 1000.0))
         x0 = v.number("simulation.initial_contraction_m", sim.get("initial_contraction_m", 0.0))
         solver = spec.get("solver", {})
@@ -212,7 +212,7 @@ class Scenario:
     def _build_source(self, v: "_Validator"):
         pr = self.spec["pressure"]
         p = self.parameters
-        source = v.required(pr, "pressure", "source")
+        source = v.required(pr, "source", prefix="pressure.")
         if not isinstance(source, str):
             v.fail("pressure.source", source, "must be a string", choices=("valve", "prescribed"))
         rating = p["rated_pressure_gauge_Pa"]
@@ -250,7 +250,7 @@ class Scenario:
                                       p["T_supply_K"], p["p_atm_Pa"])
         if source == "prescribed":
             v.allowed("pressure", pr, {"source", "prescribed"})
-            sig = signal_from_table(v, "pressure.prescribed", v.required(pr, "pressure", "prescribed"), "_gauge_bar",
+            sig = signal_from_table(v, "pressure.prescribed", v.required(pr, "prescribed", prefix="pressure."), "_gauge_bar",
                           PA_PER_BAR, self.base_dir, alt_suffix=("_gauge_Pa", 1.0))
             lo, hi = signal_range(sig)
             if hi > rating:
@@ -341,22 +341,13 @@ def _key(kind: str, name: str) -> str:
 
 
 # ---------------------------------------------------------------- validation
-class _Validator:
+class _Validator(TableChecker):
+    """The scenario file's checks; ``error`` (a :class:`ScenarioError`) also serves helpers such as
+    :mod:`pamsim.signal_tables`.  Its numbers say what type they must be, and ``positive`` takes inf."""
+
     def __init__(self, origin: str, base_dir: Path):
-        self.origin = origin
+        super().__init__(origin, ScenarioError)
         self.base_dir = base_dir
-
-    @staticmethod
-    def error(message: str) -> ScenarioError:
-        """The exception a mistake in this file raises (for helpers such as :mod:`pamsim.signal_tables`)."""
-        return ScenarioError(message)
-
-    def fail(self, key: str, value: Any, why: str, choices=None):
-        msg = f"{self.origin}: {key} = {value!r}: {why}"
-        if choices is not None:
-            close = difflib.get_close_matches(str(value), [str(c) for c in choices], n=1)
-            msg += f" (did you mean {close[0]!r}?)" if close else f" (choose from {', '.join(map(str, choices))})"
-        raise ScenarioError(msg)
 
     def check_table(self, section: str, table: Any):
         where = f"[{section}]" if section else "the top level"
@@ -366,18 +357,15 @@ class _Validator:
         for key, value in table.items():
             full = f"{section}.{key}" if section else key
             if key not in schema:
-                close = difflib.get_close_matches(key, list(schema), n=1)
-                hint = f" (did you mean {close[0]!r}?)" if close else f" (known keys in {where}: {', '.join(schema)})"
-                raise ScenarioError(f"{self.origin}: unknown key {full!r} in {where}{hint}")
+                raise ScenarioError(f"{self.origin}: unknown key {full!r} in {where}"
+                                    + choices_hint(key, schema, f"known keys in {where}:"))
             self.type_of(full, value, schema[key])
 
     def allowed(self, section: str, table: Mapping, keys: set[str]):
         for key in table:
             if key not in keys:
-                close = difflib.get_close_matches(key, sorted(keys), n=1)
-                hint = f" (did you mean {close[0]!r}?)" if close else ""
                 raise ScenarioError(f"{self.origin}: key {section}.{key} does not apply to "
-                                    f"source = {table.get('source')!r}{hint}")
+                                    f"source = {table.get('source')!r}" + did_you_mean(key, keys))
 
     def type_of(self, key: str, value: Any, expected: type):
         ok = {float: isinstance(value, (int, float)) and not isinstance(value, bool),
@@ -398,8 +386,3 @@ class _Validator:
         if not value > 0:
             self.fail(key, value, "must be positive")
         return value
-
-    def required(self, table: Mapping, section: str, key: str):
-        if key not in table:
-            raise ScenarioError(f"{self.origin}: missing key {section}.{key}")
-        return table[key]

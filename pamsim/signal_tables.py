@@ -8,13 +8,13 @@ mistake names that file, the key and the value.
 
 from __future__ import annotations
 
-import difflib
 from pathlib import Path
 from typing import Any, Mapping
 
 import numpy as np
 
 from .signals import Constant, FirstOrderLag, Ramp, Step, Trace
+from .table_checks import choices_hint
 
 # Signal kind -> (keys without a unit, value keys that take the unit suffix of where the signal is used).
 SIGNAL_KINDS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
@@ -31,7 +31,7 @@ def signal_from_table(v, where: str, spec: Any, suffix: str, scale: float, base_
     """Build a signal from a table ``{kind = ..., ...}``; values are named ``initial<suffix>``, ``final<suffix>``."""
     if not isinstance(spec, dict):
         v.fail(where, spec, "must be a table with a 'kind'")
-    kind = v.required(spec, where, "kind")
+    kind = v.required(spec, "kind", prefix=f"{where}.")
     if not isinstance(kind, str) or kind not in SIGNAL_KINDS:
         v.fail(f"{where}.kind", kind, "unknown signal kind", choices=SIGNAL_KINDS)
     suffixes = [(suffix, scale)] + ([alt_suffix] if alt_suffix else [])
@@ -39,9 +39,7 @@ def signal_from_table(v, where: str, spec: Any, suffix: str, scale: float, base_
     known = ["kind", *times, *(f"{n}{s}" for n in values for s, _ in suffixes)]
     for key in spec:
         if key not in known:
-            close = difflib.get_close_matches(key, known, n=1)
-            hint = f" (did you mean {close[0]!r}?)" if close else f" (known: {', '.join(known)})"
-            raise v.error(f"{v.origin}: unknown key {where}.{key} for kind = {kind!r}{hint}")
+            raise v.error(f"{v.origin}: unknown key {where}.{key} for kind = {kind!r}" + choices_hint(key, known, "known:"))
 
     def val(name: str, default: float | None = None) -> float:
         for s, k in suffixes:
@@ -52,7 +50,7 @@ def signal_from_table(v, where: str, spec: Any, suffix: str, scale: float, base_
         return default
 
     def t(name: str) -> float:
-        value = v.number(f"{where}.{name}", v.required(spec, where, name))
+        value = v.number(f"{where}.{name}", v.required(spec, name, prefix=f"{where}."))
         if value < 0:
             v.fail(f"{where}.{name}", value, "must not be negative")
         return value
@@ -75,7 +73,7 @@ def signal_from_table(v, where: str, spec: Any, suffix: str, scale: float, base_
 
 
 def _trace(v, where: str, spec: Mapping, suffixes, base_dir: Path) -> Trace:
-    name = v.required(spec, where, "file")
+    name = v.required(spec, "file", prefix=f"{where}.")
     if not isinstance(name, str):
         v.fail(f"{where}.file", name, "must be a string (a CSV path)")
     path = (base_dir / name) if not Path(name).is_absolute() else Path(name)

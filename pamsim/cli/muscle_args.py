@@ -4,7 +4,6 @@
 from __future__ import annotations
 
 import argparse
-import difflib
 
 from ..errors import InputError
 
@@ -18,14 +17,6 @@ def add_arguments(parser: argparse.ArgumentParser, model: bool = True) -> None:
         parser.add_argument("--variant", default=None, help="the model's variant (default: its first)")
     parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="NAME=VALUE",
                         help="override a muscle parameter, in the unit of its name (repeatable)")
-
-
-def _fail(key: str, value, why: str, choices=None):
-    hint = ""
-    if choices:
-        close = difflib.get_close_matches(str(value), [str(c) for c in choices], n=1)
-        hint = f" (did you mean {close[0]!r}?)" if close else ""
-    raise InputError(f"{key} = {value!r}: {why}{hint}")
 
 
 def _key(kind: str, name: str) -> str:
@@ -51,11 +42,11 @@ def resolve(args: argparse.Namespace):
     from ..muscle_setup import prepare
 
     return prepare(args.muscle, getattr(args, "model", None), overrides(args.overrides),
-                   getattr(args, "variant", None), fail=_fail, key=_key)
+                   getattr(args, "variant", None), key=_key)
 
 
 def resolve_parameters(args: argparse.Namespace):
     """``(muscle, parameters)`` from the parsed options (no static model)."""
     from ..muscle_setup import muscle_parameters
 
-    return muscle_parameters(args.muscle, overrides(args.overrides), fail=_fail, key=_key)
+    return muscle_parameters(args.muscle, overrides(args.overrides), key=_key)

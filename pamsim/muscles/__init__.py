@@ -19,7 +19,7 @@ from ..errors import InputError
 from ..parameter_schema import KNOWN, LOCK_DEG, Parameter, ParameterSet, unit_of
 from ..static_models import REGISTRY, StaticForce
 from ..static_models import get as get_model
-from ..static_models.base import did_you_mean
+from ..table_checks import did_you_mean
 
 
 class MuscleError(InputError):

@@ -12,7 +12,8 @@ from types import MappingProxyType
 
 from ..errors import InputError
 from . import acra2012, elastic_survey, force_map, gaylord, hyperelastic, kothera, phenomenological, two_phase
-from .base import KINDS, Domain, StaticForce, StaticModelDomainError, StaticModelSpec, did_you_mean
+from ..table_checks import did_you_mean
+from .base import KINDS, Domain, StaticForce, StaticModelDomainError, StaticModelSpec
 
 _FAMILIES = (acra2012, gaylord, kothera, hyperelastic, elastic_survey, phenomenological, two_phase, force_map)
 

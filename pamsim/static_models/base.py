@@ -11,7 +11,6 @@ nothing for it; ``evaluate_N`` checks the valid domain first.
 
 from __future__ import annotations
 
-import difflib
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -21,6 +20,7 @@ from typing import Callable, Mapping
 import numpy as np
 
 from ..errors import InputError
+from ..table_checks import did_you_mean  # noqa: F401 -- importable here, as it was
 
 def brentq(*args, **kwargs):
     """``scipy.optimize.brentq``, imported on first use: ``pamsim static`` starts without scipy.optimize."""
@@ -174,12 +174,6 @@ class StaticModelSpec:
         # Values are numbers, except file paths such as force_map_file.
         merged.update({k: v if isinstance(v, (str, Path)) else float(v) for k, v in params.items()})
         return self.builder(MappingProxyType(merged), variant)
-
-
-def did_you_mean(name: str, choices) -> str:
-    """`` (did you mean 'x'?)`` for the closest choice, or an empty string."""
-    close = difflib.get_close_matches(str(name), list(choices), n=1)
-    return f" (did you mean {close[0]!r}?)" if close else ""
 
 
 def rated_pressure_Pa(params: Mapping[str, float]) -> float:
