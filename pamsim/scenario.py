@@ -250,8 +250,8 @@ class Scenario:
                                       p["T_supply_K"], p["p_atm_Pa"])
         if source == "prescribed":
             v.allowed("pressure", pr, {"source", "prescribed"})
-            sig = signal_from_table(v, "pressure.prescribed", v.required(pr, "prescribed", prefix="pressure."), "_gauge_bar",
-                          PA_PER_BAR, self.base_dir, alt_suffix=("_gauge_Pa", 1.0))
+            sig = signal_from_table(v, "pressure.prescribed", v.required(pr, "prescribed", prefix="pressure."),
+                                    "_gauge_bar", PA_PER_BAR, self.base_dir, alt_suffix=("_gauge_Pa", 1.0))
             lo, hi = signal_range(sig)
             if hi > rating:
                 v.fail("pressure.prescribed", f"{hi / PA_PER_BAR:g} bar", f"exceeds the muscle's rating of {rating / PA_PER_BAR:g} bar")

@@ -39,7 +39,8 @@ def signal_from_table(v, where: str, spec: Any, suffix: str, scale: float, base_
     known = ["kind", *times, *(f"{n}{s}" for n in values for s, _ in suffixes)]
     for key in spec:
         if key not in known:
-            raise v.error(f"{v.origin}: unknown key {where}.{key} for kind = {kind!r}" + choices_hint(key, known, "known:"))
+            raise v.error(f"{v.origin}: unknown key {where}.{key} for kind = {kind!r}"
+                          + choices_hint(key, known, "known:"))
 
     def val(name: str, default: float | None = None) -> float:
         for s, k in suffixes:

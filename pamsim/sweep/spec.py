@@ -184,7 +184,8 @@ def _cases(check: TableChecker, spec: Mapping[str, Any], measured: list[dict] | 
         values = {}
         for axis in sorted(_AXES):
             if axis not in axes:
-                raise SweepError(f"{check.origin}: missing axis axes.{axis} (the sweep varies both pressure_bar and weight_N)")
+                raise SweepError(f"{check.origin}: missing axis axes.{axis} "
+                                 "(the sweep varies both pressure_bar and weight_N)")
             values[axis] = check.number_list(f"axes.{axis}", axes[axis])
         pairs = [(w, p) for p in values["pressure_bar"] for w in values["weight_N"]]
     else:
