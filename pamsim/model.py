@@ -49,6 +49,9 @@ class Mode(IntEnum):
 
 N_WORK = 4
 WORK_NAMES = ("W_muscle_J", "E_friction_J", "E_damping_J", "W_external_J")
+STATE_SCALES = {"x_m": 1e-2, "v_m_s": 1e-1, "p_abs_Pa": 1e5, "air_mass_kg": 1e-5}
+"""Typical magnitude of each state of the motion and the valve source (10 mm, 0.1 m/s, 1 bar, 10 mg of
+air): the simulator's absolute tolerances, the control model's scaling and the FMU's nominal values."""
 
 
 @dataclass(frozen=True)

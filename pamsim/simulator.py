@@ -25,7 +25,7 @@ from typing import Callable
 import numpy as np
 
 from .errors import InputError, SolverFailure
-from .model import Mode, MuscleModel
+from .model import STATE_SCALES, Mode, MuscleModel
 from .result import Result, TransitionEvent
 
 
@@ -56,7 +56,6 @@ class SolverOptions:
 PROGRESS_EVERY = 2000
 """Right-hand-side evaluations between two progress reports inside a segment (a few milliseconds)."""
 
-_SCALE = {"x_m": 1e-2, "v_m_s": 1e-1, "p_abs_Pa": 1e5, "air_mass_kg": 1e-5}
 _REST = (Mode.STICK, Mode.STOP_LOW, Mode.STOP_HIGH)
 _HOLD_S = 1e-9
 """First hold [s] of a load whose slip from rest ended as it began.
@@ -184,7 +183,7 @@ def simulate_model(model: MuscleModel, duration_s: float, options: SolverOptions
     opts = options or SolverOptions()
     wall0 = time.perf_counter()
     names = model.state_names
-    atol = np.array([opts.rtol * _SCALE.get(n, 0.1) for n in names])
+    atol = np.array([opts.rtol * STATE_SCALES.get(n, 0.1) for n in names])  # 0.1 J for the work integrals
     grid = np.linspace(0.0, duration_s, n_samples(duration_s, opts.sample_rate_Hz))
     breaks = sorted({b for b in model.breakpoints if 0.0 < b < duration_s} | {duration_s})
     events = _Events(model, opts)

@@ -54,6 +54,14 @@ def test_the_core_uses_the_generated_names_not_literals():
         assert not re.search(rf"#define \w+ {re.escape(literal)}\b", core)
 
 
+def test_the_core_takes_its_inputs_in_the_order_python_sends_them():
+    """``segment_u``'s columns are the variable table's inputs in table order; the C side lists them by hand."""
+    source = (c_source_dir() / "src" / "pam_native.c").read_text()
+    for prefix in ("R", "VR"):
+        listed = re.search(rf"INPUT_{prefix}\[PAM_NATIVE_NU\] = \{{([^}}]*)\}}", source).group(1)
+        assert tuple(n.strip().removeprefix(f"{prefix}_") for n in listed.split(",")) == library.INPUTS
+
+
 def test_python_reads_the_same_constants():
     p = get_parameter_set("shadow_6x300_acra2012")
     stops = EndStops.from_parameters(p)

@@ -21,7 +21,7 @@ import numpy as np
 from ..elements.pressure_source import ValveChamberSource
 from .choices import FRICTION_KINDS
 from ..errors import InputError
-from ..model import N_WORK, MuscleModel
+from ..model import N_WORK, STATE_SCALES as _SCALES, MuscleModel
 
 STATES = ("x_m", "v_m_s", "p_abs_Pa", "air_mass_kg")
 """State names of the control model (contraction, velocity, absolute chamber pressure, air mass)."""
@@ -31,7 +31,7 @@ OUTPUTS = ("contraction_m", "p_gauge_Pa", "F_tendon_N")
 """Output names: contraction, chamber gauge pressure, tendon force (static minus damping minus friction;
 not the static force alone, which the simulator and the FMU call ``F_static_N``)."""
 
-STATE_SCALES = (1e-2, 1e-1, 1e5, 1e-5)
+STATE_SCALES = tuple(_SCALES[n] for n in STATES)
 """Typical magnitude of each state (10 mm, 0.1 m/s, 1 bar, 10 mg), as the simulator's tolerances use."""
 INPUT_SCALES = (1.0, 1e5, 1.0)
 """Typical magnitude of each input (full valve opening, 1 bar, 1 N)."""

@@ -33,12 +33,10 @@ from ..scenario import Scenario
 from .build import build
 from .force_table import DEFAULT_POINTS, ForceTable, tabulate
 from .generate import token
-from .variables import (BY_NAME, DAMPING_CHOICES, FRICTION_CHOICES, NEGATIVE_LEVEL, SOURCE_CHOICES,
+from .variables import (BY_NAME, DAMPING_CHOICES, FRICTION_CHOICES, INPUTS, NEGATIVE_LEVEL, SOURCE_CHOICES,
                         STATIC_FORCE_CHOICES, VARIABLES, value_reference)
 
 OUTPUTS = ("contraction_m", "velocity_m_s", "p_gauge_Pa", "chamber_pressure_abs_Pa", "air_mass_kg")
-INPUTS = ("valve_command", "supply_pressure_gauge_Pa", "prescribed_pressure_gauge_Pa", "load_mass_kg",
-          "external_force_N")
 
 
 def cached_fmu(fmi_version: int = 2, force_table: ForceTable | None = None) -> Path:

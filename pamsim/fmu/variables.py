@@ -22,6 +22,7 @@ import re
 from dataclasses import dataclass, replace
 
 from ..core_table import C_CHOICES
+from ..model import STATE_SCALES
 from ..parameters import LOAD_MASS, get_parameter_set
 from ..simulator import SolverOptions
 
@@ -170,14 +171,15 @@ def _table() -> tuple[Variable, ...]:
                  "extra force on the load, positive along the contraction [N]", "N", 0.0),
         # States (the two mechanical ones are also outputs).
         Variable("contraction_m", "real", "output", "continuous", "contraction x = L0 - L [m]", "m",
-                 initial="calculated", nominal=0.01, depends_on=(X,), initial_depends_on=("initial_contraction_m",)),
+                 initial="calculated", nominal=STATE_SCALES["x_m"], depends_on=(X,), initial_depends_on=("initial_contraction_m",)),
         Variable("velocity_m_s", "real", "output", "continuous", "contraction velocity dx/dt [m/s]", "m/s",
-                 initial="calculated", nominal=0.1, depends_on=(V,), initial_depends_on=()),
+                 initial="calculated", nominal=STATE_SCALES["v_m_s"], depends_on=(V,), initial_depends_on=()),
         Variable("chamber_pressure_abs_Pa", "real", "local", "continuous",
-                 "absolute chamber pressure (valve source) [Pa]", "Pa", initial="calculated", nominal=1e5,
+                 "absolute chamber pressure (valve source) [Pa]", "Pa", initial="calculated",
+                 nominal=STATE_SCALES["p_abs_Pa"],
                  initial_depends_on=("p_atm_Pa", "initial_pressure_gauge_Pa")),
         Variable("air_mass_kg", "real", "local", "continuous", "air mass in the chamber (valve source) [kg]",
-                 "kg", initial="calculated", nominal=1e-5,
+                 "kg", initial="calculated", nominal=STATE_SCALES["air_mass_kg"],
                  initial_depends_on=("p_atm_Pa", "initial_pressure_gauge_Pa", "initial_contraction_m", "L0_m", "r0_m",
                                      "theta0_deg", "dead_volume_m3", "R_J_per_kg_K", "T_supply_K")),
         Variable("der(contraction_m)", "real", "local", "continuous", "d contraction / dt [m/s]", "m/s",
@@ -251,4 +253,7 @@ def value_reference(name: str) -> int:
 
 
 STATES = tuple(v.derivative_of for v in VARIABLES if v.derivative_of)
+INPUTS = tuple(v.name for v in VARIABLES if v.causality == "input")
+"""The inputs, in table order: the FMU's, and the native library's ``segment_u`` columns (whose C
+side, ``INPUT_R`` in ``fmu/src/pam_native.c``, lists them in this order; a test compares the two)."""
 EVENT_INDICATORS = ("event_indicator_1", "event_indicator_2")

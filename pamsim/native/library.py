@@ -15,12 +15,8 @@ from typing import Sequence
 
 import numpy as np
 
-from ..fmu.variables import VARIABLES
+from ..fmu.variables import INPUTS, VARIABLES  # INPUTS: held over each segment, the order of segment_u
 from .build import library_path
-
-INPUTS = ("valve_command", "supply_pressure_gauge_Pa", "prescribed_pressure_gauge_Pa", "load_mass_kg",
-          "external_force_N")
-"""The inputs held over each segment, in the order of ``segment_u`` (PAM_NATIVE_NU)."""
 SAMPLE_COLUMNS = ("x_m", "v_m_s", "p_abs_Pa", "air_mass_kg", "W_muscle_J", "E_friction_J", "E_damping_J",
                   "W_external_J", "E_impacts_J")
 """The columns of each sample (PAM_NATIVE_NOUT)."""
