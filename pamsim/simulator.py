@@ -73,7 +73,10 @@ _MAX_ZERO_LENGTH = 30
 
 
 def simulate_python(scenario, progress: Callable[[float], None] | None = None) -> Result:
-    """Backend ``python``: integrate a :class:`~pamsim.scenario.Scenario` with ``scipy.integrate.solve_ivp``."""
+    """Backend ``python``: integrate a :class:`~pamsim.scenario.Scenario` with ``scipy.integrate.solve_ivp``.
+
+    ``scenario`` is not annotated: :mod:`pamsim.scenario` imports this module, so this one cannot import it.
+    """
     return simulate_model(scenario.build_model(), scenario.duration_s, scenario.solver,
                           x0_m=scenario.initial_contraction_m, name=scenario.name,
                           p0_gauge_Pa=scenario.initial_pressure_gauge_Pa, progress=progress)
