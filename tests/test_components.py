@@ -4,7 +4,6 @@ Jacobians against central finite differences."""
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import numpy as np

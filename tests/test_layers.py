@@ -28,10 +28,12 @@ EXPECTED_LAYERS = [
     "scenario",
     "simulator | muscle_setup | signal_tables | static",
     "result | parameters",
-    "model | muscles",
+    "model | muscles | assemblies",
+    "components",
     "elements",
     "static_models | parameter_schema | signals | plotting | atlas_plots | oscillation | paperdata | data",
     "core_table | table_checks | atomic | references",
+    "modeling",  # the component machinery knows no physics: anything may build on it
     "constants | errors",
 ]
 

@@ -4,7 +4,6 @@ evaluation, the generated C against the generated Python, and reproducible gener
 from __future__ import annotations
 
 import ctypes
-import hashlib
 import math
 import os
 import shutil

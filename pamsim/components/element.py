@@ -12,7 +12,7 @@ import dataclasses
 from typing import Any, Mapping
 
 from ..modeling import Var
-from ..muscles.schema import unit_of
+from ..parameter_schema import unit_of
 
 STRUCTURAL = ("name", "domain", "negative_level")
 """Fields that are choices or metadata, never parameters."""

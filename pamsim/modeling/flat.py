@@ -11,6 +11,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
+from .signatures import FUNCTION_SIGNATURES
+
 
 @dataclass(frozen=True)
 class FlatVar:
@@ -21,17 +23,6 @@ class FlatVar:
     description: str = ""
     nominal: float = 1.0
 
-
-FUNCTION_SIGNATURES = {
-    "f": (("x", "u", "p", "q"), ("xdot",)),
-    "y": (("x", "u", "p", "q"), ("y",)),
-    "z": (("x", "u", "p", "q"), ("z",)),
-    "transition": (("x", "u", "p", "q"), ("x_next", "q_next")),
-    "rest_mode": (("x", "u", "p", "q"), ("q_rest",)),
-    "x0": (("u", "p"), ("x0", "q0")),
-    "jacobian": (("x", "u", "p", "q"), ("A", "B", "C", "D")),
-}
-"""The generated functions, their arguments and results, in the order every backend uses."""
 
 
 @dataclass(eq=False)
@@ -99,6 +90,8 @@ class FlatModel:
                 exprs = {"f": [self.f], "y": [self.y], "z": [self.z], "transition": [self.transition_x, self.transition_q],
                          "rest_mode": [self.rest_q], "x0": [self.x0, self.q0]}[name]
                 exprs = [col(e) for e in exprs]
+            # SX keeps a subexpression once only where the components shared it; cse finds the rest.
+            exprs = [ca.cse(e) for e in exprs]
             ins, outs = FUNCTION_SIGNATURES[name]
             args = {"x": x, "u": u, "p": p, "q": q}
             self._cache[key] = ca.Function(f"{self.name}_{name}", [args[a] for a in ins], exprs, list(ins), list(outs))

@@ -1,0 +1,13 @@
+"""The functions generated from every flat model: their arguments and results, in the order every
+backend (the generated Python, the generated C, CasADi) uses."""
+
+FUNCTION_SIGNATURES = {
+    "f": (("x", "u", "p", "q"), ("xdot",)),
+    "y": (("x", "u", "p", "q"), ("y",)),
+    "z": (("x", "u", "p", "q"), ("z",)),
+    "transition": (("x", "u", "p", "q"), ("x_next", "q_next")),
+    "rest_mode": (("x", "u", "p", "q"), ("q_rest",)),
+    "x0": (("u", "p"), ("x0", "q0")),
+    "jacobian": (("x", "u", "p", "q"), ("A", "B", "C", "D")),
+}
+"""``{name: (arguments, results)}``: x states, u inputs, p parameters, q modes."""
