@@ -105,6 +105,15 @@ def test_wiring_mistakes_are_refused_naming_component_and_port(build, message):
     assert message in str(err.value)
 
 
+def _arguments(flat, name, x, u, P, q, rng):
+    """The arguments of generated function ``name``: states, inputs, parameters, modes and (for a jump)
+    random flags of the indicators that crossed."""
+    from pamsim.modeling.signatures import FUNCTION_SIGNATURES
+
+    values = {"x": x, "u": u, "p": P, "q": [q], "e": rng.integers(0, 2, len(flat.e)).astype(float)}
+    return [values[a] for a in FUNCTION_SIGNATURES[name][0]]
+
+
 def _random_points(flat, rng, n):
     x = rng.uniform(-1.0, 1.0, (n, len(flat.states))) * [v.nominal for v in flat.states]
     u = rng.uniform(-1.0, 1.0, (n, len(flat.inputs)))
@@ -151,8 +160,9 @@ def test_generated_python_equals_casadi_on_the_muscle_model(fig4_flat):
     for x, u in zip(X, U):
         for q in (-1.0, 0.0, 1.0, 2.0, 3.0):
             for name in ("f", "y", "z", "transition", "rest_mode", "jacobian"):
-                want = [np.array(r).ravel(order="F") for r in flat.functions[name].call([x, u, P, [q]])]
-                got = getattr(g, "_jacobian" if name == "jacobian" else name)(list(x), list(u), P, [q])
+                args = _arguments(flat, name, x, u, P, q, rng)
+                want = [np.array(r).ravel(order="F") for r in flat.function(name).call(args)]
+                got = getattr(g, "_jacobian" if name == "jacobian" else name)(*[list(a) for a in args])
                 for w, h in zip(want, got):
                     np.testing.assert_allclose(h, w, rtol=1e-15, atol=0, equal_nan=True)
 
@@ -179,7 +189,7 @@ def test_generated_c_equals_generated_python(fig4_flat, tmp_path):
     X[:, 3] = np.abs(X[:, 3]) + 1e-6
     P = np.array(flat.parameter_values)
     for name in ("f", "y", "z", "transition", "rest_mode"):
-        fn = flat.functions[name]
+        fn = flat.function(name)
         c_fn = getattr(lib, f"one_muscle_{name}")
         n_w = fn.sz_w()
         work = (ctypes.c_double * max(n_w, 1))()
@@ -188,10 +198,10 @@ def test_generated_c_equals_generated_python(fig4_flat, tmp_path):
         res = (dbl_p * fn.sz_res())(*[o.ctypes.data_as(dbl_p) for o in outs])
         for x, u in zip(X, U):
             for q in (-1.0, 0.0, 1.0, 2.0, 3.0):
-                ins = [np.ascontiguousarray(a, dtype=float) for a in (x, u, P, [q])]
+                ins = [np.ascontiguousarray(a, dtype=float) for a in _arguments(flat, name, x, u, P, q, rng)]
                 arg = (dbl_p * fn.sz_arg())(*[a.ctypes.data_as(dbl_p) for a in ins])
                 assert c_fn(arg, res, iw, work, 0) == 0
-                got = getattr(g, name)(list(x), list(u), list(P), [q])
+                got = getattr(g, name)(*[list(a) for a in ins])
                 for i, o in enumerate(outs):
                     dense = np.zeros(fn.numel_out(i))
                     dense[fn.sparsity_out(i).find()] = o
@@ -218,7 +228,7 @@ def test_generation_is_byte_identical_across_processes():
 
 def test_flat_model_counts_and_names(fig4_flat):
     flat = fig4_flat
-    assert flat.counts == {"states": 8, "inputs": 3, "outputs": 15, "parameters": 38, "modes": 1, "indicators": 2}
+    assert flat.counts == {"states": 8, "inputs": 3, "outputs": 16, "parameters": 38, "modes": 1, "indicators": 2}
     assert [v.name for v in flat.inputs] == ["valve_command", "supply_pressure_gauge_Pa", "external_force_N"]
     assert flat.index("states", "chamber.p_abs_Pa") == 2
     with pytest.raises(KeyError, match="has no state 'chamber.T_K'"):

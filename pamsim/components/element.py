@@ -38,6 +38,20 @@ def element_parameters(element) -> dict[str, float]:
     return out
 
 
+def structure_key(element) -> tuple:
+    """What of ``element`` shapes its equations: its type and every field that is not a parameter (a
+    choice, a tuple of coefficients, a domain), recursively.  Two elements with one key differ only in
+    parameter values, so they share one generated model."""
+    items = []
+    for f in dataclasses.fields(element):
+        value = getattr(element, f.name)
+        if f.name not in STRUCTURAL and dataclasses.is_dataclass(value):
+            items.append((f.name, structure_key(value)))
+        elif f.name in STRUCTURAL or not isinstance(value, (int, float)) or isinstance(value, bool):
+            items.append((f.name, repr(value)))
+    return (type(element).__module__, type(element).__qualname__, tuple(items))
+
+
 def parameter_vars(values: Mapping[str, float], descriptions: Mapping[str, str] | None = None) -> tuple[Var, ...]:
     """Declarations of parameters named with their unit as suffix (``D1_N_s_per_m``)."""
     descriptions = descriptions or {}
@@ -69,3 +83,6 @@ class ElementParameters:
 
     def symbolic_element(self, p: Mapping[str, Any]):
         return symbolic(self.element, p)
+
+    def structure_key(self) -> tuple:
+        return super().structure_key() + (structure_key(self.element),)

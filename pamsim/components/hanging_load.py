@@ -33,6 +33,16 @@ class LoadMode(IntEnum):
         return self.name.lower()
 
 
+EVENT_NAMES = {
+    LoadMode.SLIP_UP: ("velocity_zero", "stop_high"),
+    LoadMode.SLIP_DOWN: ("velocity_zero", "stop_low"),
+    LoadMode.STICK: ("release_up", "release_down"),
+    LoadMode.STOP_LOW: ("release_up", None),
+    LoadMode.STOP_HIGH: (None, "release_down"),
+}
+"""What a crossing of each indicator means in each mode (None: that indicator never crosses there)."""
+
+
 class HangingLoad(Component):
     """A mass under gravity between two rigid stops, driven by the forces on its flange.
 
@@ -41,11 +51,12 @@ class HangingLoad(Component):
     flange reports zero velocity, so every velocity-dependent branch sees the load at rest.
 
     Event indicators, positive inside the mode (a crossing to zero ends it): sliding, the velocity
-    (shifted by ``EVENT_V_TOL_M_S``, so that a release from rest is not an event) and the distance to
-    the stop ahead (shifted by ``EVENT_X_TOL_M``); held, the margins ``F_c + release_margin -+ net``
-    by which friction still holds the load up and down.  At an event: a stop reached takes the load
+    and the distance to the stop ahead (with margins ``EVENT_V_TOL_M_S`` and ``EVENT_X_TOL_M`` for an
+    integrator that needs a release from rest not to be an event); held, the margins
+    ``F_c + release_margin -+ net`` by which friction still holds the load up and down.  At an event: a stop reached takes the load
     to it, with a rebound of ``restitution |v|`` if that exceeds ``MIN_REBOUND_SPEED_M_S``, else at
-    rest on it; a velocity reaching zero stops the load; then :attr:`Equations.rest_mode` decides a
+    rest on it (the stop takes precedence when both indicators cross at once); a velocity reaching zero
+    stops the load; then :attr:`Equations.rest_mode` decides a
     held load's mode from its forces (slip if the net force beats friction by ``stick_margin_N``).
     """
 
@@ -65,7 +76,8 @@ class HangingLoad(Component):
                Var("mass_kg", "kg", "hanging mass"), Var("F_gravity_N", "N", "weight along x"),
                Var("F_friction_N", "N", "friction on the load along x; when held, whatever holds it"),
                Var("F_stop_N", "N", "reaction of a stop along x"),
-               Var("F_coulomb_level_N", "N", "Coulomb friction level"))
+               Var("F_coulomb_level_N", "N", "Coulomb friction level"),
+               Var("kinetic_energy_J", "J", "kinetic energy of the load"))
 
     def equations(self, s: Symbols) -> Equations:
         P = s.p
@@ -81,16 +93,16 @@ class HangingLoad(Component):
         accel = if_else(slip, (F - q * level - weight) / P["mass_kg"], 0.0)
 
         eps = P["release_margin_N"]
-        z_slip = (if_else(up, v + EVENT_V_TOL_M_S, EVENT_V_TOL_M_S - v),
-                  if_else(up, P["x_high_m"] + EVENT_X_TOL_M - x, x - P["x_low_m"] + EVENT_X_TOL_M))
+        z_slip = (if_else(up, v, -v), if_else(up, P["x_high_m"] - x, x - P["x_low_m"]))
         z_held = (if_else(high, 1.0, level + eps - net), if_else(low, 1.0, level + eps + net))
         indicators = tuple(if_else(slip, a, b) for a, b in zip(z_slip, z_held))
+        margins = (if_else(slip, EVENT_V_TOL_M_S, 0.0), if_else(slip, EVENT_X_TOL_M, 0.0))
 
         margin = P["stick_margin_N"]
         rest = if_else(slip, q, if_else((1 - high) * (net - level > margin), float(M.SLIP_UP),
                                         if_else((1 - low) * (-net - level > margin), float(M.SLIP_DOWN), q)))
-        at_stop = slip * if_else(up, x >= P["x_high_m"], x <= P["x_low_m"])
-        stopped = slip * (1 - at_stop) * if_else(up, v <= 0.0, v >= 0.0)
+        at_stop = slip * s.fired[1]
+        stopped = slip * (1 - at_stop) * s.fired[0]
         rebound = P["restitution"] * abs(v)
         bounces = rebound > MIN_REBOUND_SPEED_M_S
         transition = {
@@ -107,9 +119,10 @@ class HangingLoad(Component):
             der={"x_m": v_flange, "v_m_s": accel},
             outputs={"x_m": x, "v_m_s": v_flange, "mass_kg": P["mass_kg"], "F_gravity_N": -weight,
                      "F_friction_N": if_else(slip, -q * level, if_else(held_by_friction, -net, 0.0)),
-                     "F_stop_N": if_else(on_stop, -net, 0.0), "F_coulomb_level_N": level},
+                     "F_stop_N": if_else(on_stop, -net, 0.0), "F_coulomb_level_N": level,
+                     "kinetic_energy_J": 0.5 * P["mass_kg"] * v * v},
             port={"flange": {"x_m": x, "v_m_s": v_flange}},
-            indicators=indicators, transition=transition, rest_mode=rest,
+            indicators=indicators, indicator_margins=margins, transition=transition, rest_mode=rest,
             initial={"x_m": x0, "v_m_s": 0.0,
                      "mode": if_else(x0 <= P["x_low_m"], float(M.STOP_LOW),
                                      if_else(x0 >= P["x_high_m"], float(M.STOP_HIGH), float(M.STICK)))})

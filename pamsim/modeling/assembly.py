@@ -165,17 +165,34 @@ class Assembly:
                     raise AssemblyError(f"input {c.name}.{v.name} [{v.unit}] is not connected")
         return bound
 
+    def structure_key(self) -> tuple:
+        """Equal for two assemblies that generate the same code (they may differ in parameter values)."""
+        return (self.name, tuple((c.name, c.structure_key()) for c in self.components), self.connections,
+                tuple(sorted(self.inputs.items())))
+
+    def parameter_values(self) -> list[float]:
+        """The parameter vector of the flat model, in its order, without flattening."""
+        return [float(c.values[v.name]) for c in self.components for v in c.parameter_vars()]
+
     # ------------------------------------------------------------------ flattening
-    def flatten(self) -> FlatModel:
-        """Check the wiring and return the flat model."""
+    def flatten(self, modes: Mapping[str, int] | None = None) -> FlatModel:
+        """Check the wiring and return the flat model.
+
+        ``modes`` fixes the mode of named hybrid components: their equations are then written for that
+        mode alone (no mode logic left in them), for an integrator that runs one mode at a time.  Those
+        components have no mode symbol (``q``) in the result; their indicators, jumps and rest modes are
+        still there, for that mode.
+        """
         import casadi as ca
 
+        modes = dict(modes or {})
         nets = self._nets()
         signal_sources = self._signal_sources()
         model_inputs = {name: ca.SX.sym(name) for name in self.inputs}
         params, states, placeholders = [], [], {}
         symbols: dict[str, Symbols] = {}
         mode_syms = {}
+        fired_syms: tuple = ()
         for c in self.components:
             p = {v.name: ca.SX.sym(f"{c.name}.{v.name}") for v in c.parameter_vars()}
             x = {v.name: ca.SX.sym(f"{c.name}.{v.name}") for v in c.states}
@@ -185,9 +202,15 @@ class Assembly:
                 read = pt.kind.through if pt.role == "node" else pt.kind.across
                 port[pt.name] = {v.name: ca.SX.sym(f"{c.name}.{pt.name}.{v.name}") for v in read}
             mode = None
-            if c.modes is not None:
+            if c.name in modes:
+                mode = float(c.modes(modes[c.name]))
+            elif c.modes is not None:
                 mode = mode_syms[c.name] = ca.SX.sym(f"{c.name}.mode")
-            symbols[c.name] = Symbols(p, x, u, port, mode)
+            fired = ()
+            if c.modes is not None:
+                fired = tuple(ca.SX.sym(f"{c.name}.fired{k}") for k in range(c.n_indicators))
+                fired_syms += fired
+            symbols[c.name] = Symbols(p, x, u, port, mode, fired)
             params += [(c, v, p[v.name]) for v in c.parameter_vars()]
             states += [(c, v, x[v.name]) for v in c.states]
             placeholders.update({f"{c.name}.{k}": s for k, s in u.items()})
@@ -224,6 +247,11 @@ class Assembly:
         fv = lambda c, v: FlatVar(f"{c.name}.{v.name}", v.unit, v.description, v.nominal)  # noqa: E731
         out_vars = [fv(c, v) for c in comps for v in c.outputs]
         hybrid = [c for c in comps if c.modes is not None]
+        free = [c for c in hybrid if c.name not in modes]
+
+        def mode_of(c):
+            return mode_syms[c.name] if c.name in mode_syms else float(c.modes(modes[c.name]))
+
         initial = _initial_states(states, {c.name: equations[c.name].initial for c in comps}, flat)
         transition_x = []
         for c, v, sym in states:
@@ -239,12 +267,14 @@ class Assembly:
             parameter_values=[float(c.values[v.name]) for c, v, _ in params],
             modes=[(c.name, c.modes) for c in hybrid],
             x=[s for _, _, s in states], u=list(model_inputs.values()), p=[s for _, _, s in params],
-            q=[mode_syms[c.name] for c in hybrid],
+            q=[mode_syms[c.name] for c in free], e=list(fired_syms),
             f=[flat(equations[c.name].der[v.name]) for c, v, _ in states],
             y=[flat(equations[c.name].outputs[v.name]) for c in comps for v in c.outputs],
             z=[flat(z) for c in hybrid for z in equations[c.name].indicators],
+            z_margin=[flat(m) for c in hybrid for m in (equations[c.name].indicator_margins
+                                                         or (0.0,) * c.n_indicators)],
             transition_x=transition_x,
-            transition_q=[flat(equations[c.name].transition.get("mode", mode_syms[c.name])) for c in hybrid],
+            transition_q=[flat(equations[c.name].transition.get("mode", mode_of(c))) for c in hybrid],
             rest_q=[flat(equations[c.name].rest_mode) for c in hybrid],
             x0=initial,
             q0=[flat(ca.substitute([ca.SX(equations[c.name].initial.get("mode", 0.0))],

@@ -25,7 +25,8 @@ class Symbols:
     ``port[name]`` holds, for a node port, the summed through variables of the branches connected to
     it; for a branch port, the across variables of the node it is connected to.  ``mode`` is the
     component's discrete mode (a symbol that the generated code holds constant between events), or
-    None for a component without modes.
+    None for a component without modes; ``fired`` has one flag per indicator, 1 for those that have
+    crossed at an event (for :attr:`Equations.transition`).
     """
 
     p: Mapping[str, Any]
@@ -33,6 +34,7 @@ class Symbols:
     u: Mapping[str, Any]
     port: Mapping[str, Mapping[str, Any]]
     mode: Any = None
+    fired: tuple[Any, ...] = ()
 
 
 @dataclass
@@ -42,8 +44,10 @@ class Equations:
     ``der``: the time derivative of each state.  ``outputs``: each declared output.  ``port``: for a
     node port its across variables, for a branch port its through variables.  For a component with
     modes: ``indicators``, event indicators that are positive inside the current mode (a crossing to
-    zero is an event); ``transition``, the new mode and any state resets (``{"mode": ..., state:
-    ...}``) applied where an indicator has crossed; ``rest_mode``, the mode of the component decided
+    zero is an event), and ``indicator_margins``, non-negative shifts that an integrator which cannot
+    tell the start of a segment from a crossing adds to them, so that a new mode starts strictly inside
+    its region (the C core; the Python simulator guards the segment's start instead); ``transition``, the new mode and any state resets (``{"mode": ..., state:
+    ...}``) at an event, from the flags of the indicators that crossed (``Symbols.fired``); ``rest_mode``, the mode of the component decided
     afresh from its forces (at the start and where an input jumps).  ``initial``: the state at the
     start, as expressions that may read parameters, inputs and other states (the assembly resolves
     them in order), and for a component with modes its starting mode (key ``"mode"``).
@@ -53,6 +57,7 @@ class Equations:
     outputs: dict[str, Any] = field(default_factory=dict)
     port: dict[str, dict[str, Any]] = field(default_factory=dict)
     indicators: tuple[Any, ...] = ()
+    indicator_margins: tuple[Any, ...] = ()
     transition: dict[str, Any] = field(default_factory=dict)
     rest_mode: Any = None
     initial: dict[str, Any] = field(default_factory=dict)
@@ -97,6 +102,12 @@ class Component:
 
     def equations(self, s: Symbols) -> Equations:
         raise NotImplementedError
+
+    def structure_key(self) -> tuple:
+        """What shapes this component's equations besides its parameter values (its class, and for a
+        component around an element, the element's form): components with equal keys generate equal
+        code."""
+        return (type(self).__module__, type(self).__qualname__)
 
     def port(self, name: str) -> Port:
         for p in self.ports:

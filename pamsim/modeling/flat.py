@@ -30,7 +30,8 @@ class FlatModel:
     """Counts, names and CasADi expressions of an assembled model (built by :meth:`Assembly.flatten`).
 
     ``f``: state derivatives; ``y``: outputs; ``z``: event indicators, positive inside the current
-    modes; ``transition_x``/``transition_q``: states and modes after an event; ``rest_q``: the modes
+    modes, and ``z_margin`` what an integrator that cannot tell a segment's start from a crossing adds
+    to them (:attr:`pamsim.modeling.component.Equations.indicator_margins`); ``transition_x``/``transition_q``: states and modes after an event; ``rest_q``: the modes
     decided afresh from the forces at rest; ``x0``/``q0``: the initial states and the modes where the
     hybrid components start, before :attr:`rest_q` decides them (of ``u`` and ``p``).
     """
@@ -46,9 +47,11 @@ class FlatModel:
     u: list[Any]
     p: list[Any]
     q: list[Any]
+    e: list[Any]
     f: list[Any]
     y: list[Any]
     z: list[Any]
+    z_margin: list[Any]
     transition_x: list[Any]
     transition_q: list[Any]
     rest_q: list[Any]
@@ -73,7 +76,7 @@ class FlatModel:
     # ------------------------------------------------------------------ CasADi
     def _vectors(self):
         import casadi as ca
-        return tuple(ca.vertcat(*v) if v else ca.SX(0, 1) for v in (self.x, self.u, self.p, self.q))
+        return tuple(ca.vertcat(*v) if v else ca.SX(0, 1) for v in (self.x, self.u, self.p, self.q, self.e))
 
     def function(self, name: str):
         """One of the model's CasADi ``Function`` s, by its name in :data:`FUNCTION_SIGNATURES`."""
@@ -81,19 +84,19 @@ class FlatModel:
 
         key = ("function", name)
         if key not in self._cache:
-            x, u, p, q = self._vectors()
+            x, u, p, q, e = self._vectors()
             col = lambda es: ca.vertcat(*es) if es else ca.SX(0, 1)  # noqa: E731
             if name == "jacobian":
                 f, y = col(self.f), col(self.y)
                 exprs = [ca.jacobian(f, x), ca.jacobian(f, u), ca.jacobian(y, x), ca.jacobian(y, u)]
             else:
-                exprs = {"f": [self.f], "y": [self.y], "z": [self.z], "transition": [self.transition_x, self.transition_q],
+                exprs = {"f": [self.f], "y": [self.y], "z": [self.z, self.z_margin], "transition": [self.transition_x, self.transition_q],
                          "rest_mode": [self.rest_q], "x0": [self.x0, self.q0]}[name]
                 exprs = [col(e) for e in exprs]
             # SX keeps a subexpression once only where the components shared it; cse finds the rest.
             exprs = [ca.cse(e) for e in exprs]
             ins, outs = FUNCTION_SIGNATURES[name]
-            args = {"x": x, "u": u, "p": p, "q": q}
+            args = {"x": x, "u": u, "p": p, "q": q, "e": e}
             self._cache[key] = ca.Function(f"{self.name}_{name}", [args[a] for a in ins], exprs, list(ins), list(outs))
         return self._cache[key]
 
@@ -119,10 +122,11 @@ class FlatModel:
         return out
 
     # ------------------------------------------------------------------ generated code
-    def python_source(self) -> str:
-        """Python source of every function (:mod:`pamsim.modeling.pygen`): byte-identical for one model."""
+    def python_source(self, names=None) -> str:
+        """Python source of every function, or of those in ``names`` (:mod:`pamsim.modeling.pygen`):
+        byte-identical for one model."""
         from .pygen import module_source
-        return module_source(self)
+        return module_source(self, names)
 
     def compile_python(self):
         """The generated Python functions, compiled (:class:`pamsim.modeling.pygen.GeneratedModel`)."""
