@@ -17,34 +17,20 @@ source evolves.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from enum import IntEnum
 
 import math
 
 import numpy as np
 
+from .components.hanging_load import LoadMode
 from .elements.contracts import Damping, Friction, PressureSource, StaticForce
 from .elements.load import HangingLoad
 from .elements.stops import EndStops
 from .signals import max_step_hint_s
 
 
-class Mode(IntEnum):
-    """Friction / contact mode of the load."""
-
-    SLIP_DOWN = -1
-    STICK = 0
-    SLIP_UP = 1
-    STOP_LOW = 2
-    STOP_HIGH = 3
-
-    @property
-    def is_slip(self) -> bool:
-        return self in (Mode.SLIP_UP, Mode.SLIP_DOWN)
-
-    @property
-    def label(self) -> str:
-        return self.name.lower()
+Mode = LoadMode
+"""Friction / contact mode of the load (the hanging-load component's own modes)."""
 
 
 N_WORK = 4

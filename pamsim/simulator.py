@@ -24,8 +24,11 @@ from typing import Callable
 
 import numpy as np
 
+from .assemblies import one_muscle_assembly
+from .components.hanging_load import EVENT_NAMES
 from .errors import InputError, SolverFailure
 from .model import STATE_SCALES, Mode, MuscleModel
+from .modeling.pygen import compiled_by_mode
 from .result import Result, TransitionEvent
 
 
@@ -118,65 +121,83 @@ def _from_start(fun, t0: float, y0: np.ndarray):
     return _event(guarded, fun.direction)
 
 
-class _Events:
-    """Event functions for each mode, built once per run."""
+class _Generated:
+    """The one-muscle model's generated code for one run, one set of functions per mode of the load
+    (:func:`pamsim.modeling.pygen.compiled_by_mode`, shared by runs of the same structure), with the
+    run's parameter values and its input signals in the flat model's input order."""
 
-    def __init__(self, model: MuscleModel, opts: SolverOptions):
-        stops = model.stops
-        eps = opts.release_margin_N
+    def __init__(self, model: MuscleModel, opts: SolverOptions, x0_m: float, p0_gauge_Pa: float | None,
+                 assembly=None):
+        if assembly is None:
+            assembly = one_muscle_assembly(model, x0_m, p0_gauge_Pa, opts.stick_margin_N, opts.release_margin_N)
+        self.code = compiled_by_mode(assembly, "load", ("f", "y", "z", "transition", "rest_mode", "x0"))
+        self.p = assembly.parameter_values()
+        self.kinetic = self.code[Mode.STICK].names["outputs"].index("load.kinetic_energy_J")
+        source, external_N = model.source.inputs, model.load.external_N
         self.t_left = math.inf  # inputs are read at min(t, t_left): the left limit at a segment's end
 
-        def velocity_zero(t, y):
-            return y[1]
+        def inputs(t):
+            return [*source(t), external_N(t)]
 
-        def at_low(t, y):
-            return y[0] - stops.x_low_m
+        self.inputs = inputs
 
-        def at_high(t, y):
-            return y[0] - stops.x_high_m
+    def start(self) -> tuple[np.ndarray, Mode]:
+        """The state at rest at the start, and its mode decided from the forces."""
+        u = self.inputs(0.0)
+        x0, (where,) = self.code[Mode.STICK].x0(u, self.p)
+        return np.array(x0), self.rest_mode(Mode(int(where)), 0.0, x0)
 
-        def release_up(t, y):
-            net, level = model.rest_forces(min(t, self.t_left), y)
-            return net - level - eps
+    def rest_mode(self, mode: Mode, t: float, y) -> Mode:
+        """A held load's mode decided afresh from its forces (a sliding one keeps its mode)."""
+        (q,) = self.code[mode].rest_mode(list(y), self.inputs(t), self.p, ())
+        return Mode(int(q[0]))
 
-        def release_down(t, y):
-            net, level = model.rest_forces(min(t, self.t_left), y)
-            return -net - level - eps
+    def rhs(self, mode: Mode):
+        f, inputs, p = self.code[mode].f, self.inputs, self.p
 
-        self.by_mode = {
-            Mode.SLIP_UP: [("velocity_zero", _event(velocity_zero, -1.0)), ("stop_high", _event(at_high, 1.0))],
-            Mode.SLIP_DOWN: [("velocity_zero", _event(lambda t, y: y[1], 1.0)), ("stop_low", _event(at_low, -1.0))],
-            Mode.STICK: [("release_up", _event(release_up, 1.0)), ("release_down", _event(release_down, 1.0))],
-            Mode.STOP_LOW: [("release_up", _event(release_up, 1.0))],
-            Mode.STOP_HIGH: [("release_down", _event(release_down, 1.0))],
-        }
+        def rhs(t, y):
+            return np.array(f(y.tolist(), inputs(min(t, self.t_left)), p, ())[0])
+        return rhs
 
+    def events(self, mode: Mode) -> list[tuple[str, Callable, int]]:
+        """The mode's event functions: its indicators that can cross there, each positive inside it,
+        with the event's name and the indicator's index."""
+        code = self.code[mode]
+        z, inputs, p = code.z, self.inputs, self.p
+        no_inputs = None if code.reads_inputs["z"] else [0.0] * len(code.names["inputs"])
+        out = []
+        for k, name in enumerate(EVENT_NAMES[mode]):
+            if name is None:
+                continue
 
-def _rest_mode(model: MuscleModel, t: float, y, where: Mode, stick_margin_N: float) -> Mode:
-    """Mode of a load at zero velocity: slip if the net force beats friction, else held."""
-    net, level = model.rest_forces(t, y)
-    if where != Mode.STOP_HIGH and net - level > stick_margin_N:
-        return Mode.SLIP_UP
-    if where != Mode.STOP_LOW and -net - level > stick_margin_N:
-        return Mode.SLIP_DOWN
-    return where
+            def indicator(t, y, k=k):
+                return z(y.tolist(), no_inputs or inputs(min(t, self.t_left)), p, ())[0][k]
+            out.append((name, _event(indicator, -1.0), k))
+        return out
 
-
-def initial_mode(model: MuscleModel, t: float, y, stick_margin_N: float = SolverOptions.stick_margin_N) -> Mode:
-    """Mode of a load starting at rest at ``y``."""
-    x = y[0]
-    where = Mode.STOP_LOW if x <= model.stops.x_low_m else Mode.STOP_HIGH if x >= model.stops.x_high_m else Mode.STICK
-    return _rest_mode(model, t, y, where, stick_margin_N)
+    def jump(self, mode: Mode, k_fired: int, t: float, y: np.ndarray) -> tuple[np.ndarray, Mode, float]:
+        """The state and mode after indicator ``k_fired`` crossed at ``t``, and the kinetic energy the
+        jump removed [J] (an inelastic impact, a velocity reset)."""
+        code, u = self.code[mode], self.inputs(t)
+        fired = [1.0 if k == k_fired else 0.0 for k in range(len(EVENT_NAMES[mode]))]
+        x_next, (q_next,) = code.transition(list(y), u, self.p, (), fired)
+        q = Mode(int(q_next))
+        mode_next = self.rest_mode(q, t, x_next)
+        lost = code.y(list(y), u, self.p, ())[0][self.kinetic] - self.code[q].y(x_next, u, self.p, ())[0][self.kinetic]
+        return np.array(x_next), mode_next, lost
 
 
 def simulate_model(model: MuscleModel, duration_s: float, options: SolverOptions | None = None,
                    x0_m: float = 0.0, name: str = "", p0_gauge_Pa: float | None = None,
-                   progress: Callable[[float], None] | None = None) -> Result:
+                   progress: Callable[[float], None] | None = None, assembly=None) -> Result:
     """Integrate ``model`` from rest at ``x0_m`` (chamber at ``p0_gauge_Pa``, if given) over ``[0, duration_s]``.
 
     ``progress``, if given, is called with the simulated time [s] reached, at
     every segment and every ``PROGRESS_EVERY`` right-hand-side evaluations
     within one (a long run with a small ``max_step_s`` can stay in one segment).
+
+    ``assembly`` is the model as components, when it holds more than the one-muscle assembly of
+    :func:`pamsim.assemblies.one_muscle_assembly` knows (a controller); it must have the same states.
 
     Raises :class:`SolverFailure` when ``solve_ivp`` fails, the event count
     exceeds ``options.max_events``, or the switching stops making progress.
@@ -189,13 +210,11 @@ def simulate_model(model: MuscleModel, duration_s: float, options: SolverOptions
     atol = np.array([opts.rtol * STATE_SCALES.get(n, 0.1) for n in names])  # 0.1 J for the work integrals
     grid = np.linspace(0.0, duration_s, n_samples(duration_s, opts.sample_rate_Hz))
     breaks = sorted({b for b in model.breakpoints if 0.0 < b < duration_s} | {duration_s})
-    events = _Events(model, opts)
-    m = model.load.mass_kg
+    gen = _Generated(model, opts, x0_m, p0_gauge_Pa, assembly)
     held_max_step = min(opts.held_max_step_s, model.max_input_step_s)
 
     t = 0.0
-    y = model.initial_state(x0_m, p0_gauge_Pa)
-    mode = initial_mode(model, t, y, opts.stick_margin_N)
+    y, mode = gen.start()
     ts, ys, modes = [], [], []
     transitions: list[TransitionEvent] = []
     impact_loss_J = []  # (t, J): kinetic energy removed by inelastic impacts and velocity resets
@@ -209,13 +228,15 @@ def simulate_model(model: MuscleModel, duration_s: float, options: SolverOptions
     calls = 0
     reached = 0.0  # reported time: the RHS is also evaluated at trial points, which need not increase
 
-    def rhs(tt, yy):
-        nonlocal calls, reached
-        calls += 1
-        if progress is not None and calls % PROGRESS_EVERY == 0:
-            reached = max(reached, tt)
-            progress(reached)
-        return model.rhs(tt if tt < t_left else t_left, yy, seg_mode)
+    def reporting(fun):
+        def rhs(tt, yy):
+            nonlocal calls, reached
+            calls += 1
+            if calls % PROGRESS_EVERY == 0:
+                reached = max(reached, tt)
+                progress(reached)
+            return fun(tt, yy)
+        return rhs
 
     while t < duration_s:
         if progress is not None:
@@ -223,15 +244,15 @@ def simulate_model(model: MuscleModel, duration_s: float, options: SolverOptions
             progress(reached)
         t_break = min(next(b for b in breaks if b > t), hold_until)
         j = np.searchsorted(grid, t_break, side="right")
-        named = events.by_mode[mode]
-        seg_mode = mode
+        named = gen.events(mode)
         # An input that jumps at t_break belongs to the next segment: this one sees its left limit,
         # so a jump cannot hide a crossing that happened before it.
-        t_left = events.t_left = float(np.nextafter(t_break, -math.inf))
+        t_left = gen.t_left = float(np.nextafter(t_break, -math.inf))
         max_step = opts.max_step_s if mode.is_slip else min(opts.max_step_s, held_max_step)
+        rhs = gen.rhs(mode) if progress is None else reporting(gen.rhs(mode))
         try:
             sol = solve_ivp(rhs, (t, t_break), y,
-                            method=opts.method, dense_output=True, events=[_from_start(f, t, y) for _, f in named],
+                            method=opts.method, dense_output=True, events=[_from_start(f, t, y) for _, f, _ in named],
                             rtol=opts.rtol, atol=atol, max_step=max_step)
         except (InputError, SolverFailure):
             raise
@@ -260,7 +281,7 @@ def simulate_model(model: MuscleModel, duration_s: float, options: SolverOptions
         peak_p = max(peak_p, float(np.max(p_steps)))
         if sol.status == 1:
             k = next(i for i, te in enumerate(sol.t_events) if len(te))
-            kind = named[k][0]
+            kind, _, indicator = named[k]
             t_event = float(sol.t_events[k][0])
             y = np.array(sol.y_events[k][0], dtype=float)
             zero_length = t_event - t <= 1e-12 * max(1.0, t)
@@ -268,7 +289,10 @@ def simulate_model(model: MuscleModel, duration_s: float, options: SolverOptions
             if n_zero > _MAX_ZERO_LENGTH:
                 raise SolverFailure(f"event switching made no progress at t = {t_event:.9g} s ({kind})")
             old = mode
-            mode = _transition(model, kind, t_event, y, mode, opts, impact_loss_J, m)
+            y_before = y
+            y, mode, lost_J = gen.jump(mode, indicator, t_event, y)
+            if not np.array_equal(y, y_before):
+                impact_loss_J.append((t_event, lost_J))
             hold_until = math.inf
             if kind == "velocity_zero" and zero_length and mode.is_slip:
                 mode = Mode.STICK
@@ -283,7 +307,7 @@ def simulate_model(model: MuscleModel, duration_s: float, options: SolverOptions
             hold_until = math.inf
             y = sol.y[:, -1].copy()
             if mode in _REST:
-                mode = _rest_mode(model, t, y, mode, opts.stick_margin_N)
+                mode = gen.rest_mode(mode, t, y)
 
     if progress is not None:
         progress(duration_s)
@@ -297,25 +321,4 @@ def simulate_model(model: MuscleModel, duration_s: float, options: SolverOptions
                              peaks={"x_m": peak_x, "p_gauge_Pa": peak_p, "x_min_m": low_x})
 
 
-def _transition(model: MuscleModel, kind: str, t: float, y: np.ndarray, mode: Mode, opts: SolverOptions,
-                impact_loss_J: list, mass_kg: float) -> Mode:
-    """Apply the jump at an event to ``y`` in place and return the new mode."""
-    if kind.startswith("release"):
-        return Mode.SLIP_UP if kind == "release_up" else Mode.SLIP_DOWN
-    v = y[1]
-    if kind == "velocity_zero":
-        impact_loss_J.append((t, 0.5 * mass_kg * v * v))
-        y[1] = 0.0
-        return _rest_mode(model, t, y, Mode.STICK, opts.stick_margin_N)
-    low = kind == "stop_low"
-    y[0] = model.stops.x_low_m if low else model.stops.x_high_m
-    rebound = model.stops.rebound_speed_m_s(v)
-    impact_loss_J.append((t, 0.5 * mass_kg * (v * v - rebound * rebound)))
-    if rebound > 0.0:
-        y[1] = rebound if low else -rebound
-        return Mode.SLIP_UP if low else Mode.SLIP_DOWN
-    y[1] = 0.0
-    return _rest_mode(model, t, y, Mode.STOP_LOW if low else Mode.STOP_HIGH, opts.stick_margin_N)
-
-
-__all__ = ["SolverFailure", "SolverOptions", "simulate_model", "initial_mode", "n_samples"]
+__all__ = ["SolverFailure", "SolverOptions", "simulate_model", "n_samples"]

@@ -4,6 +4,7 @@ Jacobians against central finite differences."""
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 
 import numpy as np
@@ -248,14 +249,14 @@ def test_exact_jacobians_agree_with_central_differences(spec):
     assert skipped <= 0.01 * compared, (skipped, compared)
 
 
-def test_every_static_force_of_every_shipped_muscle_is_a_component_or_refused_by_name():
-    """Each (muscle, model) pair that applies: its component's force equals the model's on floats over
-    the muscle's travel and pressure range, or the component is refused with a message naming it."""
+def test_every_static_force_of_every_shipped_muscle_is_a_component():
+    """Each (muscle, model) pair that applies: its component's force, as equations or as an external
+    function, equals the model's on floats over the muscle's travel and pressure range."""
     from pamsim.muscles import shipped_names
     from pamsim.static_models import REGISTRY
 
     sc = load_scenario(FIG4)
-    traced = refused = 0
+    traced = external = 0
     for muscle in shipped_names():
         for name in REGISTRY:
             try:
@@ -264,33 +265,46 @@ def test_every_static_force_of_every_shipped_muscle_is_a_component_or_refused_by
             except Exception:
                 continue  # the model does not apply to this muscle
             model = case.build_model()
-            try:
-                flat = _flat(model)
-            except TypeError as exc:
-                assert repr(model.static_force.name) in str(exc)
-                refused += 1
-                continue
-            outputs = flat.function("y")
+            flat = _flat(model)
+            outputs = flat.compile_python().y
             i = flat.index("outputs", "muscle.F_static_N")
             for x in np.linspace(model.stops.x_low_m, model.stops.x_high_m, 9):
                 for p in np.linspace(0.0, case.parameters["rated_pressure_gauge_Pa"], 5):
                     y = list(model.initial_state(float(x)))
                     y[2] = p + model.source.p_atm_Pa
-                    out = np.array(outputs(y, [0.0, 0.0, 0.0], flat.parameter_values, [0.0])).ravel()
+                    (out,) = outputs(y, [0.0, 0.0, 0.0], flat.parameter_values, [0.0])
                     want = float(model.static_force.force_N(float(x), float(p)))
                     assert out[i] == pytest.approx(want, rel=1e-9, abs=1e-9 * max(1.0, abs(want)), nan_ok=True), \
                         (muscle, name, x, p)
-            traced += 1
-    assert traced >= 250, (traced, refused)
+            traced += not flat.externals
+            external += bool(flat.externals)
+    assert traced >= 250, (traced, external)
 
 
-def test_a_force_table_is_refused_by_name():
-    """A tabulated static force (an implicit model's) is not yet a component: refused, never wrong."""
-    from pamsim.components import MuscleStaticForce
+def test_a_force_table_is_an_external_function():
+    """A tabulated static force (an implicit model's) has no symbolic form: the component calls it on
+    floats, the Python model equals it, and what needs symbols (C, exact Jacobians) says so by name."""
     from pamsim.elements.force_table import tabulate
     from pamsim.static_models.acra2012 import Acra2012Polynomial
 
-    poly = Acra2012Polynomial.from_parameters(load_scenario(FIG4).parameters)
-    table = tabulate(poly, (0.0, 0.05), (0.0, 4e5), key=None)
-    with pytest.raises(TypeError, match="static force 'acra2012_polynomial' cannot be written with symbols"):
-        MuscleStaticForce("muscle", table)
+    sc = load_scenario(FIG4)
+    poly = Acra2012Polynomial.from_parameters(sc.parameters)
+    table = tabulate(poly, (0.0, 0.08), (0.0, 4.5e5), n_x=33, n_p=9, key=None)
+    model = dataclasses.replace(sc.build_model(), static_force=table)
+    flat = _flat(model)
+    assert [e.name for e in flat.externals] == ["muscle.force_N"]
+    g = flat.compile_python()
+    rng = np.random.default_rng(23)
+    for _ in range(200):
+        y, ins, F_ext = _random_state(model, rng)
+        for mode in (Mode.SLIP_UP, Mode.STICK):
+            x = y.copy()
+            if not mode.is_slip:
+                x[1] = 0.0
+            want = model.slip_rhs(x, float(mode), ins, F_ext) if mode.is_slip else model.held_rhs(x, ins)
+            (got,) = g.f(list(x), [*ins, F_ext], flat.parameter_values, [float(mode)])
+            np.testing.assert_array_equal(got, want)
+    with pytest.raises(NotImplementedError, match="muscle.force_N"):
+        flat.c_sources()
+    with pytest.raises(NotImplementedError, match="muscle.force_N"):
+        flat.function("jacobian")

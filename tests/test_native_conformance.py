@@ -31,7 +31,9 @@ from pamsim.model import FitRange, Mode, MuscleModel
 from pamsim.native import library as native
 from pamsim.parameters import get_parameter_set
 from pamsim.signals import Constant
-from pamsim.simulator import SolverOptions, _Events, _rest_mode
+from pamsim.assemblies import one_muscle_assembly
+from pamsim.modeling.pygen import compiled_by_mode
+from pamsim.simulator import SolverOptions
 
 N_POINTS = 10_000
 RTOL = 1e-12
@@ -103,17 +105,20 @@ def _model(p, choice, inputs, k) -> MuscleModel:
         fit_range=FitRange(p["fit_x_min_m"], p["fit_x_max_m"], p["fit_p_max_Pa"]))
 
 
-def _c_indicators_from_python(model, mode, y, opts):
-    """The C indicators (positive inside the mode, shifted by the shared tolerances) from the Python
-    simulator's event functions (zero at the event, signed by their crossing direction)."""
-    f = dict(_Events(model, opts).by_mode[Mode(mode)])
-    if mode == Mode.SLIP_UP:
-        return f["velocity_zero"](0.0, y) + EVENT_V_TOL_M_S, EVENT_X_TOL_M - f["stop_high"](0.0, y)
-    if mode == Mode.SLIP_DOWN:
-        return EVENT_V_TOL_M_S - f["velocity_zero"](0.0, y), f["stop_low"](0.0, y) + EVENT_X_TOL_M
-    up = -f["release_up"](0.0, y) if "release_up" in f else 1.0
-    down = -f["release_down"](0.0, y) if "release_down" in f else 1.0
-    return up, down
+def _generated(model, opts):
+    """The Python code generated from the model's components (indicators and rest decisions by mode),
+    its parameter values and its inputs at t = 0."""
+    assembly = one_muscle_assembly(model, 0.0, None, opts.stick_margin_N, opts.release_margin_N)
+    code = compiled_by_mode(assembly, "load", ("z", "rest_mode"))
+    return code, assembly.parameter_values(), [*model.source.inputs(0.0), model.load.external_N(0.0)]
+
+
+def _c_indicators_from_python(generated, mode, y):
+    """The C indicators (positive inside the mode, shifted by the shared tolerances) from the
+    components' indicators and the margins they give an integrator like the C core's."""
+    code, P, u = generated
+    z, margin = code[Mode(mode)].z(list(y), u, P, ())
+    return z[0] + margin[0], z[1] + margin[1]
 
 
 @pytest.fixture(scope="module")
@@ -161,10 +166,12 @@ def evaluated():
         dy = model.rhs(0.0, y, Mode(int(mode[k])))
         py["rhs_x"][k], py["rhs_v"][k] = dy[0], dy[1]
         py["rhs_p"][k], py["rhs_m"][k] = (dy[2], dy[3]) if valve else (0.0, 0.0)
-        py["indicator_1"][k], py["indicator_2"][k] = _c_indicators_from_python(model, int(mode[k]), y, opts)
+        generated = _generated(model, opts)
+        py["indicator_1"][k], py["indicator_2"][k] = _c_indicators_from_python(generated, int(mode[k]), y)
         py["net_force_N"][k], py["level_at_rest_N"][k] = model.rest_forces(0.0, y)
         where = Mode.STICK if Mode(int(mode[k])).is_slip else Mode(int(mode[k]))
-        py["rest_mode"][k] = int(_rest_mode(model, 0.0, y, where, opts.stick_margin_N))
+        code, P, u = generated
+        py["rest_mode"][k] = int(code[where].rest_mode(list(y), u, P, ())[0][0])
         py["volume_m3"][k] = volume
         py["braid_lock_m"][k] = model.stops.x_high_m
     c = native.evaluate(reals, ints, states, mode)

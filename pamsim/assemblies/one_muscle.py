@@ -4,13 +4,15 @@
 
     valve --port-- chamber --p_gauge_Pa--> muscle, friction
                       ^ x_m, v_m_s               |
-    muscle, damping, external --flange-- load <--level_N-- friction
+    muscle, damping, friction --flange-- load <-- external force
 
 Model inputs: ``valve_command`` and ``supply_pressure_gauge_Pa`` (valve source) or
 ``prescribed_pressure_gauge_Pa`` (prescribed source), and ``external_force_N``.
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 from ..components import (CoulombFriction, ExternalForce, HangingLoad, MuscleStaticForce, PolytropicChamber,
                           PressureSignal, ProportionalValve, ViscousDamping)
@@ -21,38 +23,56 @@ INPUTS_VALVE = ("valve_command", "supply_pressure_gauge_Pa", "external_force_N")
 INPUTS_PRESCRIBED = ("prescribed_pressure_gauge_Pa", "external_force_N")
 
 
+@dataclass(frozen=True)
+class SourceParts:
+    """The components of a pressure source, their wiring (to each other and to ``load.x_m``,
+    ``load.v_m_s``), the model inputs they take, in the order of the source's ``inputs(t)``, and the
+    component whose output ``p_gauge_Pa`` is the muscle's pressure."""
+
+    parts: list
+    wiring: list
+    inputs: dict
+    pressure: str
+
+
 def one_muscle_assembly(model, x0_m: float = 0.0, p0_gauge_Pa: float | None = None,
-                        stick_margin_N: float = 1e-7, release_margin_N: float = 2e-7) -> Assembly:
+                        stick_margin_N: float = 1e-7, release_margin_N: float = 2e-7,
+                        source: SourceParts | None = None) -> Assembly:
     """The assembly of a :class:`pamsim.model.MuscleModel`'s elements (its static force, friction,
     damping, load, stops and pressure source), starting at rest at ``x0_m`` with the chamber at
     ``p0_gauge_Pa`` (ambient if None).  The margins are the simulator's
-    (:class:`pamsim.simulator.SolverOptions`)."""
+    (:class:`pamsim.simulator.SolverOptions`).  ``source`` gives the components of a pressure source
+    this module does not know (a controller's, from a layer above)."""
     load = HangingLoad("load", {
         "mass_kg": model.load.mass_kg, "g_m_s2": model.load.g_m_s2, "x_low_m": model.stops.x_low_m,
         "x_high_m": model.stops.x_high_m, "restitution": model.stops.restitution,
         "stick_margin_N": stick_margin_N, "release_margin_N": release_margin_N, "initial_contraction_m": x0_m})
-    parts = [load]
-    src = model.source
-    if isinstance(src, ValveChamberSource):
-        parts += [PolytropicChamber("chamber", src.chamber, src.p_atm_Pa, p0_gauge_Pa or 0.0, src.T_supply_K),
-                  ProportionalValve("valve", src.valve, src.T_supply_K, src.p_atm_Pa, src.chamber.R_J_per_kg_K)]
-        pressure = "chamber"
-        wiring = [("chamber.port", "valve.port"), ("load.x_m", "chamber.x_m"), ("load.v_m_s", "chamber.v_m_s")]
-        inputs = {"valve_command": "valve.command", "supply_pressure_gauge_Pa": "valve.supply_gauge_Pa"}
-    elif isinstance(src, PrescribedPressure):
-        parts.append(PressureSignal("pressure"))
-        pressure, wiring = "pressure", []
-        inputs = {"prescribed_pressure_gauge_Pa": "pressure.p_in_gauge_Pa"}
-    else:
-        raise TypeError(f"no component for the pressure source {type(src).__name__}")
+    source = source or _source_parts(model.source, p0_gauge_Pa)
+    parts = [load, *source.parts]
+    pressure, wiring, inputs = source.pressure, list(source.wiring), dict(source.inputs)
     parts += [MuscleStaticForce("muscle", model.static_force), CoulombFriction("friction", model.friction),
               ViscousDamping("damping", model.damping), ExternalForce("external")]
-    wiring += [("load.flange", "muscle.flange"), ("load.flange", "damping.flange"), ("load.flange", "external.flange"),
+    # The flange adds the forces in this order, as pamsim always has: static, damping, friction.
+    wiring += [("load.flange", "muscle.flange"), ("load.flange", "damping.flange"), ("load.flange", "friction.flange"),
                (f"{pressure}.p_gauge_Pa", "muscle.p_gauge_Pa"), (f"{pressure}.p_gauge_Pa", "friction.p_gauge_Pa"),
-               ("load.x_m", "friction.x_m"), ("load.v_m_s", "friction.v_m_s"), ("load.mass_kg", "friction.mass_kg"),
-               ("friction.level_N", "load.friction_level_N")]
+               ("load.mass_kg", "friction.mass_kg"), ("load.slip_direction", "friction.direction"),
+               ("friction.level_N", "load.friction_level_N"), ("external.F_external_N", "load.F_external_N"),
+               ("load.v_m_s", "external.v_m_s")]
     inputs["external_force_N"] = "external.F_N"
     return Assembly(parts, wiring, inputs, name="one_muscle")
+
+
+def _source_parts(src, p0_gauge_Pa: float | None) -> SourceParts:
+    if isinstance(src, ValveChamberSource):
+        return SourceParts(
+            [PolytropicChamber("chamber", src.chamber, src.p_atm_Pa, p0_gauge_Pa or 0.0, src.T_supply_K),
+             ProportionalValve("valve", src.valve, src.T_supply_K, src.p_atm_Pa, src.chamber.R_J_per_kg_K)],
+            [("chamber.port", "valve.port"), ("load.x_m", "chamber.x_m"), ("load.v_m_s", "chamber.v_m_s")],
+            {"valve_command": "valve.command", "supply_pressure_gauge_Pa": "valve.supply_gauge_Pa"}, "chamber")
+    if isinstance(src, PrescribedPressure):
+        return SourceParts([PressureSignal("pressure")], [], {"prescribed_pressure_gauge_Pa": "pressure.p_in_gauge_Pa"},
+                           "pressure")
+    raise TypeError(f"no components for the pressure source {type(src).__name__}")
 
 
 def scenario_assembly(scenario) -> Assembly:

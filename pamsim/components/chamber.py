@@ -5,35 +5,28 @@ from __future__ import annotations
 from ..modeling import PNEUMATIC, Component, Equations, Port, Symbols, Var
 from .element import ElementParameters, element_parameters
 
-CP_OVER_R_AIR = 3.5
-"""cp / R of air as an ideal diatomic gas (cp = 7/2 R): the enthalpy flow on a pneumatic port is
-cp T mdot, and the polytropic law needs R T mdot back from it."""
-
-
 class PolytropicChamber(ElementParameters, Component):
     """:class:`pamsim.elements.chamber.MuscleChamber`: states absolute pressure and air mass.
 
-    ``dp/dt = n (R T_in mdot - p dV/dt) / V``, with ``R T_in mdot`` summed over every flow into the
-    port as ``(R / cp) Hdot``.  The volume follows the contraction ``x_m`` and its rate ``v_m_s``.
+    ``dp/dt = n (R T_in mdot - p dV/dt) / V``, with the flow work ``R T_in mdot`` summed over every
+    flow into the port.  The volume follows the contraction ``x_m`` and its rate ``v_m_s``.
     """
 
     ports = (Port("port", PNEUMATIC, "node", optional=True),)
     inputs = (Var("x_m", "m", "contraction"), Var("v_m_s", "m/s", "contraction velocity"))
     states = (Var("p_abs_Pa", "Pa", "absolute chamber pressure", 1e5),
               Var("air_mass_kg", "kg", "air mass in the chamber", 1e-5))
-    outputs = (Var("p_gauge_Pa", "Pa", "chamber gauge pressure"),
+    outputs = (Var("p_gauge_Pa", "Pa", "chamber gauge pressure"), Var("p_abs_Pa", "Pa", "absolute chamber pressure"),
                Var("gas_temperature_K", "K", "chamber gas temperature p V / (m R)"),
                Var("volume_m3", "m^3", "chamber volume"))
     extra_parameters = (Var("p_atm_Pa", "Pa", "ambient pressure"),
                         Var("initial_pressure_gauge_Pa", "Pa", "chamber gauge pressure at the start"),
-                        Var("T_initial_K", "K", "gas temperature at the start"),
-                        Var("cp_J_per_kg_K", "J/(kg K)", "specific heat of air at constant pressure"))
+                        Var("T_initial_K", "K", "gas temperature at the start"))
 
     def __init__(self, name: str, element, p_atm_Pa: float, initial_pressure_gauge_Pa: float, T_initial_K: float):
         self.element = element
         values = element_parameters(element)
-        values.update(p_atm_Pa=p_atm_Pa, initial_pressure_gauge_Pa=initial_pressure_gauge_Pa, T_initial_K=T_initial_K,
-                      cp_J_per_kg_K=CP_OVER_R_AIR * values["R_J_per_kg_K"])
+        values.update(p_atm_Pa=p_atm_Pa, initial_pressure_gauge_Pa=initial_pressure_gauge_Pa, T_initial_K=T_initial_K)
         super().__init__(name, values)
 
     def equations(self, s: Symbols) -> Equations:
@@ -44,10 +37,10 @@ class PolytropicChamber(ElementParameters, Component):
         V = ch.volume_m3(x)
         T_gas = ch.gas_temperature_K(p, V, m)
         dV = ch.dvolume_dx_m2(x) * v
-        dp = ch.pressure_rate_Pa_s(p, V, dV, flow["Hdot_W"] / s.p["cp_J_per_kg_K"], 1.0)
+        dp = ch.pressure_rate_from_flow_work_Pa_s(p, V, dV, flow["flow_work_W"])
         p0 = s.p["p_atm_Pa"] + s.p["initial_pressure_gauge_Pa"]
         return Equations(
             der={"p_abs_Pa": dp, "air_mass_kg": flow["mdot_kg_s"]},
-            outputs={"p_gauge_Pa": p - s.p["p_atm_Pa"], "gas_temperature_K": T_gas, "volume_m3": V},
+            outputs={"p_gauge_Pa": p - s.p["p_atm_Pa"], "p_abs_Pa": p, "gas_temperature_K": T_gas, "volume_m3": V},
             port={"port": {"p_abs_Pa": p, "T_K": T_gas}},
             initial={"p_abs_Pa": p0, "air_mass_kg": ch.air_mass_kg(p0, V, s.p["T_initial_K"])})

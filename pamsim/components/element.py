@@ -2,19 +2,21 @@
 
 The elements are frozen dataclasses of numbers with pure methods.  Rebuilt with CasADi symbols in
 place of the numbers, the same methods give the component's equations: the physics is not copied.
-Fields that choose a form rather than give a number (``name``, ``negative_level``, a ``domain``) stay
-as they are.
+Fields that choose a form rather than give a number (``name``, ``negative_level``) stay as they are.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 from typing import Any, Mapping
+
+import numpy as np
 
 from ..modeling import Var
 from ..parameter_schema import unit_of
 
-STRUCTURAL = ("name", "domain", "negative_level")
+STRUCTURAL = ("name", "negative_level")
 """Fields that are choices or metadata, never parameters."""
 
 
@@ -38,18 +40,47 @@ def element_parameters(element) -> dict[str, float]:
     return out
 
 
-def structure_key(element) -> tuple:
-    """What of ``element`` shapes its equations: its type and every field that is not a parameter (a
-    choice, a tuple of coefficients, a domain), recursively.  Two elements with one key differ only in
-    parameter values, so they share one generated model."""
-    items = []
-    for f in dataclasses.fields(element):
-        value = getattr(element, f.name)
-        if f.name not in STRUCTURAL and dataclasses.is_dataclass(value):
-            items.append((f.name, structure_key(value)))
-        elif f.name in STRUCTURAL or not isinstance(value, (int, float)) or isinstance(value, bool):
-            items.append((f.name, repr(value)))
-    return (type(element).__module__, type(element).__qualname__, tuple(items))
+def structure_key(element, baked: bool = False) -> tuple:
+    """What of ``element`` shapes its equations, as a value equal across processes: its type and every
+    field that is not a parameter (a choice, a tuple of coefficients), recursively.  Two
+    elements with one key differ only in parameter values, so they share one generated model.
+
+    Only the numbers of dataclass elements become parameters (:func:`element_parameters`); an element
+    of another kind (a static model class holding its derived constants) is traced with its numbers
+    as constants, so they are part of its key (``baked``).
+    """
+    if dataclasses.is_dataclass(element):
+        items = []
+        for f in dataclasses.fields(element):
+            value = getattr(element, f.name)
+            if f.name in STRUCTURAL or baked or not _is_number(value):
+                items.append((f.name, _stable(value, baked or f.name in STRUCTURAL)))
+        return (type(element).__module__, type(element).__qualname__, tuple(items))
+    return _stable(element, True)
+
+
+def _is_number(value) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def _stable(value, baked: bool):
+    """``value`` as something whose equality and repr do not depend on the process (no addresses)."""
+    if value is None or isinstance(value, (bool, int, float, str)):
+        return value
+    if isinstance(value, (tuple, list)):
+        return tuple(_stable(v, baked) for v in value)
+    if isinstance(value, np.ndarray):
+        return ("ndarray", value.shape, str(value.dtype), hashlib.sha256(np.ascontiguousarray(value).tobytes()).hexdigest())
+    if dataclasses.is_dataclass(value):
+        return structure_key(value, baked)
+    if isinstance(value, Mapping):
+        return tuple(sorted((str(k), _stable(v, baked)) for k, v in value.items()))
+    if callable(value) and hasattr(value, "__qualname__"):
+        return ("callable", getattr(value, "__module__", ""), value.__qualname__)
+    if hasattr(value, "__dict__"):
+        return (type(value).__module__, type(value).__qualname__,
+                tuple(sorted((k, _stable(v, True)) for k, v in vars(value).items())))
+    return repr(value)
 
 
 def parameter_vars(values: Mapping[str, float], descriptions: Mapping[str, str] | None = None) -> tuple[Var, ...]:

@@ -1,19 +1,24 @@
-"""The Coulomb friction level F_c(x, p, m) >= 0; the load's modes decide its direction."""
+"""Coulomb friction: a branch on the load's flange whose level F_c(x, p, m) >= 0 the load's modes
+turn into a force (against the motion when sliding, nothing while held: the load is then at rest and
+friction holds whatever it must)."""
 
 from __future__ import annotations
 
-from ..modeling import Component, Equations, Symbols, Var
+from ..modeling import TRANSLATIONAL, Component, Equations, Port, Symbols, Var
 from .element import ElementParameters, element_parameters
 
 
 class CoulombFriction(ElementParameters, Component):
-    """Any law of :mod:`pamsim.elements.friction`: its level goes to the load (``level_N``).
+    """Any law of :mod:`pamsim.elements.friction`: force ``-direction F_c`` on the flange, with
+    ``direction`` (+1 or -1 sliding, 0 held) from the load, and the level to the load (``level_N``)
+    for its stick/slip decisions.
 
     State ``E_friction_J``: the energy it dissipates, integral of ``F_c |v|``.
     """
 
-    inputs = (Var("x_m", "m", "contraction"), Var("v_m_s", "m/s", "contraction velocity"),
-              Var("p_gauge_Pa", "Pa", "gauge pressure in the muscle"), Var("mass_kg", "kg", "load mass"))
+    ports = (Port("flange", TRANSLATIONAL, "branch"),)
+    inputs = (Var("p_gauge_Pa", "Pa", "gauge pressure in the muscle"), Var("mass_kg", "kg", "load mass"),
+              Var("direction", "1", "+1 or -1 while the load slides up or down, 0 while it is held"))
     states = (Var("E_friction_J", "J", "energy dissipated by Coulomb friction", 0.1),)
     outputs = (Var("level_N", "N", "Coulomb friction level"),)
 
@@ -22,6 +27,7 @@ class CoulombFriction(ElementParameters, Component):
         super().__init__(name, element_parameters(element))
 
     def equations(self, s: Symbols) -> Equations:
-        u = s.u
-        level = self.symbolic_element(s.p).level_N(u["x_m"], u["p_gauge_Pa"], u["mass_kg"])
-        return Equations(der={"E_friction_J": level * abs(u["v_m_s"])}, outputs={"level_N": level})
+        u, flange = s.u, s.port["flange"]
+        level = self.symbolic_element(s.p).level_N(flange["x_m"], u["p_gauge_Pa"], u["mass_kg"])
+        return Equations(der={"E_friction_J": level * abs(flange["v_m_s"])}, outputs={"level_N": level},
+                         port={"flange": {"F_N": -(u["direction"] * level)}})

@@ -46,8 +46,8 @@ EVENT_NAMES = {
 class HangingLoad(Component):
     """A mass under gravity between two rigid stops, driven by the forces on its flange.
 
-    Sliding (``SLIP_UP``/``SLIP_DOWN``): ``m a = F - q F_c - m g`` with ``F`` the sum of the forces
-    on the flange and ``q`` = +1 or -1.  Held (``STICK`` or on a stop): x and v are constant and the
+    Sliding (``SLIP_UP``/``SLIP_DOWN``): ``m a = F - m g + F_ext`` with ``F`` the sum of the forces
+    on the flange, friction's ``-q F_c`` among them (``q`` = +1 or -1, output ``slip_direction``).  Held (``STICK`` or on a stop): x and v are constant and the
     flange reports zero velocity, so every velocity-dependent branch sees the load at rest.
 
     Event indicators, positive inside the mode (a crossing to zero ends it): sliding, the velocity
@@ -70,14 +70,16 @@ class HangingLoad(Component):
                   Var("release_margin_N", "N", "a held load is released when the net force beats friction by this"),
                   Var("initial_contraction_m", "m", "contraction at the start, load at rest"))
     ports = (Port("flange", TRANSLATIONAL, "node"),)
-    inputs = (Var("friction_level_N", "N", "Coulomb friction level"),)
+    inputs = (Var("friction_level_N", "N", "Coulomb friction level"),
+              Var("F_external_N", "N", "external force on the load along x"))
     states = (Var("x_m", "m", "contraction x = L0 - L", 1e-2), Var("v_m_s", "m/s", "contraction velocity", 1e-1))
     outputs = (Var("x_m", "m", "contraction"), Var("v_m_s", "m/s", "contraction velocity (zero when held)"),
                Var("mass_kg", "kg", "hanging mass"), Var("F_gravity_N", "N", "weight along x"),
                Var("F_friction_N", "N", "friction on the load along x; when held, whatever holds it"),
                Var("F_stop_N", "N", "reaction of a stop along x"),
                Var("F_coulomb_level_N", "N", "Coulomb friction level"),
-               Var("kinetic_energy_J", "J", "kinetic energy of the load"))
+               Var("kinetic_energy_J", "J", "kinetic energy of the load"),
+               Var("slip_direction", "1", "+1 or -1 while sliding up or down, 0 while held"))
 
     def equations(self, s: Symbols) -> Equations:
         P = s.p
@@ -88,9 +90,11 @@ class HangingLoad(Component):
         low, high = q == M.STOP_LOW, q == M.STOP_HIGH
         v_flange = if_else(slip, v, 0.0)
         weight = P["mass_kg"] * P["g_m_s2"]
+        # The flange's forces include friction's -q F_c while sliding; at rest they hold neither
+        # friction nor damping (its velocity is zero), so they add up to the static force.
         F, level = s.port["flange"]["F_N"], s.u["friction_level_N"]
-        net = F - weight  # at rest the flange's velocity is zero, so F holds no damping
-        accel = if_else(slip, (F - q * level - weight) / P["mass_kg"], 0.0)
+        net = F - weight + s.u["F_external_N"]
+        accel = if_else(slip, net / P["mass_kg"], 0.0)
 
         eps = P["release_margin_N"]
         z_slip = (if_else(up, v, -v), if_else(up, P["x_high_m"] - x, x - P["x_low_m"]))
@@ -120,7 +124,7 @@ class HangingLoad(Component):
             outputs={"x_m": x, "v_m_s": v_flange, "mass_kg": P["mass_kg"], "F_gravity_N": -weight,
                      "F_friction_N": if_else(slip, -q * level, if_else(held_by_friction, -net, 0.0)),
                      "F_stop_N": if_else(on_stop, -net, 0.0), "F_coulomb_level_N": level,
-                     "kinetic_energy_J": 0.5 * P["mass_kg"] * v * v},
+                     "kinetic_energy_J": 0.5 * P["mass_kg"] * v * v, "slip_direction": if_else(slip, q, 0.0)},
             port={"flange": {"x_m": x, "v_m_s": v_flange}},
             indicators=indicators, indicator_margins=margins, transition=transition, rest_mode=rest,
             initial={"x_m": x0, "v_m_s": 0.0,

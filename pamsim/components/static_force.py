@@ -9,14 +9,18 @@ import numpy as np
 
 from ..modeling import TRANSLATIONAL, Component, Equations, Port, Symbols, Var
 from ..modeling.component import quiet_numpy_on_symbols
-from .element import ElementParameters, element_parameters
+from .element import ElementParameters, element_parameters, structure_key
+
+_TRACES: dict = {}
 
 
 class MuscleStaticForce(ElementParameters, Component):
     """A static force as the dynamics apply it (:func:`pamsim.elements.muscle_force.dynamics_static_force`).
 
-    The element must be written in operations that act on symbols (the closed-form models are); one
-    that is not (a force table) is refused with a ``TypeError`` naming it.  State ``W_muscle_J``: the muscle's work, integral of ``F v``.
+    An element written in operations that act on symbols (the closed-form models) becomes equations
+    with its numbers as parameters; one that is not (a force table, a numerical solve) is called on
+    floats as an external function (:attr:`pamsim.modeling.component.Symbols.external`), which runs
+    in Python only.  State ``W_muscle_J``: the muscle's work, integral of ``F v``.
     """
 
     ports = (Port("flange", TRANSLATIONAL, "branch"),)
@@ -26,12 +30,25 @@ class MuscleStaticForce(ElementParameters, Component):
 
     def __init__(self, name: str, element):
         self.element = element
-        super().__init__(name, element_parameters(element))
-        _check_traces(element)
+        key = structure_key(element)
+        if key not in _TRACES:  # whether an element traces depends on its form, not on its numbers
+            _TRACES[key] = _traces(element)
+        self.traces = _TRACES[key]
+        super().__init__(name, element_parameters(element) if self.traces else {})
+
+    def parameter_vars(self):
+        return super().parameter_vars() if self.traces else ()
+
+    def structure_key(self) -> tuple:
+        # An element called on floats is part of the generated code: its numbers are too.
+        return super().structure_key() + (() if self.traces else (structure_key(self.element, baked=True),))
 
     def equations(self, s: Symbols) -> Equations:
         x, v = s.port["flange"]["x_m"], s.port["flange"]["v_m_s"]
-        F = self.symbolic_element(s.p).force_N(x, s.u["p_gauge_Pa"])
+        if self.traces:
+            F = self.symbolic_element(s.p).force_N(x, s.u["p_gauge_Pa"])
+        else:
+            F = s.external("force_N", self.element.force_N, x, s.u["p_gauge_Pa"])
         return Equations(der={"W_muscle_J": F * v}, outputs={"F_static_N": F}, port={"flange": {"F_N": F}})
 
 
@@ -39,21 +56,19 @@ PROBE_X_M = (0.0, 0.002, 0.005, 0.01, 0.02, 0.04)
 PROBE_P_PA = (0.0, 0.5e5, 1e5, 3e5, 6e5)
 
 
-def _check_traces(element) -> None:
-    """Refuse (``TypeError``) a static force whose ``force_N`` does not give, on symbols, the value it
-    gives on floats: a table lookup, a numerical solve, or a :mod:`math` call (which turns a symbol into
-    NaN without a word).  Compared wherever the float value is finite, at a grid of contractions and
-    pressures."""
+def _traces(element) -> bool:
+    """Whether ``force_N`` gives on symbols the value it gives on floats: not for a table lookup, a
+    numerical solve, or a :mod:`math` call (which turns a symbol into NaN without a word).  Compared
+    wherever the float value is finite, at a grid of contractions and pressures."""
     import casadi as ca
 
     x, p = ca.SX.sym("x"), ca.SX.sym("p")
-    name = getattr(element, "name", type(element).__name__)
     try:
         with quiet_numpy_on_symbols(), warnings.catch_warnings(), np.errstate(all="ignore"):
             warnings.simplefilter("ignore", RuntimeWarning)  # a table's array path, probed with a symbol
             fn = ca.Function("F", [x, p], [ca.SX(element.force_N(x, p))])
-    except Exception as exc:
-        raise TypeError(f"static force {name!r} cannot be written with symbols: {type(exc).__name__}: {exc}") from None
+    except Exception:
+        return False
     for xv in PROBE_X_M:
         for pv in PROBE_P_PA:
             try:
@@ -64,5 +79,5 @@ def _check_traces(element) -> None:
                 continue
             got = float(fn(xv, pv))
             if not abs(got - want) <= 1e-9 * max(1.0, abs(want)):
-                raise TypeError(f"static force {name!r} cannot be written with symbols: at x = {xv} m, "
-                                f"p = {pv} Pa it gives {got!r} on symbols and {want!r} on floats")
+                return False
+    return True

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 from ..modeling import PNEUMATIC, Component, Equations, Port, Symbols, Var
 from ..modeling.smath import if_else
-from .chamber import CP_OVER_R_AIR
 from .element import ElementParameters, element_parameters
 
 
@@ -21,12 +20,12 @@ class ProportionalValve(ElementParameters, Component):
     outputs = (Var("mass_flow_kg_s", "kg/s", "mass flow into the port"),)
     extra_parameters = (Var("T_supply_K", "K", "supply air temperature"),
                         Var("p_atm_Pa", "Pa", "ambient (exhaust) pressure"),
-                        Var("cp_J_per_kg_K", "J/(kg K)", "specific heat of air at constant pressure"))
+                        Var("R_J_per_kg_K", "J/(kg K)", "specific gas constant of air"))
 
     def __init__(self, name: str, element, T_supply_K: float, p_atm_Pa: float, R_J_per_kg_K: float):
         self.element = element
         values = element_parameters(element)
-        values.update(T_supply_K=T_supply_K, p_atm_Pa=p_atm_Pa, cp_J_per_kg_K=CP_OVER_R_AIR * R_J_per_kg_K)
+        values.update(T_supply_K=T_supply_K, p_atm_Pa=p_atm_Pa, R_J_per_kg_K=R_J_per_kg_K)
         super().__init__(name, values)
 
     def equations(self, s: Symbols) -> Equations:
@@ -36,4 +35,4 @@ class ProportionalValve(ElementParameters, Component):
         mdot = valve.inflow_kg_s(s.u["command"], p, T, s.u["supply_gauge_Pa"] + p_atm, T_supply, p_atm)
         T_in = if_else(mdot >= 0.0, T_supply, T)
         return Equations(outputs={"mass_flow_kg_s": mdot},
-                         port={"port": {"mdot_kg_s": mdot, "Hdot_W": s.p["cp_J_per_kg_K"] * T_in * mdot}})
+                         port={"port": {"mdot_kg_s": mdot, "flow_work_W": s.p["R_J_per_kg_K"] * T_in * mdot}})

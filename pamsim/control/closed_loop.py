@@ -10,8 +10,9 @@ controller needs a position and a pressure sensor only.
 On the nonlinear model the controller runs as part of the pressure source
 (:class:`ClosedLoopValveSource`): its states (error integral, position filter)
 sit beside the chamber states, and the valve command it computes is clipped to
-[-1, 1].  So :func:`~pamsim.simulator.simulate_model` integrates the loop with
-its unchanged stick/slip event logic.  The controller is continuous-time (an
+[-1, 1].  As components (:class:`PositionController` between the chamber and the
+valve, :func:`closed_loop_assembly`), :func:`~pamsim.simulator.simulate_model`
+integrates the loop with the load's own stick/slip modes.  The controller is continuous-time (an
 analogue of a controller sampled much faster than the 4 Hz mechanical mode).
 
 Non-linear parts of the law:
@@ -33,10 +34,13 @@ from typing import Any, Callable, Mapping
 import control as ct
 import numpy as np
 
+from ..assemblies.one_muscle import SourceParts, one_muscle_assembly
+from ..components import PolytropicChamber, ProportionalValve
 from ..constants import PA_PER_BAR
 from ..elements.pressure_source import ValveChamberSource
 from ..errors import InputError
 from ..model import MuscleModel
+from ..modeling import Assembly, Component, Equations, Symbols, Var, smath
 from ..result import Result
 from ..scenario import Scenario, load_scenario
 from ..signals import Step
@@ -208,17 +212,22 @@ class ClosedLoopValveSource:
         Kx, Kv, Kp, Kz = self.K
         v_hat = (x_m - s[3]) / self.velocity_filter_time_s
         raw = -(Kx * (x_m - r) + Kv * v_hat + Kp * (s[0] - self.p_atm_Pa - p_ff) + Kz * s[2])
-        return np.clip(raw, -1.0, 1.0), raw
+        return smath.clip(raw, -1.0, 1.0), raw
+
+    def controller_rates(self, s, x_m, inputs, u, raw) -> tuple:
+        """(d error integral / dt [m], d position filter / dt [m/s]) for the command ``u`` (clipped) and
+        ``raw`` (unclipped)."""
+        e = x_m - inputs[0]
+        dead = e - smath.clip(e, -self.deadband_m, self.deadband_m)  # zero inside the deadband
+        # Back-calculation: while the valve saturates, bleed the integral so that the
+        # unclipped command returns to the limit within antiwindup_time_s.
+        dz = dead + (raw - u) / (self.K[3] * self.antiwindup_time_s)
+        return dz, (x_m - s[3]) / self.velocity_filter_time_s
 
     def derivatives(self, s, x_m, v_m_s, inputs) -> tuple[float, ...]:
         u, raw = self.command(s, x_m, inputs)
         dp, dm = self.plant.derivatives(s[:2], x_m, v_m_s, (float(u), inputs[2]))
-        e = x_m - inputs[0]
-        dead = math.copysign(max(abs(e) - self.deadband_m, 0.0), e)
-        # Back-calculation: while the valve saturates, bleed the integral so that the
-        # unclipped command returns to the limit within antiwindup_time_s.
-        dz = dead + (raw - u) / (self.K[3] * self.antiwindup_time_s)
-        return dp, dm, dz, (x_m - s[3]) / self.velocity_filter_time_s
+        return (dp, dm) + self.controller_rates(s, x_m, inputs, u, raw)
 
     @property
     def breakpoints(self) -> tuple[float, ...]:
@@ -234,6 +243,69 @@ class ClosedLoopValveSource:
                 "gas_temperature_K": T_gas, "reference_m": np.asarray(inputs[0], dtype=float) + zero,
                 "feedforward_gauge_Pa": np.asarray(inputs[1], dtype=float) + zero,
                 "z_error_integral_m_s": S[2], "velocity_estimate_m_s": (x_m - S[3]) / self.velocity_filter_time_s}
+
+
+class PositionController(Component):
+    """The controller of :class:`ClosedLoopValveSource` as a component: it reads the contraction and
+    the chamber pressure, the reference and the feedforward, and drives the valve's command.
+
+    States: the error integral and the position filter of the velocity estimate.  The law is the
+    source's own (:meth:`ClosedLoopValveSource.command`, :meth:`ClosedLoopValveSource.controller_rates`),
+    called with symbols.
+    """
+
+    parameters = (Var("Kx_per_m", "1/m", "gain on the position"), Var("Kv_s_per_m", "s/m", "gain on the velocity"),
+                  Var("Kp_per_Pa", "1/Pa", "gain on the pressure"), Var("Kz_per_m_s", "1/(m s)", "gain on the integral"),
+                  Var("velocity_filter_time_s", "s", "time constant of the velocity estimate"),
+                  Var("deadband_m", "m", "error band in which the integral stops"),
+                  Var("antiwindup_time_s", "s", "back-calculation time of the integral"),
+                  Var("p_atm_Pa", "Pa", "ambient pressure"))
+    inputs = (Var("x_m", "m", "contraction"), Var("p_abs_Pa", "Pa", "absolute chamber pressure"),
+              Var("reference_m", "m", "contraction reference"),
+              Var("feedforward_gauge_Pa", "Pa", "holding pressure of the reference"))
+    states = (Var("z_error_integral_m_s", "m s", "integral of the position error", 0.1),
+              Var("x_filter_m", "m", "position filter of the velocity estimate", 1e-2))
+    outputs = (Var("command", "1", "valve command, clipped to [-1, 1]"),)
+
+    def __init__(self, name: str, source: "ClosedLoopValveSource"):
+        self.source = source
+        Kx, Kv, Kp, Kz = source.K
+        super().__init__(name, {"Kx_per_m": Kx, "Kv_s_per_m": Kv, "Kp_per_Pa": Kp, "Kz_per_m_s": Kz,
+                                "velocity_filter_time_s": source.velocity_filter_time_s,
+                                "deadband_m": source.deadband_m, "antiwindup_time_s": source.antiwindup_time_s,
+                                "p_atm_Pa": source.p_atm_Pa})
+
+    def equations(self, s: Symbols) -> Equations:
+        P = s.p
+        law = dataclasses.replace(self.source, K=(P["Kx_per_m"], P["Kv_s_per_m"], P["Kp_per_Pa"], P["Kz_per_m_s"]),
+                                  velocity_filter_time_s=P["velocity_filter_time_s"], deadband_m=P["deadband_m"],
+                                  antiwindup_time_s=P["antiwindup_time_s"],
+                                  plant=dataclasses.replace(self.source.plant, p_atm_Pa=P["p_atm_Pa"]))
+        x = s.u["x_m"]
+        states = (s.u["p_abs_Pa"], 0.0, s.x["z_error_integral_m_s"], s.x["x_filter_m"])
+        inputs = (s.u["reference_m"], s.u["feedforward_gauge_Pa"], 0.0)
+        u, raw = law.command(states, x, inputs)
+        dz, dxf = law.controller_rates(states, x, inputs, u, raw)
+        return Equations(der={"z_error_integral_m_s": dz, "x_filter_m": dxf}, outputs={"command": u},
+                         initial={"z_error_integral_m_s": 0.0, "x_filter_m": x})
+
+
+def closed_loop_assembly(model: MuscleModel, x0_m: float, options) -> Assembly:
+    """The closed loop as an assembly: the one-muscle assembly whose valve the controller drives, the
+    chamber starting at the feedforward pressure of the first reference."""
+    source = model.source
+    p0 = source.feedforward_gauge_Pa(0.0)
+    plant = source.plant
+    parts = [PolytropicChamber("chamber", plant.chamber, plant.p_atm_Pa, p0, plant.T_supply_K),
+             PositionController("controller", source),
+             ProportionalValve("valve", plant.valve, plant.T_supply_K, plant.p_atm_Pa, plant.chamber.R_J_per_kg_K)]
+    wiring = [("chamber.port", "valve.port"), ("load.x_m", "chamber.x_m"), ("load.v_m_s", "chamber.v_m_s"),
+              ("load.x_m", "controller.x_m"), ("chamber.p_abs_Pa", "controller.p_abs_Pa"),
+              ("controller.command", "valve.command")]
+    inputs = {"reference_m": "controller.reference_m", "feedforward_gauge_Pa": "controller.feedforward_gauge_Pa",
+              "supply_pressure_gauge_Pa": "valve.supply_gauge_Pa"}
+    return one_muscle_assembly(model, x0_m, p0, options.stick_margin_N, options.release_margin_N,
+                               SourceParts(parts, wiring, inputs, "chamber"))
 
 
 def closed_loop_model(scenario: Scenario, config: ControllerConfig, design: LqrDesign) -> MuscleModel:
@@ -377,7 +449,8 @@ def run_closed_loop(scenario: Scenario | str, overrides: Mapping[str, Any] | Non
     design = design_lqr(model, config, scenario.final_pressure_gauge_Pa)
     cl_model = closed_loop_model(scenario, config, design)
     result = simulate_model(cl_model, scenario.duration_s, scenario.solver, x0_m=scenario.initial_contraction_m,
-                            name=scenario.name, progress=progress)
+                            name=scenario.name, progress=progress,
+                            assembly=closed_loop_assembly(cl_model, scenario.initial_contraction_m, scenario.solver))
     x0 = scenario.initial_contraction_m
     band = config.spec.get("settling_band_mm", 0.5) * 1e-3
     metrics = step_metrics(result.t_s, result.x_m, config.step_time_s, x0, config.target_contraction_m, band)

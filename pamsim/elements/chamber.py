@@ -56,5 +56,13 @@ class MuscleChamber:
         return p_abs_Pa * volume_m3 / (self.R_J_per_kg_K * T_K)
 
     def pressure_rate_Pa_s(self, p_abs_Pa, volume_m3, dvolume_dt_m3_s, inflow_kg_s, T_inflow_K):
-        return self.polytropic_index * (self.R_J_per_kg_K * T_inflow_K * inflow_kg_s
-                                        - p_abs_Pa * dvolume_dt_m3_s) / volume_m3
+        return self.pressure_rate_from_flow_work_Pa_s(p_abs_Pa, volume_m3, dvolume_dt_m3_s,
+                                                      self.flow_work_W(inflow_kg_s, T_inflow_K))
+
+    def flow_work_W(self, inflow_kg_s, T_inflow_K):
+        """``R T_in mdot``: the flow work an inflow at ``T_inflow_K`` brings in [W]."""
+        return self.R_J_per_kg_K * T_inflow_K * inflow_kg_s
+
+    def pressure_rate_from_flow_work_Pa_s(self, p_abs_Pa, volume_m3, dvolume_dt_m3_s, flow_work_W):
+        """``n (R T_in mdot - p dV/dt) / V`` from the summed flow work of every inflow [Pa/s]."""
+        return self.polytropic_index * (flow_work_W - p_abs_Pa * dvolume_dt_m3_s) / volume_m3

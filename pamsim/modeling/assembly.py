@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from typing import Mapping, Sequence
 
 from .component import Component, Equations, Symbols, quiet_numpy_on_symbols
-from .flat import FlatModel, FlatVar
+from .flat import External, FlatModel, FlatVar
 from .variables import Var
 
 
@@ -40,7 +40,8 @@ class Assembly:
     ----------
     components : the components, each with a name unique in the assembly.
     connections : pairs ``("a.port", "b.port")`` of ports of one kind (a node and a branch, or two
-        branches of one net), or ``("a.output", "b.input")`` of signals with one unit.
+        branches of one net), or ``("a.output", "b.input")`` of signals with one unit.  A node sums
+        its branches' through variables in the order they are first connected.
     inputs : ``{model input name: "component.input"}`` (a string or a tuple of them, for one model
         input that drives several component inputs).
     name : the assembly's name (used in generated code).
@@ -106,8 +107,14 @@ class Assembly:
                 raise AssemblyError(f"cannot connect port {a.label} ({ka.name}) to port {b.label} ({kb.name}): "
                                     "the kinds differ")
             parent[find(a.label)] = find(b.label)
+        # A net's branches in the order they were first connected: the node sums their through
+        # variables in that order, so a floating-point sum is the same whatever the component order.
+        first = {}
+        for i, pair in enumerate(self.connections):
+            for ref in pair:
+                first.setdefault(ref, i)
         groups: dict[str, list[_Endpoint]] = defaultdict(list)
-        for label, ep in ends.items():
+        for label, ep in sorted(ends.items(), key=lambda item: first.get(item[0], len(self.connections))):
             groups[find(label)].append(ep)
         nets, unconnected = [], []
         for members in groups.values():
@@ -193,6 +200,14 @@ class Assembly:
         symbols: dict[str, Symbols] = {}
         mode_syms = {}
         fired_syms: tuple = ()
+        externals: list[External] = []
+
+        def external(component: Component):
+            def call(name: str, fn, *args):
+                sym = ca.SX.sym(f"{component.name}.{name}#{len(externals)}")
+                externals.append(External(f"{component.name}.{name}", fn, sym, [ca.SX(a) for a in args]))
+                return sym
+            return call
         for c in self.components:
             p = {v.name: ca.SX.sym(f"{c.name}.{v.name}") for v in c.parameter_vars()}
             x = {v.name: ca.SX.sym(f"{c.name}.{v.name}") for v in c.states}
@@ -210,7 +225,7 @@ class Assembly:
             if c.modes is not None:
                 fired = tuple(ca.SX.sym(f"{c.name}.fired{k}") for k in range(c.n_indicators))
                 fired_syms += fired
-            symbols[c.name] = Symbols(p, x, u, port, mode, fired)
+            symbols[c.name] = Symbols(p, x, u, port, mode, fired, external(c))
             params += [(c, v, p[v.name]) for v in c.parameter_vars()]
             states += [(c, v, x[v.name]) for v in c.states]
             placeholders.update({f"{c.name}.{k}": s for k, s in u.items()})
@@ -279,6 +294,7 @@ class Assembly:
             x0=initial,
             q0=[flat(ca.substitute([ca.SX(equations[c.name].initial.get("mode", 0.0))],
                                    [sym for _, _, sym in states], initial)[0]) for c in hybrid],
+            externals=[External(e.name, e.fn, e.symbol, [flat(a) for a in e.args]) for e in externals],
         )
 
 

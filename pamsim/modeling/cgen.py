@@ -43,6 +43,9 @@ def c_sources(model, prefix: str) -> dict[str, str]:
     """``{file name: text}``: ``PREFIX.c`` and ``PREFIX.h`` (the functions) and ``PREFIX_counts.h``."""
     import casadi as ca
 
+    if model.externals:
+        raise NotImplementedError(f"{model.name}: no C for the external functions "
+                                  f"{', '.join(ext.name for ext in model.externals)} (Python-only physics)")
     gen = ca.CodeGenerator(f"{prefix}.c", {"with_header": True, "prefix": f"{prefix}_"})
     for fn in model.functions.values():
         gen.add(fn)

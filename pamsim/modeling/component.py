@@ -26,7 +26,10 @@ class Symbols:
     it; for a branch port, the across variables of the node it is connected to.  ``mode`` is the
     component's discrete mode (a symbol that the generated code holds constant between events), or
     None for a component without modes; ``fired`` has one flag per indicator, 1 for those that have
-    crossed at an event (for :attr:`Equations.transition`).
+    crossed at an event (for :attr:`Equations.transition`).  ``external(name, fn, *args)`` stands
+    for ``fn(*args)`` computed by the host on floats: for physics that has no symbolic form (a table
+    lookup, a numerical solve), at the price of a model that runs in Python only, without exact
+    Jacobians.
     """
 
     p: Mapping[str, Any]
@@ -35,6 +38,7 @@ class Symbols:
     port: Mapping[str, Mapping[str, Any]]
     mode: Any = None
     fired: tuple[Any, ...] = ()
+    external: Any = None
 
 
 @dataclass

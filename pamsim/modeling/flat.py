@@ -25,6 +25,16 @@ class FlatVar:
 
 
 
+@dataclass(frozen=True, eq=False)
+class External:
+    """``symbol`` stands for ``fn(*args)``, computed by the host on floats (:attr:`Symbols.external`)."""
+
+    name: str
+    fn: Any
+    symbol: Any
+    args: list[Any]
+
+
 @dataclass(eq=False)
 class FlatModel:
     """Counts, names and CasADi expressions of an assembled model (built by :meth:`Assembly.flatten`).
@@ -57,6 +67,7 @@ class FlatModel:
     rest_q: list[Any]
     x0: list[Any]
     q0: list[Any]
+    externals: list[External] = field(default_factory=list)
     _cache: dict = field(default_factory=dict, repr=False)
 
     # ------------------------------------------------------------------ names
@@ -85,20 +96,47 @@ class FlatModel:
         key = ("function", name)
         if key not in self._cache:
             x, u, p, q, e = self._vectors()
+            w = ca.vertcat(*[ext.symbol for ext in self.externals]) if self.externals else ca.SX(0, 1)
             col = lambda es: ca.vertcat(*es) if es else ca.SX(0, 1)  # noqa: E731
             if name == "jacobian":
+                if self.externals:
+                    raise NotImplementedError(f"{self.name}: no exact Jacobian through the external functions "
+                                              f"{', '.join(ext.name for ext in self.externals)}")
                 f, y = col(self.f), col(self.y)
                 exprs = [ca.jacobian(f, x), ca.jacobian(f, u), ca.jacobian(y, x), ca.jacobian(y, u)]
+            elif name == "externals":
+                exprs = [col([a for ext in self.externals for a in ext.args])]
             else:
-                exprs = {"f": [self.f], "y": [self.y], "z": [self.z, self.z_margin], "transition": [self.transition_x, self.transition_q],
-                         "rest_mode": [self.rest_q], "x0": [self.x0, self.q0]}[name]
-                exprs = [col(e) for e in exprs]
+                exprs = [col(e) for e in self._expressions(name)]
             # SX keeps a subexpression once only where the components shared it; cse finds the rest.
             exprs = [ca.cse(e) for e in exprs]
-            ins, outs = FUNCTION_SIGNATURES[name]
-            args = {"x": x, "u": u, "p": p, "q": q, "e": e}
+            ins, outs = self.signature(name)
+            args = {"x": x, "u": u, "p": p, "q": q, "e": e, "w": w}
             self._cache[key] = ca.Function(f"{self.name}_{name}", [args[a] for a in ins], exprs, list(ins), list(outs))
         return self._cache[key]
+
+    def signature(self, name: str) -> tuple[tuple[str, ...], tuple[str, ...]]:
+        """Arguments and results of generated function ``name``.  With external functions, each
+        function also takes ``w``, their values, and ``externals(x, u, p, q)`` gives their arguments."""
+        if name == "externals":
+            return ("x", "u", "p", "q"), ("args",)
+        ins, outs = FUNCTION_SIGNATURES[name]
+        return (ins + ("w",) if self.externals else ins), outs
+
+    def depends_on_inputs(self, name: str) -> bool:
+        """Whether function ``name`` reads the inputs at all (a sliding load's indicators do not)."""
+        import casadi as ca
+
+        fn = self.function(name)
+        if "u" not in fn.name_in() or not self.u:
+            return False
+        u = ca.vertcat(*self.u)
+        return any(ca.depends_on(ca.vertcat(*[e for e in exprs]), u) for exprs in self._expressions(name) if exprs)
+
+    def _expressions(self, name: str) -> list[list[Any]]:
+        return {"f": [self.f], "y": [self.y], "z": [self.z, self.z_margin],
+                "transition": [self.transition_x, self.transition_q], "rest_mode": [self.rest_q],
+                "x0": [self.x0, self.q0], "jacobian": [self.f, self.y]}[name]
 
     @property
     def functions(self) -> dict[str, Any]:

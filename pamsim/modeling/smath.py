@@ -30,6 +30,19 @@ def radians(a):
     return math.radians(a) if isinstance(a, (int, float)) else a * (math.pi / 180.0)
 
 
+def fmin(a, b):
+    return min(a, b) if isinstance(a, (int, float)) and isinstance(b, (int, float)) else _casadi().fmin(a, b)
+
+
+def fmax(a, b):
+    return max(a, b) if isinstance(a, (int, float)) and isinstance(b, (int, float)) else _casadi().fmax(a, b)
+
+
+def clip(a, low, high):
+    """``a`` held within ``[low, high]`` (on floats, ``min(max(a, low), high)``, as ``numpy.clip``)."""
+    return fmin(fmax(a, low), high)
+
+
 def if_else(condition, if_true, if_false):
     """``if_true`` where ``condition`` holds, else ``if_false`` (both are evaluated for a symbol)."""
     if isinstance(condition, (bool, int, float)):

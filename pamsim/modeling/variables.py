@@ -48,8 +48,8 @@ PNEUMATIC = PortKind(
     across=(Var("p_abs_Pa", "Pa", "absolute pressure of the volume"),
             Var("T_K", "K", "gas temperature of the volume")),
     through=(Var("mdot_kg_s", "kg/s", "mass flow into the volume"),
-             Var("Hdot_W", "W", "enthalpy flow into the volume, cp T_in mdot")))
-"""A gas port: pressure and temperature, mass and enthalpy flow."""
+             Var("flow_work_W", "W", "flow work the stream brings in, R T_in mdot (its enthalpy is cp/R of it)")))
+"""A gas port: pressure and temperature; mass flow and the flow work it carries."""
 
 SIGNAL = PortKind("signal", across=(), through=())
 """Plain inputs and outputs connect one to one; this kind only names them in messages."""
