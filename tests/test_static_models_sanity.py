@@ -121,3 +121,22 @@ def test_scalar_and_array_evaluations_agree():
         for x, f in zip(xs, arr):
             got = m.force_N(float(x), 3e5)
             assert isinstance(got, float) and got == pytest.approx(f, rel=1e-12, abs=1e-12)
+
+
+def _outside_points(m, L0_m):
+    """Contractions and pressures around and beyond every edge of the domain (and past the rest length)."""
+    d = m.domain
+    p_top = d.p_max_Pa if math.isfinite(d.p_max_Pa) else 1e6
+    xs = (-0.2 * L0_m, -1e-4, d.x_max_m + 1e-7, 1.2 * d.x_max_m, 0.95 * L0_m, 1.5 * L0_m)
+    ps = (-1e5, -1.0, 0.0, 0.5 * p_top, 2.0 * p_top, 1e8)
+    return [(float(x), float(p)) for x in xs for p in ps]
+
+
+@pytest.mark.parametrize("model, params, variant", [pytest.param(*c.values, id=c.id) for c in cases()])
+def test_raw_scalar_force_outside_the_domain_is_real(model, params, variant):
+    """``force_N`` checks nothing, but outside the domain it gives NaN (or a real number), never a complex one:
+    Python's ``**`` and ``math.log`` would turn the point into a complex force or an exception."""
+    m = get(model).build(params, variant)
+    for x, p in _outside_points(m, params["L0_m"]):
+        f = m.force_N(x, p)
+        assert isinstance(f, float), f"force_N({x:g}, {p:g}) = {f!r}"

@@ -7,6 +7,7 @@ from typing import Mapping
 
 from .base import Domain, StaticForce, rated_pressure_Pa, brentq
 from .geometry import Braid
+from .real_math import sqrt
 
 GEOMETRY = ("L0_m", "r0_m", "theta0_deg")
 """Rest length, braid radius at rest and rest braid angle from the axis: what every braid model needs."""
@@ -41,7 +42,7 @@ class BraidModel(StaticForce):
 
     def sin_theta(self, L):
         """Sine of the braid angle from the axis at length ``L``: ``sqrt(1 - (L/b)^2)``."""
-        return (1.0 - L * L / self.b2) ** 0.5
+        return sqrt(1.0 - L * L / self.b2)
 
 
 class BladderModel(BraidModel):

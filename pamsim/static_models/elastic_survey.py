@@ -12,6 +12,7 @@ import math
 
 from .base import StaticModelSpec
 from .braid_base import WALL, BladderModel, BraidModel
+from .real_math import sqrt
 from .sources import SURVEY
 
 HOCKING_OPTIONAL = {"hocking_E2_Pa": 0.0, "hocking_E3_Pa": 0.0, "hocking_P_c_Pa": 0.0}
@@ -61,7 +62,7 @@ class Hocking(BladderModel):
              + g.Vb / L * self._stress(L / self.L0 - 1.0, p_gauge_Pa)
              - t * L * L * self.k_hoop / r * self._stress(r / g.r0 - 1.0, p_gauge_Pa))
         if self.chou:
-            s = (1.0 - L * L / self.b2) ** 0.5
+            s = sqrt(1.0 - L * L / self.b2)
             F = F + p_gauge_Pa * (self.chou[0] * (2.0 * s - 1.0 / s) - self.chou[1])
         return F
 
@@ -90,7 +91,7 @@ class Sangian(BraidModel):
 
     def force_N(self, x_m, p_gauge_Pa):
         s = 1.0 - x_m / self.L0
-        elastic = self.k_el * ((1.0 - s * s * self.c02) ** 0.5 + self.s0)
+        elastic = self.k_el * (sqrt(1.0 - s * s * self.c02) + self.s0)
         return self.a * (self.q1 * s * s - self.q2) * (p_gauge_Pa - self.P_bar + elastic)
 
 

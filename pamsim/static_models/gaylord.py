@@ -12,6 +12,7 @@ import numpy as np
 
 from .base import StaticModelSpec
 from .braid_base import GEOMETRY, WALL, BraidModel
+from .real_math import sqrt
 from .sources import ACRA2012, KOTHERA2009, SURVEY
 
 
@@ -71,7 +72,7 @@ class ChouHannaford(BraidModel):
 
     def force_N(self, x_m, p_gauge_Pa):
         L = self.L0 - x_m
-        s = (1.0 - L * L / self.b2) ** 0.5
+        s = sqrt(1.0 - L * L / self.b2)
         return p_gauge_Pa * ((3.0 * L * L - self.b2) * self.k_gaylord + self.c1 * (2.0 * s - 1.0 / s) - self.c0)
 
 

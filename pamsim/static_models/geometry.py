@@ -15,6 +15,7 @@ from typing import Mapping
 
 from ..core_table import BRAID_LOCK_SEC2
 from .base import brentq
+from .real_math import sqrt
 
 
 
@@ -73,12 +74,12 @@ class Braid:
 
     def radius_m(self, L):
         """Braid radius [m] at length ``L`` [m]: ``sqrt(b^2 - L^2) / (2 pi N)``."""
-        return (self.b * self.b - L * L) ** 0.5 / (2.0 * math.pi * self.N)
+        return sqrt(self.b * self.b - L * L) / (2.0 * math.pi * self.N)
 
     def thickness_m(self, L, R=None):
         """Wall thickness [m] at length ``L`` from constant bladder volume (Kothera eq. 16)."""
         R = self.radius_m(L) if R is None else R
-        return R - (R * R - self.Vb / (math.pi * L)) ** 0.5
+        return R - sqrt(R * R - self.Vb / (math.pi * L))
 
     def x_fill_m(self) -> float:
         """Contraction [m] at which a constant-volume bladder fills the braid (``R^2 = V_b/(pi L)``).

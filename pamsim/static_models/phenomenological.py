@@ -14,19 +14,10 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-
 from .base import Domain, StaticForce, StaticModelSpec, rated_pressure_Pa
 from .braid_base import GEOMETRY, BraidModel
+from .real_math import exp, log, power
 from .sources import SURVEY
-
-
-def _exp(v):
-    return math.exp(v) if isinstance(v, float) else np.exp(v)
-
-
-def _log(v):
-    return math.log(v) if isinstance(v, float) else np.log(v)
 
 
 class NormalisedGaylord(BraidModel):
@@ -62,7 +53,7 @@ class TonduLopez(NormalisedGaylord):
         self.pu = params["tondu_pressure_unit_Pa"]
 
     def k_eps(self, p):
-        return self.k1 * _exp(-p / self.pu) + self.k2
+        return self.k1 * exp(-p / self.pu) + self.k2
 
 
 class Itto(NormalisedGaylord):
@@ -75,7 +66,7 @@ class Itto(NormalisedGaylord):
         self.k1, self.k2, self.k3 = params["itto_kappa1"], params["itto_kappa2_per_Pa"], params["itto_kappa3"]
 
     def k_eps(self, p):
-        e = _exp(self.k2 * p)
+        e = exp(self.k2 * p)
         return self.k1 * (1.0 + e) if self.variant == "eq44" else self.k1 * e + self.k3
 
 
@@ -98,7 +89,7 @@ class Meller(NormalisedGaylord):
 
     def eps_max(self, p):
         """Measured free contraction (fraction of L0) at gauge pressure ``p`` [Pa]."""
-        return self.k3 * _log(p / self.pu)
+        return self.k3 * log(p / self.pu)
 
     def force_N(self, x_m, p_gauge_Pa):
         s = 1.0 - self.lim / self.eps_max(p_gauge_Pa) * x_m / self.L0
@@ -135,9 +126,9 @@ class Takosoglu(NormalisedGaylord):
 
     def force_N(self, x_m, p_gauge_Pa):
         k1, k3, k4, k6 = self.k
-        n = k1 * _exp(-p_gauge_Pa / self.k2) + k3
-        q1 = k4 * _exp(-p_gauge_Pa / self.k5) + k6
-        return self.a * p_gauge_Pa * (q1 * (1.0 - x_m / self.L0) ** n - self.q2)
+        n = k1 * exp(-p_gauge_Pa / self.k2) + k3
+        q1 = k4 * exp(-p_gauge_Pa / self.k5) + k6
+        return self.a * p_gauge_Pa * (q1 * power(1.0 - x_m / self.L0, n) - self.q2)
 
 
 def _bundle(e, p, c):

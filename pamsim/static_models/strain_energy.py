@@ -20,6 +20,7 @@ import math
 from dataclasses import dataclass
 
 from .geometry import Braid
+from .real_math import power, sqrt
 
 STRETCHES = ("mean_radius", "thin")
 
@@ -64,9 +65,9 @@ class Ogden:
             if mu == 0.0:
                 continue
             e = alpha - 1.0
-            g1 = g1 + mu * l1 ** e
-            g2 = g2 + mu * l2 ** e
-            g3 = g3 + mu * l3 ** e
+            g1 = g1 + mu * power(l1, e)
+            g2 = g2 + mu * power(l2, e)
+            g3 = g3 + mu * power(l3, e)
         return g1, g2, g3
 
 
@@ -84,7 +85,7 @@ def elastic_force_N(L, braid: Braid, energy, stretch: str = "mean_radius"):
     L0, R0, t0, Vb = g.L0, g.r0, g.t0, g.Vb
     k = 1.0 / (4.0 * math.pi ** 2 * g.N ** 2)
     R2 = (g.b * g.b - L * L) * k
-    R = R2 ** 0.5
+    R = sqrt(R2)
     dR = -L * k / R
     l1 = L / L0
     if stretch == "thin":
@@ -93,7 +94,7 @@ def elastic_force_N(L, braid: Braid, energy, stretch: str = "mean_radius"):
         d2 = dR / R0
         d3 = -l3 * (1.0 / L + d2 / l2)
     else:
-        s = (R2 - Vb / (math.pi * L)) ** 0.5
+        s = sqrt(R2 - Vb / (math.pi * L))
         t = R - s
         ds = (R * dR + Vb / (2.0 * math.pi * L * L)) / s
         dt = dR - ds
