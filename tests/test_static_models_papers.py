@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from pamsim.muscles import load_muscle
-from pamsim.static_models import get
+from pamsim.static_models import StaticModelDomainError, get
 from pamsim.static_models.geometry import Braid
 from pamsim.static_models.hyperelastic import FibreStretch
 from pamsim.static_models.strain_energy import MooneyRivlin, elastic_force_N
@@ -175,6 +175,26 @@ def test_fibre_stretch_reduces_to_kotheras_braid_term_for_small_strain():
         L = 0.95 * g.L0
         kothera21 = p ** 2 * g.b ** 3 * L / (4 * math.pi ** 2 * E * A * n * g.N ** 4)
         assert fs.force_N(L, p) == pytest.approx(kothera21, rel=1e-4)
+
+
+def test_fibre_stretch_has_no_value_where_no_fibre_length_balances_the_pressure():
+    """``b = b0/(1 - c L)``, ``c = p k``: at ``c L >= 1`` the fibres cannot hold the pressure; the model has
+    no value there (NaN, outside the domain) instead of a force from a negative fibre length."""
+    E_soft = 1e7  # soft fibres bring the limit below the muscle's rating
+    params = {**K5A, "ogden_mu1_Pa": 2 * K5A["C10_Pa"], "ogden_alpha1": 2.0, "E_braid_Pa": E_soft}
+    m = get("ogden").build(params)
+    g = Braid.from_parameters(K5A)
+    fs = FibreStretch(g.b, g.N, K5A["n_fibres"], E_soft, K5A["fibre_area_m2"])
+    p_limit = 1.0 / (fs.k * g.L0)  # c L = 1 first at the rest length
+    assert p_limit < K5A["rated_pressure_gauge_Pa"]
+    assert p_limit * (1 - 1e-6) < m.domain.p_max_Pa < p_limit
+    assert math.isfinite(m.evaluate_N(0.0, m.domain.p_max_Pa))
+    for p in (p_limit, 1.5 * p_limit, 10 * p_limit):
+        assert math.isnan(fs.force_N(g.L0, p)) and math.isnan(m.force_N(0.0, p))
+        assert np.all(np.isnan(m.force_N(np.array([0.0, 1e-3]), p))) or p == p_limit  # c L < 1 at 1 mm there
+        with pytest.raises(StaticModelDomainError):
+            m.evaluate_N(0.0, p)
+    assert math.isfinite(m.force_N(0.5 * m.domain.x_max_m, 0.9 * p_limit))
 
 
 def test_trivedi_force_vanishes_at_the_papers_inflation_pressure():

@@ -10,7 +10,9 @@ from __future__ import annotations
 
 import math
 
-from .base import StaticModelSpec
+import numpy as np
+
+from .base import Domain, StaticModelSpec
 from .braid_base import WALL, BladderModel
 from .sources import OGDEN, SURVEY
 from .strain_energy import STRETCHES, NeoHookean, Ogden, elastic_force_N
@@ -33,9 +35,20 @@ class FibreStretch:
         self.k = b0 / (2.0 * math.pi * turns ** 2 * strands * E_f * A_f)
         self.stiff = strands * A_f * b0 * E_f
 
+    def p_limit_Pa(self, L_max_m: float) -> float:
+        """Pressure [Pa] at which ``c L`` reaches 1 at length ``L_max_m``: no fibre length balances it or more."""
+        return 1.0 / (self.k * L_max_m)
+
     def force_N(self, L, p):
+        """Braid force [N]; NaN where ``c L >= 1`` (the fibres cannot hold the pressure: no value)."""
         c = self.k * p
-        u = 1.0 / (1.0 - c * L)
+        s = 1.0 - c * L
+        if isinstance(s, float):
+            if not s > 0.0:
+                return math.nan
+        else:
+            s = np.where(s > 0.0, s, np.nan)
+        u = 1.0 / s
         return self.stiff * (c * L * u) * c * u * u
 
 
@@ -50,6 +63,11 @@ class HyperelasticModel(BladderModel):
             E_f = params["E_braid_Pa"]
             self.braid = (FibreStretch(self.g.b, self.g.N, params["n_fibres"], E_f, params["fibre_area_m2"])
                           if math.isfinite(E_f) else None)
+            if self.braid is not None:
+                # c L is largest at the rest length; just below the limit the force is finite (and large).
+                p_top = self.braid.p_limit_Pa(self.L0) * (1.0 - 1e-9)
+                d = self.domain
+                self.domain = Domain(d.x_min_m, d.x_max_m, d.p_min_Pa, min(d.p_max_Pa, p_top))
         else:
             self.energy = NeoHookean(params["E_bladder_Pa"])
             self.braid = None
