@@ -161,6 +161,9 @@ def build_atlas(muscle: str, models: Sequence[str] | None = None, pressures_bar:
     a pressure above a model's domain leaves that curve out.
     """
     m, params = muscle_parameters(muscle, overrides)
+    why = None if models else m.no_model_reason(model_inputs(m, params))
+    if why:
+        raise InputError(f"muscle {m.name!r}: {why}: nothing to draw")
     names = list(models) if models else [n for n, s in REGISTRY.items() if not s.missing(model_inputs(m, params))]
     for name in names:  # the same checks and messages as a scenario or `pamsim force`
         prepare(muscle, name, overrides)
@@ -189,4 +192,8 @@ def build_atlas(muscle: str, models: Sequence[str] | None = None, pressures_bar:
             F = np.asarray(model.force_N(x, p), dtype=float)
             free = model.free_contraction_m(p, 0.0)
             curves.append(Curve(name, p, x, F, float(F[0]) if x_lo == 0.0 else math.nan, float(free)))
+    if not curves:
+        raise InputError(f"muscle {m.name!r}: no curve to draw: the pressures "
+                         f"{', '.join(f'{p / PA_PER_BAR:g}' for p in pressures)} bar lie outside the domain of "
+                         f"{', '.join(names)}" + "".join(f"; {n}: {w}" for n, w in skipped.items()))
     return Atlas(m, pressures, tuple(curves), measured, skipped)

@@ -101,5 +101,8 @@ def prepare(muscle: str, model: str | None = None, overrides: Mapping[str, Any] 
     fail, key = _defaults(fail, key)
     m, params = muscle_parameters(muscle, overrides, fail, key)
     inputs = model_inputs(m, params)
+    why = None if model else m.no_model_reason(inputs)
+    if why:
+        raise InputError(f"muscle {m.name!r}: {why} (its gaps: `pamsim muscles`; or give them with --set)")
     spec = applicable_model(model or m.default_static_force, variant, m, inputs, fail, key)
     return m, params, spec.build(inputs, variant)

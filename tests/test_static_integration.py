@@ -414,6 +414,45 @@ def test_atlas_refuses_a_model_that_does_not_apply_and_writes_nothing(tmp_path):
     assert not out.exists()
 
 
+NO_MODEL = "festo_dmsp_20_120"  # its paper's geometry table and Ogden constants are not in the source text
+
+
+def test_muscles_says_why_no_model_applies_instead_of_a_count_of_zero():
+    r = run_main("muscles")
+    assert r.returncode == 0, r.stderr
+    line = next(ln for ln in r.stdout.splitlines() if ln.startswith(NO_MODEL))
+    assert "0 models apply" not in line
+    assert "no static model applies" in line and "r0_m" in line and "theta0_deg" in line and "ogden_mu1_Pa" in line
+    gaps = [ln.strip() for ln in r.stdout.splitlines() if ln.strip().startswith("gap:")]
+    assert any("Table 1" in g for g in gaps) and any("Ogden constants" in g for g in gaps)
+    row = next(x for x in json.loads(run_main("muscles", "--json").stdout) if x["name"] == NO_MODEL)
+    assert row["applicable_models"] == [] and "ogden_alpha1" in row["no_model_reason"] and row["gaps"]
+
+
+@pytest.mark.parametrize("args", [
+    ["atlas", "--muscle", NO_MODEL, "-o", "{out}"],
+    ["static", "--muscle", NO_MODEL, "--pressure-bar", "3", "--load-N", "10"],
+    ["static", "--muscle", NO_MODEL, "--pressure-bar", "3", "--load-N", "10", "--json"],
+])
+def test_a_muscle_no_model_applies_to_is_refused_naming_it_and_nothing_is_written(tmp_path, args):
+    out = tmp_path / "atlas"
+    r = run_main(*[a.format(out=out) for a in args])
+    assert r.returncode == 2 and r.stdout == ""
+    line = r.stderr.strip()
+    assert "\n" not in line and "Traceback" not in line
+    assert NO_MODEL in line and "no static model applies" in line
+    assert not out.exists()
+
+
+def test_atlas_refuses_when_no_curve_lies_in_any_models_domain(tmp_path):
+    out = tmp_path / "atlas"
+    # Ogden with soft fibres: the domain's pressure ends near 3.1 bar, below the 4 bar asked for.
+    r = run_main("atlas", "--muscle", "kothera2009_5a", "--models", "ogden", "--pressures-bar", "4", "-o", out,
+                 "--set", "ogden_mu1_Pa=2e6", "--set", "ogden_alpha1=2", "--set", "E_braid_Pa=1e7")
+    assert r.returncode == 2 and "kothera2009_5a" in r.stderr and "ogden" in r.stderr
+    assert not out.exists()
+
+
 def test_docs_list_the_dynamics_defaults():
     from pamsim.cli.params import defaults_table
 

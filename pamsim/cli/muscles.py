@@ -6,7 +6,6 @@ import argparse
 import json
 
 
-
 def register(sub) -> None:
     p = sub.add_parser("muscles", help="list the shipped muscles",
                        description="Every shipped muscle with its citation, default static model and the "
@@ -23,11 +22,16 @@ def run(args: argparse.Namespace) -> int:
         m = load_muscle(name)
         rows.append({"name": m.name, "description": m.description, "citation": m.citation,
                      "default_static_force": m.default_static_force, "applicable_models": m.applicable_models(),
-                     "parameters": list(m.parameters)})
+                     "no_model_reason": m.no_model_reason(), "gaps": list(m.gaps), "parameters": list(m.parameters)})
     if args.json:
         print(json.dumps(rows, indent=2))
         return 0
     for r in rows:
-        print(f"{r['name']:28s} default model {r['default_static_force']}; {len(r['applicable_models'])} models apply")
+        why = r["no_model_reason"]
+        applies = why or f"{len(r['applicable_models'])} models apply"
+        print(f"{r['name']:28s} default model {r['default_static_force']}; {applies}")
         print(f"{'':28s} {r['description']}")
+        if why:  # the file's own account of what its sources leave out
+            for gap in r["gaps"]:
+                print(f"{'':28s} gap: {gap}")
     return 0

@@ -68,6 +68,14 @@ class Muscle:
         inputs = self.model_inputs()
         return [name for name, spec in REGISTRY.items() if not spec.missing(inputs)]
 
+    def no_model_reason(self, inputs: Mapping[str, Any] | None = None) -> str | None:
+        """Why no library model applies to ``inputs`` (default: the file's own), or None when one does."""
+        inputs = self.model_inputs() if inputs is None else inputs
+        if any(not spec.missing(inputs) for spec in REGISTRY.values()):
+            return None
+        lacks = ", ".join(get_model(self.default_static_force).missing(inputs))
+        return f"no static model applies: its default model {self.default_static_force!r} needs {lacks}, not given"
+
     def static_force(self, model: str | None = None, variant: str | None = None,
                      overrides: Mapping[str, float] | None = None) -> StaticForce:
         """Build a library model (default: the muscle's own) for this muscle."""
