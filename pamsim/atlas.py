@@ -50,6 +50,13 @@ class Curve:
     F_N: np.ndarray = field(repr=False)
     blocked_force_N: float
     free_contraction_m: float
+    free_contraction_note: str = ""
+    """Why there is no free contraction (``free_contraction_m`` NaN), else empty."""
+
+    def table_cell(self) -> str:
+        """``blocked force / free contraction [mm]``, ``none`` for a free contraction the note explains."""
+        free = "none" if self.free_contraction_note else f"{self.free_contraction_m * 1e3:.3g}"
+        return f"{self.blocked_force_N:.4g} / {free}"
 
 
 @dataclass(frozen=True)
@@ -77,7 +84,8 @@ class Atlas:
 
     def table_rows(self) -> list[dict]:
         return [{"model": c.model, "pressure_bar": c.pressure_Pa / PA_PER_BAR, "blocked_force_N": c.blocked_force_N,
-                 "free_contraction_mm": c.free_contraction_m * 1e3} for c in self.curves]
+                 "free_contraction_mm": c.free_contraction_m * 1e3, "free_contraction_note": c.free_contraction_note}
+                for c in self.curves]
 
     def markdown_table(self) -> str:
         """Blocked force and free contraction per model (rows) and pressure (columns)."""
@@ -89,8 +97,12 @@ class Atlas:
             cells = []
             for p in self.pressures_Pa:
                 c = by.get((m, p))
-                cells.append("-" if c is None else f"{c.blocked_force_N:.4g} / {c.free_contraction_m * 1e3:.3g}")
+                cells.append("-" if c is None else c.table_cell())
             lines.append(f"| `{m}` | " + " | ".join(cells) + " |")
+        for c in self.curves:
+            if c.free_contraction_note:
+                lines.append(f"\nNo free contraction: `{c.model}` at {c.pressure_Pa / PA_PER_BAR:g} bar: "
+                             f"{c.free_contraction_note}")
         for m, why in self.skipped.items():
             lines.append(f"\nNot drawn: `{m}`: {why}")
         return "\n".join(lines) + "\n"
@@ -111,7 +123,8 @@ class Atlas:
                     for x, F in zip(c.x_m, c.F_N):
                         w.writerow([c.model, f"{c.pressure_Pa / PA_PER_BAR:g}", f"{x * 1e3:.6g}", f"{F:.6g}"])
             with open(tmp["atlas_table.csv"], "w", newline="") as fh:
-                w = csv.DictWriter(fh, ["model", "pressure_bar", "blocked_force_N", "free_contraction_mm"])
+                w = csv.DictWriter(fh, ["model", "pressure_bar", "blocked_force_N", "free_contraction_mm",
+                                        "free_contraction_note"])
                 w.writeheader()
                 w.writerows(self.table_rows())
             tmp["atlas_table.md"].write_text(self.markdown_table())
@@ -191,7 +204,9 @@ def build_atlas(muscle: str, models: Sequence[str] | None = None, pressures_bar:
                 continue
             F = np.asarray(model.force_N(x, p), dtype=float)
             free = model.free_contraction_m(p, 0.0)
-            curves.append(Curve(name, p, x, F, float(F[0]) if x_lo == 0.0 else math.nan, float(free)))
+            note = "" if math.isfinite(free) else (f"the force stays above zero up to the end of its domain "
+                                                    f"({d.x_max_m * 1e3:.3g} mm)")
+            curves.append(Curve(name, p, x, F, float(F[0]) if x_lo == 0.0 else math.nan, float(free), note))
     if not curves:
         raise InputError(f"muscle {m.name!r}: no curve to draw: the pressures "
                          f"{', '.join(f'{p / PA_PER_BAR:g}' for p in pressures)} bar lie outside the domain of "

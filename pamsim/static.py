@@ -89,7 +89,11 @@ def static_report(params: Mapping[str, float], static_force, p_gauge_Pa: float, 
     x_hi = EndStops.from_parameters(params).x_high_m
     x_eq = equilibrium_contraction_m(static_force, p_gauge_Pa, load_N, x_hi)
     d = static_force.domain
+    at_stop = x_eq == x_hi and float(static_force.force_N(x_hi, p_gauge_Pa)) > load_N
+    note = ("held at the upper stop: the model still pulls harder than the load there, "
+            "so no equilibrium lies before it") if at_stop else ""
     return {"pressure_gauge_Pa": p_gauge_Pa, "load_N": load_N, "equilibrium_contraction_m": x_eq,
+            "equilibrium_note": note,
             "max_load_N": max_load_N(static_force, p_gauge_Pa, min(x_hi, d.x_max_m)), "lifts_load": x_eq > 0.0,
             "upper_stop_m": x_hi,
             "within_fit_range": bool(d.x_min_m <= x_eq <= d.x_max_m and d.p_min_Pa <= p_gauge_Pa <= d.p_max_Pa)}

@@ -407,6 +407,34 @@ def test_atlas_writes_curves_table_and_figures_of_every_applicable_model(tmp_pat
         assert (out / name).stat().st_size > 0
 
 
+def test_atlas_gives_the_reason_where_a_model_has_no_free_contraction(tmp_path):
+    """Zang's printed law, 2 pi r0^2 p (1 - eps)^2/tan^2(theta0), stays positive over its whole domain."""
+    out = tmp_path / "atlas"
+    r = run_main("atlas", "--muscle", "mpam_survey_45mm", "--models", "gaylord,zang", "-o", out)
+    assert r.returncode == 0, r.stderr
+    for text in (r.stdout, (out / "atlas_table.md").read_text()):
+        assert "nan" not in text
+        row = next(ln for ln in text.splitlines() if ln.startswith("| `zang`"))
+        assert row.endswith("/ none |")
+        note = next(ln for ln in text.splitlines() if "`zang`" in ln and "free contraction" in ln)
+        assert "stays above zero" in note and "12.9 mm" in note and "7.58 bar" in note
+    rows = {row["model"]: row for row in csv.DictReader((out / "atlas_table.csv").open())}
+    assert "stays above zero" in rows["zang"]["free_contraction_note"] and rows["gaylord"]["free_contraction_note"] == ""
+
+
+def test_static_says_why_the_equilibrium_is_the_upper_stop():
+    args = ("static", "--muscle", "mpam_survey_45mm", "--model", "zang", "--pressure-bar", "3", "--load-N", "0.5")
+    r = run_main(*args)
+    assert r.returncode == 0, r.stderr
+    line = next(ln for ln in r.stdout.splitlines() if "equilibrium contraction" in ln)
+    assert "upper stop" in line and "pulls harder than the load" in line
+    out = json.loads(run_main(*args, "--json").stdout)
+    assert "upper stop" in out["equilibrium_note"]
+    plain = json.loads(run_main("static", "--muscle", "mpam_survey_45mm", "--model", "gaylord", "--pressure-bar", "3",
+                                "--load-N", "0.5", "--json").stdout)
+    assert plain["equilibrium_note"] == ""
+
+
 def test_atlas_refuses_a_model_that_does_not_apply_and_writes_nothing(tmp_path):
     out = tmp_path / "atlas"
     r = run_main("atlas", "--muscle", "shadow_6x300_acra2012", "--models", "gaylord,chou_hannaford", "-o", out)

@@ -39,7 +39,8 @@ def run(args: argparse.Namespace) -> int:
         return 0
     x = report["equilibrium_contraction_m"]
     print(f"muscle {muscle.name}, model {model.name}, {args.pressure_bar:g} bar, {args.load_N:g} N")
-    print(f"  equilibrium contraction: {x * 1e3:.3f} mm" + ("" if x > 0 else " (cannot lift it off the lower stop)"))
+    why = report["equilibrium_note"] or ("" if x > 0 else "cannot lift it off the lower stop")
+    print(f"  equilibrium contraction: {x * 1e3:.3f} mm" + (f" ({why})" if why else ""))
     print(f"  force capability (max load held above the lower stop): {report['max_load_N']:.2f} N")
     if not report["within_fit_range"]:
         print("  warning: outside the model's valid domain")
