@@ -39,3 +39,23 @@ def test_parameter_provenance_uses_the_short_labels_not_file_keys():
     for pset in map(get_parameter_set, shipped_names()):
         for name, entry in pset.entries.items():
             assert "acra2012_dynamic" not in entry.source and ".txt" not in entry.source, name
+
+
+def test_schulte_is_left_out_for_its_elastic_term_at_rest():
+    """Survey eq. (15): the bracket of the elastic term, l0 sin(theta) - (cos^2/sin)((b/N) sin(theta) - 2 pi r0),
+    is l0 sin(theta0) at rest, since (b/N) sin(theta0) = 2 pi r0: a pull with no pressure and no strain.
+    P_u only enters the friction term, which no static map keeps."""
+    import math
+
+    from pamsim.muscles import load_muscle
+    from pamsim.static_models.geometry import Braid
+
+    g = Braid.from_parameters(load_muscle("kothera2009_5a").parameters)
+    s0, c0 = math.sin(g.theta0), math.cos(g.theta0)
+    bracket = g.L0 * s0 - c0 ** 2 / s0 * ((g.b / g.N) * s0 - 2 * math.pi * g.r0)
+    assert bracket == pytest.approx(g.L0 * s0, rel=1e-12) and bracket > 0
+    text = (ROOT / "docs" / "static_models.md").read_text()
+    row = next(ln for ln in text.splitlines() if ln.startswith("| S-09 |"))
+    assert "needs a law for the free-tube pressure" not in row and "nonzero at rest" in row
+    listed = next(ln for ln in text.splitlines() if ln.startswith("- Schulte (S-09)"))
+    assert "under-specified" not in listed
