@@ -22,7 +22,7 @@ from pamsim.control.closed_loop import run_closed_loop
 from pamsim.control.system import STATES, MusclePlant
 from pamsim.errors import InputError
 
-from conftest import ROOT, SCENARIOS
+from conftest import ROOT, SCENARIOS, run_cli
 
 FIG4 = SCENARIOS / "acra2012_fig4.toml"
 CLOSED_LOOP = SCENARIOS / "closed_loop_position.toml"
@@ -370,6 +370,14 @@ def test_cli_linearize_json(tmp_path, cli):
     assert rep["natural_frequency_Hz"] > 0
     assert (tmp_path / "acra2012_fig4_linear_bode.png").stat().st_size > 0
     assert (tmp_path / "acra2012_fig4_linear_pzmap.png").stat().st_size > 0
+
+
+def test_cli_linearize_json_without_output_folder_writes_nothing_and_keeps_stderr_empty(tmp_path):
+    proc = run_cli("linearize", FIG4, "--json", cwd=tmp_path)  # a real process: warnings show as a user sees them
+    assert proc.returncode == 0, proc.stderr
+    assert json.loads(proc.stdout)["natural_frequency_Hz"] > 0
+    assert proc.stderr == ""
+    assert list(tmp_path.iterdir()) == []
 
 
 @pytest.mark.parametrize("args, words", [

@@ -18,12 +18,14 @@ from ..atomic import atomic_outputs, output_folder
 from ..control.choices import FRICTION_KINDS, VALVE_SLOPES
 from . import finite_float
 
+DEFAULT_OUTPUT = "out"
+
 
 def register(sub) -> None:
     p = sub.add_parser("linearize", help="linear model at an operating point (python-control)",
                        description="Linearise the muscle about an operating point of a scenario (valve source); "
                                    "print A, B, C, D, poles, the mechanical mode and DC gains; write a Bode plot "
-                                   "and a pole-zero map into DIR.")
+                                   "and a pole-zero map into DIR (with --json only when -o is given).")
     p.add_argument("scenario", help="scenario TOML file (valve source)")
     where = p.add_mutually_exclusive_group()
     where.add_argument("--at-time", type=finite_float, metavar="T", help="state of the simulation at T [s]")
@@ -36,7 +38,8 @@ def register(sub) -> None:
     p.add_argument("--valve-slope", choices=VALVE_SLOPES, default="mean",
                    help="valve slope at command 0: mean of fill and vent (default), fill, vent")
     p.add_argument("--json", action="store_true", help="print JSON")
-    p.add_argument("-o", "--output", default="out", help="directory for the PNG plots (default: out)")
+    p.add_argument("-o", "--output", default=None,
+                   help=f"directory for the PNG plots (default: {DEFAULT_OUTPUT}; with --json: no plots)")
     p.set_defaults(func=run)
 
 
@@ -89,7 +92,10 @@ def run(args: argparse.Namespace) -> int:
     from ..scenario import load_scenario
 
     scenario = load_scenario(args.scenario)
-    with output_folder(args.output) as out:  # removed again if the operating point turns out bad
+    if args.json and args.output is None:  # the numbers only: no file written, nothing on stderr
+        print(json.dumps(_linearize(scenario, args)[1], indent=2))
+        return 0
+    with output_folder(args.output or DEFAULT_OUTPUT) as out:  # removed again if the operating point turns out bad
         lin, rep, names = _linearize_and_plot(scenario, args, out)
     wrote = f"wrote {', '.join(str(out / n) for n in names)}"
     if args.json:
@@ -101,11 +107,10 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _linearize_and_plot(scenario, args: argparse.Namespace, out: Path):
-    """Linearise at the operating point the arguments choose and write the plots; (model, report, file names)."""
+def _linearize(scenario, args: argparse.Namespace):
+    """Linearise at the operating point the arguments choose: (model, report)."""
     from ..control.linear import linearize
     from ..control.operating_point import held_equilibrium, open_valve_equilibrium, trajectory_point
-    from ..control.plots import bode_figure, pole_zero_figure
     from ..control.system import FrictionTreatment
 
     model = scenario.build_model()
@@ -118,7 +123,14 @@ def _linearize_and_plot(scenario, args: argparse.Namespace, out: Path):
         op = open_valve_equilibrium(model, supply)
     friction = FrictionTreatment(args.friction, args.friction_velocity_mm_s * 1e-3)
     lin = linearize(model, op, friction, args.valve_slope)
-    rep = report(lin)
+    return lin, report(lin)
+
+
+def _linearize_and_plot(scenario, args: argparse.Namespace, out: Path):
+    """:func:`_linearize` and write the plots; (model, report, file names)."""
+    from ..control.plots import bode_figure, pole_zero_figure
+
+    lin, rep = _linearize(scenario, args)
     stem = f"{scenario.name}_linear"
     names = [f"{stem}_bode.png", f"{stem}_pzmap.png"]
     with atomic_outputs(out, names) as tmp:

@@ -29,7 +29,8 @@ def bode_figure(lin: LinearModel) -> Figure:
         ax.axvline(f_n, color="k", ls=":", lw=1)
         ax.grid(alpha=0.3, which="both")
     ax_m.set_ylabel("magnitude [SI output / SI input]")
-    ax_m.legend(fontsize=8)
+    if ax_m.get_legend_handles_labels()[0]:  # every channel switched off: matplotlib would warn of an empty legend
+        ax_m.legend(fontsize=8)
     ax_p.set_ylabel("phase [deg]")
     ax_p.set_xlabel("frequency [Hz]")
     fig.suptitle(f"Bode: {lin.op.kind}, {lin.friction.kind} friction; mechanical mode {f_n:.3g} Hz (dotted)")
