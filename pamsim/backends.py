@@ -27,6 +27,15 @@ BACKENDS: dict[str, str] = {
 }
 
 
+DESCRIPTIONS: dict[str, str] = {
+    "python": "scipy's solve_ivp (default)",
+    "native": "the C core as a shared library, built on first use (needs a C compiler)",
+    "fmu-cs": "the exported FMU, co-simulation, through FMPy",
+    "fmu-me": "the exported FMU, model exchange, through FMPy",
+}
+"""name -> one line for ``pamsim run --help``."""
+
+
 # name -> "module:function" that raises InputError for a scenario the backend cannot run, before any work
 CHECKS: dict[str, str] = {
     "native": "pamsim.native:refuse_unsupported",

@@ -332,3 +332,16 @@ def test_a_key_typed_with_a_newline_still_gives_one_line(tmp_path, cli):
                                '[pressure.command]\nkind = "constant"\nvalue = 1.0\n"tau\\ns" = 1.0'))
     code, err = _code_err(cli, "run", sc, "-o", tmp_path / "o")
     assert code == 2 and len(err.strip().splitlines()) == 1 and "tau\\ns" in err, err
+
+
+def test_run_help_describes_every_backend(cli):
+    """In the option's own help text, not only in argparse's list of choices."""
+    from pamsim.backends import BACKENDS
+    from pamsim.cli import build_parser
+
+    run = build_parser()._subparsers._group_actions[0].choices["run"]
+    backend = next(a for a in run._actions if "--backend" in a.option_strings)
+    for name in BACKENDS:
+        assert name in backend.help, name
+    text = " ".join(cli("run", "--help").stdout.split())
+    assert "native: the C core" in text

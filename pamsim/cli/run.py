@@ -14,7 +14,7 @@ import tomllib
 from pathlib import Path
 
 from ..atomic import atomic_outputs, output_folder
-from ..backends import BACKENDS, check_backend
+from ..backends import BACKENDS, DESCRIPTIONS, check_backend
 from ..errors import InputError
 from . import finite_float
 
@@ -30,7 +30,7 @@ def register(sub) -> None:
     p.add_argument("scenario", nargs="+", help="scenario TOML files, or folders of them (e.g. scenarios/)")
     p.add_argument("-o", "--output", default="out", help="output directory (default: out)")
     p.add_argument("--backend", default="python", choices=sorted(BACKENDS),
-                   help="python (solve_ivp, default) or an FMU importer")
+                   help="; ".join(f"{name}: {DESCRIPTIONS[name]}" for name in BACKENDS))
     p.add_argument("--no-plot", action="store_true", help="skip the PNG")
     p.add_argument("--max-csv-MB", type=finite_float, default=MAX_CSV_MB, metavar="MB",
                    help=f"refuse a run whose CSV could exceed this size (default {MAX_CSV_MB:g} MB; "
