@@ -10,6 +10,7 @@ import numpy as np
 
 from .atomic import atomic_path
 from .model import N_WORK, Mode
+from .run_warnings import pointless_run_warnings
 
 if TYPE_CHECKING:
     from .model import MuscleModel
@@ -92,6 +93,9 @@ class Result:
     """Largest ``x_m`` and ``p_gauge_Pa`` and smallest ``x_min_m`` of the integrated solution (every step and
     event), where the backend knows them; the samples may miss a peak between them."""
     model: "MuscleModel | None" = field(default=None, repr=False)
+    warnings: list[str] = field(default_factory=list)
+    """One line each: the fit-range violations and the signs of a pointless run
+    (:mod:`pamsim.run_warnings`); ``pamsim run`` prints them on stderr."""
 
     @classmethod
     def from_trace(cls, model: "MuscleModel", name, t, Y, modes, transitions, impact_losses, stats, wall_time_s,
@@ -123,8 +127,11 @@ class Result:
         if p_hi > fr.p_max_gauge_Pa:
             violations.append(f"pressure up to {p_hi / 1e5:.3f} bar, above the fitted {fr.p_max_gauge_Pa / 1e5:.2f} bar")
         final = model.rest_forces(float(t[-1]), Y[:, -1])
-        return cls(name, t, Y[0], Y[1], p, modes, sig, transitions, stats, wall_time_s,
-                   model.load.mass_kg, model.load.g_m_s2, float(loss_J.sum()), final, violations, peaks=peaks, model=model)
+        res = cls(name, t, Y[0], Y[1], p, modes, sig, transitions, stats, wall_time_s,
+                  model.load.mass_kg, model.load.g_m_s2, float(loss_J.sum()), final, violations, peaks=peaks, model=model)
+        res.warnings = ([f"left the static model's valid (fitted) range: {v}" for v in violations]
+                        + pointless_run_warnings(model, t, res.at_rest_at_end, float(Y[1][-1])))
+        return res
 
     # ------------------------------------------------------------------ queries
     @property
@@ -184,6 +191,7 @@ class Result:
             "wall_time_s": float(self.wall_time_s),
             "out_of_fit_range": self.out_of_fit_range,
             "fit_range_violations": list(self.fit_range_violations),
+            "warnings": list(self.warnings),
             "energy_balance": self.energy_balance(),
         }
         return s

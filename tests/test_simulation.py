@@ -357,3 +357,42 @@ def test_progress_is_reported_inside_a_long_segment():
     assert res.stats["segments"] == 1
     assert len(seen) > 3 and seen[-1] == 0.9 and 0.0 < seen[1] < 0.9
     assert all(b >= a for a, b in zip(seen, seen[1:]))
+
+
+# ---------------------------------------------------------------- warnings on pointless runs
+POINTLESS = {
+    "valve opens after the end": ({"simulation": {"duration_s": 0.5}}, ["valve", "opens at 1 s", "after the run ends"]),
+    "load beyond the blocked force": ({"load": {"weight_N": 1e30}}, ["1e+30 N", "blocked force", "3.6 bar"]),
+    "still moving at the end": ({"simulation": {"duration_s": 1.5}}, ["still moving", "duration_s"]),
+}
+
+
+@pytest.mark.parametrize("what", POINTLESS)
+def test_pointless_run_warns_once_in_the_result_the_summary_and_on_stderr(tmp_path, what):
+    from conftest import run_main
+
+    changes, words = POINTLESS[what]
+    sc = pamsim.load_scenario(SCENARIOS / "acra2012_fig4.toml").with_changes(changes)
+    res = pamsim.simulate(sc)
+    hits = [w for w in res.warnings if all(word in w for word in words)]
+    assert len(hits) == 1, res.warnings
+    assert hits[0] in res.summary()["warnings"]
+    path = tmp_path / "s.toml"
+    text = (SCENARIOS / "acra2012_fig4.toml").read_text()
+    for section, values in changes.items():
+        for key, value in values.items():
+            text = "\n".join(f"{key} = {value!r}" if line.split("=")[0].strip() == key else line
+                             for line in text.splitlines())
+    path.write_text(text)
+    r = run_main("run", path, "-o", tmp_path / "out", "--no-plot")
+    assert r.returncode == 0, r.stderr
+    lines = [ln for ln in r.stderr.splitlines() if all(word in ln for word in words)]
+    assert len(lines) == 1 and lines[0].startswith("pamsim: warning: acra2012_fig4: ")
+    import json
+
+    assert hits[0] in json.loads((tmp_path / "out" / "acra2012_fig4.json").read_text())["warnings"]
+
+
+def test_a_run_that_does_its_job_has_no_warning(paper_results):
+    _, res = paper_results["acra2012_fig4"]
+    assert res.warnings == [] and res.summary()["warnings"] == []

@@ -113,9 +113,8 @@ def _run_one(scenario, args: argparse.Namespace, out: Path) -> list[str]:
         tmp[names[1]].write_text(json.dumps(summary, indent=2) + "\n")
         if not args.no_plot:
             outcome.figure().savefig(tmp[names[2]], format="png", dpi=110)
-    for warning in result.fit_range_violations:
-        print(f"pamsim: warning: {scenario.name}: left the static model's valid (fitted) range: {warning}",
-              file=sys.stderr)
+    for warning in result.warnings:
+        print(f"pamsim: warning: {scenario.name}: {warning}", file=sys.stderr)
     s = summary
     print(f"{scenario.name}: final contraction {s['final_contraction_m'] * 1e3:.2f} mm "
           f"(peak {s['peak_contraction_m'] * 1e3:.2f} mm), final pressure {s['final_pressure_gauge_Pa'] / 1e5:.3f} bar, "
