@@ -77,7 +77,8 @@ _DELETE = object()
 
 BAD = [  # (path to change, new value, text the one-line message must contain)
     (("colour",), "red", "colour = 'red': unknown key"),
-    (("parameters", "L0_mm"), {"value": 1.0, "source": "x"}, "parameters.L0_mm = {'value': 1.0, 'source': 'x'}: unknown parameter (did you mean 'L0_m'?)"),
+    # The parameter named, not its table dumped.
+    (("parameters", "L0_mm"), {"value": 1.0, "source": "x"}, "dir/bad.toml: parameters.L0_mm: unknown parameter (did you mean 'L0_m'?)"),
     (("parameters", "L0_m", "value"), "0.1", "parameters.L0_m.value = '0.1': required, a number"),
     (("parameters", "L0_m", "value"), True, "parameters.L0_m.value = True: required, a number"),
     (("parameters", "L0_m", "value"), math.inf, "parameters.L0_m.value = inf: must be a finite number"),

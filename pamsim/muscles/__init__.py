@@ -164,13 +164,13 @@ def muscle_from_dict(raw: Mapping[str, Any], origin: str | Path = "<dict>") -> M
     tables = raw.get("parameters", {})
     if not isinstance(tables, dict):
         raise fail("parameters", tables, "must be a table of [parameters.NAME] tables")
-    entries = {name: _entry(fail, name, table) for name, table in tables.items()}
+    entries = {name: _entry(fail, origin, name, table) for name, table in tables.items()}
     if "rated_pressure_gauge_Pa" in raw:
         if "rated_pressure_gauge_Pa" in entries:
             raise fail("rated_pressure_gauge_Pa", raw["rated_pressure_gauge_Pa"],
                        "given both at the top level and under [parameters]")
         entries["rated_pressure_gauge_Pa"] = _entry(
-            fail, "rated_pressure_gauge_Pa",
+            fail, origin, "rated_pressure_gauge_Pa",
             {"value": raw["rated_pressure_gauge_Pa"], "source": f"{origin.name}: top-level rating (no source given)"})
     _convert_radial_angle(fail, entries)
     _complete_wall(fail, entries)
@@ -194,11 +194,12 @@ def muscle_from_dict(raw: Mapping[str, Any], origin: str | Path = "<dict>") -> M
                   tuple(gaps), data_file, force_map_file)
 
 
-def _entry(fail, name: str, table: Any) -> Parameter:
+def _entry(fail, origin: Path, name: str, table: Any) -> Parameter:
     """One ``[parameters.NAME]`` table -> :class:`Parameter` with the known unit and bounds."""
     key = f"parameters.{name}"
-    if name not in KNOWN and name != "alpha_radial_deg":
-        raise fail(key, table, "unknown parameter" + did_you_mean(name, list(KNOWN) + ["alpha_radial_deg"]))
+    if name not in KNOWN and name != "alpha_radial_deg":  # the name is the mistake: its table is not quoted
+        raise MuscleError(f"{origin}: {key}: unknown parameter"
+                          + did_you_mean(name, list(KNOWN) + ["alpha_radial_deg"]))
     if not isinstance(table, dict):
         raise fail(key, table, "must be a table with value and source")
     for k in table:
