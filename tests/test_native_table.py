@@ -183,6 +183,25 @@ def test_missing_compiler_is_an_input_error(monkeypatch):
     from pamsim.native import build
 
     monkeypatch.setenv("CC", "")
-    monkeypatch.setattr(build.shutil, "which", lambda name: None)
+    monkeypatch.setattr("shutil.which", lambda name: None)
     with pytest.raises(InputError, match="needs a C compiler"):
         build.library_path()
+
+
+@pytest.mark.parametrize("args", [
+    ["run", "{fig4}", "--backend", "native", "-o", "{out}"],
+    ["fmu", "build", "-o", "{out}/m.fmu"],
+])
+def test_a_cc_that_does_not_exist_is_named_as_the_c_compiler(monkeypatch, tmp_path, args):
+    from conftest import SCENARIOS, run_cli
+
+    monkeypatch.setenv("CC", "/nonexistent/cc")
+    monkeypatch.setenv("PAMSIM_NATIVE_CACHE", str(tmp_path / "cache"))  # no library built earlier to reuse
+    out = tmp_path / "out"
+    # A new process: this one may hold the library loaded by an earlier test.
+    r = run_cli(*[a.format(fig4=SCENARIOS / "acra2012_fig4.toml", out=out) for a in args])
+    assert r.returncode == 2
+    line = r.stderr.strip()
+    assert "\n" not in line and "Traceback" not in line
+    assert "CC = '/nonexistent/cc'" in line and "C compiler" in line
+    assert not out.exists()

@@ -55,6 +55,26 @@ def default_output(fmi_version: int) -> Path:
     return Path(f"{MODEL_IDENTIFIER}_fmi{fmi_version}.fmu")
 
 
+
+def c_compiler(purpose: str) -> str:
+    """The C compiler ``purpose`` (a phrase: "the native backend") uses: ``$CC``, else ``cc`` or ``gcc`` on the path.
+
+    Raises
+    ------
+    InputError
+        Naming ``CC`` if it names no program, else saying that none was found.
+    """
+    cc = os.environ.get("CC")
+    if cc:
+        if not shutil.which(cc):
+            raise InputError(f"CC = {cc!r}: no such program; CC names the C compiler {purpose} uses "
+                             "(install one there, or unset CC to use cc or gcc from the path)")
+        return cc
+    found = shutil.which("cc") or shutil.which("gcc")
+    if not found:
+        raise InputError(f"{purpose} needs a C compiler (install gcc, or set CC)")
+    return found
+
 def build(output_path: str | os.PathLike | None = None, fmi_version: int = 2,
           force_table: ForceTable | None = None) -> Path:
     """Generate, compile and zip the FMU; return the path of the ``.fmu`` file.
@@ -71,9 +91,7 @@ def build(output_path: str | os.PathLike | None = None, fmi_version: int = 2,
     out = Path(output_path) if output_path else default_output(fmi_version)
     if out.suffix != ".fmu":
         raise InputError(f"{out}: the FMU file name must end in .fmu")
-    compiler = os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc")
-    if not compiler:
-        raise InputError("no C compiler found (install gcc, or set CC)")
+    compiler = c_compiler("pamsim fmu build")
     with tempfile.TemporaryDirectory(prefix="pamsim-fmu-") as tmp:
         root = Path(tmp)
         src = root / "sources"

@@ -13,13 +13,12 @@ from __future__ import annotations
 
 import hashlib
 import os
-import shutil
 import subprocess
 import tempfile
 from pathlib import Path
 
 from ..errors import InputError
-from ..fmu.build import shared_library_suffix
+from ..fmu.build import c_compiler, shared_library_suffix
 from ..fmu.force_table import EMPTY_HEADER
 from ..fmu.generate import c_header, c_source_dir
 
@@ -32,10 +31,7 @@ CACHE_ENV = "PAMSIM_NATIVE_CACHE"
 
 def compiler() -> str:
     """The C compiler: ``$CC``, else ``cc`` or ``gcc`` on the path."""
-    found = os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc")
-    if not found:
-        raise InputError("the native backend needs a C compiler (install gcc, or set CC)")
-    return found
+    return c_compiler("the native backend")
 
 
 def cache_root() -> Path:
