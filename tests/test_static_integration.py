@@ -366,7 +366,11 @@ def test_static_with_another_model_solves_its_equilibrium():
      ["--set L0_m", "-1"]),
     (["force", "--model", "chou_hannaford", "--pressure-bar", "3", "--contraction-mm", "1"],
      ["chou_hannaford", "wall_thickness_m"]),
-    (["force", "--model", "gaylord", "--pressure-bar", "3", "--contraction-mm", "500"], ["x_m", "0.5", "domain"]),
+    # Reported as the user wrote it, in the flag's unit.
+    (["force", "--model", "gaylord", "--pressure-bar", "3", "--contraction-mm", "500"],
+     ["--contraction-mm 500", "domain", "mm"]),
+    (["force", "--pressure-bar", "3", "--contraction-mm", "-5"], ["--contraction-mm -5", "[-0.1, 76] mm"]),
+    (["force", "--pressure-bar", "-1", "--contraction-mm", "5"], ["--pressure-bar -1", "bar"]),
     (["force", "--model", "gaylord", "--muscle", "nosuch", "--pressure-bar", "3", "--contraction-mm", "1"],
      ["nosuch"]),
     (["static", "--model", "gaylord", "--pressure-bar", "3", "--load-N", "5", "--set", "festo"], ["festo"]),

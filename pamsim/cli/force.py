@@ -6,6 +6,7 @@ import argparse
 import json
 
 from ..constants import PA_PER_BAR
+from ..errors import InputError
 from . import finite_float, muscle_args
 
 
@@ -23,6 +24,7 @@ def register(sub) -> None:
 def run(args: argparse.Namespace) -> int:
     muscle, _, model = muscle_args.resolve(args)
     x_m, p_Pa = args.contraction_mm * 1e-3, args.pressure_bar * PA_PER_BAR
+    _check_domain(model, args, x_m, p_Pa)
     force = float(model.evaluate_N(x_m, p_Pa))
     if args.json:
         print(json.dumps({"muscle": muscle.name, "model": model.name, "contraction_m": x_m,
@@ -30,3 +32,14 @@ def run(args: argparse.Namespace) -> int:
         return 0
     print(f"{model.name} on {muscle.name}: {force:.6g} N at {args.contraction_mm:g} mm, {args.pressure_bar:g} bar")
     return 0
+
+
+def _check_domain(model, args: argparse.Namespace, x_m: float, p_Pa: float) -> None:
+    """The model's domain check, reported with the flag and value the user wrote, in the flag's unit."""
+    d = model.domain
+    for flag, value, si, lo, hi, scale, unit in (
+            ("--contraction-mm", args.contraction_mm, x_m, d.x_min_m, d.x_max_m, 1e3, "mm"),
+            ("--pressure-bar", args.pressure_bar, p_Pa, d.p_min_Pa, d.p_max_Pa, 1.0 / PA_PER_BAR, "bar")):
+        if not lo <= si <= hi:
+            raise InputError(f"{flag} {value:g}: outside the valid domain of static model {model.name!r}, "
+                             f"[{lo * scale:.4g}, {hi * scale:.4g}] {unit}")
