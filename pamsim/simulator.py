@@ -299,8 +299,7 @@ def simulate_model(model: MuscleModel, duration_s: float, options: SolverOptions
                 hold_until = t_event + _HOLD_S * 2.0 ** (n_zero - 1)
             transitions.append(TransitionEvent(t_event, kind, old.label, mode.label, float(y[0])))
             if len(transitions) > opts.max_events:
-                raise SolverFailure(f"more than {opts.max_events} events by t = {t_event:.6g} s "
-                                    "(raise [solver] max_events if this is expected)")
+                raise too_many_events(opts.max_events, f" by t = {t_event:.6g} s")
             t = t_event
         else:
             t = t_break
@@ -319,6 +318,12 @@ def simulate_model(model: MuscleModel, duration_s: float, options: SolverOptions
                               "method": opts.method, "rtol": opts.rtol},
                              time.perf_counter() - wall0,
                              peaks={"x_m": peak_x, "p_gauge_Pa": peak_p, "x_min_m": low_x})
+
+
+def too_many_events(max_events: int, when: str = "") -> SolverFailure:
+    """The failure of a run with more than ``max_events`` events (``when``: e.g. " by t = 1.2 s")."""
+    noun = "event" if max_events == 1 else "events"
+    return SolverFailure(f"more than {max_events} {noun}{when} (raise [solver] max_events if this is expected)")
 
 
 __all__ = ["SolverFailure", "SolverOptions", "simulate_model", "n_samples"]

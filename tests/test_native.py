@@ -116,6 +116,14 @@ def test_too_many_events_is_a_solver_failure_on_both_backends():
             pamsim.simulate(sc, backend=backend)
 
 
+def test_too_many_events_message_counts_in_the_singular_for_one():
+    sc = pamsim.load_scenario(SCENARIOS / "acra2012_fig6b.toml").with_changes({"solver": {"max_events": 1}})
+    for backend in ("python", "native"):
+        with pytest.raises(SolverFailure, match="more than 1 event ") as err:
+            pamsim.simulate(sc, backend=backend)
+        assert "1 events" not in str(err.value)
+
+
 def test_a_case_that_outgrows_the_batch_event_room_runs_again_alone(monkeypatch):
     """With room for 3 events per case, cases with more are run again alone with room for their own
     max_events, and give the numbers of a batch with room enough; a case over its own limit still

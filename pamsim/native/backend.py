@@ -38,6 +38,7 @@ from ..model import Mode, MuscleModel
 from ..result import Result, TransitionEvent
 from ..scenario import Scenario
 from ..signals import Constant, FirstOrderLag, Step
+from ..simulator import too_many_events
 from . import library as lib
 
 METHODS = ("LSODA", "RK45")
@@ -234,7 +235,7 @@ def _result(scenario: Scenario, case: CaseInputs, out: dict, i: int, wall_time_s
     if status == 2:
         raise SolverFailure(f"native backend: {message}")
     if status == 3:
-        raise SolverFailure(f"more than {case.max_events} events (raise [solver] max_events if this is expected)")
+        raise too_many_events(case.max_events)
     model = case.model
     first, n = int(out["sample_offset"][i]), case.n_samples
     S = out["samples"][len(lib.SAMPLE_COLUMNS) * first:len(lib.SAMPLE_COLUMNS) * (first + n)].reshape(-1, n)
