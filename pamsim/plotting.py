@@ -6,6 +6,8 @@ imports this module, and one direction of dependency is enough.
 
 from __future__ import annotations
 
+import textwrap
+
 import numpy as np
 from matplotlib.figure import Figure
 
@@ -79,7 +81,8 @@ def result_figure(result: "Result", title: str | None = None, compare: "list[Res
                f"({result.mass_kg:.3f} kg), {result.p_gauge_Pa[-1] / PA_PER_BAR:.2f} bar at the end")
     if backend != "python":
         default += f"\n{backend} backend (the exported FMU)"
-    fig.suptitle(title or default)
+    note = textwrap.fill(result.damping_energy_note(), 90)  # the figure is about 90 title characters wide
+    fig.suptitle((title or default) + (f"\n{note}" if note else ""))
     return fig
 
 

@@ -172,6 +172,20 @@ class Result:
         scale = max(abs(v) for v in terms.values()) or 1.0
         return {**terms, "residual_J": float(residual), "relative": float(abs(residual) / scale)}
 
+    def damping_energy_note(self) -> str:
+        """Why ``E_damping_J`` is negative (the damping added energy), or "" when it took energy as damping does."""
+        E = float(self.signals["E_damping_J"][-1])
+        if E >= 0.0:
+            return ""
+        damping = getattr(self.model, "damping", None)
+        D1, D2 = getattr(damping, "D1_N_s_per_m", None), getattr(damping, "D2_N_s2_per_m2", None)
+        why = "the damping law pushes the motion at some speeds"
+        if D1 is not None and D1 < 0.0:
+            why = f"the paper's D1 = {D1:g} N s/m < 0 pushes the motion"
+            if D2 is not None and D2 > 0.0:
+                why += f" below {-D1 / D2:.3g} m/s"
+        return f"the damping added {-E:.3g} J (E_damping_J < 0): {why}"
+
     def summary(self) -> dict:
         """The figures ``pamsim run`` writes to its JSON file."""
         s = {
@@ -194,6 +208,9 @@ class Result:
             "warnings": list(self.warnings),
             "energy_balance": self.energy_balance(),
         }
+        note = self.damping_energy_note()
+        if note:
+            s["energy_balance_note"] = note
         return s
 
     # ------------------------------------------------------------------ output

@@ -68,6 +68,21 @@ def test_backend_is_named_in_the_title_of_non_python_runs(fig4_and_pulled):
     assert "backend" not in ScenarioRun(res, "python").figure()._suptitle.get_text()
 
 
+def test_negative_damping_energy_is_explained_in_the_caption_and_the_summary(fig4_and_pulled):
+    """The paper's D1 < 0: below |v| = -D1/D2 its damping pushes the motion, so E_damping_J < 0."""
+    res = fig4_and_pulled[0]
+    assert res.energy_balance()["E_damping_J"] < 0
+    caption = result_figure(res)._suptitle.get_text()
+    note = res.summary()["energy_balance_note"]
+    for text in (caption, note):
+        assert "damping added" in text and "D1" in text and "< 0" in text
+    dissipative = pamsim.simulate(pamsim.load_scenario(SCENARIOS / "acra2012_fig4.toml").with_changes(
+        {"model": {"damping": "linear"}}))
+    assert dissipative.energy_balance()["E_damping_J"] > 0
+    assert "damping" not in result_figure(dissipative)._suptitle.get_text()
+    assert "energy_balance_note" not in dissipative.summary()
+
+
 def test_frequency_figure_labels_stay_off_the_markers_and_lines():
     """Two friction models with nearly equal frequencies (the case where per-point labels collide)."""
     weights = [12.74, 22.74, 32.74, 42.74, 52.74, 62.74, 72.74]
