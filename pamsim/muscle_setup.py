@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from typing import Any, Callable, Mapping
 
+from .errors import InputError
 from .muscles import Muscle, load_muscle
 from .parameter_schema import KNOWN, ParameterSet, known_parameter
 from .parameters import dynamics_parameters

@@ -9,8 +9,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .atomic import atomic_path
+from .constants import PA_PER_BAR
+from .elements.pressure_source import PrescribedPressure, ValveChamberSource
 from .model import N_WORK, Mode
-from .run_warnings import pointless_run_warnings
 
 if TYPE_CHECKING:
     from .model import MuscleModel
@@ -95,7 +96,7 @@ class Result:
     model: "MuscleModel | None" = field(default=None, repr=False)
     warnings: list[str] = field(default_factory=list)
     """One line each: the fit-range violations and the signs of a pointless run
-    (:mod:`pamsim.run_warnings`); ``pamsim run`` prints them on stderr."""
+    (:func:`pointless_run_warnings`); ``pamsim run`` prints them on stderr, the run itself is kept."""
 
     @classmethod
     def from_trace(cls, model: "MuscleModel", name, t, Y, modes, transitions, impact_losses, stats, wall_time_s,
@@ -244,3 +245,37 @@ class Result:
         from .plotting import plot_result
 
         return plot_result(self, path, **kwargs)
+
+
+def pointless_run_warnings(model, t_s: np.ndarray, at_rest_at_end: bool, v_end_m_s: float) -> list[str]:
+    """The valve never opens, the load is beyond the blocked force, or the load still moves at the end."""
+    t_end = float(t_s[-1])
+    out = []
+    src = model.source
+    if isinstance(src, ValveChamberSource) and not np.any(np.asarray(src.command(t_s)) > 0.0):
+        opens = getattr(src.command, "time_s", None)  # a step's opening time
+        when = f"opens at {opens:g} s, after the run ends at {t_end:g} s" if opens is not None else \
+            f"stays closed (command <= 0) until the run ends at {t_end:g} s"
+        out.append(f"the valve {when}: the muscle never sees the supply "
+                   "(raise simulation.duration_s or open the valve earlier)")
+    supply = _largest_supply_Pa(src, t_s)
+    if supply is not None:
+        blocked = float(model.static_force.force_N(0.0, supply))
+        weight = model.load.weight_N
+        if weight > blocked + float(np.max(model.load.external_N(t_s))):
+            out.append(f"the load, {weight:.4g} N, is beyond the muscle's blocked force at the supply pressure, "
+                       f"{blocked:.4g} N at {supply / PA_PER_BAR:.4g} bar: it cannot lift it")
+    if not at_rest_at_end:
+        out.append(f"still moving at the end ({v_end_m_s * 1e3:.3g} mm/s at {t_end:g} s): the run ends before the "
+                   "load settles (raise simulation.duration_s)")
+    return out
+
+
+def _largest_supply_Pa(source, t_s: np.ndarray) -> float | None:
+    """Highest gauge pressure [Pa] the source offers during the run: the valve's supply or the prescribed
+    pressure; None for a source driven by something else (a controller)."""
+    if isinstance(source, ValveChamberSource):
+        return float(np.max(source.supply_gauge_Pa(t_s)))
+    if isinstance(source, PrescribedPressure):
+        return float(np.max(source.p_gauge_Pa(t_s)))
+    return None
