@@ -21,7 +21,7 @@ EXPECTED_LAYERS = [
     "__main__",
     "cli",
     "api",
-    "sweep | identification | control | atlas",
+    "sweep | identification | control | atlas | export",
     "backends",
     "native",
     "fmu",

@@ -1,0 +1,166 @@
+"""The component layer's cost, against the commit before it, measured in the same run.
+
+    python benchmarks/bench_components.py [--baseline DIR] [--repeat N]
+
+``DIR`` is a checkout of the commit to compare with (``git worktree add DIR COMMIT``); without it
+only this checkout is measured.  Each measurement runs in a fresh process with ``PYTHONPATH`` set to
+the checkout, so both import their own pamsim from the same environment.
+
+Rows:
+
+- fig4 on the Python backend: ``pamsim.simulate`` of the paper's Figure 4 scenario, the median of N
+  calls after 3 warm-up calls (the first call of a process also generates the model's code);
+- the 66 paper cases on the Python backend, serial: best of N;
+- the first fig4 call of a process (generation included);
+- ``pamsim --help``: a fresh process, best of N;
+- this checkout only: flattening and generating the one-muscle model's Python (every function and
+  the five per-mode sets), generating its C and compiling it with the system's C compiler, and one
+  right-hand-side evaluation of the generated Python against the composed model's elements.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parents[1]
+
+MEASURE = r"""
+import json, statistics, sys, time
+t0 = time.perf_counter()
+import pamsim
+from pamsim.paperdata import acra2012_steady_state
+sc = pamsim.load_scenario(sys.argv[1] + "/scenarios/acra2012_fig4.toml")
+t1 = time.perf_counter()
+pamsim.simulate(sc)
+first = time.perf_counter() - t1
+for _ in range(3):
+    pamsim.simulate(sc)
+runs = []
+for _ in range(int(sys.argv[2]) * 10):
+    t = time.perf_counter(); pamsim.simulate(sc); runs.append(time.perf_counter() - t)
+cases = [sc.with_changes({"load": {"weight_N": float(r["weight_N"])},
+                          "pressure": {"supply_gauge_bar": float(r["pressure_stable_bar"])}})
+         for r in acra2012_steady_state()]
+grid = []
+for _ in range(int(sys.argv[2])):
+    t = time.perf_counter()
+    for c in cases:
+        pamsim.simulate(c)
+    grid.append(time.perf_counter() - t)
+print(json.dumps({"fig4_s": statistics.median(runs), "grid_s": min(grid), "first_s": first,
+                  "import_s": t1 - t0}))
+"""
+
+
+def measure(checkout: Path, repeat: int) -> dict:
+    env = {**os.environ, "PYTHONPATH": str(checkout)}
+    out = subprocess.run([sys.executable, "-c", MEASURE, str(checkout), str(repeat)], env=env, check=True,
+                         capture_output=True, text=True).stdout
+    data = json.loads(out.strip().splitlines()[-1])
+    helps = []
+    for _ in range(repeat):
+        t = time.perf_counter()
+        subprocess.run([sys.executable, "-m", "pamsim", "--help"], env=env, check=True, capture_output=True)
+        helps.append(time.perf_counter() - t)
+    data["help_s"] = min(helps)
+    return data
+
+
+GENERATE = r"""
+import json, os, shutil, subprocess, sys, tempfile, time
+import numpy as np
+t0 = time.perf_counter()
+import casadi
+import pamsim
+from pamsim.assemblies import scenario_assembly
+from pamsim.model import Mode
+from pamsim.modeling.pygen import compiled_by_mode
+sc = pamsim.load_scenario(sys.argv[1] + "/scenarios/acra2012_fig4.toml")
+t1 = time.perf_counter()
+assembly = scenario_assembly(sc)
+flat = assembly.flatten()
+t2 = time.perf_counter()
+g = flat.compile_python()
+t3 = time.perf_counter()
+by_mode = compiled_by_mode(assembly, "load", ("f", "y", "z", "transition", "rest_mode", "x0"))
+t4 = time.perf_counter()
+sources = flat.c_sources()
+t5 = time.perf_counter()
+cc = os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc")
+compile_s = float("nan")
+if cc:
+    with tempfile.TemporaryDirectory() as tmp:
+        for name, text in sources.items():
+            open(os.path.join(tmp, name), "w").write(text)
+        t = time.perf_counter()
+        subprocess.run([cc, "-O2", "-shared", "-fPIC", "-o", os.path.join(tmp, "m.so"),
+                        os.path.join(tmp, "one_muscle.c"), "-lm"], check=True)
+        compile_s = time.perf_counter() - t
+t6 = time.perf_counter()
+compiled_by_mode(assembly, "load", ("f", "y", "z", "transition", "rest_mode", "x0"))
+cached = time.perf_counter() - t6
+model = sc.build_model()
+y = np.array(model.initial_state(0.01)); y[1] = 0.01; y[2] += 2e5
+u = [*model.source.inputs(2.0), 0.0]
+P = assembly.parameter_values()
+f = by_mode[Mode.SLIP_UP].f
+n = 20000
+yl = y.tolist()
+t = time.perf_counter()
+for _ in range(n):
+    f(yl, u, P, ())
+gen_us = (time.perf_counter() - t) / n * 1e6
+t = time.perf_counter()
+for _ in range(n):
+    model.rhs(2.0, y, Mode.SLIP_UP)
+old_us = (time.perf_counter() - t) / n * 1e6
+print(json.dumps({"import_casadi_pamsim_s": t1 - t0, "flatten_s": t2 - t1, "python_all_s": t3 - t2,
+                  "python_modes_s": t4 - t3, "c_sources_s": t5 - t4, "c_compile_s": compile_s,
+                  "cached_s": cached, "rhs_generated_us": gen_us, "rhs_elements_us": old_us,
+                  "instructions": {k: fn.n_instructions() for k, fn in flat.functions.items()}}))
+"""
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--baseline", type=Path, help="a checkout of the commit to compare with")
+    ap.add_argument("--repeat", type=int, default=5)
+    args = ap.parse_args(argv)
+    now = measure(HERE, args.repeat)
+    before = measure(args.baseline, args.repeat) if args.baseline else None
+    print(f"{'measure':34s} {'this checkout':>14s}" + (f" {'baseline':>10s} {'ratio':>6s}" if before else ""))
+    rows = (("fig4, python backend [ms]", "fig4_s", 1e3), ("66 paper cases, python [s]", "grid_s", 1.0),
+            ("first fig4 call of a process [s]", "first_s", 1.0), ("import pamsim [s]", "import_s", 1.0),
+            ("pamsim --help [s]", "help_s", 1.0))
+    for label, key, scale in rows:
+        line = f"{label:34s} {now[key] * scale:14.3f}"
+        if before:
+            line += f" {before[key] * scale:10.3f} {now[key] / before[key]:6.2f}"
+        print(line)
+    gen = json.loads(subprocess.run([sys.executable, "-c", GENERATE, str(HERE)], check=True, capture_output=True,
+                                    text=True, env={**os.environ, "PYTHONPATH": str(HERE)}).stdout.splitlines()[-1])
+    print()
+    print("one-muscle model, this checkout (a fresh process):")
+    print(f"  import casadi and pamsim             {gen['import_casadi_pamsim_s']:.3f} s")
+    print(f"  flatten the assembly                 {gen['flatten_s']:.3f} s")
+    print(f"  generate + compile its Python        {gen['python_all_s']:.3f} s (every function)")
+    print(f"  the five per-mode sets               {gen['python_modes_s']:.3f} s")
+    print(f"  generate its C                       {gen['c_sources_s']:.3f} s")
+    print(f"  compile its C (cc -O2)               {gen['c_compile_s']:.3f} s")
+    print(f"  per-mode sets again (cached)         {gen['cached_s'] * 1e3:.3f} ms")
+    print(f"  right-hand side, generated Python    {gen['rhs_generated_us']:.2f} us")
+    print(f"  right-hand side, composed elements   {gen['rhs_elements_us']:.2f} us "
+          f"(ratio {gen['rhs_generated_us'] / gen['rhs_elements_us']:.2f})")
+    print(f"  operations per function              {gen['instructions']}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
