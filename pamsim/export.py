@@ -18,6 +18,7 @@ import numpy as np
 
 from .assemblies.one_muscle import one_muscle_assembly
 from .components.hanging_load import LoadMode
+from .errors import InputError
 from .scenario import Scenario
 
 
@@ -63,6 +64,10 @@ def casadi_model(scenario: Scenario, initial_contraction_m: float | None = None,
     model = scenario.build_model()
     assembly = one_muscle_assembly(model, x0_m, p0, opts.stick_margin_N, opts.release_margin_N)
     flat = assembly.flatten()
+    if flat.externals:
+        raise InputError(f"{scenario.origin}: model.static_force = {scenario.spec['model']['static_force']!r} "
+                         f"and the other elements called on floats ({', '.join(e.name for e in flat.externals)}) "
+                         "have no CasADi form; choose a closed-form model")
     p = np.array(flat.parameter_values)
     u0 = [*model.source.inputs(0.0), model.load.external_N(0.0)]
     x0, where = (np.array(r).ravel() for r in flat.function("x0").call([u0, p]))

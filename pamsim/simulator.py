@@ -126,11 +126,12 @@ class _Generated:
     (:func:`pamsim.modeling.pygen.compiled_by_mode`, shared by runs of the same structure), with the
     run's parameter values and its input signals in the flat model's input order."""
 
-    def __init__(self, model: MuscleModel, opts: SolverOptions, x0_m: float, p0_gauge_Pa: float | None,
-                 assembly=None):
-        if assembly is None:
-            assembly = one_muscle_assembly(model, x0_m, p0_gauge_Pa, opts.stick_margin_N, opts.release_margin_N)
+    def __init__(self, model: MuscleModel, opts: SolverOptions, x0_m: float, p0_gauge_Pa: float | None):
+        assembly = one_muscle_assembly(model, x0_m, p0_gauge_Pa, opts.stick_margin_N, opts.release_margin_N)
         self.code = compiled_by_mode(assembly, "load", ("f", "y", "z", "transition", "rest_mode", "x0"))
+        local = [name.split(".", 1)[1] for name in self.code[Mode.STICK].names["states"]]
+        if local != list(model.state_names):  # the tolerances, peaks and Result read the states by position
+            raise ValueError(f"the components' states {local} are not the model's {list(model.state_names)}")
         self.p = assembly.parameter_values()
         self.kinetic = self.code[Mode.STICK].names["outputs"].index("load.kinetic_energy_J")
         source, external_N = model.source.inputs, model.load.external_N
@@ -189,15 +190,12 @@ class _Generated:
 
 def simulate_model(model: MuscleModel, duration_s: float, options: SolverOptions | None = None,
                    x0_m: float = 0.0, name: str = "", p0_gauge_Pa: float | None = None,
-                   progress: Callable[[float], None] | None = None, assembly=None) -> Result:
+                   progress: Callable[[float], None] | None = None) -> Result:
     """Integrate ``model`` from rest at ``x0_m`` (chamber at ``p0_gauge_Pa``, if given) over ``[0, duration_s]``.
 
     ``progress``, if given, is called with the simulated time [s] reached, at
     every segment and every ``PROGRESS_EVERY`` right-hand-side evaluations
     within one (a long run with a small ``max_step_s`` can stay in one segment).
-
-    ``assembly`` is the model as components, when it holds more than the one-muscle assembly of
-    :func:`pamsim.assemblies.one_muscle_assembly` knows (a controller); it must have the same states.
 
     Raises :class:`SolverFailure` when ``solve_ivp`` fails, the event count
     exceeds ``options.max_events``, or the switching stops making progress.
@@ -210,7 +208,7 @@ def simulate_model(model: MuscleModel, duration_s: float, options: SolverOptions
     atol = np.array([opts.rtol * STATE_SCALES.get(n, 0.1) for n in names])  # 0.1 J for the work integrals
     grid = np.linspace(0.0, duration_s, n_samples(duration_s, opts.sample_rate_Hz))
     breaks = sorted({b for b in model.breakpoints if 0.0 < b < duration_s} | {duration_s})
-    gen = _Generated(model, opts, x0_m, p0_gauge_Pa, assembly)
+    gen = _Generated(model, opts, x0_m, p0_gauge_Pa)
     held_max_step = min(opts.held_max_step_s, model.max_input_step_s)
 
     t = 0.0

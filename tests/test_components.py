@@ -5,11 +5,14 @@ Jacobians against central finite differences."""
 from __future__ import annotations
 
 import dataclasses
+import functools
+import math
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+import pamsim
 from pamsim.assemblies import one_muscle_assembly, scenario_assembly
 from pamsim.model import Mode
 from pamsim.scenario import load_scenario
@@ -154,7 +157,7 @@ def _hand_jump(model, y, mode: Mode, u, opts):
     if (x >= stops.x_high_m) if up else (x <= stops.x_low_m):
         y[0] = stops.x_high_m if up else stops.x_low_m
         rebound = stops.restitution * abs(v)
-        if rebound > 1e-3:
+        if rebound > stops.min_rebound_speed_m_s:
             y[1] = -rebound if up else rebound
             return y, Mode.SLIP_DOWN if up else Mode.SLIP_UP, "rebound"
         y[1] = 0.0
@@ -163,10 +166,11 @@ def _hand_jump(model, y, mode: Mode, u, opts):
     return y, rest(Mode.STICK), "stopped"
 
 
-@pytest.mark.parametrize("restitution", [0.0, 0.5])
-def test_event_jumps_agree_with_a_hand_calculation(restitution):
+@pytest.mark.parametrize("restitution, min_rebound_m_s", [(0.0, 1e-3), (0.5, 1e-3), (0.5, 0.1)])
+def test_event_jumps_agree_with_a_hand_calculation(restitution, min_rebound_m_s):
     sc = _case({"parameters": {"stop_restitution": restitution}} if restitution else {})
     model = sc.build_model()
+    model = dataclasses.replace(model, stops=dataclasses.replace(model.stops, min_rebound_speed_m_s=min_rebound_m_s))
     flat = _flat(model)
     g = flat.compile_python()
     P = flat.parameter_values
@@ -308,3 +312,114 @@ def test_a_force_table_is_an_external_function():
         flat.c_sources()
     with pytest.raises(NotImplementedError, match="muscle.force_N"):
         flat.function("jacobian")
+
+
+# ---------------------------------------------------------------- elements of other forms
+
+
+@dataclasses.dataclass(frozen=True)
+class _Term:
+    k_N_per_Pa: float
+
+
+@dataclasses.dataclass(frozen=True)
+class _TermsForce:
+    """A static force whose numbers sit in a tuple of dataclasses: constants of the generated code."""
+
+    terms: tuple
+    name: str = "terms"
+
+    def force_N(self, x_m, p_gauge_Pa):
+        return sum(t.k_N_per_Pa for t in self.terms) * p_gauge_Pa * (1.0 - x_m / 0.08)
+
+
+def _scaled(a, p):
+    return a * p
+
+
+@dataclasses.dataclass(frozen=True)
+class _ShapeForce:
+    """A static force with a callable field (a closure, a partial)."""
+
+    shape: object
+    name: str = "shape"
+
+    def force_N(self, x_m, p_gauge_Pa):
+        return self.shape(p_gauge_Pa) * (1.0 - x_m / 0.08)
+
+
+def _closure(a):
+    return lambda p: a * p
+
+
+@pytest.mark.parametrize("pair", [
+    (_TermsForce((_Term(1e-4),)), _TermsForce((_Term(3e-4),))),
+    (_ShapeForce(functools.partial(_scaled, 1e-4)), _ShapeForce(functools.partial(_scaled, 3e-4))),
+    (_ShapeForce(_closure(1e-4)), _ShapeForce(_closure(3e-4))),
+], ids=["tuple of dataclasses", "partial", "closure"])
+def test_models_that_differ_in_baked_numbers_do_not_share_generated_code(pair):
+    """Generated code is shared by structure; numbers the code holds as constants are structure."""
+    from pamsim.components.element import structure_key
+
+    assert structure_key(pair[0]) != structure_key(pair[1])
+    base = load_scenario(FIG4).build_model()
+    for element in pair:  # both in one process, so a wrongly shared cache would show
+        model = dataclasses.replace(base, static_force=element)
+        assembly = one_muscle_assembly(model)
+        from pamsim.modeling.pygen import compiled_by_mode
+
+        code = compiled_by_mode(assembly, "load", ("f",))
+        y = np.array(model.initial_state(0.01))
+        y[1], y[2] = 0.05, 3e5
+        (got,) = code[Mode.SLIP_UP].f(list(y), [0.5, 4e5, 0.0], assembly.parameter_values(), ())
+        np.testing.assert_array_equal(got, model.slip_rhs(y, 1.0, (0.5, 4e5), 0.0))
+
+
+def test_input_order_is_part_of_the_structure():
+    from pamsim.modeling import Assembly
+
+    model = load_scenario(FIG4).build_model()
+    a = one_muscle_assembly(model)
+    swapped = Assembly(a.components, a.connections, dict(reversed(list(a.inputs.items()))), a.name)
+    assert a.structure_key() != swapped.structure_key()
+
+
+@dataclasses.dataclass(frozen=True)
+class _TanhDamping:
+    """A law written with math.tanh: on a symbol, math gives NaN without a word."""
+
+    c_N_s_per_m: float
+    v_s_m_s: float
+    name: str = "tanh"
+
+    def force_N(self, v_m_s):
+        return self.c_N_s_per_m * self.v_s_m_s * math.tanh(v_m_s / self.v_s_m_s)
+
+
+class _PlainFriction:
+    """A friction law that is not a dataclass: it takes symbols, its number a constant of the code."""
+
+    name = "plain"
+
+    def __init__(self, level_N):
+        self.level = level_N
+
+    def level_N(self, x_m, p_gauge_Pa, mass_kg):
+        return self.level + 0.0 * x_m
+
+
+def test_laws_with_no_symbolic_form_run_on_floats_and_agree():
+    base = load_scenario(FIG4).build_model()
+    model = dataclasses.replace(base, damping=_TanhDamping(5.0, 0.01), friction=_PlainFriction(1.5))
+    flat = _flat(model)
+    assert [e.name for e in flat.externals] == ["damping.force_N"]
+    assert not [v.name for v in flat.parameters if v.name.startswith(("friction.", "damping."))]
+    g = flat.compile_python()
+    rng = np.random.default_rng(31)
+    for _ in range(200):
+        y, ins, F_ext = _random_state(model, rng)
+        for mode in (Mode.SLIP_UP, Mode.SLIP_DOWN):
+            (got,) = g.f(list(y), [*ins, F_ext], flat.parameter_values, [float(mode)])
+            np.testing.assert_array_equal(got, model.slip_rhs(y, float(mode), ins, F_ext))
+    result = pamsim.simulate_model(model, 2.0, x0_m=0.0)
+    assert np.all(np.isfinite(result.x_m)) and result.x_m.max() > 0.01

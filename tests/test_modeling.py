@@ -131,13 +131,15 @@ def test_generated_python_reproduces_casadi_bit_for_bit_on_every_operation():
              ca.logic_not(a), ca.logic_and(a, b), ca.logic_or(a, b), ca.floor(a), ca.ceil(a), ca.fmod(a, b),
              ca.fabs(a), ca.sign(a), ca.copysign(a, b), ca.if_else(a > 0, b, 2 * b), ca.erf(a), ca.fmin(a, b),
              ca.fmax(a, b), 1 / a, ca.sinh(a), ca.cosh(a), ca.tanh(a), ca.asinh(a), ca.acosh(a), ca.atanh(a),
-             ca.atan2(a, b)]
+             ca.atan2(a, b), ca.log1p(a), ca.expm1(a), ca.hypot(a, b), ca.remainder(a, b), a ** -1, a ** 3.5,
+             b ** a]
     fn = ca.Function("ops", [ca.vertcat(a, b)], [ca.vertcat(*exprs)], ["ab"], ["out"])
     ns: dict = {}
     from pamsim.modeling.pygen import RUNTIME
     exec(RUNTIME + "\n" + function_source(fn, "ops"), ns)
     for pair in [(0.7, 1.3), (-0.7, 1.3), (2.5, -0.5), (0.0, 0.0), (-3.0, 0.0), (800.0, 2.0), (1e-3, 1e3), (1.0, -1.0),
-                 (-1.0, 2.0), (3.0, 0.5)]:
+                 (-1.0, 2.0), (3.0, 0.5), (float("inf"), 2.0), (float("-inf"), -3.0), (-0.0, 3.0),
+                 (-1e308, 2.5), (1e308, 3.0), (float("nan"), 1.0)]:
         want = np.array(fn(pair)).ravel()
         (got,) = ns["ops"](list(pair))
         np.testing.assert_allclose(got, want, rtol=4e-16, atol=0, equal_nan=True, err_msg=str(pair))
@@ -228,7 +230,7 @@ def test_generation_is_byte_identical_across_processes():
 
 def test_flat_model_counts_and_names(fig4_flat):
     flat = fig4_flat
-    assert flat.counts == {"states": 8, "inputs": 3, "outputs": 18, "parameters": 41, "modes": 1, "indicators": 2}
+    assert flat.counts == {"states": 8, "inputs": 3, "outputs": 18, "parameters": 42, "modes": 1, "indicators": 2}
     assert [v.name for v in flat.inputs] == ["valve_command", "supply_pressure_gauge_Pa", "external_force_N"]
     assert flat.index("states", "chamber.p_abs_Pa") == 2
     with pytest.raises(KeyError, match="has no state 'chamber.T_K'"):

@@ -305,6 +305,11 @@ def test_force_map_muscle_runs_in_the_dynamics(tmp_path):
     s = pamsim.Scenario.from_dict(spec, base_dir=tmp_path)
     res = pamsim.simulate(s)
     assert res.x_m[-1] == pytest.approx(s.static_model().free_contraction_m(7.58e5, 0.05), abs=2e-4)
+    from pamsim.errors import InputError
+    from pamsim.export import casadi_model
+
+    with pytest.raises(InputError, match="'force_map' and the other elements called on floats"):
+        casadi_model(s)  # a table has no CasADi form: said, not an opaque CasADi error
 
 
 def test_linearize_works_with_another_muscle_and_model(tmp_path):

@@ -13,6 +13,7 @@ Model inputs: ``valve_command`` and ``supply_pressure_gauge_Pa`` (valve source) 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any, Callable
 
 from ..components import (CoulombFriction, ExternalForce, HangingLoad, MuscleStaticForce, PolytropicChamber,
                           PressureSignal, ProportionalValve, ViscousDamping)
@@ -36,18 +37,18 @@ class SourceParts:
 
 
 def one_muscle_assembly(model, x0_m: float = 0.0, p0_gauge_Pa: float | None = None,
-                        stick_margin_N: float = 1e-7, release_margin_N: float = 2e-7,
-                        source: SourceParts | None = None) -> Assembly:
+                        stick_margin_N: float = 1e-7, release_margin_N: float = 2e-7) -> Assembly:
     """The assembly of a :class:`pamsim.model.MuscleModel`'s elements (its static force, friction,
     damping, load, stops and pressure source), starting at rest at ``x0_m`` with the chamber at
     ``p0_gauge_Pa`` (ambient if None).  The margins are the simulator's
-    (:class:`pamsim.simulator.SolverOptions`).  ``source`` gives the components of a pressure source
-    this module does not know (a controller's, from a layer above)."""
+    (:class:`pamsim.simulator.SolverOptions`).  The pressure source's components come from
+    :data:`SOURCE_PARTS`."""
     load = HangingLoad("load", {
         "mass_kg": model.load.mass_kg, "g_m_s2": model.load.g_m_s2, "x_low_m": model.stops.x_low_m,
         "x_high_m": model.stops.x_high_m, "restitution": model.stops.restitution,
+        "min_rebound_speed_m_s": model.stops.min_rebound_speed_m_s,
         "stick_margin_N": stick_margin_N, "release_margin_N": release_margin_N, "initial_contraction_m": x0_m})
-    source = source or _source_parts(model.source, p0_gauge_Pa)
+    source = _source_parts(model.source, p0_gauge_Pa)
     parts = [load, *source.parts]
     pressure, wiring, inputs = source.pressure, list(source.wiring), dict(source.inputs)
     parts += [MuscleStaticForce("muscle", model.static_force), CoulombFriction("friction", model.friction),
@@ -62,17 +63,36 @@ def one_muscle_assembly(model, x0_m: float = 0.0, p0_gauge_Pa: float | None = No
     return Assembly(parts, wiring, inputs, name="one_muscle")
 
 
+def _valve_parts(src: ValveChamberSource, p0_gauge_Pa: float | None) -> SourceParts:
+    return SourceParts(
+        [PolytropicChamber("chamber", src.chamber, src.p_atm_Pa, p0_gauge_Pa or 0.0, src.T_supply_K),
+         ProportionalValve("valve", src.valve, src.T_supply_K, src.p_atm_Pa, src.chamber.R_J_per_kg_K)],
+        [("chamber.port", "valve.port"), ("load.x_m", "chamber.x_m"), ("load.v_m_s", "chamber.v_m_s")],
+        {"valve_command": "valve.command", "supply_pressure_gauge_Pa": "valve.supply_gauge_Pa"}, "chamber")
+
+
+def _prescribed_parts(src: PrescribedPressure, p0_gauge_Pa: float | None) -> SourceParts:
+    return SourceParts([PressureSignal("pressure")], [], {"prescribed_pressure_gauge_Pa": "pressure.p_in_gauge_Pa"},
+                       "pressure")
+
+
+SOURCE_PARTS: dict[type, Callable[[Any, float | None], SourceParts]] = {
+    ValveChamberSource: _valve_parts, PrescribedPressure: _prescribed_parts}
+"""``{pressure source class: parts(source, initial gauge pressure or None)}``.  A source defined above
+this layer (a controller's) registers its own with :func:`register_source`."""
+
+
+def register_source(cls: type, parts: Callable[[Any, float | None], SourceParts]) -> None:
+    """Let ``one_muscle_assembly`` build a muscle driven by pressure sources of class ``cls``."""
+    SOURCE_PARTS[cls] = parts
+
+
 def _source_parts(src, p0_gauge_Pa: float | None) -> SourceParts:
-    if isinstance(src, ValveChamberSource):
-        return SourceParts(
-            [PolytropicChamber("chamber", src.chamber, src.p_atm_Pa, p0_gauge_Pa or 0.0, src.T_supply_K),
-             ProportionalValve("valve", src.valve, src.T_supply_K, src.p_atm_Pa, src.chamber.R_J_per_kg_K)],
-            [("chamber.port", "valve.port"), ("load.x_m", "chamber.x_m"), ("load.v_m_s", "chamber.v_m_s")],
-            {"valve_command": "valve.command", "supply_pressure_gauge_Pa": "valve.supply_gauge_Pa"}, "chamber")
-    if isinstance(src, PrescribedPressure):
-        return SourceParts([PressureSignal("pressure")], [], {"prescribed_pressure_gauge_Pa": "pressure.p_in_gauge_Pa"},
-                           "pressure")
-    raise TypeError(f"no components for the pressure source {type(src).__name__}")
+    for cls in type(src).__mro__:
+        if cls in SOURCE_PARTS:
+            return SOURCE_PARTS[cls](src, p0_gauge_Pa)
+    raise TypeError(f"no components for the pressure source {type(src).__name__} "
+                    f"(pamsim.assemblies.one_muscle.register_source names them)")
 
 
 def scenario_assembly(scenario) -> Assembly:

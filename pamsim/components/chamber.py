@@ -3,7 +3,14 @@
 from __future__ import annotations
 
 from ..modeling import PNEUMATIC, Component, Equations, Port, Symbols, Var
-from .element import ElementParameters, element_parameters
+from .element import ElementParameters, element_parameters, traces
+
+PROBE_POINTS = tuple((x,) for x in (0.0, 0.01, 0.04))
+
+
+def _volume_m3(element, x_m):
+    return element.volume_m3(x_m)
+
 
 class PolytropicChamber(ElementParameters, Component):
     """:class:`pamsim.elements.chamber.MuscleChamber`: states absolute pressure and air mass.
@@ -25,6 +32,8 @@ class PolytropicChamber(ElementParameters, Component):
 
     def __init__(self, name: str, element, p_atm_Pa: float, initial_pressure_gauge_Pa: float, T_initial_K: float):
         self.element = element
+        if not traces(element, _volume_m3, PROBE_POINTS):
+            raise TypeError(f"chamber {type(element).__name__}: its volume cannot be written with symbols")
         values = element_parameters(element)
         values.update(p_atm_Pa=p_atm_Pa, initial_pressure_gauge_Pa=initial_pressure_gauge_Pa, T_initial_K=T_initial_K)
         super().__init__(name, values)

@@ -3,7 +3,14 @@
 from __future__ import annotations
 
 from ..modeling import TRANSLATIONAL, Component, Equations, Port, Symbols, Var
-from .element import ElementParameters, element_parameters
+from .element import ElementParameters, traces
+
+PROBE_POINTS = tuple((v,) for v in (-0.5, -0.05, -1e-3, 0.0, 1e-3, 0.05, 0.5))
+"""Velocities [m/s] at which a law's symbolic form is checked."""
+
+
+def _force_N(element, v_m_s):
+    return element.force_N(v_m_s)
 
 
 class ViscousDamping(ElementParameters, Component):
@@ -19,9 +26,13 @@ class ViscousDamping(ElementParameters, Component):
 
     def __init__(self, name: str, element):
         self.element = element
-        super().__init__(name, element_parameters(element))
+        self.traces = traces(element, _force_N, PROBE_POINTS)
+        super().__init__(name, self.element_values())
 
     def equations(self, s: Symbols) -> Equations:
         v = s.port["flange"]["v_m_s"]
-        F = self.symbolic_element(s.p).force_N(v)
+        if self.traces:
+            F = self.symbolic_element(s.p).force_N(v)
+        else:  # a law with no symbolic form, called on floats
+            F = s.external("force_N", self.element.force_N, v)
         return Equations(der={"E_damping_J": F * v}, outputs={"F_damping_N": -F}, port={"flange": {"F_N": -F}})

@@ -3,51 +3,81 @@
 The elements are frozen dataclasses of numbers with pure methods.  Rebuilt with CasADi symbols in
 place of the numbers, the same methods give the component's equations: the physics is not copied.
 Fields that choose a form rather than give a number (``name``, ``negative_level``) stay as they are.
+
+An element that cannot be rebuilt so (not a dataclass, a check of its numbers in ``__post_init__``)
+or whose method does not give on symbols what it gives on floats (a table lookup, a numerical solve,
+a :mod:`math` call, which turns a symbol into NaN without a word) is called on floats instead, as an
+external function (:attr:`pamsim.modeling.component.Symbols.external`): correct, Python only.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import functools
 import hashlib
-from typing import Any, Mapping
+import math
+import types
+import warnings
+from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 
 from ..modeling import Var
+from ..modeling.component import quiet_numpy_on_symbols
 from ..parameter_schema import unit_of
 
 STRUCTURAL = ("name", "negative_level")
 """Fields that are choices or metadata, never parameters."""
 
 
-def _numbers(element, out: dict[str, float]) -> None:
+def _numbers(element, out: dict[str, float], path: str) -> None:
     for f in dataclasses.fields(element):
         value = getattr(element, f.name)
         if f.name in STRUCTURAL:
             continue
         if dataclasses.is_dataclass(value):
-            _numbers(value, out)
-        elif isinstance(value, (int, float)) and not isinstance(value, bool):
-            if f.name in out:
-                raise ValueError(f"{type(element).__name__}: parameter {f.name!r} appears twice")
-            out[f.name] = float(value)
+            _numbers(value, out, f"{path}{f.name}.")
+        elif _is_number(value):
+            # A nested element's number keeps its plain name unless another number has it already.
+            out[f.name if f.name not in out else f"{path}{f.name}"] = float(value)
 
 
 def element_parameters(element) -> dict[str, float]:
-    """``{field name: value}`` of every number in ``element`` (nested elements included)."""
+    """``{name: value}`` of every number of a dataclass ``element`` (nested elements included), named
+    by field; a field name met twice is qualified by its path (``orifice.C_m3_per_s_Pa``)."""
     out: dict[str, float] = {}
-    _numbers(element, out)
+    if dataclasses.is_dataclass(element):
+        _numbers(element, out, "")
     return out
 
 
-def structure_key(element, baked: bool = False) -> tuple:
-    """What of ``element`` shapes its equations, as a value equal across processes: its type and every
-    field that is not a parameter (a choice, a tuple of coefficients), recursively.  Two
-    elements with one key differ only in parameter values, so they share one generated model.
+def symbolic(element, symbols: Mapping[str, Any]):
+    """``element`` with each number replaced by its symbol (named as :func:`element_parameters` names it);
+    an element that is not a dataclass as it is, its numbers constants of the code."""
+    if not dataclasses.is_dataclass(element):
+        return element
+    names = iter(element_parameters(element))
 
-    Only the numbers of dataclass elements become parameters (:func:`element_parameters`); an element
-    of another kind (a static model class holding its derived constants) is traced with its numbers
-    as constants, so they are part of its key (``baked``).
+    def rebuild(obj):
+        changes = {}
+        for f in dataclasses.fields(obj):
+            value = getattr(obj, f.name)
+            if f.name in STRUCTURAL:
+                continue
+            if dataclasses.is_dataclass(value):
+                changes[f.name] = rebuild(value)
+            elif _is_number(value):
+                changes[f.name] = symbols[next(names)]
+        return dataclasses.replace(obj, **changes)
+
+    return rebuild(element)
+
+
+def structure_key(element, baked: bool = False) -> tuple:
+    """What of ``element`` shapes its equations: its type and every field that is not a parameter
+    (a choice, a tuple of coefficients), recursively.  Elements with one key differ only in parameter
+    values, so they share one generated model.  ``baked``: the numbers are constants of the generated
+    code (an element called on floats, or numbers :func:`symbolic` does not replace), so they count.
     """
     if dataclasses.is_dataclass(element):
         items = []
@@ -64,23 +94,46 @@ def _is_number(value) -> bool:
 
 
 def _stable(value, baked: bool):
-    """``value`` as something whose equality and repr do not depend on the process (no addresses)."""
+    """``value`` as a key that is equal only for values that give equal code.
+
+    Numbers inside containers and in objects other than dataclasses are constants of the code
+    (:func:`symbolic` replaces a dataclass's own numbers only), so they count.  A value whose effect
+    cannot be told from outside (a closure, a bound method, an unknown object) keys as itself: only
+    the same object shares code.
+    """
     if value is None or isinstance(value, (bool, int, float, str)):
         return value
     if isinstance(value, (tuple, list)):
-        return tuple(_stable(v, baked) for v in value)
+        return (type(value).__name__, tuple(_stable(v, True) for v in value))
     if isinstance(value, np.ndarray):
         return ("ndarray", value.shape, str(value.dtype), hashlib.sha256(np.ascontiguousarray(value).tobytes()).hexdigest())
     if dataclasses.is_dataclass(value):
         return structure_key(value, baked)
     if isinstance(value, Mapping):
-        return tuple(sorted((str(k), _stable(v, baked)) for k, v in value.items()))
-    if callable(value) and hasattr(value, "__qualname__"):
-        return ("callable", getattr(value, "__module__", ""), value.__qualname__)
-    if hasattr(value, "__dict__"):
+        return ("mapping", tuple(sorted((str(k), _stable(v, True)) for k, v in value.items())))
+    if isinstance(value, types.FunctionType) and not value.__closure__ and not value.__defaults__:
+        return ("function", value.__module__, value.__qualname__, value.__code__)
+    if isinstance(value, functools.partial):
+        return ("partial", _stable(value.func, True), _stable(value.args, True), _stable(value.keywords, True))
+    if not callable(value) and type(value).__eq__ is object.__eq__ and hasattr(value, "__dict__"):
         return (type(value).__module__, type(value).__qualname__,
                 tuple(sorted((k, _stable(v, True)) for k, v in vars(value).items())))
-    return repr(value)
+    return ("object", _Identity(value))
+
+
+class _Identity:
+    """Equal only to a wrapper of the same object, which it keeps alive (so its id is never reused)."""
+
+    __slots__ = ("obj",)
+
+    def __init__(self, obj):
+        self.obj = obj
+
+    def __eq__(self, other):
+        return isinstance(other, _Identity) and other.obj is self.obj
+
+    def __hash__(self):
+        return id(self.obj)
 
 
 def parameter_vars(values: Mapping[str, float], descriptions: Mapping[str, str] | None = None) -> tuple[Var, ...]:
@@ -89,31 +142,67 @@ def parameter_vars(values: Mapping[str, float], descriptions: Mapping[str, str] 
     return tuple(Var(name, unit_of(name), descriptions.get(name, "")) for name in values)
 
 
-def symbolic(element, symbols: Mapping[str, Any]):
-    """``element`` with each number replaced by ``symbols[field name]`` (nested elements too)."""
-    changes = {}
-    for f in dataclasses.fields(element):
-        value = getattr(element, f.name)
-        if f.name in STRUCTURAL:
+_TRACES: dict = {}
+_TRACES_SIZE = 256
+
+
+def traces(element, method: Callable, points: Sequence[tuple[float, ...]]) -> bool:
+    """Whether ``method(element rebuilt around symbols, *args)`` gives, at each of ``points``, the value
+    ``method(element, *args)`` gives on floats (compared where that is finite).  Cached by the
+    element's form: whether it traces does not depend on its numbers."""
+    key = (structure_key(element), getattr(method, "__qualname__", repr(method)))
+    if key not in _TRACES:
+        if len(_TRACES) >= _TRACES_SIZE:
+            _TRACES.pop(next(iter(_TRACES)))
+        _TRACES[key] = _probe(element, method, points)
+    return _TRACES[key]
+
+
+def _probe(element, method, points) -> bool:
+    import casadi as ca
+
+    params = element_parameters(element)
+    p = {name: ca.SX.sym(name) for name in params}
+    args = [ca.SX.sym(f"a{i}") for i in range(len(points[0]))]
+    try:
+        with quiet_numpy_on_symbols(), warnings.catch_warnings(), np.errstate(all="ignore"):
+            warnings.simplefilter("ignore", RuntimeWarning)  # a table's array path, probed with a symbol
+            sym = symbolic(element, p)
+            fn = ca.Function("probe", [ca.vertcat(*args, *p.values())], [ca.SX(method(sym, *args))])
+    except Exception:
+        return False
+    values = list(params.values())
+    for point in points:
+        try:
+            want = method(element, *point)
+        except (ValueError, ZeroDivisionError, OverflowError):
+            continue  # no value here on floats: nothing to compare
+        if isinstance(want, complex) or not math.isfinite(want):
             continue
-        if dataclasses.is_dataclass(value):
-            changes[f.name] = symbolic(value, symbols)
-        elif f.name in symbols:
-            changes[f.name] = symbols[f.name]
-    return dataclasses.replace(element, **changes)
+        got = float(fn([*point, *values]))
+        if not abs(got - want) <= 1e-9 * max(1.0, abs(want)):
+            return False
+    return True
 
 
 class ElementParameters:
-    """Mixin: a component whose parameters are the numbers of its element (``self.element``)."""
+    """Mixin: a component whose parameters are the numbers of its element (``self.element``) when the
+    element takes symbols (``self.traces``); otherwise it has none and calls the element on floats."""
 
     element: Any
+    traces: bool = True
     extra_parameters: tuple[Var, ...] = ()
 
     def parameter_vars(self) -> tuple[Var, ...]:
-        return parameter_vars(element_parameters(self.element)) + self.extra_parameters
+        own = parameter_vars(element_parameters(self.element)) if self.traces else ()
+        return own + self.extra_parameters
+
+    def element_values(self) -> dict[str, float]:
+        return element_parameters(self.element) if self.traces else {}
 
     def symbolic_element(self, p: Mapping[str, Any]):
         return symbolic(self.element, p)
 
     def structure_key(self) -> tuple:
-        return super().structure_key() + (structure_key(self.element),)
+        # An element called on floats is part of the generated code: its numbers are too.
+        return super().structure_key() + (structure_key(self.element, baked=not self.traces),)

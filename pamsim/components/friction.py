@@ -5,7 +5,14 @@ friction holds whatever it must)."""
 from __future__ import annotations
 
 from ..modeling import TRANSLATIONAL, Component, Equations, Port, Symbols, Var
-from .element import ElementParameters, element_parameters
+from .element import ElementParameters, traces
+
+PROBE_POINTS = tuple((x, p, m) for x in (0.0, 0.01, 0.04) for p in (0.0, 1e5, 4e5) for m in (0.5, 2.0, 8.0))
+"""Contractions [m], gauge pressures [Pa] and load masses [kg] at which a law's symbolic form is checked."""
+
+
+def _level_N(element, x_m, p_gauge_Pa, mass_kg):
+    return element.level_N(x_m, p_gauge_Pa, mass_kg)
 
 
 class CoulombFriction(ElementParameters, Component):
@@ -24,10 +31,15 @@ class CoulombFriction(ElementParameters, Component):
 
     def __init__(self, name: str, element):
         self.element = element
-        super().__init__(name, element_parameters(element))
+        self.traces = traces(element, _level_N, PROBE_POINTS)
+        super().__init__(name, self.element_values())
 
     def equations(self, s: Symbols) -> Equations:
         u, flange = s.u, s.port["flange"]
-        level = self.symbolic_element(s.p).level_N(flange["x_m"], u["p_gauge_Pa"], u["mass_kg"])
+        args = (flange["x_m"], u["p_gauge_Pa"], u["mass_kg"])
+        if self.traces:
+            level = self.symbolic_element(s.p).level_N(*args)
+        else:  # a law with no symbolic form, called on floats
+            level = s.external("level_N", self.element.level_N, *args)
         return Equations(der={"E_friction_J": level * abs(flange["v_m_s"])}, outputs={"level_N": level},
                          port={"flange": {"F_N": -(u["direction"] * level)}})

@@ -1,8 +1,10 @@
 """The hanging load: a mass on the muscle's flange, with its own stick/slip and end-stop modes.
 
-The mode machine that the simulator and the C core each held is written here once: the equations of
-each mode, the event indicators that end it, the jump at an event and the decision of a load at rest
-(MODEL_NOTES sec. 4; docs/model.md).  The Coulomb level comes in as a signal; this component decides
+The mode machine is written here: the equations of each mode, the event indicators that end it, the
+jump at an event and the decision of a load at rest (docs/model.md sec. 4), which the python backend
+integrates.  Until they move onto the code generated from it, the C core keeps its own copy and the
+results' force columns come from :meth:`pamsim.model.MuscleModel.breakdown`; the conformance suite and
+the tests hold them to this one.  The Coulomb level comes in as a signal; this component decides
 its direction (against the motion when sliding, whatever holds the load when it is held).
 """
 
@@ -10,7 +12,7 @@ from __future__ import annotations
 
 from enum import IntEnum
 
-from ..core_table import EVENT_V_TOL_M_S, EVENT_X_TOL_M, MIN_REBOUND_SPEED_M_S
+from ..core_table import EVENT_V_TOL_M_S, EVENT_X_TOL_M
 from ..modeling import TRANSLATIONAL, Component, Equations, Port, Symbols, Var
 from ..modeling.smath import if_else
 
@@ -54,7 +56,7 @@ class HangingLoad(Component):
     and the distance to the stop ahead (with margins ``EVENT_V_TOL_M_S`` and ``EVENT_X_TOL_M`` for an
     integrator that needs a release from rest not to be an event); held, the margins
     ``F_c + release_margin -+ net`` by which friction still holds the load up and down.  At an event: a stop reached takes the load
-    to it, with a rebound of ``restitution |v|`` if that exceeds ``MIN_REBOUND_SPEED_M_S``, else at
+    to it, with a rebound of ``restitution |v|`` if that exceeds ``min_rebound_speed_m_s``, else at
     rest on it (the stop takes precedence when both indicators cross at once); a velocity reaching zero
     stops the load; then :attr:`Equations.rest_mode` decides a
     held load's mode from its forces (slip if the net force beats friction by ``stick_margin_N``).
@@ -66,6 +68,7 @@ class HangingLoad(Component):
                   Var("g_m_s2", "m/s^2", "gravitational acceleration"),
                   Var("x_low_m", "m", "lower stop"), Var("x_high_m", "m", "upper stop"),
                   Var("restitution", "1", "coefficient of restitution at the stops"),
+                  Var("min_rebound_speed_m_s", "m/s", "a slower rebound off a stop is none: the load stays on it"),
                   Var("stick_margin_N", "N", "a stopping load is held unless the net force beats friction by more"),
                   Var("release_margin_N", "N", "a held load is released when the net force beats friction by this"),
                   Var("initial_contraction_m", "m", "contraction at the start, load at rest"))
@@ -108,7 +111,7 @@ class HangingLoad(Component):
         at_stop = slip * s.fired[1]
         stopped = slip * (1 - at_stop) * s.fired[0]
         rebound = P["restitution"] * abs(v)
-        bounces = rebound > MIN_REBOUND_SPEED_M_S
+        bounces = rebound > P["min_rebound_speed_m_s"]
         transition = {
             "x_m": if_else(at_stop, if_else(up, P["x_high_m"], P["x_low_m"]), x),
             "v_m_s": if_else(at_stop, if_else(bounces, if_else(up, -rebound, rebound), 0.0),

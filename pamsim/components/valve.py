@@ -4,7 +4,15 @@ from __future__ import annotations
 
 from ..modeling import PNEUMATIC, Component, Equations, Port, Symbols, Var
 from ..modeling.smath import if_else
-from .element import ElementParameters, element_parameters
+from .element import ElementParameters, element_parameters, traces
+
+
+PROBE_POINTS = tuple((u, p, 293.15, 5e5, 293.15, 1.01325e5) for u in (-1.0, -0.3, 0.0, 0.4, 1.0)
+                     for p in (0.5e5, 1.5e5, 4.99e5, 6e5))
+
+
+def _inflow_kg_s(element, u, p_chamber_Pa, T_chamber_K, p_supply_Pa, T_supply_K, p_exhaust_Pa):
+    return element.inflow_kg_s(u, p_chamber_Pa, T_chamber_K, p_supply_Pa, T_supply_K, p_exhaust_Pa)
 
 
 class ProportionalValve(ElementParameters, Component):
@@ -24,6 +32,8 @@ class ProportionalValve(ElementParameters, Component):
 
     def __init__(self, name: str, element, T_supply_K: float, p_atm_Pa: float, R_J_per_kg_K: float):
         self.element = element
+        if not traces(element, _inflow_kg_s, PROBE_POINTS):
+            raise TypeError(f"valve {type(element).__name__}: its flow cannot be written with symbols")
         values = element_parameters(element)
         values.update(T_supply_K=T_supply_K, p_atm_Pa=p_atm_Pa, R_J_per_kg_K=R_J_per_kg_K)
         super().__init__(name, values)

@@ -11,7 +11,7 @@ On the nonlinear model the controller runs as part of the pressure source
 (:class:`ClosedLoopValveSource`): its states (error integral, position filter)
 sit beside the chamber states, and the valve command it computes is clipped to
 [-1, 1].  As components (:class:`PositionController` between the chamber and the
-valve, :func:`closed_loop_assembly`), :func:`~pamsim.simulator.simulate_model`
+valve, registered for the one-muscle assembly), :func:`~pamsim.simulator.simulate_model`
 integrates the loop with the load's own stick/slip modes.  The controller is continuous-time (an
 analogue of a controller sampled much faster than the 4 Hz mechanical mode).
 
@@ -34,13 +34,13 @@ from typing import Any, Callable, Mapping
 import control as ct
 import numpy as np
 
-from ..assemblies.one_muscle import SourceParts, one_muscle_assembly
+from ..assemblies.one_muscle import SourceParts, register_source
 from ..components import PolytropicChamber, ProportionalValve
 from ..constants import PA_PER_BAR
 from ..elements.pressure_source import ValveChamberSource
 from ..errors import InputError
 from ..model import MuscleModel
-from ..modeling import Assembly, Component, Equations, Symbols, Var, smath
+from ..modeling import Component, Equations, Symbols, Var, smath
 from ..result import Result
 from ..scenario import Scenario, load_scenario
 from ..signals import Step
@@ -290,12 +290,11 @@ class PositionController(Component):
                          initial={"z_error_integral_m_s": 0.0, "x_filter_m": x})
 
 
-def closed_loop_assembly(model: MuscleModel, x0_m: float, options) -> Assembly:
-    """The closed loop as an assembly: the one-muscle assembly whose valve the controller drives, the
-    chamber starting at the feedforward pressure of the first reference."""
-    source = model.source
-    p0 = source.feedforward_gauge_Pa(0.0)
+def _closed_loop_parts(source: "ClosedLoopValveSource", p0_gauge_Pa: float | None) -> SourceParts:
+    """The closed loop's pressure source as components: the chamber (starting at ``p0_gauge_Pa``, or
+    the feedforward pressure of the first reference), the controller, and the valve it drives."""
     plant = source.plant
+    p0 = source.feedforward_gauge_Pa(0.0) if p0_gauge_Pa is None else p0_gauge_Pa
     parts = [PolytropicChamber("chamber", plant.chamber, plant.p_atm_Pa, p0, plant.T_supply_K),
              PositionController("controller", source),
              ProportionalValve("valve", plant.valve, plant.T_supply_K, plant.p_atm_Pa, plant.chamber.R_J_per_kg_K)]
@@ -304,8 +303,10 @@ def closed_loop_assembly(model: MuscleModel, x0_m: float, options) -> Assembly:
               ("controller.command", "valve.command")]
     inputs = {"reference_m": "controller.reference_m", "feedforward_gauge_Pa": "controller.feedforward_gauge_Pa",
               "supply_pressure_gauge_Pa": "valve.supply_gauge_Pa"}
-    return one_muscle_assembly(model, x0_m, p0, options.stick_margin_N, options.release_margin_N,
-                               SourceParts(parts, wiring, inputs, "chamber"))
+    return SourceParts(parts, wiring, inputs, "chamber")
+
+
+register_source(ClosedLoopValveSource, _closed_loop_parts)
 
 
 def closed_loop_model(scenario: Scenario, config: ControllerConfig, design: LqrDesign) -> MuscleModel:
@@ -449,8 +450,7 @@ def run_closed_loop(scenario: Scenario | str, overrides: Mapping[str, Any] | Non
     design = design_lqr(model, config, scenario.final_pressure_gauge_Pa)
     cl_model = closed_loop_model(scenario, config, design)
     result = simulate_model(cl_model, scenario.duration_s, scenario.solver, x0_m=scenario.initial_contraction_m,
-                            name=scenario.name, progress=progress,
-                            assembly=closed_loop_assembly(cl_model, scenario.initial_contraction_m, scenario.solver))
+                            name=scenario.name, progress=progress)
     x0 = scenario.initial_contraction_m
     band = config.spec.get("settling_band_mm", 0.5) * 1e-3
     metrics = step_metrics(result.t_s, result.x_m, config.step_time_s, x0, config.target_contraction_m, band)

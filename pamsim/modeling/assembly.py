@@ -175,7 +175,7 @@ class Assembly:
     def structure_key(self) -> tuple:
         """Equal for two assemblies that generate the same code (they may differ in parameter values)."""
         return (self.name, tuple((c.name, c.structure_key()) for c in self.components), self.connections,
-                tuple(sorted(self.inputs.items())))
+                tuple(self.inputs.items()))  # in their order: the flat model's inputs follow it
 
     def parameter_values(self) -> list[float]:
         """The parameter vector of the flat model, in its order, without flattening."""

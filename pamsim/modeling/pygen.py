@@ -33,11 +33,31 @@ def _div0(a, b):
 def _pow(a, b):
     try:
         r = a ** b
-    except ZeroDivisionError:
-        return _inf
+    except (ZeroDivisionError, OverflowError):
+        # C's pow: a huge or zero base; the sign is a's for an odd integer b, and there is no real
+        # power of a negative base to a fractional b.
+        if a < 0.0 and b != int(b):
+            return _nan
+        odd = b == int(b) and int(b) % 2 == 1
+        return _math.copysign(_inf, a) if odd else _inf
+    return _nan if isinstance(r, complex) else r
+
+
+def _trig(fn, a):
+    return fn(a) if abs(a) != _inf else _nan
+
+
+def _log1p(a):
+    if a > -1.0:
+        return _math.log1p(a)
+    return -_inf if a == -1.0 else _nan
+
+
+def _expm1(a):
+    try:
+        return _math.expm1(a)
     except OverflowError:
         return _inf
-    return _nan if isinstance(r, complex) else r
 
 
 def _exp(a):
@@ -101,6 +121,10 @@ def _atanh(a):
     return _math.copysign(_inf, a) if abs(a) == 1.0 else _nan
 
 
+def _fmod_remainder(a, b):
+    return _math.remainder(a, b) if b != 0.0 and abs(a) != _inf else _nan
+
+
 def _floor(a):
     return float(_math.floor(a)) if a == a and abs(a) != _inf else a
 
@@ -122,7 +146,8 @@ def _op_table() -> dict[int, str]:
         # square roots; pow and sqrt may differ in the last bit, and the Python backend's numbers
         # stay those of the elements on floats.
         "SQRT": "({0} ** 0.5 if {0} >= 0.0 else _nan)", "SQ": "{0} * {0}", "TWICE": "{0} + {0}",
-        "SIN": "_math.sin({0})", "COS": "_math.cos({0})", "TAN": "_math.tan({0})", "ASIN": "_asin({0})",
+        "SIN": "_trig(_math.sin, {0})", "COS": "_trig(_math.cos, {0})", "TAN": "_trig(_math.tan, {0})",
+        "ASIN": "_asin({0})",
         "ACOS": "_acos({0})", "ATAN": "_math.atan({0})",
         "LT": "(1.0 if {0} < {1} else 0.0)", "LE": "(1.0 if {0} <= {1} else 0.0)",
         "EQ": "(1.0 if {0} == {1} else 0.0)", "NE": "(1.0 if {0} != {1} else 0.0)",
@@ -133,9 +158,10 @@ def _op_table() -> dict[int, str]:
         "FMIN": "_fmin({0}, {1})", "FMAX": "_fmax({0}, {1})", "INV": "(1.0 / {0} if {0} else _div0(1.0, {0}))",
         "SINH": "_sinh({0})", "COSH": "_cosh({0})", "TANH": "_math.tanh({0})",
         "ASINH": "_math.asinh({0})", "ACOSH": "_acosh({0})", "ATANH": "_atanh({0})",
-        "ATAN2": "_math.atan2({0}, {1})",
+        "ATAN2": "_math.atan2({0}, {1})", "LOG1P": "_log1p({0})", "EXPM1": "_expm1({0})",
+        "HYPOT": "_math.hypot({0}, {1})", "REMAINDER": "_fmod_remainder({0}, {1})",
     }
-    return {getattr(ca, "OP_" + k): v for k, v in t.items()}
+    return {getattr(ca, "OP_" + k): v for k, v in t.items() if hasattr(ca, "OP_" + k)}
 
 
 def _literal(value: float) -> str:

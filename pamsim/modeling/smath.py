@@ -1,33 +1,15 @@
 """Elementary functions for code that runs on floats and on CasADi symbols alike.
 
-A float goes to :mod:`math` (the result is bit for bit what the plain code gives); anything else to
-CasADi.  :mod:`math` itself must not see a symbol: it converts it to ``nan`` silently.
+A float takes Python's own operation (the result is bit for bit what the plain code gives); anything
+else CasADi's.  :mod:`math` itself must not see a symbol: it converts it to ``nan`` silently.
 """
 
 from __future__ import annotations
-
-import math
 
 
 def _casadi():
     import casadi
     return casadi
-
-
-def cos(a):
-    return math.cos(a) if isinstance(a, (int, float)) else _casadi().cos(a)
-
-
-def sin(a):
-    return math.sin(a) if isinstance(a, (int, float)) else _casadi().sin(a)
-
-
-def sqrt(a):
-    return math.sqrt(a) if isinstance(a, (int, float)) else _casadi().sqrt(a)
-
-
-def radians(a):
-    return math.radians(a) if isinstance(a, (int, float)) else a * (math.pi / 180.0)
 
 
 def fmin(a, b):
