@@ -144,7 +144,7 @@ def test_upper_stop_is_the_braid_lock_angle():
     L = 0.3 - stops.x_high_m
     assert math.degrees(math.acos(L / ch.thread_length_m)) == pytest.approx(54.7356, abs=1e-3)
     assert stops.x_low_m == 0.0
-    assert stops.rebound_speed_m_s(0.5) == 0.0  # inelastic by default
+    assert stops.restitution == 0.0  # inelastic by default
 
 
 def test_signals():

@@ -153,7 +153,7 @@ def traces(element, method: Callable, points: Sequence[tuple[float, ...]]) -> bo
     key = (structure_key(element), getattr(method, "__qualname__", repr(method)))
     if key not in _TRACES:
         if len(_TRACES) >= _TRACES_SIZE:
-            _TRACES.pop(next(iter(_TRACES)))
+            _TRACES.pop(next(iter(_TRACES), None), None)
         _TRACES[key] = _probe(element, method, points)
     return _TRACES[key]
 

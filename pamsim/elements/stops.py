@@ -28,8 +28,3 @@ class EndStops:
     def from_parameters(cls, p: Mapping[str, float]) -> "EndStops":
         # Braid lock at 54.7 deg (cos^2 = 1/3): L_lock = b / sqrt(3), MODEL_NOTES sec. 5.
         return cls(0.0, Braid.from_parameters(p).x_lock_m, p["stop_restitution"])
-
-    def rebound_speed_m_s(self, impact_speed_m_s: float) -> float:
-        """Speed after an impact; below ``min_rebound_speed_m_s`` the load stays on the stop."""
-        rebound = self.restitution * abs(impact_speed_m_s)
-        return rebound if rebound > self.min_rebound_speed_m_s else 0.0

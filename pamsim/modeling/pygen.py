@@ -313,6 +313,6 @@ def compiled_by_mode(assembly, component: str, names=("f", "z", "transition", "r
     if key not in _BY_MODE_CACHE:
         modes = assembly.by_name[component].modes
         if len(_BY_MODE_CACHE) >= BY_MODE_CACHE_SIZE:
-            _BY_MODE_CACHE.pop(next(iter(_BY_MODE_CACHE)))
+            _BY_MODE_CACHE.pop(next(iter(_BY_MODE_CACHE), None), None)
         _BY_MODE_CACHE[key] = {int(m): GeneratedModel(assembly.flatten({component: int(m)}), names) for m in modes}
     return _BY_MODE_CACHE[key]
