@@ -236,3 +236,37 @@ def test_flat_model_counts_and_names(fig4_flat):
     with pytest.raises(KeyError, match="has no state 'chamber.T_K'"):
         flat.index("states", "chamber.T_K")
     assert math.isclose(flat.parameter_values[flat.index("parameters", "load.mass_kg")], 22.74 / 9.81, rel_tol=1e-3)
+
+
+RUN_FIG4 = """
+import sys
+import pamsim
+r = pamsim.simulate(sys.argv[1])
+print(repr(float(r.x_m[-1])), "casadi" in sys.modules)
+"""
+
+
+def test_generated_code_is_kept_on_disk_for_the_next_process(tmp_path):
+    """A second process runs the model from the first one's code, without CasADi; a damaged entry is
+    generated again; a key that another process could not reproduce is not stored."""
+    from pamsim.modeling import code_cache
+
+    env = {**os.environ, code_cache.CACHE_ENV: str(tmp_path / "cache")}
+    path = str(ROOT / "scenarios" / "acra2012_fig4.toml")
+
+    def run():
+        out = subprocess.run([sys.executable, "-c", RUN_FIG4, path], env=env, capture_output=True, text=True,
+                             check=True).stdout.split()
+        return float(out[0]), out[1] == "True"
+
+    first, loaded_first = run()
+    entries = sorted((tmp_path / "cache").glob("*.json"))
+    assert entries and loaded_first
+    second, loaded_second = run()
+    assert second == first and not loaded_second
+    for entry in entries:
+        entry.write_text("{ damaged")
+    third, loaded_third = run()
+    assert third == first and loaded_third
+    assert code_cache.entry_name(("model", object())) is None
+    assert code_cache.entry_name(("model", (1.0, "a", None))) is not None

@@ -22,7 +22,7 @@ from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 
-from ..modeling import Var
+from ..modeling import Var, code_cache
 from ..modeling.component import quiet_numpy_on_symbols
 from ..parameter_schema import unit_of
 
@@ -150,11 +150,15 @@ def traces(element, method: Callable, points: Sequence[tuple[float, ...]]) -> bo
     """Whether ``method(element rebuilt around symbols, *args)`` gives, at each of ``points``, the value
     ``method(element, *args)`` gives on floats (compared where that is finite).  Cached by the
     element's form: whether it traces does not depend on its numbers."""
-    key = (structure_key(element), getattr(method, "__qualname__", repr(method)))
+    key = ("traces", structure_key(element), getattr(method, "__qualname__", repr(method)))
     if key not in _TRACES:
         if len(_TRACES) >= _TRACES_SIZE:
             _TRACES.pop(next(iter(_TRACES), None), None)
-        _TRACES[key] = _probe(element, method, points)
+        stored = code_cache.load(key)  # a decision of an earlier process spares importing CasADi
+        if not isinstance(stored, bool):
+            stored = _probe(element, method, points)
+            code_cache.store(key, stored)
+        _TRACES[key] = stored
     return _TRACES[key]
 
 

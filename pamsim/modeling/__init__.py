@@ -8,11 +8,11 @@ expressions of the states, inputs, parameters and modes.  From those come the ge
 (:mod:`pamsim.modeling.pygen`), the C (:mod:`pamsim.modeling.cgen`) and the Jacobians.
 """
 
-from . import smath
+from . import code_cache, smath
 from .assembly import Assembly, AssemblyError
 from .component import Component, Equations, Symbols
 from .flat import FlatModel
 from .variables import PNEUMATIC, SIGNAL, TRANSLATIONAL, Port, PortKind, Var
 
 __all__ = ["Assembly", "AssemblyError", "Component", "Equations", "FlatModel", "PNEUMATIC", "Port", "PortKind",
-           "SIGNAL", "Symbols", "TRANSLATIONAL", "Var", "smath"]
+           "SIGNAL", "Symbols", "TRANSLATIONAL", "Var", "code_cache", "smath"]

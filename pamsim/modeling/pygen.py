@@ -13,6 +13,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from . import code_cache
 from .signatures import FUNCTION_SIGNATURES
 
 
@@ -228,8 +229,6 @@ def module_source(model, names=None) -> str:
              RUNTIME]
     if model.externals:
         parts.append(function_source(model.function("externals"), "_externals"))
-    if names is None and model.externals:
-        names = [name for name in FUNCTION_SIGNATURES if name != "jacobian"]  # none through an external
     for name in FUNCTION_SIGNATURES:
         if names is not None and name not in names:
             continue
@@ -271,10 +270,35 @@ class GeneratedModel:
     """
 
     def __init__(self, model, names=None):
-        self.source = module_source(model, names)
-        namespace: dict[str, Any] = {"__name__": f"pamsim_generated_{model.name}"}
-        namespace.update({f"_ext{i}": ext.fn for i, ext in enumerate(model.externals)})
-        exec(compile(self.source, f"<pamsim generated {model.name}>", "exec"), namespace)
+        made = [name for name in FUNCTION_SIGNATURES if (names is None or name in names)
+                and not (name == "jacobian" and model.externals)]  # no Jacobian through an external
+        fn = model.function("jacobian") if "jacobian" in made else None
+        self._load(module_source(model, made), model.name,
+                   {kind: [v.name for v in getattr(model, kind)] for kind in ("states", "inputs", "outputs", "parameters")},
+                   {name: model.depends_on_inputs(name) for name in made},
+                   [ext.fn for ext in model.externals],
+                   [(fn.size1_out(i), fn.size2_out(i)) for i in range(fn.n_out())] if fn is not None else None)
+
+    @classmethod
+    def from_payload(cls, payload: dict) -> "GeneratedModel":
+        """A model generated in another process (:meth:`payload`), without CasADi."""
+        self = cls.__new__(cls)
+        self._load(payload["source"], payload["model"], payload["names"], payload["reads_inputs"], [],
+                   payload["jacobian_shapes"])
+        return self
+
+    def payload(self) -> dict:
+        """What :meth:`from_payload` needs, as JSON values (a model with external functions has none)."""
+        return {"source": self.source, "model": self.model_name, "names": self.names,
+                "reads_inputs": self.reads_inputs, "jacobian_shapes": self._jacobian_shapes}
+
+    def _load(self, source, model_name, names, reads_inputs, externals, jacobian_shapes):
+        self.source, self.model_name, self.names = source, model_name, names
+        self.reads_inputs, self._jacobian_shapes = reads_inputs, jacobian_shapes
+        self.has_externals = bool(externals)
+        namespace: dict[str, Any] = {"__name__": f"pamsim_generated_{model_name}"}
+        namespace.update({f"_ext{i}": fn for i, fn in enumerate(externals)})
+        exec(compile(source, f"<pamsim generated {model_name}>", "exec"), namespace)
         self.f = namespace.get("f")
         self.y = namespace.get("y")
         self.z = namespace.get("z")
@@ -282,13 +306,6 @@ class GeneratedModel:
         self.rest_mode = namespace.get("rest_mode")
         self.x0 = namespace.get("x0")
         self._jacobian = namespace.get("jacobian")
-        self.names = {kind: [v.name for v in getattr(model, kind)]
-                      for kind in ("states", "inputs", "outputs", "parameters")}
-        self.reads_inputs = {name: model.depends_on_inputs(name) for name in FUNCTION_SIGNATURES
-                             if namespace.get(name) is not None}
-        if self._jacobian is not None:
-            fn = model.function("jacobian")
-            self._jacobian_shapes = [(fn.size1_out(i), fn.size2_out(i)) for i in range(fn.n_out())]
 
     def jacobian(self, x, u, p, q):
         """``(A, B, C, D)`` as numpy arrays: df/dx, df/du, dy/dx, dy/du."""
@@ -307,12 +324,30 @@ def compiled_by_mode(assembly, component: str, names=("f", "z", "transition", "r
     """``{mode: GeneratedModel}``: the assembly flattened and generated once for each mode of its hybrid
     component ``component``, with no mode logic left in the code an integrator runs in that mode.
 
-    Cached by the assembly's structure, so runs that differ only in parameter values share the code.
+    Cached by the assembly's structure, so runs that differ only in parameter values share the code,
+    in this process and, through :mod:`pamsim.modeling.code_cache`, in the next ones.
     """
     key = (assembly.structure_key(), component, tuple(names))
     if key not in _BY_MODE_CACHE:
-        modes = assembly.by_name[component].modes
         if len(_BY_MODE_CACHE) >= BY_MODE_CACHE_SIZE:
             _BY_MODE_CACHE.pop(next(iter(_BY_MODE_CACHE), None), None)
-        _BY_MODE_CACHE[key] = {int(m): GeneratedModel(assembly.flatten({component: int(m)}), names) for m in modes}
+        _BY_MODE_CACHE[key] = _by_mode_from_disk(key) or _generate_by_mode(assembly, component, names, key)
     return _BY_MODE_CACHE[key]
+
+
+def _by_mode_from_disk(key) -> dict | None:
+    stored = code_cache.load(key)
+    if not isinstance(stored, dict):
+        return None
+    try:
+        return {int(mode): GeneratedModel.from_payload(payload) for mode, payload in stored.items()}
+    except Exception:  # an entry that does not load (an older layout, a damaged file) is generated again
+        return None
+
+
+def _generate_by_mode(assembly, component: str, names, key) -> dict:
+    modes = assembly.by_name[component].modes
+    generated = {int(m): GeneratedModel(assembly.flatten({component: int(m)}), names) for m in modes}
+    if not any(g.has_externals for g in generated.values()):
+        code_cache.store(key, {str(mode): g.payload() for mode, g in generated.items()})
+    return generated
