@@ -253,14 +253,12 @@ def test_exact_jacobians_agree_with_central_differences(spec):
     assert skipped <= 0.01 * compared, (skipped, compared)
 
 
-def test_every_static_force_of_every_shipped_muscle_is_a_component():
-    """Each (muscle, model) pair that applies: its component's force, as equations or as an external
-    function, equals the model's on floats over the muscle's travel and pressure range."""
+def _applicable_static_forces():
+    """``(muscle, model name, scenario)`` for each shipped muscle and each static model that applies to it."""
     from pamsim.muscles import shipped_names
     from pamsim.static_models import REGISTRY
 
     sc = load_scenario(FIG4)
-    traced = external = 0
     for muscle in shipped_names():
         for name in REGISTRY:
             try:
@@ -268,20 +266,28 @@ def test_every_static_force_of_every_shipped_muscle_is_a_component():
                                         "pressure": {"supply_gauge_bar": 0.1}, "load": {"weight_N": 1.0}})
             except Exception:
                 continue  # the model does not apply to this muscle
-            model = case.build_model()
-            flat = _flat(model)
-            outputs = flat.compile_python().y
-            i = flat.index("outputs", "muscle.F_static_N")
-            for x in np.linspace(model.stops.x_low_m, model.stops.x_high_m, 9):
-                for p in np.linspace(0.0, case.parameters["rated_pressure_gauge_Pa"], 5):
-                    y = list(model.initial_state(float(x)))
-                    y[2] = p + model.source.p_atm_Pa
-                    (out,) = outputs(y, [0.0, 0.0, 0.0], flat.parameter_values, [0.0])
-                    want = float(model.static_force.force_N(float(x), float(p)))
-                    assert out[i] == pytest.approx(want, rel=1e-9, abs=1e-9 * max(1.0, abs(want)), nan_ok=True), \
-                        (muscle, name, x, p)
-            traced += not flat.externals
-            external += bool(flat.externals)
+            yield muscle, name, case
+
+
+def test_every_static_force_of_every_shipped_muscle_is_a_component():
+    """Each (muscle, model) pair that applies: its component's force, as equations or as an external
+    function, equals the model's on floats over the muscle's travel and pressure range."""
+    traced = external = 0
+    for muscle, name, case in _applicable_static_forces():
+        model = case.build_model()
+        flat = _flat(model)
+        outputs = flat.compile_python().y
+        i = flat.index("outputs", "muscle.F_static_N")
+        for x in np.linspace(model.stops.x_low_m, model.stops.x_high_m, 9):
+            for p in np.linspace(0.0, case.parameters["rated_pressure_gauge_Pa"], 5):
+                y = list(model.initial_state(float(x)))
+                y[2] = p + model.source.p_atm_Pa
+                (out,) = outputs(y, [0.0, 0.0, 0.0], flat.parameter_values, [0.0])
+                want = float(model.static_force.force_N(float(x), float(p)))
+                assert out[i] == pytest.approx(want, rel=1e-9, abs=1e-9 * max(1.0, abs(want)), nan_ok=True), \
+                    (muscle, name, x, p)
+        traced += not flat.externals
+        external += bool(flat.externals)
     assert traced >= 250, (traced, external)
 
 
@@ -430,53 +436,42 @@ def test_static_force_jacobians_of_every_shipped_muscle_agree_with_central_diffe
     applies to, at random points inside its domain: exact against central differences, 1e-7 relative
     (the few points whose difference step straddles a kink of the clip at F = 0 are counted, not
     compared: at most 2 %)."""
-    import casadi as ca
-    from pamsim.muscles import shipped_names
-    from pamsim.static_models import REGISTRY
-
-    sc = load_scenario(FIG4)
     rng = np.random.default_rng(37)
     compared = skipped = models = 0
-    for muscle in shipped_names():
-        for name in REGISTRY:
-            try:
-                case = sc.with_changes({"model": {"muscle": muscle, "static_force": name},
-                                        "pressure": {"supply_gauge_bar": 0.1}, "load": {"weight_N": 1.0}})
-            except Exception:
-                continue
-            model = case.build_model()
-            flat = _flat(model)
-            if flat.externals:
-                continue
-            models += 1
-            i_F = flat.index("outputs", "muscle.F_static_N")
-            C = flat.function("jacobian")
-            y_fn = flat.function("y")
-            P = flat.parameter_values
-            d = model.static_force.domain
-            x_hi = min(model.stops.x_high_m, d.x_max_m)
-            p_hi = min(case.parameters["rated_pressure_gauge_Pa"], d.p_max_Pa)
-            for _ in range(8):
-                x = rng.uniform(max(d.x_min_m, 0.0), x_hi)
-                p_gauge = rng.uniform(max(d.p_min_Pa, 0.0), p_hi)
-                y = np.array(model.initial_state(x))
-                y[2] = p_gauge + model.source.p_atm_Pa
-                u = [1.0, 3e5, 0.0]
-                dy_dx = np.array(C(y, u, P, [0.0])[2])[i_F]
-                exact = np.array([dy_dx[0], dy_dx[2]])  # d/dx, d/dp_abs
-                fd, kinks = [], []
-                for k, h in ((0, 1e-7), (2, 1e-6 * y[2])):  # about eps^(1/3) of the scale of each
-                    yp, ym = y.copy(), y.copy()
-                    yp[k] += h
-                    ym[k] -= h
-                    Fp, Fm = (float(np.array(y_fn(v, u, P, [0.0]))[i_F, 0]) for v in (yp, ym))
-                    F0 = float(np.array(y_fn(y, u, P, [0.0]))[i_F, 0])
-                    fd.append((Fp - Fm) / (2 * h))
-                    kinks.append(abs((Fp - F0) - (F0 - Fm)) > 1e-4 * abs(Fp - Fm) + 1e-12 * abs(F0))
-                for e, f, kink in zip(exact, fd, kinks):
-                    if kink:
-                        skipped += 1
-                        continue
-                    compared += 1
-                    assert abs(e - f) <= 1e-7 * max(abs(e), abs(f)) + 1e-9, (muscle, name, x, p_gauge, e, f)
+    for muscle, name, case in _applicable_static_forces():
+        model = case.build_model()
+        flat = _flat(model)
+        if flat.externals:
+            continue
+        models += 1
+        i_F = flat.index("outputs", "muscle.F_static_N")
+        C = flat.function("jacobian")
+        y_fn = flat.function("y")
+        P = flat.parameter_values
+        d = model.static_force.domain
+        x_hi = min(model.stops.x_high_m, d.x_max_m)
+        p_hi = min(case.parameters["rated_pressure_gauge_Pa"], d.p_max_Pa)
+        for _ in range(8):
+            x = rng.uniform(max(d.x_min_m, 0.0), x_hi)
+            p_gauge = rng.uniform(max(d.p_min_Pa, 0.0), p_hi)
+            y = np.array(model.initial_state(x))
+            y[2] = p_gauge + model.source.p_atm_Pa
+            u = [1.0, 3e5, 0.0]
+            dy_dx = np.array(C(y, u, P, [0.0])[2])[i_F]
+            exact = np.array([dy_dx[0], dy_dx[2]])  # d/dx, d/dp_abs
+            fd, kinks = [], []
+            for k, h in ((0, 1e-7), (2, 1e-6 * y[2])):  # about eps^(1/3) of the scale of each
+                yp, ym = y.copy(), y.copy()
+                yp[k] += h
+                ym[k] -= h
+                Fp, Fm = (float(np.array(y_fn(v, u, P, [0.0]))[i_F, 0]) for v in (yp, ym))
+                F0 = float(np.array(y_fn(y, u, P, [0.0]))[i_F, 0])
+                fd.append((Fp - Fm) / (2 * h))
+                kinks.append(abs((Fp - F0) - (F0 - Fm)) > 1e-4 * abs(Fp - Fm) + 1e-12 * abs(F0))
+            for e, f, kink in zip(exact, fd, kinks):
+                if kink:
+                    skipped += 1
+                    continue
+                compared += 1
+                assert abs(e - f) <= 1e-7 * max(abs(e), abs(f)) + 1e-9, (muscle, name, x, p_gauge, e, f)
     assert models >= 250 and skipped <= 0.02 * compared, (models, compared, skipped)

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from ..modeling import PNEUMATIC, Component, Equations, Port, Symbols, Var
-from .element import ElementParameters, element_parameters, traces
+from .element import ElementParameters
 
 PROBE_POINTS = tuple((x,) for x in (0.0, 0.01, 0.04))
 
@@ -31,10 +31,7 @@ class PolytropicChamber(ElementParameters, Component):
                         Var("T_initial_K", "K", "gas temperature at the start"))
 
     def __init__(self, name: str, element, p_atm_Pa: float, initial_pressure_gauge_Pa: float, T_initial_K: float):
-        self.element = element
-        if not traces(element, _volume_m3, PROBE_POINTS):
-            raise TypeError(f"chamber {type(element).__name__}: its volume cannot be written with symbols")
-        values = element_parameters(element)
+        values = self.wrap(element, _volume_m3, PROBE_POINTS, required="chamber")
         values.update(p_atm_Pa=p_atm_Pa, initial_pressure_gauge_Pa=initial_pressure_gauge_Pa, T_initial_K=T_initial_K)
         super().__init__(name, values)
 

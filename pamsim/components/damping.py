@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from ..modeling import TRANSLATIONAL, Component, Equations, Port, Symbols, Var
-from .element import ElementParameters, traces
+from .element import ElementParameters
 
 PROBE_POINTS = tuple((v,) for v in (-0.5, -0.05, -1e-3, 0.0, 1e-3, 0.05, 0.5))
 """Velocities [m/s] at which a law's symbolic form is checked."""
@@ -25,14 +25,9 @@ class ViscousDamping(ElementParameters, Component):
     outputs = (Var("F_damping_N", "N", "damping force on the load along x"),)
 
     def __init__(self, name: str, element):
-        self.element = element
-        self.traces = traces(element, _force_N, PROBE_POINTS)
-        super().__init__(name, self.element_values())
+        super().__init__(name, self.wrap(element, _force_N, PROBE_POINTS))
 
     def equations(self, s: Symbols) -> Equations:
         v = s.port["flange"]["v_m_s"]
-        if self.traces:
-            F = self.symbolic_element(s.p).force_N(v)
-        else:  # a law with no symbolic form, called on floats
-            F = s.external("force_N", self.element.force_N, v)
+        F = self.element_call(s, "force_N", v)
         return Equations(der={"E_damping_J": F * v}, outputs={"F_damping_N": -F}, port={"flange": {"F_N": -F}})

@@ -207,6 +207,22 @@ class ElementParameters:
     def symbolic_element(self, p: Mapping[str, Any]):
         return symbolic(self.element, p)
 
+    def wrap(self, element, probe: Callable, points, required: str = "") -> dict[str, float]:
+        """Take ``element``, decide whether it takes symbols (``probe`` at ``points``, :func:`traces`)
+        and return its parameter values.  ``required``: what to call it in the ``TypeError`` raised when
+        it must take symbols and does not (an element the python backend cannot call on floats)."""
+        self.element = element
+        self.traces = traces(element, probe, points)
+        if required and not self.traces:
+            raise TypeError(f"{required} {type(element).__name__} cannot be written with symbols")
+        return self.element_values()
+
+    def element_call(self, s, method: str, *args):
+        """``element.method(*args)``: as equations if the element takes symbols, else on floats."""
+        if self.traces:
+            return getattr(self.symbolic_element(s.p), method)(*args)
+        return s.external(method, getattr(self.element, method), *args)
+
     def structure_key(self) -> tuple:
         # An element called on floats is part of the generated code: its numbers are too.
         return super().structure_key() + (structure_key(self.element, baked=not self.traces),)

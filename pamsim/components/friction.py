@@ -5,7 +5,7 @@ friction holds whatever it must)."""
 from __future__ import annotations
 
 from ..modeling import TRANSLATIONAL, Component, Equations, Port, Symbols, Var
-from .element import ElementParameters, traces
+from .element import ElementParameters
 
 PROBE_POINTS = tuple((x, p, m) for x in (0.0, 0.01, 0.04) for p in (0.0, 1e5, 4e5) for m in (0.5, 2.0, 8.0))
 """Contractions [m], gauge pressures [Pa] and load masses [kg] at which a law's symbolic form is checked."""
@@ -30,16 +30,10 @@ class CoulombFriction(ElementParameters, Component):
     outputs = (Var("level_N", "N", "Coulomb friction level"),)
 
     def __init__(self, name: str, element):
-        self.element = element
-        self.traces = traces(element, _level_N, PROBE_POINTS)
-        super().__init__(name, self.element_values())
+        super().__init__(name, self.wrap(element, _level_N, PROBE_POINTS))
 
     def equations(self, s: Symbols) -> Equations:
         u, flange = s.u, s.port["flange"]
-        args = (flange["x_m"], u["p_gauge_Pa"], u["mass_kg"])
-        if self.traces:
-            level = self.symbolic_element(s.p).level_N(*args)
-        else:  # a law with no symbolic form, called on floats
-            level = s.external("level_N", self.element.level_N, *args)
+        level = self.element_call(s, "level_N", flange["x_m"], u["p_gauge_Pa"], u["mass_kg"])
         return Equations(der={"E_friction_J": level * abs(flange["v_m_s"])}, outputs={"level_N": level},
                          port={"flange": {"F_N": -(u["direction"] * level)}})

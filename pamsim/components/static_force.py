@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from ..modeling import TRANSLATIONAL, Component, Equations, Port, Symbols, Var
-from .element import ElementParameters, traces
+from .element import ElementParameters
 
 PROBE_POINTS = tuple((x, p) for x in (0.0, 0.002, 0.005, 0.01, 0.02, 0.04) for p in (0.0, 0.5e5, 1e5, 3e5, 6e5))
 """Contractions [m] and gauge pressures [Pa] at which a static force's symbolic form is checked."""
@@ -28,14 +28,9 @@ class MuscleStaticForce(ElementParameters, Component):
     outputs = (Var("F_static_N", "N", "static muscle force along x"),)
 
     def __init__(self, name: str, element):
-        self.element = element
-        self.traces = traces(element, _force_N, PROBE_POINTS)
-        super().__init__(name, self.element_values())
+        super().__init__(name, self.wrap(element, _force_N, PROBE_POINTS))
 
     def equations(self, s: Symbols) -> Equations:
         x, v = s.port["flange"]["x_m"], s.port["flange"]["v_m_s"]
-        if self.traces:
-            F = self.symbolic_element(s.p).force_N(x, s.u["p_gauge_Pa"])
-        else:
-            F = s.external("force_N", self.element.force_N, x, s.u["p_gauge_Pa"])
+        F = self.element_call(s, "force_N", x, s.u["p_gauge_Pa"])
         return Equations(der={"W_muscle_J": F * v}, outputs={"F_static_N": F}, port={"flange": {"F_N": F}})

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from ..modeling import PNEUMATIC, Component, Equations, Port, Symbols, Var
 from ..modeling.smath import if_else
-from .element import ElementParameters, element_parameters, traces
+from .element import ElementParameters
 
 
 PROBE_POINTS = tuple((u, p, 293.15, 5e5, 293.15, 1.01325e5) for u in (-1.0, -0.3, 0.0, 0.4, 1.0)
@@ -31,10 +31,7 @@ class ProportionalValve(ElementParameters, Component):
                         Var("R_J_per_kg_K", "J/(kg K)", "specific gas constant of air"))
 
     def __init__(self, name: str, element, T_supply_K: float, p_atm_Pa: float, R_J_per_kg_K: float):
-        self.element = element
-        if not traces(element, _inflow_kg_s, PROBE_POINTS):
-            raise TypeError(f"valve {type(element).__name__}: its flow cannot be written with symbols")
-        values = element_parameters(element)
+        values = self.wrap(element, _inflow_kg_s, PROBE_POINTS, required="valve")
         values.update(T_supply_K=T_supply_K, p_atm_Pa=p_atm_Pa, R_J_per_kg_K=R_J_per_kg_K)
         super().__init__(name, values)
 

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from typing import Mapping, Sequence
 
 from .component import Component, Equations, Symbols, quiet_numpy_on_symbols
-from .flat import External, FlatModel, FlatVar
+from .flat import External, FlatModel
 from .variables import Var
 
 
@@ -259,7 +259,7 @@ class Assembly:
             return ca.substitute([ca.SX(expr)], list(resolved), list(resolved.values()))[0] if resolved else ca.SX(expr)
 
         comps = self.components
-        fv = lambda c, v: FlatVar(f"{c.name}.{v.name}", v.unit, v.description, v.nominal)  # noqa: E731
+        fv = lambda c, v: Var(f"{c.name}.{v.name}", v.unit, v.description, v.nominal)  # noqa: E731
         out_vars = [fv(c, v) for c in comps for v in c.outputs]
         hybrid = [c for c in comps if c.modes is not None]
         free = [c for c in hybrid if c.name not in modes]
@@ -275,7 +275,7 @@ class Assembly:
         return FlatModel(
             name=self.name,
             states=[fv(c, v) for c, v, _ in states],
-            inputs=[FlatVar(n, _var(self._endpoint(refs[0]).component.inputs, self._endpoint(refs[0]).name).unit)
+            inputs=[Var(n, _var(self._endpoint(refs[0]).component.inputs, self._endpoint(refs[0]).name).unit)
                     for n, refs in self.inputs.items()],
             outputs=out_vars,
             parameters=[fv(c, v) for c, v, _ in params],

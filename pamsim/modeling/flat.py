@@ -12,16 +12,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from .signatures import FUNCTION_SIGNATURES
-
-
-@dataclass(frozen=True)
-class FlatVar:
-    """A variable of the flat model: its namespaced name, unit, meaning and nominal scale."""
-
-    name: str
-    unit: str
-    description: str = ""
-    nominal: float = 1.0
+from .variables import Var
 
 
 
@@ -47,10 +38,10 @@ class FlatModel:
     """
 
     name: str
-    states: list[FlatVar]
-    inputs: list[FlatVar]
-    outputs: list[FlatVar]
-    parameters: list[FlatVar]
+    states: list[Var]
+    inputs: list[Var]
+    outputs: list[Var]
+    parameters: list[Var]
     parameter_values: list[float]
     modes: list[tuple[str, Any]]
     x: list[Any]
