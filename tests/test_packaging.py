@@ -15,3 +15,13 @@ def test_pyproject_lists_every_subpackage():
     assert found <= listed, f"add to [tool.setuptools] packages: {sorted(found - listed)}"
     assert conf["package-dir"]["pamsim.fmu.csrc"] == "fmu"
     assert (ROOT / "fmu" / "src" / "pam_core.c").is_file()
+
+
+def test_license_file_matches_pyproject_and_ships():
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
+    assert project["license"] == "MIT"
+    # license-files puts LICENSE into the sdist and the wheel's .dist-info/licenses/.
+    assert project["license-files"] == ["LICENSE"]
+    text = (ROOT / "LICENSE").read_text()
+    assert text.startswith("MIT License\n")
+    assert "Copyright (c) 2026 the pamsim authors" in text
