@@ -25,3 +25,18 @@ def test_license_file_matches_pyproject_and_ships():
     text = (ROOT / "LICENSE").read_text()
     assert text.startswith("MIT License\n")
     assert "Copyright (c) 2026 the pamsim authors" in text
+
+
+def test_no_two_files_differ_only_by_case():
+    """A checkout on a case-insensitive file system (macOS, Windows) would keep only one of them."""
+    import subprocess
+    from collections import defaultdict
+
+    names = subprocess.run(["git", "ls-files"], cwd=ROOT, capture_output=True, text=True, check=True).stdout.split("\n")
+    by_folded = defaultdict(set)
+    for name in filter(None, names):
+        parts = name.split("/")
+        for k in range(1, len(parts) + 1):  # folders too: docs/A and Docs/B collide as folders
+            by_folded["/".join(parts[:k]).casefold()].add("/".join(parts[:k]))
+    clashes = sorted(sorted(group) for group in by_folded.values() if len(group) > 1)
+    assert not clashes, f"paths that differ only by case: {clashes}"

@@ -87,7 +87,7 @@ def test_kothera_blocked_force_decrease_is_pressure_independent():
 @pytest.mark.xfail(strict=True, reason="Kothera et al. 2009 (text after eq. 33): 'the simulated blocked force decreases "
                    "by 40 % at 10 psi to over 70 % at 60 psi' (eq. 33 vs eq. 29). At L = L0 both models are linear in "
                    "pressure, so no reading can make the decrease pressure-dependent; it is 10.8 % at every pressure "
-                   "(STATIC_MODELS.md sec. 7, not reproduced 1)")
+                   "(static_models_spec.md sec. 7, not reproduced 1)")
 def test_kothera_claim_blocked_force_drops_40_to_70_percent():
     drops = [1.0 - kothera("kothera_force_balance_thickness").blocked_force_N(psi * PSI)
              / kothera("kothera_force_balance").blocked_force_N(psi * PSI) for psi in (10, 60)]
@@ -247,7 +247,7 @@ def test_miniature_muscle_error_ranking_of_chou_kothera_trivedi_matches_the_surv
 @pytest.mark.xfail(strict=True, reason="The survey ranks Kothera 7 % < Hocking 8 % < Trivedi 29 % < Sangian 35 % < Chou 40 % "
                    "with each model's best-fit parameters, which it does not give. With the parameters it does give "
                    "(Hocking: linear term only; Sangian: no dead band) Sangian is the second best (-4 %) and Hocking "
-                   "the third (-14 %) (STATIC_MODELS.md sec. 7)")
+                   "the third (-14 %) (static_models_spec.md sec. 7)")
 def test_miniature_muscle_full_error_ranking_as_the_survey_reports():
     ranked = [k for k in MINIATURE if MINIATURE[k][5] is not None]
     by_survey = sorted(ranked, key=lambda k: MINIATURE[k][5])

@@ -102,7 +102,7 @@ class Trivedi(BraidModel):
     reaches the stretch ``l1 = L/L0``.  pamsim writes the force as Gaylord's force
     at the excess pressure, ``F = (p - P_T(l1)) (3 L^2 - b^2)/(4 pi N^2)``, which is
     zero exactly where the paper's root-find puts the free muscle.  With the
-    rebuilt numerator and denominator (STATIC_MODELS.md S-14) the singular factor
+    rebuilt numerator and denominator (static_models_spec.md S-14) the singular factor
     cancels: ``F = p (3 L^2 - b^2)/(4 pi N^2) - K Num(l1)/(l1^3 (1 - l1^2 c^2)^2)``,
     ``K = (E/3)(r0^2/ri^2 - 1) b^2/(4 pi N^2)``, ``c = cos(theta0)``.  Eq. (25)
     (the bladder's linear-elastic axial force) is not used.

@@ -1,6 +1,6 @@
 """Braid and bladder geometry shared by the physical models.
 
-Conventions (STATIC_MODELS.md sec. 1): ``theta`` is the braid angle from the
+Conventions (static_models_spec.md sec. 1): ``theta`` is the braid angle from the
 muscle axis; the fibre length ``b`` and number of turns ``N`` follow from the
 rest length ``L0``, the braid radius at rest ``r0`` and ``theta0``:
 ``L = b cos(theta)``, ``2 pi r N = b sin(theta)``.  The bladder volume

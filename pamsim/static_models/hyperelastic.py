@@ -22,7 +22,7 @@ OGDEN_OPTIONAL = {"ogden_mu2_Pa": 0.0, "ogden_alpha2": 1.0, "ogden_mu3_Pa": 0.0,
 
 
 class FibreStretch:
-    """Ogden paper eqs. (6)-(13) rebuilt (STATIC_MODELS.md O-2): braid force of extensible fibres.
+    """Ogden paper eqs. (6)-(13) rebuilt (static_models_spec.md O-2): braid force of extensible fibres.
 
     Radial balance gives the fibre tension, hence the stretched fibre length
     ``b = b0 / (1 - c L)`` with ``c = p b0 / (2 pi n^2 N_s E_f A_f)`` (``n`` turns,

@@ -1,6 +1,6 @@
 """One strain-energy routine for every hyperelastic bladder term (Mooney-Rivlin, Ogden, neo-Hookean).
 
-``elastic_force_N`` is ``F_elastic = -V_b dW/dL`` (STATIC_MODELS.md sec. 1.9 and
+``elastic_force_N`` is ``F_elastic = -V_b dW/dL`` (static_models_spec.md sec. 1.9 and
 sec. 9): the force the stretched bladder takes away from Gaylord's ideal force,
 positive while the muscle contracts.  ``W`` is an object with ``grad(l1, l2,
 l3)`` returning the partial derivatives of the strain energy density [Pa] with
