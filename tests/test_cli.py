@@ -345,3 +345,20 @@ def test_run_help_describes_every_backend(cli):
         assert name in backend.help, name
     text = " ".join(cli("run", "--help").stdout.split())
     assert "native: the C core" in text
+
+
+def test_version_prints_the_package_version():
+    """``pamsim --version`` as a user runs it: the console script (where installed) and ``python -m pamsim``."""
+    import shutil
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    from pamsim import __version__
+
+    script = shutil.which("pamsim", path=str(Path(sys.executable).parent))
+    runs = [pamsim("--version")]
+    if script is not None:
+        runs.append(subprocess.run([script, "--version"], capture_output=True, text=True, timeout=60))
+    for r in runs:
+        assert (r.returncode, r.stdout, r.stderr) == (0, f"pamsim {__version__}\n", ""), r.args
