@@ -21,6 +21,7 @@ from .atomic import atomic_outputs
 from .constants import PA_PER_BAR
 from .elements.stops import EndStops
 from .errors import InputError
+from .figure_style import check_format
 from .muscle_setup import model_inputs, muscle_parameters, prepare
 from .muscles import Muscle
 from .static_models import REGISTRY
@@ -107,14 +108,17 @@ class Atlas:
             lines.append(f"\nNot drawn: `{m}`: {why}")
         return "\n".join(lines) + "\n"
 
-    def figure_names(self) -> list[str]:
-        return [f"atlas_{p / PA_PER_BAR:g}bar.png" for p in self.pressures_Pa] + ["atlas_all.png"]
+    def figure_names(self, figure_format: str = "png") -> list[str]:
+        stems = [f"atlas_{p / PA_PER_BAR:g}bar" for p in self.pressures_Pa] + ["atlas_all"]
+        return [f"{stem}.{figure_format}" for stem in stems]
 
-    def write(self, directory: str | Path) -> list[Path]:
-        """Write ``atlas_curves.csv``, ``atlas_table.csv``, ``atlas_table.md`` and the figures."""
+    def write(self, directory: str | Path, figure_format: str = "png", dpi: int | None = None) -> list[Path]:
+        """Write ``atlas_curves.csv``, ``atlas_table.csv``, ``atlas_table.md`` and the figures (PNG, PDF or SVG by
+        ``figure_format``, at ``dpi`` dots per inch; default 110, atlas_all 100)."""
         from .atlas_plots import plot_all, plot_pressure
 
-        names = ["atlas_curves.csv", "atlas_table.csv", "atlas_table.md"] + self.figure_names()
+        figures = self.figure_names(check_format(figure_format, label="figure format"))
+        names = ["atlas_curves.csv", "atlas_table.csv", "atlas_table.md"] + figures
         with atomic_outputs(directory, names) as tmp:
             with open(tmp["atlas_curves.csv"], "w", newline="") as fh:
                 w = csv.writer(fh)
@@ -128,9 +132,9 @@ class Atlas:
                 w.writeheader()
                 w.writerows(self.table_rows())
             tmp["atlas_table.md"].write_text(self.markdown_table())
-            for p, name in zip(self.pressures_Pa, self.figure_names()):
-                plot_pressure(self, p, tmp[name])
-            plot_all(self, tmp["atlas_all.png"])
+            for p, name in zip(self.pressures_Pa, figures):
+                plot_pressure(self, p, tmp[name], dpi)
+            plot_all(self, tmp[figures[-1]], dpi)
         return [Path(directory) / n for n in names]
 
 

@@ -13,17 +13,18 @@ from matplotlib.figure import Figure
 
 from .atomic import atomic_path
 from .constants import PA_PER_BAR
+from .figure_style import format_of, save, series
 
-
-FORCE_STYLE: dict[str, tuple[str, str]] = {
-    "F_static_N": ("static", "C0"),
-    "F_gravity_N": ("gravity", "C7"),
-    "F_friction_N": ("friction", "C1"),
-    "F_damping_N": ("damping", "C2"),
-    "F_stop_N": ("stop contact", "C5"),
-    "F_external_N": ("external", "C4"),
-}
-"""Force key -> (legend label, colour): each force keeps its colour in every figure, whichever others are drawn."""
+FORCE_STYLE: dict[str, tuple[str, dict]] = {key: (label, series(k, colour)) for k, (key, label, colour) in enumerate((
+    ("F_static_N", "static", "C0"),
+    ("F_gravity_N", "gravity", "C7"),
+    ("F_friction_N", "friction", "C1"),
+    ("F_damping_N", "damping", "C2"),
+    ("F_stop_N", "stop contact", "C5"),
+    ("F_external_N", "external", "C4"),
+))}
+"""Force key -> (legend label, line style): each force keeps its colour and line style in every figure, whichever
+others are drawn."""
 
 HELD_STYLE: dict[int, tuple[str, str]] = {0: ("stuck (friction)", "0.85"), 2: ("on the lower stop", "#f2dcc0"),
                                           3: ("on the upper stop", "#cfe0f0")}
@@ -54,24 +55,24 @@ def result_figure(result: "Result", title: str | None = None, compare: "list[Res
     ax_x, ax_p, ax_f = fig.subplots(3, 1, sharex=True)
     t = result.t_s
     shade_held(ax_x, t, result.mode)
-    ax_x.plot(t, result.x_m * 1e3, color="k", label=result.name)
-    for k, other in enumerate(compare or []):
-        ax_x.plot(other.t_s, other.x_m * 1e3, "--", color=f"C{k}", label=other.name)
+    ax_x.plot(t, result.x_m * 1e3, **series(0, "k"), label=result.name)
+    for k, other in enumerate(compare or [], start=1):
+        ax_x.plot(other.t_s, other.x_m * 1e3, **series(k, f"C{k - 1}"), label=other.name)
     ax_x.set_ylabel(X_LABEL)
     ax_x.legend(loc="lower right", fontsize=8)
     ax_x.grid(alpha=0.3)
 
-    ax_p.plot(t, result.p_gauge_Pa / PA_PER_BAR, color="C3", label="muscle")
+    ax_p.plot(t, result.p_gauge_Pa / PA_PER_BAR, **series(0, "C3"), label="muscle")
     if "supply_gauge_Pa" in result.signals:
-        ax_p.plot(t, result.signals["supply_gauge_Pa"] / PA_PER_BAR, ":", color="k", label="supply")
+        ax_p.plot(t, result.signals["supply_gauge_Pa"] / PA_PER_BAR, **series(3, "k"), label="supply")
     ax_p.set_ylabel("gauge pressure [bar]")
     ax_p.legend(loc="lower right", fontsize=8)
     ax_p.grid(alpha=0.3)
 
-    for key, (label, colour) in FORCE_STYLE.items():
+    for key, (label, style) in FORCE_STYLE.items():
         values = result.signals[key]
         if np.any(values != 0.0):
-            ax_f.plot(t, values, label=label, color=colour, lw=1)
+            ax_f.plot(t, values, label=label, lw=1, **style)
     ax_f.axhline(0.0, color="k", lw=0.5)
     ax_f.set_ylabel(F_LABEL)
     ax_f.set_xlabel("time [s]")
@@ -86,10 +87,12 @@ def result_figure(result: "Result", title: str | None = None, compare: "list[Res
     return fig
 
 
-def plot_result(result: "Result", path=None, **kwargs) -> Figure:
-    """:func:`result_figure`, written to ``path`` (PNG, atomically) if one is given."""
+def plot_result(result: "Result", path=None, dpi: int | None = None, **kwargs) -> Figure:
+    """:func:`result_figure`, written to ``path`` (atomically) if one is given: PNG, PDF or SVG by the
+    path's suffix, at ``dpi`` dots per inch (default 110)."""
+    fmt = None if path is None else format_of(path)  # the temporary file's name has no suffix to go by
     fig = result_figure(result, **kwargs)
     if path is not None:
         with atomic_path(path) as tmp:
-            fig.savefig(tmp, format="png", dpi=110)
+            save(fig, tmp, fmt, dpi)
     return fig

@@ -240,11 +240,12 @@ class Result:
         with atomic_path(path) as tmp:
             np.savetxt(tmp, data, delimiter=",", header=",".join(cols), comments="", fmt="%.10g")
 
-    def plot(self, path=None, **kwargs):
-        """Plot contraction, pressure and forces (see :func:`pamsim.plotting.plot_result`)."""
+    def plot(self, path=None, dpi: int | None = None, **kwargs):
+        """Plot contraction, pressure and forces; write them to ``path`` if given, as PNG, PDF or SVG by its
+        suffix, at ``dpi`` dots per inch (default 110).  See :func:`pamsim.plotting.plot_result`."""
         from .plotting import plot_result
 
-        return plot_result(self, path, **kwargs)
+        return plot_result(self, path, dpi=dpi, **kwargs)
 
 
 def pointless_run_warnings(model, t_s: np.ndarray, at_rest_at_end: bool, v_end_m_s: float) -> list[str]:

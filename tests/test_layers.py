@@ -32,7 +32,7 @@ EXPECTED_LAYERS = [
     "components",
     "elements",
     "static_models | parameter_schema | signals | plotting | atlas_plots | oscillation | paperdata | data",
-    "core_table | table_checks | atomic | references",
+    "core_table | table_checks | atomic | references | figure_style",
     "modeling",  # the component machinery knows no physics: anything may build on it
     "constants | errors",
 ]

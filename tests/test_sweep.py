@@ -79,8 +79,8 @@ def test_the_written_figures_are_the_named_ones(written):
     from pamsim.sweep.figures import SWEEP_FIGURES
 
     assert sorted(pamsim.sweep.FIGURES) == sorted(SWEEP_FIGURES)
-    for name in pamsim.sweep.FIGURES:
-        assert (written / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n", name
+    for stem in pamsim.sweep.FIGURES:
+        assert (written / f"{stem}.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n", stem
 
 
 def test_grid_has_one_row_per_measured_test(serial, written):

@@ -9,7 +9,7 @@ from pathlib import Path
 
 from ..atomic import OutputError, ensure_output_dir
 from ..identification import choices
-from . import finite_float
+from . import figure_args, finite_float
 
 # The numerical modules (numpy, scipy, matplotlib) are imported by the run functions, not here:
 # `pamsim --help` must not load them.
@@ -113,6 +113,7 @@ def register(sub) -> None:
                    help="measured contraction at or below which a hung load counts as not lifted (default 0.5)")
     s.add_argument("-o", "--output", required=True, help="output directory")
     s.add_argument("--json", action="store_true", help="print fit.json to stdout")
+    figure_args.add_arguments(s)
     s.set_defaults(func=run_static)
 
     d = fsub.add_parser("dynamic", help="fit friction and damping to step responses (eq. 13)",
@@ -142,6 +143,7 @@ def register(sub) -> None:
     d.add_argument("--seed", type=_count, default=0, help="seed of --global (default 0)")
     d.add_argument("-o", "--output", required=True, help="output directory")
     d.add_argument("--json", action="store_true", help="print fit.json to stdout")
+    figure_args.add_arguments(d)
     d.set_defaults(func=run_dynamic)
 
 
@@ -149,6 +151,7 @@ def run_static(args: argparse.Namespace) -> int:
     from ..identification import compare, muscle_file, report, static_fit
     from ..identification.columns import read_static_data
 
+    figures = figure_args.options(args)
     params, muscle_model = muscle_file.load_muscle_parameters(args.muscle)
     model = args.model or muscle_model
     check_output_dir(args.output)
@@ -164,7 +167,7 @@ def run_static(args: argparse.Namespace) -> int:
         fits = dict(zip(others, compare.compare_models(data, params, others,
                                                        **{**options, "muscle_label": args.muscle})))
         compared = [fits.get(m, fit) for m in args.compare]
-    names = report.write_static_fit(fit, args.output, compared)
+    names = report.write_static_fit(fit, args.output, compared, *figures)
     if args.json:
         body = fit.to_json()
         if compared:
@@ -188,6 +191,7 @@ def run_dynamic(args: argparse.Namespace) -> int:
     from ..identification.columns import read_trace
     from ..scenario import load_scenario
 
+    figures = figure_args.options(args)
     scenario = load_scenario(args.scenario)
     traces = [read_trace(t, args.columns) for t in args.traces]
     check_output_dir(args.output)
@@ -202,7 +206,7 @@ def run_dynamic(args: argparse.Namespace) -> int:
     else:
         with ProcessPoolExecutor(max_workers=args.workers) as pool:
             fit = dynamic_fit.fit_dynamic(scenario, traces, executor=pool, **options)
-    names = report.write_dynamic_fit(fit, args.output)
+    names = report.write_dynamic_fit(fit, args.output, *figures)
     if args.json:
         print(report.json_text(fit.to_json()), end="")
         return 0

@@ -16,7 +16,7 @@ from pathlib import Path
 
 from ..atomic import atomic_outputs, output_folder
 from ..control.choices import FRICTION_KINDS, VALVE_SLOPES
-from . import finite_float
+from . import figure_args, finite_float
 
 DEFAULT_OUTPUT = "out"
 
@@ -39,7 +39,8 @@ def register(sub) -> None:
                    help="valve slope at command 0: mean of fill and vent (default), fill, vent")
     p.add_argument("--json", action="store_true", help="print JSON")
     p.add_argument("-o", "--output", default=None,
-                   help=f"directory for the PNG plots (default: {DEFAULT_OUTPUT}; with --json: no plots)")
+                   help=f"directory for the plots (default: {DEFAULT_OUTPUT}; with --json: no plots)")
+    figure_args.add_arguments(p)
     p.set_defaults(func=run)
 
 
@@ -91,6 +92,7 @@ def report(lin) -> dict:
 def run(args: argparse.Namespace) -> int:
     from ..scenario import load_scenario
 
+    args.figures = figure_args.options(args)
     scenario = load_scenario(args.scenario)
     if args.json and args.output is None:  # the numbers only: no file written, nothing on stderr
         print(json.dumps(_linearize(scenario, args)[1], indent=2))
@@ -129,13 +131,15 @@ def _linearize(scenario, args: argparse.Namespace):
 def _linearize_and_plot(scenario, args: argparse.Namespace, out: Path):
     """:func:`_linearize` and write the plots; (model, report, file names)."""
     from ..control.plots import bode_figure, pole_zero_figure
+    from ..figure_style import save
 
     lin, rep = _linearize(scenario, args)
     stem = f"{scenario.name}_linear"
-    names = [f"{stem}_bode.png", f"{stem}_pzmap.png"]
+    fmt, dpi = args.figures
+    names = [f"{stem}_bode.{fmt}", f"{stem}_pzmap.{fmt}"]
     with atomic_outputs(out, names) as tmp:
-        bode_figure(lin).savefig(tmp[names[0]], format="png", dpi=110)
-        pole_zero_figure(lin).savefig(tmp[names[1]], format="png", dpi=110)
+        save(bode_figure(lin), tmp[names[0]], dpi=dpi)
+        save(pole_zero_figure(lin), tmp[names[1]], dpi=dpi)
     return lin, rep, names
 
 

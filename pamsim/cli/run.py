@@ -1,4 +1,4 @@
-"""``pamsim run SCENARIO... -o DIR``: simulate scenarios, write NAME.csv, NAME.png and NAME.json for each.
+"""``pamsim run SCENARIO... -o DIR``: simulate scenarios, write NAME.csv, NAME.json and a figure (NAME.png) for each.
 
 A scenario with a ``[controller]`` table runs with its controller.  A folder
 stands for the scenario files in it (sweep files, which name a
@@ -16,7 +16,7 @@ from pathlib import Path
 from ..atomic import atomic_outputs, output_folder
 from ..backends import BACKENDS, DESCRIPTIONS, check_backend
 from ..errors import InputError
-from . import finite_float
+from . import figure_args, finite_float
 
 MAX_CSV_MB = 200.0
 """Default limit of ``pamsim run --max-csv-MB``: a CSV beyond it is refused before the run."""
@@ -24,14 +24,16 @@ MAX_CSV_MB = 200.0
 
 def register(sub) -> None:
     p = sub.add_parser("run", help="simulate scenario files",
-                       description="Simulate scenarios and write NAME.csv, NAME.png and NAME.json for each into "
-                                   "DIR.  A scenario with a [controller] table runs with its controller; exit "
-                                   "code 1 if such a run misses its [controller.spec].")
+                       description="Simulate scenarios and write NAME.csv, NAME.json and the figure NAME.png "
+                                   "(or .pdf, .svg with --format) for each into DIR.  A scenario with a [controller] "
+                                   "table runs with its controller; exit code 1 if such a run misses its "
+                                   "[controller.spec].")
     p.add_argument("scenario", nargs="+", help="scenario TOML files, or folders of them (e.g. scenarios/)")
     p.add_argument("-o", "--output", default="out", help="output directory (default: out)")
     p.add_argument("--backend", default="python", choices=sorted(BACKENDS),
                    help="; ".join(f"{name}: {DESCRIPTIONS[name]}" for name in BACKENDS))
-    p.add_argument("--no-plot", action="store_true", help="skip the PNG")
+    p.add_argument("--no-plot", action="store_true", help="skip the figure")
+    figure_args.add_arguments(p)
     p.add_argument("--max-csv-MB", type=finite_float, default=MAX_CSV_MB, metavar="MB",
                    help=f"refuse a run whose CSV could exceed this size (default {MAX_CSV_MB:g} MB; "
                         "the estimate is an upper bound, about twice the usual size)")
@@ -64,6 +66,7 @@ def scenario_paths(arguments: list[str]) -> list[Path]:
 def run(args: argparse.Namespace) -> int:
     from ..scenario import load_scenario
 
+    args.figures = figure_args.options(args)
     if not args.max_csv_MB > 0:
         raise InputError(f"--max-csv-MB = {args.max_csv_MB:g}: must be positive")
     scenarios = [load_scenario(p) for p in scenario_paths(args.scenario)]  # every file checked before any run
@@ -99,6 +102,7 @@ def _run_one(scenario, args: argparse.Namespace, out: Path) -> list[str]:
     from tqdm import tqdm
 
     from ..api import run as run_scenario
+    from ..figure_style import save
 
     # Shown only for runs that last over a second; cleared when done.
     with tqdm(total=scenario.duration_s, desc=scenario.name, unit="s simulated", delay=1.0, leave=False,
@@ -106,13 +110,14 @@ def _run_one(scenario, args: argparse.Namespace, out: Path) -> list[str]:
               "[{elapsed}<{remaining}]") as bar:
         outcome = run_scenario(scenario, args.backend, progress=lambda t: bar.update(t - bar.n))
     result = outcome.result
-    names = [f"{scenario.name}.csv", f"{scenario.name}.json"] + ([] if args.no_plot else [f"{scenario.name}.png"])
+    fmt, dpi = args.figures
+    names = [f"{scenario.name}.csv", f"{scenario.name}.json"] + ([] if args.no_plot else [f"{scenario.name}.{fmt}"])
     summary = outcome.summary()
     with atomic_outputs(out, names) as tmp:
         result.to_csv(tmp[names[0]])
         tmp[names[1]].write_text(json.dumps(summary, indent=2) + "\n")
         if not args.no_plot:
-            outcome.figure().savefig(tmp[names[2]], format="png", dpi=110)
+            save(outcome.figure(), tmp[names[2]], dpi=dpi)
     for warning in result.warnings:
         print(f"pamsim: warning: {scenario.name}: {warning}", file=sys.stderr)
     s = summary

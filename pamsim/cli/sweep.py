@@ -12,6 +12,7 @@ from pathlib import Path
 
 from ..atomic import output_folder
 from ..backends import BACKENDS
+from . import figure_args
 
 
 def _workers(text: str) -> int:
@@ -27,7 +28,7 @@ def _workers(text: str) -> int:
 def register(sub) -> None:
     p = sub.add_parser("sweep", help="run a sweep file (many cases, compared with measurements)",
                        description="Run every case of a sweep file under each friction model it names and write "
-                                   "summary.csv, report.md and PNG figures into DIR.")
+                                   "summary.csv, report.md and figures (PNG, or PDF or SVG with --format) into DIR.")
     p.add_argument("sweep_file", help="sweep TOML file (see scenarios/acra2012_grid.toml)")
     p.add_argument("-o", "--output", default="out", help="output directory (default: out)")
     where = p.add_mutually_exclusive_group()
@@ -43,12 +44,14 @@ def register(sub) -> None:
     p.add_argument("--backend", choices=sorted(BACKENDS), default=None,
                    help="backend of every run (default: the sweep file's backend key, else python)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
+    figure_args.add_arguments(p)
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
     from ..sweep.dask_cluster import dask_executor, start_worker_server
 
+    fmt, dpi = figure_args.options(args)
     if args.dask_local is not None:
         # The local workers' fork server imports Dask and pamsim while this process reads the sweep.
         start_worker_server()
@@ -70,7 +73,7 @@ def run(args: argparse.Namespace) -> int:
         with output_folder(args.output) as out:  # checked before the runs; removed again if nothing gets written
             result = run_sweep(spec, executor, progress=not args.no_progress, backend=args.backend,
                                chunk_size=args.chunk_size)
-            names = result.write(out, executor)
+            names = result.write(out, executor, fmt, dpi)
     for failure in result.failures:
         print(f"pamsim: warning: failed run {failure}", file=sys.stderr)
     samples = f", {spec.uncertainty.samples} uncertainty samples" if spec.uncertainty is not None else ""

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.figure import Figure
 
+from ..figure_style import series
 from ..plotting import X_LABEL, shade_held
 from .linear import LinearModel
 
@@ -17,16 +18,16 @@ def bode_figure(lin: LinearModel) -> Figure:
     omega = lin.frequency_grid_rad_s()
     fig = Figure(figsize=(8, 7), constrained_layout=True)
     ax_m, ax_p = fig.subplots(2, 1, sharex=True)
-    for inp, out in _BODE_CHANNELS:
+    for k, (inp, out) in enumerate(_BODE_CHANNELS):  # a channel keeps its style whichever others are drawn
         data = lin.bode(inp, out, omega)
         mag = np.asarray(data["magnitude"])
         if not np.any(mag > 0):
             continue  # a channel the operating point switches off (e.g. a saturated valve)
-        ax_m.loglog(data["frequency_Hz"], mag, label=f"{inp} -> {out}")
-        ax_p.semilogx(data["frequency_Hz"], data["phase_deg"])
+        ax_m.loglog(data["frequency_Hz"], mag, label=f"{inp} -> {out}", **series(k))
+        ax_p.semilogx(data["frequency_Hz"], data["phase_deg"], **series(k))
     f_n = lin.mechanical_mode().natural_frequency_Hz
     for ax in (ax_m, ax_p):
-        ax.axvline(f_n, color="k", ls=":", lw=1)
+        ax.axvline(f_n, color="k", ls=(0, (1, 3)), lw=1)  # sparse dots: no channel's style
         ax.grid(alpha=0.3, which="both")
     ax_m.set_ylabel("magnitude [SI output / SI input]")
     if ax_m.get_legend_handles_labels()[0]:  # every channel switched off: matplotlib would warn of an empty legend
@@ -76,13 +77,14 @@ def closed_loop_figure(run) -> Figure:
     fig = Figure(figsize=(9, 8.5), constrained_layout=True)
     ax_x, ax_p, ax_u = fig.subplots(3, 1, sharex=True)
     shade_held(ax_x, res.t_s, res.mode)
-    ax_x.plot(res.t_s, res.signals["reference_m"] * 1e3, "k--", lw=1, label="reference")
-    ax_x.plot(run.linear_t_s, run.linear_x_m * 1e3, color="C1", lw=1, label="linear loop (design model)")
-    ax_x.plot(res.t_s, res.x_m * 1e3, color="C0", label="hybrid model")
+    ax_x.plot(res.t_s, res.signals["reference_m"] * 1e3, lw=1, label="reference", **series(1, "k"))
+    ax_x.plot(run.linear_t_s, run.linear_x_m * 1e3, lw=1, label="linear loop (design model)", **series(2, "C1"))
+    ax_x.plot(res.t_s, res.x_m * 1e3, label="hybrid model", **series(0, "C0"))
     ax_x.set_ylabel(X_LABEL)
     ax_x.legend(loc="lower right", fontsize=8)
-    ax_p.plot(res.t_s, res.p_gauge_Pa / 1e5, color="C3", label="chamber")
-    ax_p.plot(res.t_s, res.signals["feedforward_gauge_Pa"] / 1e5, ":", color="k", label="holding pressure (feedforward)")
+    ax_p.plot(res.t_s, res.p_gauge_Pa / 1e5, label="chamber", **series(0, "C3"))
+    ax_p.plot(res.t_s, res.signals["feedforward_gauge_Pa"] / 1e5, label="holding pressure (feedforward)",
+              **series(3, "k"))
     ax_p.set_ylabel("gauge pressure [bar]")
     ax_p.legend(loc="lower right", fontsize=8)
     ax_u.plot(res.t_s, res.signals["valve_command"], color="C2")

@@ -8,6 +8,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from ..constants import PA_PER_BAR
+from ..figure_style import save, series
 from .equilibrium import equilibrium_m
 
 if TYPE_CHECKING:
@@ -15,13 +16,14 @@ if TYPE_CHECKING:
     from .static_fit import StaticFit
 
 
-def _save(fig: Figure, path) -> Figure:
+def _save(fig: Figure, path, dpi: int | None) -> Figure:
+    """Write ``fig`` to ``path``, if given, as PNG, PDF or SVG by its suffix, at ``dpi`` dots per inch (default 110)."""
     if path is not None:
-        fig.savefig(path, dpi=110, format="png")
+        save(fig, path, dpi=dpi)
     return fig
 
 
-def plot_static_fit(fit: "StaticFit", path=None) -> Figure:
+def plot_static_fit(fit: "StaticFit", path=None, dpi: int | None = None) -> Figure:
     """Measured contraction against pressure, one colour per load, with the fitted equilibrium curves."""
     d = fit.problem.data
     fig = Figure(figsize=(8, 5.5), constrained_layout=True)
@@ -31,23 +33,24 @@ def plot_static_fit(fit: "StaticFit", path=None) -> Figure:
     loads = np.unique(np.round(d.load_N, 6))
     for i, w in enumerate(loads):
         rows = np.isclose(d.load_N, w)
-        color = f"C{i % 10}"
+        style = series(i)
+        color = style["color"]
         cens = rows & fit.problem.censored
         ax.plot(d.pressure_gauge_Pa[rows & ~cens] / PA_PER_BAR, d.contraction_m[rows & ~cens] * 1e3, "o",
                 color=color, label=f"{w:g} N measured")
         ax.plot(d.pressure_gauge_Pa[cens] / PA_PER_BAR, d.contraction_m[cens] * 1e3, "x", color=color)
         x_fit = equilibrium_m(force, p_grid, np.full_like(p_grid, w), fit.problem.x_max_m)
-        ax.plot(p_grid / PA_PER_BAR, x_fit * 1e3, "-", color=color, lw=1.2)
+        ax.plot(p_grid / PA_PER_BAR, x_fit * 1e3, lw=1.2, **style)
     ax.set_xlabel("gauge pressure [bar]")
     ax.set_ylabel("contraction [mm]")
     ax.set_title(f"{fit.problem.model}, {fit.problem.objective} objective: lines = fitted equilibrium, "
                  "x = censored (not lifted)", fontsize=9)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7, ncol=2)
-    return _save(fig, path)
+    return _save(fig, path, dpi)
 
 
-def plot_static_residuals(fit: "StaticFit", path=None) -> Figure:
+def plot_static_residuals(fit: "StaticFit", path=None, dpi: int | None = None) -> Figure:
     """Equilibrium error (fitted minus measured) against pressure, and the objective's residuals."""
     d = fit.problem.data
     fig = Figure(figsize=(8, 6), constrained_layout=True)
@@ -66,10 +69,10 @@ def plot_static_residuals(fit: "StaticFit", path=None) -> Figure:
     ax2.set_xlabel("gauge pressure [bar] (colour: load)")
     for ax in (ax1, ax2):
         ax.grid(alpha=0.3)
-    return _save(fig, path)
+    return _save(fig, path, dpi)
 
 
-def plot_correlation(names: Sequence[str], corr: np.ndarray, path=None) -> Figure:
+def plot_correlation(names: Sequence[str], corr: np.ndarray, path=None, dpi: int | None = None) -> Figure:
     """The correlation matrix of the fitted coefficients, with its values printed."""
     k = len(names)
     fig = Figure(figsize=(1.2 + 0.9 * k, 1.0 + 0.8 * k), constrained_layout=True)
@@ -81,24 +84,25 @@ def plot_correlation(names: Sequence[str], corr: np.ndarray, path=None) -> Figur
         for j in range(k):
             ax.text(j, i, f"{corr[i, j]:.2f}", ha="center", va="center", fontsize=7)
     fig.colorbar(im, ax=ax, shrink=0.8)
-    return _save(fig, path)
+    return _save(fig, path, dpi)
 
 
-def plot_comparison(rows: Sequence[dict], path=None) -> Figure:
+def plot_comparison(rows: Sequence[dict], path=None, dpi: int | None = None) -> Figure:
     """RMS and cross-validated RMS contraction error of each compared model."""
     fig = Figure(figsize=(1.5 + 1.3 * len(rows), 4.5), constrained_layout=True)
     ax = fig.subplots()
     idx = np.arange(len(rows))
     ax.bar(idx - 0.2, [r["rms_contraction_mm"] for r in rows], 0.4, label="fit RMS")
-    ax.bar(idx + 0.2, [r["cv_rms_contraction_mm"] for r in rows], 0.4, label="cross-validated RMS")
+    ax.bar(idx + 0.2, [r["cv_rms_contraction_mm"] for r in rows], 0.4, label="cross-validated RMS", hatch="//",
+           edgecolor="white")  # hatched: told apart in grey print too
     ax.set_xticks(idx, [f"{r['model']}\n({r['n_free']} free)" for r in rows], fontsize=8)
     ax.set_ylabel("contraction error RMS [mm]")
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3, axis="y")
-    return _save(fig, path)
+    return _save(fig, path, dpi)
 
 
-def plot_dynamic_fit(fit: "DynamicFit", path=None) -> Figure:
+def plot_dynamic_fit(fit: "DynamicFit", path=None, dpi: int | None = None) -> Figure:
     """Measured and fitted contraction of every trace, with the residuals below."""
     n = len(fit.traces)
     fig = Figure(figsize=(9, 3.2 * n + 1), constrained_layout=True)
@@ -107,9 +111,9 @@ def plot_dynamic_fit(fit: "DynamicFit", path=None) -> Figure:
         ax, axr = axes[2 * i], axes[2 * i + 1]
         mask = fit.windows[i]
         ax.plot(tr.t_s, tr.x_m * 1e3, ".", ms=2, color="0.5", label="measured")
-        ax.plot(tr.t_s, fit.simulated_m[i] * 1e3, "-", color="C0", label="fitted")
+        ax.plot(tr.t_s, fit.simulated_m[i] * 1e3, **series(0), label="fitted")
         if fit.start_simulated_m:
-            ax.plot(tr.t_s, fit.start_simulated_m[i] * 1e3, "--", color="C1", lw=0.8, label="start")
+            ax.plot(tr.t_s, fit.start_simulated_m[i] * 1e3, **series(1), lw=0.8, label="start")
         ax.axvspan(tr.t_s[mask][0], tr.t_s[mask][-1], color="C2", alpha=0.06)
         ax.set_ylabel("contraction [mm]")
         ax.set_title(f"{tr.origin} ({fit.loads_N[i]:g} N): RMS {fit.rms_contraction_mm[i]:.3f} mm in the window",
@@ -119,4 +123,4 @@ def plot_dynamic_fit(fit: "DynamicFit", path=None) -> Figure:
         axr.axhline(0.0, color="k", lw=0.6)
         axr.set_ylabel("fit - meas. [mm]", fontsize=8)
     axes[-1].set_xlabel("time [s]")
-    return _save(fig, path)
+    return _save(fig, path, dpi)

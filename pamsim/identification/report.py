@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Sequence
 
 from ..atomic import atomic_outputs
+from ..figure_style import check_format
 from .compare import comparison_rows, write_comparison_csv
 from .muscle_file import muscle_toml
 from .plots import plot_comparison, plot_correlation, plot_dynamic_fit, plot_static_fit, plot_static_residuals
@@ -63,7 +64,7 @@ def correlation_lines(fit_unc) -> list[str]:
             ""] + [f"- {a} and {b}: r = {r:+.3f}" for a, b, r in pairs] + [""]
 
 
-def static_report_md(fit: "StaticFit", compare: Sequence[dict] | None) -> str:
+def static_report_md(fit: "StaticFit", compare: Sequence[dict] | None, figure_format: str = "png") -> str:
     p = fit.problem
     start = {n: p.base[n] for n in p.free}
     errs = dict(zip(fit.uncertainty.names, map(float, fit.uncertainty.standard_errors)))
@@ -78,27 +79,31 @@ def static_report_md(fit: "StaticFit", compare: Sequence[dict] | None) -> str:
     out += parameter_table(p.free, start, fit.parameters, errs) + [""]
     out += ["Standard errors come from the Jacobian at the optimum (linearised, residual variance from the fit).",
             ""] + correlation_lines(fit.uncertainty)
-    out += ["## Figures", "", "![measured and fitted](fit.png)", "", "![residuals](residuals.png)", "",
-            "![correlation](correlation.png)", ""]
+    ext = figure_format
+    out += ["## Figures", "", f"![measured and fitted](fit.{ext})", "", f"![residuals](residuals.{ext})", "",
+            f"![correlation](correlation.{ext})", ""]
     if compare:
         out += ["## Model comparison", "", "| model | free | RMS [mm] | CV RMS [mm] | AIC | BIC |", "|---|---|---|---|---|---|"]
         out += [f"| {r['model']} | {r['n_free']} | {_f(r['rms_contraction_mm'], '.3f')} | "
                 f"{_f(r['cv_rms_contraction_mm'], '.3f')} | {_f(r['aic'], '.2f')} | {_f(r['bic'], '.2f')} |"
                 for r in compare]
-        out += ["", "![comparison](compare.png)", ""]
+        out += ["", f"![comparison](compare.{ext})", ""]
     return "\n".join(out)
 
 
-def write_static_fit(fit: "StaticFit", directory, compare: Sequence["StaticFit"] | None = None) -> list[str]:
-    """Write fit.json, muscle.toml (with a copy of the data beside it), report.md and figures into
-    ``directory``; with ``compare``, also compare.csv and compare.png.  Returns the file names."""
+def write_static_fit(fit: "StaticFit", directory, compare: Sequence["StaticFit"] | None = None,
+                     figure_format: str = "png", dpi: int | None = None) -> list[str]:
+    """Write fit.json, muscle.toml (with a copy of the data beside it), report.md and figures (fit, residuals,
+    correlation; PNG, PDF or SVG by ``figure_format``, at ``dpi`` dots per inch) into ``directory``; with
+    ``compare``, also compare.csv and the compare figure.  Returns the file names."""
     p = fit.problem
+    ext = check_format(figure_format, label="figure format")
     rows = comparison_rows(compare) if compare else None
     has_file = Path(p.data.origin).is_file()
     names = ["fit.json", "muscle.toml"] + (["data.csv"] if has_file else []) + \
-        ["report.md", "fit.png", "residuals.png", "correlation.png"]
+        ["report.md", f"fit.{ext}", f"residuals.{ext}", f"correlation.{ext}"]
     if rows:
-        names += ["compare.csv", "compare.png"]
+        names += ["compare.csv", f"compare.{ext}"]
     rms = (f"RMS contraction {fit.rms_contraction_mm:.3f} mm, cross-validated "
            f"{_f(fit.cv_rms_contraction_mm, '.3f')} mm ({fit.cv_kind})")
     prov = provenance(p.data.origin, p.data.sha256, p.objective, rms)
@@ -115,13 +120,13 @@ def write_static_fit(fit: "StaticFit", directory, compare: Sequence["StaticFit"]
             citation=fit.fitted.citation, static_force=p.model, provenance=prov, data_file="data.csv" if has_file else None))
         if has_file:
             shutil.copyfile(p.data.origin, out["data.csv"])
-        out["report.md"].write_text(static_report_md(fit, rows))
-        plot_static_fit(fit, out["fit.png"])
-        plot_static_residuals(fit, out["residuals.png"])
-        plot_correlation(p.free, fit.uncertainty.correlation, out["correlation.png"])
+        out["report.md"].write_text(static_report_md(fit, rows, ext))
+        plot_static_fit(fit, out[f"fit.{ext}"], dpi)
+        plot_static_residuals(fit, out[f"residuals.{ext}"], dpi)
+        plot_correlation(p.free, fit.uncertainty.correlation, out[f"correlation.{ext}"], dpi)
         if rows:
             write_comparison_csv(rows, out["compare.csv"])
-            plot_comparison(rows, out["compare.png"])
+            plot_comparison(rows, out[f"compare.{ext}"], dpi)
     return names
 
 
@@ -172,7 +177,7 @@ def _absolute_files(value, base_dir: Path):
     return value
 
 
-def dynamic_report_md(fit: "DynamicFit") -> str:
+def dynamic_report_md(fit: "DynamicFit", figure_format: str = "png") -> str:
     p = fit.problem
     errs = dict(zip(fit.uncertainty.names, map(float, fit.uncertainty.standard_errors)))
     start = dict(zip(p.free, map(float, fit.start)))
@@ -192,15 +197,17 @@ def dynamic_report_md(fit: "DynamicFit") -> str:
                 + " | ".join(f"{row[n]:.4g}" for n in p.free) + f" | {row['rms_contraction_mm']:.4f} |"
                 for row in fit.per_trace]
         out += [""]
-    out += ["![measured and fitted](fit.png)", "", "![correlation](correlation.png)", ""]
+    out += [f"![measured and fitted](fit.{figure_format})", "", f"![correlation](correlation.{figure_format})", ""]
     return "\n".join(out)
 
 
-def write_dynamic_fit(fit: "DynamicFit", directory) -> list[str]:
-    """Write fit.json, muscle.toml, scenario.toml (the scenario with the fitted coefficients),
-    report.md, fit.png (overlays and residuals) and correlation.png; per_trace.csv with a per-trace fit."""
+def write_dynamic_fit(fit: "DynamicFit", directory, figure_format: str = "png", dpi: int | None = None) -> list[str]:
+    """Write fit.json, muscle.toml, scenario.toml (the scenario with the fitted coefficients), report.md and
+    the figures fit (overlays and residuals) and correlation (PNG, PDF or SVG by ``figure_format``, at ``dpi``
+    dots per inch); per_trace.csv with a per-trace fit."""
     p = fit.problem
-    names = ["fit.json", "muscle.toml", "scenario.toml", "report.md", "fit.png", "correlation.png"]
+    ext = check_format(figure_format, label="figure format")
+    names = ["fit.json", "muscle.toml", "scenario.toml", "report.md", f"fit.{ext}", f"correlation.{ext}"]
     if fit.per_trace:
         names.append("per_trace.csv")
     rms = f"pooled RMS contraction {fit.rms_pooled_mm:.4f} mm over {len(p.traces)} trace(s)"
@@ -220,9 +227,9 @@ def write_dynamic_fit(fit: "DynamicFit", directory) -> list[str]:
             description=f"{fitted.name} with {', '.join(p.free)} fitted by pamsim fit dynamic ({rms})",
             citation=fitted.citation, static_force=p.scenario.spec["model"]["static_force"], provenance=prov))
         out["scenario.toml"].write_text(scenario_toml(spec, [f"{k}: {v}" for k, v in prov.items()]))
-        out["report.md"].write_text(dynamic_report_md(fit))
-        plot_dynamic_fit(fit, out["fit.png"])
-        plot_correlation(p.free, fit.uncertainty.correlation, out["correlation.png"])
+        out["report.md"].write_text(dynamic_report_md(fit, ext))
+        plot_dynamic_fit(fit, out[f"fit.{ext}"], dpi)
+        plot_correlation(p.free, fit.uncertainty.correlation, out[f"correlation.{ext}"], dpi)
         if fit.per_trace:
             cols = list(fit.per_trace[0])
             with open(out["per_trace.csv"], "w", newline="") as fh:

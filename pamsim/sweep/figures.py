@@ -1,4 +1,5 @@
-"""A sweep's figures rendered to PNG bytes, on an executor's workers when one is given.
+"""A sweep's figures rendered to the bytes of their files (PNG, PDF or SVG), on an executor's workers when
+one is given.
 
 Rendering is most of the time of a fast sweep (the native backend runs the 66-case grid in well
 under a second; its four figures take seconds of matplotlib layout), and the figures are
@@ -17,22 +18,22 @@ import io
 from concurrent.futures import Executor
 from typing import Mapping
 
-DPI = 110
-"""Resolution of every sweep figure [dots per inch]."""
+from ..figure_style import save
 
 SWEEP_FIGURES = {  # slowest first, so that the workers finish together
-    "time_responses.png": "pamsim.sweep.plots:time_responses_figure",
-    "error_heatmap.png": "pamsim.sweep.plots:error_heatmap_figure",
-    "steady_state_vs_pressure.png": "pamsim.sweep.plots:steady_state_figure",
-    "frequency_vs_load.png": "pamsim.sweep.plots:frequency_figure",
+    "time_responses": "pamsim.sweep.plots:time_responses_figure",
+    "error_heatmap": "pamsim.sweep.plots:error_heatmap_figure",
+    "steady_state_vs_pressure": "pamsim.sweep.plots:steady_state_figure",
+    "frequency_vs_load": "pamsim.sweep.plots:frequency_figure",
 }
-"""``{file name: "module:function"}`` of a sweep's figures (each function takes a ``SweepResult``)."""
+"""``{file stem: "module:function"}`` of a sweep's figures (each function takes a ``SweepResult``); the files
+are ``STEM.png``, ``.pdf`` or ``.svg``."""
 
 UNCERTAINTY_FIGURES = {
-    "uncertainty_histograms.png": "pamsim.sweep.uncertainty_plots:histogram_figure",
-    "uncertainty_ecdf.png": "pamsim.sweep.uncertainty_plots:ecdf_figure",
+    "uncertainty_histograms": "pamsim.sweep.uncertainty_plots:histogram_figure",
+    "uncertainty_ecdf": "pamsim.sweep.uncertainty_plots:ecdf_figure",
 }
-"""``{file name: "module:function"}`` of an uncertainty study's figures (each takes an ``UncertaintyResult``)."""
+"""``{file stem: "module:function"}`` of an uncertainty study's figures (each takes an ``UncertaintyResult``)."""
 
 
 def maker(name: str):
@@ -41,15 +42,17 @@ def maker(name: str):
     return getattr(importlib.import_module(module), function)
 
 
-def render_png(maker_name: str, data) -> bytes:
-    """The figure of ``maker(maker_name)(data)`` (a matplotlib Figure) as PNG bytes."""
+def render(maker_name: str, data, figure_format: str = "png", dpi: int | None = None) -> bytes:
+    """The figure of ``maker(maker_name)(data)`` (a matplotlib Figure) as the bytes of a ``figure_format`` file
+    at ``dpi`` dots per inch (default 110)."""
     buffer = io.BytesIO()
-    maker(maker_name)(data).savefig(buffer, format="png", dpi=DPI)
+    save(maker(maker_name)(data), buffer, figure_format, dpi)
     return buffer.getvalue()
 
 
-def render_all(jobs: Mapping[str, tuple[str, object]], executor: Executor | None = None) -> dict[str, bytes]:
-    """Render ``{file name: (maker name, data)}``, in this process or on ``executor``; return ``{file name: png}``.
+def render_all(jobs: Mapping[str, tuple[str, object]], executor: Executor | None = None, figure_format: str = "png",
+               dpi: int | None = None) -> dict[str, bytes]:
+    """Render ``{file name: (maker name, data)}``, in this process or on ``executor``; return ``{file name: bytes}``.
 
     Jobs are submitted in the order given (put the slowest first so the workers finish together).
     A figure the executor cannot give (a pool broken by a worker killed during the sweep, a cluster
@@ -57,20 +60,20 @@ def render_all(jobs: Mapping[str, tuple[str, object]], executor: Executor | None
     caller writes anything.
     """
     if executor is None:
-        return {name: render_png(maker_name, data) for name, (maker_name, data) in jobs.items()}
+        return {name: render(maker_name, data, figure_format, dpi) for name, (maker_name, data) in jobs.items()}
     futures = {}
     for name, (maker_name, data) in jobs.items():
         try:
-            futures[name] = executor.submit(render_png, maker_name, data)
+            futures[name] = executor.submit(render, maker_name, data, figure_format, dpi)
         except Exception:  # noqa: BLE001 -- a broken pool (a worker killed during the sweep): drawn here
             futures[name] = None
-    pngs = {}
+    files = {}
     for name, future in futures.items():
         if future is not None:
             try:
-                pngs[name] = future.result()
+                files[name] = future.result()
                 continue
             except Exception:  # noqa: BLE001 -- the executor failed, or the figure did: drawn here,
                 pass  # which gives the figure or raises the figure's own error
-        pngs[name] = render_png(*jobs[name])
-    return pngs
+        files[name] = render(*jobs[name], figure_format, dpi)
+    return files

@@ -17,6 +17,7 @@ from matplotlib.colors import TwoSlopeNorm
 from matplotlib.figure import Figure
 
 from ..constants import PA_PER_BAR
+from ..figure_style import REFERENCE, series
 
 
 def _grid_pressure(row: Mapping) -> float:
@@ -100,12 +101,11 @@ def steady_state_figure(result: "SweepResult") -> Figure:
         for k, w in enumerate(weights):
             rs = sorted((r for r in rows if r["weight_N"] == w), key=lambda r: r["pressure_bar"])
             p = np.array([r["pressure_bar"] for r in rs])
-            colour = f"C{k % 10}"
+            style = series(k)
             meas = np.array([r["measured_contraction_m"] for r in rs]) * 1e3
             if np.isfinite(meas).any():
-                ax.plot(p, meas, "o", color=colour, ms=6, mfc="none", mew=1.5)
-            ax.plot(p, np.array([r[col] for r in rs], dtype=float) * 1e3, "-", color=colour, lw=1.8,
-                    label=f"{w:g} N")
+                ax.plot(p, meas, "o", color=style["color"], ms=6, mfc="none", mew=1.5)
+            ax.plot(p, np.array([r[col] for r in rs], dtype=float) * 1e3, lw=1.8, label=f"{w:g} N", **style)
         ax.set_xlabel("pressure [bar] (measured stable pressure)")
         ax.set_title(title, fontsize=10, y=1.0)
         ax.grid(alpha=0.3)
@@ -128,19 +128,17 @@ def time_responses_figure(result: "SweepResult") -> Figure:
     nrows = math.ceil(len(names) / ncols)
     margins = dict(left=0.05, right=0.95, top=1 - 0.75 / height_in, bottom=0.5 / height_in, wspace=0.2, hspace=0.42)
     axes = np.atleast_1d(fig.subplots(nrows, ncols, squeeze=False, gridspec_kw=margins).ravel())
-    styles = ["-", "--", ":", "-."]
     for ax, name in zip(axes, names):
         runs = result.responses[name]
         for k, (f, out) in enumerate(runs.items()):
             if out.get("error"):
                 ax.text(0.5, 0.2 + 0.1 * k, f"{f}: failed", transform=ax.transAxes, color="red")
                 continue
-            ax.plot(out["t_s"], out["x_m"] * 1e3, styles[k % len(styles)], color=f"C{k}", lw=1.6,
-                    label=f"{f} friction")
+            ax.plot(out["t_s"], out["x_m"] * 1e3, lw=1.6, label=f"{f} friction", **series(k))
         pax = ax.twinx()
         first = next((o for o in runs.values() if not o.get("error")), None)
         if first is not None:
-            pax.plot(first["t_s"], first["p_gauge_Pa"] / PA_PER_BAR, color="0.6", lw=0.8)
+            pax.plot(first["t_s"], first["p_gauge_Pa"] / PA_PER_BAR, **REFERENCE)
         pax.set_ylabel("pressure [bar]", color="0.5", fontsize=8)
         pax.tick_params(axis="y", colors="0.5", labelsize=8)
         # An explicit y spares matplotlib the search for tick labels above each axes (a third of the
@@ -153,7 +151,7 @@ def time_responses_figure(result: "SweepResult") -> Figure:
         ax.set_axis_off()
     for ax in axes[max(0, len(names) - ncols):len(names)]:
         ax.set_xlabel("time [s]")
-    fig.suptitle("Time responses: load-dependent against constant friction (grey: muscle pressure, right axis)")
+    fig.suptitle("Time responses: load-dependent against constant friction (grey dots: muscle pressure, right axis)")
     return fig
 
 
@@ -172,8 +170,7 @@ def frequency_figure(result: "SweepResult") -> Figure:
     for k, f in enumerate(models):
         freq = np.array([r[f"{f}_frequency_Hz"] for r in rows], dtype=float)
         n = [r[f"{f}_n_half_cycles"] for r in rows]
-        ax.plot(w, freq, "o-" if k == 0 else "s--", color=f"C{k}", ms=7, mfc="none" if k else None,
-                label=f"{f} friction")
+        ax.plot(w, freq, ms=7, mfc="none" if k else None, label=f"{f} friction", **series(k, points=True))
         for wi, fi, ni in zip(w, freq, n):
             strip.text(wi, len(models) - k, f"{ni}" if math.isfinite(fi) else "-", ha="center", va="center",
                        fontsize=8, color=f"C{k}")

@@ -27,8 +27,8 @@ def _num(v: float, fmt: str = ".2f") -> str:
     return "n/a" if not (isinstance(v, (int, float)) and math.isfinite(v)) else format(v, fmt)
 
 
-def write_report(result: "SweepResult") -> str:
-    """The markdown text of ``report.md``."""
+def write_report(result: "SweepResult", figure_format: str = "png") -> str:
+    """The markdown text of ``report.md``, its figures linked as ``figure_format`` files."""
     spec = result.spec
     models = spec.friction_models
     thr_mm = spec.capability_min_equilibrium_m * 1e3
@@ -104,9 +104,10 @@ def write_report(result: "SweepResult") -> str:
         out.append("")
     if result.failures:
         out += ["## Failed runs", ""] + [f"- {m}" for m in result.failures] + [""]
-    out += ["## Figures", "", "![error heatmap](error_heatmap.png)", "",
-            "![steady state against pressure](steady_state_vs_pressure.png)", "",
-            "![time responses](time_responses.png)", "", "![frequency against load](frequency_vs_load.png)", ""]
+    ext = figure_format
+    out += ["## Figures", "", f"![error heatmap](error_heatmap.{ext})", "",
+            f"![steady state against pressure](steady_state_vs_pressure.{ext})", "",
+            f"![time responses](time_responses.{ext})", "", f"![frequency against load](frequency_vs_load.{ext})", ""]
     return "\n".join(out)
 
 

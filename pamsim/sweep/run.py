@@ -20,6 +20,7 @@ import numpy as np
 from ..atomic import atomic_outputs
 from ..constants import PA_PER_BAR
 from ..errors import InputError
+from ..figure_style import check_format
 from ..oscillation import estimate_oscillation
 from ..scenario import Scenario
 from ..static import friction_band_m, static_report
@@ -37,8 +38,9 @@ LAST_WINDOW_S = 1.0
 
 UNCERTAINTY_TABLES = ("uncertainty_samples.csv", "uncertainty_summary.csv")
 
-FIGURES = ("error_heatmap.png", "steady_state_vs_pressure.png", "time_responses.png", "frequency_vs_load.png")
-"""File names of a sweep's figures, in the order of the report (:data:`.figures.SWEEP_FIGURES` renders them)."""
+FIGURES = ("error_heatmap", "steady_state_vs_pressure", "time_responses", "frequency_vs_load")
+"""File stems of a sweep's figures, in the order of the report (:data:`.figures.SWEEP_FIGURES` renders them);
+the files are ``STEM.png``, ``.pdf`` or ``.svg``."""
 
 
 @dataclass(frozen=True)
@@ -204,7 +206,8 @@ class SweepResult:
         """Column names of ``summary.csv``."""
         return list(self.rows[0]) if self.rows else []
 
-    def write(self, directory: str | Path, executor: Executor | None = None) -> list[str]:
+    def write(self, directory: str | Path, executor: Executor | None = None, figure_format: str = "png",
+              dpi: int | None = None) -> list[str]:
         """Write ``summary.csv``, ``report.md`` and the figures into ``directory``, all or nothing.
 
         Parameters
@@ -214,6 +217,10 @@ class SweepResult:
         executor : concurrent.futures.Executor, optional
             Render the figures on its workers (they are most of the time of a fast sweep);
             ``None`` renders them here.  The files do not depend on it.
+        figure_format : {"png", "pdf", "svg"}
+            The figures' file format (the reports link to these files).
+        dpi : int, optional
+            The figures' resolution in dots per inch (default 110).
 
         Returns
         -------
@@ -223,25 +230,26 @@ class SweepResult:
         from .figures import render_all
         from .report import write_report
 
+        fmt = check_format(figure_format, label="figure format")
         study = self.uncertainty
         jobs = {}
         # A pure uncertainty study (no cases) writes only its own outputs.
         if self.spec.cases or study is None:
-            jobs = {name: (maker, self) for name, maker in SWEEP_FIGURES.items()}
-        names = ["summary.csv", "report.md", *FIGURES] if jobs else []
+            jobs = {f"{stem}.{fmt}": (maker, self) for stem, maker in SWEEP_FIGURES.items()}
+        names = ["summary.csv", "report.md", *(f"{stem}.{fmt}" for stem in FIGURES)] if jobs else []
         if study is not None:
-            jobs.update({name: (maker, study) for name, maker in UNCERTAINTY_FIGURES.items()})
-            names += [*UNCERTAINTY_TABLES, "uncertainty.md", *UNCERTAINTY_FIGURES]
-        figures = render_all(jobs, executor)
+            jobs.update({f"{stem}.{fmt}": (maker, study) for stem, maker in UNCERTAINTY_FIGURES.items()})
+            names += [*UNCERTAINTY_TABLES, "uncertainty.md", *(f"{stem}.{fmt}" for stem in UNCERTAINTY_FIGURES)]
+        figures = render_all(jobs, executor, fmt, dpi)
         with atomic_outputs(directory, names) as tmp:
             if "summary.csv" in names:
                 self.to_csv(tmp["summary.csv"])
-                tmp["report.md"].write_text(write_report(self))
+                tmp["report.md"].write_text(write_report(self, fmt))
             if study is not None:
                 study.write_tables(*(tmp[n] for n in UNCERTAINTY_TABLES))
-                tmp["uncertainty.md"].write_text(study.report(self.spec.name))
-            for name, png in figures.items():
-                tmp[name].write_bytes(png)
+                tmp["uncertainty.md"].write_text(study.report(self.spec.name, fmt))
+            for name, data in figures.items():
+                tmp[name].write_bytes(data)
         return names
 
     def to_csv(self, path: str | Path) -> None:

@@ -259,8 +259,8 @@ class UncertaintyResult:
                 for row in rows:
                     w.writerow({k: (f"{v:.9g}" if isinstance(v, float) else v) for k, v in row.items()})
 
-    def report(self, sweep_name: str) -> str:
-        """The markdown text of ``uncertainty.md``."""
+    def report(self, sweep_name: str, figure_format: str = "png") -> str:
+        """The markdown text of ``uncertainty.md``, its figures linked as ``figure_format`` files."""
         s = self.spec
         out = [f"# Uncertainty study: {sweep_name}", "",
                f"{s.samples} samples ({s.sampling.replace('_', ' ')}, seed {s.seed}) of {len(s.parameters)} "
@@ -277,5 +277,6 @@ class UncertaintyResult:
             nums = [row["mean"], row["std"], *(row[f"q{p:g}"] for p in s.quantiles)]
             out.append(f"| {row['friction_model']} | {QUANTITIES[row['quantity']]} | {row['runs']} | {row['failed']} | "
                        + " | ".join(f"{v * scale:.4g}" for v in nums) + " |")
-        out += ["", "![histograms](uncertainty_histograms.png)", "", "![ECDF](uncertainty_ecdf.png)", ""]
+        out += ["", f"![histograms](uncertainty_histograms.{figure_format})", "",
+                f"![ECDF](uncertainty_ecdf.{figure_format})", ""]
         return "\n".join(out)

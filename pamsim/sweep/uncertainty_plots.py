@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.figure import Figure
 
+from ..figure_style import series
 from .uncertainty import QUANTITIES, UncertaintyResult
 
 def _panels(result: UncertaintyResult, title: str):
@@ -19,17 +20,18 @@ def _panels(result: UncertaintyResult, title: str):
     for ax, (q, label) in zip(axes, QUANTITIES.items()):
         scale = 1e3 if q.endswith("_m") else 1.0
         ax.set_xlabel(label)
-        for f in result.outputs:
-            yield fig, ax, f, np.sort(result.values(f, q)) * scale
+        for k, f in enumerate(result.outputs):
+            yield fig, ax, f, series(k), np.sort(result.values(f, q)) * scale
 
 
 def histogram_figure(result: UncertaintyResult) -> Figure:
-    """One histogram panel per quantity, one outline per friction model, median dashed."""
+    """One histogram panel per quantity, one outline per friction model, its median a thin line of its style."""
     fig = None
-    for fig, ax, f, v in _panels(result, "Histograms"):
+    for fig, ax, f, style, v in _panels(result, "Histograms"):
         if v.size:
-            _, _, patches = ax.hist(v, bins=min(50, max(5, int(np.sqrt(v.size)))), histtype="step", label=f)
-            ax.axvline(np.median(v), ls="--", lw=0.8, color=patches[0].get_edgecolor())
+            ax.hist(v, bins=min(50, max(5, int(np.sqrt(v.size)))), histtype="step", label=f,
+                    color=style["color"], linestyle=style["linestyle"])
+            ax.axvline(np.median(v), lw=0.8, color=style["color"], linestyle=style["linestyle"])
         ax.set_ylabel("runs")
         if ax.get_legend_handles_labels()[0]:  # none when every run of the study failed
             ax.legend(fontsize=8)
@@ -39,9 +41,9 @@ def histogram_figure(result: UncertaintyResult) -> Figure:
 def ecdf_figure(result: UncertaintyResult) -> Figure:
     """One empirical-CDF panel per quantity, with the study's quantiles marked."""
     fig = None
-    for fig, ax, f, v in _panels(result, "Empirical CDF"):
+    for fig, ax, f, style, v in _panels(result, "Empirical CDF"):
         if v.size:
-            ax.step(v, np.arange(1, v.size + 1) / v.size, where="post", label=f)
+            ax.step(v, np.arange(1, v.size + 1) / v.size, where="post", label=f, **style)
         for p in result.spec.quantiles:
             ax.axhline(p, lw=0.5, color="0.7")
         ax.set_ylabel("fraction of runs <= value")
