@@ -55,3 +55,8 @@ def missing_inputs(name: str, params: Mapping[str, float]) -> list[str]:
 def optional_defaults(name: str) -> dict[str, float]:
     """The model's optional coefficients and their defaults (free-able with ``--free``)."""
     return dict(static_models.REGISTRY[name].optional)
+
+
+def static_parameters(name: str) -> tuple[str, ...]:
+    """The parameters model ``name`` is built from."""
+    return tuple(static_models.REGISTRY[name].parameters)

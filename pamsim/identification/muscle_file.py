@@ -11,7 +11,7 @@ import json
 import math
 from typing import Mapping
 
-from ..muscles import load_muscle
+from ..muscles import DERIVED, load_muscle
 from ..parameters import DYNAMICS_DEFAULTS, ParameterSet, dynamics_parameters
 
 
@@ -39,6 +39,8 @@ def muscle_toml(params: ParameterSet, name: str, description: str, citation: str
               f"default_static_force = {_s(static_force)}", ""]
     for key, entry in params.entries.items():
         if key in DYNAMICS_DEFAULTS and (entry.value, entry.source) == DYNAMICS_DEFAULTS[key]:
+            continue
+        if entry.source.startswith(DERIVED):  # the reader derives it again; written, it could contradict
             continue
         lines += [f"[parameters.{key}]", f"value = {_v(entry.value)}", f"source = {_s(entry.source)}",
                   f"description = {_s(entry.description)}", ""]

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cached_property
 from typing import Mapping, Sequence
 
@@ -27,16 +27,22 @@ from scipy.optimize import least_squares
 
 from ..elements.stops import EndStops
 from ..errors import InputError
+from ..muscles import DERIVED, WALL_PAIR, geometry_violation, rederive
+from ..parameter_schema import LOCK_DEG
 from ..parameters import ParameterSet, known_parameter
 from .choices import CENSOR_THRESHOLD_M, LOSSES, OBJECTIVES
 from .columns import StaticData
 from .crossval import cross_validate
 from .equilibrium import equilibrium_m, slope_N_per_m
-from .models import build_static, check_model, default_free, missing_inputs, optional_defaults
+from .models import build_static, check_model, default_free, missing_inputs, optional_defaults, static_parameters
 from .uncertainty import Uncertainty, information_criteria, linearised_uncertainty
 
 _FD_REL = 1e-6
 """Relative step of the force sensitivities dF/dtheta (the force is a smooth, cheap function)."""
+_PENALTY = 1e6
+"""Residual [mm or N] of every test at coefficients outside the muscle's geometry (a wall as thick as the
+radius, a braid at its locking angle) or that the model cannot be built from: far above any residual a
+real muscle gives, so the optimiser steps back rather than stopping there."""
 
 
 @dataclass(frozen=True)
@@ -59,15 +65,30 @@ class StaticProblem:
             return np.zeros(len(self.data), dtype=bool)
         return self.data.contraction_m <= self.censor_threshold_m
 
-    def params(self, theta: np.ndarray) -> dict[str, float]:
-        return {**self.base_values, **dict(zip(self.free, map(float, theta)))}
+    def parameter_set(self, theta: np.ndarray, source: str = "fit trial point") -> ParameterSet:
+        """The muscle at ``theta``, its derived values (a wall thickness from the radii, ...) following."""
+        moved = self.base.with_overrides(dict(zip(self.free, map(float, theta))), source=source)
+        return ParameterSet(moved.name, moved.citation, rederive(moved.entries)) if self.derives else moved
 
     @cached_property
-    def base_values(self) -> dict[str, float]:
-        return dict(self.base)
+    def derives(self) -> bool:
+        return any(p.source.startswith(DERIVED) for p in self.base.entries.values())
+
+    def params(self, theta: np.ndarray) -> dict[str, float]:
+        return dict(self.parameter_set(theta))
 
     def force(self, theta: np.ndarray):
         return build_static(self.model, self.params(theta))
+
+    def feasible_force(self, theta: np.ndarray):
+        """The model at ``theta``, or None where the geometry is impossible or the model cannot be built."""
+        values = self.params(theta)
+        if geometry_violation(values):
+            return None
+        try:
+            return build_static(self.model, values)
+        except (ValueError, ArithmeticError):  # a model refusing its inputs: a bad trial point, not an error
+            return None
 
     def predict_m(self, theta: np.ndarray, data: StaticData | None = None) -> np.ndarray:
         """Equilibrium contraction [m] of each test under its load."""
@@ -78,10 +99,13 @@ class StaticProblem:
         """The objective's residuals (contraction in mm, force in N)."""
         d = self.data
         cens = self.censored
+        model = self.feasible_force(theta)
+        if model is None:
+            return np.full(len(d), _PENALTY)
         if self.objective == "force":
-            r = self.force(theta).force_N(d.contraction_m, d.pressure_gauge_Pa) - d.load_N
+            r = model.force_N(d.contraction_m, d.pressure_gauge_Pa) - d.load_N
             return np.where(cens, np.maximum(r, 0.0), r)
-        x = self.predict_m(theta)
+        x = equilibrium_m(model.force_N, d.pressure_gauge_Pa, d.load_N, self.x_max_m)
         return 1e3 * np.where(cens, np.maximum(x - self.censor_threshold_m, 0.0), x - d.contraction_m)
 
     def jacobian(self, theta: np.ndarray) -> np.ndarray:
@@ -103,7 +127,12 @@ class StaticProblem:
             h = _FD_REL * max(abs(theta[j]), 1.0)
             t = theta.copy()
             t[j] += h
-            J[:, j] = (self.force(t).force_N(x, d.pressure_gauge_Pa) - f0) / h
+            model = self.feasible_force(t)
+            if model is None:  # the optimum sits at the edge of the geometry: difference backwards
+                h = -h
+                t[j] = theta[j] + h
+                model = self.force(t)
+            J[:, j] = (model.force_N(x, d.pressure_gauge_Pa) - f0) / h
         cens = self.censored
         if self.objective == "force":
             active = ~cens | (f0 - d.load_N > 0.0)
@@ -204,9 +233,51 @@ def make_problem(data: StaticData, params: ParameterSet, model: str = "acra2012_
         raise InputError(f"--censor-threshold-mm = {censor_threshold_m * 1e3:g}: must not be negative")
     x_max = EndStops.from_parameters(params).x_high_m
     params = with_optional(params, {k: v for k, v in optional.items() if k in free}, model)
+    params = _independent(params, free, model)
     lower = np.array([params.entries[n].lower for n in free], dtype=float)
     upper = np.array([params.entries[n].upper for n in free], dtype=float)
+    for i, name in enumerate(free):
+        lower[i], upper[i] = _physical_bounds(name, params, free, lower[i], upper[i])
     return StaticProblem(data, model, params, free, objective, censor_threshold_m, x_max, (lower, upper))
+
+
+def _independent(params: ParameterSet, free: Sequence[str], model: str) -> ParameterSet:
+    """``params`` with the free coefficients independent values and, of the bladder's inner radius and
+    wall thickness, the one not freed derived from the braid radius (so that a fitted muscle stays
+    consistent and its file gives only independent values)."""
+    pair_free = [n for n in WALL_PAIR if n in free]
+    if len(pair_free) == 2:
+        raise InputError(f"--free = {','.join(free)}: free at most one of ri0_m and wall_thickness_m "
+                         "(the other is r0_m minus it)")
+    if not all(n in params for n in (*WALL_PAIR, "r0_m")) or not (pair_free or "r0_m" in free):
+        return params
+    if pair_free:
+        keep = pair_free[0]
+    else:  # the radius moves: keep what the model is built from, derive the other
+        keep = "ri0_m" if "ri0_m" in static_parameters(model) else "wall_thickness_m"
+    other = next(n for n in WALL_PAIR if n != keep)
+    entries = dict(params.entries)
+    if entries[keep].source.startswith(DERIVED):
+        entries[keep] = replace(entries[keep], source=f"starting value, {entries[keep].source}")
+    entries[other] = replace(entries[other], source=f"{DERIVED}r0_m and {keep}")
+    return ParameterSet(params.name, params.citation, rederive(entries))
+
+
+def _physical_bounds(name: str, params: ParameterSet, free: Sequence[str], lower: float, upper: float):
+    """Bounds of a free geometric coefficient that keep the muscle physical: a braid below its locking
+    angle, a wall thinner and a radius smaller than the values they must stay below while those are fixed
+    (when both move, the residuals' penalty keeps them apart)."""
+    fixed = {k: v for k, v in params.items() if k not in free}
+    if name == "theta0_deg":
+        upper = min(upper, LOCK_DEG)
+    elif name in WALL_PAIR and "r0_m" in fixed:
+        upper = min(upper, fixed["r0_m"])
+    elif name == "r0_m":
+        if "L0_m" in fixed:
+            upper = min(upper, fixed["L0_m"])
+        if "wall_thickness_m" in fixed and not params.entries["wall_thickness_m"].source.startswith(DERIVED):
+            lower = max(lower, fixed["wall_thickness_m"])
+    return lower, upper
 
 
 def with_optional(params: ParameterSet, optional: Mapping[str, float], model: str) -> ParameterSet:
@@ -285,9 +356,8 @@ def fit_static(data: StaticData, params: ParameterSet, model: str = "acra2012_po
                                      lambda th, test: problem.predict_m(th, data.subset(test)) - data.contraction_m[test],
                                      len(data), len(theta), cv, k_folds, seed)
     aic, bic = information_criteria(float(residuals @ residuals), len(data), len(theta))
-    fitted = problem.base.with_overrides(dict(zip(problem.free, map(float, theta))),
-                                   source=f"fitted: pamsim fit static ({problem.objective} objective) on "
-                                          f"{data.origin}")
+    fitted = problem.parameter_set(theta, source=f"fitted: pamsim fit static ({problem.objective} objective) on "
+                                                 f"{data.origin}")
     return StaticFit(problem, theta, fitted, unc, predicted, residuals, rms_force,
                      float(np.sqrt(np.mean(err_mm ** 2))),
                      float(np.sqrt(np.mean(cv_err ** 2))) * 1e3 if cv_err.size else math.nan, cv_kind,

@@ -247,6 +247,12 @@ def _convert_radial_angle(fail, entries: dict[str, Parameter]) -> None:
                                       known.lower, known.upper, known.lower_open, known.upper_open)
 
 
+DERIVED = "derived: "
+"""Start of the ``source`` of a value computed from others when a muscle is read (never written back)."""
+WALL_PAIR = ("ri0_m", "wall_thickness_m")
+"""The bladder's inner radius and wall thickness: a muscle gives either, the other is ``r0_m`` minus it."""
+
+
 def _complete_wall(fail, entries: dict[str, Parameter]) -> None:
     """Derive the wall thickness from the inner radius or the reverse; check them if both are given."""
     r0, ri0, t = entries.get("r0_m"), entries.get("ri0_m"), entries.get("wall_thickness_m")
@@ -258,30 +264,50 @@ def _complete_wall(fail, entries: dict[str, Parameter]) -> None:
                        f"inconsistent with r0_m - ri0_m = {r0.value - ri0.value:g} m")
     elif ri0 is not None:
         k = KNOWN["wall_thickness_m"]
-        entries["wall_thickness_m"] = Parameter(r0.value - ri0.value, "m", "derived: r0_m - ri0_m", k.description,
+        entries["wall_thickness_m"] = Parameter(r0.value - ri0.value, "m", f"{DERIVED}r0_m - ri0_m", k.description,
                                                 k.lower, k.upper, k.lower_open)
     elif t is not None:
         k = KNOWN["ri0_m"]
-        entries["ri0_m"] = Parameter(r0.value - t.value, "m", "derived: r0_m - wall_thickness_m", k.description,
+        entries["ri0_m"] = Parameter(r0.value - t.value, "m", f"{DERIVED}r0_m - wall_thickness_m", k.description,
                                      k.lower, k.upper, k.lower_open)
+
+
+def rederive(entries: Mapping[str, Parameter]) -> dict[str, Parameter]:
+    """``entries`` with every derived value computed again from the values it depends on (after some
+    of those changed, as in a fit).  Independent values are kept as they are."""
+    out = {k: p for k, p in entries.items() if not p.source.startswith(DERIVED)}
+
+    def fail(key, value, why):
+        return MuscleError(f"{key} = {value!r}: {why}")
+
+    _complete_wall(fail, out)
+    return {k: out[k] for k in entries if k in out} | {k: p for k, p in out.items() if k not in entries}
+
+
+def geometry_violation(values: Mapping[str, float]) -> tuple[str, float, str] | None:
+    """``(name, value, why)`` of the first inconsistency between geometry values, or None."""
+    v = values
+    if "r0_m" in v and "wall_thickness_m" in v and not v["r0_m"] > v["wall_thickness_m"]:
+        return ("r0_m", v["r0_m"], f"braid radius must exceed the bladder wall thickness ({v['wall_thickness_m']:g} m): "
+                "the bladder would have no bore")
+    if "theta0_deg" in v and v["theta0_deg"] >= LOCK_DEG:
+        return ("theta0_deg", v["theta0_deg"],
+                f"at or beyond the braid locking angle {LOCK_DEG:.4f} deg: the muscle would not contract")
+    if "fit_x_min_m" in v and "fit_x_max_m" in v and not v["fit_x_min_m"] < v["fit_x_max_m"]:
+        return ("fit_x_min_m", v["fit_x_min_m"], f"must be below fit_x_max_m = {v['fit_x_max_m']:g}")
+    if "valve_b" in v and "valve_laminar_ratio" in v and not v["valve_b"] < v["valve_laminar_ratio"]:
+        return ("valve_b", v["valve_b"], f"must be below valve_laminar_ratio = {v['valve_laminar_ratio']:g}")
+    if "L0_m" in v and "r0_m" in v and not v["r0_m"] < v["L0_m"]:
+        return ("r0_m", v["r0_m"], f"braid radius must be below the rest length ({v['L0_m']:g} m)")
+    return None
 
 
 def _check_geometry(fail, entries: dict[str, Parameter]) -> None:
     """Consistency checks between geometry values."""
-    v = {k: p.value for k, p in entries.items()}
-    if "r0_m" in v and "wall_thickness_m" in v and not v["r0_m"] > v["wall_thickness_m"]:
-        raise fail("parameters.r0_m", v["r0_m"],
-                   f"braid radius must exceed the bladder wall thickness ({v['wall_thickness_m']:g} m): "
-                   "the bladder would have no bore")
-    if "theta0_deg" in v and v["theta0_deg"] >= LOCK_DEG:
-        raise fail("parameters.theta0_deg", v["theta0_deg"],
-                   f"at or beyond the braid locking angle {LOCK_DEG:.4f} deg: the muscle would not contract")
-    if "fit_x_min_m" in v and "fit_x_max_m" in v and not v["fit_x_min_m"] < v["fit_x_max_m"]:
-        raise fail("parameters.fit_x_min_m", v["fit_x_min_m"], f"must be below fit_x_max_m = {v['fit_x_max_m']:g}")
-    if "valve_b" in v and "valve_laminar_ratio" in v and not v["valve_b"] < v["valve_laminar_ratio"]:
-        raise fail("parameters.valve_b", v["valve_b"], f"must be below valve_laminar_ratio = {v['valve_laminar_ratio']:g}")
-    if "L0_m" in v and "r0_m" in v and not v["r0_m"] < v["L0_m"]:
-        raise fail("parameters.r0_m", v["r0_m"], f"braid radius must be below the rest length ({v['L0_m']:g} m)")
+    why = geometry_violation({k: p.value for k, p in entries.items()})
+    if why:
+        raise fail(f"parameters.{why[0]}", why[1], why[2])
 
 
-__all__ = ["Muscle", "MuscleError", "load_muscle", "muscle_from_dict", "shipped_names"]
+__all__ = ["Muscle", "MuscleError", "load_muscle", "muscle_from_dict", "shipped_names", "rederive",
+           "geometry_violation", "DERIVED", "WALL_PAIR"]

@@ -95,4 +95,8 @@ class Braid:
         L_peak = self.b / math.sqrt(BRAID_LOCK_SEC2)  # R^2 L is largest here, so g's root lies below it
         if g(L_peak) <= 0.0:
             return 0.0
+        if g(L_lo) >= 0.0:
+            # A wall so thin (a fit passes through such walls) that it would fill the braid only at
+            # a length below L_lo: as without a bladder, nothing fills it over any real stroke.
+            return self.L0
         return self.L0 - brentq(g, L_lo, L_peak, xtol=1e-15)
