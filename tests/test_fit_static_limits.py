@@ -3,6 +3,7 @@ muscle file loads back, and the result claims no more than the data show."""
 
 from __future__ import annotations
 
+import json
 import re
 import tomllib
 
@@ -82,3 +83,51 @@ def test_freeing_both_wall_values_is_refused(tmp_path, readme_muscle):
     proc = pamsim_cli("fit", "static", data, "--muscle", readme_muscle, "--free", "ri0_m,wall_thickness_m", "-o", out)
     assert proc.returncode == 2 and "at most one of ri0_m and wall_thickness_m" in proc.stderr
     assert proc.stderr.count("\n") == 1 and not out.exists()
+
+
+def test_a_blind_direction_is_not_identified_never_a_zero_error():
+    from pamsim.identification.uncertainty import linearised_uncertainty
+
+    rng = np.random.default_rng(0)
+    a, b = rng.normal(size=20), rng.normal(size=20)
+    r = rng.normal(0.0, 0.1, 20)
+    zero = linearised_uncertainty(("a", "b", "c"), np.column_stack([a, b, np.zeros(20)]), r)
+    assert zero.not_identified() == ("c",) and np.isnan(zero.standard_errors[2])
+    assert np.all(np.isfinite(zero.standard_errors[:2]) & (zero.standard_errors[:2] > 0))
+    twins = linearised_uncertainty(("a", "b", "c"), np.column_stack([a, b, 3.0 * b]), r)
+    assert twins.not_identified() == ("b", "c") and np.all(np.isnan(twins.standard_errors[1:]))
+
+
+FORCE_AT_REST = "pressure_bar,contraction_mm,force_N\n" + "".join(
+    f"{p:g},0,{23.9 * p - 11.56 + 0.05 * (-1) ** i:.4f}\n" for i, p in enumerate(np.linspace(0.5, 4.0, 12)))
+"""A force gauge holding the Shadow muscle at rest only: the terms in x and x^2 are never seen."""
+
+
+def test_coefficients_the_data_do_not_see_are_reported_as_not_identified(tmp_path):
+    data = tmp_path / "at_rest.csv"
+    data.write_text(FORCE_AT_REST)
+    out = tmp_path / "fit"
+    proc = pamsim_cli("fit", "static", data, "-o", out, "--json")
+    assert proc.returncode == 0, proc.stderr
+    body = json.loads(proc.stdout)
+    blind = {"K1_N_per_bar_m2", "K2_N_per_bar_m", "S1_N_per_m2", "S2_N_per_m"}
+    assert set(body["not_identified"]) == blind
+    assert all(body["standard_errors"][n] is None for n in blind)
+    assert body["standard_errors"]["C1_N_per_bar"] > 0 and body["standard_errors"]["S3_N"] > 0
+    report = (out / "report.md").read_text()
+    assert "the data separate them" not in report
+    assert report.count("| not identified |") == 4 and "**Not identified:**" in report
+
+
+@pytest.mark.parametrize("rows, message", [
+    ("2,10,20\n3,20,20\n", "2 tests for 3 free coefficients"),
+    ("2,10,20\n3,20,20\n4,25,30\n", "3 tests for 3 free coefficients"),
+    ("1,0,90\n2,0.2,120\n3,0,150\n4,0.5,160\n", "every one of the 4 tests is censored"),
+])
+def test_data_that_cannot_fix_the_coefficients_are_refused(tmp_path, readme_muscle, rows, message):
+    data = tmp_path / "few.csv"
+    data.write_text("pressure_bar,contraction_mm,weight_N\n" + rows)
+    out = tmp_path / "fit"
+    proc = pamsim_cli("fit", "static", data, "--muscle", readme_muscle, "-o", out)
+    assert proc.returncode == 2 and message in proc.stderr, proc.stderr
+    assert proc.stderr.count("\n") == 1 and "Traceback" not in proc.stderr and not out.exists()

@@ -147,6 +147,14 @@ def register(sub) -> None:
     d.set_defaults(func=run_dynamic)
 
 
+def _print_warnings(uncertainty) -> None:
+    """What the data do not show, below a fit's summary."""
+    for name in uncertainty.not_identified():
+        print(f"  warning: {name} is not identified: the data carry no information on it")
+    for a, b, r in uncertainty.inseparable_pairs():
+        print(f"  warning: {a} and {b} are correlated (r = {r:+.3f}): the data do not separate them")
+
+
 def run_static(args: argparse.Namespace) -> int:
     from ..identification import compare, muscle_file, report, static_fit
     from ..identification.columns import read_static_data
@@ -178,8 +186,7 @@ def run_static(args: argparse.Namespace) -> int:
     print(f"{model} on {args.data}: RMS contraction {fit.rms_contraction_mm:.3f} mm "
           f"(cross-validated {cv}, {fit.cv_kind}), "
           f"{fit.n_points} tests, {fit.n_censored} censored")
-    for a, b, r in fit.uncertainty.inseparable_pairs():
-        print(f"  warning: {a} and {b} are correlated (r = {r:+.3f}): the data do not separate them")
+    _print_warnings(fit.uncertainty)
     print(f"wrote {', '.join(str(Path(args.output) / n) for n in names)}")
     return 0
 
@@ -214,7 +221,6 @@ def run_dynamic(args: argparse.Namespace) -> int:
           f"{fit.wall_time_s:.2f} s on {args.workers} worker(s), {args.backend} backend")
     for name, value in fit.parameters.items():
         print(f"  {name} = {value:.6g}")
-    for a, b, r in fit.uncertainty.inseparable_pairs():
-        print(f"  warning: {a} and {b} are correlated (r = {r:+.3f}): the data do not separate them")
+    _print_warnings(fit.uncertainty)
     print(f"wrote {', '.join(str(Path(args.output) / n) for n in names)}")
     return 0

@@ -196,6 +196,7 @@ class DynamicFit:
                 "standard_errors": dict(zip(u.names, map(float, u.standard_errors))),
                 "correlation": u.correlation_table(),
                 "inseparable_pairs": [[a, b, r] for a, b, r in u.inseparable_pairs()],
+                "not_identified": list(u.not_identified()),
                 "rms_contraction_mm": {"per_trace": dict(zip(names, self.rms_contraction_mm)),
                                        "pooled": self.rms_pooled_mm},
                 "n_simulations": self.n_simulations, "wall_time_s": self.wall_time_s, "backend": self.backend,

@@ -49,25 +49,35 @@ def provenance(origin: str, sha256: str, objective: str, rms_text: str) -> dict:
             "objective": objective, "fit quality": rms_text}
 
 
-def parameter_table(names: Sequence[str], start: dict, fitted: dict, errors: dict) -> list[str]:
-    """Markdown rows: coefficient, start value, fitted value, standard error."""
+def parameter_table(names: Sequence[str], start: dict, fitted: dict, unc) -> list[str]:
+    """Markdown rows: coefficient, start value, fitted value, standard error ("not identified" where
+    the data carry no information on the coefficient)."""
+    errors = dict(zip(unc.names, map(float, unc.standard_errors)))
+    blind = set(unc.not_identified())
     out = ["| coefficient | start | fitted | standard error |", "|---|---|---|---|"]
-    out += [f"| {n} | {_f(start[n])} | {_f(fitted[n])} | {_f(errors[n])} |" for n in names]
+    out += [f"| {n} | {_f(start[n])} | {_f(fitted[n])} | {'not identified' if n in blind else _f(errors[n])} |"
+            for n in names]
     return out
 
 
 def correlation_lines(fit_unc) -> list[str]:
     pairs = fit_unc.inseparable_pairs()
-    if not pairs:
+    blind = fit_unc.not_identified()
+    out = []
+    if blind:
+        out += [f"**Not identified:** {', '.join(blind)}: the data carry no information on "
+                f"{'it' if len(blind) == 1 else 'them'} (the fitted value is the optimiser's, not the data's).", ""]
+    if not pairs and not blind:
         return ["No two coefficients are correlated beyond |r| = 0.95: the data separate them.", ""]
-    return ["**Coefficients the data cannot separate** (|r| > 0.95); trust their combination, not each alone:",
-            ""] + [f"- {a} and {b}: r = {r:+.3f}" for a, b, r in pairs] + [""]
+    if pairs:
+        out += ["**Coefficients the data cannot separate** (|r| > 0.95); trust their combination, not each alone:",
+                ""] + [f"- {a} and {b}: r = {r:+.3f}" for a, b, r in pairs] + [""]
+    return out
 
 
 def static_report_md(fit: "StaticFit", compare: Sequence[dict] | None, figure_format: str = "png") -> str:
     p = fit.problem
     start = {n: p.base[n] for n in p.free}
-    errs = dict(zip(fit.uncertainty.names, map(float, fit.uncertainty.standard_errors)))
     out = [f"# Static fit: {p.model} on {Path(p.data.origin).name}", "",
            f"- muscle: {fit.muscle}; objective: **{p.objective}**; loss: {fit.loss}; extra starts: {fit.n_starts}",
            f"- tests: {fit.n_points}, censored (not lifted, <= {p.censor_threshold_m * 1e3:g} mm): {fit.n_censored}",
@@ -76,7 +86,7 @@ def static_report_md(fit: "StaticFit", compare: Sequence[dict] | None, figure_fo
            f"- RMS force error over the lifted tests: {_f(fit.rms_force_N, '.3f')} N",
            f"- AIC {_f(fit.aic, '.2f')}, BIC {_f(fit.bic, '.2f')}; optimiser: {fit.message} ({fit.nfev} evaluations)",
            "", "## Coefficients", ""]
-    out += parameter_table(p.free, start, fit.parameters, errs) + [""]
+    out += parameter_table(p.free, start, fit.parameters, fit.uncertainty) + [""]
     out += ["Standard errors come from the Jacobian at the optimum (linearised, residual variance from the fit).",
             ""] + correlation_lines(fit.uncertainty)
     ext = figure_format
@@ -179,7 +189,6 @@ def _absolute_files(value, base_dir: Path):
 
 def dynamic_report_md(fit: "DynamicFit", figure_format: str = "png") -> str:
     p = fit.problem
-    errs = dict(zip(fit.uncertainty.names, map(float, fit.uncertainty.standard_errors)))
     start = dict(zip(p.free, map(float, fit.start)))
     out = [f"# Dynamic fit (eq. 13) on {len(p.traces)} trace(s), scenario {p.scenario.name}", "",
            f"- pooled RMS contraction error in the window: **{fit.rms_pooled_mm:.4f} mm**",
@@ -187,7 +196,7 @@ def dynamic_report_md(fit: "DynamicFit", figure_format: str = "png") -> str:
            "| trace | load [N] | pressure | RMS [mm] |", "|---|---|---|---|"]
     out += [f"| {tr.origin} | {w:g} | {'recorded' if tr.p_gauge_Pa is not None else 'scenario valve'} | {r:.4f} |"
             for tr, w, r in zip(p.traces, p.loads_N, fit.rms_contraction_mm)]
-    out += ["", "## Coefficients", ""] + parameter_table(p.free, start, fit.parameters, errs) + [""]
+    out += ["", "## Coefficients", ""] + parameter_table(p.free, start, fit.parameters, fit.uncertainty) + [""]
     out += correlation_lines(fit.uncertainty)
     if fit.per_trace:
         out += ["## Each trace alone (the layout of the paper's Table 4)", "",

@@ -191,6 +191,7 @@ class StaticFit:
                 "standard_errors": {n: _num(v) for n, v in zip(u.names, u.standard_errors)},
                 "correlation": u.correlation_table(),
                 "inseparable_pairs": [[a, b, r] for a, b, r in u.inseparable_pairs()],
+                "not_identified": list(u.not_identified()),
                 "rms_force_N": _num(self.rms_force_N), "rms_contraction_mm": _num(self.rms_contraction_mm),
                 "cv_rms_contraction_mm": _num(self.cv_rms_contraction_mm), "cv_kind": self.cv_kind,
                 "n_points": self.n_points, "n_censored": self.n_censored,
@@ -280,6 +281,19 @@ def _physical_bounds(name: str, params: ParameterSet, free: Sequence[str], lower
     return lower, upper
 
 
+def check_information(problem: StaticProblem, exact: bool = False) -> None:
+    """Refuse data that cannot fix the free coefficients: no lifted test, or no more tests than
+    coefficients (as many are accepted with ``exact``: an exact fit, no uncertainty)."""
+    n, k, d = len(problem.data), len(problem.free), problem.data
+    if problem.censored.all():
+        raise InputError(f"{d.origin}: every one of the {n} tests is censored (contraction at or below "
+                         f"{problem.censor_threshold_m * 1e3:g} mm: no load was lifted); they say nothing about "
+                         f"{', '.join(problem.free)}")
+    if n < k or (n == k and not exact):
+        raise InputError(f"{d.origin}: {n} tests for {k} free coefficients ({', '.join(problem.free)}): "
+                         "a fit needs more tests than coefficients to say how far to trust it")
+
+
 def with_optional(params: ParameterSet, optional: Mapping[str, float], model: str) -> ParameterSet:
     """``params`` plus a model's optional coefficients at their defaults (ranges from the muscle schema),
     so they can be fitted and written to the fitted muscle."""
@@ -302,7 +316,7 @@ def fit_static(data: StaticData, params: ParameterSet, model: str = "acra2012_po
                free: Sequence[str] | None = None, objective: str | None = None, loss: str = "linear",
                f_scale: float = 1.0, n_starts: int = 0, seed: int = 0,
                censor_threshold_m: float = CENSOR_THRESHOLD_M, cv: str | None = "auto", k_folds: int = 10,
-               muscle_label: str = "") -> StaticFit:
+               muscle_label: str = "", exact: bool = False) -> StaticFit:
     """Fit the free coefficients of a static force model to static tests.
 
     Parameters
@@ -327,6 +341,10 @@ def fit_static(data: StaticData, params: ParameterSet, model: str = "acra2012_po
         Contraction [m] at or below which a hung load counts as not lifted.
     cv : {"auto", "loo", "kfold", None}
         Cross-validation: leave-one-out, ``k_folds``-fold, or ``auto`` (leave-one-out up to 100 tests).
+    exact : bool
+        Accept as many tests as free coefficients (the ACRA paper's training approach): the fit then
+        passes through the tests and gives no standard errors.  Without it such data are refused, as
+        are fewer tests than coefficients and data where no test lifted its load.
     """
     start = time.perf_counter()
     if loss not in LOSSES:
@@ -336,6 +354,7 @@ def fit_static(data: StaticData, params: ParameterSet, model: str = "acra2012_po
     if n_starts < 0:
         raise InputError(f"--starts = {n_starts}: must not be negative")
     problem = make_problem(data, params, model, free, objective, censor_threshold_m)
+    check_information(problem, exact)
     theta0 = np.array([problem.base[n] for n in problem.free], dtype=float)
     theta, res = _solve(problem, theta0, loss, f_scale)
     nfev = res.nfev

@@ -26,6 +26,12 @@ class Uncertainty:
     standard_errors: np.ndarray
     correlation: np.ndarray
     sigma: float
+    identified: np.ndarray
+    """Per coefficient: False where the data carry no information on it (its error is NaN)."""
+
+    def not_identified(self) -> tuple[str, ...]:
+        """Coefficients the data carry no information on."""
+        return tuple(n for n, ok in zip(self.names, self.identified) if not ok)
 
     def inseparable_pairs(self, limit: float = CORRELATION_LIMIT) -> list[tuple[str, str, float]]:
         """``(a, b, r)`` for every pair with ``|r| > limit``, strongest first."""
@@ -77,9 +83,21 @@ class Uncertainty:
         return {"names": list(self.names), "matrix": [[_num(v) for v in row] for row in self.correlation]}
 
 
+RANK_TOLERANCE = 1.5e-8
+"""Singular values of the column-scaled Jacobian below this fraction of the largest are taken as zero:
+about the square root of the machine epsilon, the noise of the force sensitivities' differences."""
+NULL_WEIGHT = 1e-6
+"""A coefficient with at least this weight in a direction the data do not see is not identified."""
+
+
 def linearised_uncertainty(names, jacobian: np.ndarray, residuals: np.ndarray) -> Uncertainty:
     """Standard errors and correlation of the coefficients ``names`` from the Jacobian of the residuals
-    with respect to them (physical units) at the optimum."""
+    with respect to them (physical units) at the optimum.
+
+    A coefficient along a direction the Jacobian does not see (a zero column, two columns alike) is
+    not identified: its standard error and its correlations are NaN, never the 0 a pseudo-inverse
+    would give.
+    """
     J = np.asarray(jacobian, dtype=float)
     r = np.asarray(residuals, dtype=float)
     n, k = J.shape
@@ -89,15 +107,21 @@ def linearised_uncertainty(names, jacobian: np.ndarray, residuals: np.ndarray) -
     col = np.linalg.norm(J, axis=0)
     col[col == 0.0] = 1.0
     Js = J / col
-    cov_s = np.linalg.pinv(Js.T @ Js)
+    _, sv, vt = np.linalg.svd(Js, full_matrices=True)
+    sv = np.concatenate([sv, np.zeros(k - sv.size)])
+    seen = sv > RANK_TOLERANCE * (sv[0] if sv.size and sv[0] > 0 else 1.0)
+    identified = ~np.any(np.abs(vt[~seen]) >= NULL_WEIGHT, axis=0)
+    with np.errstate(divide="ignore"):
+        inv_sv2 = np.where(seen, 1.0 / np.where(seen, sv, 1.0) ** 2, 0.0)
+    cov_s = (vt.T * inv_sv2) @ vt
     cov_unit = cov_s / np.outer(col, col)
-    d = np.sqrt(np.clip(np.diag(cov_unit), 0.0, None))
+    d = np.where(identified, np.sqrt(np.clip(np.diag(cov_unit), 0.0, None)), math.nan)
     with np.errstate(invalid="ignore", divide="ignore"):
         corr = cov_unit / np.outer(d, d)
     corr = np.where(np.outer(d, d) > 0, corr, np.nan)
     np.fill_diagonal(corr, 1.0)
     return Uncertainty(tuple(names), d * math.sqrt(sigma2) if dof > 0 else np.full(k, math.nan),
-                       np.clip(corr, -1.0, 1.0), math.sqrt(sigma2) if dof > 0 else math.nan)
+                       np.clip(corr, -1.0, 1.0), math.sqrt(sigma2) if dof > 0 else math.nan, identified)
 
 
 def information_criteria(ssr: float, n: int, k: int) -> tuple[float, float]:
