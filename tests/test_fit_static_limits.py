@@ -131,3 +131,33 @@ def test_data_that_cannot_fix_the_coefficients_are_refused(tmp_path, readme_musc
     proc = pamsim_cli("fit", "static", data, "--muscle", readme_muscle, "-o", out)
     assert proc.returncode == 2 and message in proc.stderr, proc.stderr
     assert proc.stderr.count("\n") == 1 and "Traceback" not in proc.stderr and not out.exists()
+
+
+def test_censored_tests_the_model_does_not_lift_are_no_observations():
+    from pamsim.identification.uncertainty import linearised_uncertainty
+
+    rng = np.random.default_rng(1)
+    J, r = rng.normal(size=(12, 3)), rng.normal(0.0, 0.5, 12)
+    alone = linearised_uncertainty("abc", J, r)
+    # Ten censored tests the model does not lift: residual 0, derivatives 0.
+    padded = linearised_uncertainty("abc", np.vstack([J, np.zeros((10, 3))]), np.concatenate([r, np.zeros(10)]))
+    np.testing.assert_allclose(padded.standard_errors, alone.standard_errors, rtol=1e-12)
+    assert padded.dof == alone.dof == 9 and padded.sigma == pytest.approx(np.sqrt(r @ r / 9))
+
+
+def test_censored_fit_counts_only_the_tests_that_observe(readme_muscle):
+    # The README muscle's own tests, half of them too heavy to lift: sigma from the lifted half only.
+    from pamsim.identification import fit_static
+    from pamsim.identification.muscle_file import load_muscle_parameters
+    from pamsim.elements.stops import EndStops
+    from pamsim.identification.synthetic import synthetic_static
+
+    params, model = load_muscle_parameters(str(readme_muscle))
+    p = np.repeat([1e5, 2e5, 3e5, 4e5], 6)
+    w = np.tile([5.0, 15.0, 30.0, 400.0, 500.0, 600.0], 4)
+    force = pamsim.load_muscle(readme_muscle).static_force().force_N
+    data = synthetic_static(force, p, w, EndStops.from_parameters(params).x_high_m, 0.3e-3, seed=2)
+    fit = fit_static(data, params, model=model, cv=None)
+    lifted = ~fit.problem.censored
+    assert fit.n_censored == 12 and fit.uncertainty.dof == lifted.sum() - 3
+    assert fit.uncertainty.sigma == pytest.approx(np.sqrt(fit.residuals @ fit.residuals / (lifted.sum() - 3)))

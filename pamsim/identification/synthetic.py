@@ -1,5 +1,6 @@
-"""Synthetic measurements made by pamsim itself, for recovery studies: a scenario run with chosen
-"true" coefficients, the pressure recorded, seeded Gaussian noise on the contraction."""
+"""Synthetic measurements made by pamsim itself, for recovery and coverage studies: a scenario run with
+chosen "true" coefficients, the pressure recorded, seeded Gaussian noise on the contraction; static
+tests of a static force model under hung weights."""
 
 from __future__ import annotations
 
@@ -9,7 +10,8 @@ import numpy as np
 
 from ..backends import simulate
 from ..scenario import Scenario
-from .columns import TraceData
+from .columns import StaticData, TraceData
+from .equilibrium import equilibrium_m
 
 
 def synthetic_trace(scenario: Scenario, truth: Mapping[str, float], weight_N: float, noise_m: float = 0.05e-3,
@@ -28,3 +30,14 @@ def synthetic_trace(scenario: Scenario, truth: Mapping[str, float], weight_N: fl
     label = f"synthetic {weight_N:g} N"
     clean = TraceData(res.t_s, res.x_m, res.p_gauge_Pa, weight_N, label)
     return TraceData(res.t_s, res.x_m + noise, res.p_gauge_Pa, weight_N, label), clean
+
+
+def synthetic_static(force_N, p_gauge_Pa: np.ndarray, load_N: np.ndarray, x_max_m: float, noise_m: float,
+                     seed: int = 0, origin: str = "synthetic static tests") -> StaticData:
+    """Hanging-weight static tests of the model ``force_N(x_m, p_gauge_Pa)``: each test's equilibrium
+    contraction plus seeded Gaussian noise of ``noise_m`` [m] where the load is lifted, and 0 where
+    it is not (the muscle rests on its lower stop, which a rig reads without noise)."""
+    x = equilibrium_m(force_N, p_gauge_Pa, load_N, x_max_m)
+    noisy = x + np.random.default_rng(seed).normal(0.0, noise_m, x.shape)
+    return StaticData(np.asarray(p_gauge_Pa, float), np.where(x > 0.0, noisy, 0.0), np.asarray(load_N, float),
+                      "weight", origin)

@@ -17,8 +17,9 @@ CORRELATION_LIMIT = 0.95
 class Uncertainty:
     """Linearised uncertainty of a least-squares fit.
 
-    ``covariance = s^2 (J^T J)^+`` with ``s^2 = SSR / (n - k)``; with no degrees of freedom left
-    (``n <= k``) the standard errors are NaN but the correlations (which do not depend on
+    ``covariance = s^2 (J^T J)^+`` with ``s^2 = SSR / (n - k)``, ``n`` the observations: rows of
+    the Jacobian whose residual or derivatives are not all zero (a censored test the model does not lift
+    observes nothing).  With no degrees of freedom left (``n <= k``) the standard errors are NaN but the correlations (which do not depend on
     ``s^2``) are still given.
     """
 
@@ -28,6 +29,8 @@ class Uncertainty:
     sigma: float
     identified: np.ndarray
     """Per coefficient: False where the data carry no information on it (its error is NaN)."""
+    dof: int
+    """Degrees of freedom of ``sigma``: observations minus coefficients."""
 
     def not_identified(self) -> tuple[str, ...]:
         """Coefficients the data carry no information on."""
@@ -100,7 +103,10 @@ def linearised_uncertainty(names, jacobian: np.ndarray, residuals: np.ndarray) -
     """
     J = np.asarray(jacobian, dtype=float)
     r = np.asarray(residuals, dtype=float)
-    n, k = J.shape
+    k = J.shape[1]
+    # A row with no residual and no derivative (a censored test the model does not lift) observes
+    # nothing: counted in n it shrinks s^2 and the errors with it.
+    n = int(np.count_nonzero((r != 0.0) | np.any(J != 0.0, axis=1)))
     dof = n - k
     sigma2 = float(r @ r) / dof if dof > 0 else math.nan
     # Scale the columns before inverting: the coefficients differ by orders of magnitude.
@@ -121,7 +127,7 @@ def linearised_uncertainty(names, jacobian: np.ndarray, residuals: np.ndarray) -
     corr = np.where(np.outer(d, d) > 0, corr, np.nan)
     np.fill_diagonal(corr, 1.0)
     return Uncertainty(tuple(names), d * math.sqrt(sigma2) if dof > 0 else np.full(k, math.nan),
-                       np.clip(corr, -1.0, 1.0), math.sqrt(sigma2) if dof > 0 else math.nan, identified)
+                       np.clip(corr, -1.0, 1.0), math.sqrt(sigma2) if dof > 0 else math.nan, identified, dof)
 
 
 def information_criteria(ssr: float, n: int, k: int) -> tuple[float, float]:
