@@ -161,3 +161,70 @@ def test_censored_fit_counts_only_the_tests_that_observe(readme_muscle):
     lifted = ~fit.problem.censored
     assert fit.n_censored == 12 and fit.uncertainty.dof == lifted.sum() - 3
     assert fit.uncertainty.sigma == pytest.approx(np.sqrt(fit.residuals @ fit.residuals / (lifted.sum() - 3)))
+
+
+GOOD_ROWS = ["3.0,20.1,30", "3.5,25.3,30", "4.0,27.9,40", "2.5,12.2,30", "3.0,18.0,40", "4.0,30.5,20", "2.0,6.1,30"]
+
+
+def fit_rows(tmp_path, muscle, header, change, out):
+    """``pamsim fit static`` on GOOD_ROWS under ``header``, with row ``change[0]`` replaced by ``change[1]``."""
+    rows = list(GOOD_ROWS)
+    if change:
+        rows[change[0]] = change[1]
+    data = tmp_path / "rig.csv"
+    data.write_text(header + "\n" + "\n".join(rows) + "\n")
+    return pamsim_cli("fit", "static", data, "--muscle", muscle, "-o", out)
+
+
+@pytest.mark.parametrize("header, change, message", [
+    ("pressure_bar,contraction_mm,weight_N", (2, "-1.5,20.0,30"), "column pressure_bar, data row 3: value -1.5"),
+    ("pressure_bar,contraction_mm,weight_N", (5, "3.0,180,40"), "column contraction_mm, data row 6: value 180"),
+    ("pressure_bar,contraction_m,weight_N", None, "column contraction_m, data row 1: value 20.1"),
+    ("pressure_bar,contraction_mm,weight_N", (0, "300000,20.1,30"), "column pressure_bar, data row 1: value 300000"),
+])
+def test_impossible_values_are_refused_by_column_row_and_value(tmp_path, readme_muscle, header, change, message):
+    out = tmp_path / "fit"
+    proc = fit_rows(tmp_path, readme_muscle, header, change, out)
+    assert proc.returncode == 2 and message in proc.stderr, proc.stderr
+    assert proc.stderr.count("\n") == 1 and "Traceback" not in proc.stderr and not out.exists()
+
+
+@pytest.mark.parametrize("header, change, message", [
+    ("pressure_Pa,contraction_mm,weight_N", None, "column pressure_Pa, data row 3: value 4: every pressure is below 1 kPa"),
+    ("pressure_bar,contraction_mm,weight_N", (1, "3.5,25.3,3000"), "column weight_N, data row 2: value 3000: more than twice"),
+    ("pressure_bar,contraction_mm,weight_N", (3, "2.5,-4,30"), "column contraction_mm, data row 4: value -4"),
+    ("pressure_bar,contraction_mm,weight_N", (4, "3.5,25.3,30"), "data rows 2, 5: repeated tests"),
+    ("pressure_bar,contraction_mm,weight_N", (4, "7,25.3,30"), "column pressure_bar, data row 5: value 7: above the muscle's rated"),
+])
+def test_implausible_values_are_one_warning_line(tmp_path, readme_muscle, header, change, message):
+    proc = fit_rows(tmp_path, readme_muscle, header, change, tmp_path / "fit")
+    assert proc.returncode == 0, proc.stderr
+    lines = proc.stderr.splitlines()
+    assert len(lines) == 1 and lines[0].startswith("warning: ") and message in lines[0], proc.stderr
+    assert "RuntimeWarning" not in proc.stderr
+
+
+def test_repeated_tests_stay_in_one_fold():
+    from pamsim.identification.crossval import folds
+
+    groups = np.array([0, 1, 2, 1, 3, 2, 4])
+    _, loo = folds(7, "loo", 0, 0, groups)
+    assert sorted(map(tuple, loo)) == [(0,), (1, 3), (2, 5), (4,), (6,)]
+    _, kfold = folds(7, "kfold", 3, 5, groups)
+    assert sorted(np.concatenate(kfold)) == list(range(7))
+    for part in kfold:
+        assert all(set(np.flatnonzero(groups == groups[i])) <= set(part) for i in part)
+
+
+def test_overflow_at_trial_points_does_not_reach_the_user():
+    import warnings
+
+    from pamsim.identification import fit_static, read_static_data
+
+    data = read_static_data(ROOT / "pamsim" / "data" / "acra2012_steady_state.csv")
+    start = pamsim.get_parameter_set("shadow_6x300_acra2012").with_overrides(
+        {"S1_N_per_m2": 1e306, "K1_N_per_bar_m2": 1e306})  # squares overflow to inf
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        fit_static(data, start, cv=None)
+    assert not [w for w in caught if issubclass(w.category, RuntimeWarning)]

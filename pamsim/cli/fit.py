@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import sys
 from pathlib import Path
 
 from ..atomic import OutputError, ensure_output_dir
@@ -164,6 +165,8 @@ def run_static(args: argparse.Namespace) -> int:
     model = args.model or muscle_model
     check_output_dir(args.output)
     data = read_static_data(args.data, args.columns)
+    for line in static_fit.check_data(data, params, model):
+        print(f"warning: {line}", file=sys.stderr)
     options = dict(objective=args.objective, loss=args.loss, f_scale=args.f_scale, n_starts=args.starts,
                    seed=args.seed, censor_threshold_m=args.censor_threshold_mm * 1e-3, cv=args.cv,
                    k_folds=args.folds)

@@ -44,6 +44,8 @@ class StaticData:
     kind: str
     origin: str = "<arrays>"
     sha256: str = ""
+    columns: tuple[tuple[str, float], ...] = (("pressure_gauge_Pa", 1.0), ("contraction_m", 1.0), ("load_N", 1.0))
+    """The file's column of the pressure, the contraction and the load, each with its factor to SI."""
 
     def __len__(self) -> int:
         return len(self.load_N)
@@ -51,7 +53,7 @@ class StaticData:
     def subset(self, rows) -> "StaticData":
         """The tests at ``rows`` (indices or a boolean mask)."""
         return StaticData(self.pressure_gauge_Pa[rows], self.contraction_m[rows], self.load_N[rows], self.kind,
-                          self.origin, self.sha256)
+                          self.origin, self.sha256, self.columns)
 
 
 @dataclass(frozen=True)
@@ -181,7 +183,7 @@ def read_static_data(path: str | Path, columns: Mapping[str, str] | None = None)
     if kind == "weight" and np.any(load <= 0):
         i = int(np.flatnonzero(load <= 0)[0])
         raise DataError(f"{path}: column {l_col}, data row {i + 1}: value {load[i]:g} must be positive")
-    return StaticData(p, x, load, kind, str(path), digest)
+    return StaticData(p, x, load, kind, str(path), digest, ((p_col, p_k), (x_col, x_k), (l_col, 1.0)))
 
 
 def read_trace(path: str | Path, columns: Mapping[str, str] | None = None) -> TraceData:

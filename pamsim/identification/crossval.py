@@ -13,22 +13,30 @@ LOO_MAX_POINTS = 100
 """``auto`` uses leave-one-out up to this many tests, k-fold above (each refit costs a fit)."""
 
 
-def folds(n: int, kind: str, k: int, seed: int) -> tuple[str, list[np.ndarray]]:
-    """The label (``leave-one-out`` or ``k-fold (k=K)``) and the held-out index sets."""
+def folds(n: int, kind: str, k: int, seed: int, groups: np.ndarray | None = None) -> tuple[str, list[np.ndarray]]:
+    """The label (``leave-one-out`` or ``k-fold (k=K)``) and the held-out index sets.
+
+    Tests with the same label in ``groups`` (repeated tests) are held out together: a copy left in
+    the training set would predict its twin, and the error would look smaller than it is.
+    """
+    groups = np.arange(n) if groups is None else np.asarray(groups)
+    labels, members = np.unique(groups, return_inverse=True)
+    m = labels.size
     if kind == "auto":
-        kind = "loo" if n <= LOO_MAX_POINTS else "kfold"
+        kind = "loo" if m <= LOO_MAX_POINTS else "kfold"
     if kind == "loo":
-        return "leave-one-out", [np.array([i]) for i in range(n)]
+        return "leave-one-out", [np.flatnonzero(members == g) for g in range(m)]
     if kind == "kfold":
-        if not 2 <= k <= n:
-            raise InputError(f"--folds = {k}: need 2 <= k <= {n} (the number of tests)")
-        order = np.random.default_rng(seed).permutation(n)
-        return f"{k}-fold", [np.sort(part) for part in np.array_split(order, k)]
+        if not 2 <= k <= m:
+            raise InputError(f"--folds = {k}: need 2 <= k <= {m} (the number of distinct tests)")
+        order = np.random.default_rng(seed).permutation(m)
+        return f"{k}-fold", [np.flatnonzero(np.isin(members, part)) for part in np.array_split(order, k)]
     raise InputError(f"--cv = {kind!r}: choose from {', '.join(CV_CHOICES)}")
 
 
 def cross_validate(fit: Callable[[np.ndarray], np.ndarray], errors: Callable[[np.ndarray, np.ndarray], np.ndarray],
-                   n: int, n_free: int, kind: str | None, k: int = 10, seed: int = 0) -> tuple[str, np.ndarray]:
+                   n: int, n_free: int, kind: str | None, k: int = 10, seed: int = 0,
+                   groups: np.ndarray | None = None) -> tuple[str, np.ndarray]:
     """Prediction error of every test from a fit that did not see it.
 
     Parameters
@@ -41,6 +49,8 @@ def cross_validate(fit: Callable[[np.ndarray], np.ndarray], errors: Callable[[np
         Number of tests and of free coefficients.  A training set smaller than ``n_free`` cannot
         determine the coefficients: then no cross-validation is done.
     kind : {"auto", "loo", "kfold", "none", None}
+    groups : array, optional
+        A label per test; tests sharing one are always in the same fold (see :func:`folds`).
 
     Returns
     -------
@@ -50,7 +60,7 @@ def cross_validate(fit: Callable[[np.ndarray], np.ndarray], errors: Callable[[np
     """
     if kind in (None, "none"):
         return "none", np.empty(0)
-    label, parts = folds(n, kind, k, seed)
+    label, parts = folds(n, kind, k, seed, groups)
     if n - max(len(p) for p in parts) < n_free:
         return f"none (a training set of {n - max(len(p) for p in parts)} tests cannot fix {n_free} coefficients)", \
             np.empty(0)

@@ -35,6 +35,7 @@ from .columns import StaticData
 from .crossval import cross_validate
 from .equilibrium import equilibrium_m, slope_N_per_m
 from .models import build_static, check_model, default_free, missing_inputs, optional_defaults, static_parameters
+from .plausibility import check_static_data, duplicate_groups
 from .uncertainty import Uncertainty, information_criteria, linearised_uncertainty
 
 _FD_REL = 1e-6
@@ -102,11 +103,16 @@ class StaticProblem:
         model = self.feasible_force(theta)
         if model is None:
             return np.full(len(d), _PENALTY)
-        if self.objective == "force":
-            r = model.force_N(d.contraction_m, d.pressure_gauge_Pa) - d.load_N
-            return np.where(cens, np.maximum(r, 0.0), r)
-        x = equilibrium_m(model.force_N, d.pressure_gauge_Pa, d.load_N, self.x_max_m)
-        return 1e3 * np.where(cens, np.maximum(x - self.censor_threshold_m, 0.0), x - d.contraction_m)
+        try:
+            if self.objective == "force":
+                r = model.force_N(d.contraction_m, d.pressure_gauge_Pa) - d.load_N
+                r = np.where(cens, np.maximum(r, 0.0), r)
+            else:
+                x = equilibrium_m(model.force_N, d.pressure_gauge_Pa, d.load_N, self.x_max_m)
+                r = 1e3 * np.where(cens, np.maximum(x - self.censor_threshold_m, 0.0), x - d.contraction_m)
+        except ArithmeticError:  # a Python float overflowing in a model's formula
+            return np.full(len(d), _PENALTY)
+        return np.where(np.isfinite(r), r, _PENALTY)
 
     def jacobian(self, theta: np.ndarray) -> np.ndarray:
         """d residual / d theta (physical units).
@@ -294,6 +300,17 @@ def check_information(problem: StaticProblem, exact: bool = False) -> None:
                          "a fit needs more tests than coefficients to say how far to trust it")
 
 
+def check_data(data: StaticData, params: ParameterSet, model: str) -> list[str]:
+    """Refuse static tests no rig can give for this muscle; return one-line warnings on implausible ones
+    (:func:`pamsim.identification.plausibility.check_static_data`, on the scale of the starting muscle)."""
+    problem = make_problem(data, params, model, objective="contraction" if data.kind == "weight" else "force")
+    with np.errstate(all="ignore"):
+        force = problem.feasible_force(np.array([problem.base[n] for n in problem.free], dtype=float))
+    rated = params["rated_pressure_gauge_Pa"] if "rated_pressure_gauge_Pa" in params else math.inf
+    blocked = (lambda p: 0.0) if force is None else (lambda p: force.force_N(0.0, p))
+    return check_static_data(data, params["L0_m"], problem.x_max_m, rated, blocked)
+
+
 def with_optional(params: ParameterSet, optional: Mapping[str, float], model: str) -> ParameterSet:
     """``params`` plus a model's optional coefficients at their defaults (ranges from the muscle schema),
     so they can be fitted and written to the fitted muscle."""
@@ -346,6 +363,15 @@ def fit_static(data: StaticData, params: ParameterSet, model: str = "acra2012_po
         passes through the tests and gives no standard errors.  Without it such data are refused, as
         are fewer tests than coefficients and data where no test lifted its load.
     """
+    # A trial point far from the data may overflow in a model's formula; it is a bad point (its
+    # residuals become the penalty), not something to tell the user about.
+    with np.errstate(all="ignore"):
+        return _fit_static(data, params, model, free, objective, loss, f_scale, n_starts, seed, censor_threshold_m,
+                           cv, k_folds, muscle_label, exact)
+
+
+def _fit_static(data, params, model, free, objective, loss, f_scale, n_starts, seed, censor_threshold_m, cv,
+                k_folds, muscle_label, exact) -> StaticFit:
     start = time.perf_counter()
     if loss not in LOSSES:
         raise InputError(f"--loss = {loss!r}: choose from {', '.join(LOSSES)}")
@@ -373,7 +399,7 @@ def fit_static(data: StaticData, params: ParameterSet, model: str = "acra2012_po
     rms_force = float(np.sqrt(np.mean(force_err[lifted] ** 2))) if lifted.any() else math.nan
     cv_kind, cv_err = cross_validate(lambda train: _solve(_restrict(problem, train), theta, loss, f_scale)[0],
                                      lambda th, test: problem.predict_m(th, data.subset(test)) - data.contraction_m[test],
-                                     len(data), len(theta), cv, k_folds, seed)
+                                     len(data), len(theta), cv, k_folds, seed, duplicate_groups(data))
     aic, bic = information_criteria(float(residuals @ residuals), len(data), len(theta))
     fitted = problem.parameter_set(theta, source=f"fitted: pamsim fit static ({problem.objective} objective) on "
                                                  f"{data.origin}")
