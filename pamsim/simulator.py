@@ -200,58 +200,73 @@ def simulate_model(model: MuscleModel, duration_s: float, options: SolverOptions
     Raises :class:`SolverFailure` when ``solve_ivp`` fails, the event count
     exceeds ``options.max_events``, or the switching stops making progress.
     """
-    from scipy.integrate import solve_ivp  # here, not at the top: `pamsim --help` should not pay for it
-
-    opts = options or SolverOptions()
     wall0 = time.perf_counter()
-    names = model.state_names
-    atol = np.array([opts.rtol * STATE_SCALES.get(n, 0.1) for n in names])  # 0.1 J for the work integrals
-    grid = np.linspace(0.0, duration_s, n_samples(duration_s, opts.sample_rate_Hz))
-    breaks = sorted({b for b in model.breakpoints if 0.0 < b < duration_s} | {duration_s})
-    gen = _Generated(model, opts, x0_m, p0_gauge_Pa)
-    held_max_step = min(opts.held_max_step_s, model.max_input_step_s)
+    run = _Run(model, duration_s, options or SolverOptions(), x0_m, p0_gauge_Pa, progress)
+    while run.t < duration_s:
+        run.report(run.t)
+        t_break = min(next(b for b in run.breaks if b > run.t), run.hold_until)
+        sol, named = run.segment(t_break)
+        run.record(sol, t_break)
+        if sol.status == 1:
+            run.at_event(sol, named)
+        else:
+            run.at_breakpoint(sol, t_break)
+    if progress is not None:
+        progress(duration_s)
+    return run.result(name, time.perf_counter() - wall0)
 
-    t = 0.0
-    y, mode = gen.start()
-    ts, ys, modes = [], [], []
-    transitions: list[TransitionEvent] = []
-    impact_loss_J = []  # (t, J): kinetic energy removed by inelastic impacts and velocity resets
-    nfev = 0
-    n_segments = 0
-    n_zero = 0
-    hold_until = math.inf  # end of a short hold after a slip too small to resolve (see _HOLD_S)
-    next_sample = 0
-    low_x, peak_x, peak_p = math.inf, -math.inf, -math.inf  # over every integrator step and event, not the samples
 
-    calls = 0
-    reached = 0.0  # reported time: the RHS is also evaluated at trial points, which need not increase
+class _Run:
+    """One run of :func:`simulate_model`: where it is, what it has sampled and seen so far."""
 
-    def reporting(fun):
+    def __init__(self, model: MuscleModel, duration_s: float, opts: SolverOptions, x0_m: float,
+                 p0_gauge_Pa: float | None, progress: Callable[[float], None] | None):
+        self.model, self.opts, self.progress = model, opts, progress
+        self.atol = np.array([opts.rtol * STATE_SCALES.get(n, 0.1) for n in model.state_names])  # 0.1 J: work
+        self.grid = np.linspace(0.0, duration_s, n_samples(duration_s, opts.sample_rate_Hz))
+        self.breaks = sorted({b for b in model.breakpoints if 0.0 < b < duration_s} | {duration_s})
+        self.gen = _Generated(model, opts, x0_m, p0_gauge_Pa)
+        self.held_max_step = min(opts.held_max_step_s, model.max_input_step_s)
+        self.t = 0.0
+        self.y, self.mode = self.gen.start()
+        self.ts, self.ys, self.modes = [], [], []
+        self.transitions: list[TransitionEvent] = []
+        self.impact_loss_J = []  # (t, J): kinetic energy removed by inelastic impacts and velocity resets
+        self.nfev = self.n_segments = self.n_zero = self.next_sample = 0
+        self.hold_until = math.inf  # end of a short hold after a slip too small to resolve (see _HOLD_S)
+        # Over every integrator step and event, not the samples.
+        self.low_x, self.peak_x, self.peak_p = math.inf, -math.inf, -math.inf
+        self.calls = 0
+        self.reached = 0.0  # reported time: the RHS is also evaluated at trial points, which need not increase
+
+    def report(self, t: float) -> None:
+        if self.progress is not None:
+            self.reached = max(self.reached, t)
+            self.progress(self.reached)
+
+    def _reporting(self, fun):
         def rhs(tt, yy):
-            nonlocal calls, reached
-            calls += 1
-            if calls % PROGRESS_EVERY == 0:
-                reached = max(reached, tt)
-                progress(reached)
+            self.calls += 1
+            if self.calls % PROGRESS_EVERY == 0:
+                self.report(tt)
             return fun(tt, yy)
         return rhs
 
-    while t < duration_s:
-        if progress is not None:
-            reached = max(reached, t)
-            progress(reached)
-        t_break = min(next(b for b in breaks if b > t), hold_until)
-        j = np.searchsorted(grid, t_break, side="right")
-        named = gen.events(mode)
+    def segment(self, t_break: float):
+        """Integrate the current mode from ``t`` to ``t_break`` or its first event."""
+        from scipy.integrate import solve_ivp  # here, not at the top: `pamsim --help` should not pay for it
+
+        opts, mode, t, y = self.opts, self.mode, self.t, self.y
+        named = self.gen.events(mode)
         # An input that jumps at t_break belongs to the next segment: this one sees its left limit,
         # so a jump cannot hide a crossing that happened before it.
-        t_left = gen.t_left = float(np.nextafter(t_break, -math.inf))
-        max_step = opts.max_step_s if mode.is_slip else min(opts.max_step_s, held_max_step)
-        rhs = gen.rhs(mode) if progress is None else reporting(gen.rhs(mode))
+        self.t_left = self.gen.t_left = float(np.nextafter(t_break, -math.inf))
+        max_step = opts.max_step_s if mode.is_slip else min(opts.max_step_s, self.held_max_step)
+        rhs = self.gen.rhs(mode) if self.progress is None else self._reporting(self.gen.rhs(mode))
         try:
             sol = solve_ivp(rhs, (t, t_break), y,
                             method=opts.method, dense_output=True, events=[_from_start(f, t, y) for _, f, _ in named],
-                            rtol=opts.rtol, atol=atol, max_step=max_step)
+                            rtol=opts.rtol, atol=self.atol, max_step=max_step)
         except (InputError, SolverFailure):
             raise
         except Exception as exc:
@@ -259,63 +274,68 @@ def simulate_model(model: MuscleModel, duration_s: float, options: SolverOptions
             # from brentq, ZeroDivisionError, LinAlgError...); to the caller it is a solver failure (exit 3).
             raise SolverFailure(f"solve_ivp raised {type(exc).__name__} at t = {t:.6g} s in mode {mode.label}: "
                                 f"{exc}") from exc
-        nfev += sol.nfev
-        n_segments += 1
+        self.nfev += sol.nfev
+        self.n_segments += 1
         if sol.status == -1:
             raise SolverFailure(f"solve_ivp failed at t = {t:.6g} s in mode {mode.label}: {sol.message}")
-        # sol.t, sol.y: every step of the integrator, ending at the event or at t_break.
-        samples = grid[next_sample:j]
+        return sol, named
+
+    def record(self, sol, t_break: float) -> None:
+        """The segment's output samples (from the dense output) and extremes (over its steps)."""
+        j = np.searchsorted(self.grid, t_break, side="right")
+        samples = self.grid[self.next_sample:j]
         samples = samples[samples <= sol.t[-1]]
         if samples.size:
-            ts.append(samples)
-            ys.append(sol.sol(samples))
-            modes.append(np.full(samples.size, int(mode)))
-            next_sample += samples.size
+            self.ts.append(samples)
+            self.ys.append(sol.sol(samples))
+            self.modes.append(np.full(samples.size, int(self.mode)))
+            self.next_sample += samples.size
         # x is monotonic within a segment (the velocity keeps its sign between events), so its peak
         # is at a step; the pressure's peak is taken over the steps as well.
-        low_x, peak_x = min(low_x, float(sol.y[0].min())), max(peak_x, float(sol.y[0].max()))
-        p_steps = model.source.pressure_gauge_Pa(sol.y[2:2 + model.n_source], model.source.inputs(
-            np.minimum(sol.t, t_left)))
-        peak_p = max(peak_p, float(np.max(p_steps)))
-        if sol.status == 1:
-            k = next(i for i, te in enumerate(sol.t_events) if len(te))
-            kind, _, indicator = named[k]
-            t_event = float(sol.t_events[k][0])
-            y = np.array(sol.y_events[k][0], dtype=float)
-            zero_length = t_event - t <= 1e-12 * max(1.0, t)
-            n_zero = n_zero + 1 if zero_length else 0
-            if n_zero > _MAX_ZERO_LENGTH:
-                raise SolverFailure(f"event switching made no progress at t = {t_event:.9g} s ({kind})")
-            old = mode
-            y_before = y
-            y, mode, lost_J = gen.jump(mode, indicator, t_event, y)
-            if not np.array_equal(y, y_before):
-                impact_loss_J.append((t_event, lost_J))
-            hold_until = math.inf
-            if kind == "velocity_zero" and zero_length and mode.is_slip:
-                mode = Mode.STICK
-                hold_until = t_event + _HOLD_S * 2.0 ** (n_zero - 1)
-            transitions.append(TransitionEvent(t_event, kind, old.label, mode.label, float(y[0])))
-            if len(transitions) > opts.max_events:
-                raise too_many_events(opts.max_events, f" by t = {t_event:.6g} s")
-            t = t_event
-        else:
-            t = t_break
-            hold_until = math.inf
-            y = sol.y[:, -1].copy()
-            if mode in _REST:
-                mode = gen.rest_mode(mode, t, y)
+        self.low_x, self.peak_x = min(self.low_x, float(sol.y[0].min())), max(self.peak_x, float(sol.y[0].max()))
+        source = self.model.source
+        p_steps = source.pressure_gauge_Pa(sol.y[2:2 + self.model.n_source],
+                                           source.inputs(np.minimum(sol.t, self.t_left)))
+        self.peak_p = max(self.peak_p, float(np.max(p_steps)))
 
-    if progress is not None:
-        progress(duration_s)
-    t_out = np.concatenate(ts)
-    Y = np.concatenate(ys, axis=1)
-    mode_arr = np.concatenate(modes)
-    return Result.from_trace(model, name, t_out, Y, mode_arr, transitions, impact_loss_J,
-                             {"rhs_evaluations": int(nfev), "events": len(transitions), "segments": n_segments,
-                              "method": opts.method, "rtol": opts.rtol},
-                             time.perf_counter() - wall0,
-                             peaks={"x_m": peak_x, "p_gauge_Pa": peak_p, "x_min_m": low_x})
+    def at_event(self, sol, named) -> None:
+        """The jump at the segment's event, and the short hold of a slip too small to resolve."""
+        k = next(i for i, te in enumerate(sol.t_events) if len(te))
+        kind, _, indicator = named[k]
+        t_event = float(sol.t_events[k][0])
+        y = np.array(sol.y_events[k][0], dtype=float)
+        zero_length = t_event - self.t <= 1e-12 * max(1.0, self.t)
+        self.n_zero = self.n_zero + 1 if zero_length else 0
+        if self.n_zero > _MAX_ZERO_LENGTH:
+            raise SolverFailure(f"event switching made no progress at t = {t_event:.9g} s ({kind})")
+        old = self.mode
+        self.y, self.mode, lost_J = self.gen.jump(old, indicator, t_event, y)
+        if not np.array_equal(self.y, y):
+            self.impact_loss_J.append((t_event, lost_J))
+        self.hold_until = math.inf
+        if kind == "velocity_zero" and zero_length and self.mode.is_slip:
+            self.mode = Mode.STICK
+            self.hold_until = t_event + _HOLD_S * 2.0 ** (self.n_zero - 1)
+        self.transitions.append(TransitionEvent(t_event, kind, old.label, self.mode.label, float(self.y[0])))
+        if len(self.transitions) > self.opts.max_events:
+            raise too_many_events(self.opts.max_events, f" by t = {t_event:.6g} s")
+        self.t = t_event
+
+    def at_breakpoint(self, sol, t_break: float) -> None:
+        """The segment reached an input breakpoint: a held load's mode is decided again there."""
+        self.t = t_break
+        self.hold_until = math.inf
+        self.y = sol.y[:, -1].copy()
+        if self.mode in _REST:
+            self.mode = self.gen.rest_mode(self.mode, self.t, self.y)
+
+    def result(self, name: str, wall_time_s: float) -> Result:
+        return Result.from_trace(self.model, name, np.concatenate(self.ts), np.concatenate(self.ys, axis=1),
+                                 np.concatenate(self.modes), self.transitions, self.impact_loss_J,
+                                 {"rhs_evaluations": int(self.nfev), "events": len(self.transitions),
+                                  "segments": self.n_segments, "method": self.opts.method, "rtol": self.opts.rtol},
+                                 wall_time_s, peaks={"x_m": self.peak_x, "p_gauge_Pa": self.peak_p,
+                                                     "x_min_m": self.low_x})
 
 
 def too_many_events(max_events: int, when: str = "") -> SolverFailure:
