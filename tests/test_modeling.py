@@ -61,6 +61,24 @@ class Volume(Component):
         return Equations(port={"port": {"p_abs_Pa": 1e5, "T_K": 293.15}})
 
 
+class FloatForce(Component):
+    """A force computed on floats from an input: the model reads the input only through it."""
+
+    inputs = (Var("u_N", "N"),)
+    ports = (Port("flange", TRANSLATIONAL, "branch"),)
+
+    def equations(self, s: Symbols) -> Equations:
+        return Equations(port={"flange": {"F_N": s.external("F", lambda u: 2.0 * u, s.u["u_N"])}})
+
+
+def test_a_model_reads_the_inputs_an_external_function_reads():
+    flat = Assembly([Body("body", {"m_kg": 2.0}), FloatForce("push")], [("body.flange", "push.flange")],
+                    {"u_N": "push.u_N"}).flatten()
+    assert flat.depends_on_inputs("f")  # only through the external function's argument
+    (xdot,) = flat.compile_python().f([0.0, 0.0], [3.0], flat.parameter_values, [])
+    assert xdot == [0.0, 3.0]  # 2 u / m
+
+
 def _oscillator(k=4.0, m=1.0):
     return Assembly([Body("body", {"m_kg": m}), Spring("spring", {"k_N_per_m": k})],
                     [("body.flange", "spring.flange")], name="oscillator")

@@ -115,14 +115,17 @@ class FlatModel:
         return (ins + ("w",) if self.externals else ins), outs
 
     def depends_on_inputs(self, name: str) -> bool:
-        """Whether function ``name`` reads the inputs at all (a sliding load's indicators do not)."""
+        """Whether function ``name`` reads the inputs at all (a sliding load's indicators do not),
+        directly or through the arguments of an external function it reads."""
         import casadi as ca
 
-        fn = self.function(name)
-        if "u" not in fn.name_in() or not self.u:
+        if not self.u:
             return False
         u = ca.vertcat(*self.u)
-        return any(ca.depends_on(ca.vertcat(*[e for e in exprs]), u) for exprs in self._expressions(name) if exprs)
+        exprs = [e for es in self._expressions(name) for e in es]
+        exprs += [a for ext in self.externals if any(ca.depends_on(ca.SX(e), ext.symbol) for e in exprs)
+                  for a in ext.args]
+        return any(ca.depends_on(ca.SX(e), u) for e in exprs)
 
     def _expressions(self, name: str) -> list[list[Any]]:
         return {"f": [self.f], "y": [self.y], "z": [self.z, self.z_margin],
