@@ -15,6 +15,10 @@ Rows:
 - the first fig4 call of a process: with an empty code cache (generation included), then in a
   second process that finds the first one's code on disk (``pamsim.modeling.code_cache``);
 - ``pamsim --help``: a fresh process, best of N;
+- fig4 on the native backend (median of 20 N calls after 3 warm-up calls) and the 66 paper cases in
+  one native batch (best of 4 N); the first native fig4 call of a process with empty caches (this
+  checkout generates the model's C and compiles the engine, the baseline compiles its C core), then
+  in a second process that finds the library on disk;
 - this checkout only: flattening and generating the one-muscle model's Python (every function and
   the five per-mode sets), generating its C and compiling it with the system's C compiler, and one
   right-hand-side evaluation of the generated Python against the composed model's elements.
@@ -56,20 +60,36 @@ for _ in range(int(sys.argv[2])):
     for c in cases:
         pamsim.simulate(c)
     grid.append(time.perf_counter() - t)
+from pamsim.native import simulate_batch
+t = time.perf_counter()
+pamsim.simulate(sc, backend="native")
+native_first = time.perf_counter() - t
+for _ in range(3):
+    pamsim.simulate(sc, backend="native")
+native = []
+for _ in range(int(sys.argv[2]) * 20):
+    t = time.perf_counter(); pamsim.simulate(sc, backend="native"); native.append(time.perf_counter() - t)
+batch = []
+for _ in range(int(sys.argv[2]) * 4):
+    t = time.perf_counter(); simulate_batch(cases); batch.append(time.perf_counter() - t)
 print(json.dumps({"fig4_s": statistics.median(runs), "grid_s": min(grid), "first_s": first,
-                  "import_s": t1 - t0}))
+                  "import_s": t1 - t0, "native_fig4_s": statistics.median(native), "native_grid_s": min(batch),
+                  "native_first_s": native_first}))
 """
 
 
 def measure(checkout: Path, repeat: int) -> dict:
-    with tempfile.TemporaryDirectory() as cache:
-        # A cache folder of its own: the first process generates the model's code, the second finds it.
-        env = {**os.environ, "PYTHONPATH": str(checkout), "PAMSIM_CODE_CACHE": cache}
+    with tempfile.TemporaryDirectory() as cache, tempfile.TemporaryDirectory() as native_cache:
+        # Cache folders of its own: the first process generates the model's code and compiles the native
+        # library, the second finds both.
+        env = {**os.environ, "PYTHONPATH": str(checkout), "PAMSIM_CODE_CACHE": cache,
+               "PAMSIM_NATIVE_CACHE": native_cache}
         runs = [json.loads(subprocess.run([sys.executable, "-c", MEASURE, str(checkout), str(repeat)], env=env,
                                           check=True, capture_output=True, text=True).stdout.strip().splitlines()[-1])
                 for _ in range(2)]
     data = runs[0]
     data["first_cached_s"] = runs[1]["first_s"]
+    data["native_first_cached_s"] = runs[1]["native_first_s"]
     helps = []
     for _ in range(repeat):
         t = time.perf_counter()
@@ -153,7 +173,10 @@ def main(argv=None) -> int:
     rows = (("fig4, python backend [ms]", "fig4_s", 1e3), ("66 paper cases, python [s]", "grid_s", 1.0),
             ("first fig4 call of a process [s]", "first_s", 1.0),
             ("  the same, code kept on disk [s]", "first_cached_s", 1.0), ("import pamsim [s]", "import_s", 1.0),
-            ("pamsim --help [s]", "help_s", 1.0))
+            ("pamsim --help [s]", "help_s", 1.0), ("fig4, native backend [ms]", "native_fig4_s", 1e3),
+            ("66 paper cases, native batch [ms]", "native_grid_s", 1e3),
+            ("first native fig4 of a process [s]", "native_first_s", 1.0),
+            ("  the same, library kept on disk [s]", "native_first_cached_s", 1.0))
     for label, key, scale in rows:
         line = f"{label:34s} {now[key] * scale:14.3f}"
         if before:

@@ -10,7 +10,16 @@ that commit, with ``PYTHONPATH`` pointing at it), then ``compare`` on the new co
 backend only: the others have no controller).  Per backend, ``compare`` prints the largest difference
 of the final and the peak contraction [mm], of the sampled contraction [mm], of the event times [s]
 and the number of cases whose event sequence (kinds and modes) differs, against the bounds:
-final and peak contraction 1e-6 mm, events 1e-9 s.  It exits 1 if a bound is missed.
+final and peak contraction 1e-6 mm, the first ``BOUNDED_EVENTS`` events of each case 1e-9 s.  It
+exits 1 if a bound is missed.
+
+Why the later events have no bound: in the lightly damped cases (a light load on a low pressure) the
+load reverses dozens of times at nearly zero speed, and each reversal amplifies a difference in the
+last bits of the state, by a factor of up to 10 per reversal.  Code that computes the same
+expressions in another order (the generated C against the hand-written C it replaced) starts 1e-15 s
+apart, is up to 4e-9 s apart by the 7th event and 5e-5 s by the 38th; the native and python
+backends, two integrators, are 1e-7 s apart at the first event and 3e-3 s at the 40th.  The later events' largest difference is printed (``late events s``) so that a
+change in it is seen.
 """
 
 from __future__ import annotations
@@ -28,6 +37,7 @@ SCENARIOS = ("acra2012_fig3", "acra2012_fig4", "acra2012_fig5", "acra2012_fig6a"
              "acra2012_fig4_chou_hannaford", "closed_loop_position")
 BOUND_MM = 1e-6
 BOUND_EVENT_S = 1e-9
+BOUNDED_EVENTS = 5
 
 
 def cases():
@@ -83,10 +93,10 @@ def compare(folder: Path, backends: list[str]) -> int:
     all_cases = cases()
     failed = 0
     print(f"{'backend':8s} {'cases':>5s} {'final mm':>10s} {'peak mm':>10s} {'trace mm':>10s} {'events s':>10s} "
-          f"{'sequence':>8s}  worst case")
+          f"{'late events s':>13s} {'sequence':>8s}  worst case")
     for backend in backends:
         saved = json.loads((folder / f"{backend}.json").read_text())
-        worst = {"final": 0.0, "peak": 0.0, "trace": 0.0, "event": 0.0}
+        worst = {"final": 0.0, "peak": 0.0, "trace": 0.0, "event": 0.0, "late event": 0.0}
         where = {}
         sequence_differs = []
         n = 0
@@ -108,8 +118,9 @@ def compare(folder: Path, backends: list[str]) -> int:
             if not same_kinds:
                 sequence_differs.append(name)
             else:
-                te_new, te_old = _event_times(new["events"]), _event_times(old["events"])
-                diffs["event"] = float(np.max(np.abs(te_new - te_old), initial=0.0))
+                dt = np.abs(_event_times(new["events"]) - _event_times(old["events"]))
+                diffs["event"] = float(np.max(dt[:BOUNDED_EVENTS], initial=0.0))
+                diffs["late event"] = float(np.max(dt[BOUNDED_EVENTS:], initial=0.0))
             for k, v in diffs.items():
                 if v > worst[k]:
                     worst[k], where[k] = v, name
@@ -117,7 +128,7 @@ def compare(folder: Path, backends: list[str]) -> int:
                or sequence_differs)
         failed += bool(bad)
         print(f"{backend:8s} {n:5d} {worst['final']:10.3g} {worst['peak']:10.3g} {worst['trace']:10.3g} "
-              f"{worst['event']:10.3g} {len(sequence_differs):8d}  "
+              f"{worst['event']:10.3g} {worst['late event']:13.3g} {len(sequence_differs):8d}  "
               + ", ".join(f"{k}: {v}" for k, v in where.items()))
         for name in sequence_differs[:10]:
             print(f"    event sequence differs: {name}")

@@ -148,13 +148,13 @@ def test_order_checks_are_shared_by_the_parameter_set_and_the_core():
         assert any(name == a and f"below {b}" in why for name, _, why in bad.violations())
     # The core checks the same pairs: a scenario's parameters swapped past each other are refused.
     sc = pamsim.load_scenario(SCENARIOS / "acra2012_fig4.toml")
-    from pamsim.native.backend import _run, case_inputs
+    from pamsim.native.backend import _run_core, case_inputs
 
     case = case_inputs(sc)
     for a, b in core_table.ORDER_CHECKS:
         reals = case.reals.copy()
         reals[library.REAL_INDEX[a]] = reals[library.REAL_INDEX[b]]
-        out = _run([case.__class__(reals, case.ints, case.duration_s, case.n_samples, case.segment_t_s,
+        out = _run_core([case.__class__(reals, case.ints, case.duration_s, case.n_samples, case.segment_t_s,
                                    case.segment_u, case.max_events, case.model)], [10])
         assert out["status"][0] == 1 and out["messages"][0].startswith(f"invalid parameters: {a} = ")
         assert f"must be below {b}" in out["messages"][0]

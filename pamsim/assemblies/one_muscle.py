@@ -63,11 +63,16 @@ def one_muscle_assembly(model, x0_m: float = 0.0, p0_gauge_Pa: float | None = No
     return Assembly(parts, wiring, inputs, name="one_muscle")
 
 
+VALVE_CHAMBER_WIRING = (("chamber.port", "valve.port"), ("load.x_m", "chamber.x_m"), ("load.v_m_s", "chamber.v_m_s"),
+                        ("valve.p_settle_abs_Pa", "chamber.p_settle_abs_Pa"))
+"""How a ``chamber`` on the load's flange and the ``valve`` that fills it are wired."""
+
+
 def _valve_parts(src: ValveChamberSource, p0_gauge_Pa: float | None) -> SourceParts:
     return SourceParts(
         [PolytropicChamber("chamber", src.chamber, src.p_atm_Pa, p0_gauge_Pa or 0.0, src.T_supply_K),
          ProportionalValve("valve", src.valve, src.T_supply_K, src.p_atm_Pa, src.chamber.R_J_per_kg_K)],
-        [("chamber.port", "valve.port"), ("load.x_m", "chamber.x_m"), ("load.v_m_s", "chamber.v_m_s")],
+        list(VALVE_CHAMBER_WIRING),
         {"valve_command": "valve.command", "supply_pressure_gauge_Pa": "valve.supply_gauge_Pa"}, "chamber")
 
 

@@ -138,19 +138,25 @@ class _Identity:
 
 def parameter_vars(values: Mapping[str, float], descriptions: Mapping[str, str] | None = None) -> tuple[Var, ...]:
     """Declarations of parameters named with their unit as suffix (``D1_N_s_per_m``)."""
-    descriptions = descriptions or {}
-    return tuple(Var(name, unit_of(name), descriptions.get(name, "")) for name in values)
+    return _declared(tuple(values), tuple(sorted((descriptions or {}).items())))
+
+
+@functools.lru_cache(maxsize=256)
+def _declared(names: tuple[str, ...], descriptions: tuple[tuple[str, str], ...]) -> tuple[Var, ...]:
+    text = dict(descriptions)
+    return tuple(Var(name, unit_of(name), text.get(name, "")) for name in names)
 
 
 _TRACES: dict = {}
 _TRACES_SIZE = 256
 
 
-def traces(element, method: Callable, points: Sequence[tuple[float, ...]]) -> bool:
+def traces(element, method: Callable, points: Sequence[tuple[float, ...]], form: tuple | None = None) -> bool:
     """Whether ``method(element rebuilt around symbols, *args)`` gives, at each of ``points``, the value
     ``method(element, *args)`` gives on floats (compared where that is finite).  Cached by the
-    element's form: whether it traces does not depend on its numbers."""
-    key = ("traces", structure_key(element), getattr(method, "__qualname__", repr(method)))
+    element's form (``form``: its :func:`structure_key`, if the caller has it): whether it traces does
+    not depend on its numbers."""
+    key = ("traces", form if form is not None else structure_key(element), getattr(method, "__qualname__", repr(method)))
     if key not in _TRACES:
         if len(_TRACES) >= _TRACES_SIZE:
             _TRACES.pop(next(iter(_TRACES), None), None)
@@ -198,8 +204,11 @@ class ElementParameters:
     extra_parameters: tuple[Var, ...] = ()
 
     def parameter_vars(self) -> tuple[Var, ...]:
-        own = parameter_vars(element_parameters(self.element)) if self.traces else ()
-        return own + self.extra_parameters
+        # Kept: the element does not change after wrap, and an assembly asks many times.
+        if "_parameter_vars" not in self.__dict__:
+            own = parameter_vars(element_parameters(self.element)) if self.traces else ()
+            self._parameter_vars = own + self.extra_parameters
+        return self._parameter_vars
 
     def element_values(self) -> dict[str, float]:
         return element_parameters(self.element) if self.traces else {}
@@ -212,7 +221,8 @@ class ElementParameters:
         and return its parameter values.  ``required``: what to call it in the ``TypeError`` raised when
         it must take symbols and does not (an element the python backend cannot call on floats)."""
         self.element = element
-        self.traces = traces(element, probe, points)
+        self._form = structure_key(element)
+        self.traces = traces(element, probe, points, self._form)
         if required and not self.traces:
             raise TypeError(f"{required} {type(element).__name__} cannot be written with symbols")
         return self.element_values()
@@ -225,4 +235,5 @@ class ElementParameters:
 
     def structure_key(self) -> tuple:
         # An element called on floats is part of the generated code: its numbers are too.
-        return super().structure_key() + (structure_key(self.element, baked=not self.traces),)
+        form = self._form if self.traces else structure_key(self.element, baked=True)
+        return super().structure_key() + (form,)

@@ -2,9 +2,9 @@
 
 The mode machine is written here: the equations of each mode, the event indicators that end it, the
 jump at an event and the decision of a load at rest (docs/model.md sec. 4), which the python backend
-integrates.  Until they move onto the code generated from it, the C core keeps its own copy and the
-results' force columns come from :meth:`pamsim.model.MuscleModel.breakdown`; the conformance suite and
-the tests hold them to this one.  The Coulomb level comes in as a signal; this component decides
+and the native backend's C engine integrate.  Until the FMU moves onto the code generated from it,
+the hand-written C core keeps its own copy, and the results' force columns come from
+:meth:`pamsim.model.MuscleModel.breakdown`; the conformance suite and the tests hold them to this one.  The Coulomb level comes in as a signal; this component decides
 its direction (against the motion when sliding, whatever holds the load when it is held).
 """
 
@@ -43,6 +43,15 @@ EVENT_NAMES = {
     LoadMode.STOP_HIGH: (None, "release_down"),
 }
 """What a crossing of each indicator means in each mode (None: that indicator never crosses there)."""
+
+
+def event_name(mode: LoadMode, fired: int, to: LoadMode) -> str:
+    """The name of an event that left ``mode`` for ``to`` with the indicators in the bit mask ``fired``:
+    a stop reached takes precedence over a velocity reaching zero (as in the transition), and a
+    release is named by the direction the load takes."""
+    if mode.is_slip:
+        return EVENT_NAMES[mode][1] if fired & 2 else EVENT_NAMES[mode][0]
+    return "release_up" if to == LoadMode.SLIP_UP else "release_down"
 
 
 class HangingLoad(Component):

@@ -19,13 +19,17 @@ class ProportionalValve(ElementParameters, Component):
     """:class:`pamsim.elements.valve.ProportionalValve33` on an ISO 6358 orifice: a pneumatic branch.
 
     Inputs: the command in [-1, 1] (1 open to supply, -1 open to exhaust) and the supply gauge
-    pressure.  Inflow carries the supply temperature, outflow the volume's gas temperature.
+    pressure.  Inflow carries the supply temperature, outflow the volume's gas temperature.  Output
+    ``p_settle_abs_Pa``: the port pressure at which the flow stops, the supply's or the exhaust's
+    (the port's own while the valve is closed), for a chamber that settles
+    (:class:`pamsim.components.PolytropicChamber`).
     """
 
     ports = (Port("port", PNEUMATIC, "branch"),)
     inputs = (Var("command", "1", "valve command in [-1, 1]"),
               Var("supply_gauge_Pa", "Pa", "supply gauge pressure"))
-    outputs = (Var("mass_flow_kg_s", "kg/s", "mass flow into the port"),)
+    outputs = (Var("mass_flow_kg_s", "kg/s", "mass flow into the port"),
+               Var("p_settle_abs_Pa", "Pa", "port pressure at which the flow stops"))
     extra_parameters = (Var("T_supply_K", "K", "supply air temperature"),
                         Var("p_atm_Pa", "Pa", "ambient (exhaust) pressure"),
                         Var("R_J_per_kg_K", "J/(kg K)", "specific gas constant of air"))
@@ -39,7 +43,9 @@ class ProportionalValve(ElementParameters, Component):
         valve = self.symbolic_element(s.p)
         p, T = s.port["port"]["p_abs_Pa"], s.port["port"]["T_K"]
         T_supply, p_atm = s.p["T_supply_K"], s.p["p_atm_Pa"]
-        mdot = valve.inflow_kg_s(s.u["command"], p, T, s.u["supply_gauge_Pa"] + p_atm, T_supply, p_atm)
+        u, p_supply = s.u["command"], s.u["supply_gauge_Pa"] + p_atm
+        mdot = valve.inflow_kg_s(u, p, T, p_supply, T_supply, p_atm)
         T_in = if_else(mdot >= 0.0, T_supply, T)
-        return Equations(outputs={"mass_flow_kg_s": mdot},
+        return Equations(outputs={"mass_flow_kg_s": mdot,
+                                  "p_settle_abs_Pa": if_else(u > 0.0, p_supply, if_else(u < 0.0, p_atm, p))},
                          port={"port": {"mdot_kg_s": mdot, "flow_work_W": s.p["R_J_per_kg_K"] * T_in * mdot}})

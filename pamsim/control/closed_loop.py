@@ -34,7 +34,7 @@ from typing import Any, Callable, Mapping
 import control as ct
 import numpy as np
 
-from ..assemblies.one_muscle import SourceParts, register_source
+from ..assemblies.one_muscle import VALVE_CHAMBER_WIRING, SourceParts, register_source
 from ..components import PolytropicChamber, ProportionalValve
 from ..constants import PA_PER_BAR
 from ..elements.pressure_source import ValveChamberSource
@@ -298,8 +298,7 @@ def _closed_loop_parts(source: "ClosedLoopValveSource", p0_gauge_Pa: float | Non
     parts = [PolytropicChamber("chamber", plant.chamber, plant.p_atm_Pa, p0, plant.T_supply_K),
              PositionController("controller", source),
              ProportionalValve("valve", plant.valve, plant.T_supply_K, plant.p_atm_Pa, plant.chamber.R_J_per_kg_K)]
-    wiring = [("chamber.port", "valve.port"), ("load.x_m", "chamber.x_m"), ("load.v_m_s", "chamber.v_m_s"),
-              ("load.x_m", "controller.x_m"), ("chamber.p_abs_Pa", "controller.p_abs_Pa"),
+    wiring = [*VALVE_CHAMBER_WIRING, ("load.x_m", "controller.x_m"), ("chamber.p_abs_Pa", "controller.p_abs_Pa"),
               ("controller.command", "valve.command")]
     inputs = {"reference_m": "controller.reference_m", "feedforward_gauge_Pa": "controller.feedforward_gauge_Pa",
               "supply_pressure_gauge_Pa": "valve.supply_gauge_Pa"}

@@ -27,7 +27,7 @@ from .variables import BY_NAME, EVENT_INDICATORS, STATES, VARIABLES, value_refer
 MODEL_NAME = "pamsim_muscle"
 MODEL_IDENTIFIER = "pamsim_muscle"
 C_DIR = Path(__file__).resolve().parents[2] / "fmu"  # the source tree; an installed wheel has pamsim.fmu.csrc
-CORE_SOURCES = ("pam_core.c", "pam_core.h", "pam_shared.h", "fmi_shell.c", "fmi_shell.h")
+CORE_SOURCES = ("pam_core.c", "pam_core.h", "pam_dopri.h", "pam_shared.h", "fmi_shell.c", "fmi_shell.h")
 """The hand-written C sources (pam_shared.h is generated but committed); ``pam_variables.h`` and
 ``pam_force_table.h`` are generated at build time."""
 WRAPPERS = {2: "fmi2_wrapper.c", 3: "fmi3_wrapper.c"}

@@ -52,6 +52,7 @@ class Assembly:
         self.name = name
         self.components = tuple(components)
         self.connections = tuple(tuple(c) for c in connections)
+        self._key = None
         self.inputs = {k: (v,) if isinstance(v, str) else tuple(v) for k, v in (inputs or {}).items()}
         by_name: dict[str, Component] = {}
         for c in self.components:
@@ -174,8 +175,10 @@ class Assembly:
 
     def structure_key(self) -> tuple:
         """Equal for two assemblies that generate the same code (they may differ in parameter values)."""
-        return (self.name, tuple((c.name, c.structure_key()) for c in self.components), self.connections,
-                tuple(self.inputs.items()))  # in their order: the flat model's inputs follow it
+        if self._key is None:  # kept: an assembly does not change after it is made
+            self._key = (self.name, tuple((c.name, c.structure_key()) for c in self.components), self.connections,
+                         tuple(self.inputs.items()))  # in their order: the flat model's inputs follow it
+        return self._key
 
     def parameter_values(self) -> list[float]:
         """The parameter vector of the flat model, in its order, without flattening."""
@@ -201,6 +204,7 @@ class Assembly:
         mode_syms = {}
         fired_syms: tuple = ()
         externals: list[External] = []
+        tol = ca.SX.sym("tol")
 
         def external(component: Component):
             def call(name: str, fn, *args):
@@ -225,7 +229,7 @@ class Assembly:
             if c.modes is not None:
                 fired = tuple(ca.SX.sym(f"{c.name}.fired{k}") for k in range(c.n_indicators))
                 fired_syms += fired
-            symbols[c.name] = Symbols(p, x, u, port, mode, fired, external(c))
+            symbols[c.name] = Symbols(p, x, u, port, mode, fired, external(c), tol)
             params += [(c, v, p[v.name]) for v in c.parameter_vars()]
             states += [(c, v, x[v.name]) for v in c.states]
             placeholders.update({f"{c.name}.{k}": s for k, s in u.items()})
@@ -268,10 +272,8 @@ class Assembly:
             return mode_syms[c.name] if c.name in mode_syms else float(c.modes(modes[c.name]))
 
         initial = _initial_states(states, {c.name: equations[c.name].initial for c in comps}, flat)
-        transition_x = []
-        for c, v, sym in states:
-            eq = equations[c.name]
-            transition_x.append(flat(eq.transition.get(v.name, sym)))
+        transition_x = [flat(equations[c.name].transition.get(v.name, sym)) for c, v, sym in states]
+        settle_x = [flat(equations[c.name].settle.get(v.name, sym)) for c, v, sym in states]
         return FlatModel(
             name=self.name,
             states=[fv(c, v) for c, v, _ in states],
@@ -288,7 +290,7 @@ class Assembly:
             z=[flat(z) for c in hybrid for z in equations[c.name].indicators],
             z_margin=[flat(m) for c in hybrid for m in (equations[c.name].indicator_margins
                                                          or (0.0,) * c.n_indicators)],
-            transition_x=transition_x,
+            transition_x=transition_x, settle_x=settle_x, tol=tol,
             transition_q=[flat(equations[c.name].transition.get("mode", mode_of(c))) for c in hybrid],
             rest_q=[flat(equations[c.name].rest_mode) for c in hybrid],
             x0=initial,
@@ -310,6 +312,10 @@ def _checked(c: Component, eq: Equations) -> Equations:
             raise AssemblyError(f"component {c.name} ({type(c).__name__}) gives no {what} for {', '.join(lacking)}")
 
     need("derivative", eq.der, [v.name for v in c.states])
+    foreign = sorted(set(eq.settle) - {v.name for v in c.states})
+    if foreign:
+        raise AssemblyError(f"component {c.name} ({type(c).__name__}) settles {', '.join(foreign)}, "
+                            "which are not its states")
     need("value", eq.outputs, [v.name for v in c.outputs])
     for pt in c.ports:
         given = pt.kind.across if pt.role == "node" else pt.kind.through

@@ -29,7 +29,8 @@ class Symbols:
     crossed at an event (for :attr:`Equations.transition`).  ``external(name, fn, *args)`` stands
     for ``fn(*args)`` computed by the host on floats: for physics that has no symbolic form (a table
     lookup, a numerical solve), at the price of a model that runs in Python only, without exact
-    Jacobians.
+    Jacobians.  ``tol`` is the relative tolerance of the integrator that asks for
+    :attr:`Equations.settle`.
     """
 
     p: Mapping[str, Any]
@@ -39,6 +40,7 @@ class Symbols:
     mode: Any = None
     fired: tuple[Any, ...] = ()
     external: Any = None
+    tol: Any = None
 
 
 @dataclass
@@ -55,6 +57,13 @@ class Equations:
     afresh from its forces (at the start and where an input jumps).  ``initial``: the state at the
     start, as expressions that may read parameters, inputs and other states (the assembly resolves
     them in order), and for a component with modes its starting mode (key ``"mode"``).
+
+    ``settle``: for an explicit integrator, the component's states set to the steady state they are
+    approaching, where they are already within the integrator's tolerance (``Symbols.tol``) of it, and
+    unchanged elsewhere.  A chamber approaches its source's pressure exponentially, with a time constant
+    of milliseconds; an explicit integrator would follow the rest of that approach, far below its
+    tolerance, in steps of that size for as long as the load is held.  The C core asks for it while the
+    load is held; the Python simulator (LSODA) does not need it.
     """
 
     der: dict[str, Any] = field(default_factory=dict)
@@ -65,6 +74,7 @@ class Equations:
     transition: dict[str, Any] = field(default_factory=dict)
     rest_mode: Any = None
     initial: dict[str, Any] = field(default_factory=dict)
+    settle: dict[str, Any] = field(default_factory=dict)
 
 
 class Component:

@@ -34,7 +34,9 @@ class FlatModel:
     modes, and ``z_margin`` what an integrator that cannot tell a segment's start from a crossing adds
     to them (:attr:`pamsim.modeling.component.Equations.indicator_margins`); ``transition_x``/``transition_q``: states and modes after an event; ``rest_q``: the modes
     decided afresh from the forces at rest; ``x0``/``q0``: the initial states and the modes where the
-    hybrid components start, before :attr:`rest_q` decides them (of ``u`` and ``p``).
+    hybrid components start, before :attr:`rest_q` decides them (of ``u`` and ``p``); ``settle_x``:
+    the states settled within the integrator's relative tolerance ``tol``
+    (:attr:`pamsim.modeling.component.Equations.settle`).
     """
 
     name: str
@@ -58,6 +60,8 @@ class FlatModel:
     rest_q: list[Any]
     x0: list[Any]
     q0: list[Any]
+    settle_x: list[Any] = field(default_factory=list)
+    tol: Any = None
     externals: list[External] = field(default_factory=list)
     _cache: dict = field(default_factory=dict, repr=False)
 
@@ -78,7 +82,14 @@ class FlatModel:
     # ------------------------------------------------------------------ CasADi
     def _vectors(self):
         import casadi as ca
-        return tuple(ca.vertcat(*v) if v else ca.SX(0, 1) for v in (self.x, self.u, self.p, self.q, self.e))
+        return tuple(ca.vertcat(*v) if v else ca.SX(0, 1) for v in (self.x, self.u, self.p, self.q, self.e,
+                                                                      [self._tol()]))
+
+    def _tol(self):
+        if self.tol is None:
+            import casadi as ca
+            self.tol = ca.SX.sym("tol")
+        return self.tol
 
     def function(self, name: str):
         """One of the model's CasADi ``Function`` s, by its name in :data:`FUNCTION_SIGNATURES`."""
@@ -86,7 +97,7 @@ class FlatModel:
 
         key = ("function", name)
         if key not in self._cache:
-            x, u, p, q, e = self._vectors()
+            x, u, p, q, e, tol = self._vectors()
             w = ca.vertcat(*[ext.symbol for ext in self.externals]) if self.externals else ca.SX(0, 1)
             col = lambda es: ca.vertcat(*es) if es else ca.SX(0, 1)  # noqa: E731
             if name == "jacobian":
@@ -102,7 +113,7 @@ class FlatModel:
             # SX keeps a subexpression once only where the components shared it; cse finds the rest.
             exprs = [ca.cse(e) for e in exprs]
             ins, outs = self.signature(name)
-            args = {"x": x, "u": u, "p": p, "q": q, "e": e, "w": w}
+            args = {"x": x, "u": u, "p": p, "q": q, "e": e, "tol": tol, "w": w}
             self._cache[key] = ca.Function(f"{self.name}_{name}", [args[a] for a in ins], exprs, list(ins), list(outs))
         return self._cache[key]
 
@@ -130,7 +141,8 @@ class FlatModel:
     def _expressions(self, name: str) -> list[list[Any]]:
         return {"f": [self.f], "y": [self.y], "z": [self.z, self.z_margin],
                 "transition": [self.transition_x, self.transition_q], "rest_mode": [self.rest_q],
-                "x0": [self.x0, self.q0], "jacobian": [self.f, self.y]}[name]
+                "x0": [self.x0, self.q0], "settle": [self.settle_x or self.x],
+                "jacobian": [self.f, self.y]}[name]
 
     @property
     def functions(self) -> dict[str, Any]:
@@ -151,6 +163,27 @@ class FlatModel:
             for r, c in zip(*sp.get_triplet()):
                 rows[r].append(c)
             out[name] = [sorted(r) for r in rows]
+        return out
+
+    def quadratures(self) -> list[int]:
+        """The states that only accumulate (a work integral): nothing reads them but the outputs, no
+        event resets them, and no other derivative, indicator or mode depends on them.  An integrator
+        may compute them by quadrature of its solution rather than carry them in its error control."""
+        import casadi as ca
+
+        def reads(exprs, sym):
+            return any(ca.depends_on(ca.SX(e), sym) for e in exprs)
+
+        out = []
+        for i, xi in enumerate(self.x):
+            others = [e for j, e in enumerate(self.f) if j != i] + [self.f[i]]
+            others += self.z + self.z_margin + self.transition_q + self.rest_q + self.q0
+            others += [e for j, e in enumerate(self.transition_x) if j != i]
+            others += [e for j, e in enumerate(self.settle_x) if j != i]
+            others += [a for ext in self.externals for a in ext.args]
+            own = [self.transition_x[i], *(self.settle_x[i:i + 1] or [xi])]
+            if not reads(others, xi) and all(ca.is_equal(ca.SX(e), xi) for e in own):
+                out.append(i)
         return out
 
     # ------------------------------------------------------------------ generated code

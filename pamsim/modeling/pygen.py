@@ -305,6 +305,7 @@ class GeneratedModel:
         self.transition = namespace.get("transition")
         self.rest_mode = namespace.get("rest_mode")
         self.x0 = namespace.get("x0")
+        self.settle = namespace.get("settle")
         self._jacobian = namespace.get("jacobian")
 
     def jacobian(self, x, u, p, q):

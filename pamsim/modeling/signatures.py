@@ -8,7 +8,8 @@ FUNCTION_SIGNATURES = {
     "transition": (("x", "u", "p", "q", "e"), ("x_next", "q_next")),
     "rest_mode": (("x", "u", "p", "q"), ("q_rest",)),
     "x0": (("u", "p"), ("x0", "q0")),
+    "settle": (("x", "u", "p", "q", "tol"), ("x_settled",)),
     "jacobian": (("x", "u", "p", "q"), ("A", "B", "C", "D")),
 }
 """``{name: (arguments, results)}``: x states, u inputs, p parameters, q modes, e the event indicators
-that have crossed (1) or not (0)."""
+that have crossed (1) or not (0), tol the integrator's relative tolerance."""

@@ -1,9 +1,12 @@
-"""The native backend: scenarios run by the C core (``pamsim.simulate(scenario, backend="native")``).
+"""The native backend: scenarios run in C (``pamsim.simulate(scenario, backend="native")``).
 
 Every case's inputs are built here (parameters, element choices, and the
-input signals as segments over which they are held); the library then runs a
+input signals as segments over which they are held); a library then runs a
 whole batch in one call, and the traces become the same :class:`Result` as the
-Python backend's: columns, modes, events, work integrals and summary.
+Python backend's: columns, modes, events, work integrals and summary.  A case
+without a force table runs on the generic engine compiled with its assembly's
+generated C (:mod:`pamsim.native.engine`); a case with one on the hand-written C
+core (:mod:`pamsim.native.library`).
 
 Differences from the Python backend, all documented in ``docs/scaling.md``:
 
@@ -29,6 +32,8 @@ from typing import Sequence
 
 import numpy as np
 
+from ..assemblies import one_muscle_assembly
+from ..components.hanging_load import event_name
 from ..core_table import C_CHOICES, SCENARIO_KEYS, unimplemented_choice
 from ..elements.pressure_source import ValveChamberSource
 from ..errors import InputError, SolverFailure
@@ -40,6 +45,7 @@ from ..scenario import Scenario
 from ..signals import Constant, FirstOrderLag, Step
 from ..simulator import too_many_events
 from . import library as lib
+from .engine import EngineCase, engine_library
 
 METHODS = ("LSODA", "RK45")
 """``solver.method`` values the native backend honours: its Dormand-Prince 5(4) is RK45's method, and
@@ -79,6 +85,16 @@ class CaseInputs:
     max_events: int
     model: MuscleModel
     table: ForceTable | None = None
+    assembly: object | None = None
+
+    def engine_case(self, library, capacity: int) -> EngineCase:
+        """This case as the generic engine takes it: the flat model's parameters and inputs."""
+        names = library.names["inputs"]
+        u = self.segment_u[:, [lib.INPUTS.index(n) for n in names]]
+        return EngineCase(np.array(self.assembly.parameter_values()), float(self.reals[lib.REAL_INDEX["cs_relative_tolerance"]]),
+                          float(self.reals[lib.REAL_INDEX["cs_max_step_s"]]),
+                          int(self.ints[lib.INT_INDEX["cs_max_internal_steps"]]), self.duration_s, self.n_samples,
+                          self.segment_t_s, u, int(capacity))
 
 
 def refuse_unsupported(scenario: Scenario) -> None:
@@ -200,10 +216,34 @@ def case_inputs(scenario: Scenario, model: MuscleModel | None = None) -> CaseInp
         if sig is not None:
             u[:, k] = sig(mid)
     u[:, lib.INPUTS.index("load_mass_kg")] = model.load.mass_kg
-    return CaseInputs(reals, ints, T, n_samples, starts, u, opts.max_events, model, table)
+    assembly = None
+    if table is None:  # the generic engine runs the generated model; a force table stays with the C core
+        assembly = one_muscle_assembly(model, scenario.initial_contraction_m, scenario.initial_pressure_gauge_Pa,
+                                       opts.stick_margin_N, opts.release_margin_N)
+    return CaseInputs(reals, ints, T, n_samples, starts, u, opts.max_events, model, table, assembly)
 
 
-def _run(cases: Sequence[CaseInputs], capacity: Sequence[int]) -> dict:
+def _run(cases: Sequence[CaseInputs], capacity: Sequence[int]) -> list[tuple[dict, int]]:
+    """Each case's batch output and its index in it: cases of one assembly structure in one engine call,
+    the cases with a force table in one call of the C core."""
+    where: list = [None] * len(cases)
+    groups: dict = {}
+    for i, c in enumerate(cases):
+        key = c.assembly.structure_key() if c.assembly is not None else None
+        groups.setdefault(key, []).append(i)
+    for key, members in groups.items():
+        if key is None:
+            out = _run_core([cases[i] for i in members], [capacity[i] for i in members])
+        else:
+            library = engine_library(cases[members[0]].assembly)
+            out = library.run([cases[i].engine_case(library, capacity[i]) for i in members])
+            out["library"] = library
+        for j, i in enumerate(members):
+            where[i] = (out, j)
+    return where
+
+
+def _run_core(cases: Sequence[CaseInputs], capacity: Sequence[int]) -> dict:
     tables: list[ForceTable] = []
     index: dict[int, int] = {}  # id(table) -> its place in tables: the cases of one muscle share one table
     for c in cases:
@@ -236,6 +276,12 @@ def _result(scenario: Scenario, case: CaseInputs, out: dict, i: int, wall_time_s
         raise SolverFailure(f"native backend: {message}")
     if status == 3:
         raise too_many_events(case.max_events)
+    if t is None:
+        t = np.linspace(0.0, case.duration_s, case.n_samples)
+    stats = {"rhs_evaluations": int(out["stats"][i][0]), "segments": int(out["stats"][i][2]),
+             "method": METHOD_LABEL, "rtol": scenario.solver.rtol}
+    if "library" in out:
+        return _engine_result(scenario, case, out, i, wall_time_s, t, stats)
     model = case.model
     first, n = int(out["sample_offset"][i]), case.n_samples
     S = out["samples"][len(lib.SAMPLE_COLUMNS) * first:len(lib.SAMPLE_COLUMNS) * (first + n)].reshape(-1, n)
@@ -245,15 +291,38 @@ def _result(scenario: Scenario, case: CaseInputs, out: dict, i: int, wall_time_s
     transitions = [TransitionEvent(e[0], kinds[int(e[1])], labels[int(e[2])], labels[int(e[3])], e[4])
                    for e in events]
     losses = [(e[0], e[5]) for e in events]
-    n_rhs, _, segments = (int(v) for v in out["stats"][i])
-    stats = {"rhs_evaluations": n_rhs, "events": len(transitions), "segments": segments, "method": METHOD_LABEL,
-             "rtol": scenario.solver.rtol}
-    if t is None:
-        t = np.linspace(0.0, case.duration_s, case.n_samples)
+    stats["events"] = len(transitions)
     x_max, x_min, p_max = (float(v) for v in out["peaks"][i])
     return Result.from_trace(model, scenario.name, t, Y, out["modes"][first:first + n].astype(int), transitions,
                              losses, stats, wall_time_s, peaks={"x_m": x_max, "x_min_m": x_min, "p_gauge_Pa": p_max},
                              impacts_J=S[_IMPACTS_ROW])
+
+
+def _engine_result(scenario: Scenario, case: CaseInputs, out: dict, i: int, wall_time_s: float, t: np.ndarray,
+                   stats: dict) -> Result:
+    """Case ``i`` of a generic engine's batch as a :class:`Result`: its states in the flat model's order
+    (the model's, which :class:`pamsim.simulator._Generated` checks), events named from the indicators
+    that fired, the kinetic energy an event removed from the load's output."""
+    names = out["library"].names
+    outputs, n_y, n = names["outputs"], len(names["outputs"]), case.n_samples
+    first, ns = int(out["sample_offset"][i]), len(names["states"])
+    Y = out["samples"][ns * first:ns * (first + n)].reshape(ns, n)
+    rows = out["events"][out["event_offset"][i]:out["event_offset"][i] + out["n_events"][i]]
+    x_at, ke_at = outputs.index("load.x_m"), outputs.index("load.kinetic_energy_J")
+    labels = _MODE_LABELS
+    transitions, losses = [], []
+    for e in rows:
+        before, after = e[4:4 + n_y], e[4 + n_y:4 + 2 * n_y]
+        name = event_name(Mode(int(e[1])), int(e[3]), Mode(int(e[2])))
+        transitions.append(TransitionEvent(float(e[0]), name, labels[int(e[1])], labels[int(e[2])], float(after[x_at])))
+        losses.append((float(e[0]), float(before[ke_at] - after[ke_at])))
+    stats["events"] = len(transitions)
+    high, low = out["extremes"][i][:n_y], out["extremes"][i][n_y:]
+    pressure = next(a for a, b in case.assembly.connections if b == "muscle.p_gauge_Pa")
+    peaks = {"x_m": float(high[x_at]), "x_min_m": float(low[x_at]),
+             "p_gauge_Pa": float(high[outputs.index(pressure)])}
+    return Result.from_trace(case.model, scenario.name, t, Y, out["modes"][first:first + n].astype(int), transitions,
+                             losses, stats, wall_time_s, peaks=peaks)
 
 
 def _sample_grids(cases: Sequence[CaseInputs]) -> list[np.ndarray]:
@@ -280,15 +349,15 @@ def simulate_batch(scenarios: Sequence[Scenario], return_exceptions: bool = Fals
     """
     cases = [case_inputs(s) for s in scenarios]
     wall0 = time.perf_counter()
-    out = _run(cases, [event_capacity(c.max_events) for c in cases])
+    found = _run(cases, [event_capacity(c.max_events) for c in cases])
     wall = (time.perf_counter() - wall0) / max(len(cases), 1)
     results = []
-    for i, (scenario, case, t) in enumerate(zip(scenarios, cases, _sample_grids(cases))):
+    for (out, i), scenario, case, t in zip(found, scenarios, cases, _sample_grids(cases)):
         try:
             if outgrew_batch(int(out["status"][i]), case.max_events):
                 again = time.perf_counter()
-                alone = _run([case], [case.max_events + 1])
-                results.append(_result(scenario, case, alone, 0, time.perf_counter() - again, t))
+                [(alone, k)] = _run([case], [case.max_events + 1])
+                results.append(_result(scenario, case, alone, k, time.perf_counter() - again, t))
             else:
                 results.append(_result(scenario, case, out, i, wall, t))
         except (InputError, SolverFailure) as exc:

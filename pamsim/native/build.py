@@ -22,7 +22,7 @@ from ..fmu.build import c_compiler, shared_library_suffix
 from ..fmu.force_table import EMPTY_HEADER
 from ..fmu.generate import c_header, c_source_dir
 
-SOURCES = ("pam_native.c", "pam_native.h", "pam_core.c", "pam_core.h", "pam_shared.h")
+SOURCES = ("pam_native.c", "pam_native.h", "pam_core.c", "pam_core.h", "pam_dopri.h", "pam_shared.h")
 """The C files the library is built from (pam_native.c includes pam_core.c: one translation unit)."""
 FLAGS = ("-shared", "-fPIC", "-O3", "-std=c99", "-Wall", "-fvisibility=hidden")
 LIBRARY_NAME = "libpamsim_native"
@@ -70,11 +70,17 @@ def library_path() -> Path:
         (work / "pam_variables.h").write_text(c_header(2))
         # No force table: the library runs the polynomial; other static forces are refused before a run.
         (work / "pam_force_table.h").write_text(EMPTY_HEADER)
-        src = c_source_dir() / "src"
-        partial = work / path.name
-        cmd = [cc, *FLAGS, "-I", str(work), "-I", str(src), str(src / "pam_native.c"), "-o", str(partial), "-lm"]
-        proc = subprocess.run(cmd, capture_output=True, text=True)
-        if proc.returncode != 0:
-            raise InputError(f"compiling the native library failed ({cc} ...): {proc.stderr.strip()}")
-        os.replace(partial, path)
+        os.replace(compile_library(cc, "pam_native.c", work, path.name, "the native library"), path)
     return path
+
+
+def compile_library(cc: str, main: str, work: Path, name: str, what: str) -> Path:
+    """Compile ``main`` (a unity build, in the C source folder) with the generated headers in ``work``
+    into ``work / name``; raises :class:`InputError` with the compiler's message if it fails."""
+    src = c_source_dir() / "src"
+    partial = work / name
+    cmd = [cc, *FLAGS, "-I", str(work), "-I", str(src), str(src / main), "-o", str(partial), "-lm"]
+    proc = subprocess.run(cmd, capture_output=True, text=True)
+    if proc.returncode != 0:
+        raise InputError(f"compiling {what} failed ({cc} ...): {proc.stderr.strip()}")
+    return partial

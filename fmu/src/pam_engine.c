@@ -1,0 +1,275 @@
+/* pamsim generic engine; see pam_engine.h.  The integrator, event location and mode switching of
+ * the hand-written core (pam_core.c), with every physical quantity taken from the generated model. */
+#include "pam_engine.h"
+#include "pam_dopri.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+/* A legitimate cascade of events at one instant (a stop, a stick, a release) needs a handful. */
+#define PAM_ENGINE_MAX_ZERO_LENGTH 50
+/* A held model's step longer than max_step_s is checked at this many points of its dense output. */
+#define PAM_ENGINE_HELD_CHECKS 16
+
+static void engine_logf(PamEngine *e, int level, const char *fmt, ...) {
+    char buf[512];
+    va_list ap;
+    if (!e->log) return;
+    va_start(ap, fmt);
+    vsnprintf(buf, sizeof buf, fmt, ap);
+    va_end(ap);
+    e->log(e->log_env, level, buf);
+}
+
+static int held(const PamEngine *e) { return PM_MODE_HELD[e->mode]; }
+
+static void rhs(PamEngine *e, const double *y, double *dy) {
+    e->n_rhs++;
+    pm_f(e->mode, y, e->u, e->p, dy);
+}
+
+static double min_indicator(const PamEngine *e, const double *y) {
+    double z[PM_NZ > 0 ? PM_NZ : 1], m = INFINITY;
+    int k;
+    if (PM_NZ == 0) return m;
+    pm_z(e->mode, y, e->u, e->p, z);
+    for (k = 0; k < PM_NZ; k++) m = fmin(m, z[k]);
+    return m;
+}
+
+static int mode_of(double value) {
+    int k = pm_mode_index(value);
+    return k < 0 ? 0 : k;
+}
+
+/* The mode of a held model decided afresh from its forces (a moving one keeps its mode). */
+static int rest_mode(const PamEngine *e, int mode, const double *y) {
+    double q = PM_MODE_VALUE[mode];
+    pm_rest(mode, y, e->u, e->p, &q);
+    return mode_of(q);
+}
+
+/* The jump at an event whose indicators `fired` (bit k: indicator k) have crossed: new states in y,
+ * new mode in e->mode; returns 1 if a state changed. */
+static int transition(PamEngine *e, double *y, unsigned fired) {
+    double flags[PM_NZ > 0 ? PM_NZ : 1], next[PM_NX], q = PM_MODE_VALUE[e->mode];
+    int k, jumped = 0;
+    for (k = 0; k < PM_NZ; k++) flags[k] = (fired >> k) & 1u ? 1.0 : 0.0;
+    pm_tr(e->mode, y, e->u, e->p, flags, next, &q);
+    for (k = 0; k < PM_NX; k++) {
+        jumped |= next[k] != y[k];
+        y[k] = next[k];
+    }
+    e->mode = rest_mode(e, mode_of(q), y);
+    return jumped;
+}
+
+static unsigned fired_indicators(const PamEngine *e, const double *y) {
+    double z[PM_NZ > 0 ? PM_NZ : 1];
+    unsigned fired = 0;
+    int k;
+    if (PM_NZ == 0) return 0;
+    pm_z(e->mode, y, e->u, e->p, z);
+    for (k = 0; k < PM_NZ; k++)
+        if (z[k] <= 0.0) fired |= 1u << k;
+    return fired;
+}
+
+void pam_engine_reset(PamEngine *e) {
+    memset(e, 0, sizeof *e);
+    e->rtol = 1e-6;
+    e->max_step_s = 1e-3;
+    e->max_steps = 1000000;
+    e->h_s = 1e-4;
+}
+
+/* Initial states from the inputs and parameters, and the mode decided from the forces there. */
+void pam_engine_initialize(PamEngine *e) {
+    double x[PM_NS > 0 ? PM_NS : 1], q0 = 0.0;
+    int k;
+    pm_x0(e->u, e->p, x, &q0);
+    memcpy(e->q_start, x, sizeof e->q_start);
+    for (k = 0; k < PM_NX; k++) e->x[k] = x[PM_DYNAMIC[k]];
+    e->mode = rest_mode(e, mode_of(q0), e->x);
+    e->inputs_changed = 0;
+}
+
+/* One trial step; returns the scaled RMS error norm.  k[0] must hold f(y0). */
+static double dp_step(PamEngine *e, const double *y0, double h, PamStages *s, double *y1) {
+    double yt[PM_NX], err = 0.0, rtol = e->rtol;
+    int st, j, n;
+    for (st = 1; st < 7; st++) {
+        for (n = 0; n < PM_NX; n++) {
+            double acc = 0.0;
+            for (j = 0; j < st; j++) acc += DP_A[st][j] * s->k[j][n];
+            yt[n] = y0[n] + h * acc;
+        }
+        rhs(e, yt, s->k[st]);
+    }
+    for (n = 0; n < PM_NX; n++) {
+        double d = 0.0, sc;
+        y1[n] = yt[n]; /* stage 7 is evaluated at the 5th-order solution (FSAL) */
+        for (st = 0; st < 7; st++) d += DP_E[st] * s->k[st][n];
+        sc = rtol * PM_NOMINAL[n] + rtol * fmax(fabs(y0[n]), fabs(y1[n]));
+        err += (h * d / sc) * (h * d / sc);
+    }
+    return sqrt(err / PM_NX);
+}
+
+static void dp_dense(const PamStages *s, const double *y0, double h, double th, double *y) {
+    double pw[4] = {th, th * th, th * th * th, th * th * th * th};
+    int n, st, j;
+    for (n = 0; n < PM_NX; n++) {
+        double acc = 0.0;
+        for (st = 0; st < 7; st++) {
+            double q = 0.0;
+            for (j = 0; j < 4; j++) q += DP_P[st][j] * pw[j];
+            acc += s->k[st][n] * q;
+        }
+        y[n] = y0[n] + h * acc;
+    }
+}
+
+/* Where an indicator first reaches zero over an accepted step, as a fraction of the step in
+ * (lo, hi], or 0 if none does.  A moving step is checked at its end (max_step_s keeps it short
+ * against a sign change and back).  A held model's step is not limited by max_step_s (its states
+ * approach their sources monotonically, so its force margins seldom turn back), so a long one is
+ * also checked at PAM_ENGINE_HELD_CHECKS points of its dense output. */
+static int first_crossing(const PamEngine *e, const PamStages *s, const double *y, const double *y1, double h,
+                          double *lo, double *hi) {
+    int n = (held(e) && h > e->max_step_s) ? PAM_ENGINE_HELD_CHECKS : 1, k;
+    double ye[PM_NX];
+    for (k = 1; k <= n; k++) {
+        if (k < n) dp_dense(s, y, h, (double)k / n, ye);
+        if (min_indicator(e, k < n ? ye : y1) <= 0.0) {
+            *lo = (double)(k - 1) / n;
+            *hi = (double)k / n;
+            return 1;
+        }
+    }
+    return 0;
+}
+
+/* A held model within the integrator's tolerance of the steady state it approaches is set to it
+ * (the model's settle function), so that its derivatives are exactly zero: the rest of an
+ * exponential approach is below the tolerance, and an explicit integrator would follow it in steps
+ * of its time constant for ever.  Not where the change would cross an event indicator.  Returns 1
+ * if it changed y. */
+static int settle(PamEngine *e, double *y) {
+    double settled[PM_NX];
+    int k, changed = 0;
+    if (!held(e)) return 0;
+    pm_settle(e->mode, y, e->u, e->p, e->rtol, settled);
+    for (k = 0; k < PM_NX; k++) changed |= settled[k] != y[k];
+    if (!changed || min_indicator(e, settled) <= 0.0) return 0;
+    memcpy(y, settled, sizeof settled);
+    return 1;
+}
+
+/* Leaves the engine at the last instant reached and fails. */
+static int step_failed(PamEngine *e, double t, const double *y) {
+    e->time_s = t;
+    memcpy(e->x, y, sizeof e->x);
+    return -1;
+}
+
+/* The event located at y (time t): the jump and the new mode; -1 if events make no progress. */
+static int at_event(PamEngine *e, double t, double *y, int *zero_length) {
+    double y_before[PM_NX];
+    int old = e->mode, jumped;
+    unsigned fired = fired_indicators(e, y);
+    memcpy(y_before, y, sizeof y_before);
+    jumped = transition(e, y, fired);
+    if (!jumped && e->mode == old) {
+        if (++*zero_length > PAM_ENGINE_MAX_ZERO_LENGTH) {
+            engine_logf(e, PAM_ENGINE_ERROR, "event switching made no progress at t = %.9g s", t);
+            return -1;
+        }
+        return 0;
+    }
+    *zero_length = 0;
+    e->n_events++;
+    if (e->on_event) e->on_event(e->event_env, t, old, e->mode, fired, y_before, y);
+    return 0;
+}
+
+/* Integrate to t_end with the inputs held; 0 on success, -1 on failure (logged), which leaves
+ * time_s, the states and the mode at the last instant reached. */
+int pam_engine_do_step(PamEngine *e, double t_end) {
+    double y[PM_NX], y1[PM_NX], t = e->time_s, h_max = e->max_step_s;
+    PamStages s;
+    long steps = 0;
+    int zero_length = 0, n;
+    memcpy(y, e->x, sizeof y);
+    if (e->inputs_changed && held(e)) {
+        /* a held model is re-checked where its inputs jump */
+        int old = e->mode;
+        e->mode = rest_mode(e, e->mode, y);
+        if (e->mode != old) e->n_events++;
+    }
+    e->inputs_changed = 0;
+    rhs(e, y, s.k[0]);
+    /* A remainder below the time resolution (left by an event located just before t_end) is not a step. */
+    while (t_end - t > 1e-13 * fmax(1.0, fabs(t_end))) {
+        double h, err, factor, lo = 0.0, hi = 1.0;
+        int last, at_rest = held(e);
+        if (settle(e, y)) rhs(e, y, s.k[0]);
+        /* A held model whose states do not change stays as it is while the inputs are held. */
+        for (n = 0; n < PM_NX && at_rest; n++) at_rest = s.k[0][n] == 0.0;
+        if (at_rest) {
+            if (e->on_step) e->on_step(e->step_env, t, t_end, 0.0, y, NULL);
+            t = t_end;
+            break;
+        }
+        h = fmin(held(e) ? e->h_s : fmin(e->h_s, h_max), t_end - t);
+        last = h >= t_end - t;
+        if (++steps > e->max_steps) {
+            engine_logf(e, PAM_ENGINE_ERROR, "more than %ld internal steps between t = %.9g s and %.9g s",
+                        e->max_steps, e->time_s, t_end);
+            return step_failed(e, t, y);
+        }
+        if (h < 1e-14 * fmax(1.0, fabs(t))) {
+            engine_logf(e, PAM_ENGINE_ERROR, "step size underflow at t = %.9g s", t);
+            return step_failed(e, t, y);
+        }
+        err = dp_step(e, y, h, &s, y1);
+        if (!(err <= 1.0)) {
+            e->h_s = h * (isfinite(err) ? fmax(0.2, 0.9 * pow(err, -0.2)) : 0.1);
+            continue;
+        }
+        factor = err == 0.0 ? 10.0 : fmin(10.0, fmax(0.2, 0.9 * pow(err, -0.2)));
+        e->n_steps++;
+        if (first_crossing(e, &s, y, y1, h, &lo, &hi)) {
+            /* Locate the first crossing on the dense output; keep the far side so that the event test holds. */
+            double ye[PM_NX], t_event;
+            int it;
+            for (it = 0; it < 100 && (hi - lo) * h > 1e-15 * fmax(1.0, fabs(t)); it++) {
+                double mid = 0.5 * (lo + hi);
+                dp_dense(&s, y, h, mid, ye);
+                if (min_indicator(e, ye) <= 0.0) hi = mid;
+                else lo = mid;
+            }
+            if (hi < 1.0) dp_dense(&s, y, h, hi, ye);
+            else memcpy(ye, y1, sizeof ye);
+            t_event = hi < 1.0 ? t + hi * h : (last ? t_end : t + h);
+            if (e->on_step) e->on_step(e->step_env, t, t_event, h, y, &s);
+            t = t_event;
+            memcpy(y, ye, sizeof y);
+            memcpy(e->x, y, sizeof y);
+            if (at_event(e, t, y, &zero_length)) return step_failed(e, t, y);
+            e->h_s = fmax(fmin(h * hi, h_max), 1e-6);
+            rhs(e, y, s.k[0]);
+            continue;
+        }
+        if (e->on_step) e->on_step(e->step_env, t, last ? t_end : t + h, h, y, &s);
+        t = last ? t_end : t + h;
+        memcpy(y, y1, sizeof y);
+        memcpy(s.k[0], s.k[6], sizeof s.k[0]);
+        if (!last || factor < 1.0) e->h_s = h * factor;
+    }
+    e->time_s = t_end;
+    memcpy(e->x, y, sizeof y);
+    return 0;
+}
