@@ -24,20 +24,30 @@ REST_SPEED_M_S = 1e-4
 
 
 class Signals(Mapping):
-    """``Result.signals``: the work integrals at once, the force breakdown and source outputs
-    (:meth:`MuscleModel.breakdown`) when first read, since a sweep reads only a few figures of
-    each run and the breakdown costs more than a native run."""
+    """``Result.signals``: the work integrals at once, the force breakdown and source outputs when
+    first read, since a sweep reads only a few figures of each run and the breakdown costs more than a
+    native run.  The forces are the generated outputs of the run's assembly where the backend ran one
+    (``outputs``, :class:`pamsim.assemblies.one_muscle.RigOutputs`), else those of
+    :meth:`MuscleModel.breakdown`; the source's own columns (its command, supply, air mass) come from
+    the source."""
 
-    def __init__(self, work: dict[str, np.ndarray], model: "MuscleModel", t, Y, modes):
+    def __init__(self, work: dict[str, np.ndarray], model: "MuscleModel", t, Y, modes, outputs=None):
         self._work = work
         self._trace = (model, t, Y, modes)
+        self._outputs = outputs
         self._all: dict[str, np.ndarray] | None = None
 
     def _everything(self) -> dict[str, np.ndarray]:
         if self._all is None:
             model, t, Y, modes = self._trace
-            sig = model.breakdown(t, Y, modes)
-            sig.pop("p_gauge_Pa")
+            if self._outputs is None:
+                sig = model.breakdown(t, Y, modes)
+                sig.pop("p_gauge_Pa")
+            else:
+                generated = self._outputs.sampled()
+                own = model.source.outputs(t, Y[2:2 + model.n_source], Y[0])
+                forces = {k: v for k, v in generated.items() if k.startswith("F_")}
+                sig = {**forces, **{k: generated.get(k, v) for k, v in own.items()}, **generated}
             self._all = {**sig, **self._work}
         return self._all
 
@@ -100,11 +110,13 @@ class Result:
 
     @classmethod
     def from_trace(cls, model: "MuscleModel", name, t, Y, modes, transitions, impact_losses, stats, wall_time_s,
-                   peaks: dict[str, float] | None = None, impacts_J: np.ndarray | None = None):
+                   peaks: dict[str, float] | None = None, impacts_J: np.ndarray | None = None, outputs=None):
         """A Result from a sampled trace ``Y`` (one row per model state, one column per time ``t`` [s]).
 
         ``impact_losses`` lists ``(t_s, loss_J)`` of every event; ``impacts_J`` is their running sum
-        at the samples [J] where the backend has it, else it is summed here.
+        at the samples [J] where the backend has it, else it is summed here.  ``outputs``: the run's
+        generated outputs (:class:`pamsim.assemblies.one_muscle.RigOutputs`), which give the force
+        columns and the forces at rest at the end; without them the composed model computes both.
         """
         work = {key: Y[-N_WORK + i] for i, key in enumerate(model.state_names[-N_WORK:])}
         loss_J = np.array([b for _, b in impact_losses])
@@ -113,7 +125,7 @@ class Result:
             cum = np.concatenate([[0.0], np.cumsum(loss_J)])
             impacts_J = cum[np.searchsorted(loss_t, t, side="right")]
         work["E_impacts_J"] = impacts_J
-        sig = Signals(work, model, t, Y, modes)
+        sig = Signals(work, model, t, Y, modes, outputs)
         p = model.pressure_trace_Pa(t, Y)
         fr = model.fit_range
         peaks = dict(peaks or {})
@@ -127,7 +139,7 @@ class Result:
             violations.append(f"contraction up to {x_hi * 1e3:.2f} mm, above the fitted {fr.x_max_m * 1e3:.1f} mm")
         if p_hi > fr.p_max_gauge_Pa:
             violations.append(f"pressure up to {p_hi / 1e5:.3f} bar, above the fitted {fr.p_max_gauge_Pa / 1e5:.2f} bar")
-        final = model.rest_forces(float(t[-1]), Y[:, -1])
+        final = model.rest_forces(float(t[-1]), Y[:, -1]) if outputs is None else outputs.rest_forces()
         res = cls(name, t, Y[0], Y[1], p, modes, sig, transitions, stats, wall_time_s,
                   model.load.mass_kg, model.load.g_m_s2, float(loss_J.sum()), final, violations, peaks=peaks, model=model)
         res.warnings = ([f"left the static model's valid (fitted) range: {v}" for v in violations]

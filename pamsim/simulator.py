@@ -25,6 +25,7 @@ from typing import Callable
 import numpy as np
 
 from .assemblies import one_muscle_assembly
+from .assemblies.one_muscle import RUN_FUNCTIONS, RigOutputs
 from .components.hanging_load import EVENT_NAMES
 from .errors import InputError, SolverFailure
 from .model import STATE_SCALES, Mode, MuscleModel
@@ -127,8 +128,9 @@ class _Generated:
     run's parameter values and its input signals in the flat model's input order."""
 
     def __init__(self, model: MuscleModel, opts: SolverOptions, x0_m: float, p0_gauge_Pa: float | None):
-        assembly = one_muscle_assembly(model, x0_m, p0_gauge_Pa, opts.stick_margin_N, opts.release_margin_N)
-        self.code = compiled_by_mode(assembly, "load", ("f", "y", "z", "transition", "rest_mode", "x0"))
+        assembly = self.assembly = one_muscle_assembly(model, x0_m, p0_gauge_Pa, opts.stick_margin_N,
+                                                       opts.release_margin_N)
+        self.code = compiled_by_mode(assembly, "load", RUN_FUNCTIONS)
         local = [name.split(".", 1)[1] for name in self.code[Mode.STICK].names["states"]]
         if local != list(model.state_names):  # the tolerances, peaks and Result read the states by position
             raise ValueError(f"the components' states {local} are not the model's {list(model.state_names)}")
@@ -330,12 +332,13 @@ class _Run:
             self.mode = self.gen.rest_mode(self.mode, self.t, self.y)
 
     def result(self, name: str, wall_time_s: float) -> Result:
-        return Result.from_trace(self.model, name, np.concatenate(self.ts), np.concatenate(self.ys, axis=1),
-                                 np.concatenate(self.modes), self.transitions, self.impact_loss_J,
+        t, Y, modes = np.concatenate(self.ts), np.concatenate(self.ys, axis=1), np.concatenate(self.modes)
+        return Result.from_trace(self.model, name, t, Y, modes, self.transitions, self.impact_loss_J,
                                  {"rhs_evaluations": int(self.nfev), "events": len(self.transitions),
                                   "segments": self.n_segments, "method": self.opts.method, "rtol": self.opts.rtol},
                                  wall_time_s, peaks={"x_m": self.peak_x, "p_gauge_Pa": self.peak_p,
-                                                     "x_min_m": self.low_x})
+                                                     "x_min_m": self.low_x},
+                                 outputs=RigOutputs(self.gen.assembly, self.model, t, Y, modes))
 
 
 def too_many_events(max_events: int, when: str = "") -> SolverFailure:

@@ -152,7 +152,7 @@ def test_quadratures_are_the_states_nothing_reads():
 def test_held_modes_are_those_where_the_load_does_not_move():
     model = CModel(scenario_assembly(FIG4))
     assert dict(zip(model.mode_values, model.held)) == {int(m): not m.is_slip for m in LoadMode}
-    assert model.counts == {"nx": 4, "nq": 4, "nu": 3, "np": 42, "ny": 19, "nz": 2, "nmodes": 5}
+    assert model.counts == {"nx": 4, "nq": 4, "nu": 3, "np": 42, "ny": 20, "nz": 2, "nmodes": 5}
 
 
 GENERATE = """
@@ -207,3 +207,30 @@ def test_a_structure_the_engine_cannot_run_is_refused_by_name():
     assembly = one_muscle_assembly(model)
     with pytest.raises(NotImplementedError, match="at most one hybrid component"):
         CModel(assembly, component="chamber")
+
+
+@pytest.mark.parametrize("backend", ["python", "native"])
+@pytest.mark.parametrize("name", ["fig4", "fig6b", "prescribed step", "start part-way, pressurised"])
+def test_result_columns_are_the_generated_outputs(backend, name):
+    """The force columns and flows of a python or native result come from the assembly's generated
+    outputs; they equal the composed model's breakdown of the same trace, and the forces at rest at the
+    end equal its rest forces."""
+    scenario = CASES[name]
+    res = pamsim.simulate(scenario, backend=backend)
+    model = res.model
+    sig = res.signals
+    rows = [res.x_m, res.v_m_s]
+    if model.n_source:
+        rows += [res.p_gauge_Pa + model.source.p_atm_Pa, sig["air_mass_kg"]]
+    rows += [sig[k] for k in ("W_muscle_J", "E_friction_J", "E_damping_J", "W_external_J")]
+    want = model.breakdown(res.t_s, np.array(rows), res.mode)
+    checked = 0
+    for key, values in want.items():
+        if key == "p_gauge_Pa":
+            continue
+        scale = max(1.0, np.max(np.abs(values)))
+        assert np.max(np.abs(sig[key] - values)) <= 1e-9 * scale, key
+        checked += 1
+    assert checked >= (12 if model.n_source else 7)
+    net, level = model.rest_forces(float(res.t_s[-1]), np.array([r[-1] for r in rows]))
+    assert res.final_rest_forces_N == pytest.approx((net, level), rel=1e-12, abs=1e-12)

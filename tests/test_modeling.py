@@ -248,7 +248,7 @@ def test_generation_is_byte_identical_across_processes():
 
 def test_flat_model_counts_and_names(fig4_flat):
     flat = fig4_flat
-    assert flat.counts == {"states": 8, "inputs": 3, "outputs": 19, "parameters": 42, "modes": 1, "indicators": 2}
+    assert flat.counts == {"states": 8, "inputs": 3, "outputs": 20, "parameters": 42, "modes": 1, "indicators": 2}
     assert [v.name for v in flat.inputs] == ["valve_command", "supply_pressure_gauge_Pa", "external_force_N"]
     assert flat.index("states", "chamber.p_abs_Pa") == 2
     with pytest.raises(KeyError, match="has no state 'chamber.T_K'"):

@@ -15,10 +15,13 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any, Callable
 
+import numpy as np
+
 from ..components import (CoulombFriction, ExternalForce, HangingLoad, MuscleStaticForce, PolytropicChamber,
                           PressureSignal, ProportionalValve, ViscousDamping)
 from ..elements.pressure_source import PrescribedPressure, ValveChamberSource
 from ..modeling import Assembly
+from ..modeling.pygen import compiled_by_mode, outputs_by_mode
 
 INPUTS_VALVE = ("valve_command", "supply_pressure_gauge_Pa", "external_force_N")
 INPUTS_PRESCRIBED = ("prescribed_pressure_gauge_Pa", "external_force_N")
@@ -98,6 +101,57 @@ def _source_parts(src, p0_gauge_Pa: float | None) -> SourceParts:
             return SOURCE_PARTS[cls](src, p0_gauge_Pa)
     raise TypeError(f"no components for the pressure source {type(src).__name__} "
                     f"(pamsim.assemblies.one_muscle.register_source names them)")
+
+
+RIG_COMPONENTS = frozenset({"load", "muscle", "friction", "damping", "external", "chamber", "valve", "pressure",
+                            "controller"})
+"""The rig's own components (every pressure source's included); any other was added to it."""
+
+RUN_FUNCTIONS = ("f", "y", "z", "transition", "rest_mode", "x0")
+"""The generated functions a run uses (one set per load mode, shared by the backends through
+:func:`pamsim.modeling.pygen.compiled_by_mode`'s cache)."""
+
+OUTPUT_COLUMNS = {"muscle.F_static_N": "F_static_N", "load.F_friction_N": "F_friction_N",
+                  "damping.F_damping_N": "F_damping_N", "load.F_gravity_N": "F_gravity_N",
+                  "external.F_external_N": "F_external_N", "load.F_stop_N": "F_stop_N",
+                  "load.F_coulomb_level_N": "F_coulomb_level_N", "valve.mass_flow_kg_s": "valve_mass_flow_kg_s",
+                  "chamber.gas_temperature_K": "gas_temperature_K"}
+"""The rig's outputs under the names results have always given them, in the order of their columns
+(an output of a component added to the rig keeps its namespaced name)."""
+
+
+class RigOutputs:
+    """The generated outputs of a run of the rig, computed when first asked for: at the samples (``t``,
+    states ``Y`` one row per state, ``modes``), and at rest at the end."""
+
+    def __init__(self, assembly: Assembly, model, t, Y, modes):
+        self.code = compiled_by_mode(assembly, "load", RUN_FUNCTIONS)
+        self.p = assembly.parameter_values()
+        self.added = {c.name for c in assembly.components} - RIG_COMPONENTS
+        self.model, self.t, self.Y, self.modes = model, t, Y, modes
+
+    def inputs(self, t):
+        """The model inputs at times ``t``, in the flat model's order: the source's, then the external force."""
+        return [*self.model.source.inputs(t), self.model.load.external_N(t)]
+
+    def sampled(self) -> dict:
+        """``{column: array at the samples}``: the rig's outputs under :data:`OUTPUT_COLUMNS`' names, and
+        every output of a component added to the rig under its namespaced name."""
+        out = outputs_by_mode(self.code, self.p, list(self.Y), self.inputs(self.t), self.modes)
+        columns = {column: out[name] for name, column in OUTPUT_COLUMNS.items() if name in out}
+        columns.update({name: values for name, values in out.items() if name.split(".", 1)[0] in self.added})
+        return columns
+
+    def rest_forces(self) -> tuple[float, float]:
+        """Net force on the load at rest at the last sample, and the Coulomb level [N] there."""
+        from ..components.hanging_load import LoadMode
+
+        y = [float(v) for v in self.Y[:, -1]]
+        y[1] = 0.0
+        out = outputs_by_mode(self.code, self.p, [[v] for v in y], [[float(np.asarray(v))] for v in
+                                                                    self.inputs(float(self.t[-1]))],
+                              [int(LoadMode.STICK)])
+        return float(out["load.F_net_N"][0]), float(out["load.F_coulomb_level_N"][0])
 
 
 def scenario_assembly(scenario) -> Assembly:

@@ -91,6 +91,7 @@ class HangingLoad(Component):
                Var("F_stop_N", "N", "reaction of a stop along x"),
                Var("F_coulomb_level_N", "N", "Coulomb friction level"),
                Var("kinetic_energy_J", "J", "kinetic energy of the load"),
+               Var("F_net_N", "N", "sum of the forces on the load; held, of those other than friction and the stops"),
                Var("slip_direction", "1", "+1 or -1 while sliding up or down, 0 while held"))
 
     def equations(self, s: Symbols) -> Equations:
@@ -136,7 +137,8 @@ class HangingLoad(Component):
             outputs={"x_m": x, "v_m_s": v_flange, "mass_kg": P["mass_kg"], "F_gravity_N": -weight,
                      "F_friction_N": if_else(slip, -q * level, if_else(held_by_friction, -net, 0.0)),
                      "F_stop_N": if_else(on_stop, -net, 0.0), "F_coulomb_level_N": level,
-                     "kinetic_energy_J": 0.5 * P["mass_kg"] * v * v, "slip_direction": if_else(slip, q, 0.0)},
+                     "kinetic_energy_J": 0.5 * P["mass_kg"] * v * v, "F_net_N": net,
+                     "slip_direction": if_else(slip, q, 0.0)},
             port={"flange": {"x_m": x, "v_m_s": v_flange}},
             indicators=indicators, indicator_margins=margins, transition=transition, rest_mode=rest,
             initial={"x_m": x0, "v_m_s": 0.0,

@@ -20,6 +20,8 @@ from .signatures import FUNCTION_SIGNATURES
 RUNTIME = '''\
 import math as _math
 
+import numpy as _np
+
 _nan = float("nan")
 _inf = float("inf")
 
@@ -165,6 +167,33 @@ def _op_table() -> dict[int, str]:
     return {getattr(ca, "OP_" + k): v for k, v in t.items() if hasattr(ca, "OP_" + k)}
 
 
+def _numpy_op_table() -> dict[int, str]:
+    """The operations on numpy arrays, with C's results where numpy's differ only by raising (numpy's
+    IEEE arithmetic gives C's inf and NaN once its warnings are silenced, which the caller does)."""
+    import casadi as ca
+
+    flag = "_np.where({0}, 1.0, 0.0)"
+    t = {
+        "ASSIGN": "{0}", "ADD": "{0} + {1}", "SUB": "{0} - {1}", "MUL": "{0} * {1}", "DIV": "_np.divide({0}, {1})",
+        "NEG": "-{0}", "EXP": "_np.exp({0})", "LOG": "_np.log({0})", "POW": "_np.power({0}, {1})",
+        "CONSTPOW": "_np.power({0}, {1})", "SQRT": "_np.sqrt({0})", "SQ": "{0} * {0}", "TWICE": "{0} + {0}",
+        "SIN": "_np.sin({0})", "COS": "_np.cos({0})", "TAN": "_np.tan({0})", "ASIN": "_np.arcsin({0})",
+        "ACOS": "_np.arccos({0})", "ATAN": "_np.arctan({0})",
+        "LT": flag.format("{0} < {1}"), "LE": flag.format("{0} <= {1}"), "EQ": flag.format("{0} == {1}"),
+        "NE": flag.format("{0} != {1}"), "NOT": flag.format("_np.logical_not({0})"),
+        "AND": flag.format("_np.logical_and({0}, {1})"), "OR": flag.format("_np.logical_or({0}, {1})"),
+        "FLOOR": "_np.floor({0})", "CEIL": "_np.ceil({0})", "FMOD": "_np.fmod({0}, {1})", "FABS": "_np.abs({0})",
+        "SIGN": "_np.sign({0})", "COPYSIGN": "_np.copysign({0}, {1})", "IF_ELSE_ZERO": "_np.where({0}, {1}, 0.0)",
+        "ERF": "_np.vectorize(_math.erf, otypes=[float])({0})", "FMIN": "_np.fmin({0}, {1})",
+        "FMAX": "_np.fmax({0}, {1})", "INV": "_np.divide(1.0, {0})", "SINH": "_np.sinh({0})",
+        "COSH": "_np.cosh({0})", "TANH": "_np.tanh({0})", "ASINH": "_np.arcsinh({0})", "ACOSH": "_np.arccosh({0})",
+        "ATANH": "_np.arctanh({0})", "ATAN2": "_np.arctan2({0}, {1})", "LOG1P": "_np.log1p({0})",
+        "EXPM1": "_np.expm1({0})", "HYPOT": "_np.hypot({0}, {1})",
+        "REMAINDER": "_np.vectorize(_fmod_remainder, otypes=[float])({0}, {1})",
+    }
+    return {getattr(ca, "OP_" + k): v for k, v in t.items() if hasattr(ca, "OP_" + k)}
+
+
 def _literal(value: float) -> str:
     if math.isnan(value):
         return "_nan"
@@ -173,14 +202,19 @@ def _literal(value: float) -> str:
     return repr(float(value))
 
 
-def function_source(fn, py_name: str) -> str:
+def function_source(fn, py_name: str, arrays: bool = False) -> str:
     """One CasADi SX ``Function`` as a Python ``def``: dense vector arguments (sequences of floats), each
-    result a list of floats (a matrix column by column)."""
+    result a list of floats (a matrix column by column).
+
+    ``arrays``: each argument entry may be a numpy array (all of one length, or floats), and so is each
+    result entry (of the arguments' length ``_n``, the last argument): the function at many points at
+    once, for results' columns rather than an integrator.
+    """
     import casadi as ca
 
-    ops = _op_table()
+    ops = _numpy_op_table() if arrays else _op_table()
     args = [fn.name_in(i) for i in range(fn.n_in())]
-    lines = [f"def {py_name}({', '.join(args)}):"]
+    lines = [f"def {py_name}({', '.join(args + (['_n'] if arrays else []))}):"]
     dense_index = []
     results = []
     for i in range(fn.n_out()):
@@ -204,7 +238,8 @@ def function_source(fn, py_name: str) -> str:
             lines.append(f"    w{outs[0]} = {_literal(value)}")
             constant[outs[0]] = value
             continue
-        elif op == ca.OP_DIV and math.isfinite(constant.get(ins[1], 0.0)) and constant.get(ins[1], 0.0) != 0.0:
+        elif (op == ca.OP_DIV and not arrays and math.isfinite(constant.get(ins[1], 0.0))
+              and constant.get(ins[1], 0.0) != 0.0):
             lines.append(f"    w{outs[0]} = w{ins[0]} / w{ins[1]}")
         elif op in ops:
             operands = [f"w{j}" for j in ins]
@@ -212,6 +247,8 @@ def function_source(fn, py_name: str) -> str:
         else:
             raise NotImplementedError(f"{fn.name()}: CasADi operation {op} has no Python form")
         constant.pop(outs[0], None)
+    if arrays:
+        results = [[f"_np.broadcast_to(_np.asarray({r}, dtype=float), (_n,))" for r in res] for res in results]
     returned = ", ".join("[" + ", ".join(r) + "]" for r in results)
     lines.append(f"    return {returned}" + ("," if len(results) == 1 else ""))
     return "\n".join(lines) + "\n"
@@ -229,35 +266,42 @@ def module_source(model, names=None) -> str:
              RUNTIME]
     if model.externals:
         parts.append(function_source(model.function("externals"), "_externals"))
+        if names is None or "y" in names:
+            parts.append(function_source(model.function("externals"), "_externals_arrays", arrays=True))
     for name in FUNCTION_SIGNATURES:
         if names is not None and name not in names:
             continue
-        if not model.externals:
-            parts.append(function_source(model.function(name), name))
-            continue
-        parts.append(function_source(model.function(name), f"_body_{name}"))
-        parts.append(_wrapper(model, name))
+        for arrays in ((False, True) if name == "y" else (False,)):
+            suffix = "_arrays" if arrays else ""
+            if not model.externals:
+                parts.append(function_source(model.function(name), name + suffix, arrays))
+                continue
+            parts.append(function_source(model.function(name), f"_body_{name}{suffix}", arrays))
+            parts.append(_wrapper(model, name, arrays))
     return "\n\n".join(parts)
 
 
-def _wrapper(model, name: str) -> str:
+def _wrapper(model, name: str, arrays: bool = False) -> str:
     import casadi as ca
 
-    args = FUNCTION_SIGNATURES[name][0]
-    lines = [f"def {name}({', '.join(args)}):"]
+    args = FUNCTION_SIGNATURES[name][0] + (("_n",) if arrays else ())
+    suffix = "_arrays" if arrays else ""
+    lines = [f"def {name}{suffix}({', '.join(args)}):"]
     if "x" not in args:
         w = ca.vertcat(*[ext.symbol for ext in model.externals])
         if any(ca.depends_on(ca.vertcat(*exprs), w) for exprs in model._expressions(name) if exprs):
             raise NotImplementedError(f"{model.name}: {name} reads an external function, which needs the states")
         lines.append(f"    return _body_{name}({', '.join(args)}, ())")
         return "\n".join(lines) + "\n"
-    lines.append("    a = _externals(x, u, p, q)[0]")
+    lines.append(f"    a = _externals{suffix}(x, u, p, q{', _n' if arrays else ''})[0]")
     calls, k = [], 0
     for i, ext in enumerate(model.externals):
-        calls.append(f"_ext{i}({', '.join(f'a[{k + j}]' for j in range(len(ext.args)))})")
+        fn = f"_np.vectorize(_ext{i}, otypes=[float])" if arrays else f"_ext{i}"
+        calls.append(f"{fn}({', '.join(f'a[{k + j}]' for j in range(len(ext.args)))})")
         k += len(ext.args)
     lines.append(f"    w = [{', '.join(calls)}]")
-    lines.append(f"    return _body_{name}({', '.join(args)}, w)")
+    body_args = [a for a in args if a != "_n"] + ["w"] + (["_n"] if arrays else [])
+    lines.append(f"    return _body_{name}{suffix}({', '.join(body_args)})")
     return "\n".join(lines) + "\n"
 
 
@@ -301,6 +345,7 @@ class GeneratedModel:
         exec(compile(source, f"<pamsim generated {model_name}>", "exec"), namespace)
         self.f = namespace.get("f")
         self.y = namespace.get("y")
+        self._y_arrays = namespace.get("y_arrays")
         self.z = namespace.get("z")
         self.transition = namespace.get("transition")
         self.rest_mode = namespace.get("rest_mode")
@@ -308,12 +353,37 @@ class GeneratedModel:
         self.settle = namespace.get("settle")
         self._jacobian = namespace.get("jacobian")
 
+    def y_arrays(self, X, U, p, q=()) -> list:
+        """The outputs at many points: ``X`` one row per state and ``U`` one row per input (arrays of
+        one length n, or floats), ``p`` the parameters; a list of n-arrays, one per output."""
+        import numpy as np
+
+        n = max([np.size(r) for r in (*X, *U)] or [1])
+        with np.errstate(all="ignore"):  # C's inf and NaN, as the scalar code gives them
+            return self._y_arrays(X, U, p, q, n)[0]
+
     def jacobian(self, x, u, p, q):
         """``(A, B, C, D)`` as numpy arrays: df/dx, df/du, dy/dx, dy/du."""
         import numpy as np
 
         return tuple(np.array(b, dtype=float).reshape(shape, order="F")
                      for b, shape in zip(self._jacobian(x, u, p, q), self._jacobian_shapes))
+
+
+def outputs_by_mode(code: dict, p, X, U, modes) -> dict:
+    """``{output name: array}``: the outputs of per-mode code (:func:`compiled_by_mode`) at samples whose
+    states are the columns of ``X``, inputs the columns of ``U`` (rows may be floats) and modes
+    ``modes``; each sample in its own mode's code."""
+    import numpy as np
+
+    modes = np.asarray(modes)
+    names = next(iter(code.values())).names["outputs"]
+    out = np.full((len(names), modes.size), np.nan)
+    for mode in np.unique(modes):
+        at = modes == mode
+        rows = lambda M: [np.asarray(r, dtype=float)[at] if np.ndim(r) else r for r in M]  # noqa: E731
+        out[:, at] = code[int(mode)].y_arrays(rows(X), rows(U), p)
+    return dict(zip(names, out))
 
 
 _BY_MODE_CACHE: dict = {}

@@ -33,6 +33,7 @@ from typing import Sequence
 import numpy as np
 
 from ..assemblies import one_muscle_assembly
+from ..assemblies.one_muscle import RigOutputs
 from ..components.hanging_load import event_name
 from ..core_table import C_CHOICES, SCENARIO_KEYS, unimplemented_choice
 from ..elements.pressure_source import ValveChamberSource
@@ -321,8 +322,9 @@ def _engine_result(scenario: Scenario, case: CaseInputs, out: dict, i: int, wall
     pressure = next(a for a, b in case.assembly.connections if b == "muscle.p_gauge_Pa")
     peaks = {"x_m": float(high[x_at]), "x_min_m": float(low[x_at]),
              "p_gauge_Pa": float(high[outputs.index(pressure)])}
-    return Result.from_trace(case.model, scenario.name, t, Y, out["modes"][first:first + n].astype(int), transitions,
-                             losses, stats, wall_time_s, peaks=peaks)
+    modes = out["modes"][first:first + n].astype(int)
+    return Result.from_trace(case.model, scenario.name, t, Y, modes, transitions, losses, stats, wall_time_s,
+                             peaks=peaks, outputs=RigOutputs(case.assembly, case.model, t, Y, modes))
 
 
 def _sample_grids(cases: Sequence[CaseInputs]) -> list[np.ndarray]:
