@@ -62,7 +62,8 @@ def casadi_model(scenario: Scenario, initial_contraction_m: float | None = None,
     x0_m = scenario.initial_contraction_m if initial_contraction_m is None else initial_contraction_m
     p0 = scenario.initial_pressure_gauge_Pa if initial_pressure_gauge_Pa is None else initial_pressure_gauge_Pa
     model = scenario.build_model()
-    assembly = one_muscle_assembly(model, x0_m, p0, opts.stick_margin_N, opts.release_margin_N)
+    assembly = one_muscle_assembly(model, x0_m, p0, opts.stick_margin_N, opts.release_margin_N,
+                                   scenario.added_components)
     flat = assembly.flatten()
     if flat.externals:
         raise InputError(f"{scenario.origin}: model.static_force = {scenario.spec['model']['static_force']!r} "

@@ -73,6 +73,10 @@ def result_figure(result: "Result", title: str | None = None, compare: "list[Res
         values = result.signals[key]
         if np.any(values != 0.0):
             ax_f.plot(t, values, label=label, lw=1, **style)
+    # the forces of components added to the rig: their namespaced F_ outputs
+    added = [k for k in result.signals if "." in k and k.split(".", 1)[1].startswith("F_")]
+    for k, key in enumerate(added, start=len(FORCE_STYLE)):
+        ax_f.plot(t, result.signals[key], label=key.split(".", 1)[0], lw=1, **series(k, f"C{k % 10}"))
     ax_f.axhline(0.0, color="k", lw=0.5)
     ax_f.set_ylabel(F_LABEL)
     ax_f.set_xlabel("time [s]")

@@ -118,7 +118,9 @@ class Result:
         generated outputs (:class:`pamsim.assemblies.one_muscle.RigOutputs`), which give the force
         columns and the forces at rest at the end; without them the composed model computes both.
         """
-        work = {key: Y[-N_WORK + i] for i, key in enumerate(model.state_names[-N_WORK:])}
+        n = len(model.state_names)  # rows past them: the states of components added to the rig, by name
+        work = {key: Y[n - N_WORK + i] for i, key in enumerate(model.state_names[-N_WORK:])}
+        work.update(zip(outputs.added_states if outputs is not None else (), Y[n:]))
         loss_J = np.array([b for _, b in impact_losses])
         if impacts_J is None:
             loss_t = np.array([a for a, _ in impact_losses])
@@ -172,7 +174,8 @@ class Result:
         """Work of the muscle and external force against the energy the load gained and lost [J].
 
         ``residual_J`` = work in - (kinetic + potential gain + friction + damping + impacts);
-        ``relative`` divides it by the largest term.
+        ``relative`` divides it by the largest term.  A component added to the rig brings its own
+        terms, by their namespaced names: ``W_`` work it did on the load, ``E_`` energy it took.
         """
         s = self.signals
         d_ke = 0.5 * self.mass_kg * (self.v_m_s[-1] ** 2 - self.v_m_s[0] ** 2)
@@ -180,8 +183,12 @@ class Result:
         terms = {"W_muscle_J": float(s["W_muscle_J"][-1]), "W_external_J": float(s["W_external_J"][-1]),
                  "dKE_J": float(d_ke), "dPE_J": float(d_pe), "E_friction_J": float(s["E_friction_J"][-1]),
                  "E_damping_J": float(s["E_damping_J"][-1]), "E_impacts_J": float(s["E_impacts_J"][-1])}
+        # A component added to the rig reports the work it does on the load (W_...) or takes from it (E_...).
+        added = {k: float(v[-1]) for k, v in s.items() if "." in k and k.split(".", 1)[1][:2] in ("W_", "E_")}
+        terms.update(added)
         residual = (terms["W_muscle_J"] + terms["W_external_J"] - terms["dKE_J"] - terms["dPE_J"]
-                    - terms["E_friction_J"] - terms["E_damping_J"] - terms["E_impacts_J"])
+                    - terms["E_friction_J"] - terms["E_damping_J"] - terms["E_impacts_J"]
+                    + sum(v if k.split(".", 1)[1].startswith("W_") else -v for k, v in added.items()))
         scale = max(abs(v) for v in terms.values()) or 1.0
         return {**terms, "residual_J": float(residual), "relative": float(abs(residual) / scale)}
 

@@ -31,6 +31,7 @@ from .model import FitRange, MuscleModel
 from .muscle_setup import applicable_model, model_inputs, with_overrides
 from .muscles import Muscle, load_muscle, shipped_names
 from .parameters import LOAD_MASS, ParameterSet, dynamics_parameters
+from .scenario_components import added_components, check_wiring
 from .static_models import REGISTRY
 from .signal_tables import signal_from_table, signal_range
 from .signals import Constant, Step
@@ -41,7 +42,7 @@ from .table_checks import TableChecker, choices_hint, did_you_mean
 # Schema: section -> {key: (type, required)}; a nested dict is a sub-table.
 _SCHEMA: dict[str, dict[str, Any]] = {
     "": {"name": str, "description": str, "model": dict, "parameters": dict, "load": dict, "pressure": dict,
-         "simulation": dict, "solver": dict, "controller": dict},
+         "simulation": dict, "solver": dict, "controller": dict, "component": list},
     "model": {"muscle": str, "parameter_set": str, "static_force": str, "static_force_variant": str,
               "static_force_negative": str, "friction": str, "damping": str, "friction_negative_level": str},
     "load": {"weight_N": float, "mass_kg": float, "external_force": dict},
@@ -154,6 +155,9 @@ class Scenario:
             object.__setattr__(scenario, "_static_force", scenario._build_static_force())
         except ValueError as exc:  # an implicit model that cannot be tabulated over the muscle's range
             v.fail("model.static_force", model["static_force"], str(exc))
+        object.__setattr__(scenario, "_added", added_components(v, spec.get("component", [])))
+        if scenario._added:
+            check_wiring(scenario, ScenarioError)
         return scenario
 
     def with_changes(self, changes: Mapping[str, Mapping[str, Any]], name: str | None = None) -> "Scenario":
@@ -286,6 +290,12 @@ class Scenario:
         )
 
     @property
+    def added_components(self) -> tuple:
+        """The components the scenario adds to the rig (``[[component]]`` tables), as
+        :class:`pamsim.assemblies.one_muscle.AddedComponent` s."""
+        return self._added
+
+    @property
     def initial_contraction_m(self) -> float:
         return float(self.spec["simulation"].get("initial_contraction_m", 0.0))
 
@@ -370,9 +380,10 @@ class _Validator(TableChecker):
     def type_of(self, key: str, value: Any, expected: type):
         ok = {float: isinstance(value, (int, float)) and not isinstance(value, bool),
               int: isinstance(value, int) and not isinstance(value, bool),
-              str: isinstance(value, str), dict: isinstance(value, dict)}[expected]
+              str: isinstance(value, str), dict: isinstance(value, dict), list: isinstance(value, list)}[expected]
         if not ok:
-            names = {float: "a number", int: "an integer", str: "a string", dict: "a table"}
+            names = {float: "a number", int: "an integer", str: "a string", dict: "a table",
+                     list: "an array of tables ([[...]])"}
             self.fail(key, value, f"must be {names[expected]}, not {type(value).__name__}")
         if expected is float and not math.isfinite(value):
             self.fail(key, value, "must be a finite number")

@@ -83,7 +83,8 @@ def simulate_python(scenario, progress: Callable[[float], None] | None = None) -
     """
     return simulate_model(scenario.build_model(), scenario.duration_s, scenario.solver,
                           x0_m=scenario.initial_contraction_m, name=scenario.name,
-                          p0_gauge_Pa=scenario.initial_pressure_gauge_Pa, progress=progress)
+                          p0_gauge_Pa=scenario.initial_pressure_gauge_Pa, progress=progress,
+                          added=scenario.added_components)
 
 
 def n_samples(duration_s: float, sample_rate_Hz: float) -> int:
@@ -127,13 +128,18 @@ class _Generated:
     (:func:`pamsim.modeling.pygen.compiled_by_mode`, shared by runs of the same structure), with the
     run's parameter values and its input signals in the flat model's input order."""
 
-    def __init__(self, model: MuscleModel, opts: SolverOptions, x0_m: float, p0_gauge_Pa: float | None):
+    def __init__(self, model: MuscleModel, opts: SolverOptions, x0_m: float, p0_gauge_Pa: float | None,
+                 added: tuple = ()):
         assembly = self.assembly = one_muscle_assembly(model, x0_m, p0_gauge_Pa, opts.stick_margin_N,
-                                                       opts.release_margin_N)
+                                                       opts.release_margin_N, added)
         self.code = compiled_by_mode(assembly, "load", RUN_FUNCTIONS)
         local = [name.split(".", 1)[1] for name in self.code[Mode.STICK].names["states"]]
-        if local != list(model.state_names):  # the tolerances, peaks and Result read the states by position
-            raise ValueError(f"the components' states {local} are not the model's {list(model.state_names)}")
+        if local[:len(model.state_names)] != list(model.state_names):  # peaks and Result read them by position
+            raise ValueError(f"the components' states {local} do not begin with the model's {list(model.state_names)}")
+        # Absolute tolerances: the rig's states' typical scales (10 mm, 0.1 m/s, 1 bar, 10 mg of air, 0.1 J of
+        # work and of a controller's states, as always), then each added component's declared nominals.
+        added_nominal = [v.nominal for c in assembly.components[-len(added):] for v in c.states] if added else []
+        self.nominal = np.array([STATE_SCALES.get(n, 0.1) for n in model.state_names] + added_nominal)
         self.p = assembly.parameter_values()
         self.kinetic = self.code[Mode.STICK].names["outputs"].index("load.kinetic_energy_J")
         source, external_N = model.source.inputs, model.load.external_N
@@ -192,8 +198,9 @@ class _Generated:
 
 def simulate_model(model: MuscleModel, duration_s: float, options: SolverOptions | None = None,
                    x0_m: float = 0.0, name: str = "", p0_gauge_Pa: float | None = None,
-                   progress: Callable[[float], None] | None = None) -> Result:
-    """Integrate ``model`` from rest at ``x0_m`` (chamber at ``p0_gauge_Pa``, if given) over ``[0, duration_s]``.
+                   progress: Callable[[float], None] | None = None, added: tuple = ()) -> Result:
+    """Integrate ``model`` from rest at ``x0_m`` (chamber at ``p0_gauge_Pa``, if given) over ``[0, duration_s]``,
+    with the components ``added`` to the rig (:class:`pamsim.assemblies.one_muscle.AddedComponent`).
 
     ``progress``, if given, is called with the simulated time [s] reached, at
     every segment and every ``PROGRESS_EVERY`` right-hand-side evaluations
@@ -203,7 +210,7 @@ def simulate_model(model: MuscleModel, duration_s: float, options: SolverOptions
     exceeds ``options.max_events``, or the switching stops making progress.
     """
     wall0 = time.perf_counter()
-    run = _Run(model, duration_s, options or SolverOptions(), x0_m, p0_gauge_Pa, progress)
+    run = _Run(model, duration_s, options or SolverOptions(), x0_m, p0_gauge_Pa, progress, added)
     while run.t < duration_s:
         run.report(run.t)
         t_break = min(next(b for b in run.breaks if b > run.t), run.hold_until)
@@ -222,12 +229,12 @@ class _Run:
     """One run of :func:`simulate_model`: where it is, what it has sampled and seen so far."""
 
     def __init__(self, model: MuscleModel, duration_s: float, opts: SolverOptions, x0_m: float,
-                 p0_gauge_Pa: float | None, progress: Callable[[float], None] | None):
+                 p0_gauge_Pa: float | None, progress: Callable[[float], None] | None, added: tuple = ()):
         self.model, self.opts, self.progress = model, opts, progress
-        self.atol = np.array([opts.rtol * STATE_SCALES.get(n, 0.1) for n in model.state_names])  # 0.1 J: work
         self.grid = np.linspace(0.0, duration_s, n_samples(duration_s, opts.sample_rate_Hz))
         self.breaks = sorted({b for b in model.breakpoints if 0.0 < b < duration_s} | {duration_s})
-        self.gen = _Generated(model, opts, x0_m, p0_gauge_Pa)
+        self.gen = _Generated(model, opts, x0_m, p0_gauge_Pa, added)
+        self.atol = opts.rtol * self.gen.nominal
         self.held_max_step = min(opts.held_max_step_s, model.max_input_step_s)
         self.t = 0.0
         self.y, self.mode = self.gen.start()

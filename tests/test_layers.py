@@ -26,6 +26,7 @@ EXPECTED_LAYERS = [
     "native",
     "fmu",
     "scenario",
+    "scenario_components",
     "simulator | muscle_setup | signal_tables | static",
     "result | parameters",
     "model | muscles | assemblies",

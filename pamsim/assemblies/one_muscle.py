@@ -39,13 +39,24 @@ class SourceParts:
     pressure: str
 
 
+@dataclass(frozen=True)
+class AddedComponent:
+    """A component added to the rig, and what its ports and inputs connect to (``{"flange": "load.flange"}``:
+    a port or input of its own, then a port or output of the rig or of another added component)."""
+
+    component: Any
+    connect: dict
+
+
 def one_muscle_assembly(model, x0_m: float = 0.0, p0_gauge_Pa: float | None = None,
-                        stick_margin_N: float = 1e-7, release_margin_N: float = 2e-7) -> Assembly:
+                        stick_margin_N: float = 1e-7, release_margin_N: float = 2e-7,
+                        added: tuple = ()) -> Assembly:
     """The assembly of a :class:`pamsim.model.MuscleModel`'s elements (its static force, friction,
     damping, load, stops and pressure source), starting at rest at ``x0_m`` with the chamber at
     ``p0_gauge_Pa`` (ambient if None).  The margins are the simulator's
     (:class:`pamsim.simulator.SolverOptions`).  The pressure source's components come from
-    :data:`SOURCE_PARTS`."""
+    :data:`SOURCE_PARTS`; ``added`` (:class:`AddedComponent` s) come after the rig's own, so the
+    rig's states and outputs keep their places."""
     load = HangingLoad("load", {
         "mass_kg": model.load.mass_kg, "g_m_s2": model.load.g_m_s2, "x_low_m": model.stops.x_low_m,
         "x_high_m": model.stops.x_high_m, "restitution": model.stops.restitution,
@@ -63,6 +74,9 @@ def one_muscle_assembly(model, x0_m: float = 0.0, p0_gauge_Pa: float | None = No
                ("friction.level_N", "load.friction_level_N"), ("external.F_external_N", "load.F_external_N"),
                ("load.v_m_s", "external.v_m_s")]
     inputs["external_force_N"] = "external.F_N"
+    for extra in added:
+        parts.append(extra.component)
+        wiring += [(target, f"{extra.component.name}.{own}") for own, target in extra.connect.items()]
     return Assembly(parts, wiring, inputs, name="one_muscle")
 
 
@@ -128,6 +142,7 @@ class RigOutputs:
         self.code = compiled_by_mode(assembly, "load", RUN_FUNCTIONS)
         self.p = assembly.parameter_values()
         self.added = {c.name for c in assembly.components} - RIG_COMPONENTS
+        self.added_states = [f"{c.name}.{v.name}" for c in assembly.components if c.name in self.added for v in c.states]
         self.model, self.t, self.Y, self.modes = model, t, Y, modes
 
     def inputs(self, t):
@@ -154,8 +169,10 @@ class RigOutputs:
         return float(out["load.F_net_N"][0]), float(out["load.F_coulomb_level_N"][0])
 
 
-def scenario_assembly(scenario) -> Assembly:
-    """The assembly of a :class:`pamsim.scenario.Scenario`: its model, start and the solver's margins."""
+def scenario_assembly(scenario, model=None) -> Assembly:
+    """The assembly of a :class:`pamsim.scenario.Scenario`: its model (``model``, if given, in its place:
+    one with another pressure source), start, the solver's margins and the components it adds."""
     opts = scenario.solver
-    return one_muscle_assembly(scenario.build_model(), scenario.initial_contraction_m,
-                               scenario.initial_pressure_gauge_Pa, opts.stick_margin_N, opts.release_margin_N)
+    return one_muscle_assembly(model or scenario.build_model(), scenario.initial_contraction_m,
+                               scenario.initial_pressure_gauge_Pa, opts.stick_margin_N, opts.release_margin_N,
+                               scenario.added_components)

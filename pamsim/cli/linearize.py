@@ -15,6 +15,7 @@ import math
 from pathlib import Path
 
 from ..atomic import atomic_outputs, output_folder
+from ..errors import InputError
 from ..control.choices import FRICTION_KINDS, VALVE_SLOPES
 from . import figure_args, finite_float
 
@@ -114,7 +115,9 @@ def _linearize(scenario, args: argparse.Namespace):
     from ..control.linear import linearize
     from ..control.operating_point import held_equilibrium, open_valve_equilibrium, trajectory_point
     from ..control.system import FrictionTreatment
+    from ..scenario_components import refuse_added
 
+    refuse_added(scenario, "pamsim linearize", InputError)
     model = scenario.build_model()
     supply = scenario.final_pressure_gauge_Pa
     if args.at_time is not None:

@@ -6,14 +6,17 @@ around an element and calls the element's own functions with symbols, so the equ
 place and every generated form comes from them.
 """
 
+from .catalogue import COMPONENT_TYPES, register_component
 from .chamber import PolytropicChamber
 from .damping import ViscousDamping
 from .external_force import ExternalForce
 from .friction import CoulombFriction
 from .hanging_load import HangingLoad, LoadMode
 from .pressure import PressureSignal
+from .spring import LinearSpring
 from .static_force import MuscleStaticForce
 from .valve import ProportionalValve
 
-__all__ = ["CoulombFriction", "ExternalForce", "HangingLoad", "LoadMode", "MuscleStaticForce",
-           "PolytropicChamber", "PressureSignal", "ProportionalValve", "ViscousDamping"]
+__all__ = ["COMPONENT_TYPES", "CoulombFriction", "ExternalForce", "HangingLoad", "LinearSpring", "LoadMode",
+           "MuscleStaticForce", "PolytropicChamber", "PressureSignal", "ProportionalValve", "ViscousDamping",
+           "register_component"]

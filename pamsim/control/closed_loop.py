@@ -43,6 +43,7 @@ from ..model import MuscleModel
 from ..modeling import Component, Equations, Symbols, Var, smath
 from ..result import Result
 from ..scenario import Scenario, load_scenario
+from ..scenario_components import refuse_added
 from ..signals import Step
 from ..simulator import simulate_model
 from .linear import LinearModel, linearize
@@ -96,6 +97,7 @@ class ControllerConfig:
             Naming the file and key for a missing, unknown or non-positive entry.
         """
         where = scenario.origin
+        refuse_added(scenario, "the closed loop's controller design", InputError)
         table = scenario.spec.get("controller")
         if not isinstance(table, dict):
             raise InputError(f"{where}: missing table [controller] (see docs/control.md)")

@@ -50,7 +50,8 @@ def run_simulation(task: SimulationTask) -> np.ndarray:
         if task.pressure_t_s is not None:
             model = replace(model, source=PrescribedPressure(PiecewiseLinearInput(task.pressure_t_s, task.pressure_Pa)))
             p0 = None
-        res = simulate_model(model, sc.duration_s, sc.solver, x0_m=sc.initial_contraction_m, p0_gauge_Pa=p0)
+        res = simulate_model(model, sc.duration_s, sc.solver, x0_m=sc.initial_contraction_m, p0_gauge_Pa=p0,
+                             added=sc.added_components)
         return np.interp(task.sample_t_s, res.t_s, res.x_m)
     except Exception:  # noqa: BLE001 -- a trial point that cannot be simulated is a bad point, not an error
         return np.full(task.sample_t_s.shape, np.nan)

@@ -32,7 +32,7 @@ from typing import Sequence
 
 import numpy as np
 
-from ..assemblies import one_muscle_assembly
+from ..assemblies import scenario_assembly
 from ..assemblies.one_muscle import RigOutputs
 from ..components.hanging_load import event_name
 from ..core_table import C_CHOICES, SCENARIO_KEYS, unimplemented_choice
@@ -102,9 +102,16 @@ def refuse_unsupported(scenario: Scenario) -> None:
     """Raise :class:`InputError` naming the first setting of ``scenario`` the native backend cannot honour."""
     spec = scenario.spec
     where = scenario.origin
+    table_force = spec["model"]["static_force"] != "acra2012_polynomial"
     for section, keys in REPRESENTED.items():
         table = spec if not section else spec.get(section, {})
         for key in sorted(set(table) - keys):
+            if not section and key == "component" and not table_force:
+                continue  # the generated model holds them
+            if not section and key == "component":
+                raise InputError(f"{where}: component: components added to the rig run natively only with the "
+                                 "acra2012_polynomial static force (another runs as a force table on the "
+                                 "hand-written C core); run it with the python backend")
             name = f"{section}.{key}" if section else key
             raise InputError(f"{where}: {name}: the native backend cannot honour this key; "
                              "run it with the python backend")
@@ -219,8 +226,7 @@ def case_inputs(scenario: Scenario, model: MuscleModel | None = None) -> CaseInp
     u[:, lib.INPUTS.index("load_mass_kg")] = model.load.mass_kg
     assembly = None
     if table is None:  # the generic engine runs the generated model; a force table stays with the C core
-        assembly = one_muscle_assembly(model, scenario.initial_contraction_m, scenario.initial_pressure_gauge_Pa,
-                                       opts.stick_margin_N, opts.release_margin_N)
+        assembly = scenario_assembly(scenario, model)
     return CaseInputs(reals, ints, T, n_samples, starts, u, opts.max_events, model, table, assembly)
 
 

@@ -18,6 +18,7 @@ from typing import Any, Mapping
 from ..elements.friction import FRICTION_MODELS
 from ..errors import InputError
 from ..scenario import Scenario, load_scenario, read_toml
+from ..scenario_components import refuse_added
 from ..table_checks import TableChecker
 from .uncertainty import UncertaintySpec, parse_uncertainty
 
@@ -118,6 +119,7 @@ def sweep_from_dict(spec: Mapping[str, Any], base_dir: str | Path = ".", origin:
     check.check_keys("the top level", "", spec, _TOP_KEYS)
     base_name = check.required(spec, "base_scenario", str)
     base = load_scenario(_resolve(base_dir, base_name))
+    refuse_added(base, "a sweep's static analysis", SweepError)
     frictions = tuple(check.typed("friction_models", spec.get("friction_models", [base.spec["model"]["friction"]]),
                                   list))
     if not frictions:

@@ -1,0 +1,94 @@
+"""A scenario's ``[[component]]`` tables: components added to the rig, checked and wired.
+
+::
+
+    [[component]]
+    name = "spring"            # unique, and not one of the rig's own (load, muscle, chamber, ...)
+    type = "linear_spring"     # pamsim.components.COMPONENT_TYPES
+    k_N_per_m = 400.0          # each of its parameters, by name
+    x_free_m = 0.0
+    [component.connect]        # each of its ports and inputs -> a port or output of the rig or of
+    flange = "load.flange"     # another added component
+
+Every mistake is refused with the table's index and the key: an unknown type or parameter, a missing
+or non-numeric value, a name taken, and every wiring error of the assembly (an unconnected port, a
+unit mismatch, an algebraic loop), which :func:`check_wiring` finds by flattening the scenario's
+assembly once per structure.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from .assemblies.one_muscle import RIG_COMPONENTS, AddedComponent, scenario_assembly
+from .components.catalogue import COMPONENT_TYPES
+from .modeling import AssemblyError
+from .table_checks import did_you_mean
+
+RESERVED_KEYS = ("name", "type", "connect")
+
+_CHECKED: set = set()
+"""Assembly structures whose wiring has been checked in this process (a sweep's cases share one)."""
+
+
+def added_components(v, entries: list) -> tuple[AddedComponent, ...]:
+    """The :class:`AddedComponent` s of a scenario's ``component`` array; ``v`` is the scenario's
+    validator (its ``fail(key, value, why, choices=...)`` raises)."""
+    out, names = [], set()
+    for i, entry in enumerate(entries):
+        where = f"component[{i}]"
+        if not isinstance(entry, dict):
+            v.fail(where, entry, "must be a table ([[component]])")
+        name = entry.get("name")
+        if not isinstance(name, str) or not name.isidentifier():
+            v.fail(f"{where}.name", name, "must be a name made of letters, digits and underscores")
+        if name in RIG_COMPONENTS or name in names:
+            v.fail(f"{where}.name", name, "is taken (by the rig's own components or an earlier [[component]])")
+        names.add(name)
+        kind = entry.get("type")
+        if kind not in COMPONENT_TYPES:
+            v.fail(f"{where}.type", kind, "unknown component type", choices=sorted(COMPONENT_TYPES))
+        cls = COMPONENT_TYPES[kind]
+        declared = [p.name for p in cls.parameters]
+        values: dict[str, float] = {}
+        for key, value in entry.items():
+            if key in RESERVED_KEYS:
+                continue
+            if key not in declared:
+                v.fail(f"{where}.{key}", value, f"not a parameter of {kind}" + did_you_mean(key, declared),
+                       choices=declared)
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+                v.fail(f"{where}.{key}", value, "must be a finite number")
+            values[key] = float(value)
+        for key in declared:
+            if key not in values:
+                v.fail(f"{where}.{key}", None, f"missing: {kind} needs {', '.join(declared)}")
+        connect = entry.get("connect", {})
+        if not isinstance(connect, dict) or not all(isinstance(t, str) for t in connect.values()):
+            v.fail(f"{where}.connect", connect, 'must be a table of its ports and inputs, e.g. {flange = "load.flange"}')
+        out.append(AddedComponent(cls(name, values), dict(connect)))
+    return tuple(out)
+
+
+def refuse_added(scenario: Any, what: str, error: type[Exception]) -> None:
+    """Raise ``error`` if ``scenario`` adds components to the rig: ``what`` (a command, a study) works
+    on the rig alone and would leave them out without a word."""
+    if scenario.added_components:
+        names = ", ".join(repr(a.component.name) for a in scenario.added_components)
+        raise error(f"{scenario.origin}: component: {what} takes the rig alone, not the components added to it "
+                    f"({names}); run the scenario with `pamsim run` (python or native backend)")
+
+
+def check_wiring(scenario: Any, error: type[Exception]) -> None:
+    """Refuse (``error``, the scenario's) a scenario whose added components do not wire into the rig,
+    naming the component and the port."""
+    try:
+        assembly = scenario_assembly(scenario)
+        key = assembly.structure_key()
+        if key not in _CHECKED:
+            assembly.flatten()
+            _CHECKED.add(key)
+    except (AssemblyError, KeyError, ValueError) as exc:
+        text = exc.args[0] if isinstance(exc, KeyError) and exc.args else exc
+        raise error(f"{scenario.origin}: [[component]]: {text}") from None

@@ -1,0 +1,149 @@
+"""A component added to the rig from a scenario: the linear spring of the architecture tutorial.
+
+Checked against hand calculations (the equilibrium of the muscle, the weight and the spring; the
+spring's force law), conservation (the energy balance with the spring's work), the rig without it
+(a spring of zero stiffness changes nothing), and the other backend; and every mistake in a
+``[[component]]`` table is refused naming it, with exit 2 and nothing written.
+"""
+
+from __future__ import annotations
+
+import copy
+import subprocess
+import sys
+import tomllib
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+import pamsim
+from conftest import SCENARIOS
+from pamsim.errors import InputError
+
+SPEC = tomllib.loads((SCENARIOS / "parallel_spring.toml").read_text())
+
+
+def _scenario(changes=None, spring=None, **top):
+    spec = copy.deepcopy(SPEC)
+    for section, values in (changes or {}).items():
+        spec.setdefault(section, {}).update(values)
+    spec["component"][0].update(spring or {})
+    spec.update(top)
+    return pamsim.Scenario.from_dict(spec, base_dir=SCENARIOS)
+
+
+@pytest.mark.parametrize("backend", ["python", "native"])
+def test_a_frictionless_load_settles_where_muscle_weight_and_spring_balance(backend):
+    """No Coulomb friction and linear damping: the load comes to rest where F_static(x, p_supply) =
+    W + k (x - x_free), found here by root-finding on the static model."""
+    k, x_free = 300.0, 0.005
+    sc = _scenario({"model": {"friction": "none", "damping": "linear"}, "simulation": {"duration_s": 12.0}},
+                   {"k_N_per_m": k, "x_free_m": x_free})
+    res = pamsim.simulate(sc, backend=backend)
+    model = sc.build_model()
+    p = sc.final_pressure_gauge_Pa
+    x_eq = brentq(lambda x: model.static_force.force_N(x, p) - model.load.weight_N - k * (x - x_free), 0.0, 0.06)
+    assert abs(res.x_m[-1] - x_eq) < 1e-6  # 1 um: the decaying oscillation's last trace
+    assert abs(res.v_m_s[-1]) < 1e-4
+
+
+@pytest.mark.parametrize("backend", ["python", "native"])
+def test_the_spring_force_is_its_law_and_the_energy_balance_closes(backend):
+    sc = pamsim.load_scenario(SCENARIOS / "parallel_spring.toml")
+    res = pamsim.simulate(sc, backend=backend)
+    spring = SPEC["component"][0]
+    np.testing.assert_allclose(res.signals["spring.F_spring_N"],
+                               -spring["k_N_per_m"] * (res.x_m - spring["x_free_m"]), rtol=1e-12, atol=1e-12)
+    balance = res.energy_balance()
+    assert balance["spring.W_spring_J"] < -0.1  # the spring took energy as the load rose
+    assert balance["relative"] < 2e-5
+    # held at the end: the net force at rest counts the spring (static - weight + spring)
+    net, _ = res.final_rest_forces_N
+    last = res.signals
+    assert net == pytest.approx(last["F_static_N"][-1] + last["F_gravity_N"][-1] + last["spring.F_spring_N"][-1],
+                                abs=1e-9)
+
+
+def test_a_spring_of_no_stiffness_changes_nothing():
+    with_spring = pamsim.simulate(_scenario(spring={"k_N_per_m": 0.0}))
+    without = pamsim.simulate(pamsim.load_scenario(SCENARIOS / "acra2012_fig4.toml"))
+    assert np.array_equal(with_spring.x_m, without.x_m)
+    assert with_spring.transitions == without.transitions
+
+
+def test_the_native_backend_agrees_with_python():
+    sc = pamsim.load_scenario(SCENARIOS / "parallel_spring.toml")
+    py, nat = pamsim.simulate(sc), pamsim.simulate(sc, backend="native")
+    assert abs(py.x_m[-1] - nat.x_m[-1]) < 2e-6
+    assert [e.kind for e in py.transitions] == [e.kind for e in nat.transitions]
+
+
+BAD = [
+    ({"type": "lineer_spring"}, "component[0].type", "did you mean 'linear_spring'"),
+    ({"k_N_per_mm": 2.0}, "component[0].k_N_per_mm", "not a parameter of linear_spring"),
+    ({"k_N_per_m": "stiff"}, "component[0].k_N_per_m", "must be a finite number"),
+    ({"name": "load"}, "component[0].name", "is taken"),
+    ({"connect": {}}, "[[component]]", "spring.flange"),
+    ({"connect": {"flange": "chamber.port"}}, "[[component]]", "spring.flange"),
+    ({"connect": {"flange": "load.flang"}}, "[[component]]", "load.flang"),
+]
+
+
+@pytest.mark.parametrize("entry, key, why", BAD)
+def test_a_bad_component_table_is_refused_naming_it(entry, key, why):
+    with pytest.raises(InputError) as err:
+        _scenario(spring=entry)
+    assert key in str(err.value) and why in str(err.value)
+
+
+def test_a_missing_parameter_is_refused():
+    spec = copy.deepcopy(SPEC)
+    del spec["component"][0]["x_free_m"]
+    with pytest.raises(InputError, match=r"component\[0\]\.x_free_m.*missing"):
+        pamsim.Scenario.from_dict(spec)
+
+
+def test_the_cli_refuses_with_exit_2_and_writes_nothing(tmp_path):
+    text = (SCENARIOS / "parallel_spring.toml").read_text().replace('type = "linear_spring"', 'type = "coil"')
+    bad = tmp_path / "bad.toml"
+    bad.write_text(text)
+    proc = subprocess.run([sys.executable, "-m", "pamsim", "run", str(bad), "-o", str(tmp_path / "out")],
+                          capture_output=True, text=True)
+    assert proc.returncode == 2 and "component[0].type" in proc.stderr and "Traceback" not in proc.stderr
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("backend, changes", [
+    ("fmu-cs", {}),
+    ("native", {"model": {"static_force": "gaylord"}}),
+])
+def test_backends_that_cannot_run_added_components_refuse_them(backend, changes):
+    with pytest.raises(InputError, match="component"):
+        pamsim.simulate(_scenario(changes), backend=backend)
+
+
+def test_commands_that_take_the_rig_alone_refuse_added_components(tmp_path):
+    proc = subprocess.run([sys.executable, "-m", "pamsim", "linearize", str(SCENARIOS / "parallel_spring.toml"),
+                           "-o", str(tmp_path / "lin")], capture_output=True, text=True)
+    assert proc.returncode == 2 and "'spring'" in proc.stderr and "Traceback" not in proc.stderr
+    assert not (tmp_path / "lin").exists()
+    from pamsim.sweep import load_sweep
+
+    sweep = tmp_path / "sweep.toml"
+    sweep.write_text(f'base_scenario = "{SCENARIOS / "parallel_spring.toml"}"\n'
+                     '[axes]\npressure_bar = [2.0, 3.0]\nweight_N = [12.74]\n')
+    with pytest.raises(InputError, match="static analysis.*'spring'"):
+        load_sweep(sweep)
+    from pamsim.control.closed_loop import ControllerConfig
+
+    with pytest.raises(InputError, match="controller design.*'spring'"):
+        ControllerConfig.from_scenario(pamsim.load_scenario(SCENARIOS / "parallel_spring.toml"))
+
+
+def test_the_casadi_export_holds_the_added_component():
+    from pamsim.export import casadi_model
+
+    flat = casadi_model(pamsim.load_scenario(SCENARIOS / "parallel_spring.toml"))._assembly.flatten()
+    assert "spring.W_spring_J" in [v.name for v in flat.states]
+    assert "spring.F_spring_N" in [v.name for v in flat.outputs]
