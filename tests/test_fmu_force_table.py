@@ -15,6 +15,7 @@ from pamsim.fmu import build
 from pamsim.fmu.force_table import tabulate
 from pamsim.fmu.runner import force_table_for, run_cs, run_me, set_values, tabulate_model
 from pamsim.fmu.variables import value_reference
+from pamsim.muscles import load_muscle
 from test_fmu import _Api, _initialise_with, _instance, _start_fig4
 
 RATED_PA = 4.5e5
@@ -168,6 +169,10 @@ def test_cli_builds_a_table_fmu_from_a_muscle_and_model(tmp_path):
     assert not (tmp_path / "bad.fmu").exists()
     lone = run_main("fmu", "build", "--static-force", "kothera_energy", "-o", tmp_path / "lone.fmu")
     assert lone.returncode == 2 and "--muscle" in lone.stderr
+    # Without --static-force: the muscle's default_static_force, as every other command takes it.
+    default = run_main("fmu", "build", "--muscle", "kothera2009_5a", "-o", tmp_path / "default.fmu")
+    assert default.returncode == 0, default.stderr
+    assert f"table of {load_muscle('kothera2009_5a').default_static_force}" in default.stdout
 
 
 @pytest.mark.parametrize("version", [2, 3])

@@ -1,4 +1,4 @@
-"""``pamsim fmu build [-o PATH] [--fmi 2|3] [--scenario S.toml | --muscle M --static-force NAME]``:
+"""``pamsim fmu build [-o PATH] [--fmi 2|3] [--scenario S.toml | --muscle M [--static-force NAME]]``:
 compile the muscle model as an FMU."""
 
 from __future__ import annotations
@@ -22,8 +22,9 @@ def register(sub) -> None:
                    help="bake the scenario's static force into the FMU as a force table (F(x, p) over its valid "
                         "domain, interpolated bicubically); the FMU then starts on the table")
     b.add_argument("--muscle", default=None,
-                   help="with --static-force: bake this muscle's (shipped name or TOML path) static force instead")
-    b.add_argument("--static-force", default=None, help="library static force model to bake (with --muscle)")
+                   help="bake this muscle's (shipped name or TOML path) static force instead")
+    b.add_argument("--static-force", default=None,
+                   help="with --muscle: the library static force model (default: the muscle's default_static_force)")
     b.add_argument("--static-force-variant", default=None, help="variant of that model (default: its default)")
     b.set_defaults(func=run_build)
 
@@ -32,13 +33,15 @@ def _muscle_scenario(args: argparse.Namespace):
     """The smallest scenario naming the muscle and model, so they are checked as a scenario file's would be."""
     from ..scenario import Scenario
 
-    model = {"muscle": args.muscle, "static_force": args.static_force}
+    model = {"muscle": args.muscle}
+    if args.static_force:  # else the scenario's default: the muscle's default_static_force
+        model["static_force"] = args.static_force
     if args.static_force_variant:
         model["static_force_variant"] = args.static_force_variant
     spec = {"model": model, "load": {"weight_N": 1.0},
             "pressure": {"source": "valve", "supply_gauge_bar": 0.0, "valve_open_time_s": 0.0},
             "simulation": {"duration_s": 1.0}}
-    return Scenario.from_dict(spec, name="fmu_force_table", origin="pamsim fmu build --muscle/--static-force")
+    return Scenario.from_dict(spec, name="fmu_force_table", origin="pamsim fmu build --muscle")
 
 
 def run_build(args: argparse.Namespace) -> int:
@@ -48,10 +51,10 @@ def run_build(args: argparse.Namespace) -> int:
         raise InputError(f"--fmi = {args.fmi!r}: must be 2 or 3")
     by_muscle = args.muscle is not None or args.static_force is not None or args.static_force_variant is not None
     if args.scenario and by_muscle:
-        raise InputError(f"--scenario = {args.scenario!r}: give either --scenario or --muscle with --static-force")
-    if by_muscle and (args.muscle is None or args.static_force is None):
-        missing = "--muscle" if args.muscle is None else "--static-force"
-        raise InputError(f"{missing}: needed with {'--static-force' if args.muscle is None else '--muscle'}")
+        raise InputError(f"--scenario = {args.scenario!r}: give either --scenario or --muscle")
+    if by_muscle and args.muscle is None:
+        given = "--static-force" if args.static_force is not None else "--static-force-variant"
+        raise InputError(f"--muscle: needed with {given}")
     table = None
     if args.scenario or by_muscle:
         from ..fmu.runner import tabulate_model
