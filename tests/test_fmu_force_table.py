@@ -189,3 +189,20 @@ def test_table_choice_without_a_table_reads_nan_during_initialisation(fmus, vers
     get(dx.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), 4)  # evaluates the model, outputs included
     assert np.isnan(_Api(fmu, version).get("F_static_N")[0])
     fmu.freeInstance()
+
+
+def test_a_table_fmu_says_which_model_it_tabulates(smooth_fmus, fmus, tmp_path):
+    from fmpy import read_model_description
+
+    from pamsim.fmu.generate import DESCRIPTION
+    from pamsim.static_models import REGISTRY
+
+    smooth = read_model_description(str(smooth_fmus[2])).description
+    assert "static force polynomial" not in smooth and "static force smooth_test_force, tabulated" in smooth
+    table = force_table_for(_kothera_energy_scenario())
+    kothera = read_model_description(str(build(tmp_path / "k.fmu", 3, table))).description
+    spec = REGISTRY["kothera_energy"]
+    assert f"static force kothera_energy ({spec.summary}; {spec.source}), tabulated" in kothera
+    assert f"over contraction 0 to {table.x_max_m * 1e3:g} mm and gauge pressure 0 to {table.p_max_Pa:g} Pa" in kothera
+    assert "static force polynomial" not in kothera
+    assert read_model_description(str(fmus[2])).description == DESCRIPTION

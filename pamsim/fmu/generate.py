@@ -35,6 +35,23 @@ HEADERS = {2: ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h"),
            3: ("fmi3Functions.h", "fmi3FunctionTypes.h", "fmi3PlatformTypes.h")}
 DESCRIPTION = ("McKibben muscle lifting a hanging load (ACRA 2012 model, pamsim): static force polynomial, "
                "load-dependent Coulomb friction with stick/slip, damping, ISO 6358 valve and chamber, end stops")
+"""The model description's ``description`` of an FMU without a force table (:func:`description`)."""
+
+
+def description(table: ForceTable | None = None) -> str:
+    """What the FMU is: the exact polynomial (:data:`DESCRIPTION`) or, for a table FMU, which static model
+    it tabulates, from what and over which domain."""
+    if table is None:
+        return DESCRIPTION
+    from ..static_models import REGISTRY
+
+    spec = REGISTRY.get(table.model_name)
+    what = f"{table.model_name} ({spec.summary}; {spec.source})" if spec else table.model_name
+    nx, n_p = table.shape
+    return ("McKibben muscle lifting a hanging load (pamsim): static force " + what + ", tabulated at build "
+            f"time as a {nx} x {n_p} bicubic force table over contraction {table.x_min_m * 1e3:g} to "
+            f"{table.x_max_m * 1e3:g} mm and gauge pressure {table.p_min_Pa:g} to {table.p_max_Pa:g} Pa, "
+            "load-dependent Coulomb friction with stick/slip, damping, ISO 6358 valve and chamber, end stops")
 
 
 AUTHOR = "pamsim developers"
@@ -174,7 +191,7 @@ def _dependencies(names, key) -> dict[str, str]:
 def _header(fmi_version: int, table: ForceTable | None) -> str:
     token_attr = "guid" if fmi_version == 2 else "instantiationToken"
     attrs = _attrs(modelName=MODEL_NAME, **{token_attr: token(fmi_version, table)},
-                   description=DESCRIPTION + (f"; static force: a table of {table.model_name}" if table else ""),
+                   description=description(table),
                    author=AUTHOR,
                    version=__version__, license=LICENSE, generationTool="pamsim.fmu",
                    generationDateAndTime=generation_date(), variableNamingConvention="flat")
@@ -419,7 +436,8 @@ def documentation_html(fmi_version: int, table: ForceTable | None = None) -> str
         rows.append("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in cells) + "</tr>")
     head = "".join(f"<th>{h}</th>" for h in ("value reference", "name", "causality", "type", "unit", "start",
                                               "range", "choices", "description"))
-    sections = "".join(f"<h2>{html.escape(t)}</h2>\n<p>{html.escape(p)}</p>\n" for t, p in USAGE)
+    usage = (("What it is", description(table) + USAGE[0][1][len(DESCRIPTION):]),) + USAGE[1:]
+    sections = "".join(f"<h2>{html.escape(t)}</h2>\n<p>{html.escape(p)}</p>\n" for t, p in usage)
     return (f'<!DOCTYPE html>\n<html lang="en">\n<head><meta charset="utf-8"><title>{MODEL_NAME} (FMI '
             f'{fmi_version}.0)</title></head>\n<body>\n<h1>{MODEL_NAME}: pamsim {__version__}, FMI {fmi_version}.0'
             f'</h1>\n{sections}<h2>Variables</h2>\n<table>\n<tr>{head}</tr>\n' + "\n".join(rows)
