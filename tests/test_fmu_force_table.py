@@ -140,17 +140,23 @@ def test_scenario_with_another_static_model_runs_on_its_table_like_python(interf
 
 
 def test_cli_builds_a_table_fmu_from_a_scenario(tmp_path):
+    """A scenario's static force other than the polynomial is baked in as a table; the polynomial stays exact
+    (its table would end at its fit range, which the load rises past)."""
     from conftest import run_main
-
-    out = run_main("fmu", "build", "--scenario", SCENARIOS / "acra2012_fig4.toml", "-o", tmp_path / "t.fmu")
-    assert out.returncode == 0, out.stderr
-    assert "table of acra2012_polynomial" in out.stdout
     from fmpy import read_model_description
 
+    out = run_main("fmu", "build", "--scenario", SCENARIOS / "acra2012_fig4_chou_hannaford.toml", "-o", tmp_path / "t.fmu")
+    assert out.returncode == 0, out.stderr
+    assert "table of chou_hannaford" in out.stdout
     md = read_model_description(str(tmp_path / "t.fmu"))
     start = {v.name: v.start for v in md.modelVariables}
     assert start["static_force_model"] == "1"
     assert value_reference("static_force_model") == 63
+    exact = run_main("fmu", "build", "--scenario", SCENARIOS / "acra2012_fig4.toml", "-o", tmp_path / "p.fmu")
+    assert exact.returncode == 0, exact.stderr
+    assert "the ACRA 2012 polynomial, exact" in exact.stdout
+    start = {v.name: v.start for v in read_model_description(str(tmp_path / "p.fmu")).modelVariables}
+    assert start["static_force_model"] == "0"
 
 
 def test_cli_builds_a_table_fmu_from_a_muscle_and_model(tmp_path):
@@ -191,6 +197,18 @@ def test_table_choice_without_a_table_reads_nan_during_initialisation(fmus, vers
     fmu.freeInstance()
 
 
+def _muscle_preset(muscle, model=None):
+    """The preset of ``pamsim fmu build --muscle muscle [--static-force model]``, with its force table."""
+    from pamsim.fmu.preset import for_muscle
+
+    spec = {"model": {"muscle": muscle, **({"static_force": model} if model else {})}, "load": {"weight_N": 1.0},
+            "pressure": {"source": "valve", "supply_gauge_bar": 0.0, "valve_open_time_s": 0.0},
+            "simulation": {"duration_s": 1.0}}
+    preset = for_muscle(pamsim.Scenario.from_dict(spec))
+    assert preset.table is not None
+    return preset
+
+
 def test_a_table_fmu_says_which_model_it_tabulates(smooth_fmus, fmus, tmp_path):
     from fmpy import read_model_description
 
@@ -199,10 +217,11 @@ def test_a_table_fmu_says_which_model_it_tabulates(smooth_fmus, fmus, tmp_path):
 
     smooth = read_model_description(str(smooth_fmus[2])).description
     assert "static force polynomial" not in smooth and "static force smooth_test_force, tabulated" in smooth
-    table = force_table_for(_kothera_energy_scenario())
-    kothera = read_model_description(str(build(tmp_path / "k.fmu", 3, table))).description
+    preset = _muscle_preset("kothera2009_5a", "kothera_energy")
+    table = preset.table
+    kothera = read_model_description(str(build(tmp_path / "k.fmu", 3, preset=preset))).description
     spec = REGISTRY["kothera_energy"]
     assert f"static force kothera_energy ({spec.summary}; {spec.source}), tabulated" in kothera
     assert f"over contraction 0 to {table.x_max_m * 1e3:g} mm and gauge pressure 0 to {table.p_max_Pa:g} Pa" in kothera
-    assert "static force polynomial" not in kothera
+    assert "static force polynomial" not in kothera and kothera.endswith("built for muscle kothera2009_5a")
     assert read_model_description(str(fmus[2])).description == DESCRIPTION

@@ -153,14 +153,15 @@ fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReferenc
 fmi2Status fmi2EnterEventMode(fmi2Component c) { return STATUS(fmu_enter_event_mode(FMU(c), __func__)); }
 
 fmi2Status fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo *info) {
-    int changed;
-    if (fmu_update_discrete_states(FMU(c), __func__, &changed)) return fmi2Error;
+    int changed, next_defined;
+    double next;
+    if (fmu_update_discrete_states(FMU(c), __func__, &changed, &next_defined, &next)) return fmi2Error;
     info->valuesOfContinuousStatesChanged = changed ? fmi2True : fmi2False;
     info->newDiscreteStatesNeeded = fmi2False;
     info->terminateSimulation = fmi2False;
     info->nominalsOfContinuousStatesChanged = fmi2False;
-    info->nextEventTimeDefined = fmi2False;
-    info->nextEventTime = 0.0;
+    info->nextEventTimeDefined = next_defined ? fmi2True : fmi2False;
+    info->nextEventTime = next;
     return fmi2OK;
 }
 

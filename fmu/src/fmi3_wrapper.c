@@ -364,14 +364,15 @@ fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boolean *discrete
                                     fmi3Boolean *terminateSimulation, fmi3Boolean *nominalsOfContinuousStatesChanged,
                                     fmi3Boolean *valuesOfContinuousStatesChanged, fmi3Boolean *nextEventTimeDefined,
                                     fmi3Float64 *nextEventTime) {
-    int changed;
-    if (fmu_update_discrete_states(FMU(instance), __func__, &changed)) return fmi3Error;
+    int changed, next_defined;
+    double next;
+    if (fmu_update_discrete_states(FMU(instance), __func__, &changed, &next_defined, &next)) return fmi3Error;
     *valuesOfContinuousStatesChanged = changed ? fmi3True : fmi3False;
     *discreteStatesNeedUpdate = fmi3False;
     *terminateSimulation = fmi3False;
     *nominalsOfContinuousStatesChanged = fmi3False;
-    *nextEventTimeDefined = fmi3False;
-    *nextEventTime = 0.0;
+    *nextEventTimeDefined = next_defined ? fmi3True : fmi3False;
+    *nextEventTime = next;
     return fmi3OK;
 }
 

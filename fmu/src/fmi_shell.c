@@ -80,6 +80,8 @@ int fmu_exit_initialization_mode(FmuInstance *in, const char *function) {
         return -1;
     }
     pam_initialize(&in->core);
+    in->core.event_time_s = in->core.time_s;
+    in->core.inputs_set = 0; /* input_source is fixed from here: a set input is checked when it is set */
     in->state = in->is_cs ? FMU_STEP : FMU_EVENT;
     return 0;
 }
@@ -87,6 +89,8 @@ int fmu_exit_initialization_mode(FmuInstance *in, const char *function) {
 int fmu_enter_event_mode(FmuInstance *in, const char *function) {
     if (!fmu_allowed(in, function, FMU_EVENT | FMU_CONT) || in->is_cs) return -1;
     in->state = FMU_EVENT;
+    in->core.event_time_s = in->core.time_s;
+    pam_inputs_at(&in->core, in->core.time_s, 0); /* an event sees the signals' values after a breakpoint */
     return 0;
 }
 
@@ -195,8 +199,16 @@ int fmu_set_reals(FmuInstance *in, const char *function, const unsigned vr[], si
     if (!fmu_allowed(in, function, FMU_INSTANTIATED | FMU_INIT | FMU_EVENT | FMU_CONT | FMU_STEP) || n_values != nvr)
         return -1;
     for (k = 0; k < nvr; k++) {
-        double *dst;
+        double *dst, scheduled;
         if (!check_vr(in, function, vr[k], 'r') || !settable(in, function, vr[k])) return -1;
+        if (in->state & (FMU_INSTANTIATED | FMU_INIT)) pam_mark_input_set(&in->core, vr[k]);
+        else if (pam_input_scheduled(&in->core, vr[k], &scheduled) && values[k] != scheduled) {
+            /* Echoing the signal's value is harmless; driving an input the FMU overrides would be ignored. */
+            pam_logf(&in->core, PAM_LOG_ERROR, "%s: %s = %g: this FMU's inputs follow the signals of the scenario "
+                     "it was built from (input_source = scenario; %g at t = %g s); set input_source = importer (0) "
+                     "to drive them", function, PAM_VARS[vr[k] - 1].name, values[k], scheduled, in->core.time_s);
+            return -1;
+        }
         if (pam_check_value(&in->core, vr[k], values[k])) return -1;
         dst = &in->core.r[PAM_VARS[vr[k] - 1].index];
         if (*dst != values[k]) in->core.inputs_changed = 1;
@@ -328,9 +340,14 @@ int fmu_directional_derivative(FmuInstance *in, const char *function, const unsi
 
 /* ------------------------------------------------------------ Model Exchange */
 
-int fmu_update_discrete_states(FmuInstance *in, const char *function, int *states_changed) {
+int fmu_update_discrete_states(FmuInstance *in, const char *function, int *states_changed, int *next_time_defined,
+                               double *next_time) {
     if (!fmu_allowed(in, function, FMU_EVENT)) return -1;
     *states_changed = pam_event_update(&in->core);
+    /* The signals' breakpoints are time events: a held load is checked again there, as in co-simulation. */
+    *next_time = pam_next_breakpoint(&in->core, in->core.time_s);
+    *next_time_defined = isfinite(*next_time);
+    if (!*next_time_defined) *next_time = 0.0;
     return 0;
 }
 
@@ -341,6 +358,10 @@ int fmu_completed_integrator_step(FmuInstance *in, const char *function) {
 int fmu_set_time(FmuInstance *in, const char *function, double time) {
     if (!fmu_allowed(in, function, FMU_EVENT | FMU_CONT)) return -1;
     in->core.time_s = time;
+    /* Continuous time runs from the last event, where it sees the signals from the right, to the next
+     * time event, where it sees them from the left; the event itself sees them from the right. */
+    if (in->state == FMU_EVENT) in->core.event_time_s = time;
+    pam_inputs_at(&in->core, time, in->state == FMU_CONT && time > in->core.event_time_s);
     return 0;
 }
 

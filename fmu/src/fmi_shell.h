@@ -108,7 +108,9 @@ int fmu_directional_derivative(FmuInstance *in, const char *function, const unsi
                                double sensitivity[], size_t n_sensitivity);
 
 /* Model exchange */
-int fmu_update_discrete_states(FmuInstance *in, const char *function, int *states_changed);
+/* next_time: the next time event (a breakpoint of the scenario's signals), if next_time_defined. */
+int fmu_update_discrete_states(FmuInstance *in, const char *function, int *states_changed, int *next_time_defined,
+                               double *next_time);
 int fmu_completed_integrator_step(FmuInstance *in, const char *function);
 int fmu_set_time(FmuInstance *in, const char *function, double time);
 int fmu_set_continuous_states(FmuInstance *in, const char *function, const double x[], size_t nx);

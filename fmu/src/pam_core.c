@@ -45,6 +45,107 @@ void pam_reset(PamCore *c) {
     c->inputs_changed = 0;
     c->h_s = 1e-4;
     c->n_steps = c->n_rhs = c->n_events = 0;
+    c->event_time_s = 0.0;
+    c->inputs_set = 0;
+}
+
+/* ------------------------------------------------------------ the scenario's input signals */
+
+static int scheduled(const PamCore *c) {
+    return PAM_NSIG > 0 && c->i[I_input_source] == PAM_INPUT_SOURCE_SCENARIO;
+}
+
+/* pamsim.fmu.preset.InputSignal: knots interpolated as numpy.interp does and held outside them, a knot
+ * time given twice being a step; or a step through a first-order lag (pamsim.signals.FirstOrderLag).
+ * `left`: the value from the left of t, which the integrator takes up to a breakpoint. */
+static double signal_value(const PamSignal *s, double t, int left) {
+    int lo = 0, hi = s->n, k;
+    if (s->n == 0) {
+        if (t < s->time_s) return s->initial;
+        return s->final + (s->initial - s->final) * exp(-(t - s->time_s) / s->tau_s);
+    }
+    while (lo < hi) { /* lo: the knots before t (left) or at or before it (right) */
+        int mid = (lo + hi) / 2;
+        if (left ? s->t_s[mid] < t : s->t_s[mid] <= t) lo = mid + 1;
+        else hi = mid;
+    }
+    k = lo - 1;
+    if (k < 0) return s->value[0];
+    if (k == s->n - 1) return s->value[k];
+    return (s->value[k + 1] - s->value[k]) / (s->t_s[k + 1] - s->t_s[k]) * (t - s->t_s[k]) + s->value[k];
+}
+
+/* The signals at t_s, but for the inputs in `keep` (bit k: signal k). */
+static void apply_signals(PamCore *c, double t_s, int left, unsigned keep) {
+    int k;
+    if (!scheduled(c)) return;
+    for (k = 0; k < PAM_NSIG; k++)
+        if (!(keep >> k & 1u)) c->r[PAM_SIGNALS[k].r] = signal_value(&PAM_SIGNALS[k], t_s, left);
+}
+
+void pam_inputs_at(PamCore *c, double t_s, int left) { apply_signals(c, t_s, left, 0u); }
+
+void pam_mark_input_set(PamCore *c, unsigned vr) {
+    int k;
+    for (k = 0; k < PAM_NSIG; k++)
+        if (PAM_SIGNALS[k].vr == vr) c->inputs_set |= 1u << k;
+}
+
+int pam_input_scheduled(const PamCore *c, unsigned vr, double *value) {
+    int k;
+    if (!scheduled(c)) return 0;
+    for (k = 0; k < PAM_NSIG; k++)
+        if (PAM_SIGNALS[k].vr == vr) {
+            *value = signal_value(&PAM_SIGNALS[k], c->time_s, 0);
+            return 1;
+        }
+    return 0;
+}
+
+double pam_next_breakpoint(const PamCore *c, double t_s) {
+    double next = HUGE_VAL;
+    int k, j;
+    if (!scheduled(c)) return next;
+    for (k = 0; k < PAM_NSIG; k++) {
+        const PamSignal *s = &PAM_SIGNALS[k];
+        if (s->n == 0 && s->time_s > t_s) next = fmin(next, s->time_s);
+        for (j = 0; j < s->n; j++)
+            if (s->t_s[j] > t_s) {
+                next = fmin(next, s->t_s[j]);
+                break;
+            }
+    }
+    return next;
+}
+
+static int at_breakpoint(const PamCore *c, double t_s) {
+    int k, j;
+    if (!scheduled(c)) return 0;
+    for (k = 0; k < PAM_NSIG; k++) {
+        const PamSignal *s = &PAM_SIGNALS[k];
+        if (s->n == 0 && s->time_s == t_s) return 1;
+        for (j = 0; j < s->n; j++)
+            if (s->t_s[j] == t_s) return 1;
+    }
+    return 0;
+}
+
+/* 1 if no input changes from t_s to the next breakpoint: a held load whose chamber does not change then
+ * stays as it is until there. */
+static int inputs_constant(const PamCore *c, double t_s) {
+    int k;
+    if (!scheduled(c)) return 1;
+    for (k = 0; k < PAM_NSIG; k++) {
+        const PamSignal *s = &PAM_SIGNALS[k];
+        if (s->n == 0) {
+            if (t_s >= s->time_s && s->initial != s->final) return 0;
+        } else {
+            int j = 0;
+            while (j < s->n && s->t_s[j] <= t_s) j++;
+            if (j > 0 && j < s->n && s->value[j - 1] != s->value[j]) return 0;
+        }
+    }
+    return 1;
 }
 
 /* ------------------------------------------------------------ elements */
@@ -282,6 +383,42 @@ static double named_real(const PamCore *c, const char *name) {
     return NAN;
 }
 
+/* input_source = scenario: the FMU has signals, and each stays in its input's range at every knot
+ * (the rating and the other parameters may have been changed since the build). */
+static int check_signals(PamCore *c) {
+    int k, j, bad = 0;
+    if (PAM_NSIG == 0) {
+        pam_logf(c, PAM_LOG_ERROR, "invalid parameters: input_source = 1 (scenario): this FMU was built without a "
+                 "scenario (build it with pamsim fmu build --scenario)");
+        return -1;
+    }
+    for (k = 0; k < PAM_NSIG; k++) {
+        const PamSignal *s = &PAM_SIGNALS[k];
+        double now = signal_value(s, c->time_s, 0);
+        if ((c->inputs_set >> k & 1u) && c->r[s->r] != now) {
+            pam_logf(c, PAM_LOG_ERROR, "invalid parameters: %s = %g, set by the importer: this FMU's inputs follow "
+                     "the signals of the scenario it was built from (input_source = scenario; %g at t = %g s); set "
+                     "input_source = importer (0) to drive them", PAM_VARS[s->vr - 1].name, c->r[s->r], now,
+                     c->time_s);
+            bad = -1;
+        }
+    }
+    for (k = 0; k < PAM_NSIG; k++) {
+        const PamSignal *s = &PAM_SIGNALS[k];
+        int n = s->n ? s->n : 2;
+        for (j = 0; j < n; j++) {
+            double value = s->n ? s->value[j] : j ? s->final : s->initial;
+            if (pam_check_value(c, s->vr, value)) {
+                pam_logf(c, PAM_LOG_ERROR, "invalid parameters: input_source = 1 (scenario): the scenario's signal "
+                         "of %s leaves the input's range", PAM_VARS[s->vr - 1].name);
+                bad = -1;
+                break;
+            }
+        }
+    }
+    return bad;
+}
+
 int pam_check_parameters(PamCore *c) {
     const double *r = c->r;
     int bad = 0, k;
@@ -323,6 +460,7 @@ int pam_check_parameters(PamCore *c) {
                  "a force table (build it with pamsim fmu build --scenario)");
         bad = -1;
     }
+    if (c->i[I_input_source] == PAM_INPUT_SOURCE_SCENARIO && check_signals(c)) bad = -1;
     if (!(r[R_initial_pressure_gauge_Pa] <= r[R_rated_pressure_gauge_Pa])) {
         pam_logf(c, PAM_LOG_ERROR,
                  "invalid parameters: initial_pressure_gauge_Pa = %g: must be at most rated_pressure_gauge_Pa = %g",
@@ -352,6 +490,7 @@ void pam_initialize(PamCore *c) {
     c->braid_turns = n;
     c->x_low_m = 0.0;
     c->x_high_m = c->r[R_L0_m] - b / sqrt(PAM_BRAID_LOCK_SEC2); /* braid lock at 54.7 deg, elements.stops */
+    apply_signals(c, c->time_s, 0, c->inputs_set); /* the ones the importer set are checked equal */
     y[X] = c->r[R_initial_contraction_m];
     y[V] = 0.0;
     y[P] = c->r[R_p_atm_Pa] + c->r[R_initial_pressure_gauge_Pa]; /* ValveChamberSource.initial_state */
@@ -383,6 +522,7 @@ void pam_evaluate(PamCore *c) {
     c->r[R_F_friction_N] = friction;
     c->i[I_friction_mode] = mode;
 }
+
 
 /* ------------------------------------------------------------ events */
 
@@ -428,12 +568,18 @@ int pam_event_update(PamCore *c) {
 
 /* ------------------------------------------------------------ Dormand-Prince 5(4) */
 
+/* The nodes of the tableau of pam_dopri.h: the right-hand side depends on time through the inputs, held
+ * over a communication step, or following the scenario's signals (input_source = scenario), which are
+ * set at each stage's node. */
+static const double DP_C[7] = {0.0, 1.0 / 5, 3.0 / 10, 4.0 / 5, 8.0 / 9, 1.0, 1.0};
+
 typedef struct {
     double k[7][PAM_NX];
 } DpStages;
 
-/* One trial step; returns the scaled RMS error norm. k[0] must hold f(y0). */
-static double dp_step(PamCore *c, const double *y0, double h, DpStages *s, double *y1) {
+/* One trial step from t0; returns the scaled RMS error norm. k[0] must hold f(t0, y0).  The inputs are
+ * left at their values from the left of t0 + h. */
+static double dp_step(PamCore *c, double t0, const double *y0, double h, DpStages *s, double *y1) {
     double yt[PAM_NX], err = 0.0, rtol = c->r[R_cs_relative_tolerance];
     int st, j, n;
     for (st = 1; st < 7; st++) {
@@ -442,6 +588,7 @@ static double dp_step(PamCore *c, const double *y0, double h, DpStages *s, doubl
             for (j = 0; j < st; j++) acc += DP_A[st][j] * s->k[j][n];
             yt[n] = y0[n] + h * acc;
         }
+        pam_inputs_at(c, t0 + DP_C[st] * h, 1);
         rhs(c, c->mode, yt, s->k[st]);
     }
     for (n = 0; n < PAM_NX; n++) {
@@ -482,12 +629,13 @@ static int sliding(int mode) { return mode == PAM_SLIP_UP || mode == PAM_SLIP_DO
  * pressure moves monotonically toward its source, so its force margins seldom turn back), so a long
  * one is also checked at HELD_CHECKS points of its dense output. */
 #define HELD_CHECKS 16
-static int first_crossing(const PamCore *c, const DpStages *s, const double *y, const double *y1, double h,
+static int first_crossing(PamCore *c, const DpStages *s, double t, const double *y, const double *y1, double h,
                           double *lo, double *hi) {
     int n = (!sliding(c->mode) && h > c->r[R_cs_max_step_s]) ? HELD_CHECKS : 1, k;
     double ye[PAM_NX];
     for (k = 1; k <= n; k++) {
         if (k < n) dp_dense(s, y, h, (double)k / n, ye);
+        pam_inputs_at(c, k < n ? t + (double)k / n * h : t + h, 1);
         if (min_indicator(c, k < n ? ye : y1) <= 0.0) {
             *lo = (double)(k - 1) / n;
             *hi = (double)k / n;
@@ -522,40 +670,62 @@ static int settle_chamber(PamCore *c, double *y) {
 /* Leaves the instance at the last instant reached (time, states, mode and outputs agree) and fails. */
 static int step_failed(PamCore *c, double t, const double *y) {
     c->time_s = t;
+    pam_inputs_at(c, t, 0);
     put_states(c, y);
     pam_evaluate(c);
     return -1;
 }
 
+/* simulator: a held load's mode is decided again where its inputs jump or reach a breakpoint. */
+static void recheck_held(PamCore *c, const double *y) {
+    int old = c->mode;
+    if (sliding(c->mode)) return;
+    c->mode = rest_mode(c, y, c->mode);
+    if (c->mode != old) c->n_events++;
+}
+
+/* The end of the piece of [t, t_end] the integrator crosses next: t_end, or the first breakpoint of the
+ * signals before it (they are smooth in between). */
+static double piece_end(const PamCore *c, double t, double t_end) {
+    return fmin(t_end, pam_next_breakpoint(c, t));
+}
+
 int pam_do_step(PamCore *c, double t_end) {
-    double y[PAM_NX], y1[PAM_NX], t = c->time_s, h_max = c->r[R_cs_max_step_s];
+    double y[PAM_NX], y1[PAM_NX], t = c->time_s, h_max = c->r[R_cs_max_step_s], t_piece;
     DpStages s;
     long steps = 0, max_steps = c->i[I_cs_max_internal_steps];
     int zero_length = 0, n;
     get_states(c, y);
-    if (c->inputs_changed && !sliding(c->mode)) {
-        /* simulator: a held load is re-checked where its inputs jump */
-        int old = c->mode;
-        c->mode = rest_mode(c, y, c->mode);
-        if (c->mode != old) c->n_events++;
-    }
+    pam_inputs_at(c, t, 0);
+    if (c->inputs_changed || at_breakpoint(c, t)) recheck_held(c, y);
     c->inputs_changed = 0;
     rhs(c, c->mode, y, s.k[0]);
+    t_piece = piece_end(c, t, t_end);
     /* A remainder below the time resolution (left by an event located just before t_end) is not a step. */
     while (t_end - t > 1e-13 * fmax(1.0, fabs(t_end))) {
         double h, err, factor, lo = 0.0, hi = 1.0;
         int last, at_rest = !sliding(c->mode);
+        if (t_piece - t <= 1e-13 * fmax(1.0, fabs(t_piece))) {
+            /* A breakpoint of the signals: they take their values from the right. */
+            t = t_piece;
+            pam_inputs_at(c, t, 0);
+            recheck_held(c, y);
+            rhs(c, c->mode, y, s.k[0]);
+            t_piece = piece_end(c, t, t_end);
+            continue;
+        }
+        pam_inputs_at(c, t, 0); /* a rejected trial step left them at its end */
         if (settle_chamber(c, y)) rhs(c, c->mode, y, s.k[0]);
         /* A held load whose chamber does not change stays as it is while the inputs are held:
          * the solution is constant, however long the step. */
         for (n = 0; n < PAM_NX && at_rest; n++) at_rest = s.k[0][n] == 0.0;
-        if (at_rest) {
-            if (c->on_step) c->on_step(c->step_env, t, t_end, 0.0, y, NULL);
-            t = t_end;
-            break;
+        if (at_rest && inputs_constant(c, t)) {
+            if (c->on_step) c->on_step(c->step_env, t, t_piece, 0.0, y, NULL);
+            t = t_piece;
+            continue;
         }
-        h = fmin(sliding(c->mode) ? fmin(c->h_s, h_max) : c->h_s, t_end - t);
-        last = h >= t_end - t;
+        h = fmin(sliding(c->mode) ? fmin(c->h_s, h_max) : c->h_s, t_piece - t);
+        last = h >= t_piece - t;
         if (++steps > max_steps) {
             pam_logf(c, PAM_LOG_ERROR, "more than %ld internal steps (cs_max_internal_steps) between t = %.9g s "
                      "and %.9g s", max_steps, c->time_s, t_end);
@@ -565,27 +735,29 @@ int pam_do_step(PamCore *c, double t_end) {
             pam_logf(c, PAM_LOG_ERROR, "step size underflow at t = %.9g s", t);
             return step_failed(c, t, y);
         }
-        err = dp_step(c, y, h, &s, y1);
+        err = dp_step(c, t, y, h, &s, y1);
         if (!(err <= 1.0)) {
             c->h_s = h * (isfinite(err) ? fmax(0.2, 0.9 * pow(err, -0.2)) : 0.1);
             continue;
         }
         factor = err == 0.0 ? 10.0 : fmin(10.0, fmax(0.2, 0.9 * pow(err, -0.2)));
         c->n_steps++;
-        if (first_crossing(c, &s, y, y1, h, &lo, &hi)) {
+        if (first_crossing(c, &s, t, y, y1, h, &lo, &hi)) {
             /* Locate the first crossing on the dense output; keep the far side so that the event test holds. */
             double ye[PAM_NX];
             int it;
             for (it = 0; it < 100 && (hi - lo) * h > 1e-15 * fmax(1.0, fabs(t)); it++) {
                 double mid = 0.5 * (lo + hi);
                 dp_dense(&s, y, h, mid, ye);
+                pam_inputs_at(c, t + mid * h, 1);
                 if (min_indicator(c, ye) <= 0.0) hi = mid;
                 else lo = mid;
             }
             if (hi < 1.0) dp_dense(&s, y, h, hi, ye);
             else memcpy(ye, y1, sizeof ye);
-            if (c->on_step) c->on_step(c->step_env, t, hi < 1.0 ? t + hi * h : (last ? t_end : t + h), h, y, &s);
-            t = hi < 1.0 ? t + hi * h : (last ? t_end : t + h);
+            if (c->on_step) c->on_step(c->step_env, t, hi < 1.0 ? t + hi * h : (last ? t_piece : t + h), h, y, &s);
+            t = hi < 1.0 ? t + hi * h : (last ? t_piece : t + h);
+            pam_inputs_at(c, t, 1);
             memcpy(y, ye, sizeof y);
             put_states(c, y);
             {
@@ -608,13 +780,14 @@ int pam_do_step(PamCore *c, double t_end) {
             rhs(c, c->mode, y, s.k[0]);
             continue;
         }
-        if (c->on_step) c->on_step(c->step_env, t, last ? t_end : t + h, h, y, &s);
-        t = last ? t_end : t + h;
+        if (c->on_step) c->on_step(c->step_env, t, last ? t_piece : t + h, h, y, &s);
+        t = last ? t_piece : t + h;
         memcpy(y, y1, sizeof y);
         memcpy(s.k[0], s.k[6], sizeof s.k[0]);
         if (!last || factor < 1.0) c->h_s = h * factor;
     }
     c->time_s = t_end;
+    pam_inputs_at(c, t_end, 0);
     put_states(c, y);
     pam_evaluate(c);
     return 0;

@@ -60,6 +60,8 @@ typedef struct PamCore {
     PamStepFn on_step;
     void *step_env;
     const PamTable *table; /* static_force_model = table; pam_reset points it at the built-in one */
+    double event_time_s;   /* model exchange: the last event, where continuous time starts from */
+    unsigned inputs_set;   /* before the end of initialisation: the signals (bit k) whose input the importer set */
 } PamCore;
 
 void pam_reset(PamCore *c);
@@ -79,6 +81,17 @@ int pam_do_step(PamCore *c, double t_end);
 int pam_directional_derivative(PamCore *c, const unsigned *unknowns, int n_unknowns, const unsigned *knowns,
                                int n_knowns, const double *seed, double *sensitivity);
 void pam_logf(PamCore *c, int level, const char *fmt, ...);
+/* With input_source = scenario, the inputs follow the signals the FMU was built with (PAM_SIGNALS of
+ * pam_variables.h); otherwise these do nothing.  pam_inputs_at sets them at t_s, their values from the
+ * left of t_s (left != 0: the end of an interval) or from the right (an event, a start). */
+void pam_inputs_at(PamCore *c, double t_s, int left);
+/* 1 if input `vr` follows a signal, its value now (from the right) in *value; else 0. */
+int pam_input_scheduled(const PamCore *c, unsigned vr, double *value);
+/* Before the end of initialisation the importer may still choose input_source: an input it sets is
+ * marked here, keeps its value, and is checked against its signal by pam_check_parameters. */
+void pam_mark_input_set(PamCore *c, unsigned vr);
+/* The first breakpoint (knot, step, a lag's start) of the signals after t_s, or HUGE_VAL if none. */
+double pam_next_breakpoint(const PamCore *c, double t_s);
 
 #if defined(__GNUC__)
 #pragma GCC visibility pop

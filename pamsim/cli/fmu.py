@@ -1,5 +1,5 @@
 """``pamsim fmu build [-o PATH] [--fmi 2|3] [--scenario S.toml | --muscle M [--static-force NAME]]``:
-compile the muscle model as an FMU."""
+compile the muscle model as an FMU, for a scenario or a muscle if one is given."""
 
 from __future__ import annotations
 
@@ -19,10 +19,12 @@ def register(sub) -> None:
                    help="FMU file to write (default: pamsim_muscle_fmi<version>.fmu in the current folder)")
     b.add_argument("--fmi", default="2", help="FMI version: 2 (FMI 2.0) or 3 (FMI 3.0); default 2")
     b.add_argument("--scenario", default=None,
-                   help="bake the scenario's static force into the FMU as a force table (F(x, p) over its valid "
-                        "domain, interpolated bicubically); the FMU then starts on the table")
+                   help="build the FMU for this scenario: its muscle's and its own values (parameters, choices, "
+                        "initial state, input signals, run) are the FMU's start values, and a static force other "
+                        "than the ACRA 2012 polynomial is baked in as a force table")
     b.add_argument("--muscle", default=None,
-                   help="bake this muscle's (shipped name or TOML path) static force instead")
+                   help="build the FMU for this muscle (shipped name or TOML path): its parameters are the FMU's "
+                        "start values, and its static force is baked in as a force table")
     b.add_argument("--static-force", default=None,
                    help="with --muscle: the library static force model (default: the muscle's default_static_force)")
     b.add_argument("--static-force-variant", default=None, help="variant of that model (default: its default)")
@@ -55,13 +57,19 @@ def run_build(args: argparse.Namespace) -> int:
     if by_muscle and args.muscle is None:
         given = "--static-force" if args.static_force is not None else "--static-force-variant"
         raise InputError(f"--muscle: needed with {given}")
-    table = None
+    preset = None
     if args.scenario or by_muscle:
-        from ..fmu.runner import tabulate_model
+        from ..fmu import preset as presets
         from ..scenario import load_scenario
 
-        table = tabulate_model(load_scenario(args.scenario) if args.scenario else _muscle_scenario(args))
-    path = build(args.output, int(args.fmi), table)
-    what = f", static force: a {table.shape[0]} x {table.shape[1]} table of {table.model_name}" if table else ""
+        preset = (presets.for_scenario(load_scenario(args.scenario)) if args.scenario
+                  else presets.for_muscle(_muscle_scenario(args)))
+    path = build(args.output, int(args.fmi), preset=preset)
+    what = ""
+    if preset is not None:
+        table = preset.table
+        force = (f"a {table.shape[0]} x {table.shape[1]} table of {table.model_name}" if table
+                 else "the ACRA 2012 polynomial, exact")
+        what = f", for {preset.built_for}; static force: {force}"
     print(f"wrote {path} (FMI {args.fmi}.0, Model Exchange and Co-Simulation{what})")
     return 0

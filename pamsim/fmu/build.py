@@ -76,18 +76,24 @@ def c_compiler(purpose: str) -> str:
     return found
 
 def build(output_path: str | os.PathLike | None = None, fmi_version: int = 2,
-          force_table: ForceTable | None = None) -> Path:
+          force_table: ForceTable | None = None, preset=None) -> Path:
     """Generate, compile and zip the FMU; return the path of the ``.fmu`` file.
 
     ``force_table`` (:func:`pamsim.fmu.force_table.tabulate`) bakes a static force table into the
     FMU, which then starts with ``static_force_model`` = table; without one the FMU has only the
-    exact ACRA 2012 polynomial.
+    exact ACRA 2012 polynomial.  ``preset`` (:func:`pamsim.fmu.preset.for_muscle`,
+    :func:`~pamsim.fmu.preset.for_scenario`) builds the FMU for a muscle or a scenario: its values
+    become the FMU's start values, and its table the FMU's (``force_table`` must then be None).
 
     Raises :class:`~pamsim.errors.InputError` for an unknown FMI version, a
     missing C compiler or a failed compilation (with the compiler's message).
     """
     if fmi_version not in FMI_VERSIONS:
         raise InputError(f"FMI version must be 2 or 3, not {fmi_version!r}")
+    if preset is not None:
+        if force_table is not None:
+            raise ValueError("give the force table in the preset, not beside it")
+        force_table = preset.table
     out = Path(output_path) if output_path else default_output(fmi_version)
     if out.suffix != ".fmu":
         raise InputError(f"{out}: the FMU file name must end in .fmu")
@@ -95,12 +101,12 @@ def build(output_path: str | os.PathLike | None = None, fmi_version: int = 2,
     with tempfile.TemporaryDirectory(prefix="pamsim-fmu-") as tmp:
         root = Path(tmp)
         src = root / "sources"
-        write_sources(src, fmi_version, force_table)
-        (root / "modelDescription.xml").write_text(model_description(fmi_version, force_table))
+        write_sources(src, fmi_version, force_table, preset)
+        (root / "modelDescription.xml").write_text(model_description(fmi_version, force_table, preset))
         bin_dir = root / "binaries" / platform_folder(fmi_version)
         bin_dir.mkdir(parents=True)
         lib = bin_dir / (MODEL_IDENTIFIER + shared_library_suffix())
-        write_documentation(root / "documentation", fmi_version, force_table)
+        write_documentation(root / "documentation", fmi_version, force_table, preset)
         # Only the FMI functions are exported; relative source paths keep the temporary folder's name
         # out of the binary, so that the same sources give the same archive.
         cmd = [compiler, "-shared", "-fPIC", "-O2", "-std=c99", "-Wall", "-fvisibility=hidden", "-I", ".",

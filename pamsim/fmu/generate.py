@@ -22,7 +22,8 @@ from .. import __version__
 from ..references import REFERENCES
 from .units import base_unit
 from .force_table import EMPTY_HEADER, ForceTable
-from .variables import BY_NAME, EVENT_INDICATORS, STATES, VARIABLES, value_reference, with_force_table
+from .variables import (BY_NAME, EVENT_INDICATORS, INPUT_SOURCE_CHOICES, INPUTS, STATES, VARIABLES,
+                        value_reference, with_preset)
 
 MODEL_NAME = "pamsim_muscle"
 MODEL_IDENTIFIER = "pamsim_muscle"
@@ -38,20 +39,23 @@ DESCRIPTION = ("McKibben muscle lifting a hanging load (ACRA 2012 model, pamsim)
 """The model description's ``description`` of an FMU without a force table (:func:`description`)."""
 
 
-def description(table: ForceTable | None = None) -> str:
+def description(table: ForceTable | None = None, preset=None) -> str:
     """What the FMU is: the exact polynomial (:data:`DESCRIPTION`) or, for a table FMU, which static model
-    it tabulates, from what and over which domain."""
+    it tabulates, from what and over which domain; and what it was built for."""
     if table is None:
-        return DESCRIPTION
-    from ..static_models import REGISTRY
+        text = DESCRIPTION
+    else:
+        from ..static_models import REGISTRY
 
-    spec = REGISTRY.get(table.model_name)
-    what = f"{table.model_name} ({spec.summary}; {spec.source})" if spec else table.model_name
-    nx, n_p = table.shape
-    return ("McKibben muscle lifting a hanging load (pamsim): static force " + what + ", tabulated at build "
-            f"time as a {nx} x {n_p} bicubic force table over contraction {table.x_min_m * 1e3:g} to "
-            f"{table.x_max_m * 1e3:g} mm and gauge pressure {table.p_min_Pa:g} to {table.p_max_Pa:g} Pa, "
-            "load-dependent Coulomb friction with stick/slip, damping, ISO 6358 valve and chamber, end stops")
+        spec = REGISTRY.get(table.model_name)
+        what = f"{table.model_name} ({spec.summary}; {spec.source})" if spec else table.model_name
+        nx, n_p = table.shape
+        text = ("McKibben muscle lifting a hanging load (pamsim): static force " + what + ", tabulated at build "
+                f"time as a {nx} x {n_p} bicubic force table over contraction {table.x_min_m * 1e3:g} to "
+                f"{table.x_max_m * 1e3:g} mm and gauge pressure {table.p_min_Pa:g} to {table.p_max_Pa:g} Pa, "
+                "load-dependent Coulomb friction with stick/slip, damping, ISO 6358 valve "
+                "and chamber, end stops")
+    return text + (f"; built for {preset.built_for}" if preset is not None else "")
 
 
 AUTHOR = "pamsim developers"
@@ -104,7 +108,7 @@ def table_text() -> str:
     return "\n".join(repr(v) for v in VARIABLES)
 
 
-def token(fmi_version: int, table: ForceTable | None = None) -> str:
+def token(fmi_version: int, table: ForceTable | None = None, preset=None) -> str:
     h = hashlib.sha256()
     src = c_source_dir() / "src"
     for name in CORE_SOURCES + (WRAPPERS[fmi_version],):
@@ -113,6 +117,8 @@ def token(fmi_version: int, table: ForceTable | None = None) -> str:
     h.update(str(fmi_version).encode())
     if table is not None:
         h.update(table.digest().encode())
+    if preset is not None:
+        h.update(preset.digest().encode())
     return "{" + str(uuid.UUID(bytes=h.digest()[:16])) + "}"
 
 
@@ -159,11 +165,14 @@ LOG_CATEGORIES = (("logStatusOK", "informative messages (only with debug logging
 """The categories the C code logs under (fmi_shell.c, level_category)."""
 
 
-def _common_elements() -> list[str]:
+def _common_elements(preset=None) -> list[str]:
+    """Log categories and the DefaultExperiment: a scenario's run, else the paper's 8 s tests."""
+    run = preset.experiment if preset is not None and preset.experiment is not None else None
+    stop, tolerance, step = (run.stop_time_s, run.tolerance, run.step_size_s) if run else (8.0, 1e-6, DEFAULT_STEP_S)
     lines = ["  <LogCategories>"]
     lines += [f"    <Category{_attrs(name=n, description=d)}/>" for n, d in LOG_CATEGORIES]
     lines += ["  </LogCategories>",
-              f'  <DefaultExperiment startTime="0.0" stopTime="8.0" tolerance="1e-06" stepSize="{DEFAULT_STEP_S!r}"/>']
+              f'  <DefaultExperiment{_attrs(startTime=0.0, stopTime=float(stop), tolerance=float(tolerance), stepSize=float(step))}/>']
     return lines
 
 
@@ -188,10 +197,10 @@ def _dependencies(names, key) -> dict[str, str]:
     return {"dependencies": " ".join(str(key(n)) for n in sorted(names, key=key))}
 
 
-def _header(fmi_version: int, table: ForceTable | None) -> str:
+def _header(fmi_version: int, table: ForceTable | None, preset) -> str:
     token_attr = "guid" if fmi_version == 2 else "instantiationToken"
-    attrs = _attrs(modelName=MODEL_NAME, **{token_attr: token(fmi_version, table)},
-                   description=description(table),
+    attrs = _attrs(modelName=MODEL_NAME, **{token_attr: token(fmi_version, table, preset)},
+                   description=description(table, preset),
                    author=AUTHOR,
                    version=__version__, license=LICENSE, generationTool="pamsim.fmu",
                    generationDateAndTime=generation_date(), variableNamingConvention="flat")
@@ -199,12 +208,13 @@ def _header(fmi_version: int, table: ForceTable | None) -> str:
     return f'<fmiModelDescription fmiVersion="{fmi_version}.0"{attrs}{extra}>'
 
 
-def model_description(fmi_version: int, table: ForceTable | None = None) -> str:
-    """``modelDescription.xml``; ``table``: the force table the FMU is built with, if any."""
+def model_description(fmi_version: int, table: ForceTable | None = None, preset=None) -> str:
+    """``modelDescription.xml``; ``table``: the force table the FMU is built with, if any; ``preset``: the
+    :class:`pamsim.fmu.preset.Preset` of the muscle or scenario it is built for, if any."""
     if fmi_version == 2:
-        return _fmi2(table)
+        return _fmi2(table, preset)
     if fmi_version == 3:
-        return _fmi3(table)
+        return _fmi3(table, preset)
     raise ValueError(f"FMI version must be 2 or 3, not {fmi_version!r}")
 
 
@@ -212,10 +222,10 @@ def _attrs(**kw) -> str:
     return "".join(f" {k}={quoteattr(str(v))}" for k, v in kw.items() if v is not None)
 
 
-def _fmi2(table: ForceTable | None) -> str:
-    variables = with_force_table(VARIABLES, table is not None)
+def _fmi2(table: ForceTable | None, preset) -> str:
+    variables = with_preset(VARIABLES, table, preset)
     src_files = "".join(f'\n      <File name="{n}"/>' for n in compiled_sources(2))
-    lines = ['<?xml version="1.0" encoding="UTF-8"?>', _header(2, table),
+    lines = ['<?xml version="1.0" encoding="UTF-8"?>', _header(2, table, preset),
              f'  <ModelExchange modelIdentifier="{MODEL_IDENTIFIER}" canGetAndSetFMUstate="true"'
              ' canSerializeFMUstate="true" providesDirectionalDerivative="true"'
              ' canNotUseMemoryManagementFunctions="true">',
@@ -224,7 +234,7 @@ def _fmi2(table: ForceTable | None) -> str:
              ' canGetAndSetFMUstate="true" canSerializeFMUstate="true" providesDirectionalDerivative="true"'
              ' canNotUseMemoryManagementFunctions="true">',
              f'    <SourceFiles>{src_files}\n    </SourceFiles>', '  </CoSimulation>']
-    lines += _unit_definitions() + _type_definitions(2) + _common_elements() + ['  <ModelVariables>']
+    lines += _unit_definitions() + _type_definitions(2) + _common_elements(preset) + ['  <ModelVariables>']
     index = {v.name: i for i, v in enumerate(variables, start=1)}  # FMI 2.0 refers to variables by position
     for v in variables:
         head = _attrs(name=v.name, valueReference=value_reference(v.name), description=v.description,
@@ -257,14 +267,14 @@ def _fmi2(table: ForceTable | None) -> str:
     return "\n".join(lines)
 
 
-def _fmi3(table: ForceTable | None) -> str:
-    variables = with_force_table(VARIABLES, table is not None)
-    lines = ['<?xml version="1.0" encoding="UTF-8"?>', _header(3, table),
+def _fmi3(table: ForceTable | None, preset) -> str:
+    variables = with_preset(VARIABLES, table, preset)
+    lines = ['<?xml version="1.0" encoding="UTF-8"?>', _header(3, table, preset),
              f'  <ModelExchange modelIdentifier="{MODEL_IDENTIFIER}" canGetAndSetFMUState="true"'
              ' canSerializeFMUState="true" providesDirectionalDerivatives="true"/>',
              f'  <CoSimulation modelIdentifier="{MODEL_IDENTIFIER}" canHandleVariableCommunicationStepSize="true"'
              ' canGetAndSetFMUState="true" canSerializeFMUState="true" providesDirectionalDerivatives="true"/>']
-    lines += _unit_definitions() + _type_definitions(3) + _common_elements()
+    lines += _unit_definitions() + _type_definitions(3) + _common_elements(preset)
     lines += ['  <ModelVariables>',
               '    <Float64 name="time" valueReference="0" causality="independent" variability="continuous"'
               ' description="simulation time [s]" unit="s"/>']
@@ -316,16 +326,17 @@ def _c_bound(x: float) -> str:
     return repr(float(x))
 
 
-def c_header(fmi_version: int, table: ForceTable | None = None) -> str:
-    """``pam_variables.h``: indices into the value arrays, value references, start values, the token."""
-    variables = with_force_table(VARIABLES, table is not None)
+def c_header(fmi_version: int, table: ForceTable | None = None, preset=None) -> str:
+    """``pam_variables.h``: indices into the value arrays, value references, start values, the token, and
+    the input signals of the scenario the FMU is built for (``preset``), if any."""
+    variables = with_preset(VARIABLES, table, preset)
     reals = [v for v in variables if v.kind == "real"]
     ints = [v for v in variables if v.kind == "integer"]
     n_slots = max(value_reference(v.name) for v in variables)
     kinds = {"parameter": "PAM_PARAMETER", "input": "PAM_INPUT", "output": "PAM_OUTPUT", "local": "PAM_LOCAL"}
     out = ["/* Generated by pamsim.fmu.generate from pamsim/fmu/variables.py. Do not edit. */",
            "#ifndef PAM_VARIABLES_H", "#define PAM_VARIABLES_H", "", "#include <math.h>", "",
-           f'#define PAM_TOKEN "{token(fmi_version, table)}"', f"#define PAM_NR {len(reals)}",
+           f'#define PAM_TOKEN "{token(fmi_version, table, preset)}"', f"#define PAM_NR {len(reals)}",
            f"#define PAM_NI {len(ints)}",
            f"#define PAM_NVARS {n_slots}", f"#define PAM_NX {len(STATES)}",
            f"#define PAM_NZ {len(EVENT_INDICATORS)}", ""]
@@ -359,12 +370,38 @@ def c_header(fmi_version: int, table: ForceTable | None = None) -> str:
             "static const int PAM_DERIV_R[PAM_NX] = {"
             + ", ".join(f"R_{v.c_name}" for v in variables if v.derivative_of) + "};",
             "static const double PAM_NOMINAL[PAM_NX] = {"
-            + ", ".join(repr(float(BY_NAME[s].nominal)) for s in STATES) + "};",
-            "", "#endif", ""]
-    return "\n".join(out)
+            + ", ".join(repr(float(BY_NAME[s].nominal)) for s in STATES) + "};", ""]
+    out += _c_signals(preset.signals if preset is not None else {})
+    return "\n".join(out + ["", "#endif", ""])
 
 
-def write_sources(dest: Path, fmi_version: int, table: ForceTable | None = None) -> list[str]:
+def _c_signals(signals) -> list[str]:
+    """The input signals (:class:`pamsim.fmu.preset.InputSignal`) for ``pam_core.c``, in :data:`INPUTS` order."""
+    out = ["/* input_source (pamsim.fmu.variables.INPUT_SOURCE_CHOICES) */",
+           "enum { " + ", ".join(f"PAM_INPUT_SOURCE_{c.upper()} = {i}" for i, c in enumerate(INPUT_SOURCE_CHOICES))
+           + " };",
+           "/* An input's signal (pamsim.fmu.preset.InputSignal): n knots (t_s, value), or with n = 0 a step from",
+           " * initial to final at time_s through a first-order lag tau_s.  r: the input's index in r[]. */",
+           "typedef struct {", "    int r; unsigned vr; int n; const double *t_s, *value;",
+           "    double time_s, initial, final, tau_s;", "} PamSignal;",
+           "/* The signals of the scenario this FMU was built for (none: PAM_NSIG 0). */",
+           f"#define PAM_NSIG {len(signals)}"]
+    rows = []
+    for k, name in enumerate(n for n in INPUTS if n in signals):
+        sig, c = signals[name], BY_NAME[name].c_name
+        if sig.lag is not None:
+            rows.append(f"    {{R_{c}, VR_{c}, 0, 0, 0, " + ", ".join(repr(float(x)) for x in sig.lag) + "},")
+            continue
+        out.append(f"static const double PAM_SIG{k}_T[{len(sig.knots_t_s)}] = {{"
+                   + ", ".join(repr(float(t)) for t in sig.knots_t_s) + "};")
+        out.append(f"static const double PAM_SIG{k}_V[{len(sig.knots)}] = {{"
+                   + ", ".join(repr(float(x)) for x in sig.knots) + "};")
+        rows.append(f"    {{R_{c}, VR_{c}, {len(sig.knots)}, PAM_SIG{k}_T, PAM_SIG{k}_V, 0.0, 0.0, 0.0, 0.0}},")
+    rows = rows or ["    {0, 0u, 0, 0, 0, 0.0, 0.0, 0.0, 0.0},"]
+    return out + ["static const PamSignal PAM_SIGNALS[" + (str(len(signals)) if signals else "1") + "] = {"] + rows + ["};"]
+
+
+def write_sources(dest: Path, fmi_version: int, table: ForceTable | None = None, preset=None) -> list[str]:
     """Write the sources an FMU ships (C files, generated header, FMI headers, licence) into ``dest``."""
     dest.mkdir(parents=True, exist_ok=True)
     root = c_source_dir()
@@ -376,7 +413,7 @@ def write_sources(dest: Path, fmi_version: int, table: ForceTable | None = None)
         (dest / name).write_bytes((root / "include" / f"fmi{fmi_version}" / name).read_bytes())
         names.append(name)
     (dest / "FMI_HEADERS_LICENSE.txt").write_bytes((root / "include" / "LICENSE.txt").read_bytes())
-    (dest / "pam_variables.h").write_text(c_header(fmi_version, table))
+    (dest / "pam_variables.h").write_text(c_header(fmi_version, table, preset))
     (dest / "pam_force_table.h").write_text(table.c_header() if table is not None else EMPTY_HEADER)
     (dest / "buildDescription.xml").write_text(build_description(fmi_version))
     return names + ["pam_variables.h", "pam_force_table.h", "buildDescription.xml"]
@@ -425,9 +462,9 @@ USAGE = (
 """The usage page in the FMU's documentation/index.html."""
 
 
-def documentation_html(fmi_version: int, table: ForceTable | None = None) -> str:
+def documentation_html(fmi_version: int, table: ForceTable | None = None, preset=None) -> str:
     """``documentation/index.html``: a short usage page and the variable table."""
-    variables = with_force_table(VARIABLES, table is not None)
+    variables = with_preset(VARIABLES, table, preset)
     rows = []
     for v in variables:
         cells = (str(value_reference(v.name)), v.name, v.causality, v.kind, v.unit or "",
@@ -436,7 +473,14 @@ def documentation_html(fmi_version: int, table: ForceTable | None = None) -> str
         rows.append("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in cells) + "</tr>")
     head = "".join(f"<th>{h}</th>" for h in ("value reference", "name", "causality", "type", "unit", "start",
                                               "range", "choices", "description"))
-    usage = (("What it is", description(table) + USAGE[0][1][len(DESCRIPTION):]),) + USAGE[1:]
+    usage = (("What it is", description(table, preset) + USAGE[0][1][len(DESCRIPTION):]),) + USAGE[1:]
+    if preset is not None:  # its start values are not the Shadow muscle's
+        usage = usage[:1] + (("Driving it", f"Set the parameters before the end of initialisation; the defaults are "
+                              f"the values of {preset.built_for}, each variable's description naming its source. "
+                              + USAGE[1][1].split(" with a 22.74 N load. ", 1)[1]
+                              + (" As built, the inputs follow the scenario's signals (input_source = scenario), "
+                                 "exactly within each step; set input_source = importer to drive them."
+                                 if preset.signals else "")),) + usage[2:]
     sections = "".join(f"<h2>{html.escape(t)}</h2>\n<p>{html.escape(p)}</p>\n" for t, p in usage)
     return (f'<!DOCTYPE html>\n<html lang="en">\n<head><meta charset="utf-8"><title>{MODEL_NAME} (FMI '
             f'{fmi_version}.0)</title></head>\n<body>\n<h1>{MODEL_NAME}: pamsim {__version__}, FMI {fmi_version}.0'
@@ -444,10 +488,10 @@ def documentation_html(fmi_version: int, table: ForceTable | None = None) -> str
             + "\n</table>\n</body>\n</html>\n")
 
 
-def write_documentation(dest: Path, fmi_version: int, table: ForceTable | None = None) -> None:
+def write_documentation(dest: Path, fmi_version: int, table: ForceTable | None = None, preset=None) -> None:
     """Write the FMU's ``documentation/`` folder into ``dest``."""
     dest.mkdir(parents=True, exist_ok=True)
-    (dest / "index.html").write_text(documentation_html(fmi_version, table))
+    (dest / "index.html").write_text(documentation_html(fmi_version, table, preset))
 
 
 def shared_header() -> str:

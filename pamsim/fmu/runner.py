@@ -33,8 +33,8 @@ from ..scenario import Scenario
 from .build import build
 from .force_table import DEFAULT_POINTS, ForceTable, tabulate
 from .generate import token
-from .variables import (BY_NAME, DAMPING_CHOICES, FRICTION_CHOICES, INPUTS, NEGATIVE_LEVEL, SOURCE_CHOICES,
-                        STATIC_FORCE_CHOICES, VARIABLES, value_reference)
+from .variables import (BY_NAME, DAMPING_CHOICES, FRICTION_CHOICES, INPUT_SOURCE_CHOICES, INPUTS, NEGATIVE_LEVEL,
+                        SOURCE_CHOICES, STATIC_FORCE_CHOICES, VARIABLES, value_reference)
 
 OUTPUTS = ("contraction_m", "velocity_m_s", "p_gauge_Pa", "chamber_pressure_abs_Pa", "air_mass_kg")
 
@@ -137,6 +137,8 @@ def start_values(scenario: Scenario) -> dict[str, float | int]:
     values["initial_pressure_gauge_Pa"] = float(pressure.get("initial_gauge_bar", 0.0)) * PA_PER_BAR
     values["stick_margin_N"] = scenario.solver.stick_margin_N
     values["release_margin_N"] = scenario.solver.release_margin_N
+    # The runner drives the inputs, also of an FMU built from a scenario (which starts on its signals).
+    values["input_source"] = INPUT_SOURCE_CHOICES.index("importer")
     return values
 
 

@@ -39,6 +39,10 @@ STATIC_FORCE_CHOICES = C_CHOICES["static_force_model"]
 build time (any other static model; :mod:`pamsim.fmu.force_table`)."""
 NEGATIVE_LEVEL = C_CHOICES["friction_negative_level"]
 """``friction_negative_level`` values 0, 1 (the scenario's ``model.friction_negative_level`` names)."""
+INPUT_SOURCE_CHOICES = ("importer", "scenario")
+"""``input_source`` values 0, 1: the inputs are the importer's, or follow the signals of the scenario the
+FMU was built from (:mod:`pamsim.fmu.preset`).  The FMU's own choice, so its C enumeration is generated
+into ``pam_variables.h`` rather than ``pam_shared.h``."""
 
 
 VALUE_REFERENCES = {
@@ -53,7 +57,7 @@ VALUE_REFERENCES = {
     "friction_model": 33, "damping_model": 34, "pressure_source": 35, "initial_contraction_m": 36,
     "stick_margin_N": 37, "release_margin_N": 38, "cs_relative_tolerance": 39, "cs_max_step_s": 40,
     "friction_negative_level": 41, "initial_pressure_gauge_Pa": 42, "cs_max_internal_steps": 62,
-    "static_force_model": 63,
+    "static_force_model": 63, "input_source": 64,
     # Inputs, states, derivatives, outputs, event indicators.
     "valve_command": 43, "supply_pressure_gauge_Pa": 44, "prescribed_pressure_gauge_Pa": 45, "load_mass_kg": 46,
     "external_force_N": 47, "contraction_m": 48, "velocity_m_s": 49, "chamber_pressure_abs_Pa": 50, "air_mass_kg": 51,
@@ -217,6 +221,9 @@ def _table() -> tuple[Variable, ...]:
         Variable("cs_max_internal_steps", "integer", "parameter", "fixed",
                  "co-simulation: a doStep that needs more internal steps than this fails (a bound on its "
                  "run time) [1]", None, 10_000_000, "exact", lower=1, upper=2**31 - 1),
+        _choice("input_source", "where the inputs come from: {} (the signals of the scenario this FMU was "
+                "built from; an input set to another value than its signal's is then refused)",
+                INPUT_SOURCE_CHOICES),
     ]
     return tuple(rows)
 
@@ -240,6 +247,34 @@ def with_force_table(variables: tuple[Variable, ...], has_table: bool) -> tuple[
         return variables
     return tuple(replace(v, start=STATIC_FORCE_CHOICES.index("table")) if v.name == "static_force_model" else v
                  for v in variables)
+
+
+def _with_source(v: Variable, source: str) -> str:
+    """``v``'s description with its start value's provenance: a parameter's ``(source: ...)`` replaced,
+    anything else's appended."""
+    head, sep, _ = v.description.rpartition(" (source: ")
+    if sep and v.causality == "parameter" and v.kind == "real":
+        return f"{head} (source: {source})"
+    return f"{v.description} (start value: {source})"
+
+
+def with_preset(variables: tuple[Variable, ...], table, preset) -> tuple[Variable, ...]:
+    """The table of an FMU built with a force ``table`` and a :class:`pamsim.fmu.preset.Preset` (or
+    None): the preset's start values, each with its provenance in the description."""
+    variables = with_force_table(variables, table is not None)
+    if preset is None:
+        return variables
+    unknown = sorted(set(preset.starts) - {v.name for v in variables})
+    if unknown:
+        raise ValueError(f"preset start values for variables the FMU does not have: {unknown}")
+    out = []
+    for v in variables:
+        if v.name in preset.starts:
+            start = preset.starts[v.name]
+            v = replace(v, start=int(start) if v.kind == "integer" else float(start),
+                        description=_with_source(v, preset.sources[v.name]))
+        out.append(v)
+    return tuple(out)
 
 
 VARIABLES: tuple[Variable, ...] = _table()
