@@ -13,7 +13,7 @@ import pamsim
 from conftest import SCENARIOS
 from pamsim.fmu import build
 from pamsim.fmu.force_table import tabulate
-from pamsim.fmu.runner import force_table_for, run_cs, run_me, set_values, tabulate_model
+from pamsim.fmu.runner import force_table_for, run_cs, run_me, set_values
 from pamsim.fmu.variables import value_reference
 from pamsim.muscles import load_muscle
 from test_fmu import _Api, _initialise_with, _instance, _start_fig4
@@ -82,7 +82,11 @@ def test_tabulated_polynomial_runs_as_the_exact_polynomial(tmp_path, version):
     """Fig. 4 in co-simulation on the polynomial's table and on the exact polynomial (one FMU, both
     choices): the bicubic table reproduces a force cubic in x and p, so the runs agree."""
     sc = pamsim.load_scenario(SCENARIOS / "acra2012_fig4.toml")
-    path = build(tmp_path / "poly_table.fmu", version, tabulate_model(sc))
+    # Over the whole travel and rating (its fit range, tabulate_model's domain, is narrower: the load rises past it).
+    travel = (0.0, sc.build_model().stops.x_high_m)
+    table = tabulate(sc.static_model(), travel, (0.0, sc.parameters["rated_pressure_gauge_Pa"]),
+                     model_name="acra2012_polynomial")
+    path = build(tmp_path / "poly_table.fmu", version, table)
     runs = {}
     for choice in (0, 1):
         fmu = _instance({version: path}, version)
@@ -145,7 +149,8 @@ def test_cli_builds_a_table_fmu_from_a_scenario(tmp_path):
     from conftest import run_main
     from fmpy import read_model_description
 
-    out = run_main("fmu", "build", "--scenario", SCENARIOS / "acra2012_fig4_chou_hannaford.toml", "-o", tmp_path / "t.fmu")
+    out = run_main("fmu", "build", "--scenario", SCENARIOS / "acra2012_fig4_chou_hannaford.toml",
+                   "-o", tmp_path / "t.fmu")
     assert out.returncode == 0, out.stderr
     assert "table of chou_hannaford" in out.stdout
     md = read_model_description(str(tmp_path / "t.fmu"))
@@ -197,6 +202,9 @@ def test_table_choice_without_a_table_reads_nan_during_initialisation(fmus, vers
     fmu.freeInstance()
 
 
+# ------------------------------------------------------------------ the table is never extrapolated
+
+
 def _muscle_preset(muscle, model=None):
     """The preset of ``pamsim fmu build --muscle muscle [--static-force model]``, with its force table."""
     from pamsim.fmu.preset import for_muscle
@@ -207,6 +215,89 @@ def _muscle_preset(muscle, model=None):
     preset = for_muscle(pamsim.Scenario.from_dict(spec))
     assert preset.table is not None
     return preset
+
+
+def _refused(path, start_values):
+    from fmpy import simulate_fmu
+    from fmpy.fmi1 import FMICallException
+
+    with pytest.raises(FMICallException):
+        simulate_fmu(str(path), stop_time=0.1, start_values=start_values)
+
+
+def test_a_table_fmu_refuses_a_travel_beyond_its_table(tmp_path, capfd):
+    """The survey's 40 mm muscle's table covers its own travel, to 11.45 mm; the Shadow muscle's
+    geometry (the FMU's old start values) travels to 115.68 mm and is refused at initialisation."""
+    from fmpy import simulate_fmu
+
+    from pamsim.elements.stops import EndStops
+    from pamsim.parameters import get_parameter_set
+
+    preset = _muscle_preset("mpam_survey_40mm")
+    table = preset.table
+    path = build(tmp_path / "survey40.fmu", 2, preset=preset)
+    shadow = get_parameter_set("shadow_6x300_acra2012")
+    capfd.readouterr()
+    _refused(path, {n: shadow[n] for n in ("L0_m", "r0_m", "theta0_deg")})
+    log = capfd.readouterr().out
+    travel = EndStops.from_parameters(shadow).x_high_m
+    assert (f"invalid parameters: L0_m = {shadow['L0_m']:g}, theta0_deg = {shadow['theta0_deg']:g}: the load's "
+            f"travel, 0 to {travel:.6g} m (the braid-lock stop), leaves the force table of "
+            f"{table.model_name}, which covers contraction 0 to {table.x_max_m:.6g} m") in log
+    # Its own geometry: at 7.58 bar the load rises to its stop, the table's edge, and no further.
+    res = simulate_fmu(str(path), stop_time=2.0, start_values={
+        "valve_command": 1.0, "supply_pressure_gauge_Pa": 7.58e5, "load_mass_kg": 0.005})
+    assert res["contraction_m"].max() == pytest.approx(table.x_max_m, abs=1e-9)
+    assert "left the force table" not in capfd.readouterr().out
+
+
+@pytest.mark.parametrize("muscle,model", [("kothera2009_2b", None), ("kothera2009_5a", "kothera_energy")])
+def test_a_table_fmu_refuses_pressures_beyond_its_table(tmp_path, capfd, muscle, model):
+    """Kothera's actuators are rated (and tabulated) to 60 psi, 4.14 bar: a 4.4 bar supply is refused
+    as above the rating, and a rating raised past the table at initialisation."""
+    from fmpy import simulate_fmu
+
+    preset = _muscle_preset(muscle, model)
+    table, rating = preset.table, preset.starts["rated_pressure_gauge_Pa"]
+    assert table.p_max_Pa == rating
+    path = build(tmp_path / "k.fmu", 2, preset=preset)
+    capfd.readouterr()
+    _refused(path, {"supply_pressure_gauge_Pa": 4.4e5})
+    assert (f"supply_pressure_gauge_Pa = 440000 Pa: exceeds the muscle's rating rated_pressure_gauge_Pa = "
+            f"{rating:g} Pa") in capfd.readouterr().out
+    _refused(path, {"rated_pressure_gauge_Pa": 4.5e5, "supply_pressure_gauge_Pa": 4.4e5})
+    assert (f"invalid parameters: rated_pressure_gauge_Pa = 450000: above the force table of {table.model_name}, "
+            f"which covers gauge pressure 0 to {table.p_max_Pa:g} Pa") in capfd.readouterr().out
+    # At its rating the chamber overshoots the supply a little as the load swings back: held at the
+    # table's edge, too little to report.
+    res = simulate_fmu(str(path), stop_time=2.0, start_values={
+        "valve_command": 1.0, "supply_pressure_gauge_Pa": rating, "load_mass_kg": 0.5})
+    assert res["p_gauge_Pa"].max() <= rating + 1e-2 * (table.p_max_Pa - table.p_min_Pa)
+    assert "left the force table" not in capfd.readouterr().out
+
+
+def test_a_pressure_beyond_the_table_takes_the_edge_force_and_is_reported_once(smooth_fmus, capfd):
+    """A load yanked down compresses the chamber far above the supply (the table's top): the force is
+    the table's value at its edge, the model's own there, not the edge cell's cubic carried on."""
+    from fmpy import simulate_fmu
+
+    names = ("time", "valve_command", "supply_pressure_gauge_Pa", "load_mass_kg", "external_force_N")
+    rows = [(0.0, 1.0, RATED_PA, 1.0, 0.0), (1.0, 1.0, RATED_PA, 1.0, 0.0), (1.0, 1.0, RATED_PA, 1.0, -300.0),
+            (2.0, 1.0, RATED_PA, 1.0, -300.0)]
+    capfd.readouterr()
+    res = simulate_fmu(str(smooth_fmus[2]), stop_time=2.0, output_interval=1e-3, validate=False,
+                       input=np.array(rows, dtype=[(n, float) for n in names]),
+                       output=["contraction_m", "p_gauge_Pa", "F_static_N"])
+    log = capfd.readouterr().out
+    k = int(np.argmax(res["p_gauge_Pa"]))
+    x, p = res["contraction_m"][k], res["p_gauge_Pa"][k]
+    assert p > 1.5 * RATED_PA
+    model = SmoothForce()
+    edge = max(float(model.force_N(x, RATED_PA)), 0.0)
+    assert res["F_static_N"][k] == pytest.approx(edge, abs=1e-3 * float(model.force_N(0.0, RATED_PA)))
+    assert abs(float(model.force_N(x, p)) - edge) > 10.0  # extrapolating would have told another story
+    assert log.count("left the force table of smooth_test_force") == 1
+    assert f"(0 to {RATED_PA:g} Pa): the static force is held at the table's edge" in log
 
 
 def test_a_table_fmu_says_which_model_it_tabulates(smooth_fmus, fmus, tmp_path):

@@ -111,16 +111,14 @@ int fmu_reset(FmuInstance *in, const char *function) {
 
 /* ------------------------------------------------------------ variables */
 
-/* Outputs of the initialization mode follow the parameters set so far; invalid ones are
- * reported once, by ExitInitializationMode, not at every read. */
+/* Outputs of the initialization mode follow the parameters set so far; invalid ones (and a start
+ * outside the force table) are reported once, by ExitInitializationMode, not at every read. */
 static void refresh(FmuInstance *in, int evaluate_in) {
     PamLogFn log = in->core.log;
-    int valid;
     if (in->state == FMU_INIT) {
         in->core.log = 0;
-        valid = pam_check_parameters(&in->core) == 0;
+        if (pam_check_parameters(&in->core) == 0) pam_initialize(&in->core);
         in->core.log = log;
-        if (valid) pam_initialize(&in->core);
     }
     if (in->state & evaluate_in) pam_evaluate(&in->core);
 }
@@ -352,7 +350,9 @@ int fmu_update_discrete_states(FmuInstance *in, const char *function, int *state
 }
 
 int fmu_completed_integrator_step(FmuInstance *in, const char *function) {
-    return fmu_allowed(in, function, FMU_CONT) ? 0 : -1;
+    if (!fmu_allowed(in, function, FMU_CONT)) return -1;
+    pam_note_table_edge(&in->core);
+    return 0;
 }
 
 int fmu_set_time(FmuInstance *in, const char *function, double time) {

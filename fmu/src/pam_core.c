@@ -45,6 +45,7 @@ void pam_reset(PamCore *c) {
     c->inputs_changed = 0;
     c->h_s = 1e-4;
     c->n_steps = c->n_rhs = c->n_events = 0;
+    c->table_edge_logged = 0;
     c->event_time_s = 0.0;
     c->inputs_set = 0;
 }
@@ -177,6 +178,18 @@ static int has_table(const PamCore *c) {
     return c->table != NULL && c->table->nx >= 2 && c->table->np >= 2;
 }
 
+/* The table built into the FMU never extrapolates: its contraction range bounds the travel (the end
+ * stops, pam_initialize; a travel beyond it is refused by pam_check_parameters) and a pressure beyond
+ * its range takes the force at its edge (logged once).  A table given at run time (the native library,
+ * tabulated over the scenario's stops and rating) extrapolates its edge cells, as the Python model it
+ * stands for is evaluated there. */
+static int table_guarded(const PamCore *c) {
+    return c->i[I_static_force_model] == PAM_STATIC_FORCE_MODEL_TABLE && has_table(c) && c->table == &BUILT_IN_TABLE;
+}
+
+static double table_x_end_m(const PamTable *T) { return T->x0 + (T->nx - 1) * T->dx; }
+static double table_p_end_Pa(const PamTable *T) { return T->p0 + (T->np - 1) * T->dp; }
+
 /* The force table (pamsim.fmu.force_table; the FMU's baked in at build time, the native library's
  * given per case): bicubic Hermite interpolation of the value and the derivatives F_x, F_p, F_xp at
  * the four corners of the cell holding (x, p).  Outside the grid the edge cell's cubic extrapolates. */
@@ -212,8 +225,13 @@ static double table_force_N(const PamCore *c, double x, double p) {
 static double static_force_N(const PamCore *c, double x, double p_gauge) {
     const double *r = c->r;
     double p_bar = p_gauge / PA_PER_BAR, f;
-    if (c->i[I_static_force_model] == PAM_STATIC_FORCE_MODEL_TABLE) f = table_force_N(c, x, p_gauge);
-    else f = ((r[R_K1_N_per_bar_m2] * x + r[R_K2_N_per_bar_m]) * x + r[R_C1_N_per_bar]) * p_bar
+    if (c->i[I_static_force_model] == PAM_STATIC_FORCE_MODEL_TABLE) {
+        if (table_guarded(c)) {
+            x = fmin(fmax(x, c->table->x0), table_x_end_m(c->table));
+            p_gauge = fmin(fmax(p_gauge, c->table->p0), table_p_end_Pa(c->table));
+        }
+        f = table_force_N(c, x, p_gauge);
+    } else f = ((r[R_K1_N_per_bar_m2] * x + r[R_K2_N_per_bar_m]) * x + r[R_C1_N_per_bar]) * p_bar
              + (r[R_S1_N_per_m2] * x + r[R_S2_N_per_m]) * x + r[R_S3_N];
     return f < 0.0 ? 0.0 : f;  /* NaN (a table choice without a table) stays NaN */
 }
@@ -383,6 +401,43 @@ static double named_real(const PamCore *c, const char *name) {
     return NAN;
 }
 
+/* The part of the table's range by which the same bound may differ when computed in Python (the
+ * tabulated domain) and here: a few roundings. */
+#define TABLE_COVER_TOL 1e-12
+
+/* The built-in table covers the load's travel (0 to the braid lock) and the gauge pressures the chamber
+ * starts and is driven at (0 to the rating, the bound of the supply, prescribed and initial pressures):
+ * the table was built for one muscle, and the geometry or rating of another would leave it. */
+static int check_table_covers(PamCore *c) {
+    const double *r = c->r;
+    const PamTable *T = c->table;
+    double b, n, x_high, x_end = table_x_end_m(T), p_end = table_p_end_Pa(T);
+    double x_tol = TABLE_COVER_TOL * (x_end - T->x0), p_tol = TABLE_COVER_TOL * (p_end - T->p0);
+    int bad = 0;
+    braid_geometry(r, &b, &n);
+    x_high = r[R_L0_m] - b / sqrt(PAM_BRAID_LOCK_SEC2);
+    if (x_high > x_end + x_tol || T->x0 > x_tol) {
+        pam_logf(c, PAM_LOG_ERROR, "invalid parameters: L0_m = %g, theta0_deg = %g: the load's travel, 0 to %.6g m "
+                 "(the braid-lock stop), leaves the force table of %s, which covers contraction %.6g to %.6g m "
+                 "(a table is built for one muscle: build the FMU for this geometry)", r[R_L0_m], r[R_theta0_deg],
+                 x_high, PAM_FT_MODEL, T->x0, x_end);
+        bad = -1;
+    }
+    if (r[R_rated_pressure_gauge_Pa] > p_end + p_tol) {
+        pam_logf(c, PAM_LOG_ERROR, "invalid parameters: rated_pressure_gauge_Pa = %g: above the force table of %s, "
+                 "which covers gauge pressure %g to %g Pa (the supply, prescribed and initial pressures may reach "
+                 "the rating)", r[R_rated_pressure_gauge_Pa], PAM_FT_MODEL, T->p0, p_end);
+        bad = -1;
+    }
+    if (T->p0 > p_tol) {
+        pam_logf(c, PAM_LOG_ERROR, "invalid parameters: static_force_model = 1 (table): the force table of %s starts "
+                 "at gauge pressure %g Pa, above the ambient pressure an exhausted chamber reaches", PAM_FT_MODEL,
+                 T->p0);
+        bad = -1;
+    }
+    return bad;
+}
+
 /* input_source = scenario: the FMU has signals, and each stays in its input's range at every knot
  * (the rating and the other parameters may have been changed since the build). */
 static int check_signals(PamCore *c) {
@@ -460,6 +515,7 @@ int pam_check_parameters(PamCore *c) {
                  "a force table (build it with pamsim fmu build --scenario)");
         bad = -1;
     }
+    if (table_guarded(c) && check_table_covers(c)) bad = -1;
     if (c->i[I_input_source] == PAM_INPUT_SOURCE_SCENARIO && check_signals(c)) bad = -1;
     if (!(r[R_initial_pressure_gauge_Pa] <= r[R_rated_pressure_gauge_Pa])) {
         pam_logf(c, PAM_LOG_ERROR,
@@ -483,6 +539,34 @@ int pam_check_parameters(PamCore *c) {
 
 /* ------------------------------------------------------------ state and outputs */
 
+/* A pressure (or a contraction) further outside the built-in table than this part of its range is
+ * reported: the force there is the table's edge value, not the model's.  Closer, it is the chamber's
+ * ordinary overshoot of a supply at the rating (the table's top) as the load swings back, or its dip
+ * below ambient as the muscle swells, where the edge value is as good as the model's. */
+#define TABLE_EDGE_REPORT 1e-2
+
+static void note_table_edge(PamCore *c, double t, const double *y) {
+    const PamTable *T = c->table;
+    double p, x_end, p_end, x_tol, p_tol;
+    if (c->table_edge_logged || !table_guarded(c)) return;
+    p = pressure_gauge_Pa(c, y);
+    x_end = table_x_end_m(T);
+    p_end = table_p_end_Pa(T);
+    x_tol = TABLE_EDGE_REPORT * (x_end - T->x0);
+    p_tol = TABLE_EDGE_REPORT * (p_end - T->p0);
+    if (p < T->p0 - p_tol || p > p_end + p_tol) {
+        pam_logf(c, PAM_LOG_WARNING, "at t = %.9g s the chamber's gauge pressure, %g Pa, left the force table of %s "
+                 "(%g to %g Pa): the static force is held at the table's edge, never extrapolated (reported once)",
+                 t, p, PAM_FT_MODEL, T->p0, p_end);
+        c->table_edge_logged = 1;
+    } else if (y[X] < T->x0 - x_tol || y[X] > x_end + x_tol) {
+        pam_logf(c, PAM_LOG_WARNING, "at t = %.9g s the contraction, %g m, left the force table of %s (%g to %g m): "
+                 "the static force is held at the table's edge, never extrapolated (reported once)", t, y[X],
+                 PAM_FT_MODEL, T->x0, x_end);
+        c->table_edge_logged = 1;
+    }
+}
+
 void pam_initialize(PamCore *c) {
     double y[PAM_NX], b, n;
     braid_geometry(c->r, &b, &n);
@@ -490,6 +574,10 @@ void pam_initialize(PamCore *c) {
     c->braid_turns = n;
     c->x_low_m = 0.0;
     c->x_high_m = c->r[R_L0_m] - b / sqrt(PAM_BRAID_LOCK_SEC2); /* braid lock at 54.7 deg, elements.stops */
+    if (table_guarded(c)) { /* the table's edge is a stop: the travel within it up to rounding (checked) */
+        c->x_low_m = fmax(c->x_low_m, c->table->x0);
+        c->x_high_m = fmin(c->x_high_m, table_x_end_m(c->table));
+    }
     apply_signals(c, c->time_s, 0, c->inputs_set); /* the ones the importer set are checked equal */
     y[X] = c->r[R_initial_contraction_m];
     y[V] = 0.0;
@@ -500,6 +588,8 @@ void pam_initialize(PamCore *c) {
     c->mode = rest_mode(c, y, y[X] <= c->x_low_m ? PAM_STOP_LOW : y[X] >= c->x_high_m ? PAM_STOP_HIGH : PAM_STICK);
     c->inputs_changed = 0;
     pam_evaluate(c);
+    c->table_edge_logged = 0; /* a run starts */
+    note_table_edge(c, c->time_s, y);
 }
 
 void pam_evaluate(PamCore *c) {
@@ -523,6 +613,11 @@ void pam_evaluate(PamCore *c) {
     c->i[I_friction_mode] = mode;
 }
 
+void pam_note_table_edge(PamCore *c) {
+    double y[PAM_NX];
+    get_states(c, y);
+    note_table_edge(c, c->time_s, y);
+}
 
 /* ------------------------------------------------------------ events */
 
@@ -558,6 +653,7 @@ int pam_event_update(PamCore *c) {
     double y[PAM_NX];
     int old = c->mode, jumped;
     get_states(c, y);
+    note_table_edge(c, c->time_s, y);
     jumped = transition(c, y);
     if (jumped || c->mode != old) c->n_events++;
     put_states(c, y);
@@ -760,6 +856,7 @@ int pam_do_step(PamCore *c, double t_end) {
             pam_inputs_at(c, t, 1);
             memcpy(y, ye, sizeof y);
             put_states(c, y);
+            note_table_edge(c, t, y);
             {
                 double y_before[PAM_NX];
                 int old = c->mode, jumped;
@@ -784,12 +881,14 @@ int pam_do_step(PamCore *c, double t_end) {
         t = last ? t_piece : t + h;
         memcpy(y, y1, sizeof y);
         memcpy(s.k[0], s.k[6], sizeof s.k[0]);
+        note_table_edge(c, t, y);
         if (!last || factor < 1.0) c->h_s = h * factor;
     }
     c->time_s = t_end;
     pam_inputs_at(c, t_end, 0);
     put_states(c, y);
     pam_evaluate(c);
+    note_table_edge(c, t_end, y);
     return 0;
 }
 

@@ -60,6 +60,7 @@ typedef struct PamCore {
     PamStepFn on_step;
     void *step_env;
     const PamTable *table; /* static_force_model = table; pam_reset points it at the built-in one */
+    int table_edge_logged; /* the built-in table's edge has been reached (logged once) */
     double event_time_s;   /* model exchange: the last event, where continuous time starts from */
     unsigned inputs_set;   /* before the end of initialisation: the signals (bit k) whose input the importer set */
 } PamCore;
@@ -72,10 +73,13 @@ int pam_check_parameters(PamCore *c);
 void pam_initialize(PamCore *c);
 /* Derivatives, outputs and event indicators from the states, inputs and mode. */
 void pam_evaluate(PamCore *c);
+/* Reports once (a warning) a state outside the built-in force table, whose edge value the static force
+ * then takes: at each solution point (an accepted step, an event), not at an integrator's trial points. */
+void pam_note_table_edge(PamCore *c);
 /* Model-exchange event update: apply one mode transition; returns 1 if x or v jumped. */
 int pam_event_update(PamCore *c);
-/* Co-simulation: integrate to t_end with the inputs held; 0 on success, -1 on failure (logged), which
- * leaves time_s, the states, the mode and the outputs at the last instant reached. */
+/* Co-simulation: integrate to t_end, the inputs held or following their signals; 0 on success, -1 on
+ * failure (logged), which leaves time_s, the states, the mode and the outputs at the last instant reached. */
 int pam_do_step(PamCore *c, double t_end);
 /* Directional derivative d(unknowns)/d(knowns) * seed: a central difference per known, mode held. */
 int pam_directional_derivative(PamCore *c, const unsigned *unknowns, int n_unknowns, const unsigned *knowns,

@@ -52,8 +52,8 @@ def description(table: ForceTable | None = None, preset=None) -> str:
         nx, n_p = table.shape
         text = ("McKibben muscle lifting a hanging load (pamsim): static force " + what + ", tabulated at build "
                 f"time as a {nx} x {n_p} bicubic force table over contraction {table.x_min_m * 1e3:g} to "
-                f"{table.x_max_m * 1e3:g} mm and gauge pressure {table.p_min_Pa:g} to {table.p_max_Pa:g} Pa, "
-                "load-dependent Coulomb friction with stick/slip, damping, ISO 6358 valve "
+                f"{table.x_max_m * 1e3:g} mm and gauge pressure {table.p_min_Pa:g} to {table.p_max_Pa:g} Pa "
+                "(never extrapolated), load-dependent Coulomb friction with stick/slip, damping, ISO 6358 valve "
                 "and chamber, end stops")
     return text + (f"; built for {preset.built_for}" if preset is not None else "")
 
@@ -171,8 +171,8 @@ def _common_elements(preset=None) -> list[str]:
     stop, tolerance, step = (run.stop_time_s, run.tolerance, run.step_size_s) if run else (8.0, 1e-6, DEFAULT_STEP_S)
     lines = ["  <LogCategories>"]
     lines += [f"    <Category{_attrs(name=n, description=d)}/>" for n, d in LOG_CATEGORIES]
-    lines += ["  </LogCategories>",
-              f'  <DefaultExperiment{_attrs(startTime=0.0, stopTime=float(stop), tolerance=float(tolerance), stepSize=float(step))}/>']
+    run_attrs = _attrs(startTime=0.0, stopTime=float(stop), tolerance=float(tolerance), stepSize=float(step))
+    lines += ["  </LogCategories>", f"  <DefaultExperiment{run_attrs}/>"]
     return lines
 
 
@@ -270,8 +270,8 @@ def _fmi2(table: ForceTable | None, preset) -> str:
 def _fmi3(table: ForceTable | None, preset) -> str:
     variables = with_preset(VARIABLES, table, preset)
     lines = ['<?xml version="1.0" encoding="UTF-8"?>', _header(3, table, preset),
-             f'  <ModelExchange modelIdentifier="{MODEL_IDENTIFIER}" canGetAndSetFMUState="true"'
-             ' canSerializeFMUState="true" providesDirectionalDerivatives="true"/>',
+             f'  <ModelExchange modelIdentifier="{MODEL_IDENTIFIER}" needsCompletedIntegratorStep="true"'
+             ' canGetAndSetFMUState="true" canSerializeFMUState="true" providesDirectionalDerivatives="true"/>',
              f'  <CoSimulation modelIdentifier="{MODEL_IDENTIFIER}" canHandleVariableCommunicationStepSize="true"'
              ' canGetAndSetFMUState="true" canSerializeFMUState="true" providesDirectionalDerivatives="true"/>']
     lines += _unit_definitions() + _type_definitions(3) + _common_elements(preset)
@@ -398,7 +398,8 @@ def _c_signals(signals) -> list[str]:
                    + ", ".join(repr(float(x)) for x in sig.knots) + "};")
         rows.append(f"    {{R_{c}, VR_{c}, {len(sig.knots)}, PAM_SIG{k}_T, PAM_SIG{k}_V, 0.0, 0.0, 0.0, 0.0}},")
     rows = rows or ["    {0, 0u, 0, 0, 0, 0.0, 0.0, 0.0, 0.0},"]
-    return out + ["static const PamSignal PAM_SIGNALS[" + (str(len(signals)) if signals else "1") + "] = {"] + rows + ["};"]
+    size = str(len(signals)) if signals else "1"
+    return out + [f"static const PamSignal PAM_SIGNALS[{size}] = {{"] + rows + ["};"]
 
 
 def write_sources(dest: Path, fmi_version: int, table: ForceTable | None = None, preset=None) -> list[str]:
