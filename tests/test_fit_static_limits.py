@@ -145,6 +145,19 @@ def test_censored_tests_the_model_does_not_lift_are_no_observations():
     assert padded.dof == alone.dof == 9 and padded.sigma == pytest.approx(np.sqrt(r @ r / 9))
 
 
+def test_a_long_trace_costs_no_square_matrix_of_its_samples():
+    """A dynamic fit's Jacobian has a row per sample: 200,000 rows would be a 298 GiB square matrix,
+    which the decomposition must not form.  Fewer rows than coefficients still find the blind ones."""
+    from pamsim.identification.uncertainty import linearised_uncertainty
+
+    rng = np.random.default_rng(2)
+    J, r = rng.normal(size=(200_000, 3)), rng.normal(0.0, 0.1, 200_000)
+    u = linearised_uncertainty("abc", J, r)
+    np.testing.assert_allclose(u.standard_errors, 0.1 / np.sqrt(200_000), rtol=0.02)
+    wide = linearised_uncertainty("abc", J[:2], r[:2])
+    assert len(wide.not_identified()) >= 1 and np.isnan(wide.sigma)
+
+
 def test_censored_fit_counts_only_the_tests_that_observe(readme_muscle):
     # The README muscle's own tests, half of them too heavy to lift: sigma from the lifted half only.
     from pamsim.identification import fit_static

@@ -113,7 +113,9 @@ def linearised_uncertainty(names, jacobian: np.ndarray, residuals: np.ndarray) -
     col = np.linalg.norm(J, axis=0)
     col[col == 0.0] = 1.0
     Js = J / col
-    _, sv, vt = np.linalg.svd(Js, full_matrices=True)
+    # Only V is used: the thin decomposition gives all of it (k x k) unless there are fewer rows than
+    # coefficients; the full one would also form U, n x n, 0.5 GB and seconds for an 8 s trace at 1 kHz.
+    _, sv, vt = np.linalg.svd(Js, full_matrices=J.shape[0] < k)
     sv = np.concatenate([sv, np.zeros(k - sv.size)])
     seen = sv > RANK_TOLERANCE * (sv[0] if sv.size and sv[0] > 0 else 1.0)
     identified = ~np.any(np.abs(vt[~seen]) >= NULL_WEIGHT, axis=0)
