@@ -233,6 +233,40 @@ def test_per_trace_table_beside_the_pooled_fit_on_the_native_backend(scenario, s
     assert fit.parameters["N0_N_per_bar"] == pytest.approx(6.0, rel=0.02)
 
 
+VALVE_LOADS_N = (12.74, 22.74)
+VALVE_DURATION_S = 2.0
+
+
+def check_trials_are_native_runs(scenario, free, factor=1.05):
+    """A trial's contraction is ``pamsim.simulate`` of the trace's scenario with the trial's coefficients
+    on the native backend, to 1e-12 m: traces driven by the scenario's valve (no recorded pressure),
+    which a scenario describes whole, at the start and at the coefficients moved by ``factor``."""
+    t = np.linspace(0.0, VALVE_DURATION_S, int(VALVE_DURATION_S * 1000) + 1)
+    traces = [TraceData(t, np.zeros_like(t), None, w) for w in VALVE_LOADS_N]
+    prob = make_problem(scenario, traces, free=free)
+    start = np.array([scenario.parameters[n] for n in free])
+    thetas = np.vstack([start, start * factor])
+    sims = make_trials(prob, "native")(thetas)
+    for k, theta in enumerate(thetas):
+        for i, w in enumerate(VALVE_LOADS_N):
+            sc = trace_scenario(scenario, dict(zip(free, theta)), w, VALVE_DURATION_S)
+            ref = pamsim.simulate(sc, backend="native")
+            x = sims[k * len(VALVE_LOADS_N) + i]
+            assert np.max(np.abs(x - ref.x_m)) <= 1e-12, (free, theta, w)
+    assert np.max(np.abs(sims[0] - sims[len(VALVE_LOADS_N)])) > 1e-6  # the coefficients move the motion
+
+
+def test_a_library_static_force_fits_on_its_force_table(scenario):
+    """A static model other than the polynomial runs on the C core as its force table, which every
+    trial case carries; the load mass follows a free g."""
+    gaylord = scenario.with_changes({"model": {"static_force": "gaylord"}})
+    check_trials_are_native_runs(gaylord, ("N0_N_per_bar", "g_m_s2"))
+    noisy, _ = synthetic_trace(gaylord, {"N0_N_per_bar": 6.0}, 22.74, NOISE_M, seed=3, duration_s=2.0)
+    fit = fit_dynamic(gaylord, [noisy], free=["N0_N_per_bar"], backend="native")
+    assert fit.parameters["N0_N_per_bar"] == pytest.approx(6.0, rel=0.02)
+    assert fit.rms_pooled_mm == pytest.approx(NOISE_M * 1e3, rel=0.2)
+
+
 @pytest.mark.parametrize("changes, key", [
     ({"solver": {"method": "Radau"}}, "solver.method"),
     ({"model": {"static_force_negative": "keep"}}, "model.static_force_negative"),

@@ -51,11 +51,14 @@ class Chunk:
     segment_u: np.ndarray
     max_events: np.ndarray
     sample_t_s: tuple[np.ndarray, ...]
+    tables: tuple = ()
 
 
 def _run(chunk: Chunk, capacity: np.ndarray) -> dict:
+    """One library call; the cases share the fit's one force table, if its static model has one."""
     return lib.run_batch(chunk.reals, chunk.ints, chunk.duration_s, chunk.n_samples, chunk.segment_counts,
-                         chunk.segment_t_s, chunk.segment_u, capacity)
+                         chunk.segment_t_s, chunk.segment_u, capacity, chunk.tables,
+                         np.zeros(len(chunk.duration_s), dtype=np.int64) if chunk.tables else None)
 
 
 def _sub(chunk: Chunk, a: int, b: int) -> Chunk:
@@ -63,7 +66,7 @@ def _sub(chunk: Chunk, a: int, b: int) -> Chunk:
     seg = np.concatenate([[0], np.cumsum(chunk.segment_counts)])
     return Chunk(chunk.reals[a:b], chunk.ints[a:b], chunk.duration_s[a:b], chunk.n_samples[a:b],
                  chunk.segment_counts[a:b], chunk.segment_t_s[seg[a]:seg[b]], chunk.segment_u[seg[a]:seg[b]],
-                 chunk.max_events[a:b], chunk.sample_t_s[a:b])
+                 chunk.max_events[a:b], chunk.sample_t_s[a:b], chunk.tables)
 
 
 def run_chunk(chunk: Chunk) -> list[np.ndarray]:
@@ -96,7 +99,8 @@ def _stack(cases: Sequence[CaseInputs], reals: np.ndarray, samples: Sequence[np.
                  np.array([c.n_samples for c in cases], dtype=np.int64),
                  np.array([len(c.segment_t_s) for c in cases], dtype=np.int64),
                  np.concatenate([c.segment_t_s for c in cases]), np.concatenate([c.segment_u for c in cases]),
-                 np.array([c.max_events for c in cases], dtype=np.int64), tuple(samples))
+                 np.array([c.max_events for c in cases], dtype=np.int64), tuple(samples),
+                 (cases[0].table,) if cases[0].table is not None else ())  # one static model: one table
 
 
 TABLE_SHAPERS = ("rated_pressure_gauge_Pa", "L0_m", "r0_m", "theta0_deg")
