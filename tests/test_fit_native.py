@@ -128,27 +128,32 @@ def test_input_hold_error_is_second_order_in_the_sample_interval(scenario):
 
 
 def test_trial_cases_are_the_native_backends_own_cases_with_the_coefficients_changed(scenario, pooled):
-    """A trial changes only the parameter vector (and the load mass through g): the same inputs as
-    building the trial's scenario and model from scratch."""
-    from dataclasses import replace
+    """A trial changes only the flat model's parameters: the same engine case as building the trial's
+    scenario and model from scratch, whether each coefficient is copied into the vector (N0), left
+    unread by a model the recorded pressure drives (the valve's conductance) or derived (g: the load's
+    mass is the weight over g)."""
+    from dataclasses import fields, replace
 
     from pamsim.elements.pressure_source import PrescribedPressure
+    from pamsim.native.backend import event_capacity
+    from pamsim.native.engine import EngineCase, engine_library
 
     _, fit = pooled
-    free = ("N0_N_per_bar", "valve_C_m3_per_s_Pa", "g_m_s2")
-    prob = make_problem(scenario, fit.problem.traces[:2], free=free)
-    theta = np.array([scenario.parameters[n] for n in free]) * 1.07
-    chunk = NativeTrials(prob, FIT_RTOL).chunk(theta)
-    offset = 0
-    for i, (tr, w, sig) in enumerate(zip(prob.traces, prob.loads_N, prob.inputs)):
-        sc = trace_scenario(scenario, dict(zip(free, theta)), w, float(tr.t_s[-1] - tr.t_s[0]))
-        ref = case_inputs(sc, replace(sc.build_model(), source=PrescribedPressure(sig)))
-        n = len(ref.segment_t_s)
-        np.testing.assert_array_equal(chunk.reals[i], ref.reals)
-        np.testing.assert_array_equal(chunk.ints[i], ref.ints)
-        np.testing.assert_array_equal(chunk.segment_t_s[offset:offset + n], ref.segment_t_s)
-        np.testing.assert_allclose(chunk.segment_u[offset:offset + n], ref.segment_u, rtol=1e-15)
-        offset += n
+    for free, derived in ((("N0_N_per_bar", "D1_N_s_per_m"), ()),
+                          (("N0_N_per_bar", "valve_C_m3_per_s_Pa", "g_m_s2"), (1, 2))):
+        prob = make_problem(scenario, fit.problem.traces[:2], free=free)
+        theta = np.array([scenario.parameters[n] for n in free]) * 1.07
+        trials = NativeTrials(prob, FIT_RTOL)
+        assert [tr.derived for tr in trials.trials.traces] == [derived, derived]
+        chunk = trials.chunk(theta)
+        for i, (tr, w, sig) in enumerate(zip(prob.traces, prob.loads_N, prob.inputs)):
+            sc = trace_scenario(scenario, dict(zip(free, theta)), w, float(tr.t_s[-1] - tr.t_s[0]))
+            ref = case_inputs(sc, replace(sc.build_model(), source=PrescribedPressure(sig)))
+            library = engine_library(ref.assembly)
+            assert chunk.libraries[chunk.library_of[i]] == (str(library.path), library.names)
+            expected = ref.engine_case(library, int(event_capacity(ref.max_events)))
+            for f in fields(EngineCase):
+                np.testing.assert_array_equal(getattr(chunk.cases[i], f.name), getattr(expected, f.name), f.name)
 
 
 def test_fd_step_is_far_above_the_native_simulation_noise(scenario):
@@ -240,12 +245,15 @@ VALVE_DURATION_S = 2.0
 def check_trials_are_native_runs(scenario, free, factor=1.05):
     """A trial's contraction is ``pamsim.simulate`` of the trace's scenario with the trial's coefficients
     on the native backend, to 1e-12 m: traces driven by the scenario's valve (no recorded pressure),
-    which a scenario describes whole, at the start and at the coefficients moved by ``factor``."""
+    which a scenario describes whole, at the start, at every coefficient moved by ``factor`` and at
+    the first alone moved (a Jacobian's column: the others' values as at the start)."""
     t = np.linspace(0.0, VALVE_DURATION_S, int(VALVE_DURATION_S * 1000) + 1)
     traces = [TraceData(t, np.zeros_like(t), None, w) for w in VALVE_LOADS_N]
     prob = make_problem(scenario, traces, free=free)
     start = np.array([scenario.parameters[n] for n in free])
-    thetas = np.vstack([start, start * factor])
+    first = start.copy()
+    first[0] *= factor
+    thetas = np.vstack([start, start * factor, first])
     sims = make_trials(prob, "native")(thetas)
     for k, theta in enumerate(thetas):
         for i, w in enumerate(VALVE_LOADS_N):
@@ -254,6 +262,15 @@ def check_trials_are_native_runs(scenario, free, factor=1.05):
             x = sims[k * len(VALVE_LOADS_N) + i]
             assert np.max(np.abs(x - ref.x_m)) <= 1e-12, (free, theta, w)
     assert np.max(np.abs(sims[0] - sims[len(VALVE_LOADS_N)])) > 1e-6  # the coefficients move the motion
+
+
+@pytest.mark.parametrize("free", [("N0_N_per_bar", "D1_N_s_per_m"), ("g_m_s2",), ("theta0_deg",),
+                                  ("N0_N_per_bar", "g_m_s2", "theta0_deg", "valve_C_m3_per_s_Pa")])
+def test_engine_trials_are_native_runs_of_the_trace_scenario(scenario, free):
+    """Coefficients copied into the flat model's parameters (N0, D1, the valve's conductance) and derived
+    ones (g: the load's mass; theta0: the chamber's thread length and turns and the upper stop), alone
+    and together, on the generic engine."""
+    check_trials_are_native_runs(scenario, free)
 
 
 def test_a_library_static_force_fits_on_its_force_table(scenario):
@@ -324,9 +341,9 @@ def test_trials_that_outgrow_the_batch_event_room_run_again_alone(pooled, monkey
     thetas = np.array([_truth_vector(), 1.01 * _truth_vector()])
     reference = make_trials(fit.problem, "native")(thetas)
     capacities = []
-    run = native_fit._run
-    monkeypatch.setattr(native_fit, "_run",
-                        lambda chunk, capacity: capacities.append(list(capacity)) or run(chunk, capacity))
+    run = native_fit._run_engine
+    monkeypatch.setattr(native_fit, "_run_engine", lambda library, cases: capacities.append(
+        [c.event_capacity for c in cases]) or run(library, cases))
     monkeypatch.setattr(backend, "BATCH_EVENT_CAPACITY", 2)
     again = make_trials(fit.problem, "native")(thetas)
     limit = fit.problem.scenario.solver.max_events + 1

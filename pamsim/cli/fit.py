@@ -140,7 +140,7 @@ def register(sub) -> None:
     d.add_argument("--knot-tolerance-Pa", type=finite_float, default=choices.KNOT_TOLERANCE_PA,
                    help="largest deviation of the thinned measured pressure [Pa] (default 10)")
     d.add_argument("--backend", choices=choices.DYNAMIC_BACKENDS, default="python",
-                   help="simulator of the fit: python (default) or native (the C core, one batch per step)")
+                   help="simulator of the fit: python (default) or native (compiled C, one batch per step)")
     d.add_argument("--seed", type=_count, default=0, help="seed of --global (default 0)")
     d.add_argument("-o", "--output", required=True, help="output directory")
     d.add_argument("--json", action="store_true", help="print fit.json to stdout")

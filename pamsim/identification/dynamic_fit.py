@@ -9,8 +9,9 @@ value given by the caller, or the scenario's.
 
 The simulations of one optimiser iteration (every trace, and every finite-difference column of the
 Jacobian) are independent tasks sent to a :class:`concurrent.futures.Executor`, as sweeps do.  On
-the native backend (``backend="native"``, :mod:`.native_fit`) they are one call of the C core's
-batch entry point instead, split into one chunk per worker when there is an executor.
+the native backend (``backend="native"``, :mod:`.native_fit`) they are one library call instead (the
+generic engine running the generated model, or the C core for a force table), split into one chunk
+per worker when there is an executor.
 
 Finite differences: the residuals are exact simulations, but each carries integration error of
 about ``rtol`` times the state scale and event times located to the solver's tolerance.  A step of
@@ -303,8 +304,8 @@ def fit_dynamic(scenario: Scenario, traces: Sequence[TraceData], free: Sequence[
         Largest deviation [Pa] of the thinned recorded pressure from the recorded one.
     backend : {"python", "native"}
         Simulator of the fit.  ``native`` runs each optimiser step's simulations (each
-        differential-evolution generation's too) in one call of the C core, one per worker with an
-        executor; it holds a recorded pressure at its midpoint over every output sample (see
+        differential-evolution generation's too) in one call of the native library, one per worker
+        with an executor; it holds a recorded pressure at its midpoint over every output sample (see
         :mod:`.native_fit`) and refuses, before anything runs, a scenario setting it cannot honour.
     """
     start_time = time.perf_counter()

@@ -1,35 +1,65 @@
 """The simulations of a dynamic fit on the native backend: every trial point of one optimiser step
 (every trace, every finite-difference column, a whole differential-evolution generation) in one
-call of the C core's batch entry point, or in one call per worker with an executor.
+library call, or in one call per worker with an executor.
 
 Each trace's case is built once, at the start of the fit, exactly as the native backend builds a
 scenario's (:func:`pamsim.native.backend.case_inputs`), with the trace's load, duration and the
-fit's tolerance, and with the recorded pressure as the source when there is one.  A trial point
-only changes the free coefficients, which are entries of the case's parameter vector, so a trial
-case is that vector with the free entries replaced: no scenario or model is built per trial.  The
-one input derived from a coefficient, the load mass ``weight_N / g_m_s2``, is recomputed from the
-trial's ``g_m_s2``.
+fit's tolerance, and with the recorded pressure as the source when there is one.  Like the backend,
+the fit runs such a case on the generic engine compiled with the case's generated model
+(:mod:`pamsim.native.engine`), and a case with a force table on the hand-written C core
+(:mod:`pamsim.native.library`).
 
-What this approximates (docs/identification.md has the measured effect on a fit): the C core holds
-its inputs constant over segments, so the recorded pressure, linear between its knots, is held at
-its midpoint value over every output-sample interval (:func:`pamsim.native.backend.hold_interval_s`;
-a knot inside an interval is passed over, a turning knot is a segment boundary).  Over an interval
-with no knot inside, the midpoint value is the interval's mean pressure, a second-order
-approximation; the Python backend follows the polyline exactly.
+**A trial point on the engine.**  The engine takes the flat model's parameter vector
+(``assembly.parameter_values()``: ``friction.N0_N_per_bar``, ``load.mass_kg``, ...), whose entries are
+not always the scenario's parameters: some are copies of one (``N0_N_per_bar`` is
+``friction.N0_N_per_bar``), others are derived (the load's mass is the trace's weight over ``g_m_s2``;
+the chamber's thread length and turns and the upper stop come from ``L0_m``, ``r0_m`` and
+``theta0_deg``).  Which is which is found per trace, at set-up, by rebuilding the trace's model with
+each free coefficient moved to two nearby values (:meth:`_EngineTrials._probe`):
+
+- a coefficient that moves the same entries at both, each to the coefficient's value, is a *copy*:
+  a trial writes its value into those entries, with no model built;
+- any other is *derived*: one that moves an entry to another value (``g_m_s2``, the geometry), and
+  one that moves none at the probes (a parameter the trace's elements do not read, such as the
+  valve's conductance with a recorded pressure: it might at other values, and rebuilding costs
+  little).  A trial rebuilds the trace's model with its derived coefficients, as ``case_inputs``
+  builds it, so those entries are the backend's own by construction, then writes the copies in.
+  A rebuild costs about 0.3 ms a trace (an 8 s simulation about 1 ms); the vectors are kept by the
+  derived values, so a Jacobian's columns of the copied coefficients share one.  Should a derived
+  coefficient move an entry a copy writes, or a probe fail, every coefficient is rebuilt.
+
+A trial whose coefficients the parameter set refuses (a value outside its range, a pair out of order)
+is refused without a run, NaN as on the Python backend, and so is one whose rebuilt scenario fails its
+own checks.
+
+**A trial point on the core** (force tables): the free coefficients are entries of the core's vector
+of every variable, so a trial is that vector with them replaced, and the load mass, an input of the
+core, is recomputed from the trial's ``g_m_s2``.
+
+What this approximates (docs/identification.md has the measured effect on a fit): the native
+backend holds its inputs constant over segments, so the recorded pressure, linear between its knots,
+is held at its midpoint value over every output-sample interval
+(:func:`pamsim.native.backend.hold_interval_s`; a knot inside an interval is passed over, a turning
+knot is a segment boundary).  Over an interval with no knot inside, the midpoint value is the
+interval's mean pressure, a second-order approximation; the Python backend follows the polyline
+exactly.
 """
 
 from __future__ import annotations
 
 import os
 from dataclasses import dataclass, replace
+from pathlib import Path
 from typing import Sequence
 
 import numpy as np
 
+from ..assemblies import one_muscle_assembly
 from ..elements.pressure_source import PrescribedPressure
 from ..errors import InputError
 from ..native import library as lib
 from ..native.backend import CaseInputs, case_inputs, event_capacity, outgrew_batch
+from ..native.engine import EngineCase, EngineLibrary, engine_library
 from ..static_models import get as get_static_model
 from .trials import trace_scenario
 
@@ -38,9 +68,33 @@ _MASS = lib.INPUTS.index("load_mass_kg")
 _G = lib.REAL_INDEX["g_m_s2"]
 
 
+def _contractions(n_cases: int, max_events, sample_t_s, first_pass, alone, trace) -> list[np.ndarray]:
+    """Each case's contraction [m] at its sample times, NaN for a case that failed.
+
+    ``first_pass(i)`` is case i's batch output and its place in it; ``alone(i)`` runs case i again by
+    itself with room for its ``max_events`` (a case that outgrew the batch's event room, as
+    :func:`pamsim.native.simulate_batch` does, so the event limit is the scenario's, as on the Python
+    backend); ``trace(out, k, i)`` is the contraction on the case's own sample grid and that grid.
+    """
+    xs = []
+    for i in range(n_cases):
+        found, k = first_pass(i)
+        status = int(found["status"][k])
+        if outgrew_batch(status, int(max_events[i])):
+            found, k = alone(i), 0
+            status = int(found["status"][0])
+        if status != 0:  # bad input, solver failure or too many events: a bad trial point, as in Python
+            xs.append(np.full(sample_t_s[i].shape, np.nan))
+            continue
+        grid, x = trace(found, k, i)
+        xs.append(np.interp(sample_t_s[i], grid, x))
+    return xs
+
+
+# ------------------------------------------------------------------------------------- the C core
 @dataclass(frozen=True)
 class Chunk:
-    """Trial cases sent to the library in one call (pickles to a worker process)."""
+    """Trial cases with a force table, sent to the C core in one call (pickles to a worker process)."""
 
     reals: np.ndarray
     ints: np.ndarray
@@ -53,54 +107,259 @@ class Chunk:
     sample_t_s: tuple[np.ndarray, ...]
     tables: tuple = ()
 
+    def __len__(self) -> int:
+        return len(self.duration_s)
+
+    def sub(self, a: int, b: int) -> "Chunk":
+        """Cases ``a`` to ``b - 1``."""
+        seg = np.concatenate([[0], np.cumsum(self.segment_counts)])
+        return Chunk(self.reals[a:b], self.ints[a:b], self.duration_s[a:b], self.n_samples[a:b],
+                     self.segment_counts[a:b], self.segment_t_s[seg[a]:seg[b]], self.segment_u[seg[a]:seg[b]],
+                     self.max_events[a:b], self.sample_t_s[a:b], self.tables)
+
+    def run(self) -> list[np.ndarray]:
+        out = _run(self, event_capacity(self.max_events))
+
+        def trace(found, k, i):
+            first, m = int(found["sample_offset"][k]), int(self.n_samples[i])
+            block = found["samples"][len(lib.SAMPLE_COLUMNS) * first:len(lib.SAMPLE_COLUMNS) * (first + m)]
+            return np.linspace(0.0, self.duration_s[i], m), block.reshape(-1, m)[_X_ROW]
+
+        return _contractions(len(self), self.max_events, self.sample_t_s, lambda i: (out, i),
+                             lambda i: _run(self.sub(i, i + 1), self.max_events[i:i + 1] + 1), trace)
+
 
 def _run(chunk: Chunk, capacity: np.ndarray) -> dict:
-    """One library call; the cases share the fit's one force table, if its static model has one."""
+    """One call of the C core; the cases share the fit's one force table."""
     return lib.run_batch(chunk.reals, chunk.ints, chunk.duration_s, chunk.n_samples, chunk.segment_counts,
                          chunk.segment_t_s, chunk.segment_u, capacity, chunk.tables,
-                         np.zeros(len(chunk.duration_s), dtype=np.int64) if chunk.tables else None)
+                         np.zeros(len(chunk), dtype=np.int64) if chunk.tables else None)
 
 
-def _sub(chunk: Chunk, a: int, b: int) -> Chunk:
-    """Cases ``a`` to ``b - 1`` of ``chunk``."""
-    seg = np.concatenate([[0], np.cumsum(chunk.segment_counts)])
-    return Chunk(chunk.reals[a:b], chunk.ints[a:b], chunk.duration_s[a:b], chunk.n_samples[a:b],
-                 chunk.segment_counts[a:b], chunk.segment_t_s[seg[a]:seg[b]], chunk.segment_u[seg[a]:seg[b]],
-                 chunk.max_events[a:b], chunk.sample_t_s[a:b], chunk.tables)
+class _CoreTrials:
+    """Trial chunks of traces whose cases have a force table: the free coefficients replaced in each
+    case's vector of every variable, the load mass recomputed from the trial's ``g_m_s2``."""
+
+    def __init__(self, problem, cases: Sequence[CaseInputs], samples: Sequence[np.ndarray]):
+        self.cases, self.samples = list(cases), list(samples)
+        self.weights_N = np.array(problem.loads_N)
+        self.free_index = np.array([lib.REAL_INDEX[n] for n in problem.free], dtype=int)
+        # One scenario, one static model: the traces share its table.
+        self.tables = () if cases[0].table is None else (cases[0].table,)
+
+    def chunk(self, thetas: np.ndarray) -> Chunk:
+        n_tr, cases = len(self.cases), self.cases * len(thetas)
+        reals = np.repeat(np.array([c.reals for c in self.cases])[None], len(thetas), axis=0)
+        reals[:, :, self.free_index] = thetas[:, None, :]
+        reals = reals.reshape(len(thetas) * n_tr, -1)
+        counts = np.array([len(c.segment_t_s) for c in cases], dtype=np.int64)
+        u = np.concatenate([c.segment_u for c in cases])
+        # The load mass is the only input a coefficient feeds (through g): the trial's own.
+        u[:, _MASS] = np.repeat(np.tile(self.weights_N, len(thetas)) / reals[:, _G], counts)
+        return Chunk(reals, np.array([c.ints for c in cases]), np.array([c.duration_s for c in cases]),
+                     np.array([c.n_samples for c in cases], dtype=np.int64), counts,
+                     np.concatenate([c.segment_t_s for c in cases]), u,
+                     np.array([c.max_events for c in cases], dtype=np.int64), tuple(self.samples * len(thetas)),
+                     self.tables)
 
 
-def run_chunk(chunk: Chunk) -> list[np.ndarray]:
+# ------------------------------------------------------------------------------- the generic engine
+_LIBRARIES: dict[str, EngineLibrary] = {}
+
+
+def _library(path: str, names: dict) -> EngineLibrary:
+    """The engine library at ``path``, loaded once per process: a worker re-creates it from the path and
+    names a chunk carries (a ctypes library does not pickle)."""
+    if path not in _LIBRARIES:
+        _LIBRARIES[path] = EngineLibrary(Path(path), names)
+    return _LIBRARIES[path]
+
+
+def _run_engine(library: EngineLibrary, cases: Sequence[EngineCase]) -> dict:
+    """One call of an engine library."""
+    return library.run(cases)
+
+
+@dataclass(frozen=True)
+class EngineChunk:
+    """Trial cases for the generic engine (pickles to a worker process: the libraries by path and names).
+
+    ``library_of[i]`` indexes ``libraries`` (path, names), or is -1 for a trial point refused before
+    running (its contraction is NaN); ``cases[i]`` is then None.
+    """
+
+    libraries: tuple[tuple[str, dict], ...]
+    library_of: tuple[int, ...]
+    cases: tuple[EngineCase | None, ...]
+    max_events: tuple[int, ...]
+    sample_t_s: tuple[np.ndarray, ...]
+
+    def __len__(self) -> int:
+        return len(self.cases)
+
+    def sub(self, a: int, b: int) -> "EngineChunk":
+        """Cases ``a`` to ``b - 1``."""
+        return EngineChunk(self.libraries, self.library_of[a:b], self.cases[a:b], self.max_events[a:b],
+                           self.sample_t_s[a:b])
+
+    def run(self) -> list[np.ndarray]:
+        where: list = [None] * len(self)
+        for j, (path, names) in enumerate(self.libraries):
+            members = [i for i, k in enumerate(self.library_of) if k == j]
+            if members:
+                out = _run_engine(_library(path, names), [self.cases[i] for i in members])
+                for k, i in enumerate(members):
+                    where[i] = (out, k)
+        refused = {"status": np.array([1])}
+
+        def alone(i):
+            path, names = self.libraries[self.library_of[i]]
+            return _run_engine(_library(path, names), [replace(self.cases[i], event_capacity=self.max_events[i] + 1)])
+
+        def trace(found, k, i):
+            names, case = self.libraries[self.library_of[i]][1], self.cases[i]
+            ns, first, m = len(names["states"]), int(found["sample_offset"][k]), case.n_samples
+            block = found["samples"][ns * first:ns * (first + m)].reshape(ns, m)
+            return np.linspace(0.0, case.duration_s, m), block[names["states"].index("load.x_m")]
+
+        return _contractions(len(self), self.max_events, self.sample_t_s,
+                             lambda i: where[i] if where[i] is not None else (refused, 0), alone, trace)
+
+
+def _probe_values(value: float, upper: float) -> tuple[float, float]:
+    """Two values near ``value``, below it if its upper bound leaves no room above (a value at its lower
+    bound, such as a restitution of 0, has room above)."""
+    h = 1e-3 * abs(value) if value != 0.0 else 1e-3
+    return (value + h, value + 2 * h) if value + 2 * h < upper else (value - h, value - 2 * h)
+
+
+@dataclass
+class _EngineTrace:
+    """One trace on the engine: its case, its library, and how a trial's coefficients reach its vector.
+
+    ``copies`` maps the position of a free coefficient that is copied into the flat model's parameters
+    to the entries it is copied into; ``derived`` lists the positions of the others, with which a trial
+    rebuilds the trace's model."""
+
+    case: EngineCase
+    library: EngineLibrary
+    copies: dict[int, np.ndarray]
+    derived: tuple[int, ...]
+    max_events: int
+
+
+BUILT_SIZE = 256
+"""Rebuilt parameter vectors kept per fit, by trace and derived values (a Jacobian's columns of the
+copied coefficients share one)."""
+
+
+class _EngineTrials:
+    """Trial chunks of traces whose cases run on the generic engine."""
+
+    def __init__(self, problem, rtol: float, cases: Sequence[CaseInputs], samples: Sequence[np.ndarray]):
+        self.problem, self.rtol, self.samples = problem, rtol, list(samples)
+        self._built: dict[tuple, tuple[EngineLibrary | None, np.ndarray | None]] = {}
+        self.traces = [self._set_up(i, c) for i, c in enumerate(cases)]
+
+    def _assembly(self, i: int, overrides: dict):
+        """Trace ``i``'s assembly with ``overrides``, as :func:`case_inputs` builds it."""
+        sc, model = _trace_model(self.problem, i, overrides, self.rtol)
+        opts = sc.solver
+        return one_muscle_assembly(model, sc.initial_contraction_m, sc.initial_pressure_gauge_Pa,
+                                   opts.stick_margin_N, opts.release_margin_N)
+
+    def _set_up(self, i: int, case: CaseInputs) -> _EngineTrace:
+        library = engine_library(case.assembly)
+        _LIBRARIES.setdefault(str(library.path), library)
+        base = case.engine_case(library, int(event_capacity(case.max_events)))
+        copies, derived, touched = {}, [], []
+        upper = self.problem.bounds[1]
+        for j, name in enumerate(self.problem.free):
+            value = float(self.problem.scenario.parameters[name])
+            moved, copy = self._probe(i, name, _probe_values(value, upper[j]), base.params)
+            if copy and np.all(base.params[moved] == value):
+                copies[j] = moved
+            else:
+                derived.append(j)
+                touched.append(moved)
+        written = np.concatenate([np.zeros(0, dtype=int), *copies.values()])
+        if any(m is None for m in touched) or np.intersect1d(written, np.concatenate([[], *touched])).size:
+            # A derived entry a copy would overwrite, or one a probe could not find: rebuild with all.
+            copies, derived = {}, list(range(len(self.problem.free)))
+        return _EngineTrace(base, library, copies, tuple(derived), case.max_events)
+
+    def _probe(self, i: int, name: str, values: Sequence[float], base: np.ndarray) -> tuple[np.ndarray | None, bool]:
+        """The flat entries ``name`` moves when trace ``i``'s model is rebuilt at each of ``values``
+        (None if it cannot be rebuilt there), and whether they are its copies: the same entries at
+        every value, each holding the value."""
+        moved, copy = None, True
+        for value in values:
+            try:
+                p = np.array(self._assembly(i, {name: value}).parameter_values())
+            except InputError:
+                return None, False
+            changed = np.flatnonzero(p != base)
+            copy = (copy and changed.size > 0 and bool(np.all(p[changed] == value))
+                    and (moved is None or np.array_equal(changed, moved)))
+            moved = changed if moved is None else np.union1d(moved, changed)
+        return moved, copy
+
+    def _build(self, k: int, overrides: dict) -> tuple[EngineLibrary | None, np.ndarray | None]:
+        """Trace ``k``'s library and parameter vector rebuilt with ``overrides``; (None, None) if the
+        scenario refuses them or the model cannot be built."""
+        try:
+            assembly = self._assembly(k, overrides)
+            return engine_library(assembly), np.array(assembly.parameter_values())
+        except Exception:  # noqa: BLE001 -- a trial point that cannot be built is a bad point, as in Python
+            return None, None
+
+    def _trial(self, k: int, theta: np.ndarray) -> tuple[EngineLibrary | None, EngineCase | None]:
+        """Trace ``k``'s case at ``theta`` (whose values the parameter set accepts) and the library to
+        run it on, or (None, None) if the trial point is refused."""
+        tr = self.traces[k]
+        library, params = tr.library, tr.case.params
+        if tr.derived:
+            key = (k, *(float(theta[j]) for j in tr.derived))
+            if key not in self._built:
+                if len(self._built) >= BUILT_SIZE:
+                    self._built.pop(next(iter(self._built)))
+                self._built[key] = self._build(k, {self.problem.free[j]: float(theta[j]) for j in tr.derived})
+            library, params = self._built[key]
+            if library is None:
+                return None, None
+        params = params.copy()
+        for j, entries in tr.copies.items():
+            params[entries] = theta[j]
+        return library, replace(tr.case, params=params)
+
+    def chunk(self, thetas: np.ndarray) -> EngineChunk:
+        params = self.problem.scenario.parameters
+        paths: dict[str, int] = {}
+        libraries, library_of, cases, max_events = [], [], [], []
+        for theta in thetas:
+            # The checks the scenario makes of its parameters (ranges, pairs in order), once per point.
+            valid = not params.with_overrides(dict(zip(self.problem.free, map(float, theta)))).violations()
+            for k, tr in enumerate(self.traces):
+                library, case = self._trial(k, theta) if valid else (None, None)
+                if library is not None and str(library.path) not in paths:
+                    paths[str(library.path)] = len(libraries)
+                    libraries.append((str(library.path), library.names))
+                library_of.append(-1 if library is None else paths[str(library.path)])
+                cases.append(case)
+                max_events.append(tr.max_events)
+        return EngineChunk(tuple(libraries), tuple(library_of), tuple(cases), tuple(max_events),
+                           tuple(self.samples * len(thetas)))
+
+
+def run_chunk(chunk: Chunk | EngineChunk) -> list[np.ndarray]:
     """Contraction [m] of every case of ``chunk`` at its sample times; NaN for a case that failed.
 
-    One library call for the chunk.  Events are kept up to :data:`pamsim.native.backend.BATCH_EVENT_CAPACITY` per case;
-    a case that had more is run again alone with room for its ``max_events``, as
-    :func:`pamsim.native.simulate_batch` does, so the event limit is the scenario's, as on the
-    Python backend.
+    One library call for the chunk (one per engine library: traces with and without a recorded
+    pressure are two structures).  Events are kept up to
+    :data:`pamsim.native.backend.BATCH_EVENT_CAPACITY` per case; a case that had more is run again
+    alone with room for its ``max_events``.
     """
-    out = _run(chunk, event_capacity(chunk.max_events))
-    xs = []
-    for i in range(len(chunk.duration_s)):
-        status, found, k = int(out["status"][i]), out, i
-        if outgrew_batch(status, int(chunk.max_events[i])):
-            found, k = _run(_sub(chunk, i, i + 1), chunk.max_events[i:i + 1] + 1), 0
-            status = int(found["status"][0])
-        if status != 0:  # bad input, solver failure or too many events: a bad trial point, as in Python
-            xs.append(np.full(chunk.sample_t_s[i].shape, np.nan))
-            continue
-        first, m = int(found["sample_offset"][k]), int(chunk.n_samples[i])
-        block = found["samples"][len(lib.SAMPLE_COLUMNS) * first:len(lib.SAMPLE_COLUMNS) * (first + m)]
-        grid = np.linspace(0.0, chunk.duration_s[i], m)
-        xs.append(np.interp(chunk.sample_t_s[i], grid, block.reshape(-1, m)[_X_ROW]))
-    return xs
-
-
-def _stack(cases: Sequence[CaseInputs], reals: np.ndarray, samples: Sequence[np.ndarray]) -> Chunk:
-    return Chunk(reals, np.array([c.ints for c in cases]), np.array([c.duration_s for c in cases]),
-                 np.array([c.n_samples for c in cases], dtype=np.int64),
-                 np.array([len(c.segment_t_s) for c in cases], dtype=np.int64),
-                 np.concatenate([c.segment_t_s for c in cases]), np.concatenate([c.segment_u for c in cases]),
-                 np.array([c.max_events for c in cases], dtype=np.int64), tuple(samples),
-                 (cases[0].table,) if cases[0].table is not None else ())  # one static model: one table
+    return chunk.run()
 
 
 TABLE_SHAPERS = ("rated_pressure_gauge_Pa", "L0_m", "r0_m", "theta0_deg")
@@ -127,44 +386,39 @@ def executor_workers(executor) -> int:
     return int(getattr(executor, "_max_workers", None) or os.cpu_count() or 1)
 
 
+def _trace_model(problem, i: int, overrides: dict, rtol: float):
+    """Trace ``i``'s scenario with ``overrides`` and its model, driven by the recorded pressure if any."""
+    tr, w, sig = problem.traces[i], problem.loads_N[i], problem.inputs[i]
+    sc = trace_scenario(problem.scenario, overrides, w, float(tr.t_s[-1] - tr.t_s[0]), rtol)
+    model = sc.build_model()
+    return sc, (model if sig is None else replace(model, source=PrescribedPressure(sig)))
+
+
 class NativeTrials:
-    """The fit's simulations on the C core: ``trials(thetas, executor)`` gives every trace's contraction
-    at its sample times for every row of ``thetas``, theta-major (the Python backend's task order)."""
+    """The fit's simulations on the native backend: ``trials(thetas, executor)`` gives every trace's
+    contraction at its sample times for every row of ``thetas``, theta-major (the Python backend's task
+    order)."""
 
     def __init__(self, problem, rtol: float):
         _refuse_free_table_parameters(problem)
-        self.cases = []
-        for tr, w, sig in zip(problem.traces, problem.loads_N, problem.inputs):
-            sc = trace_scenario(problem.scenario, {}, w, float(tr.t_s[-1] - tr.t_s[0]), rtol)
-            model = sc.build_model()
-            if sig is not None:
-                model = replace(model, source=PrescribedPressure(sig))
-            self.cases.append(case_inputs(sc, model))
-        self.weights_N = np.array(problem.loads_N)
-        self.samples = [tr.t_s - tr.t_s[0] for tr in problem.traces]
-        self.free_index = np.array([lib.REAL_INDEX[n] for n in problem.free], dtype=int)
+        cases = [case_inputs(*_trace_model(problem, i, {}, rtol)) for i in range(len(problem.traces))]
+        samples = [tr.t_s - tr.t_s[0] for tr in problem.traces]
+        # One scenario, one static model: every trace's case has a force table or none does.
+        if cases[0].assembly is None:
+            self.trials = _CoreTrials(problem, cases, samples)
+        else:
+            self.trials = _EngineTrials(problem, rtol, cases, samples)
 
-    def chunk(self, thetas: np.ndarray) -> Chunk:
+    def chunk(self, thetas: np.ndarray) -> Chunk | EngineChunk:
         """Every trace at every row of ``thetas`` as one batch."""
-        thetas = np.atleast_2d(np.asarray(thetas, dtype=float))
-        n_tr = len(self.cases)
-        reals = np.repeat(np.array([c.reals for c in self.cases])[None], len(thetas), axis=0)
-        reals[:, :, self.free_index] = thetas[:, None, :]
-        reals = reals.reshape(len(thetas) * n_tr, -1)
-        cases = self.cases * len(thetas)
-        chunk = _stack(cases, reals, self.samples * len(thetas))
-        # The load mass is the only input a coefficient feeds (through g): the trial's own.
-        mass = np.repeat(np.tile(self.weights_N, len(thetas)) / reals[:, _G], chunk.segment_counts)
-        chunk.segment_u[:, _MASS] = mass
-        return chunk
+        return self.trials.chunk(np.atleast_2d(np.asarray(thetas, dtype=float)))
 
     def __call__(self, thetas: np.ndarray, executor=None) -> list[np.ndarray]:
         chunk = self.chunk(thetas)
-        n = len(chunk.duration_s)
+        n = len(chunk)
         parts = 1 if executor is None else min(executor_workers(executor), n)
         if parts <= 1:
             return run_chunk(chunk)
         bounds = np.linspace(0, n, parts + 1).round().astype(int)
-        subs = [_sub(chunk, a, b) for a, b in zip(bounds[:-1], bounds[1:])]
+        subs = [chunk.sub(a, b) for a, b in zip(bounds[:-1], bounds[1:])]
         return [x for part in executor.map(run_chunk, subs) for x in part]
-
