@@ -273,6 +273,12 @@ def test_engine_trials_are_native_runs_of_the_trace_scenario(scenario, free):
     check_trials_are_native_runs(scenario, free)
 
 
+def test_engine_trials_keep_the_components_a_scenario_adds():
+    """A rebuilt trial is the scenario's whole assembly: the spring parallel_spring.toml adds stays."""
+    spring = pamsim.load_scenario(SCENARIOS / "parallel_spring.toml")
+    check_trials_are_native_runs(spring, ("N0_N_per_bar", "g_m_s2"))
+
+
 def test_a_library_static_force_fits_on_its_force_table(scenario):
     """A static model other than the polynomial runs on the C core as its force table, which every
     trial case carries; the load mass follows a free g."""

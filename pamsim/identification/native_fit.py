@@ -54,7 +54,7 @@ from typing import Sequence
 
 import numpy as np
 
-from ..assemblies import one_muscle_assembly
+from ..assemblies import scenario_assembly
 from ..elements.pressure_source import PrescribedPressure
 from ..errors import InputError
 from ..native import library as lib
@@ -262,11 +262,9 @@ class _EngineTrials:
         self.traces = [self._set_up(i, c) for i, c in enumerate(cases)]
 
     def _assembly(self, i: int, overrides: dict):
-        """Trace ``i``'s assembly with ``overrides``, as :func:`case_inputs` builds it."""
-        sc, model = _trace_model(self.problem, i, overrides, self.rtol)
-        opts = sc.solver
-        return one_muscle_assembly(model, sc.initial_contraction_m, sc.initial_pressure_gauge_Pa,
-                                   opts.stick_margin_N, opts.release_margin_N)
+        """Trace ``i``'s assembly with ``overrides``, as :func:`case_inputs` builds it (with the
+        components the scenario adds)."""
+        return scenario_assembly(*_trace_model(self.problem, i, overrides, self.rtol))
 
     def _set_up(self, i: int, case: CaseInputs) -> _EngineTrace:
         library = engine_library(case.assembly)
