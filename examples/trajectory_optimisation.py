@@ -1,13 +1,18 @@
-"""Single-shooting trajectory optimisation of the valve command on pamsim's CasADi model.
+"""
+Trajectory optimisation of the valve command
+============================================
+
+Single-shooting trajectory optimisation of the valve command on pamsim's CasADi model.
 
 Moves the 22.74 N load of ``scenarios/closed_loop_position.toml`` from rest at 20 mm (the chamber
 at the holding pressure) to 40 mm: 40 valve commands held for 10 ms each, in [0, 1] (the load only
 rises, so the valve only fills or closes), chosen by IPOPT to minimise the squared distance to 40 mm
 over the move and the speed at its end.  The
 optimiser sees the load sliding up (``CasadiModel.rhs("slip_up")``, RK4); the command it finds is
-then run open loop on pamsim's hybrid model, with stick/slip and all, for the answer.
+then run open loop on pamsim's hybrid model, with stick/slip and all, for the answer.  It writes the
+command and the response to ``trajectory_optimisation.png``::
 
-    python examples/trajectory_optimisation.py
+    cd examples && python trajectory_optimisation.py
 """
 
 from __future__ import annotations
@@ -22,7 +27,8 @@ from pamsim.control.operating_point import holding_pressure_Pa
 from pamsim.export import casadi_model
 from pamsim.simulator import simulate_model
 
-ROOT = Path(__file__).resolve().parents[1]
+# The examples run from their folder (the documentation build runs them there too).
+SCENARIO = Path("..") / "scenarios" / "closed_loop_position.toml"
 N, DT_S, SUBSTEPS = 40, 0.01, 4
 X0_M, TARGET_M, HOLD_S = 0.020, 0.040, 0.6
 
@@ -40,7 +46,7 @@ class HeldCommand:
 
 
 def optimise():
-    scenario = pamsim.load_scenario(ROOT / "scenarios" / "closed_loop_position.toml")
+    scenario = pamsim.load_scenario(SCENARIO)
     model = scenario.build_model()
     supply_Pa = scenario.final_pressure_gauge_Pa
     p_hold = holding_pressure_Pa(model, X0_M, model.load.weight_N, supply_Pa)
@@ -80,6 +86,25 @@ def optimise():
     return solver.stats(), u_opt, result
 
 
+def figure(u_opt, result):
+    """The command IPOPT chose, and the contraction it gives on the hybrid model."""
+    from matplotlib.figure import Figure
+
+    from pamsim.figure_style import series
+
+    fig = Figure(figsize=(7, 5), constrained_layout=True)
+    ax_u, ax_x = fig.subplots(2, 1, sharex=True)
+    t_u = np.append(DT_S * np.arange(N), result.t_s[-1])  # held at its last value after the move
+    ax_u.step(t_u, np.append(u_opt, u_opt[-1]), where="post", **series(0))
+    ax_u.set_ylabel("valve command [-]")
+    ax_x.plot(result.t_s, 1e3 * result.x_m, label="hybrid model", **series(0))
+    ax_x.axhline(1e3 * TARGET_M, label="target", **series(1, colour="0.4"))
+    ax_x.set_xlabel("time [s]")
+    ax_x.set_ylabel("contraction [mm]")
+    ax_x.legend()
+    return fig
+
+
 def main():
     stats, u_opt, result = optimise()
     t_move = N * DT_S
@@ -90,6 +115,7 @@ def main():
     print(f"hybrid model at {t_move:.2f} s: {1e3 * np.interp(t_move, result.t_s, result.x_m):.2f} mm; "
           f"final ({result.t_s[-1]:.2f} s): {1e3 * result.x_m[-1]:.2f} mm, mode {result.final_mode.label}; "
           f"after the move within {1e3 * np.max(np.abs(result.x_m[after] - TARGET_M)):.2f} mm of 40 mm")
+    figure(u_opt, result).savefig("trajectory_optimisation.png", dpi=110)
     return result
 
 

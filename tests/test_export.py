@@ -36,7 +36,8 @@ def test_casadi_model_is_the_scenarios_model():
     assert A[0, 1] == 1.0  # dx/dt = v
 
 
-def test_trajectory_optimisation_example_moves_the_load_to_40_mm():
+def test_trajectory_optimisation_example_moves_the_load_to_40_mm(monkeypatch):
+    monkeypatch.chdir(ROOT / "examples")  # the examples run from their folder
     spec = importlib.util.spec_from_file_location("trajectory_optimisation",
                                                   ROOT / "examples" / "trajectory_optimisation.py")
     example = importlib.util.module_from_spec(spec)

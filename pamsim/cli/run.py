@@ -1,4 +1,4 @@
-"""``pamsim run SCENARIO... -o DIR``: simulate scenarios, write NAME.csv, NAME.json and a figure (NAME.png) for each.
+"""``pamsim run SCENARIO -o DIR``: simulate scenarios (files, or folders of them), write NAME.csv, NAME.json and a figure (NAME.png) for each.
 
 A scenario with a ``[controller]`` table runs with its controller.  A folder
 stands for the scenario files in it (sweep files, which name a

@@ -15,7 +15,7 @@ Two non-smooth points are handled explicitly:
   from the venting to the filling conductance.  ``valve_slope`` picks
   ``mean`` (the central difference: the average of the two slopes, which is
   also the describing-function gain of the kink for a symmetric command),
-  ``fill`` or ``vent`` (one-sided).  At a saturated command (|u| = 1) the
+  ``fill`` or ``vent`` (one-sided).  At a saturated command (``|u| = 1``) the
   one-sided difference into the valve's range is used.
 
 Near a pressure ratio of 1 (chamber at supply pressure with the valve open)

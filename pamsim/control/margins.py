@@ -2,7 +2,7 @@
 
     python -m pamsim.control.margins scenarios/closed_loop_position.toml
 
-prints the gain crossover (|L| = 1) with its phase margin, the phase crossover
+prints the gain crossover (``|L| = 1``) with its phase margin, the phase crossover
 (phase -180 deg) with its gain margin, and the phase a pure delay costs at the
 gain crossover.  The loop is the linear design loop: the held plant
 linearisation at the design contraction (Coulomb friction dropped) and the

@@ -15,7 +15,7 @@ from .contracts import NO_OPTIONS, Builder, Damping, ElementOptions
 class PaperDamping:
     """Literal reading of paper eq. (8): ``D1 v + D2 v |v|`` (MODEL_NOTES sec. 3).
 
-    With the paper's D1 < 0 this adds energy below |v| = -D1/D2; the work
+    With the paper's D1 < 0 this adds energy below ``|v| = -D1/D2``; the work
     balance in the results reports it.
     """
 
