@@ -72,6 +72,7 @@ class Atlas:
 
     @property
     def models(self) -> list[str]:
+        """The models drawn, each once, in the order of the curves."""
         return list(dict.fromkeys(c.model for c in self.curves))
 
     def measured_near(self, p_Pa: float) -> np.ndarray:
@@ -84,6 +85,7 @@ class Atlas:
         return self.measured[keep]
 
     def table_rows(self) -> list[dict]:
+        """One row per model and pressure: blocked force [N], free contraction [mm] and the note on it."""
         return [{"model": c.model, "pressure_bar": c.pressure_Pa / PA_PER_BAR, "blocked_force_N": c.blocked_force_N,
                  "free_contraction_mm": c.free_contraction_m * 1e3, "free_contraction_note": c.free_contraction_note}
                 for c in self.curves]
@@ -109,6 +111,7 @@ class Atlas:
         return "\n".join(lines) + "\n"
 
     def figure_names(self, figure_format: str = "png") -> list[str]:
+        """File names of the figures :meth:`write` writes: one per pressure, then ``atlas_all``, in ``figure_format``."""
         stems = [f"atlas_{p / PA_PER_BAR:g}bar" for p in self.pressures_Pa] + ["atlas_all"]
         return [f"{stem}.{figure_format}" for stem in stems]
 

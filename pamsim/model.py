@@ -64,10 +64,12 @@ class MuscleModel:
 
     @property
     def n_source(self) -> int:
+        """Number of the pressure source's states."""
         return len(self.source.state_names)
 
     @property
     def state_names(self) -> tuple[str, ...]:
+        """Names of the state vector: contraction, velocity, the source's states, the work integrals."""
         return ("x_m", "v_m_s") + tuple(self.source.state_names) + WORK_NAMES
 
     def initial_state(self, x0_m: float = 0.0, p0_gauge_Pa: float | None = None) -> np.ndarray:
@@ -77,6 +79,7 @@ class MuscleModel:
 
     @property
     def breakpoints(self) -> tuple[float, ...]:
+        """Times [s] where an input of the source or the load jumps; the integrator restarts there."""
         return tuple(self.source.breakpoints) + tuple(self.load.breakpoints)
 
     @property
@@ -90,6 +93,9 @@ class MuscleModel:
         return self.rest_forces_with_inputs(y, self.source.inputs(t), self.load.external_N(t))
 
     def rest_forces_with_inputs(self, y, source_inputs, F_ext_N) -> tuple[float, float]:
+        """``(net force [N], Coulomb level [N])`` at rest in state ``y``, with the source's inputs and the
+        external force ``F_ext_N`` given.
+        """
         y = y.tolist()  # Python floats: scalar arithmetic on numpy scalars is several times slower
         x = y[0]
         p = self.source.pressure_gauge_Pa(y[2:2 + self.n_source], source_inputs)

@@ -151,6 +151,7 @@ class Result:
     # ------------------------------------------------------------------ queries
     @property
     def final_mode(self) -> Mode:
+        """The friction/contact mode at the end of the run."""
         return Mode(int(self.mode[-1]))
 
     @property
@@ -168,6 +169,7 @@ class Result:
 
     @property
     def out_of_fit_range(self) -> bool:
+        """Whether the run left the static model's valid domain (``fit_range_violations``)."""
         return bool(self.fit_range_violations)
 
     def energy_balance(self) -> dict[str, float]:
@@ -247,6 +249,7 @@ class Result:
         return int(n_samples) * len(one.columns()) * CSV_BYTES_PER_VALUE
 
     def columns(self) -> dict[str, np.ndarray]:
+        """Every column of the CSV by name: time, contraction, velocity, pressure, mode and the signals."""
         cols = {"t_s": self.t_s, "x_m": self.x_m, "v_m_s": self.v_m_s, "p_gauge_Pa": self.p_gauge_Pa,
                 "mode": self.mode}
         cols.update(self.signals)

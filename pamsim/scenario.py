@@ -191,6 +191,7 @@ class Scenario:
     # ------------------------------------------------------------ model build
     @property
     def mass_kg(self) -> float:
+        """Mass of the load [kg], given or from its weight."""
         load = self.spec["load"]
         return load["mass_kg"] if "mass_kg" in load else load["weight_N"] / self.parameters["g_m_s2"]
 
@@ -297,6 +298,7 @@ class Scenario:
 
     @property
     def initial_contraction_m(self) -> float:
+        """Contraction [m] at the start (``simulation.initial_contraction_m``, default 0)."""
         return float(self.spec["simulation"].get("initial_contraction_m", 0.0))
 
     @property

@@ -110,6 +110,7 @@ def _trace(v, where: str, spec: Mapping, suffixes, base_dir: Path) -> Trace:
 
 
 def signal_range(sig) -> tuple[float, float]:
+    """``(lowest, highest)`` value a signal takes."""
     if isinstance(sig, Trace):
         return float(sig.values.min()), float(sig.values.max())
     vals = [getattr(sig, a) for a in ("value", "initial", "final") if hasattr(sig, a)]

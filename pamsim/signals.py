@@ -48,6 +48,7 @@ class Constant(_Signal):
 
     @property
     def final_value(self) -> float:
+        """The constant value."""
         return self.value
 
 
@@ -118,6 +119,7 @@ class Trace(_Signal):
 
     @property
     def final_value(self) -> float:
+        """The last sample's value."""
         return float(self.values[-1])
 
     @property

@@ -30,6 +30,9 @@ COMMANDS = (
 
 
 def build_parser() -> argparse.ArgumentParser:
+    """The ``pamsim`` parser: ``--version`` and one subcommand per module of :data:`COMMANDS`, each added by
+    its ``register``.
+    """
     parser = argparse.ArgumentParser(prog="pamsim", description="McKibben muscle simulator")
     parser.add_argument("--version", action="version", version="pamsim " + __import__("pamsim").__version__)
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
@@ -39,6 +42,12 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Run the ``pamsim`` command with ``argv`` (default: the process's arguments) and return its exit code.
+
+    0 on success (1 for a closed-loop run that misses its specification); a user mistake
+    (:class:`~pamsim.errors.InputError`, or a file that cannot be read or written) prints one ``pamsim: error:``
+    line and returns 2, a :class:`~pamsim.errors.SolverFailure` returns 3, an interrupt 130.
+    """
     parser = build_parser()
     args = parser.parse_args(argv)
     try:

@@ -13,6 +13,7 @@ def _list(text: str) -> list[str]:
 
 
 def register(sub) -> None:
+    """Add ``pamsim atlas`` and its options to ``sub``, the subparsers of :func:`pamsim.cli.build_parser`."""
     p = sub.add_parser("atlas", help="force-contraction curves of every static model of a muscle",
                        description="Write atlas_curves.csv, atlas_table.csv/.md (blocked force and free "
                                    "contraction per model and pressure), one figure per pressure and "
@@ -29,6 +30,9 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    """``pamsim atlas``: build the muscle's atlas, write its figures, curves and table into ``--output`` and print the
+    table; exit code 0.
+    """
     from ..atlas import build_atlas
     from ..atomic import ensure_output_dir
 

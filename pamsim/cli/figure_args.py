@@ -12,6 +12,9 @@ from ..figure_style import DEFAULT_DPI, FORMATS, MAX_DPI, check_dpi, check_forma
 
 
 def add_arguments(parser: argparse.ArgumentParser, default_dpi: str = str(DEFAULT_DPI)) -> None:
+    """Add ``--format`` and ``--dpi`` to ``parser`` (``default_dpi``: the default its help names); :func:`options`
+    checks the values.
+    """
     parser.add_argument("--format", dest="figure_format", default="png", metavar="{" + ",".join(FORMATS) + "}",
                         help="file format of the figures (default png; pdf and svg are vector graphics for papers)")
     parser.add_argument("--dpi", default=None, metavar="N",

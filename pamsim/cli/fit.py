@@ -85,6 +85,9 @@ def check_output_dir(directory: str) -> None:
 
 
 def register(sub) -> None:
+    """Add ``pamsim fit static`` and ``pamsim fit dynamic`` and their options to ``sub``, the subparsers of
+    :func:`pamsim.cli.build_parser`.
+    """
     p = sub.add_parser("fit", help="identify a muscle from static tests or step responses",
                        description="Fit static force coefficients to static tests (fit static) or friction and "
                                    "damping coefficients to step responses (fit dynamic).")
@@ -157,6 +160,9 @@ def _print_warnings(uncertainty) -> None:
 
 
 def run_static(args: argparse.Namespace) -> int:
+    """``pamsim fit static``: fit the static force model to the static tests of ``DATA.csv`` (and compare models
+    with ``--compare``), write the fit, the muscle file, the report and the figures; exit code 0.
+    """
     from ..identification import compare, muscle_file, report, static_fit
     from ..identification.columns import read_static_data
 
@@ -195,6 +201,9 @@ def run_static(args: argparse.Namespace) -> int:
 
 
 def run_dynamic(args: argparse.Namespace) -> int:
+    """``pamsim fit dynamic``: fit friction and damping to the step responses with the scenario's model (on
+    ``--workers`` processes or the native backend), write the fit, the report and the figures; exit code 0.
+    """
     from concurrent.futures import ProcessPoolExecutor
 
     from ..identification import dynamic_fit, report

@@ -9,6 +9,7 @@ from ..errors import InputError
 
 
 def register(sub) -> None:
+    """Add ``pamsim fmu build`` and its options to ``sub``, the subparsers of :func:`pamsim.cli.build_parser`."""
     p = sub.add_parser("fmu", help="export the model as an FMU",
                        description="Build a Functional Mock-up Unit (Model Exchange and Co-Simulation) of the "
                                    "muscle model with the system C compiler (docs/fmu.md).")
@@ -47,6 +48,9 @@ def _muscle_scenario(args: argparse.Namespace):
 
 
 def run_build(args: argparse.Namespace) -> int:
+    """``pamsim fmu build``: compile the FMU (FMI 2.0 or 3.0), with the static force of ``--scenario`` or of
+    ``--muscle`` and ``--static-force`` baked in as a table when given; exit code 0.
+    """
     from ..fmu import build
 
     if args.fmi not in ("2", "3"):

@@ -11,6 +11,7 @@ from . import finite_float, muscle_args
 
 
 def register(sub) -> None:
+    """Add ``pamsim force`` and its options to ``sub``, the subparsers of :func:`pamsim.cli.build_parser`."""
     p = sub.add_parser("force", help="static force of a model at one contraction and pressure",
                        description="The raw static force (positive pulls; may be negative) of a library model "
                                    "for a muscle, after checking the point against the model's valid domain.")
@@ -22,6 +23,9 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    """``pamsim force``: print the raw static force of one model at one contraction and pressure (as JSON with
+    ``--json``); a point outside the model's domain is refused naming the flag; exit code 0.
+    """
     muscle, _, model = muscle_args.resolve(args)
     x_m, p_Pa = args.contraction_mm * 1e-3, args.pressure_bar * PA_PER_BAR
     _check_domain(model, args, x_m, p_Pa)

@@ -23,6 +23,7 @@ DEFAULT_OUTPUT = "out"
 
 
 def register(sub) -> None:
+    """Add ``pamsim linearize`` and its options to ``sub``, the subparsers of :func:`pamsim.cli.build_parser`."""
     p = sub.add_parser("linearize", help="linear model at an operating point (python-control)",
                        description="Linearise the muscle about an operating point of a scenario (valve source); "
                                    "print A, B, C, D, poles, the mechanical mode and DC gains; write a Bode plot "
@@ -91,6 +92,10 @@ def report(lin) -> dict:
 
 
 def run(args: argparse.Namespace) -> int:
+    """``pamsim linearize``: linearise the scenario at the operating point the options choose and print the
+    figures (as JSON with ``--json``) and write the Bode and pole-zero plots (not with ``--json`` alone,
+    without ``-o``); exit code 0.
+    """
     from ..scenario import load_scenario
 
     args.figures = figure_args.options(args)

@@ -8,6 +8,7 @@ import json
 
 
 def register(sub) -> None:
+    """Add ``pamsim models`` and its options to ``sub``, the subparsers of :func:`pamsim.cli.build_parser`."""
     p = sub.add_parser("models", help="list the static force models",
                        description="Every static force model with its kind, source and required muscle parameters.")
     p.add_argument("--json", action="store_true",
@@ -16,6 +17,9 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    """``pamsim models``: print every static force model of the registry with its kind, source and required
+    parameters (as JSON with ``--json``); exit code 0.
+    """
     from ..static_models import REGISTRY
 
     rows = [{"name": s.name, "kind": s.kind, "source": s.source, "parameters": list(s.parameters),

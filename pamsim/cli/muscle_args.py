@@ -9,6 +9,9 @@ from ..errors import InputError
 
 
 def add_arguments(parser: argparse.ArgumentParser, model: bool = True) -> None:
+    """Add ``--muscle`` and ``--set NAME=VALUE`` to ``parser``, and with ``model`` also ``--model`` (alias
+    ``--static-force``) and ``--variant``.
+    """
     parser.add_argument("--muscle", default="shadow_6x300_acra2012",
                         help="shipped muscle name (`pamsim muscles`) or a muscle TOML file (default: the Shadow muscle)")
     if model:

@@ -7,6 +7,7 @@ import json
 
 
 def register(sub) -> None:
+    """Add ``pamsim muscles`` and its options to ``sub``, the subparsers of :func:`pamsim.cli.build_parser`."""
     p = sub.add_parser("muscles", help="list the shipped muscles",
                        description="Every shipped muscle with its citation, default static model and the "
                                    "models whose parameters it gives.")
@@ -15,6 +16,9 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    """``pamsim muscles``: print the shipped muscles, their default model and the models that apply (for a
+    muscle none applies to: why, and the file's gaps); as JSON with ``--json``; exit code 0.
+    """
     from ..muscles import load_muscle, shipped_names
 
     rows = []

@@ -10,6 +10,7 @@ from . import muscle_args
 
 
 def register(sub) -> None:
+    """Add ``pamsim params`` and its options to ``sub``, the subparsers of :func:`pamsim.cli.build_parser`."""
     p = sub.add_parser("params", help="list a muscle's parameters with units and provenance",
                        description="A muscle's parameters with the dynamics' assumed defaults for what its "
                                    "file does not give, each with unit, range and source.")
@@ -22,6 +23,9 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    """``pamsim params``: print a muscle's parameters with units and provenance (as JSON or markdown), or with
+    ``--defaults`` the dynamics' assumed defaults; exit code 0.
+    """
     if args.defaults:
         print(defaults_table())
         return 0

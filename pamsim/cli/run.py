@@ -23,6 +23,7 @@ MAX_CSV_MB = 200.0
 
 
 def register(sub) -> None:
+    """Add ``pamsim run`` and its options to ``sub``, the subparsers of :func:`pamsim.cli.build_parser`."""
     p = sub.add_parser("run", help="simulate scenario files",
                        description="Simulate scenarios and write NAME.csv, NAME.json and the figure NAME.png "
                                    "(or .pdf, .svg with --format) for each into DIR.  A scenario with a [controller] "
@@ -64,6 +65,9 @@ def scenario_paths(arguments: list[str]) -> list[Path]:
 
 
 def run(args: argparse.Namespace) -> int:
+    """``pamsim run``: check every scenario, then simulate each and write its CSV, JSON and figure into
+    ``--output``; exit code 1 if a closed-loop run misses its ``[controller.spec]``, else 0.
+    """
     from ..scenario import load_scenario
 
     args.figures = figure_args.options(args)

@@ -11,6 +11,7 @@ from . import finite_float, muscle_args
 
 
 def register(sub) -> None:
+    """Add ``pamsim static`` and its options to ``sub``, the subparsers of :func:`pamsim.cli.build_parser`."""
     p = sub.add_parser("static", help="static equilibrium and force capability",
                        description="Equilibrium contraction of a hanging load and the largest load held above "
                                    "the lower stop, from a static force model alone.")
@@ -22,6 +23,9 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    """``pamsim static``: print the static equilibrium contraction under the load and the largest load held
+    above the lower stop at the pressure (as JSON with ``--json``); exit code 0.
+    """
     from ..static import static_report
 
     muscle, params, model = muscle_args.resolve(args)

@@ -26,6 +26,7 @@ def _workers(text: str) -> int:
 
 
 def register(sub) -> None:
+    """Add ``pamsim sweep`` and its options to ``sub``, the subparsers of :func:`pamsim.cli.build_parser`."""
     p = sub.add_parser("sweep", help="run a sweep file (many cases, compared with measurements)",
                        description="Run every case of a sweep file under each friction model it names and write "
                                    "summary.csv, report.md and figures (PNG, or PDF or SVG with --format) into DIR.")
@@ -49,6 +50,9 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    """``pamsim sweep``: run the sweep file's cases on worker processes or a Dask cluster and write the summary,
+    report and figures into ``--output``; exit code 0 (a failed run is a warning on stderr).
+    """
     from ..sweep.dask_cluster import dask_executor, start_worker_server
 
     fmt, dpi = figure_args.options(args)

@@ -192,6 +192,7 @@ class ClosedLoopValveSource:
 
     @property
     def p_atm_Pa(self) -> float:
+        """Ambient pressure [Pa] of the plant."""
         return self.plant.p_atm_Pa
 
     def initial_state(self, x_m: float, p_gauge_Pa: float | None = None) -> list[float]:
@@ -200,12 +201,15 @@ class ClosedLoopValveSource:
         return self.plant.initial_state(x_m, p) + [0.0, x_m]
 
     def inputs(self, t_s) -> tuple:
+        """``(reference [m], feedforward gauge pressure [Pa], supply gauge pressure [Pa])`` at ``t_s`` [s]."""
         return self.reference_m(t_s), self.feedforward_gauge_Pa(t_s), self.plant.supply_gauge_Pa(t_s)
 
     def pressure_gauge_Pa(self, s, inputs):
+        """Gauge pressure [Pa] of the chamber: its absolute pressure state less the ambient pressure."""
         return s[0] - self.p_atm_Pa
 
     def pressure_trace_Pa(self, t_s, S):
+        """Gauge pressure [Pa] along a trace, as the plant's."""
         return self.plant.pressure_trace_Pa(t_s, S)
 
     def command(self, s, x_m, inputs):
@@ -227,15 +231,22 @@ class ClosedLoopValveSource:
         return dz, (x_m - s[3]) / self.velocity_filter_time_s
 
     def derivatives(self, s, x_m, v_m_s, inputs) -> tuple[float, ...]:
+        """Rates of pressure, air mass, error integral and position filter, with the valve at the controller's
+        (clipped) command.
+        """
         u, raw = self.command(s, x_m, inputs)
         dp, dm = self.plant.derivatives(s[:2], x_m, v_m_s, (float(u), inputs[2]))
         return (dp, dm) + self.controller_rates(s, x_m, inputs, u, raw)
 
     @property
     def breakpoints(self) -> tuple[float, ...]:
+        """Times [s] where the reference or the supply pressure jumps."""
         return self.reference_m.breakpoints + tuple(getattr(self.plant.supply_gauge_Pa, "breakpoints", ()))
 
     def outputs(self, t_s, S, x_m) -> dict[str, np.ndarray]:
+        """Extra trace columns: air mass, valve flow and command, supply pressure, gas temperature, reference,
+        feedforward, error integral and velocity estimate.
+        """
         inputs = self.inputs(t_s)
         u, _ = self.command(S, x_m, inputs)
         mdot, T_gas = self.plant.inflow_kg_s(S[:2], self.plant.chamber.volume_m3(x_m), (u, inputs[2]))
@@ -278,6 +289,9 @@ class PositionController(Component):
                                 "p_atm_Pa": source.p_atm_Pa})
 
     def equations(self, s: Symbols) -> Equations:
+        """The source's control law on symbols: the command, and the rates of the error integral and the
+        position filter.
+        """
         P = s.p
         law = dataclasses.replace(self.source, K=(P["Kx_per_m"], P["Kv_s_per_m"], P["Kp_per_Pa"], P["Kz_per_m_s"]),
                                   velocity_filter_time_s=P["velocity_filter_time_s"], deadband_m=P["deadband_m"],
@@ -418,6 +432,9 @@ class ClosedLoopRun:
         return [msg.format(value, s[key]) for key, value, msg in checks if key in s and not value <= s[key]]
 
     def summary(self) -> dict:
+        """The run as JSON-ready figures: gains, design poles, metrics of the run and of the linear prediction,
+        the specification and what the run misses, events and wall time.
+        """
         return {"scenario": self.result.name, "gains_K": [float(k) for k in self.design.K],
                 "gain_order": ["x_m", "v_m_s", "p_gauge_Pa", "z_error_integral_m_s"],
                 "design_poles": [[float(p.real), float(p.imag)] for p in self.design.closed_loop_poles],

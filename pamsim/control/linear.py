@@ -109,6 +109,7 @@ class MechanicalMode:
 
     @property
     def natural_frequency_Hz(self) -> float:
+        """Undamped natural frequency [Hz]."""
         return self.omega_n_rad_s / (2.0 * math.pi)
 
 

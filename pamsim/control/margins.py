@@ -38,6 +38,7 @@ class LoopMargins:
 
     @property
     def gain_margin_dB(self) -> float:
+        """The gain margin in decibels."""
         return 20.0 * math.log10(self.gain_margin)
 
     def delay_phase_deg(self, delay_s: float) -> float:
@@ -66,6 +67,9 @@ def loop_margins(scenario: Scenario | str) -> LoopMargins:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """``python -m pamsim.control.margins SCENARIO``: print the margins (as JSON with ``--json``); exit code 0,
+    or 2 for bad input.
+    """
     ap = argparse.ArgumentParser(prog="python -m pamsim.control.margins", description=__doc__.split("\n")[0])
     ap.add_argument("scenario", help="scenario TOML with a [controller] table")
     ap.add_argument("--delay-ms", type=float, default=0.5, help="delay whose phase cost is reported [ms]")

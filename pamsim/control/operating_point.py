@@ -47,6 +47,7 @@ class OperatingPoint:
     description: str
 
     def as_dict(self) -> dict:
+        """The operating point as JSON-ready values: kind, mode, description, states and inputs."""
         return {"kind": self.kind, "mode": self.mode.label, "description": self.description,
                 "states": [float(v) for v in self.states], "inputs": [float(v) for v in self.inputs]}
 

@@ -78,6 +78,7 @@ class FrictionTreatment:
         return self.direction
 
     def describe(self) -> str:
+        """One line saying how the Coulomb friction enters the linearisation."""
         if self.kind == "dropped":
             return "Coulomb friction dropped (no linearisation at rest)"
         if self.kind == "regularised":
@@ -109,6 +110,7 @@ class MusclePlant:
 
     @property
     def source(self) -> ValveChamberSource:
+        """The model's valve-and-chamber pressure source."""
         return self.model.source
 
     def rhs(self, x, u, friction: FrictionTreatment) -> np.ndarray:

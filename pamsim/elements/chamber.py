@@ -38,24 +38,32 @@ class MuscleChamber:
 
     @classmethod
     def from_parameters(cls, p: Mapping[str, float]) -> "MuscleChamber":
+        """The chamber of a muscle's parameters (braid geometry, dead volume, polytropic index, gas constant)."""
         braid = Braid.from_parameters(p)
         return cls(p["L0_m"], braid.b, braid.N, p["dead_volume_m3"], p["polytropic_index"], p["R_J_per_kg_K"])
 
     def volume_m3(self, x_m):
+        """Chamber volume [m^3] at contraction ``x_m``: the braid's cylinder plus the dead volume."""
         L = self.L0_m - x_m
         return L * (self.thread_length_m ** 2 - L * L) / (4.0 * math.pi * self.turns ** 2) + self.dead_volume_m3
 
     def dvolume_dx_m2(self, x_m):
+        """Derivative of the volume with respect to contraction, ``dV/dx`` [m^2]."""
         L = self.L0_m - x_m
         return -(self.thread_length_m ** 2 - 3.0 * L * L) / (4.0 * math.pi * self.turns ** 2)
 
     def gas_temperature_K(self, p_abs_Pa, volume_m3, air_mass_kg):
+        """Gas temperature [K] of the air mass at absolute pressure and volume: ``p V / (m R)``."""
         return p_abs_Pa * volume_m3 / (air_mass_kg * self.R_J_per_kg_K)
 
     def air_mass_kg(self, p_abs_Pa, volume_m3, T_K):
+        """Air mass [kg] of the ideal gas at absolute pressure, volume and temperature: ``p V / (R T)``."""
         return p_abs_Pa * volume_m3 / (self.R_J_per_kg_K * T_K)
 
     def pressure_rate_Pa_s(self, p_abs_Pa, volume_m3, dvolume_dt_m3_s, inflow_kg_s, T_inflow_K):
+        """Rate of the absolute pressure [Pa/s] for the volume's rate of change and an inflow [kg/s] at
+        ``T_inflow_K``.
+        """
         return self.pressure_rate_from_flow_work_Pa_s(p_abs_Pa, volume_m3, dvolume_dt_m3_s,
                                                       self.flow_work_W(inflow_kg_s, T_inflow_K))
 

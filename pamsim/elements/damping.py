@@ -25,9 +25,11 @@ class PaperDamping:
 
     @classmethod
     def from_parameters(cls, p: Mapping[str, float], options: ElementOptions = NO_OPTIONS) -> "PaperDamping":
+        """The paper's damping with D1 and D2 of the muscle's parameters."""
         return cls(p["D1_N_s_per_m"], p["D2_N_s2_per_m2"])
 
     def force_N(self, v_m_s):
+        """Damping force [N]: ``(D1 + D2 |v|) v``."""
         return (self.D1_N_s_per_m + self.D2_N_s2_per_m2 * abs(v_m_s)) * v_m_s
 
 
@@ -40,9 +42,11 @@ class LinearDamping:
 
     @classmethod
     def from_parameters(cls, p: Mapping[str, float], options: ElementOptions = NO_OPTIONS) -> "LinearDamping":
+        """Linear damping with ``c = |D1|`` of the muscle's parameters."""
         return cls(abs(p["D1_N_s_per_m"]))
 
     def force_N(self, v_m_s):
+        """Damping force [N]: ``c v``."""
         return self.c_N_s_per_m * v_m_s
 
 
@@ -54,9 +58,11 @@ class NoDamping:
 
     @classmethod
     def from_parameters(cls, p: Mapping[str, float], options: ElementOptions = NO_OPTIONS) -> "NoDamping":
+        """No damping; the parameters are not read."""
         return cls()
 
     def force_N(self, v_m_s):
+        """Zero, of the shape of ``v_m_s``."""
         return 0.0 * v_m_s
 
 

@@ -22,10 +22,12 @@ class WrappedStaticForce:
 
     @property
     def name(self) -> str:
+        """The wrapped model's name."""
         return self.inner.name
 
     @property
     def domain(self):
+        """The wrapped model's domain."""
         return self.inner.domain
 
 

@@ -41,6 +41,9 @@ class LoadDependentCoulomb:
         return cls(p["N2_N_per_bar_m2"], p["N1_N_per_bar_m"], p["N0_N_per_bar"], p["phi_bar_per_kg"], negative_level)
 
     def level_N(self, x_m, p_gauge_Pa, mass_kg):
+        """Friction level [N] at contraction, gauge pressure and load mass; a negative level is clipped to 0
+        or taken as its magnitude, by ``negative_level``.
+        """
         level = ((p_gauge_Pa / PA_PER_BAR - self.phi_bar_per_kg * mass_kg)
                  * ((self.N2_N_per_bar_m2 * x_m + self.N1_N_per_bar_m) * x_m + self.N0_N_per_bar))
         if self.negative_level == "abs":
@@ -57,9 +60,11 @@ class ConstantCoulomb:
 
     @classmethod
     def from_parameters(cls, p: Mapping[str, float], options: ElementOptions = NO_OPTIONS) -> "ConstantCoulomb":
+        """A constant level of ``coulomb_constant_N`` of the muscle's parameters."""
         return cls(p["coulomb_constant_N"])
 
     def level_N(self, x_m, p_gauge_Pa, mass_kg):
+        """The constant level [N], of the shape of ``x_m``."""
         return self.level_constant_N + 0.0 * x_m
 
 
@@ -71,9 +76,11 @@ class NoCoulomb:
 
     @classmethod
     def from_parameters(cls, p: Mapping[str, float], options: ElementOptions = NO_OPTIONS) -> "NoCoulomb":
+        """No Coulomb friction; the parameters are not read."""
         return cls()
 
     def level_N(self, x_m, p_gauge_Pa, mass_kg):
+        """Zero, of the shape of ``x_m``."""
         return 0.0 * x_m
 
 

@@ -20,13 +20,16 @@ class HangingLoad:
 
     @property
     def weight_N(self) -> float:
+        """Weight of the load [N]: mass times gravity."""
         return self.mass_kg * self.g_m_s2
 
     def external_N(self, t_s):
+        """External force [N] on the load at ``t_s`` [s] (zero without one)."""
         if self.external_force_N is None:
             return 0.0 * t_s
         return self.external_force_N(t_s)
 
     @property
     def breakpoints(self) -> tuple[float, ...]:
+        """Times [s] where the external force jumps."""
         return getattr(self.external_force_N, "breakpoints", ())

@@ -36,6 +36,9 @@ class ValveChamberSource:
     state_names: tuple[str, ...] = ("p_abs_Pa", "air_mass_kg")
 
     def initial_state(self, x_m: float, p_gauge_Pa: float = 0.0) -> list[float]:
+        """``[absolute pressure, air mass]`` of the chamber at rest at ``x_m`` and gauge pressure ``p_gauge_Pa``,
+        filled at the supply temperature.
+        """
         p = self.p_atm_Pa + p_gauge_Pa
         return [p, self.chamber.air_mass_kg(p, self.chamber.volume_m3(x_m), self.T_supply_K)]
 
@@ -44,9 +47,11 @@ class ValveChamberSource:
         return self.command(t_s), self.supply_gauge_Pa(t_s)
 
     def pressure_gauge_Pa(self, s, inputs):
+        """Gauge pressure [Pa] of the chamber: its absolute pressure state less the ambient pressure."""
         return s[0] - self.p_atm_Pa
 
     def pressure_trace_Pa(self, t_s, S):
+        """Gauge pressure [Pa] along a trace, from the pressure state."""
         return np.asarray(S[0], dtype=float) - self.p_atm_Pa  # a state: the inputs are not needed
 
     def inflow_kg_s(self, s, V, inputs):
@@ -69,13 +74,16 @@ class ValveChamberSource:
 
     @property
     def breakpoints(self) -> tuple[float, ...]:
+        """Times [s] where the supply pressure or the valve command jumps."""
         return tuple(getattr(self.supply_gauge_Pa, "breakpoints", ())) + tuple(getattr(self.command, "breakpoints", ()))
 
     @property
     def max_input_step_s(self) -> float:
+        """Longest step [s] over which the supply pressure and the command are monotonic."""
         return max_step_hint_s(self.supply_gauge_Pa, self.command)
 
     def outputs(self, t_s, S, x_m) -> dict[str, np.ndarray]:
+        """Extra trace columns: air mass, valve mass flow, valve command, supply pressure, gas temperature."""
         inputs = self.inputs(t_s)
         mdot, T_gas = self.inflow_kg_s(S, self.chamber.volume_m3(x_m), inputs)
         return {"air_mass_kg": S[1], "valve_mass_flow_kg_s": np.asarray(mdot, dtype=float),
@@ -93,6 +101,7 @@ class PrescribedPressure:
     state_names: tuple[str, ...] = ()
 
     def initial_state(self, x_m: float, p_gauge_Pa: float = 0.0) -> list[float]:
+        """No states: an empty list."""
         return []
 
     def inputs(self, t_s) -> tuple:
@@ -100,21 +109,27 @@ class PrescribedPressure:
         return (self.p_gauge_Pa(t_s),)
 
     def pressure_gauge_Pa(self, s, inputs):
+        """The prescribed gauge pressure [Pa], the source's only input."""
         return inputs[0]
 
     def pressure_trace_Pa(self, t_s, S):
+        """The prescribed gauge pressure [Pa] at the times ``t_s`` [s]."""
         return np.asarray(self.p_gauge_Pa(t_s), dtype=float) + 0.0 * t_s
 
     def derivatives(self, s, x_m, v_m_s, inputs) -> tuple[()]:
+        """No states, no derivatives."""
         return ()
 
     @property
     def breakpoints(self) -> tuple[float, ...]:
+        """Times [s] where the prescribed pressure jumps."""
         return tuple(getattr(self.p_gauge_Pa, "breakpoints", ()))
 
     @property
     def max_input_step_s(self) -> float:
+        """Longest step [s] over which the prescribed pressure is monotonic."""
         return max_step_hint_s(self.p_gauge_Pa)
 
     def outputs(self, t_s, S, x_m) -> dict[str, np.ndarray]:
+        """No extra columns."""
         return {}

@@ -27,4 +27,7 @@ class EndStops:
     @classmethod
     def from_parameters(cls, p: Mapping[str, float]) -> "EndStops":
         # Braid lock at 54.7 deg (cos^2 = 1/3): L_lock = b / sqrt(3), MODEL_NOTES sec. 5.
+        """Stops at zero contraction and at the braid lock of the muscle's geometry, with its
+        ``stop_restitution``.
+        """
         return cls(0.0, Braid.from_parameters(p).x_lock_m, p["stop_restitution"])

@@ -24,6 +24,9 @@ class Iso6358Orifice:
 
     @classmethod
     def from_parameters(cls, p: Mapping[str, float]) -> "Iso6358Orifice":
+        """The valve of a muscle's parameters: sonic conductance, critical pressure ratio, laminar ratio and
+        reference conditions.
+        """
         return cls(p["valve_C_m3_per_s_Pa"], p["valve_b"], p["valve_laminar_ratio"],
                    p["rho0_kg_m3"], p["T0_K"])
 

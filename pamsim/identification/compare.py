@@ -33,6 +33,7 @@ def comparison_rows(fits: Sequence[StaticFit]) -> list[dict]:
 
 
 def write_comparison_csv(rows: Sequence[dict], path) -> None:
+    """Write the model comparison ``rows`` to the CSV file ``path``, one column per :data:`COMPARE_COLUMNS`."""
     with open(path, "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=COMPARE_COLUMNS)
         w.writeheader()

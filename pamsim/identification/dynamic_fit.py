@@ -63,6 +63,7 @@ class DynamicProblem:
     inputs: tuple[PiecewiseLinearInput | None, ...]
 
     def tasks(self, theta: np.ndarray) -> list[SimulationTask]:
+        """One simulation task per trace with the coefficients ``theta`` (in the order of ``free``)."""
         overrides = dict(zip(self.free, map(float, theta)))
         out = []
         for tr, w, sig in zip(self.traces, self.loads_N, self.inputs):
@@ -172,21 +173,28 @@ class DynamicFit:
 
     @property
     def traces(self) -> tuple[TraceData, ...]:
+        """The measured traces fitted."""
         return self.problem.traces
 
     @property
     def windows(self) -> tuple[np.ndarray, ...]:
+        """Boolean mask of each trace's samples inside the fitting window."""
         return self.problem.windows
 
     @property
     def loads_N(self) -> tuple[float, ...]:
+        """Hanging load [N] of each trace."""
         return self.problem.loads_N
 
     @property
     def parameters(self) -> dict[str, float]:
+        """The fitted coefficients by name."""
         return dict(zip(self.problem.free, map(float, self.theta)))
 
     def to_json(self) -> dict:
+        """The fit as JSON-ready values: traces and their hashes, coefficients with start values, standard
+        errors and correlations, and the errors.
+        """
         u = self.uncertainty
         names = [tr.origin for tr in self.traces]
         body = {"scenario": self.problem.scenario.origin, "traces": names,

@@ -42,6 +42,7 @@ class PiecewiseLinearInput:
 
     @property
     def final_value(self) -> float:
+        """The last knot's value."""
         return float(self.values[-1])
 
 

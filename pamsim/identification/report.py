@@ -61,6 +61,9 @@ def parameter_table(names: Sequence[str], start: dict, fitted: dict, unc) -> lis
 
 
 def correlation_lines(fit_unc) -> list[str]:
+    """Markdown lines on what the data do not show: coefficients not identified, and pairs correlated
+    beyond ``|r| = 0.95``.
+    """
     pairs = fit_unc.inseparable_pairs()
     blind = fit_unc.not_identified()
     out = []
@@ -76,6 +79,9 @@ def correlation_lines(fit_unc) -> list[str]:
 
 
 def static_report_md(fit: "StaticFit", compare: Sequence[dict] | None, figure_format: str = "png") -> str:
+    """The static fit's report in Markdown: errors, coefficients, correlations, the compared models and
+    figures.
+    """
     p = fit.problem
     start = {n: p.base[n] for n in p.free}
     out = [f"# Static fit: {p.model} on {Path(p.data.origin).name}", "",
@@ -188,6 +194,7 @@ def _absolute_files(value, base_dir: Path):
 
 
 def dynamic_report_md(fit: "DynamicFit", figure_format: str = "png") -> str:
+    """The dynamic fit's report in Markdown: errors per trace, coefficients, correlations and figures."""
     p = fit.problem
     start = dict(zip(p.free, map(float, fit.start)))
     out = [f"# Dynamic fit (eq. 13) on {len(p.traces)} trace(s), scenario {p.scenario.name}", "",

@@ -73,12 +73,15 @@ class StaticProblem:
 
     @cached_property
     def derives(self) -> bool:
+        """Whether the base parameter set derives a parameter from others (so the fit re-derives it)."""
         return any(p.source.startswith(DERIVED) for p in self.base.entries.values())
 
     def params(self, theta: np.ndarray) -> dict[str, float]:
+        """The parameters with the coefficients ``theta`` (in the order of ``free``) in place."""
         return dict(self.parameter_set(theta))
 
     def force(self, theta: np.ndarray):
+        """The static force model with the coefficients ``theta``."""
         return build_static(self.model, self.params(theta))
 
     def feasible_force(self, theta: np.ndarray):
@@ -179,17 +182,23 @@ class StaticFit:
 
     @property
     def parameters(self) -> dict[str, float]:
+        """The fitted coefficients by name."""
         return dict(zip(self.problem.free, map(float, self.theta)))
 
     @property
     def n_points(self) -> int:
+        """Number of static tests fitted."""
         return len(self.problem.data)
 
     @property
     def n_censored(self) -> int:
+        """Number of censored tests: loads the muscle did not lift."""
         return int(self.problem.censored.sum())
 
     def to_json(self) -> dict:
+        """The fit as JSON-ready values: model, data and its hash, coefficients, standard errors,
+        correlations, errors and cross-validation.
+        """
         u = self.uncertainty
         return {"model": self.problem.model, "muscle": self.muscle, "objective": self.problem.objective,
                 "data": self.problem.data.origin, "data_sha256": self.problem.data.sha256,

@@ -38,6 +38,8 @@ def _rms(err_m: np.ndarray) -> float:
 
 
 def static_study() -> None:
+    """The paper's static polynomial refitted to its steady states, against the printed coefficients, and the
+    applicable models compared; Markdown tables."""
     path = resources.files("pamsim.data").joinpath("acra2012_steady_state.csv")
     data = read_static_data(str(path))
     P = get_parameter_set("shadow_6x300_acra2012")
@@ -165,6 +167,7 @@ def inputs_study(scenario_path: str) -> None:
 
 
 def dynamic_study(scenario_path: str) -> None:
+    """Finite-difference steps and the recovery of synthetic truth from one and from three loads."""
     from ..scenario import load_scenario
 
     sc = load_scenario(scenario_path)
@@ -205,6 +208,7 @@ def native_study(scenario_path: str) -> None:
 
 
 def main() -> None:
+    """``python -m pamsim.identification.studies static|dynamic|inputs|native [--scenario S]``."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("which", choices=("static", "dynamic", "inputs", "native"))
     parser.add_argument("--scenario", default="scenarios/acra2012_fig4.toml")

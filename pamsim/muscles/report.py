@@ -59,6 +59,8 @@ def muscle_table() -> str:
 
 
 def kothera_table() -> str:
+    """Kothera's actuator 5a: blocked force and free length (fraction of L0) at 10, 30 and 60 psi, the
+    specification's against pamsim's."""
     muscle = load_muscle("kothera2009_5a")
     L0 = muscle.parameters["L0_m"]
     lines = ["| quantity (actuator 5a) | spec 10 / 30 / 60 psi | pamsim 10 / 30 / 60 psi | largest deviation |",
@@ -75,6 +77,9 @@ def kothera_table() -> str:
 
 
 def miniature_table() -> str:
+    """The survey's 45 mm miniature muscle: free contraction at 758 kPa of each model, against the
+    measured 13 mm.
+    """
     params = load_muscle("mpam_survey_45mm").parameters
     lines = ["| model (45 mm, 36 deg, 758 kPa) | load [N] | spec [mm] | pamsim [mm] | vs measured 13 mm | survey's error (40 mm) |",
              "|---|---|---|---|---|---|"]
@@ -145,6 +150,7 @@ def two_phase_rows() -> list[str]:
 
 
 def main(argv: list[str] | None = None) -> None:
+    """``python -m pamsim.muscles.report [--models | --muscles]``: print the tables."""
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--models", action="store_true", help="print only the table of models")
     ap.add_argument("--muscles", action="store_true", help="print only the table of shipped muscles")

@@ -88,6 +88,7 @@ class ForceMap(StaticForce):
 
     @classmethod
     def from_csv(cls, path: str | Path) -> "ForceMap":
+        """The force map of a CSV file of measured forces over contraction and pressure."""
         return cls(*read_force_map(path), origin=str(path))
 
     def force_N(self, x_m, p_gauge_Pa):

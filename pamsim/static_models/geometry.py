@@ -41,6 +41,7 @@ class Braid:
 
     @classmethod
     def from_parameters(cls, p: Mapping[str, float]) -> "Braid":
+        """The braid of a muscle's ``L0_m``, ``r0_m``, ``theta0_deg`` and ``wall_thickness_m`` (0 if not given)."""
         L0, r0 = p["L0_m"], p["r0_m"]
         theta0 = math.radians(p["theta0_deg"])
         t0 = p.get("wall_thickness_m", 0.0)
@@ -66,10 +67,12 @@ class Braid:
 
     @property
     def q1(self) -> float:
+        """``3 / tan^2(theta0)``, the first constant of Gaylord's normalised law."""
         return 3.0 / math.tan(self.theta0) ** 2
 
     @property
     def q2(self) -> float:
+        """``1 / sin^2(theta0)``, the second constant of Gaylord's normalised law."""
         return 1.0 / math.sin(self.theta0) ** 2
 
     def radius_m(self, L):

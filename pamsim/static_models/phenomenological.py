@@ -33,9 +33,11 @@ class NormalisedGaylord(BraidModel):
         """Read the model's fitted constants."""
 
     def k_f(self, p):
+        """Force correction factor at gauge pressure ``p`` [Pa]: 1 here; subclasses fit it."""
         return 1.0
 
     def k_eps(self, p):
+        """Strain correction factor at gauge pressure ``p`` [Pa]: 1 here; subclasses fit it."""
         return 1.0
 
     def force_N(self, x_m, p_gauge_Pa):
@@ -53,6 +55,7 @@ class TonduLopez(NormalisedGaylord):
         self.pu = params["tondu_pressure_unit_Pa"]
 
     def k_eps(self, p):
+        """Strain correction at gauge pressure ``p`` [Pa]: ``kappa1 exp(-p/p_u) + kappa2``."""
         return self.k1 * exp(-p / self.pu) + self.k2
 
 
@@ -66,6 +69,7 @@ class Itto(NormalisedGaylord):
         self.k1, self.k2, self.k3 = params["itto_kappa1"], params["itto_kappa2_per_Pa"], params["itto_kappa3"]
 
     def k_eps(self, p):
+        """Strain correction at gauge pressure ``p`` [Pa], in the form of the variant."""
         e = exp(self.k2 * p)
         return self.k1 * (1.0 + e) if self.variant == "eq44" else self.k1 * e + self.k3
 
@@ -92,6 +96,7 @@ class Meller(NormalisedGaylord):
         return self.k3 * log(p / self.pu)
 
     def force_N(self, x_m, p_gauge_Pa):
+        """Static force [N]: the measured blocked force times the normalised Gaylord shape."""
         s = 1.0 - self.lim / self.eps_max(p_gauge_Pa) * x_m / self.L0
         return (self.k1 * p_gauge_Pa + self.k2) * (self.q1 * s * s - self.q2) / (self.q1 - self.q2)
 
@@ -108,6 +113,7 @@ class Andrikopoulos(NormalisedGaylord):
         self.e_th = params["alpha_l_per_K"] * params["delta_T_K"]
 
     def force_N(self, x_m, p_gauge_Pa):
+        """Static force [N] with the thermal strain added to the contraction strain."""
         s = 1.0 - self.ke * (x_m / self.L0 + self.e_th)
         return self.a * p_gauge_Pa * self.kf * (self.q1 * s * s - self.q2)
 
@@ -125,6 +131,7 @@ class Takosoglu(NormalisedGaylord):
             self.a *= 4.0
 
     def force_N(self, x_m, p_gauge_Pa):
+        """Static force [N] with the pressure-dependent exponent and ``q1``."""
         k1, k3, k4, k6 = self.k
         n = k1 * exp(-p_gauge_Pa / self.k2) + k3
         q1 = k4 * exp(-p_gauge_Pa / self.k5) + k6

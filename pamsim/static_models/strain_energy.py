@@ -33,6 +33,7 @@ class MooneyRivlin:
     C01_Pa: float
 
     def grad(self, l1, l2, l3):
+        """Partial derivatives of ``W`` [Pa] with respect to the three principal stretches."""
         a, c = 2.0 * self.C10_Pa, 2.0 * self.C01_Pa
         s1, s2, s3 = l1 * l1, l2 * l2, l3 * l3
         return (a * l1 + c * l1 * (s2 + s3), a * l2 + c * l2 * (s3 + s1), a * l3 + c * l3 * (s1 + s2))
@@ -45,6 +46,7 @@ class NeoHookean:
     E_Pa: float
 
     def grad(self, l1, l2, l3):
+        """Partial derivatives of ``W`` [Pa] with respect to the three principal stretches."""
         k = self.E_Pa / 3.0
         return (k * l1, k * l2, k * l3)
 
@@ -60,6 +62,7 @@ class Ogden:
     terms: tuple[tuple[float, float], ...]
 
     def grad(self, l1, l2, l3):
+        """Partial derivatives of ``W`` [Pa] with respect to the three principal stretches."""
         g1 = g2 = g3 = 0.0
         for mu, alpha in self.terms:
             if mu == 0.0:

@@ -78,6 +78,7 @@ class TwoPhaseTube:
 
     @classmethod
     def from_parameters(cls, p: Mapping[str, float]) -> "TwoPhaseTube":
+        """The tube of a muscle's radii, length, braid angle, sleeve gap and bladder material."""
         return cls(p["r0_m"], p["ri0_m"], p["L0_m"], math.radians(p["theta0_deg"]), p["sleeve_gap_m"],
                    p["E_bladder_Pa"], p["nu_bladder"])
 
