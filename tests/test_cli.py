@@ -279,6 +279,16 @@ def test_quick_commands_do_not_import_heavy_modules(argv, heavy):
     assert "usage" in r.stdout or "equilibrium" in r.stdout
 
 
+def test_importing_the_main_module_runs_nothing():
+    """The API reference's build imports every module of the package, ``pamsim.__main__`` among them."""
+    import subprocess
+    import sys
+
+    r = subprocess.run([sys.executable, "-c", "import pamsim.__main__", "run"], capture_output=True, text=True,
+                       timeout=120)
+    assert (r.returncode, r.stdout, r.stderr) == (0, "", "")
+
+
 @pytest.mark.parametrize("command", [
     ["run", SCENARIOS / "acra2012_fig4.toml", "-o"],
     ["sweep", SCENARIOS / "acra2012_grid.toml", "-o"],
