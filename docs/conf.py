@@ -53,6 +53,7 @@ autodoc_default_options = {
 autodoc_typehints = "signature"
 autodoc_preserve_defaults = True
 autodoc_member_order = "bysource"
+toc_object_entries = False  # objects stay out of the navigation tree (each module page has its summary table)
 numpydoc_show_class_members = False  # autodoc lists the members; numpydoc would list them twice
 numpydoc_xref_param_type = False
 
