@@ -204,6 +204,7 @@ class ElementParameters:
     extra_parameters: tuple[Var, ...] = ()
 
     def parameter_vars(self) -> tuple[Var, ...]:
+        """The parameters: the element's numbers (if it takes symbols), then the component's own."""
         # Kept: the element does not change after wrap, and an assembly asks many times.
         if "_parameter_vars" not in self.__dict__:
             own = parameter_vars(element_parameters(self.element)) if self.traces else ()
@@ -211,9 +212,11 @@ class ElementParameters:
         return self._parameter_vars
 
     def element_values(self) -> dict[str, float]:
+        """``{name: value}`` of the element's numbers that are parameters (none if it is called on floats)."""
         return element_parameters(self.element) if self.traces else {}
 
     def symbolic_element(self, p: Mapping[str, Any]):
+        """The element rebuilt with its numbers replaced by the symbols ``p``."""
         return symbolic(self.element, p)
 
     def wrap(self, element, probe: Callable, points, required: str = "") -> dict[str, float]:
@@ -234,6 +237,7 @@ class ElementParameters:
         return s.external(method, getattr(self.element, method), *args)
 
     def structure_key(self) -> tuple:
+        """The component's key, with the element's form (and its numbers, if they are baked into the code)."""
         # An element called on floats is part of the generated code: its numbers are too.
         form = self._form if self.traces else structure_key(self.element, baked=True)
         return super().structure_key() + (form,)

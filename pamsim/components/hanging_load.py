@@ -28,10 +28,12 @@ class LoadMode(IntEnum):
 
     @property
     def is_slip(self) -> bool:
+        """Whether the load slides in this mode (up or down)."""
         return self in (LoadMode.SLIP_UP, LoadMode.SLIP_DOWN)
 
     @property
     def label(self) -> str:
+        """The mode's name in results and events (``slip_up``, ``stick``...)."""
         return self.name.lower()
 
 

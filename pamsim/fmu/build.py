@@ -38,6 +38,7 @@ def platform_folder(fmi_version: int) -> str:
 
 
 def shared_library_suffix() -> str:
+    """The platform's shared library suffix: ``.so``, ``.dylib`` or ``.dll``."""
     return {"darwin": ".dylib", "win32": ".dll"}.get(sys.platform, ".so")
 
 
@@ -52,6 +53,7 @@ def _zip_time() -> tuple[int, int, int, int, int, int]:
 
 
 def default_output(fmi_version: int) -> Path:
+    """Where ``pamsim fmu build`` writes the FMU when no path is given."""
     return Path(f"{MODEL_IDENTIFIER}_fmi{fmi_version}.fmu")
 
 

@@ -45,6 +45,7 @@ class ForceTable:
 
     @property
     def shape(self) -> tuple[int, int]:
+        """Grid nodes along the contraction and along the pressure."""
         return self.values.shape[0], self.values.shape[1]
 
     def c_header(self) -> str:

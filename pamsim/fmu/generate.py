@@ -109,6 +109,7 @@ def table_text() -> str:
 
 
 def token(fmi_version: int, table: ForceTable | None = None, preset=None) -> str:
+    """A hash of everything an FMU's binary is built from: sources, generated headers, table, preset."""
     h = hashlib.sha256()
     src = c_source_dir() / "src"
     for name in CORE_SOURCES + (WRAPPERS[fmi_version],):
@@ -311,6 +312,7 @@ def _fmi3(table: ForceTable | None, preset) -> str:
 
 
 def build_description(fmi_version: int) -> str:
+    """The FMU's ``buildDescription.xml``: its C sources and include folders, for importers that compile it."""
     files = "".join(f'\n      <SourceFile name="{n}"/>' for n in compiled_sources(fmi_version))
     return ('<?xml version="1.0" encoding="UTF-8"?>\n'
             '<fmiBuildDescription fmiVersion="3.0">\n'

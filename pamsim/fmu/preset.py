@@ -132,6 +132,7 @@ class Preset:
         return "\n".join(lines)
 
     def digest(self) -> str:
+        """A hash of the preset's text: part of the FMU build's cache key."""
         return hashlib.sha256(self.text().encode()).hexdigest()
 
 

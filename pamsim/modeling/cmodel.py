@@ -99,6 +99,7 @@ class CModel:
 
     @property
     def counts(self) -> dict[str, int]:
+        """``nx`` integrated states, ``nq`` quadratures, ``nu`` inputs, ``np`` parameters, ``ny`` outputs, ``nz`` indicators, ``nmodes`` modes."""
         f = self.full
         return {"nx": len(self.dynamic), "nq": len(self.quadratures), "nu": len(f.u), "np": len(f.p),
                 "ny": len(f.y), "nz": len(f.z), "nmodes": len(self.mode_values)}

@@ -115,6 +115,7 @@ class Component:
         return self.parameters
 
     def equations(self, s: Symbols) -> Equations:
+        """The component's equations, written on the symbols ``s`` (:class:`Symbols`); every subclass writes its own."""
         raise NotImplementedError
 
     def structure_key(self) -> tuple:
@@ -124,6 +125,7 @@ class Component:
         return (type(self).__module__, type(self).__qualname__)
 
     def port(self, name: str) -> Port:
+        """The declared port called ``name`` (``KeyError`` if there is none)."""
         for p in self.ports:
             if p.name == name:
                 return p

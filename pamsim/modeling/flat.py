@@ -68,6 +68,7 @@ class FlatModel:
     # ------------------------------------------------------------------ names
     @property
     def counts(self) -> dict[str, int]:
+        """How many states, inputs, outputs, parameters, hybrid components (``modes``) and event indicators."""
         return {"states": len(self.states), "inputs": len(self.inputs), "outputs": len(self.outputs),
                 "parameters": len(self.parameters), "modes": len(self.modes), "indicators": len(self.z)}
 

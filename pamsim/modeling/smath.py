@@ -13,10 +13,12 @@ def _casadi():
 
 
 def fmin(a, b):
+    """The smaller of ``a`` and ``b`` (C's ``fmin``), on floats or symbols."""
     return min(a, b) if isinstance(a, (int, float)) and isinstance(b, (int, float)) else _casadi().fmin(a, b)
 
 
 def fmax(a, b):
+    """The larger of ``a`` and ``b`` (C's ``fmax``), on floats or symbols."""
     return max(a, b) if isinstance(a, (int, float)) and isinstance(b, (int, float)) else _casadi().fmax(a, b)
 
 

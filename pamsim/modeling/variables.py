@@ -33,6 +33,7 @@ class PortKind:
 
     @property
     def variables(self) -> tuple[Var, ...]:
+        """The across variables, then the through variables."""
         return self.across + self.through
 
 
