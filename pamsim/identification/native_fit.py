@@ -118,6 +118,7 @@ class Chunk:
                      self.max_events[a:b], self.sample_t_s[a:b], self.tables)
 
     def run(self) -> list[np.ndarray]:
+        """Contraction [m] of every case at its sample times; NaN for a case that failed."""
         out = _run(self, event_capacity(self.max_events))
 
         def trace(found, k, i):
@@ -203,6 +204,7 @@ class EngineChunk:
                            self.sample_t_s[a:b])
 
     def run(self) -> list[np.ndarray]:
+        """Contraction [m] of every case at its sample times; NaN for a case that failed."""
         where: list = [None] * len(self)
         for j, (path, names) in enumerate(self.libraries):
             members = [i for i, k in enumerate(self.library_of) if k == j]
