@@ -1,6 +1,7 @@
-"""Library static models on the native backend: the C core runs the FMU's bicubic force table of the
-model, so its trajectories follow the Python backend's (which evaluates the model itself) to within
-the table's interpolation error."""
+"""Library static models on the native backend: one written in symbols runs as generated C on the
+engine, any other as the FMU's bicubic force table on the hand-written core; either way its trajectories
+follow the Python backend's (which evaluates the model itself) to within the integrators' and the
+table's errors."""
 
 from pathlib import Path
 
@@ -24,8 +25,8 @@ def test_native_table_run_follows_the_python_model(changes):
         sc = sc.with_changes(changes)
     nat, py = pamsim.simulate(sc, backend="native"), pamsim.simulate(sc)
     assert nat.final_mode == py.final_mode
-    # The table's error is below 0.1 % of the blocked force (tested through the FMU); over a run it
-    # moves the contraction by micrometres (measured: at most 2.7 um).  Bound: 10 um.
+    # These models are written in symbols: the engine runs them exactly, and the two integrators differ by
+    # micrometres over the run (measured: at most 2.7 um).  Bound: 10 um.
     assert np.max(np.abs(nat.x_m - py.x_m)) < 1e-5
     assert nat.energy_balance()["relative"] < 1e-4
 

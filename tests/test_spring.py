@@ -27,6 +27,8 @@ SPEC = tomllib.loads((SCENARIOS / "parallel_spring.toml").read_text())
 def _scenario(changes=None, spring=None, **top):
     spec = copy.deepcopy(SPEC)
     for section, values in (changes or {}).items():
+        if section == "model" and "muscle" in values:
+            spec["model"].pop("parameter_set")
         spec.setdefault(section, {}).update(values)
     spec["component"][0].update(spring or {})
     spec.update(top)
@@ -116,7 +118,8 @@ def test_the_cli_refuses_with_exit_2_and_writes_nothing(tmp_path):
 
 @pytest.mark.parametrize("backend, changes", [
     ("fmu-cs", {}),
-    ("native", {"model": {"static_force": "gaylord"}}),
+    ("native", {"model": {"muscle": "mpam_survey_45mm", "static_force": "mpam_two_phase"},
+                "parameters": {"E_nylon_Pa": 3e9}}),  # nylon 6: 2-4 GPa; an implicit model, tabulated
 ])
 def test_backends_that_cannot_run_added_components_refuse_them(backend, changes):
     with pytest.raises(InputError, match="component"):

@@ -98,20 +98,27 @@ class CaseInputs:
                           self.segment_t_s, u, int(capacity))
 
 
+def engine_assembly(scenario: Scenario, model: MuscleModel | None = None):
+    """The scenario's assembly if the generic engine can run it (every component written in symbols),
+    else None: a static model called on floats (an implicit or tabulated one) runs as a force table on
+    the hand-written C core.  ``model``: as :func:`case_inputs` takes it."""
+    assembly = scenario_assembly(scenario, model)
+    return assembly if all(getattr(c, "traces", True) for c in assembly.components) else None
+
+
 def refuse_unsupported(scenario: Scenario) -> None:
     """Raise :class:`InputError` naming the first setting of ``scenario`` the native backend cannot honour."""
     spec = scenario.spec
     where = scenario.origin
-    table_force = spec["model"]["static_force"] != "acra2012_polynomial"
     for section, keys in REPRESENTED.items():
         table = spec if not section else spec.get(section, {})
         for key in sorted(set(table) - keys):
-            if not section and key == "component" and not table_force:
-                continue  # the generated model holds them
             if not section and key == "component":
-                raise InputError(f"{where}: component: components added to the rig run natively only with the "
-                                 "acra2012_polynomial static force (another runs as a force table on the "
-                                 "hand-written C core); run it with the python backend")
+                if engine_assembly(scenario) is not None:
+                    continue  # the generated model holds them
+                raise InputError(f"{where}: component: components added to the rig run natively only with a "
+                                 f"static force written in symbols, not {spec['model']['static_force']!r} (it runs "
+                                 "as a force table on the hand-written C core); run it with the python backend")
             name = f"{section}.{key}" if section else key
             raise InputError(f"{where}: {name}: the native backend cannot honour this key; "
                              "run it with the python backend")
@@ -209,7 +216,9 @@ def case_inputs(scenario: Scenario, model: MuscleModel | None = None) -> CaseInp
                "friction_negative_level": ("friction_negative_level", spec["model"]["friction_negative_level"])}
     for name, (key, value) in choices.items():
         ints[lib.INT_INDEX[name]] = C_CHOICES[key].index(value)
-    table = force_table(scenario)
+    # the generic engine runs the generated model; a force table stays with the hand-written core
+    assembly = engine_assembly(scenario, model)
+    table = force_table(scenario) if assembly is None else None
     ints[lib.INT_INDEX["static_force_model"]] = C_CHOICES["static_force_model"].index(
         "acra2012_polynomial" if table is None else "table")
     signals = _signals(model)
@@ -224,9 +233,6 @@ def case_inputs(scenario: Scenario, model: MuscleModel | None = None) -> CaseInp
         if sig is not None:
             u[:, k] = sig(mid)
     u[:, lib.INPUTS.index("load_mass_kg")] = model.load.mass_kg
-    assembly = None
-    if table is None:  # the generic engine runs the generated model; a force table stays with the C core
-        assembly = scenario_assembly(scenario, model)
     return CaseInputs(reals, ints, T, n_samples, starts, u, opts.max_events, model, table, assembly)
 
 
