@@ -50,13 +50,15 @@ class AddedComponent:
 
 def one_muscle_assembly(model, x0_m: float = 0.0, p0_gauge_Pa: float | None = None,
                         stick_margin_N: float = 1e-7, release_margin_N: float = 2e-7,
-                        added: tuple = ()) -> Assembly:
+                        added: tuple = (), friction_direction: str = "load.slip_direction") -> Assembly:
     """The assembly of a :class:`pamsim.model.MuscleModel`'s elements (its static force, friction,
     damping, load, stops and pressure source), starting at rest at ``x0_m`` with the chamber at
     ``p0_gauge_Pa`` (ambient if None).  The margins are the simulator's
     (:class:`pamsim.simulator.SolverOptions`).  The pressure source's components come from
     :data:`SOURCE_PARTS`; ``added`` (:class:`AddedComponent` s) come after the rig's own, so the
-    rig's states and outputs keep their places."""
+    rig's states and outputs keep their places.  ``friction_direction`` is the output that gives the
+    friction its direction: the load's (+1 or -1 sliding, 0 held), or an added component's (a
+    linearisation's smooth treatment of the Coulomb term)."""
     load = HangingLoad("load", {
         "mass_kg": model.load.mass_kg, "g_m_s2": model.load.g_m_s2, "x_low_m": model.stops.x_low_m,
         "x_high_m": model.stops.x_high_m, "restitution": model.stops.restitution,
@@ -70,7 +72,7 @@ def one_muscle_assembly(model, x0_m: float = 0.0, p0_gauge_Pa: float | None = No
     # The flange adds the forces in this order, as pamsim always has: static, damping, friction.
     wiring += [("load.flange", "muscle.flange"), ("load.flange", "damping.flange"), ("load.flange", "friction.flange"),
                (f"{pressure}.p_gauge_Pa", "muscle.p_gauge_Pa"), (f"{pressure}.p_gauge_Pa", "friction.p_gauge_Pa"),
-               ("load.mass_kg", "friction.mass_kg"), ("load.slip_direction", "friction.direction"),
+               ("load.mass_kg", "friction.mass_kg"), (friction_direction, "friction.direction"),
                ("friction.level_N", "load.friction_level_N"), ("external.F_external_N", "load.F_external_N"),
                ("load.v_m_s", "external.v_m_s")]
     inputs["external_force_N"] = "external.F_N"

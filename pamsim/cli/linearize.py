@@ -87,6 +87,7 @@ def report(lin) -> dict:
         "residual_f_x0_u0": [float(v) for v in lin.residual],
         "friction": lin.friction.describe(),
         "valve_slope": lin.valve_slope,
+        "jacobians": lin.jacobian_method,
         "dropped_states": list(lin.dropped_states),
     }
 
@@ -156,7 +157,8 @@ def _print_text(lin, rep: dict) -> None:
 
     np.set_printoptions(precision=6, linewidth=140)
     print(f"operating point: {lin.op.description}")
-    print(f"friction: {rep['friction']}; valve slope at command 0: {lin.valve_slope}")
+    print(f"friction: {rep['friction']}; valve slope at command 0: {lin.valve_slope}; "
+          f"Jacobians: {lin.jacobian_method}")
     if lin.dropped_states:
         print(f"dropped (unobservable, decoupled): {', '.join(lin.dropped_states)}")
     print(f"states:  {', '.join(rep['states'])}")

@@ -1,11 +1,14 @@
 """Linearisation of the muscle model about an operating point.
 
-The Jacobians are central differences of :class:`~pamsim.control.system.MusclePlant`
-(the model's own right-hand side) with one Richardson extrapolation step, the
-step of each variable scaled by its typical magnitude (``STATE_SCALES``).
-python-control's own ``linearize`` uses a forward difference with one
-absolute step of 1e-6 for every variable, which is 1e-11 of a pressure in Pa
-and 10 % of an air mass in kg; hence this module.
+The Jacobians are exact: CasADi's derivatives of the components' own expressions
+(:mod:`pamsim.control.exact`).  A model with an element that has no symbolic form (a
+tabulated or implicit static model) falls back to central differences of
+:class:`~pamsim.control.system.MusclePlant` (the model's own right-hand side) with one
+Richardson extrapolation step, the step of each variable scaled by its typical magnitude
+(``STATE_SCALES``); :attr:`LinearModel.jacobian_method` says which.  python-control's own
+``linearize`` uses a forward difference with one absolute step of 1e-6 for every
+variable, which is 1e-11 of a pressure in Pa and 10 % of an air mass in kg; hence this
+module.
 
 Two non-smooth points are handled explicitly:
 
@@ -35,6 +38,7 @@ import numpy as np
 from ..errors import InputError
 from ..model import MuscleModel
 from .choices import VALVE_SLOPES
+from .exact import exact_jacobians
 from .operating_point import OperatingPoint
 from .system import INPUT_SCALES, INPUTS, OUTPUTS, STATE_SCALES, STATES, FrictionTreatment, MusclePlant
 
@@ -128,6 +132,8 @@ class LinearModel:
     valve_slope: str
     residual: np.ndarray
     dropped_states: tuple[str, ...]
+    jacobian_method: str = "exact"
+    """``exact`` (CasADi's derivatives of the generated expressions) or ``central differences``."""
 
     def mechanical_mode(self) -> MechanicalMode:
         """The two poles with the largest participation of the velocity state.
@@ -226,7 +232,14 @@ def linearize(model: MuscleModel, op: OperatingPoint, friction: FrictionTreatmen
                              "linearisation (use 'dropped' or 'regularised')")
         friction = FrictionTreatment("sliding", friction.velocity_scale_m_s, math.copysign(1.0, v0))
     plant = MusclePlant(model)
-    A, B, C, D = jacobians(plant, op, friction, valve_slope)
+    if valve_slope not in VALVE_SLOPES:
+        raise InputError(f"valve slope {valve_slope!r}: choose from {', '.join(VALVE_SLOPES)}")
+    try:
+        A, B, C, D = exact_jacobians(model, op.states, op.inputs, friction, valve_slope)
+        method = "exact"
+    except NotImplementedError:  # an element called on floats
+        A, B, C, D = jacobians(plant, op, friction, valve_slope)
+        method = "central differences"
     residual = plant.rhs(op.states, op.inputs, friction)
     keep = list(range(len(STATES)))
     k_m = STATES.index("air_mass_kg")
@@ -240,4 +253,4 @@ def linearize(model: MuscleModel, op: OperatingPoint, friction: FrictionTreatmen
             keep, dropped = others, ("air_mass_kg",)
     sys = ct.ss(A[np.ix_(keep, keep)], B[keep], C[:, keep], D, states=[STATES[k] for k in keep],
                 inputs=list(INPUTS), outputs=list(OUTPUTS), name="muscle_linear")
-    return LinearModel(sys, op, friction, valve_slope, residual, dropped)
+    return LinearModel(sys, op, friction, valve_slope, residual, dropped, method)

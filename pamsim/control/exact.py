@@ -1,0 +1,131 @@
+"""Exact Jacobians of the control model, from the components' generated expressions.
+
+The control model is the one-muscle rig's assembly with the load sliding (``SLIP_UP``: the load
+moves and every force acts on it) and the Coulomb term's direction given by a
+:class:`FrictionDirection` component that writes the :class:`~pamsim.control.system.FrictionTreatment`
+on symbols: 0 (dropped), ``tanh(v / v_s)`` (regularised) or the sliding direction.  CasADi
+differentiates it: no difference quotient, no step to choose.  The work integrals are left out (they
+feed nothing back) and the tendon force is ``m a + W - F_ext`` of the same expressions, as
+:meth:`~pamsim.control.system.MusclePlant.output` defines it.
+
+The valve's kink at command 0 has two one-sided slopes: the derivative is taken just inside the
+filling and the venting branch (commands of +-1e-300, where the flow itself is zero to machine
+precision), and ``valve_slope`` picks one or their mean; at a saturated command, just inside the
+valve's range.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..assemblies.one_muscle import AddedComponent, one_muscle_assembly
+from ..components.hanging_load import LoadMode
+from ..modeling import Component, Equations, Symbols, Var
+from .system import FrictionTreatment
+
+INSIDE_KINK = 1e-300
+"""Command [1] just inside either branch of the valve at its kink, 0: a slope, but no flow."""
+TIE_STEP = 1e-12
+"""Either side of the point [fraction of each variable's typical scale] at which a column is taken."""
+INSIDE_SATURATION = 1e-12
+"""Distance [1] inside the valve's range at a saturated command: the slope there differs from the
+limit by that fraction of the curvature."""
+
+
+class FrictionDirection(Component):
+    """The factor of the Coulomb level in a smooth control model: ``direction`` from the load's
+    velocity ``v_m_s`` as a :class:`FrictionTreatment` says."""
+
+    inputs = (Var("v_m_s", "m/s", "load velocity"),)
+    outputs = (Var("direction", "1", "factor of the Coulomb level (0, tanh(v / v_s), or +-1)"),)
+
+    def __init__(self, name: str, treatment: FrictionTreatment):
+        self.treatment = treatment
+        super().__init__(name)
+
+    def structure_key(self) -> tuple:
+        """The class and the treatment: they are part of the generated code."""
+        t = self.treatment
+        return super().structure_key() + (t.kind, t.velocity_scale_m_s, t.direction)
+
+    def equations(self, s: Symbols) -> Equations:
+        t, v = self.treatment, s.u["v_m_s"]
+        if t.kind == "dropped":
+            direction = 0.0 * v
+        elif t.kind == "regularised":
+            direction = np.tanh(v / t.velocity_scale_m_s)
+        else:
+            direction = t.direction + 0.0 * v
+        return Equations(outputs={"direction": direction})
+
+
+def control_functions(model, friction: FrictionTreatment):
+    """CasADi functions ``(x, u) -> (f, y)`` and ``(x, u) -> (df/dx, df/du, dy/dx, dy/du)`` of the four
+    control states ``(x_m, v_m_s, p_abs_Pa, air_mass_kg)``, inputs ``(valve_command, supply_gauge_Pa,
+    F_ext_N)`` and outputs ``(contraction_m, p_gauge_Pa, F_tendon_N)``, with ``model``'s parameter
+    values as constants."""
+    import casadi as ca
+
+    added = (AddedComponent(FrictionDirection("treatment", friction), {"v_m_s": "load.v_m_s"}),)
+    assembly = one_muscle_assembly(model, added=added, friction_direction="treatment.direction")
+    flat = assembly.flatten({"load": int(LoadMode.SLIP_UP)})
+    if flat.externals:  # an element called on floats: CasADi would take it for a constant
+        raise NotImplementedError(f"no exact Jacobian through {', '.join(e.name for e in flat.externals)}")
+    names = [v.name for v in flat.states]
+    keep = [names.index(n) for n in ("load.x_m", "load.v_m_s", "chamber.p_abs_Pa", "chamber.air_mass_kg")]
+    x = ca.vertcat(*[flat.x[i] for i in keep])
+    u = ca.vertcat(*flat.u)
+    p = dict(zip([v.name for v in flat.parameters], flat.p))
+    values = dict(zip([v.name for v in flat.parameters], flat.parameter_values))
+    f = ca.vertcat(*[flat.f[i] for i in keep])
+    mass, g = p["load.mass_kg"], p["load.g_m_s2"]
+    out = {v.name: e for v, e in zip(flat.outputs, flat.y)}
+    y = ca.vertcat(flat.x[keep[0]], out["chamber.p_gauge_Pa"], mass * f[1] + mass * g - flat.u[2])
+    # The parameters become the model's numbers; the work states, which nothing reads, are not there.
+    fixed = [ca.substitute(e, ca.vertcat(*flat.p), ca.DM([values[k] for k in p])) for e in (f, y)]
+    values_fn = ca.Function("control_fy", [x, u], fixed)
+    jac = ca.Function("control_jacobian", [x, u], [ca.jacobian(fixed[0], x), ca.jacobian(fixed[0], u),
+                                                    ca.jacobian(fixed[1], x), ca.jacobian(fixed[1], u)])
+    return values_fn, jac
+
+
+def exact_jacobians(model, states, inputs, friction: FrictionTreatment, valve_slope: str):
+    """``(A, B, C, D)`` of the control model at ``states``, ``inputs`` (numpy arrays).
+
+    Each column is the mean of the analytic derivative just either side of the point, a step of
+    :data:`TIE_STEP` of the variable's typical scale away: where a branch of the model switches exactly
+    there (a chamber at its supply's pressure, where the flow's direction flips), the derivative at the
+    point itself would be the convention of one branch (CasADi's derivative of ``|x|`` at 0 is 0), and
+    the mean is what a central difference gives.  Elsewhere the two sides agree to that fraction of the
+    curvature.  The valve's column at a kink or a saturation is taken as the module notes say.
+    """
+    from .system import INPUT_SCALES, STATE_SCALES
+
+    _, jac = control_functions(model, friction)
+    x0 = np.asarray(states, dtype=float)
+    u0 = np.asarray(inputs, dtype=float)
+
+    def at(x, u):
+        return [np.array(m) for m in jac(x, u)]
+
+    def column(i: int, of_state: bool, points) -> tuple[np.ndarray, np.ndarray]:
+        """Column i of (A, C) or (B, D), the mean over ``points`` (values of that variable)."""
+        cols = []
+        for value in points:
+            x, u = x0.copy(), u0.copy()
+            (x if of_state else u)[i] = value
+            A, B, C, D = at(x, u)
+            cols.append((A[:, i], C[:, i]) if of_state else (B[:, i], D[:, i]))
+        return np.mean([a for a, _ in cols], axis=0), np.mean([c for _, c in cols], axis=0)
+
+    A, B, C, D = at(x0, u0)
+    for i, scale in enumerate(STATE_SCALES):
+        A[:, i], C[:, i] = column(i, True, (x0[i] + TIE_STEP * scale, x0[i] - TIE_STEP * scale))
+    for j, scale in enumerate(INPUT_SCALES):
+        points = (u0[j] + TIE_STEP * scale, u0[j] - TIE_STEP * scale)
+        if j == 0 and u0[0] == 0.0:
+            points = [INSIDE_KINK * s for s in {"mean": (1.0, -1.0), "fill": (1.0,), "vent": (-1.0,)}[valve_slope]]
+        elif j == 0 and abs(u0[0]) >= 1.0:
+            points = (np.sign(u0[0]) * (1.0 - INSIDE_SATURATION),)
+        B[:, j], D[:, j] = column(j, False, points)
+    return A, B, C, D
