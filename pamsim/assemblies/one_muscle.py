@@ -163,12 +163,12 @@ class RigOutputs:
         """Net force on the load at rest at the last sample, and the Coulomb level [N] there."""
         from ..components.hanging_load import LoadMode
 
+        code = self.code[int(LoadMode.STICK)]
         y = [float(v) for v in self.Y[:, -1]]
         y[1] = 0.0
-        out = outputs_by_mode(self.code, self.p, [[v] for v in y], [[float(np.asarray(v))] for v in
-                                                                    self.inputs(float(self.t[-1]))],
-                              [int(LoadMode.STICK)])
-        return float(out["load.F_net_N"][0]), float(out["load.F_coulomb_level_N"][0])
+        (out,) = code.y(y, [float(np.asarray(v)) for v in self.inputs(float(self.t[-1]))], self.p, ())
+        names = code.names["outputs"]
+        return float(out[names.index("load.F_net_N")]), float(out[names.index("load.F_coulomb_level_N")])
 
 
 def scenario_assembly(scenario, model=None) -> Assembly:

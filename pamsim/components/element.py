@@ -207,13 +207,15 @@ class ElementParameters:
         """The parameters: the element's numbers (if it takes symbols), then the component's own."""
         # Kept: the element does not change after wrap, and an assembly asks many times.
         if "_parameter_vars" not in self.__dict__:
-            own = parameter_vars(element_parameters(self.element)) if self.traces else ()
+            own = parameter_vars(self.element_values()) if self.traces else ()
             self._parameter_vars = own + self.extra_parameters
         return self._parameter_vars
 
     def element_values(self) -> dict[str, float]:
         """``{name: value}`` of the element's numbers that are parameters (none if it is called on floats)."""
-        return element_parameters(self.element) if self.traces else {}
+        if "_element_values" not in self.__dict__:  # kept: the element does not change after wrap
+            self._element_values = element_parameters(self.element) if self.traces else {}
+        return dict(self._element_values)  # a copy: a component adds its own parameters to what wrap returns
 
     def symbolic_element(self, p: Mapping[str, Any]):
         """The element rebuilt with its numbers replaced by the symbols ``p``."""
@@ -224,6 +226,8 @@ class ElementParameters:
         and return its parameter values.  ``required``: what to call it in the ``TypeError`` raised when
         it must take symbols and does not (an element the python backend cannot call on floats)."""
         self.element = element
+        for kept in ("_element_values", "_parameter_vars"):
+            self.__dict__.pop(kept, None)
         self._form = structure_key(element)
         self.traces = traces(element, probe, points, self._form)
         if required and not self.traces:
