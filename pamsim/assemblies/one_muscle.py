@@ -23,8 +23,6 @@ from ..elements.pressure_source import PrescribedPressure, ValveChamberSource
 from ..modeling import Assembly
 from ..modeling.pygen import compiled_by_mode, outputs_by_mode
 
-INPUTS_VALVE = ("valve_command", "supply_pressure_gauge_Pa", "external_force_N")
-INPUTS_PRESCRIBED = ("prescribed_pressure_gauge_Pa", "external_force_N")
 
 
 @dataclass(frozen=True)

@@ -134,12 +134,8 @@ def refuse_unsupported(scenario: Scenario) -> None:
     if method not in METHODS:
         raise InputError(f"{where}: solver.method = {method!r}: the native backend integrates with Dormand-Prince "
                          f"5(4) and honours only {', '.join(METHODS)}; run it with the python backend")
-    if spec["model"]["static_force"] != "acra2012_polynomial":
-        return  # a parameter the core lacks (wall_thickness_m, E_bladder_Pa, ...) only shapes the force table
-    for name in scenario.parameters.entries:
-        if name not in lib.REAL_INDEX:
-            raise InputError(f"{where}: parameters.{name}: the C core has no such parameter "
-                             f"(muscle {spec['model']['muscle']!r}); run it with the python backend")
+    # A parameter the core lacks (wall_thickness_m, E_bladder_Pa, ...) is a component's on the engine, and
+    # only shapes the force table on the core.
 
 
 TABLE_CACHE_SIZE = 32
@@ -147,13 +143,11 @@ TABLE_CACHE_SIZE = 32
 _tables: "OrderedDict[tuple, ForceTable]" = OrderedDict()
 
 
-def force_table(scenario: Scenario) -> ForceTable | None:
+def force_table(scenario: Scenario) -> ForceTable:
     """The static force table of ``scenario`` as the FMU would bake it (:func:`pamsim.fmu.runner.tabulate_model`),
-    or None for the ACRA 2012 polynomial, which the core computes exactly.  Tables are cached by the
-    model, its variant, the parameters and the force-map file, so the cases of a sweep tabulate once."""
+    for a static model the engine cannot run (:func:`engine_assembly`).  Tables are cached by the model,
+    its variant, the parameters and the force-map file, so the cases of a sweep tabulate once."""
     m = scenario.spec["model"]
-    if m["static_force"] == "acra2012_polynomial":
-        return None
     key = (m["static_force"], m.get("static_force_variant"), tuple(sorted(scenario.parameters.items())),
            scenario.muscle.force_map_file if scenario.muscle is not None else None)
     if key in _tables:
