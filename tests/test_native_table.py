@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import re
 
+import numpy as np
+
 import pytest
 
 import pamsim
@@ -137,12 +139,20 @@ def test_every_registry_entry_has_a_c_counterpart_or_is_refused_cleanly(key):
 @pytest.mark.parametrize("key, registry, builder", [
     ("friction", FRICTION_MODELS, ConstantCoulomb.from_parameters),
 ])
-def test_a_new_python_element_is_refused_by_the_c_backends_until_the_core_has_it(monkeypatch, key, registry,
-                                                                                   builder):
-    """Adding an element to a Python registry alone must not run the C backends silently with
-    another element (or zero friction), nor end in a bare ValueError."""
+def test_a_new_python_element_runs_natively_from_its_symbols_and_the_fmu_refuses_it(monkeypatch, key, registry,
+                                                                                     builder):
+    """An element added to a Python registry alone: the native backend generates it from its own
+    functions on symbols (here the constant law under a new name: the same code, so the same numbers
+    as the constant choice, bit for bit); the FMU, whose core is hand-written, refuses it by name
+    rather than run another element (or zero friction) silently."""
     monkeypatch.setitem(registry, "added_in_python_only", builder)
-    _assert_refused_by_the_c_backends(_scenario(key, "added_in_python_only"), key, "added_in_python_only")
+    scenario = _scenario(key, "added_in_python_only")
+    added = pamsim.simulate(scenario, backend="native")
+    known = pamsim.simulate(_scenario(key, "constant"), backend="native")
+    assert np.array_equal(added.x_m, known.x_m) and added.transitions == known.transitions
+    where = core_table.SCENARIO_KEYS[key]
+    with pytest.raises(InputError, match=rf"{re.escape(where)} = 'added_in_python_only'"):
+        start_values(scenario)
 
 
 def test_order_checks_are_shared_by_the_parameter_set_and_the_core():

@@ -125,8 +125,10 @@ def refuse_unsupported(scenario: Scenario) -> None:
     if spec["model"]["static_force_negative"] != "clip":
         raise InputError(f"{where}: model.static_force_negative = {spec['model']['static_force_negative']!r}: "
                          "the C core clips a negative static force at zero; run it with the python backend")
-    lacking = unimplemented_choice(spec, skip=("static_force",))  # any static force: through a force table
-    if lacking:
+    # Any static force runs (on the engine, or as a force table); another choice the core lacks runs on the
+    # engine when it is written in symbols (a friction or damping law added in Python alone).
+    lacking = unimplemented_choice(spec, skip=("static_force",))
+    if lacking and engine_assembly(scenario) is None:
         key = next(k for k, w in SCENARIO_KEYS.items() if w == lacking[0])
         raise InputError(f"{where}: {lacking[0]} = {lacking[1]!r}: the C core implements only "
                          f"{', '.join(C_CHOICES[key])}; run it with the python backend")
@@ -203,15 +205,16 @@ def case_inputs(scenario: Scenario, model: MuscleModel | None = None) -> CaseInp
                "cs_max_step_s": opts.max_step_s if math.isfinite(opts.max_step_s) else _DEFAULT_MAX_STEP_S}
     for name, value in fmu_own.items():
         reals[lib.REAL_INDEX[name]] = value
+    # the generic engine runs the generated model; a force table stays with the hand-written core
+    assembly = engine_assembly(scenario, model)
     ints = lib.INT_DEFAULTS.copy()
     choices = {"friction_model": ("friction", spec["model"]["friction"]),
                "damping_model": ("damping", spec["model"]["damping"]),
                "pressure_source": ("source", "valve" if isinstance(model.source, ValveChamberSource) else "prescribed"),
                "friction_negative_level": ("friction_negative_level", spec["model"]["friction_negative_level"])}
     for name, (key, value) in choices.items():
-        ints[lib.INT_INDEX[name]] = C_CHOICES[key].index(value)
-    # the generic engine runs the generated model; a force table stays with the hand-written core
-    assembly = engine_assembly(scenario, model)
+        if value in C_CHOICES[key]:  # the core's choices (the engine reads none of them)
+            ints[lib.INT_INDEX[name]] = C_CHOICES[key].index(value)
     table = force_table(scenario) if assembly is None else None
     ints[lib.INT_INDEX["static_force_model"]] = C_CHOICES["static_force_model"].index(
         "acra2012_polynomial" if table is None else "table")
