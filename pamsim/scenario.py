@@ -35,7 +35,7 @@ from .scenario_components import added_components, check_wiring
 from .static_models import REGISTRY
 from .signal_tables import signal_from_table, signal_range
 from .signals import Constant, Step
-from .simulator import SolverOptions
+from .simulator import MIN_MAX_STEP_S, SolverOptions
 from .table_checks import TableChecker, choices_hint, did_you_mean
 
 
@@ -52,9 +52,6 @@ _SCHEMA: dict[str, dict[str, Any]] = {
     "solver": {"method": str, "rtol": float, "max_events": int, "max_step_s": float},
 }
 _MAX_SAMPLES = 1e7  # 8 s at 1 kHz is 8,001; beyond this the output would not fit in memory comfortably
-MIN_MAX_STEP_S = 1e-6
-"""Smallest ``solver.max_step_s`` [s]: a thousandth of the shortest time scale of the model (the valve's
-millisecond pressure transients); smaller steps only make a run hang."""
 MAX_STEPS = 1e7
 """``solver.max_step_s`` may not ask for more steps than this over the run (minutes of computing)."""
 _METHODS = ("LSODA", "RK45", "DOP853", "Radau", "BDF", "RK23")

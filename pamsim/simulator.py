@@ -57,6 +57,11 @@ class SolverOptions:
     release_margin_N: float = 2e-7
 
 
+MIN_MAX_STEP_S = 1e-6
+"""Smallest ``solver.max_step_s`` [s]: a thousandth of the shortest time scale of the model (the valve's
+millisecond pressure transients); smaller steps only make a run hang."""
+
+
 PROGRESS_EVERY = 2000
 """Right-hand-side evaluations between two progress reports inside a segment (a few milliseconds)."""
 

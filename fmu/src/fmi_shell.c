@@ -253,11 +253,92 @@ typedef struct {
     int state;
 } Snapshot;
 
-/* The serialized form is the snapshot behind the token of this build. */
-#define SERIAL_SIZE (sizeof(PAM_TOKEN) + sizeof(Snapshot))
+/* The serialized form: values only, never an address (a state may be loaded in another process,
+ * where the instance's table, logger and callbacks live elsewhere):
+ *   "PAMSTATE" | format version | this build's token | the values, in a fixed order | FNV-1a 64 checksum
+ * of everything before it.  A state is for the build that wrote it (the token), whose layout of r[]
+ * and i[] it shares. */
+static const char SERIAL_MAGIC[8] = {'P', 'A', 'M', 'S', 'T', 'A', 'T', 'E'};
+#define SERIAL_VERSION 1u
 
-/* A state the caller had from before is reused, as the standards allow; calloc so that the
- * padding a serialized state carries is not uninitialised memory. */
+typedef struct {
+    unsigned char *bytes; /* NULL: only count */
+    size_t at;
+} Writer;
+
+static void put(Writer *w, const void *value, size_t size) {
+    if (w->bytes) memcpy(w->bytes + w->at, value, size);
+    w->at += size;
+}
+
+typedef struct {
+    const unsigned char *bytes;
+    size_t at, size;
+} Reader;
+
+static void take(Reader *r, void *value, size_t size) {
+    if (r->at + size <= r->size) memcpy(value, r->bytes + r->at, size);
+    r->at += size;
+}
+
+/* Each field the state holds, written or read in one order; `dir` is put or take. */
+#define SERIAL_FIELDS(dir, io, snap)                                                          \
+    do {                                                                                      \
+        int32_t mode_ = (int32_t)(snap)->core.mode, changed_ = (snap)->core.inputs_changed;  \
+        int32_t edge_ = (snap)->core.table_edge_logged, state_ = (snap)->state;              \
+        int64_t steps_ = (snap)->core.n_steps, rhs_ = (snap)->core.n_rhs;                    \
+        int64_t events_ = (snap)->core.n_events;                                             \
+        uint32_t set_ = (snap)->core.inputs_set;                                             \
+        dir(io, (snap)->core.r, sizeof (snap)->core.r);                                      \
+        dir(io, (snap)->core.i, sizeof (snap)->core.i);                                      \
+        dir(io, &(snap)->core.time_s, sizeof(double));                                       \
+        dir(io, &mode_, sizeof mode_);                                                       \
+        dir(io, &(snap)->core.braid_b_m, sizeof(double));                                    \
+        dir(io, &(snap)->core.braid_turns, sizeof(double));                                  \
+        dir(io, &(snap)->core.x_low_m, sizeof(double));                                      \
+        dir(io, &(snap)->core.x_high_m, sizeof(double));                                     \
+        dir(io, &changed_, sizeof changed_);                                                 \
+        dir(io, &(snap)->core.h_s, sizeof(double));                                          \
+        dir(io, &steps_, sizeof steps_);                                                     \
+        dir(io, &rhs_, sizeof rhs_);                                                         \
+        dir(io, &events_, sizeof events_);                                                   \
+        dir(io, &edge_, sizeof edge_);                                                       \
+        dir(io, &(snap)->core.event_time_s, sizeof(double));                                 \
+        dir(io, &set_, sizeof set_);                                                         \
+        dir(io, &state_, sizeof state_);                                                     \
+        (snap)->core.mode = mode_;                                                           \
+        (snap)->core.inputs_changed = changed_;                                              \
+        (snap)->core.table_edge_logged = edge_;                                              \
+        (snap)->core.n_steps = (long)steps_;                                                 \
+        (snap)->core.n_rhs = (long)rhs_;                                                     \
+        (snap)->core.n_events = (long)events_;                                               \
+        (snap)->core.inputs_set = set_;                                                      \
+        (snap)->state = state_;                                                              \
+    } while (0)
+
+static uint64_t fnv1a64(const unsigned char *bytes, size_t size) {
+    uint64_t h = 14695981039346656037ull;
+    size_t k;
+    for (k = 0; k < size; k++) {
+        h ^= bytes[k];
+        h *= 1099511628211ull;
+    }
+    return h;
+}
+
+static size_t serial_size(void) {
+    Snapshot dummy;
+    Writer w = {NULL, 0};
+    uint32_t version = SERIAL_VERSION;
+    memset(&dummy, 0, sizeof dummy);
+    put(&w, SERIAL_MAGIC, sizeof SERIAL_MAGIC);
+    put(&w, &version, sizeof version);
+    put(&w, PAM_TOKEN, sizeof(PAM_TOKEN));
+    SERIAL_FIELDS(put, &w, &dummy);
+    return w.at + sizeof(uint64_t);
+}
+
+/* A state the caller had from before is reused, as the standards allow. */
 static Snapshot *snapshot_for(void **s) {
     return *s ? (Snapshot *)*s : (Snapshot *)calloc(1, sizeof(Snapshot));
 }
@@ -274,16 +355,19 @@ int fmu_get_fmu_state(FmuInstance *in, const char *function, void **s) {
 }
 
 int fmu_set_fmu_state(FmuInstance *in, const char *function, const void *s) {
-    PamLogFn log;
-    void *log_env;
+    PamCore mine;
     if (!fmu_allowed(in, function, FMU_ANY) || !s) return -1;
-    /* The logger belongs to this instance, not to the one the state was taken from. */
-    log = in->core.log;
-    log_env = in->core.log_env;
+    /* The values are the state's; the table, the logger and the callbacks are this instance's. */
+    mine = in->core;
     in->core = ((const Snapshot *)s)->core;
     in->state = ((const Snapshot *)s)->state;
-    in->core.log = log;
-    in->core.log_env = log_env;
+    in->core.log = mine.log;
+    in->core.log_env = mine.log_env;
+    in->core.on_event = mine.on_event;
+    in->core.event_env = mine.event_env;
+    in->core.on_step = mine.on_step;
+    in->core.step_env = mine.step_env;
+    in->core.table = mine.table;
     return 0;
 }
 
@@ -298,27 +382,74 @@ int fmu_free_fmu_state(FmuInstance *in, const char *function, void **s) {
 
 int fmu_serialized_fmu_state_size(FmuInstance *in, const char *function, size_t *size) {
     if (!fmu_allowed(in, function, FMU_ANY)) return -1;
-    *size = SERIAL_SIZE;
+    *size = serial_size();
     return 0;
 }
 
 int fmu_serialize_fmu_state(FmuInstance *in, const char *function, const void *s, void *bytes, size_t size) {
-    if (!fmu_allowed(in, function, FMU_ANY) || !s || size < SERIAL_SIZE) return -1;
-    memcpy(bytes, PAM_TOKEN, sizeof(PAM_TOKEN));
-    memcpy((char *)bytes + sizeof(PAM_TOKEN), s, sizeof(Snapshot));
+    Snapshot copy;
+    Writer w;
+    uint32_t version = SERIAL_VERSION;
+    uint64_t sum;
+    if (!fmu_allowed(in, function, FMU_ANY) || !s) return -1;
+    if (size < serial_size()) return fmu_refuse(in, function, "the buffer is smaller than SerializedFMUstateSize");
+    copy = *(const Snapshot *)s;
+    w.bytes = (unsigned char *)bytes;
+    w.at = 0;
+    put(&w, SERIAL_MAGIC, sizeof SERIAL_MAGIC);
+    put(&w, &version, sizeof version);
+    put(&w, PAM_TOKEN, sizeof(PAM_TOKEN));
+    SERIAL_FIELDS(put, &w, &copy);
+    sum = fnv1a64(w.bytes, w.at);
+    put(&w, &sum, sizeof sum);
     return 0;
 }
 
+/* The reason a deserialized state cannot be this FMU's, or NULL. */
+static const char *invalid_state(const Snapshot *snap) {
+    const PamCore *c = &snap->core;
+    int known = snap->state > 0 && (snap->state & FMU_ANY) == snap->state && (snap->state & (snap->state - 1)) == 0;
+    if (!known) return "its state-machine state is not one of this FMU's";
+    if (c->mode < PAM_SLIP_DOWN || c->mode > PAM_STOP_HIGH) return "its load mode is not one of -1, 0, 1, 2, 3";
+    if (!isfinite(c->time_s) || !(c->h_s > 0.0) || !isfinite(c->h_s)) return "its time or step is not finite";
+    if (c->n_steps < 0 || c->n_rhs < 0 || c->n_events < 0) return "a count is negative";
+    return NULL;
+}
+
 int fmu_deserialize_fmu_state(FmuInstance *in, const char *function, const void *bytes, size_t size, void **s) {
-    Snapshot *copy;
+    Snapshot read, *copy;
+    Reader r;
+    uint32_t version = 0;
+    uint64_t sum = 0;
+    char magic[sizeof SERIAL_MAGIC];
+    char token[sizeof(PAM_TOKEN)];
+    const char *why;
     if (!fmu_allowed(in, function, FMU_ANY)) return -1;
-    if (size != SERIAL_SIZE || memcmp(bytes, PAM_TOKEN, sizeof(PAM_TOKEN)) != 0) {
-        pam_logf(&in->core, PAM_LOG_ERROR, "%s: the bytes are not a state of this FMU build", function);
+    if (!bytes || size != serial_size())
+        return fmu_refuse(in, function, "the bytes are not a state of this FMU build (wrong size)");
+    memset(&read, 0, sizeof read);
+    r.bytes = (const unsigned char *)bytes;
+    r.at = 0;
+    r.size = size;
+    take(&r, magic, sizeof magic);
+    take(&r, &version, sizeof version);
+    take(&r, token, sizeof token);
+    if (memcmp(magic, SERIAL_MAGIC, sizeof magic) != 0 || version != SERIAL_VERSION)
+        return fmu_refuse(in, function, "the bytes are not a pamsim FMU state of this format version");
+    if (memcmp(token, PAM_TOKEN, sizeof token) != 0)
+        return fmu_refuse(in, function, "the bytes are a state of another build of this FMU");
+    SERIAL_FIELDS(take, &r, &read);
+    take(&r, &sum, sizeof sum);
+    if (sum != fnv1a64(r.bytes, size - sizeof sum))
+        return fmu_refuse(in, function, "the state's checksum does not match: the bytes were changed");
+    why = invalid_state(&read);
+    if (why) {
+        pam_logf(&in->core, PAM_LOG_ERROR, "%s: the state cannot be this FMU's: %s", function, why);
         return -1;
     }
     copy = snapshot_for(s);
     if (!copy) return -1;
-    memcpy(copy, (const char *)bytes + sizeof(PAM_TOKEN), sizeof(Snapshot));
+    *copy = read; /* no address: fmu_set_fmu_state gives it this instance's */
     *s = copy;
     return 0;
 }

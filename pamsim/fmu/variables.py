@@ -24,7 +24,7 @@ from dataclasses import dataclass, replace
 from ..core_table import C_CHOICES
 from ..model import STATE_SCALES
 from ..parameters import LOAD_MASS, get_parameter_set
-from ..simulator import SolverOptions
+from ..simulator import MIN_MAX_STEP_S, SolverOptions
 
 PARAMETER_SET = "shadow_6x300_acra2012"
 
@@ -154,7 +154,7 @@ def _table() -> tuple[Variable, ...]:
         Variable("cs_max_step_s", "real", "parameter", "fixed",
                  "largest internal step of the co-simulation integrator while the load slides [s]", "s", 0.01,
                  "exact",
-                 lower=0.0, lower_open=True),
+                 lower=MIN_MAX_STEP_S),  # as a scenario's solver.max_step_s: smaller ones only make a step hang
         _choice("friction_negative_level", "load-dependent friction where its level "
                 "(P_bar - phi m)(N2 x^2 + N1 x + N0) is negative: {} (clamp: level 0; abs: its magnitude)",
                 NEGATIVE_LEVEL),
