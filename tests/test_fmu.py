@@ -689,3 +689,44 @@ def test_runner_refuses_scenario_settings_the_fmu_cannot_represent(fmus, monkeyp
     for run in (run_cs, run_me):
         with pytest.raises(pamsim.errors.InputError, match="cannot represent"):
             run(sc, 2, fmu_path=fmus[2])
+
+
+@pytest.mark.parametrize("version", [2, 3])
+@pytest.mark.parametrize("known, unknown", [
+    ("initial_contraction_m", "contraction_m"),   # the state follows the parameter: 1
+    ("r0_m", "air_mass_kg"),                      # the chamber's volume follows the braid's geometry
+    ("theta0_deg", "air_mass_kg"),
+    ("initial_contraction_m", "air_mass_kg"),
+])
+def test_directional_derivatives_in_initialisation_follow_the_parameters(fmus, version, known, unknown):
+    """In initialisation mode a parameter's seed moves the states, the geometry and the stops derived
+    from it, as the end of initialisation will: against the difference of two instances initialised
+    with the parameter either side."""
+    h = {"initial_contraction_m": 1e-5, "r0_m": 1e-6, "theta0_deg": 1e-3}[known]
+
+    def initialised(delta):
+        fmu = _instance(fmus, version)
+        api = _Api(fmu, version)
+        _start_fig4(api)
+        base = _inputs_and_starts("acra2012_fig4")[2][known]
+        if known == "initial_contraction_m" and base == 0.0:
+            base = 0.02  # inside the travel, where the state is free to follow
+        api.set(known, base + delta)
+        if version == 2:
+            fmu.setupExperiment(startTime=0.0)
+        fmu.enterInitializationMode()
+        return fmu, api
+
+    fmu, api = initialised(0.0)
+    dd_fmu = fmu.getDirectionalDerivative([value_reference(unknown)], [value_reference(known)], [1.0])[0]
+    fmu.freeInstance()
+    values = []
+    for delta in (h, -h):
+        other, other_api = initialised(delta)
+        other.exitInitializationMode()
+        values.append(other_api.get(unknown)[0])
+        other.terminate()
+        other.freeInstance()
+    expected = (values[0] - values[1]) / (2 * h)
+    assert expected != 0.0
+    assert dd_fmu == pytest.approx(expected, rel=1e-4)

@@ -460,7 +460,7 @@ int fmu_directional_derivative(FmuInstance *in, const char *function, const unsi
     if (!fmu_allowed(in, function, FMU_INIT | FMU_EVENT | FMU_CONT | FMU_STEP | FMU_TERMINATED)) return -1;
     if (n_seed != n_knowns || n_sensitivity != n_unknowns
         || pam_directional_derivative(&in->core, unknowns, (int)n_unknowns, knowns, (int)n_knowns, seed,
-                                      sensitivity)) {
+                                      sensitivity, in->state == FMU_INIT)) {
         pam_logf(&in->core, PAM_LOG_ERROR, "%s: only %s can be differentiated", function, in->flavour->differentiable);
         return -1;
     }

@@ -567,7 +567,8 @@ static void note_table_edge(PamCore *c, double t, const double *y) {
     }
 }
 
-void pam_initialize(PamCore *c) {
+/* Geometry, stops, the state at rest and its mode, from the parameters and the inputs as they are. */
+static void derive_start(PamCore *c) {
     double y[PAM_NX], b, n;
     braid_geometry(c->r, &b, &n);
     c->braid_b_m = b;
@@ -578,7 +579,6 @@ void pam_initialize(PamCore *c) {
         c->x_low_m = fmax(c->x_low_m, c->table->x0);
         c->x_high_m = fmin(c->x_high_m, table_x_end_m(c->table));
     }
-    apply_signals(c, c->time_s, 0, c->inputs_set); /* the ones the importer set are checked equal */
     y[X] = c->r[R_initial_contraction_m];
     y[V] = 0.0;
     y[P] = c->r[R_p_atm_Pa] + c->r[R_initial_pressure_gauge_Pa]; /* ValveChamberSource.initial_state */
@@ -588,6 +588,13 @@ void pam_initialize(PamCore *c) {
     c->mode = rest_mode(c, y, y[X] <= c->x_low_m ? PAM_STOP_LOW : y[X] >= c->x_high_m ? PAM_STOP_HIGH : PAM_STICK);
     c->inputs_changed = 0;
     pam_evaluate(c);
+}
+
+void pam_initialize(PamCore *c) {
+    double y[PAM_NX];
+    apply_signals(c, c->time_s, 0, c->inputs_set); /* the ones the importer set are checked equal */
+    derive_start(c);
+    get_states(c, y);
     c->table_edge_logged = 0; /* a run starts */
     note_table_edge(c, c->time_s, y);
 }
@@ -913,7 +920,11 @@ static double known_scale(unsigned vr, double value) {
  * relative to that known's own scale, since the knowns may be of any scale (m and Pa) and a seed
  * may hold zeros. */
 int pam_directional_derivative(PamCore *c, const unsigned *unknowns, int n_unknowns, const unsigned *knowns,
-                               int n_knowns, const double *seed, double *sensitivity) {
+                               int n_knowns, const double *seed, double *sensitivity, int initializing) {
+    /* In initialisation mode the states, the geometry and the stops follow the parameters: each side of
+     * a difference derives them again, as the end of initialisation will. */
+    void (*evaluate)(PamCore *) = initializing ? derive_start : pam_evaluate;
+    PamCore saved_core = *c;
     double saved[PAM_NR], up[PAM_NR];
     int k, u;
     for (k = 0; k < n_knowns; k++)
@@ -928,17 +939,16 @@ int pam_directional_derivative(PamCore *c, const unsigned *unknowns, int n_unkno
         if (seed[k] == 0.0) continue;
         h = 1e-6 * known_scale(knowns[k], *known);
         *known = saved[PAM_VARS[knowns[k] - 1].index] + h;
-        pam_evaluate(c);
+        evaluate(c);
         memcpy(up, c->r, sizeof up);
-        memcpy(c->r, saved, sizeof saved);
+        *c = saved_core;
         *known = saved[PAM_VARS[knowns[k] - 1].index] - h;
-        pam_evaluate(c);
+        evaluate(c);
         for (u = 0; u < n_unknowns; u++) {
             int idx = PAM_VARS[unknowns[u] - 1].index;
             sensitivity[u] += seed[k] * (up[idx] - c->r[idx]) / (2.0 * h);
         }
-        memcpy(c->r, saved, sizeof saved);
+        *c = saved_core;
     }
-    pam_evaluate(c);
     return 0;
 }

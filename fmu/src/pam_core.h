@@ -81,9 +81,10 @@ int pam_event_update(PamCore *c);
 /* Co-simulation: integrate to t_end, the inputs held or following their signals; 0 on success, -1 on
  * failure (logged), which leaves time_s, the states, the mode and the outputs at the last instant reached. */
 int pam_do_step(PamCore *c, double t_end);
-/* Directional derivative d(unknowns)/d(knowns) * seed: a central difference per known, mode held. */
+/* Directional derivative d(unknowns)/d(knowns) * seed: a central difference per known, mode held;
+ * `initializing`: the states, geometry and stops derived again from the parameters on each side. */
 int pam_directional_derivative(PamCore *c, const unsigned *unknowns, int n_unknowns, const unsigned *knowns,
-                               int n_knowns, const double *seed, double *sensitivity);
+                               int n_knowns, const double *seed, double *sensitivity, int initializing);
 void pam_logf(PamCore *c, int level, const char *fmt, ...);
 /* With input_source = scenario, the inputs follow the signals the FMU was built with (PAM_SIGNALS of
  * pam_variables.h); otherwise these do nothing.  pam_inputs_at sets them at t_s, their values from the
