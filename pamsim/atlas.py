@@ -25,6 +25,7 @@ from .figure_style import check_format
 from .muscle_setup import model_inputs, muscle_parameters, prepare
 from .muscles import Muscle
 from .static_models import REGISTRY
+from .table_checks import LENGTH_UNITS_M, PRESSURE_UNITS_PA, unit_column
 
 N_POINTS = 201
 """Points per curve along the contraction."""
@@ -32,13 +33,16 @@ RATING_FRACTIONS = (0.25, 0.5, 0.75, 1.0)
 """Default pressures as fractions of the rating, for a muscle without measured points."""
 MATCH_FRACTION = 0.1
 """A measured point is drawn on the figure of the nearest atlas pressure within 10 % of it."""
+SAME_CURVE_FRACTION = 1e-9
+"""Two models' curves are the same curve when they agree at every point to this fraction of their largest
+force (equal but for rounding: Gaylord's model and those that reduce to it give curves 1e-15 apart)."""
 
-# Column sets of the measured-point files shipped with muscles: (pressure column, its scale to Pa,
-# contraction column, its scale to m, force column).
-_DATA_FORMATS = (
-    ("pressure_stable_bar", PA_PER_BAR, "contraction_stable_mm", 1e-3, "weight_N"),
-    ("pressure_gauge_Pa", 1.0, "contraction_mm", 1e-3, "load_N"),
-)
+# How a muscle's measured-point file names its columns: the rule of the fits' measurement files
+# (pamsim.table_checks.unit_column), the stable pressure preferred where the file has one (the ACRA tables).
+_POINT_COLUMNS = (("pressure", ("pressure", "p_"), PRESSURE_UNITS_PA),
+                  ("contraction", ("contraction", "x_"), LENGTH_UNITS_M),
+                  ("force or hung weight", ("force", "weight", "load"), {"_N": 1.0}))
+_PREFERRED_PRESSURE = "pressure_stable_bar"
 
 
 @dataclass(frozen=True)
@@ -75,6 +79,23 @@ class Atlas:
         """The models drawn, each once, in the order of the curves."""
         return list(dict.fromkeys(c.model for c in self.curves))
 
+    @property
+    def groups(self) -> list[tuple[str, ...]]:
+        """The models in groups that give the same curve at every pressure (:func:`same_curve`), each
+        group and the models in it in the order of the curves: the figures draw one line per group."""
+        by_model = {m: {c.pressure_Pa: c for c in self.curves if c.model == m} for m in self.models}
+        groups: list[list[str]] = []
+        for m in self.models:
+            mine = by_model[m]
+            for group in groups:
+                first = by_model[group[0]]
+                if first.keys() == mine.keys() and all(same_curve(first[p], mine[p]) for p in mine):
+                    group.append(m)
+                    break
+            else:
+                groups.append([m])
+        return [tuple(g) for g in groups]
+
     def measured_near(self, p_Pa: float) -> np.ndarray:
         """Measured points whose pressure is nearest to ``p_Pa`` among the atlas pressures (within 10 %)."""
         if not len(self.measured):
@@ -106,6 +127,9 @@ class Atlas:
             if c.free_contraction_note:
                 lines.append(f"\nNo free contraction: `{c.model}` at {c.pressure_Pa / PA_PER_BAR:g} bar: "
                              f"{c.free_contraction_note}")
+        same = [" = ".join(f"`{m}`" for m in g) for g in self.groups if len(g) > 1]
+        if same:
+            lines.append("\nSame curves at every pressure, drawn as one line: " + "; ".join(same))
         for m, why in self.skipped.items():
             lines.append(f"\nNot drawn: `{m}`: {why}")
         return "\n".join(lines) + "\n"
@@ -141,24 +165,48 @@ class Atlas:
         return [Path(directory) / n for n in names]
 
 
+def same_curve(a: Curve, b: Curve) -> bool:
+    """Whether two curves are one: the same contractions, and forces within :data:`SAME_CURVE_FRACTION` of
+    the larger curve's largest force at every point."""
+    if a.pressure_Pa != b.pressure_Pa or a.x_m.shape != b.x_m.shape or not np.array_equal(a.x_m, b.x_m):
+        return False
+    with np.errstate(invalid="ignore"):
+        scale = max(np.nanmax(np.abs(a.F_N), initial=0.0), np.nanmax(np.abs(b.F_N), initial=0.0))
+    return bool(np.allclose(a.F_N, b.F_N, rtol=0.0, atol=SAME_CURVE_FRACTION * scale, equal_nan=True))
+
+
 def measured_points(path: Path | None) -> np.ndarray:
     """Rows ``(p_Pa, x_m, F_N)`` of a muscle's measured-point file (empty if it has none).
+
+    The columns are found by their names' units, as a fit's measurement file's are
+    (:func:`pamsim.identification.read_static_data`): a gauge pressure (``pressure*`` or ``p_*`` in
+    ``_bar``, ``_Pa``, ``_kPa``, ``_psi``; ``pressure_stable_bar`` first), a contraction (``contraction*``
+    or ``x_*`` in ``_mm`` or ``_m``) and a force (``force*``, ``weight*`` or ``load*`` in ``_N``), so the
+    ``data.csv`` that ``pamsim fit static`` copies beside its ``muscle.toml`` is read as it was fitted.
 
     Raises
     ------
     InputError
-        A file in none of the known column layouts.
+        A file without such columns, or with a value that is not a number.
     """
     if path is None:
         return np.empty((0, 3))
     lines = [ln for ln in Path(path).read_text().splitlines() if ln.strip() and not ln.startswith("#")]
-    rows = list(csv.DictReader(lines))
-    header = set(rows[0]) if rows else set()
-    for p_col, p_scale, x_col, x_scale, f_col in _DATA_FORMATS:
-        if {p_col, x_col, f_col} <= header:
-            return np.array([(float(r[p_col]) * p_scale, float(r[x_col]) * x_scale, float(r[f_col])) for r in rows])
-    raise InputError(f"{path}: no known columns for measured points (expected one of "
-                     f"{'; '.join(', '.join((a, c, e)) for a, _, c, _, e in _DATA_FORMATS)})")
+    reader = csv.DictReader(lines)
+    header = [h.strip() for h in reader.fieldnames or []]
+    reader.fieldnames = header
+    rows = list(reader)
+    found = [unit_column(header, stems, units) for _, stems, units in _POINT_COLUMNS]
+    if _PREFERRED_PRESSURE in header:
+        found[0] = (_PREFERRED_PRESSURE, PA_PER_BAR)
+    missing = [f"a {what} column ({' or '.join(s + '*' for s in stems)} ending in {' / '.join(units)})"
+               for (what, stems, units), col in zip(_POINT_COLUMNS, found) if col is None]
+    if missing:
+        raise InputError(f"{path}: no measured points: need {', '.join(missing)} (columns: {', '.join(header)})")
+    try:
+        return np.array([[float(r[name]) * k for name, k in found] for r in rows], dtype=float).reshape(-1, 3)
+    except (TypeError, ValueError):
+        raise InputError(f"{path}: a measured point is not a number (columns {', '.join(n for n, _ in found)})") from None
 
 
 def default_pressures_Pa(measured: np.ndarray, rating_Pa: float) -> tuple[float, ...]:

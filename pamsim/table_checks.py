@@ -93,3 +93,27 @@ class TableChecker:
         if not value:
             self.fail(key, value, "is empty: give at least one value")
         return [self.number(key, v) for v in value]
+
+
+PRESSURE_UNITS_PA = {"_gauge_Pa": 1.0, "_Pa": 1.0, "_kPa": 1e3, "_gauge_bar": 1e5, "_bar": 1e5, "_psi": 6894.757293168}
+"""Gauge pressure suffixes of a measurement file's column names and their factor to Pa (psi: 0.45359237 kg *
+9.80665 / 0.0254^2)."""
+LENGTH_UNITS_M = {"_mm": 1e-3, "_m": 1.0}
+"""Contraction suffixes of a measurement file's column names and their factor to metres."""
+
+
+def unit_suffix(name: str, units: Mapping[str, float]) -> str | None:
+    """The suffix of ``units`` that ``name`` ends in, the longest one (``_kPa`` before ``_Pa``), or None."""
+    return next((s for s in sorted(units, key=len, reverse=True) if name.endswith(s)), None)
+
+
+def unit_column(header, stems: tuple[str, ...], units: Mapping[str, float]) -> tuple[str, float] | None:
+    """The first column of ``header`` whose name starts with one of ``stems`` and ends in a unit of ``units``,
+    with that unit's factor to SI; None if there is none.  Measurement files name their columns so
+    (``pressure_bar``, ``contraction_mm``, ``weight_N``): the readers of fits and of a muscle's measured
+    points find them by this one rule."""
+    for name in header:
+        suffix = unit_suffix(name, units) if name.startswith(stems) else None
+        if suffix is not None:
+            return name, units[suffix]
+    return None

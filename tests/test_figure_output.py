@@ -177,10 +177,11 @@ def test_atlas_keeps_its_own_default_resolution_until_dpi_is_given(tmp_path):
     assert run_main(*args, "-o", tmp_path / "a").returncode == 0
     assert run_main(*args, "-o", tmp_path / "b", "--dpi", "50").returncode == 0
     assert _png_size(tmp_path / "a" / "atlas_2.0684bar.png") == (880, 605)  # 8 x 5.5 in at 110
-    w_all, h_all = _png_size(tmp_path / "a" / "atlas_all.png")  # 6.7 x 3.4 in at 100
-    assert (w_all, h_all) == (670, 340)
+    # one 4.2 x 3.4 in panel and a legend as wide as its longest entry, "gaylord = ... = tondu_lopez" (54
+    # characters: 0.6 + 0.055 x 54 in): 7.77 x 3.4 in, at 100 dots per inch unless --dpi says otherwise
+    assert _png_size(tmp_path / "a" / "atlas_all.png") == (777, 340)
     assert _png_size(tmp_path / "b" / "atlas_2.0684bar.png") == (400, 275)
-    assert _png_size(tmp_path / "b" / "atlas_all.png") == (335, 170)
+    assert _png_size(tmp_path / "b" / "atlas_all.png") == (388, 170)
 
 
 BAD = [("--format", "bmp", "not a figure format (choose png, pdf or svg)"),

@@ -19,11 +19,8 @@ from typing import Mapping
 import numpy as np
 
 from ..errors import InputError
+from ..table_checks import LENGTH_UNITS_M, PRESSURE_UNITS_PA, unit_column, unit_suffix  # noqa: F401 -- re-exported
 
-PRESSURE_UNITS_PA = {"_gauge_Pa": 1.0, "_Pa": 1.0, "_kPa": 1e3, "_gauge_bar": 1e5, "_bar": 1e5, "_psi": 6894.757293168}
-"""Gauge pressure suffixes and their factor to Pa (psi: 0.45359237 kg * 9.80665 / 0.0254^2)."""
-LENGTH_UNITS_M = {"_mm": 1e-3, "_m": 1.0}
-"""Contraction suffixes and their factor to metres."""
 QUANTITIES = ("pressure", "contraction", "force", "weight", "time")
 
 
@@ -117,16 +114,14 @@ def _unit_column(path: Path, header: list[str], quantity: str, units: Mapping[st
         name = columns[quantity]
         if name not in header:
             raise DataError(f"{path}: --columns {quantity}={name}: no such column (columns: {', '.join(header)})")
-        suffix = next((s for s in sorted(units, key=len, reverse=True) if name.endswith(s)), None)
+        suffix = unit_suffix(name, units)
         if suffix is None:
             raise DataError(f"{path}: --columns {quantity}={name}: the name must end in a unit "
                             f"({', '.join(units)})")
         return name, units[suffix]
-    for name in header:
-        if name.startswith(stems):
-            suffix = next((s for s in sorted(units, key=len, reverse=True) if name.endswith(s)), None)
-            if suffix is not None:
-                return name, units[suffix]
+    found = unit_column(header, stems, units)
+    if found is not None:
+        return found
     if required:
         want = " or ".join(f"{s}*" for s in stems)
         raise DataError(f"{path}: no {quantity} column: need {want} ending in {' / '.join(units)} "
