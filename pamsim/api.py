@@ -19,6 +19,7 @@ from .simulator import simulate_python  # noqa: F401 -- re-exported
 
 if TYPE_CHECKING:
     from .control.closed_loop import ClosedLoopRun
+    from .paperdata import SteadyState
 
 
 @dataclass
@@ -26,12 +27,15 @@ class ScenarioRun:
     """One run of a scenario as ``pamsim run`` does it: open loop, or with its ``[controller]``.
 
     ``closed_loop`` is the :class:`~pamsim.control.closed_loop.ClosedLoopRun`
-    of a scenario with a controller, else None.
+    of a scenario with a controller, else None.  ``measured`` is the measured end of
+    the test the scenario's ``[measured]`` table names
+    (:meth:`~pamsim.scenario.Scenario.measured_steady_state`), else None.
     """
 
     result: Result
     backend: str
     closed_loop: "ClosedLoopRun | None" = None
+    measured: "SteadyState | None" = None
 
     def summary(self) -> dict:
         """The result's summary, with the backend and, in closed loop, the controller's figures."""
@@ -45,12 +49,13 @@ class ScenarioRun:
         """The controller specification items the run misses (empty in open loop)."""
         return [] if self.closed_loop is None else self.closed_loop.failures()
 
-    def figure(self):
-        """The run's figure: contraction, pressure and forces, or the closed-loop response."""
+    def figure(self, measured: bool = True):
+        """The run's figure: contraction, pressure and forces (with the measured end of the test, unless
+        ``measured`` is False), or the closed-loop response."""
         if self.closed_loop is None:
             from .plotting import result_figure
 
-            return result_figure(self.result, backend=self.backend)
+            return result_figure(self.result, backend=self.backend, measured=self.measured if measured else None)
         from .control.plots import closed_loop_figure
 
         return closed_loop_figure(self.closed_loop)
@@ -76,5 +81,5 @@ def run(scenario: "Scenario | str | os.PathLike", backend: str = "python",
 
         loop = run_closed_loop(scenario, progress=progress)
         return ScenarioRun(loop.result, backend, loop)
-    return ScenarioRun(simulate(scenario, backend, progress), backend)
+    return ScenarioRun(simulate(scenario, backend, progress), backend, measured=scenario.measured_steady_state())
 

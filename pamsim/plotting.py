@@ -43,13 +43,40 @@ def shade_held(ax, t_s: np.ndarray, mode: np.ndarray) -> None:
                             label=label)
 
 
+MEASURED_STYLE = {"color": "C4", "linewidth": 4.0, "alpha": 0.55, "solid_capstyle": "butt", "marker": "D",
+                  "markersize": 5, "markevery": [1], "zorder": 3}
+"""A measured end of a test: a thick bar over the window it is the mean of, a diamond at the window's end."""
+
+
+def measured_labels(measured) -> tuple[str, str]:
+    """Legend entries of a measured steady state (:class:`pamsim.paperdata.SteadyState`): its final contraction
+    and its stable pressure, each with its value and the window it is the mean of."""
+    t0, t1 = measured.window_s
+    return (f"measured final contraction {measured.contraction_mm:.2f} mm (mean over {t0:g}-{t1:g} s)",
+            f"measured stable pressure {measured.pressure_stable_bar:.3f} bar (mean over {t0:g}-{t1:g} s)")
+
+
+def measured_note(measured) -> str:
+    """The caption's line on a measured steady state: what it is, where it is printed, and that it is all."""
+    return (f"measured ({measured.source}): only the final contraction and pressure; the paper draws "
+            "this test's trace but does not give it as numbers")
+
+
+def draw_measured(ax, measured, value: float, label: str) -> None:
+    """Mark a measured end value (contraction [mm] or pressure [bar]) on ``ax`` over the window it is the mean of."""
+    ax.plot(list(measured.window_s), [value] * 2, label=label, **MEASURED_STYLE)
+
+
 def result_figure(result: "Result", title: str | None = None, compare: "list[Result] | None" = None,
-                  backend: str = "python") -> Figure:
+                  backend: str = "python", measured=None) -> Figure:
     """Contraction, pressure and force components against time.
 
     ``compare`` overlays the contraction of other results (for example the
     constant-friction model).  A ``backend`` other than ``"python"`` is named
-    in the title.
+    in the title.  ``measured`` (a :class:`pamsim.paperdata.SteadyState`, such as
+    :meth:`pamsim.Scenario.measured_steady_state` gives) marks the measured final
+    contraction and stable pressure of the test, and the title says that these are
+    all the paper gives of it as numbers.
     """
     fig = Figure(figsize=(9, 9), constrained_layout=True)
     ax_x, ax_p, ax_f = fig.subplots(3, 1, sharex=True)
@@ -58,6 +85,8 @@ def result_figure(result: "Result", title: str | None = None, compare: "list[Res
     ax_x.plot(t, result.x_m * 1e3, **series(0, "k"), label=result.name)
     for k, other in enumerate(compare or [], start=1):
         ax_x.plot(other.t_s, other.x_m * 1e3, **series(k, f"C{k - 1}"), label=other.name)
+    if measured is not None:
+        draw_measured(ax_x, measured, measured.contraction_mm, measured_labels(measured)[0])
     ax_x.set_ylabel(X_LABEL)
     ax_x.legend(loc="lower right", fontsize=8)
     ax_x.grid(alpha=0.3)
@@ -65,6 +94,8 @@ def result_figure(result: "Result", title: str | None = None, compare: "list[Res
     ax_p.plot(t, result.p_gauge_Pa / PA_PER_BAR, **series(0, "C3"), label="muscle")
     if "supply_gauge_Pa" in result.signals:
         ax_p.plot(t, result.signals["supply_gauge_Pa"] / PA_PER_BAR, **series(3, "k"), label="supply")
+    if measured is not None:
+        draw_measured(ax_p, measured, measured.pressure_stable_bar, measured_labels(measured)[1])
     ax_p.set_ylabel("gauge pressure [bar]")
     ax_p.legend(loc="lower right", fontsize=8)
     ax_p.grid(alpha=0.3)
@@ -85,8 +116,11 @@ def result_figure(result: "Result", title: str | None = None, compare: "list[Res
     default = (f"{result.name}: {result.mass_kg * result.g_m_s2:.2f} N hanging weight "
                f"({result.mass_kg:.3f} kg), {result.p_gauge_Pa[-1] / PA_PER_BAR:.2f} bar at the end")
     if backend != "python":
-        default += f"\n{backend} backend (the exported FMU)"
-    note = textwrap.fill(result.damping_energy_note(), 90)  # the figure is about 90 title characters wide
+        what = "compiled C" if backend == "native" else "the exported FMU"
+        default += f"\n{backend} backend ({what})"
+    notes = [measured_note(measured)] if measured is not None else []
+    notes += [result.damping_energy_note()]
+    note = "\n".join(textwrap.fill(n, 90) for n in notes if n)  # the figure is about 90 title characters wide
     fig.suptitle((title or default) + (f"\n{note}" if note else ""))
     return fig
 

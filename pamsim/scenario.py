@@ -30,6 +30,7 @@ from .elements.valve import Iso6358Orifice, ProportionalValve33
 from .model import FitRange, MuscleModel
 from .muscle_setup import applicable_model, model_inputs, with_overrides
 from .muscles import Muscle, load_muscle, shipped_names
+from .paperdata import STEADY_STATE_SETS, SteadyState, steady_state
 from .parameters import LOAD_MASS, ParameterSet, dynamics_parameters
 from .scenario_components import added_components, check_wiring
 from .static_models import REGISTRY
@@ -42,7 +43,7 @@ from .table_checks import TableChecker, choices_hint, did_you_mean
 # Schema: section -> {key: (type, required)}; a nested dict is a sub-table.
 _SCHEMA: dict[str, dict[str, Any]] = {
     "": {"name": str, "description": str, "model": dict, "parameters": dict, "load": dict, "pressure": dict,
-         "simulation": dict, "solver": dict, "controller": dict, "component": list},
+         "simulation": dict, "solver": dict, "controller": dict, "component": list, "measured": dict},
     "model": {"muscle": str, "parameter_set": str, "static_force": str, "static_force_variant": str,
               "static_force_negative": str, "friction": str, "damping": str, "friction_negative_level": str},
     "load": {"weight_N": float, "mass_kg": float, "external_force": dict},
@@ -50,6 +51,7 @@ _SCHEMA: dict[str, dict[str, Any]] = {
                  "command": dict, "prescribed": dict, "initial_gauge_bar": float},
     "simulation": {"duration_s": float, "sample_rate_Hz": float, "initial_contraction_m": float},
     "solver": {"method": str, "rtol": float, "max_events": int, "max_step_s": float},
+    "measured": {"steady_state": str},
 }
 _MAX_SAMPLES = 1e7  # 8 s at 1 kHz is 8,001; beyond this the output would not fit in memory comfortably
 MAX_STEPS = 1e7
@@ -91,9 +93,13 @@ class Scenario:
         """:meth:`from_dict` of a dict nobody else holds (it is completed in place and kept)."""
         v = _Validator(origin, Path(base_dir))
         v.check_table("", spec)
-        for section in ("model", "load", "pressure", "simulation", "solver"):
+        for section in ("model", "load", "pressure", "simulation", "solver", "measured"):
             if section in spec:
                 v.check_table(section, spec[section])
+        if "measured" in spec:
+            measured = v.required(spec["measured"], "steady_state", prefix="measured.")
+            if measured not in STEADY_STATE_SETS:
+                v.fail("measured.steady_state", measured, "unknown measured steady states", choices=STEADY_STATE_SETS)
         for section in ("load", "pressure", "simulation"):
             if section not in spec:
                 raise ScenarioError(f"{origin}: missing section [{section}]")
@@ -297,6 +303,18 @@ class Scenario:
     def initial_contraction_m(self) -> float:
         """Contraction [m] at the start (``simulation.initial_contraction_m``, default 0)."""
         return float(self.spec["simulation"].get("initial_contraction_m", 0.0))
+
+    def measured_steady_state(self) -> SteadyState | None:
+        """The measured end of this test that ``[measured] steady_state`` names, for the scenario's supply step
+        (a valve source) and hung weight: None without the table, or when the data have no such test.
+
+        It says what a run should end at, so that its figure can show it (``pamsim run``); it does not
+        enter the model.
+        """
+        name = self.spec.get("measured", {}).get("steady_state")
+        if name is None or self.spec["pressure"]["source"] != "valve":
+            return None
+        return steady_state(name, self.final_pressure_gauge_Pa / PA_PER_BAR, self.mass_kg * self.parameters["g_m_s2"])
 
     @property
     def initial_pressure_gauge_Pa(self) -> float | None:

@@ -12,10 +12,11 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 
 import pamsim
 from pamsim.api import ScenarioRun
+from pamsim.paperdata import acra2012_steady_state
 from pamsim.plotting import result_figure
 from pamsim.sweep.plots import frequency_figure
 
-from conftest import SCENARIOS
+from conftest import PAPER_SCENARIOS, SCENARIOS, run_main
 
 
 @pytest.fixture(scope="module")
@@ -64,8 +65,82 @@ def test_time_on_the_lower_stop_is_shaded_like_stuck_time(fig4_and_pulled):
 
 def test_backend_is_named_in_the_title_of_non_python_runs(fig4_and_pulled):
     res = fig4_and_pulled[0]
-    assert "fmu-me" in ScenarioRun(res, "fmu-me").figure()._suptitle.get_text()
+    assert "fmu-me backend (the exported FMU)" in ScenarioRun(res, "fmu-me").figure()._suptitle.get_text()
+    assert "native backend (compiled C)" in ScenarioRun(res, "native").figure()._suptitle.get_text()
     assert "backend" not in ScenarioRun(res, "python").figure()._suptitle.get_text()
+
+
+# ---------------------------------------------------------------- the paper's measured points
+def _measured_lines(fig) -> dict[str, list]:
+    """{axes y label: the lines labelled "measured ..."} of a run's figure."""
+    return {ax.get_ylabel(): [ln for ln in ax.get_lines() if ln.get_label().startswith("measured")]
+            for ax in fig.axes}
+
+
+@pytest.mark.parametrize("name", sorted(PAPER_SCENARIOS))
+def test_paper_scenarios_mark_the_measured_end_of_their_test(name):
+    """Figures 3-6 of the ACRA 2012 paper draw traces it does not give as numbers; its Tables 1 and 2 give the
+    end of each test.  The figure marks those two numbers, taken from pamsim.paperdata for the test the
+    paper's caption names, and says that they are all there is."""
+    step_bar, weight_N = PAPER_SCENARIOS[name]
+    rows = acra2012_steady_state()
+    row = rows[(rows["pressure_step_bar"] == step_bar) & (rows["weight_N"] == weight_N)]
+    assert len(row) == 1
+    sc = pamsim.load_scenario(SCENARIOS / f"{name}.toml")
+    run = pamsim.run(sc.with_changes({"simulation": {"duration_s": 1.2}}))  # the measured values are the test's
+    lines = _measured_lines(run.figure())
+    (x_line,), (p_line,), () = lines.values()
+    assert list(x_line.get_ydata()) == [row["contraction_stable_mm"][0]] * 2
+    assert list(p_line.get_ydata()) == [row["pressure_stable_bar"][0]] * 2
+    for line in (x_line, p_line):
+        assert list(line.get_xdata()) == [6.0, 8.0]  # the paper's averaging window (its sec. 3.2)
+        assert "mean over 6-8 s" in line.get_label()
+    assert "final contraction" in x_line.get_label() and "stable pressure" in p_line.get_label()
+    title = run.figure()._suptitle.get_text()
+    assert "only the final contraction and pressure" in title and "Tables 1 and 2" in title
+    assert all(not v for v in _measured_lines(run.figure(measured=False)).values())
+
+
+def test_measured_end_follows_the_scenarios_conditions_not_its_name():
+    rows = acra2012_steady_state()
+    table2 = {(r["pressure_step_bar"], r["weight_N"]): r["contraction_stable_mm"] for r in rows}
+    sc = pamsim.load_scenario(SCENARIOS / "acra2012_fig4.toml")
+    assert sc.measured_steady_state().contraction_mm == table2[3.6, 22.74] == 59.67
+    assert sc.with_changes({"load": {"weight_N": 32.74}}).measured_steady_state().contraction_mm == table2[3.6, 32.74]
+    assert sc.with_changes({"load": {"mass_kg": 42.74 / 9.81}}).measured_steady_state().contraction_mm == \
+        table2[3.6, 42.74]
+    assert sc.with_changes({"load": {"weight_N": 30.0}}).measured_steady_state() is None  # no such test
+    assert sc.with_changes({"pressure": {"supply_gauge_bar": 3.634}}).measured_steady_state() is None
+    plain = dict(sc.spec)
+    plain.pop("measured")
+    assert pamsim.Scenario.from_dict(plain).measured_steady_state() is None  # opt-in
+
+
+def test_pamsim_run_draws_the_measured_end_unless_told_not_to(tmp_path, monkeypatch):
+    from matplotlib.figure import Figure
+
+    saved = []
+    original = Figure.savefig
+    monkeypatch.setattr(Figure, "savefig", lambda fig, *a, **k: (saved.append(fig), original(fig, *a, **k))[1])
+    fig4 = SCENARIOS / "acra2012_fig4.toml"
+    assert run_main("run", fig4, "-o", tmp_path / "a", "--no-progress", "--format", "svg").returncode == 0
+    assert [len(v) for v in _measured_lines(saved[-1]).values()] == [1, 1, 0]
+    assert "measured final contraction 59.67 mm" in (tmp_path / "a" / "acra2012_fig4.svg").read_text()
+    assert run_main("run", fig4, "-o", tmp_path / "b", "--no-progress", "--no-measured").returncode == 0
+    assert [len(v) for v in _measured_lines(saved[-1]).values()] == [0, 0, 0]
+    other = tmp_path / "fig4_30N.toml"
+    other.write_text(fig4.read_text().replace("weight_N = 22.74", "weight_N = 30.0"))
+    r = run_main("run", other, "-o", tmp_path / "c", "--no-progress")
+    assert r.returncode == 0 and "no measured test at a 3.6 bar supply step with 30 N" in r.stderr
+
+
+def test_an_unknown_measured_data_set_is_refused_naming_the_key(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text((SCENARIOS / "acra2012_fig4.toml").read_text().replace('steady_state = "acra2012"',
+                                                                           'steady_state = "acra2013"'))
+    r = run_main("run", bad, "-o", tmp_path / "out")
+    assert r.returncode == 2 and "measured.steady_state" in r.stderr and "acra2013" in r.stderr
+    assert "did you mean 'acra2012'" in r.stderr and not (tmp_path / "out").exists()
 
 
 def test_negative_damping_energy_is_explained_in_the_caption_and_the_summary(fig4_and_pulled):
@@ -108,3 +183,22 @@ def test_frequency_figure_labels_stay_off_the_markers_and_lines():
                 inside = ((pts[:, 0] > box.x0 - r) & (pts[:, 0] < box.x1 + r)
                           & (pts[:, 1] > box.y0 - r) & (pts[:, 1] < box.y1 + r))
                 assert not inside.any(), (line.get_label(), box)
+
+
+def test_the_sweeps_time_responses_mark_the_measured_end_of_each_paper_test():
+    from pamsim.sweep import run_sweep, sweep_from_dict
+    from pamsim.sweep.plots import time_responses_figure
+
+    spec = sweep_from_dict({"base_scenario": "acra2012_fig4.toml", "friction_models": ["constant"],
+                            "axes": {"pressure_bar": [3.6], "weight_N": [22.74]},
+                            "time_responses": {"scenarios": ["acra2012_fig6b.toml", "parallel_spring.toml"]}},
+                           base_dir=SCENARIOS)
+    fig = time_responses_figure(run_sweep(spec))
+    panels = {ax.get_title(): ax for ax in fig.axes if ax.get_title()}
+    rows = acra2012_steady_state()
+    row = rows[(rows["pressure_step_bar"] == 2.0) & (rows["weight_N"] == 22.74)]
+    (line,) = [ln for ln in panels["acra2012_fig6b"].get_lines() if ln.get_label().startswith("measured")]
+    assert list(line.get_ydata()) == [row["contraction_stable_mm"][0]] * 2 and list(line.get_xdata()) == [6.0, 8.0]
+    # fig4 with a spring added names no measured test: nothing measured is drawn for it
+    assert not [ln for ln in panels["parallel_spring"].get_lines() if ln.get_label().startswith("measured")]
+    assert "the final contraction only" in fig._suptitle.get_text()

@@ -34,6 +34,9 @@ def register(sub) -> None:
     p.add_argument("--backend", default="python", choices=sorted(BACKENDS),
                    help="; ".join(f"{name}: {DESCRIPTIONS[name]}" for name in BACKENDS))
     p.add_argument("--no-plot", action="store_true", help="skip the figure")
+    p.add_argument("--no-measured", action="store_true",
+                   help="leave the measured end of the test that a scenario's [measured] table names (the ACRA 2012 "
+                        "paper's final contraction and pressure) out of the figure")
     figure_args.add_arguments(p)
     p.add_argument("--max-csv-MB", type=finite_float, default=MAX_CSV_MB, metavar="MB",
                    help=f"refuse a run whose CSV could exceed this size (default {MAX_CSV_MB:g} MB; "
@@ -101,6 +104,18 @@ def _check_csv_size(scenario, limit_MB: float) -> None:
                          f"the limit of {limit_MB:g} MB (lower the rate, or raise the limit with --max-csv-MB)")
 
 
+def _measured_warnings(scenario, outcome) -> list[str]:
+    """A ``[measured]`` table that names no test at the scenario's conditions: said, since nothing is drawn."""
+    name = scenario.spec.get("measured", {}).get("steady_state")
+    if name is None or outcome.measured is not None or outcome.closed_loop is not None:
+        return []
+    pr = scenario.spec["pressure"]
+    at = (f"a {scenario.final_pressure_gauge_Pa / 1e5:g} bar supply step" if pr["source"] == "valve"
+          else "a prescribed pressure (its tests are valve steps)")
+    return [f"measured.steady_state = {name!r}: no measured test at {at} with "
+            f"{scenario.mass_kg * scenario.parameters['g_m_s2']:g} N; the figure shows no measured values"]
+
+
 def _run_one(scenario, args: argparse.Namespace, out: Path) -> list[str]:
     """Run one scenario and write its files; returns the controller specification items it misses."""
     from tqdm import tqdm
@@ -121,8 +136,8 @@ def _run_one(scenario, args: argparse.Namespace, out: Path) -> list[str]:
         result.to_csv(tmp[names[0]])
         tmp[names[1]].write_text(json.dumps(summary, indent=2) + "\n")
         if not args.no_plot:
-            save(outcome.figure(), tmp[names[2]], dpi=dpi)
-    for warning in result.warnings:
+            save(outcome.figure(measured=not args.no_measured), tmp[names[2]], dpi=dpi)
+    for warning in result.warnings + _measured_warnings(scenario, outcome):
         print(f"pamsim: warning: {scenario.name}: {warning}", file=sys.stderr)
     s = summary
     print(f"{scenario.name}: final contraction {s['final_contraction_m'] * 1e3:.2f} mm "

@@ -80,7 +80,8 @@ def force_table_for(scenario: Scenario) -> ForceTable | None:
 # own Dormand-Prince 5(4) (CS).  [controller] is read by ``pamsim control-example`` only, as with
 # the python backend.
 REPRESENTED = {
-    "": {"name", "description", "model", "parameters", "load", "pressure", "simulation", "solver", "controller"},
+    "": {"name", "description", "model", "parameters", "load", "pressure", "simulation", "solver", "controller",
+         "measured"},  # [measured] names what the figure draws beside the run, not the model
     "model": {"muscle", "parameter_set", "static_force", "static_force_negative", "friction", "damping",
               "friction_negative_level"},
     "load": {"weight_N", "mass_kg", "external_force"},

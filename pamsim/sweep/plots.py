@@ -18,6 +18,7 @@ from matplotlib.figure import Figure
 
 from ..constants import PA_PER_BAR
 from ..figure_style import REFERENCE, series
+from ..plotting import draw_measured, measured_labels
 
 
 def _grid_pressure(row: Mapping) -> float:
@@ -126,7 +127,9 @@ def time_responses_figure(result: "SweepResult") -> Figure:
         return _empty(fig, "no [time_responses] in the sweep file")
     ncols = 2 if len(names) > 1 else 1
     nrows = math.ceil(len(names) / ncols)
-    margins = dict(left=0.05, right=0.95, top=1 - 0.75 / height_in, bottom=0.5 / height_in, wspace=0.2, hspace=0.42)
+    measured = {s.name: s.measured_steady_state() for s in result.spec.time_responses}
+    title_in = 0.75 + (0.2 if any(m is not None for m in measured.values()) else 0.0)  # a second title line
+    margins = dict(left=0.05, right=0.95, top=1 - title_in / height_in, bottom=0.5 / height_in, wspace=0.2, hspace=0.42)
     axes = np.atleast_1d(fig.subplots(nrows, ncols, squeeze=False, gridspec_kw=margins).ravel())
     for ax, name in zip(axes, names):
         runs = result.responses[name]
@@ -135,6 +138,8 @@ def time_responses_figure(result: "SweepResult") -> Figure:
                 ax.text(0.5, 0.2 + 0.1 * k, f"{f}: failed", transform=ax.transAxes, color="red")
                 continue
             ax.plot(out["t_s"], out["x_m"] * 1e3, lw=1.6, label=f"{f} friction", **series(k))
+        if measured.get(name) is not None:
+            draw_measured(ax, measured[name], measured[name].contraction_mm, measured_labels(measured[name])[0])
         pax = ax.twinx()
         first = next((o for o in runs.values() if not o.get("error")), None)
         if first is not None:
@@ -151,7 +156,12 @@ def time_responses_figure(result: "SweepResult") -> Figure:
         ax.set_axis_off()
     for ax in axes[max(0, len(names) - ncols):len(names)]:
         ax.set_xlabel("time [s]")
-    fig.suptitle("Time responses: load-dependent against constant friction (grey dots: muscle pressure, right axis)")
+    title = "Time responses: load-dependent against constant friction (grey dots: muscle pressure, right axis)"
+    sources = sorted({m.source for m in measured.values() if m is not None})
+    if sources:
+        title += (f"\nmeasured: the final contraction only ({'; '.join(sources)}); "
+                  "the paper draws the traces but does not give them as numbers")
+    fig.suptitle(title)
     return fig
 
 
