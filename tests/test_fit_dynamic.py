@@ -18,6 +18,7 @@ from pamsim.identification.pressure_input import knots, thinned_input
 from pamsim.signals import Trace
 from pamsim.simulator import simulate_model
 from pamsim.errors import InputError
+from pamsim.identification.plots import plot_dynamic_fit
 
 from conftest import SCENARIOS
 from synthetic_fit import FREE, NOISE_M, fit_in_pool, friction_polynomial_error, traces, truth_vector
@@ -157,6 +158,11 @@ def test_two_traces_pooled(scenario, short_pair):
     assert fit.parameters["N0_N_per_bar"] == pytest.approx(6.0, rel=0.02)
     for rms in fit.rms_contraction_mm:
         assert rms == pytest.approx(NOISE_M * 1e3, rel=0.2)
+    # the figure names each trace by its file, as the reports do, not by the folder it was read from
+    traces = [replace(n, origin=f"/some/folder/step_{i}.csv") for i, (n, _) in enumerate(short_pair)]
+    fig = plot_dynamic_fit(replace(fit, problem=replace(fit.problem, traces=tuple(traces))))
+    titles = [ax.get_title() for ax in fig.axes if ax.get_title()]
+    assert [t.split(" (")[0] for t in titles] == ["step_0.csv", "step_1.csv"]
 
 
 def test_without_recorded_pressure_the_scenario_valve_drives_the_fit(scenario, short_pair):

@@ -250,6 +250,24 @@ def test_muscle_file_round_trip(tmp_path, robust_fit):
         load_muscle_parameters(str(path))
 
 
+def test_a_muscle_files_own_parameters_fit_as_the_command_fits_them():
+    """``fit_static(data, pamsim.load_muscle(name).parameters, ...)``, the Python path the docs give, stopped
+    with a KeyError ('stop_restitution', a dynamics value a muscle file leaves to pamsim's defaults); it now
+    fits as ``pamsim fit static --muscle name`` does, to the same coefficients."""
+    from pamsim.identification.synthetic import synthetic_static
+
+    muscle = pamsim.load_muscle("kothera2009_5a")
+    own = muscle.parameters
+    assert "stop_restitution" not in own
+    p, w = np.meshgrid([1.0e5, 2.0e5, 3.0e5, 4.0e5], [10.0, 20.0, 30.0])
+    tests = synthetic_static(muscle.static_force().force_N, p.ravel(), w.ravel(), 0.02, noise_m=0.1e-3, seed=3)
+    direct = fit_static(tests, own, model=muscle.default_static_force, free=["r0_m", "theta0_deg"], cv="none")
+    params, model = load_muscle_parameters("kothera2009_5a")
+    command = fit_static(tests, params, model=model, free=["r0_m", "theta0_deg"], cv="none")
+    assert direct.parameters == command.parameters
+    assert direct.rms_contraction_mm == command.rms_contraction_mm < 0.2
+
+
 def test_a_failed_write_leaves_no_folder(tmp_path, robust_fit, monkeypatch):
     from pamsim.identification import report
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import TYPE_CHECKING, Sequence
 
 import numpy as np
@@ -116,7 +117,7 @@ def plot_dynamic_fit(fit: "DynamicFit", path=None, dpi: int | None = None) -> Fi
             ax.plot(tr.t_s, fit.start_simulated_m[i] * 1e3, **series(1), lw=0.8, label="start")
         ax.axvspan(tr.t_s[mask][0], tr.t_s[mask][-1], color="C2", alpha=0.06)
         ax.set_ylabel("contraction [mm]")
-        ax.set_title(f"{tr.origin} ({fit.loads_N[i]:g} N): RMS {fit.rms_contraction_mm[i]:.3f} mm in the window",
+        ax.set_title(f"{Path(tr.origin).name} ({fit.loads_N[i]:g} N): RMS {fit.rms_contraction_mm[i]:.3f} mm in the window",
                      fontsize=9)
         ax.legend(fontsize=8)
         axr.plot(tr.t_s[mask], (fit.simulated_m[i][mask] - tr.x_m[mask]) * 1e3, color="C3", lw=0.8)

@@ -29,7 +29,7 @@ from ..elements.stops import EndStops
 from ..errors import InputError
 from ..muscles import DERIVED, WALL_PAIR, geometry_violation, rederive
 from ..parameter_schema import LOCK_DEG
-from ..parameters import ParameterSet, known_parameter
+from ..parameters import ParameterSet, dynamics_parameters, known_parameter
 from .choices import CENSOR_THRESHOLD_M, LOSSES, OBJECTIVES
 from .columns import StaticData
 from .crossval import cross_validate
@@ -225,9 +225,12 @@ def make_problem(data: StaticData, params: ParameterSet, model: str = "acra2012_
                  censor_threshold_m: float = CENSOR_THRESHOLD_M) -> StaticProblem:
     """Check the choices of a static fit and bundle them.
 
+    ``params`` may be a muscle's own parameters (``pamsim.load_muscle(path).parameters``): what the
+    dynamics need and it does not give takes pamsim's defaults, as ``pamsim fit static --muscle`` does.
     ``objective`` defaults to ``contraction`` for hanging-weight data and ``force`` for force data.
     The search for the equilibrium ends at the muscle's upper stop (braid lock).
     """
+    params = dynamics_parameters(params)
     check_model(model)
     missing = missing_inputs(model, params)
     if missing:
