@@ -13,7 +13,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from .signals import Constant, FirstOrderLag, Ramp, Step, Trace
+from .signals import Constant, FirstOrderLag, PiecewiseConstant, Ramp, Step, Trace
 from .table_checks import choices_hint
 
 # Signal kind -> (keys without a unit, value keys that take the unit suffix of where the signal is used).
@@ -23,6 +23,7 @@ SIGNAL_KINDS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
     "ramp": (("start_s", "end_s"), ("initial", "final")),
     "lag": (("time_s", "tau_s"), ("initial", "final")),
     "trace": (("file", "time_column", "value_column"), ()),
+    "steps": (("times_s",), ("values",)),
 }
 
 
@@ -56,6 +57,8 @@ def signal_from_table(v, where: str, spec: Any, suffix: str, scale: float, base_
             v.fail(f"{where}.{name}", value, "must not be negative")
         return value
 
+    if kind == "steps":
+        return _steps(v, where, spec, suffixes)
     if kind == "constant":
         return Constant(val("value"))
     if kind == "step":
@@ -71,6 +74,29 @@ def signal_from_table(v, where: str, spec: Any, suffix: str, scale: float, base_
             v.fail(f"{where}.tau_s", tau, "must be positive")
         return FirstOrderLag(t("time_s"), val("initial", 0.0), val("final"), tau)
     return _trace(v, where, spec, suffixes, base_dir)
+
+
+def _numbers(v, key: str, value: Any) -> list[float]:
+    if not isinstance(value, (list, tuple)) or not value:
+        v.fail(key, value, "must be a non-empty list of numbers")
+    return [v.number(f"{key}[{k}]", x) for k, x in enumerate(value)]
+
+
+def _steps(v, where: str, spec: Mapping, suffixes) -> PiecewiseConstant:
+    times = _numbers(v, f"{where}.times_s", v.required(spec, "times_s", prefix=f"{where}."))
+    given = [(f"values{s}", k) for s, k in suffixes if f"values{s}" in spec]
+    if not given:
+        raise v.error(f"{v.origin}: missing key {where}.values{suffixes[0][0]}")
+    key, scale = given[0]
+    values = [x * scale for x in _numbers(v, f"{where}.{key}", spec[key])]
+    if len(values) != len(times):
+        v.fail(f"{where}.{key}", f"{len(values)} values", f"must be as many as times_s ({len(times)})")
+    if times[0] < 0:
+        v.fail(f"{where}.times_s[0]", times[0], "must not be negative")
+    for k in range(1, len(times)):
+        if times[k] <= times[k - 1]:
+            v.fail(f"{where}.times_s[{k}]", times[k], f"must be after times_s[{k - 1}] = {times[k - 1]:g}")
+    return PiecewiseConstant(tuple(times), tuple(values))
 
 
 def _trace(v, where: str, spec: Mapping, suffixes, base_dir: Path) -> Trace:
@@ -113,5 +139,7 @@ def signal_range(sig) -> tuple[float, float]:
     """``(lowest, highest)`` value a signal takes."""
     if isinstance(sig, Trace):
         return float(sig.values.min()), float(sig.values.max())
+    if isinstance(sig, PiecewiseConstant):
+        return min(sig.values), max(sig.values)
     vals = [getattr(sig, a) for a in ("value", "initial", "final") if hasattr(sig, a)]
     return min(vals), max(vals)

@@ -9,6 +9,7 @@ over a discontinuity.
 
 from __future__ import annotations
 
+import bisect
 import math
 from dataclasses import dataclass, field
 from typing import ClassVar
@@ -125,6 +126,37 @@ class Trace(_Signal):
     @property
     def max_step_s(self) -> float:
         return float(np.min(np.diff(self.t_s)))
+
+
+@dataclass(frozen=True)
+class PiecewiseConstant(_Signal):
+    """``values[k]`` from ``times_s[k]`` until ``times_s[k + 1]``, the last value from its time on, and
+    ``values[0]`` before ``times_s[0]``: a sampled command held between its samples (a zero-order hold),
+    such as a controller's or a reinforcement-learning agent's actions.
+
+    Every time is a breakpoint, also where the value does not change: the integrator restarts there,
+    as it does at each step of a controller that sets its output every sample, so a run of this signal
+    takes the steps that such a controller's run takes.
+    """
+
+    times_s: tuple[float, ...]
+    values: tuple[float, ...]
+
+    def __call__(self, t):
+        if isinstance(t, float):  # numpy float64 is a float; np.ndim costs more than the signal
+            return self.values[max(bisect.bisect_right(self.times_s, t) - 1, 0)]
+        k = np.searchsorted(np.asarray(self.times_s), np.asarray(t, dtype=float), side="right") - 1
+        return np.asarray(self.values, dtype=float)[np.maximum(k, 0)]
+
+    @property
+    def breakpoints(self) -> tuple[float, ...]:
+        """Every time of the signal."""
+        return tuple(self.times_s)
+
+    @property
+    def final_value(self) -> float:
+        """The last value."""
+        return float(self.values[-1])
 
 
 def max_step_hint_s(*signals) -> float:

@@ -25,7 +25,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..scenario import Scenario
-from ..signals import Constant, FirstOrderLag, Ramp, Step, Trace
+from ..signals import Constant, FirstOrderLag, PiecewiseConstant, Ramp, Step, Trace
 from .force_table import ForceTable
 from .runner import ScenarioInputs, force_table_for, start_values
 from .variables import INPUT_SOURCE_CHOICES, INPUTS, VARIABLES
@@ -98,7 +98,12 @@ def input_signal(signal, unit: str) -> InputSignal:
     if isinstance(signal, Trace):
         return InputSignal(tuple(map(float, signal.t_s)), tuple(map(float, signal.values)),
                            text=f"trace of {len(signal.t_s)} points ({signal.source or 'table'})")
-    raise InputError(f"the FMU can carry only constant, step, ramp, lag and trace signals, not {signal!r}")
+    if isinstance(signal, PiecewiseConstant):  # each value from its time on: a repeated knot per time
+        times = signal.times_s[1:]
+        return InputSignal((signal.times_s[0], *(t for t in times for _ in (0, 1))),
+                           tuple(float(v) for v in signal.values[:-1] for _ in (0, 1)) + (float(signal.values[-1]),),
+                           text=f"{len(signal.times_s)} steps")
+    raise InputError(f"the FMU can carry only constant, step, ramp, lag, trace and steps signals, not {signal!r}")
 
 
 @dataclass(frozen=True)

@@ -17,7 +17,7 @@ Differences from the Python backend, all documented in ``docs/scaling.md``:
   table of the model (:func:`force_table`), not the model itself;
 - the work integrals are Gauss-Legendre quadratures of each step's dense output
   (the Python backend integrates them as states);
-- a signal that is neither constant nor a step (ramp, lag, trace, external
+- a signal that is neither constant nor a step nor steps (ramp, lag, trace, external
   force) is held at its midpoint value over intervals of at most
   :func:`hold_interval_s`, a second-order approximation.
 """
@@ -43,7 +43,7 @@ from ..fmu.runner import REPRESENTED, tabulate_model
 from ..model import Mode, MuscleModel
 from ..result import Result, TransitionEvent
 from ..scenario import Scenario
-from ..signals import Constant, FirstOrderLag, Step
+from ..signals import Constant, FirstOrderLag, PiecewiseConstant, Step
 from ..simulator import too_many_events
 from . import library as lib
 from .engine import EngineCase, engine_library
@@ -68,7 +68,7 @@ def outgrew_batch(status: int, max_events: int) -> bool:
 HOLD_STEPS_PER_TAU = 10
 """A first-order lag is held over at most tau / 10 (and never longer than one output sample)."""
 METHOD_LABEL = "native DOPRI5(4)"
-_EXACT = (Constant, Step)  # constant between breakpoints: held exactly
+_EXACT = (Constant, Step, PiecewiseConstant)  # constant between breakpoints: held exactly
 _STATE_ROWS = {2: slice(0, 8), 0: [0, 1, 4, 5, 6, 7]}  # Result's state rows by source state count (a view if it can)
 _DEFAULT_MAX_STEP_S = float(lib.REAL_DEFAULTS[lib.REAL_INDEX["cs_max_step_s"]])
 
