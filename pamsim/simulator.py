@@ -230,6 +230,97 @@ def simulate_model(model: MuscleModel, duration_s: float, options: SolverOptions
     return run.result(name, time.perf_counter() - wall0)
 
 
+class SteppedRun:
+    """A run of ``model`` advanced by its caller, one piece at a time, as a controller drives it.
+
+    Between two calls of :meth:`advance` the caller may change what the model's input signals return
+    (a held value it owns, such as an agent's last action).  ``advance(t_k1)`` after ``advance(t_k)``
+    takes the steps, events and modes that :func:`simulate_model` takes between the breakpoints ``t_k``
+    and ``t_k1`` of a signal that holds the same values (:class:`pamsim.signals.PiecewiseConstant`): a
+    held load's mode is decided again at ``t_k`` with the new inputs, as at a breakpoint.  The run
+    starts at the first :meth:`advance`, from the state and mode its inputs decide; before that,
+    :attr:`y` and :attr:`mode` are the start that the inputs at construction decide.
+
+    Parameters
+    ----------
+    model : MuscleModel
+        The model, with its input signals.
+    options : SolverOptions, optional
+        Integrator settings (``sample_rate_Hz`` is not used: the caller reads the state).
+    x0_m : float
+        Contraction at the start [m].
+    p0_gauge_Pa : float, optional
+        Chamber pressure at the start [Pa gauge] (None: ambient).
+    added : tuple
+        Components added to the rig (:class:`pamsim.assemblies.one_muscle.AddedComponent`).
+    """
+
+    def __init__(self, model: MuscleModel, options: SolverOptions | None = None, x0_m: float = 0.0,
+                 p0_gauge_Pa: float | None = None, added: tuple = ()):
+        self._run = _Run(model, 0.0, options or SolverOptions(), x0_m, p0_gauge_Pa, None, added)
+        self._started = False
+        self.assembly = self._run.gen.assembly
+        """The assembly the run integrates (the rig and the components added to it)."""
+        self.state_names = tuple(self._run.gen.code[Mode.STICK].names["states"])
+        """The states' names, in the order of :attr:`y` (the flat model's)."""
+        self.output_names = tuple(self._run.gen.code[Mode.STICK].names["outputs"])
+        """The outputs' names, in the order :meth:`outputs` returns them."""
+
+    @property
+    def t_s(self) -> float:
+        """The time reached [s]."""
+        return self._run.t
+
+    @property
+    def y(self) -> np.ndarray:
+        """Every state at :attr:`t_s`, in the order of :attr:`state_names`."""
+        return self._run.y
+
+    @property
+    def mode(self) -> Mode:
+        """The load's mode at :attr:`t_s`."""
+        return self._run.mode
+
+    @property
+    def events(self) -> list[TransitionEvent]:
+        """The mode changes so far."""
+        return self._run.transitions
+
+    @property
+    def stats(self) -> dict:
+        """Right-hand-side evaluations and events so far (as a :class:`Result`'s ``stats`` counts them)."""
+        return {"rhs_evaluations": int(self._run.nfev), "events": len(self._run.transitions)}
+
+    def outputs(self) -> list[float]:
+        """Every output at :attr:`t_s` in the current mode, in the order of :attr:`output_names`."""
+        gen = self._run.gen
+        return gen.code[self._run.mode].y(list(self._run.y), gen.inputs(self._run.t), gen.p, ())[0]
+
+    def advance(self, t_end_s: float) -> None:
+        """Integrate to ``t_end_s`` [s] with the inputs the model's signals give now.
+
+        Raises
+        ------
+        SolverFailure
+            As :func:`simulate_model` does.
+        """
+        run = self._run
+        if not self._started:
+            run.y, run.mode = run.gen.start()
+            self._started = True
+        elif run.mode in _REST:
+            run.mode = run.gen.rest_mode(run.mode, run.t, run.y)
+        while run.t < t_end_s:
+            t_break = min(t_end_s, run.hold_until)
+            sol, named = run.segment(t_break)
+            if sol.status == 1:
+                run.at_event(sol, named)
+            elif t_break < t_end_s:
+                run.at_breakpoint(sol, t_break)
+            else:  # the mode is decided at the next advance, with the inputs it brings
+                run.t, run.hold_until, run.y = t_break, math.inf, sol.y[:, -1].copy()
+
+
 class _Run:
     """One run of :func:`simulate_model`: where it is, what it has sampled and seen so far."""
 
@@ -359,4 +450,4 @@ def too_many_events(max_events: int, when: str = "") -> SolverFailure:
     return SolverFailure(f"more than {max_events} {noun}{when} (raise [solver] max_events if this is expected)")
 
 
-__all__ = ["SolverFailure", "SolverOptions", "simulate_model", "n_samples"]
+__all__ = ["SolverFailure", "SolverOptions", "SteppedRun", "simulate_model", "n_samples"]

@@ -5,7 +5,8 @@
  * (pamsim/native/engine.py mirrors these layouts).  Each case runs from the model's initial state,
  * with inputs held constant over given segments, and is sampled on a uniform grid: every state
  * (the quadratures from each step's dense output), the mode, the events, and the extremes of every
- * output over every step end and event.
+ * output over every step end and event.  pam_engine_session.c, included at the end, runs one case
+ * step by step instead.
  */
 #include "pam_engine.c"
 
@@ -338,3 +339,5 @@ PAM_EXPORT int64_t pam_engine_layout(int64_t which) {
                              PAM_ENGINE_MSG, (int64_t)sizeof(PamEngineBatch)};
     return which >= 0 && which < (int64_t)(sizeof sizes / sizeof sizes[0]) ? sizes[which] : -1;
 }
+
+#include "pam_engine_session.c"

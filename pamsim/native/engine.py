@@ -5,6 +5,10 @@ values are arguments, so every run of a sweep over parameters shares it.  A libr
 (:class:`pamsim.modeling.cmodel.CModel`) and compiled on first use and kept in the native cache
 folder (:func:`pamsim.native.build.cache_root`) under a hash of the structure, of pamsim's sources,
 of the engine's C sources and of the compiler and its flags; within a process it is loaded once.
+
+A library runs whole cases in one call (:meth:`EngineLibrary.run`), or one case step by step
+(:class:`EngineSession`, ``fmu/src/pam_engine_session.c``): a controller or an environment sets the
+inputs, advances to a time and reads the states and outputs.
 """
 
 from __future__ import annotations
@@ -13,24 +17,27 @@ import ctypes
 import hashlib
 import os
 import tempfile
+import weakref
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Sequence
 
 import numpy as np
 
+from ..errors import InputError, SolverFailure
 from ..fmu.build import shared_library_suffix
 from ..fmu.generate import c_source_dir
 from ..modeling import code_cache
 from .build import FLAGS, cache_root, compile_library, compiler
 
-ENGINE_SOURCES = ("pam_engine_batch.c", "pam_engine.c", "pam_engine.h", "pam_dopri.h")
+ENGINE_SOURCES = ("pam_engine_batch.c", "pam_engine_session.c", "pam_engine.c", "pam_engine.h", "pam_dopri.h")
 LAYOUT = ("nx", "nq", "nu", "np", "ny", "nz", "nmodes", "ns", "event_columns", "message_bytes", "batch_bytes")
 """What ``pam_engine_layout(k)`` returns, by k."""
 STATUS = ("ok", "bad input", "solver failed", "event buffer full")
 MESSAGE_BYTES = 256
 
 _D = ctypes.POINTER(ctypes.c_double)
+_P = ctypes.c_void_p
 _I32 = ctypes.POINTER(ctypes.c_int32)
 _I64 = ctypes.POINTER(ctypes.c_int64)
 
@@ -79,7 +86,21 @@ class EngineLibrary:
             raise RuntimeError(f"engine library {path.name}: layout differs from pamsim.native.engine's: {wrong}")
         lib.pam_engine_run_batch.restype = ctypes.c_int64
         lib.pam_engine_run_batch.argtypes = [ctypes.POINTER(EngineBatch)]
+        # Sessions: pointers as plain addresses (c_void_p), the cheapest conversion per call.
+        signatures = {"new": (_P, []), "free": (None, [_P]),
+                      "reset": (ctypes.c_int32, [_P, _P, _P, ctypes.c_double, ctypes.c_double, ctypes.c_int64]),
+                      "advance": (ctypes.c_int32, [_P, _P, ctypes.c_double]),
+                      "read": (ctypes.c_int32, [_P, _P, _P, _P]),
+                      "step": (ctypes.c_int32, [_P, _P, ctypes.c_double, _P, _P]),
+                      "extremes": (None, [_P, _P]), "message": (ctypes.c_char_p, [_P])}
+        for name, (restype, argtypes) in signatures.items():
+            fn = getattr(lib, f"pam_engine_session_{name}")
+            fn.restype, fn.argtypes = restype, argtypes
         self._lib = lib
+
+    def session(self) -> "EngineSession":
+        """A new :class:`EngineSession` of this library (one run, advanced step by step)."""
+        return EngineSession(self)
 
     def run(self, cases: Sequence[EngineCase]) -> dict:
         """Run ``cases`` in one call.  Returns per case, concatenated: ``samples`` (a block of every state
@@ -122,6 +143,140 @@ class EngineLibrary:
         out["messages"] = [raw[MESSAGE_BYTES * i:MESSAGE_BYTES * (i + 1)].split(b"\0", 1)[0].decode(errors="replace")
                            for i in range(n)]
         return out
+
+
+class EngineSession:
+    """One run of an engine library advanced by its caller, with the inputs held over each advance.
+
+    A session is what one case of :meth:`EngineLibrary.run` does, cut where its caller chooses: after
+    :meth:`reset`, each :meth:`advance` (or :meth:`step`) holds its inputs from the session's time to
+    its end time, as a batch case holds one input segment.  Advanced from ``t_k`` to ``t_(k+1)`` with the
+    inputs ``u_k``, a session takes the same integrator steps, events and modes as a batch case whose
+    segments start at every ``t_k`` with those inputs, and ends at the same states to the last bit.
+    The run starts at the first advance, from the state and mode its inputs decide (a batch case starts
+    from its first segment's inputs); until then :attr:`states` and :attr:`outputs` are the start the
+    reset's inputs decide.
+
+    Parameters
+    ----------
+    library : EngineLibrary
+        The compiled engine of the model's assembly.
+
+    Notes
+    -----
+    The arrays :attr:`states` and :attr:`outputs` are the session's own buffers, overwritten by every
+    :meth:`step` and :meth:`read`; copy what must outlive the next call.  A session is not thread-safe
+    and cannot be pickled: a worker process makes its own.
+    """
+
+    def __init__(self, library: EngineLibrary):
+        self.library = library
+        self._lib = lib = library._lib
+        handle = lib.pam_engine_session_new()
+        if not handle:
+            raise MemoryError("pam_engine_session_new: out of memory")
+        self._handle = handle
+        self._free = weakref.finalize(self, lib.pam_engine_session_free, handle)
+        L = library.layout
+        self.states = np.zeros(L["ns"])
+        """Every state, in the flat model's order (``library.names["states"]``)."""
+        self.outputs = np.zeros(L["ny"])
+        """Every output, in the flat model's order (``library.names["outputs"]``), in the current mode."""
+        self._u = np.zeros(L["nu"])
+        self._info = np.zeros(5)
+        self._x_at, self._y_at = self.states.ctypes.data, self.outputs.ctypes.data
+        self._u_at, self._info_at = self._u.ctypes.data, self._info.ctypes.data
+        self._step = lib.pam_engine_session_step
+
+    def _check(self, status: int, what: str) -> None:
+        if status == 0:
+            return
+        message = self._lib.pam_engine_session_message(self._handle).decode(errors="replace")
+        if status == 1:
+            raise InputError(f"{what}: {message}")
+        raise SolverFailure(f"native backend: {message}")
+
+    def reset(self, params: Sequence[float], inputs: Sequence[float], rtol: float, max_step_s: float,
+              max_steps: int) -> None:
+        """Start a new run at t = 0.
+
+        Parameters
+        ----------
+        params : sequence of float
+            The flat model's parameter vector (``library.names["parameters"]``).
+        inputs : sequence of float
+            The inputs (``library.names["inputs"]``) that decide the start shown until the first advance.
+        rtol : float
+            Relative tolerance; the absolute ones are ``rtol`` times each state's nominal value.
+        max_step_s : float
+            The longest step while the model moves [s].
+        max_steps : int
+            The most internal steps of one advance.
+
+        Raises
+        ------
+        InputError
+            A parameter or input that is not a finite number, or a non-positive setting (naming it).
+        """
+        p = np.ascontiguousarray(params, dtype=np.float64)
+        u = np.ascontiguousarray(inputs, dtype=np.float64)
+        L = self.library.layout
+        if p.shape != (L["np"],) or u.shape != (L["nu"],):
+            raise ValueError(f"expected {L['np']} parameters and {L['nu']} inputs, got {p.shape} and {u.shape}")
+        status = self._lib.pam_engine_session_reset(self._handle, p.ctypes.data, u.ctypes.data, float(rtol),
+                                                    float(max_step_s), int(max_steps))
+        self._check(status, "engine session reset")
+        self.read()
+
+    def advance(self, inputs: Sequence[float], t_end_s: float) -> None:
+        """Hold ``inputs`` from the session's time to ``t_end_s`` [s] and integrate there.
+
+        Raises
+        ------
+        InputError
+            An input that is not a finite number, or ``t_end_s`` not after the session's time: nothing
+            changes.
+        SolverFailure
+            The integrator failed; the session must be reset before it advances again.
+        """
+        self._u[:] = inputs
+        self._check(self._lib.pam_engine_session_advance(self._handle, self._u_at, float(t_end_s)), "engine session")
+        self.read()
+
+    def step(self, inputs: np.ndarray, t_end_s: float) -> None:
+        """:meth:`advance` and then :meth:`read` in one library call, the cheapest way to step.
+
+        ``inputs`` must be a C-contiguous float64 array of the model's inputs; the result is in
+        :attr:`states` and :attr:`outputs`.
+        """
+        status = self._step(self._handle, inputs.ctypes.data, t_end_s, self._x_at, self._y_at)
+        if status:
+            self._check(status, "engine session")
+
+    def read(self) -> int:
+        """Fill :attr:`states` and :attr:`outputs`; returns the mode's value."""
+        return int(self._lib.pam_engine_session_read(self._handle, self._x_at, self._y_at, self._info_at))
+
+    @property
+    def time_s(self) -> float:
+        """The session's time [s] (as of the last :meth:`read`, which every method but :meth:`step` does)."""
+        return float(self._info[0])
+
+    @property
+    def mode(self) -> int:
+        """The mode's value (``library.names["modes"]``), as of the last :meth:`read`."""
+        return int(self._info[1])
+
+    @property
+    def stats(self) -> dict:
+        """Right-hand-side evaluations, accepted steps and events since the reset, as of the last :meth:`read`."""
+        return {"rhs_evaluations": int(self._info[2]), "steps": int(self._info[3]), "events": int(self._info[4])}
+
+    def extremes(self) -> tuple[np.ndarray, np.ndarray]:
+        """Each output's largest and smallest value since the start, over every step end and event."""
+        out = np.empty(2 * self.library.layout["ny"])
+        self._lib.pam_engine_session_extremes(self._handle, out.ctypes.data)
+        return out[:len(out) // 2], out[len(out) // 2:]
 
 
 _LOADED: dict = {}
