@@ -21,7 +21,7 @@ EXPECTED_LAYERS = [
     "__main__",
     "cli",
     "api",
-    "sweep | identification | control | atlas | export",
+    "sweep | identification | control | atlas | export | envs",
     "backends",
     "native",
     "fmu",
