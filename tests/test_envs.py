@@ -172,6 +172,10 @@ def test_gymnasium_make_by_module_prefix_and_kwargs():
     assert env.unwrapped.scenario.spec["load"] == {"weight_N": 12.74}
     obs, info = env.reset(seed=0, options={"reference_m": 0.03})
     assert obs[3] == 0.03 and info == {"time_s": 0.0}
+    lo, hi = env.unwrapped.reachable_range_m
+    for reference in (lo, hi):  # beyond the range references are drawn from, inside the observation space
+        obs, _ = env.reset(options={"reference_m": reference})
+        assert obs[3] == reference and obs in env.observation_space
     obs, _, _, _, info = env.step(np.array([1.0]))
     assert info == {"time_s": 0.02} and obs[2] > 0.0
 

@@ -184,8 +184,9 @@ class MusclePositionEnv(gymnasium.Env):
         drive = model.static_force.force_N(stops.x_low_m, p_bound) + abs(load.mass_kg * load.g_m_s2) \
             + abs(load.external_N(0.0))
         v_bound = SPEED_BOUND_FACTOR * math.sqrt(2.0 * drive * (stops.x_high_m - stops.x_low_m) / load.mass_kg)
-        self._low = np.array([stops.x_low_m, -v_bound, -p_atm, self.reference_range_m[0]])
-        self._high = np.array([stops.x_high_m, v_bound, p_bound, self.reference_range_m[1]])
+        # the reference: within the reachable range, where reset's option may set it
+        self._low = np.array([stops.x_low_m, -v_bound, -p_atm, x_lo])
+        self._high = np.array([stops.x_high_m, v_bound, p_bound, x_hi])
         self.observation_space = spaces.Box(self._low, self._high, dtype=np.float64)
         low = -1.0 if command == "valve" else 0.0  # Gymnasium's advice: [-1, 1] or [0, 1]
         self.action_space = spaces.Box(low, 1.0, shape=(1,), dtype=np.float64)
