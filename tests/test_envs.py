@@ -69,6 +69,7 @@ def test_default_plant_is_the_fig4_scenarios():
     # the same plant from the file
     from_file = MusclePositionEnv(SCENARIOS / "acra2012_fig4.toml")
     assert from_file.scenario.spec["model"] == env.scenario.spec["model"]
+    assert "measured" in fig4.spec and "measured" not in from_file.scenario.spec  # not the environment's test
     assert from_file.reachable_range_m == env.reachable_range_m
 
 

@@ -360,7 +360,8 @@ class MusclePositionEnv(gymnasium.Env):
 
     def _scenario_with(self, base: Scenario, times_s: list, values: list, n_steps: int) -> Scenario:
         spec = copy.deepcopy(dict(base.spec))
-        spec.pop("controller", None)
+        spec.pop("controller", None)  # the environment's agent is the controller
+        spec.pop("measured", None)  # a paper's measured test is not the environment's
         signal = {"kind": "steps", "times_s": times_s}
         if self.command == "valve":
             pressure = {"source": "valve", "supply_gauge_Pa": self.supply_gauge_Pa,
