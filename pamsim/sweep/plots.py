@@ -10,6 +10,7 @@ the result imports this module to write itself, and one direction is enough.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Mapping
 
 import numpy as np
@@ -40,37 +41,20 @@ def error_heatmap_figure(result: "SweepResult") -> Figure:
     fig = Figure(figsize=(13, 6))
     if not rows:
         return _empty(fig, "no measured data to compare with")
-    pressures = sorted({_grid_pressure(r) for r in rows})
-    weights = sorted({r["weight_N"] for r in rows})
+    grid = _TestGrid.of(rows)
     first = result.spec.friction_models[0]
     panels = [("equilibrium_error_m", "static equilibrium - measured"),
               ("error_m", f"simulated final ({first} friction) - measured")]
-    grids = []
-    for col, _ in panels:
-        g = np.full((len(pressures), len(weights)), np.nan)
-        for r in rows:
-            g[pressures.index(_grid_pressure(r)), weights.index(r["weight_N"])] = r[col] * 1e3
-        grids.append(g)
-    limit = max(float(np.nanmax(np.abs(g))) for g in grids) if any(np.isfinite(g).any() for g in grids) else 1.0
+    values = [grid.values_mm(col) for col, _ in panels]
+    limit = _colour_limit(values)
     norm = TwoSlopeNorm(vcenter=0.0, vmin=-limit, vmax=limit)
     # Fixed margins rather than a layout engine: its extra layout pass is a third of a figure's time.
     axes = fig.subplots(1, 2, sharey=True, gridspec_kw=dict(left=0.05, right=0.9, top=0.89, bottom=0.09, wspace=0.05))
-    for ax, g, (col, title) in zip(axes, grids, panels):
+    for ax, g, (col, title) in zip(axes, values, panels):
         im = ax.imshow(g, origin="lower", cmap="RdBu_r", norm=norm, aspect="auto")
         ax.set_facecolor("0.85")  # missing tests show grey
-        for i, p in enumerate(pressures):
-            for j, w in enumerate(weights):
-                if not math.isfinite(g[i, j]):
-                    ax.text(j, i, "no data", ha="center", va="center", fontsize=7, color="0.4")
-                    continue
-                row = next(r for r in rows if _grid_pressure(r) == p and r["weight_N"] == w)
-                ax.text(j, i, f"{g[i, j]:+.1f}", ha="center", va="center", fontsize=8,
-                        color="white" if abs(g[i, j]) > 0.6 * limit else "black",
-                        fontweight="bold" if row["within_capability"] else "normal")
-                if not row["within_capability"]:
-                    ax.add_patch(_hatch(j, i))
-        ax.set_xticks(range(len(weights)), [f"{w:g}" for w in weights])
-        ax.set_yticks(range(len(pressures)), [f"{p:g}" for p in pressures])
+        grid.label_cells(ax, g, limit)
+        grid.set_ticks(ax)
         ax.set_xlabel("hanging weight [N]")
         ax.set_title(title, fontsize=10, y=1.0)
     axes[0].set_ylabel("pressure step [bar]")
@@ -79,6 +63,51 @@ def error_heatmap_figure(result: "SweepResult") -> Figure:
     fig.suptitle(f"{result.spec.name}: contraction error; hatched = beyond force capability "
                  f"(static equilibrium < {thr:g} mm), bold = within")
     return fig
+
+
+def _colour_limit(values: list[np.ndarray]) -> float:
+    """The largest absolute error of the panels, which both colour scales reach (1 where all are missing)."""
+    if any(np.isfinite(g).any() for g in values):
+        return max(float(np.nanmax(np.abs(g))) for g in values)
+    return 1.0
+
+
+@dataclass(frozen=True)
+class _TestGrid:
+    """The measured cases on the heatmap's pressure x load grid."""
+
+    rows: list[Mapping]
+    pressures: list[float]
+    weights: list[float]
+
+    @classmethod
+    def of(cls, rows: list[Mapping]) -> "_TestGrid":
+        return cls(rows, sorted({_grid_pressure(r) for r in rows}), sorted({r["weight_N"] for r in rows}))
+
+    def values_mm(self, col: str) -> np.ndarray:
+        """Column ``col`` of the rows [mm] on the grid, NaN where no test was measured."""
+        g = np.full((len(self.pressures), len(self.weights)), np.nan)
+        for r in self.rows:
+            g[self.pressures.index(_grid_pressure(r)), self.weights.index(r["weight_N"])] = r[col] * 1e3
+        return g
+
+    def label_cells(self, ax, g: np.ndarray, limit: float) -> None:
+        """Write each cell's error, bold within force capability, the cell hatched beyond it."""
+        for i, p in enumerate(self.pressures):
+            for j, w in enumerate(self.weights):
+                if not math.isfinite(g[i, j]):
+                    ax.text(j, i, "no data", ha="center", va="center", fontsize=7, color="0.4")
+                    continue
+                row = next(r for r in self.rows if _grid_pressure(r) == p and r["weight_N"] == w)
+                ax.text(j, i, f"{g[i, j]:+.1f}", ha="center", va="center", fontsize=8,
+                        color="white" if abs(g[i, j]) > 0.6 * limit else "black",
+                        fontweight="bold" if row["within_capability"] else "normal")
+                if not row["within_capability"]:
+                    ax.add_patch(_hatch(j, i))
+
+    def set_ticks(self, ax) -> None:
+        ax.set_xticks(range(len(self.weights)), [f"{w:g}" for w in self.weights])
+        ax.set_yticks(range(len(self.pressures)), [f"{p:g}" for p in self.pressures])
 
 
 def _hatch(j: int, i: int):

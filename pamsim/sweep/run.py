@@ -27,7 +27,7 @@ from ..static import friction_band_m, static_report
 from .figures import SWEEP_FIGURES, UNCERTAINTY_FIGURES
 from .gc_control import frozen_gc, paused_gc
 from .spec import SweepCase, SweepSpec, load_sweep
-from .uncertainty import UncertaintyResult
+from .uncertainty import Samples, UncertaintyResult
 
 SETTLED_FRACTION = 0.05
 """The pressure counts as settled once it stays within 5 % of its step of its final value; the
@@ -301,53 +301,93 @@ def run_sweep(spec: SweepSpec | str | Path, executor: Executor | None = None, pr
         spec = load_sweep(spec)
     backend = backend or spec.backend
     check_backend(spec, backend)
-    tasks = [_task("case", (i, f), spec.case_scenario(c, f), backend=backend) for i, c in enumerate(spec.cases)
-             for f in spec.friction_models]
-    if spec.frequency is not None:
-        tasks += [_task("frequency", (w, f), spec.frequency_scenario(w, f), backend=backend)
-                  for w in spec.frequency.weights_N for f in spec.friction_models]
-    tasks += [_task("response", (s.name, f), s.with_changes({"model": {"friction": f}}), True, backend)
-              for s in spec.time_responses for f in spec.friction_models]
+    tasks = _study_tasks(spec, backend)
     start = time.perf_counter()
     samples = spec.uncertainty.draw() if spec.uncertainty is not None else None
     if samples is not None:
-        # Thousands of small objects that live until the end: no garbage for the collector to find.
-        with paused_gc():
-            for f in spec.friction_models:
-                base = spec.base.with_changes({"model": {"friction": f}})
-                tasks += [_task("sample", (k, f), base, backend=backend,
-                                parameters=tuple(zip(samples.names, map(float, values))))
-                          for k, values in enumerate(samples.values)]
-    if chunk_size is not None and (isinstance(chunk_size, bool) or not isinstance(chunk_size, int) or chunk_size < 1):
-        raise InputError(f"chunk_size = {chunk_size!r}: must be a positive integer")
+        tasks += _sample_tasks(spec, samples, backend)
+    _check_chunk_size(chunk_size)
     from tqdm import tqdm
 
     with tqdm(total=len(tasks), unit="run", desc=spec.name, file=sys.stderr, disable=not progress,
               dynamic_ncols=True) as bar:
         outputs = _execute(tasks, executor, bar, chunk_size or auto_chunk_size(len(tasks), backend))
-    wall = time.perf_counter() - start
+    return _result(spec, tasks, outputs, samples, time.perf_counter() - start)
+
+
+def _study_tasks(spec: SweepSpec, backend: str) -> list[_Task]:
+    """The runs of the cases, the frequency study and the time responses, under every friction model."""
+    models = spec.friction_models
+    tasks = [_task("case", (i, f), spec.case_scenario(c, f), backend=backend) for i, c in enumerate(spec.cases)
+             for f in models]
+    if spec.frequency is not None:
+        tasks += [_task("frequency", (w, f), spec.frequency_scenario(w, f), backend=backend)
+                  for w in spec.frequency.weights_N for f in models]
+    tasks += [_task("response", (s.name, f), s.with_changes({"model": {"friction": f}}), True, backend)
+              for s in spec.time_responses for f in models]
+    return tasks
+
+
+def _sample_tasks(spec: SweepSpec, samples: Samples, backend: str) -> list[_Task]:
+    """One run per uncertainty sample and friction model, each carrying its parameter values."""
+    tasks = []
+    # Thousands of small objects that live until the end: no garbage for the collector to find.
+    with paused_gc():
+        for f in spec.friction_models:
+            base = spec.base.with_changes({"model": {"friction": f}})
+            tasks += [_task("sample", (k, f), base, backend=backend,
+                            parameters=tuple(zip(samples.names, map(float, values))))
+                      for k, values in enumerate(samples.values)]
+    return tasks
+
+
+def _result(spec: SweepSpec, tasks: list[_Task], outputs: list[dict], samples: Samples | None,
+            wall_time_s: float) -> SweepResult:
+    """The sweep's tables from its runs' outputs (``outputs[k]`` is the output of ``tasks[k]``)."""
     by_key = {(t.kind, t.key): o for t, o in zip(tasks, outputs)}
-    failures = [f"{t.scenario.name}{f' sample {t.key[0]}' if t.kind == 'sample' else ''}: {o['error']}"
-                for t, o in zip(tasks, outputs) if o["error"]]
     case_scenarios = {t.key: t.scenario for t in tasks if t.kind == "case"}
     rows = [_case_row(spec, i, case, by_key, case_scenarios) for i, case in enumerate(spec.cases)]
-    freq_rows = []
-    if spec.frequency is not None:
-        for w in spec.frequency.weights_N:
-            row = {"weight_N": w, "pressure_bar": spec.frequency.pressure_bar}
-            for f in spec.friction_models:
-                o = by_key[("frequency", (w, f))]
-                for k in ("frequency_Hz", "damping_ratio", "n_half_cycles", "half_period_asymmetry",
-                          "final_contraction_m", "peak_contraction_m", "at_rest"):
-                    row[f"{f}_{k}"] = o.get(k, math.nan)
-            freq_rows.append(row)
     responses = {s.name: {f: by_key[("response", (s.name, f))] for f in spec.friction_models}
                  for s in spec.time_responses}
-    study = None
-    if samples is not None:
-        study = UncertaintyResult(spec.uncertainty, samples, {
-            f: [by_key[("sample", (k, f))] for k in range(len(samples.values))] for f in spec.friction_models})
-    return SweepResult(spec, rows, freq_rows, responses, wall, failures, study)
+    return SweepResult(spec, rows, _frequency_rows(spec, by_key), responses, wall_time_s, _failures(tasks, outputs),
+                       _uncertainty_result(spec, samples, by_key))
+
+
+def _check_chunk_size(chunk_size: Any) -> None:
+    if chunk_size is not None and (isinstance(chunk_size, bool) or not isinstance(chunk_size, int) or chunk_size < 1):
+        raise InputError(f"chunk_size = {chunk_size!r}: must be a positive integer")
+
+
+def _failures(tasks: list[_Task], outputs: list[dict]) -> list[str]:
+    """The message of every failed run, naming its scenario (and its sample)."""
+    return [f"{t.scenario.name}{f' sample {t.key[0]}' if t.kind == 'sample' else ''}: {o['error']}"
+            for t, o in zip(tasks, outputs) if o["error"]]
+
+
+_FREQUENCY_COLUMNS = ("frequency_Hz", "damping_ratio", "n_half_cycles", "half_period_asymmetry",
+                      "final_contraction_m", "peak_contraction_m", "at_rest")
+
+
+def _frequency_rows(spec: SweepSpec, by_key: Mapping) -> list[dict]:
+    """One row per load of the frequency study, with each friction model's columns prefixed by its name."""
+    if spec.frequency is None:
+        return []
+    rows = []
+    for w in spec.frequency.weights_N:
+        row = {"weight_N": w, "pressure_bar": spec.frequency.pressure_bar}
+        for f in spec.friction_models:
+            o = by_key[("frequency", (w, f))]
+            row.update({f"{f}_{k}": o.get(k, math.nan) for k in _FREQUENCY_COLUMNS})
+        rows.append(row)
+    return rows
+
+
+def _uncertainty_result(spec: SweepSpec, samples: Samples | None, by_key: Mapping) -> UncertaintyResult | None:
+    """The uncertainty study's outputs, sample by sample for each friction model (None without a study)."""
+    if samples is None:
+        return None
+    return UncertaintyResult(spec.uncertainty, samples, {
+        f: [by_key[("sample", (k, f))] for k in range(len(samples.values))] for f in spec.friction_models})
 
 
 def check_backend(spec: SweepSpec, backend: str) -> None:
@@ -407,7 +447,7 @@ def _case_row(spec: SweepSpec, i: int, case: SweepCase, by_key: Mapping, scenari
     """One summary row: inputs, static analysis, measurement, and each friction model's run.
 
     ``scenarios`` maps ``(i, friction)`` to the case scenarios the runs used (built once, in
-    :func:`run_sweep`), so the row's static analysis describes the very model that ran.
+    :func:`_study_tasks`), so the row's static analysis describes the very model that ran.
     """
     params = spec.base.parameters
     models = {f: scenarios[(i, f)].build_model() for f in spec.friction_models}

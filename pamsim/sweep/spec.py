@@ -120,13 +120,7 @@ def sweep_from_dict(spec: Mapping[str, Any], base_dir: str | Path = ".", origin:
     base_name = check.required(spec, "base_scenario", str)
     base = load_scenario(_resolve(base_dir, base_name))
     refuse_added(base, "a sweep's static analysis", SweepError)
-    frictions = tuple(check.typed("friction_models", spec.get("friction_models", [base.spec["model"]["friction"]]),
-                                  list))
-    if not frictions:
-        raise SweepError(f"{origin}: friction_models = []: name at least one friction model")
-    for f in frictions:
-        if not isinstance(f, str) or f not in FRICTION_MODELS:
-            check.fail("friction_models", f, "unknown friction model", FRICTION_MODELS)
+    frictions = _friction_models(check, spec.get("friction_models", [base.spec["model"]["friction"]]))
     threshold_mm = check.number("capability_min_equilibrium_mm", spec.get("capability_min_equilibrium_mm", 5.0))
     measured = _read_measured(check, base_dir, spec["measured"]) if "measured" in spec else None
     uncertainty = parse_uncertainty(check, spec["uncertainty"], base) if "uncertainty" in spec else None
@@ -134,29 +128,45 @@ def sweep_from_dict(spec: Mapping[str, Any], base_dir: str | Path = ".", origin:
     no_cases = uncertainty is not None and not any(k in spec for k in ("cases", "axes", "case"))
     cases = () if no_cases else _cases(check, spec, measured)
     frequency = _frequency(check, spec["frequency"]) if "frequency" in spec else None
-    responses = ()
-    if "time_responses" in spec:
-        table = spec["time_responses"]
-        check.check_keys("[time_responses]", "time_responses.", table, {"scenarios"})
-        names = check.required(table, "scenarios", list, "time_responses.")
-        responses = tuple(load_scenario(_resolve(base_dir, check.typed("time_responses.scenarios", n, str)))
-                          for n in names)
+    responses = _time_responses(check, base_dir, spec["time_responses"]) if "time_responses" in spec else ()
     result = SweepSpec(check.typed("name", spec.get("name", default_name), str),
                        check.typed("description", spec.get("description", ""), str), origin, base, cases,
                        frictions, threshold_mm * 1e-3, frequency, responses,
                        _backend(check, spec.get("backend", "python")), uncertainty)
-    # Build every scenario once so a bad value (a pressure above the rating...) fails before the run.
+    _build_every_scenario(result)
+    return result
+
+
+def _friction_models(check: TableChecker, names: Any) -> tuple[str, ...]:
+    frictions = tuple(check.typed("friction_models", names, list))
+    if not frictions:
+        raise SweepError(f"{check.origin}: friction_models = []: name at least one friction model")
+    for f in frictions:
+        if not isinstance(f, str) or f not in FRICTION_MODELS:
+            check.fail("friction_models", f, "unknown friction model", FRICTION_MODELS)
+    return frictions
+
+
+def _time_responses(check: TableChecker, base_dir: Path, table: Any) -> tuple[Scenario, ...]:
+    """The scenarios ``[time_responses]`` names, read and validated."""
+    check.check_keys("[time_responses]", "time_responses.", table, {"scenarios"})
+    names = check.required(table, "scenarios", list, "time_responses.")
+    return tuple(load_scenario(_resolve(base_dir, check.typed("time_responses.scenarios", n, str))) for n in names)
+
+
+def _build_every_scenario(spec: SweepSpec) -> None:
+    """Build every case's scenario once, so that a bad value (a pressure above the rating...) fails before the run."""
+    first = spec.friction_models[0]
     try:
-        for case in cases:
-            result.case_scenario(case, frictions[0])
-        if frequency is not None:
-            for w in frequency.weights_N:
-                result.frequency_scenario(w, frictions[0])
+        for case in spec.cases:
+            spec.case_scenario(case, first)
+        if spec.frequency is not None:
+            for w in spec.frequency.weights_N:
+                spec.frequency_scenario(w, first)
     except SweepError:
         raise
     except InputError as exc:  # a ScenarioError names the base file; say which sweep produced the value
-        raise SweepError(f"{origin}: a case does not make a valid scenario: {exc}") from None
-    return result
+        raise SweepError(f"{spec.origin}: a case does not make a valid scenario: {exc}") from None
 
 
 def _backend(check: TableChecker, name: Any) -> str:
@@ -168,44 +178,59 @@ def _backend(check: TableChecker, name: Any) -> str:
 
 
 def _cases(check: TableChecker, spec: Mapping[str, Any], measured: list[dict] | None) -> tuple[SweepCase, ...]:
+    """The cases of the one table that lists them: ``[cases]``, ``[axes]`` or ``[[case]]``."""
     given = [k for k in ("cases", "axes", "case") if k in spec]
     if len(given) != 1:
         raise SweepError(f"{check.origin}: give exactly one of [cases] from_measured = true, [axes] or [[case]] "
                          f"(found {', '.join(given) or 'none'})")
     if "cases" in spec:
-        table = spec["cases"]
-        check.check_keys("[cases]", "cases.", table, {"from_measured"})
-        if table.get("from_measured") is not True:
-            check.fail("cases.from_measured", table.get("from_measured"), "must be true (or use [axes] / [[case]])")
-        if measured is None:
-            raise SweepError(f"{check.origin}: cases.from_measured = true needs a [measured] file")
-        return tuple(_named(row["weight_N"], row["pressure_stable_bar"], measured) for row in measured)
-    if "axes" in spec:
-        axes = spec["axes"]
-        check.check_keys("[axes]", "axes.", axes, _AXES, what="axis")
-        values = {}
-        for axis in sorted(_AXES):
-            if axis not in axes:
-                raise SweepError(f"{check.origin}: missing axis axes.{axis} "
-                                 "(the sweep varies both pressure_bar and weight_N)")
-            values[axis] = check.number_list(f"axes.{axis}", axes[axis])
-        pairs = [(w, p) for p in values["pressure_bar"] for w in values["weight_N"]]
-    else:
-        rows = spec["case"]
-        if not isinstance(rows, list) or not rows:
-            check.fail("case", rows, "must be a non-empty array of tables [[case]]")
-        pairs = []
-        for i, row in enumerate(rows):
-            where = f"case[{i}]."
-            check.check_keys(f"[[case]] number {i + 1}", where, row, _AXES)
-            pairs.append((check.positive(where + "weight_N", check.required(row, "weight_N", float, where)),
-                          check.number(where + "pressure_bar", check.required(row, "pressure_bar", float, where))))
+        return _cases_from_measured(check, spec["cases"], measured)
+    pairs = _axes_pairs(check, spec["axes"]) if "axes" in spec else _listed_pairs(check, spec["case"])
+    _check_loads_and_pressures(check, pairs)
+    return tuple(_named(w, p, measured or []) for w, p in pairs)
+
+
+def _check_loads_and_pressures(check: TableChecker, pairs: list[tuple[float, float]]) -> None:
     for w, p in pairs:
         if w <= 0:
             check.fail("weight_N", w, "must be positive")
         if p < 0:
             check.fail("pressure_bar", p, "must not be negative")
-    return tuple(_named(w, p, measured or []) for w, p in pairs)
+
+
+def _cases_from_measured(check: TableChecker, table: Any, measured: list[dict] | None) -> tuple[SweepCase, ...]:
+    """``[cases] from_measured = true``: one case per measured row, at its load and stable pressure."""
+    check.check_keys("[cases]", "cases.", table, {"from_measured"})
+    if table.get("from_measured") is not True:
+        check.fail("cases.from_measured", table.get("from_measured"), "must be true (or use [axes] / [[case]])")
+    if measured is None:
+        raise SweepError(f"{check.origin}: cases.from_measured = true needs a [measured] file")
+    return tuple(_named(row["weight_N"], row["pressure_stable_bar"], measured) for row in measured)
+
+
+def _axes_pairs(check: TableChecker, axes: Any) -> list[tuple[float, float]]:
+    """``[axes]``: every (weight, pressure) of the two axes, pressure by pressure."""
+    check.check_keys("[axes]", "axes.", axes, _AXES, what="axis")
+    values = {}
+    for axis in sorted(_AXES):
+        if axis not in axes:
+            raise SweepError(f"{check.origin}: missing axis axes.{axis} "
+                             "(the sweep varies both pressure_bar and weight_N)")
+        values[axis] = check.number_list(f"axes.{axis}", axes[axis])
+    return [(w, p) for p in values["pressure_bar"] for w in values["weight_N"]]
+
+
+def _listed_pairs(check: TableChecker, rows: Any) -> list[tuple[float, float]]:
+    """``[[case]]``: the (weight, pressure) of each table."""
+    if not isinstance(rows, list) or not rows:
+        check.fail("case", rows, "must be a non-empty array of tables [[case]]")
+    pairs = []
+    for i, row in enumerate(rows):
+        where = f"case[{i}]."
+        check.check_keys(f"[[case]] number {i + 1}", where, row, _AXES)
+        pairs.append((check.positive(where + "weight_N", check.required(row, "weight_N", float, where)),
+                      check.number(where + "pressure_bar", check.required(row, "pressure_bar", float, where))))
+    return pairs
 
 
 def _named(weight_N: float, pressure_bar: float, measured: list[dict]) -> SweepCase:
@@ -240,13 +265,7 @@ def _read_measured(check: TableChecker, base_dir: Path, table: Any) -> list[dict
     if not path.is_file():
         check.fail("measured.file", name, f"no such file ({path})")
     cols = {k: check.typed(f"measured.{k}", table.get(k, d), str) for k, d in _MEASURED_DEFAULTS.items()}
-    try:
-        lines = [ln for ln in path.read_text().splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
-    except (OSError, UnicodeDecodeError) as exc:
-        check.fail("measured.file", name, f"cannot read: {exc}")
-    if not lines:
-        check.fail("measured.file", name, "has no header row")
-    reader = csv.DictReader(lines)
+    reader = csv.DictReader(_data_lines(check, name, path))
     header = reader.fieldnames or []
     required = [cols["weight_column"], cols["pressure_column"], cols["contraction_column"]]
     missing = [c for c in required if c not in header]
@@ -254,23 +273,38 @@ def _read_measured(check: TableChecker, base_dir: Path, table: Any) -> list[dict
         raise SweepError(f"{check.origin}: measured.file = {name!r}: columns {', '.join(missing)} not found "
                          f"(its columns: {', '.join(header)}; set measured.weight_column, pressure_column, "
                          "contraction_column)")
-    rows = []
-    for line_no, raw in enumerate(reader, start=2):
-        try:
-            row = {"weight_N": float(raw[cols["weight_column"]]),
-                   "pressure_stable_bar": float(raw[cols["pressure_column"]]),
-                   "contraction_mm": float(raw[cols["contraction_column"]])}
-            if cols["nominal_pressure_column"] in header:
-                row["pressure_step_bar"] = float(raw[cols["nominal_pressure_column"]])
-        except (TypeError, ValueError):
-            raise SweepError(f"{check.origin}: measured.file = {name!r}: data row {line_no - 1} is not numeric: "
-                             f"{dict(raw)}") from None
-        if not all(math.isfinite(v) for v in row.values()):
-            raise SweepError(f"{check.origin}: measured.file = {name!r}: data row {line_no - 1} has a non-finite value")
-        rows.append(row)
+    where = f"{check.origin}: measured.file = {name!r}: data row"
+    rows = [_measured_row(raw, cols, header, f"{where} {k}") for k, raw in enumerate(reader, start=1)]
     if not rows:
         check.fail("measured.file", name, "has no data rows")
     return rows
+
+
+def _data_lines(check: TableChecker, name: str, path: Path) -> list[str]:
+    """The CSV's header and data lines, without blank lines and ``#`` comments."""
+    try:
+        lines = [ln for ln in path.read_text().splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
+    except (OSError, UnicodeDecodeError) as exc:
+        check.fail("measured.file", name, f"cannot read: {exc}")
+    if not lines:
+        check.fail("measured.file", name, "has no header row")
+    return lines
+
+
+def _measured_row(raw: Mapping[str, str], cols: Mapping[str, str], header: list[str], where: str) -> dict:
+    """One data row of the measured CSV as finite numbers under the sweep's own names; ``where`` names the
+    row in an error."""
+    try:
+        row = {"weight_N": float(raw[cols["weight_column"]]),
+               "pressure_stable_bar": float(raw[cols["pressure_column"]]),
+               "contraction_mm": float(raw[cols["contraction_column"]])}
+        if cols["nominal_pressure_column"] in header:
+            row["pressure_step_bar"] = float(raw[cols["nominal_pressure_column"]])
+    except (TypeError, ValueError):
+        raise SweepError(f"{where} is not numeric: {dict(raw)}") from None
+    if not all(math.isfinite(v) for v in row.values()):
+        raise SweepError(f"{where} has a non-finite value")
+    return row
 
 
 def _with_case(base: Scenario, weight_N: float, pressure_bar: float, friction: str, name: str,
