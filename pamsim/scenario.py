@@ -92,75 +92,23 @@ class Scenario:
     def _from_own_dict(cls, spec: dict, name: str | None, base_dir: str | Path, origin: str) -> "Scenario":
         """:meth:`from_dict` of a dict nobody else holds (it is completed in place and kept)."""
         v = _Validator(origin, Path(base_dir))
-        v.check_table("", spec)
-        for section in ("model", "load", "pressure", "simulation", "solver", "measured"):
-            if section in spec:
-                v.check_table(section, spec[section])
-        if "measured" in spec:
-            measured = v.required(spec["measured"], "steady_state", prefix="measured.")
-            if measured not in STEADY_STATE_SETS:
-                v.fail("measured.steady_state", measured, "unknown measured steady states", choices=STEADY_STATE_SETS)
-        for section in ("load", "pressure", "simulation"):
-            if section not in spec:
-                raise ScenarioError(f"{origin}: missing section [{section}]")
+        _check_sections(v, spec)
         model = spec.setdefault("model", {})
         muscle = _muscle(v, model)
-        for key, registry, default in (("friction", FRICTION_MODELS, "load_dependent"),
-                                       ("damping", DAMPING_MODELS, "paper"),
-                                       ("friction_negative_level", NEGATIVE_LEVEL_CHOICES, "clamp"),
-                                       ("static_force_negative", NEGATIVE_FORCE_CHOICES, "clip")):
-            choice = model.setdefault(key, default)
-            if choice not in registry:
-                v.fail(f"model.{key}", choice, "unknown choice", choices=registry)
+        _default_choices(v, model)
         params = with_overrides(dynamics_parameters(muscle.parameters), spec.get("parameters", {}), v.fail, _key,
                                 f"override in {origin}")
         applicable_model(model.setdefault("static_force", muscle.default_static_force),
                          model.get("static_force_variant"), muscle, model_inputs(muscle, params), v.fail, _key)
-        sim = spec["simulation"]
-        duration = v.positive("simulation.duration_s", v.required(sim, "duration_s", prefix="simulation."))
-        sample_rate = v.positive("simulation.sample_rate_Hz", sim.get("sample_rate_Hz", 1000.0))
-        x0 = v.number("simulation.initial_contraction_m", sim.get("initial_contraction_m", 0.0))
-        solver = spec.get("solver", {})
-        method = solver.get("method", "LSODA")
-        if method not in _METHODS:
-            v.fail("solver.method", method, "unknown method", choices=_METHODS)
-        rtol = v.number("solver.rtol", solver.get("rtol", 1e-6))
-        if not 1e-13 <= rtol <= 1e-2:
-            v.fail("solver.rtol", rtol, "must lie in [1e-13, 1e-2]")
-        max_events = solver.get("max_events", 20000)
-        if max_events < 1:
-            v.fail("solver.max_events", max_events, "must be at least 1")
-        max_step = v.positive("solver.max_step_s", solver.get("max_step_s", math.inf))
-        smallest_step = max(MIN_MAX_STEP_S, duration / MAX_STEPS)
-        if max_step < smallest_step:
-            v.fail("solver.max_step_s", max_step, f"must be at least {smallest_step:.3g} s (1 us, and no more than "
-                   f"{MAX_STEPS:.0e} steps over duration_s = {duration:g} s)")
-        opts = SolverOptions(method=method, rtol=rtol, sample_rate_Hz=sample_rate, max_events=int(max_events),
-                             max_step_s=max_step)
-        name = name or spec.get("name") or "scenario"
-        if any(bad in name for bad in ("/", "\\", "..", "\0")):
-            # The name is the stem of the output files: it must not lead out of the output folder.
-            v.fail("name", name, "must be a plain file name stem, without path separators or '..'")
+        duration, sample_rate, x0 = _simulation(v, spec["simulation"])
+        opts = _solver_options(v, spec.get("solver", {}), duration, sample_rate)
+        name = _checked_name(v, name or spec.get("name") or "scenario")
         scenario = cls(name, spec, params, duration, opts, Path(base_dir), origin, muscle)
         if duration * sample_rate > _MAX_SAMPLES:
             v.fail("simulation.sample_rate_Hz", sample_rate,
                    f"with duration_s = {duration:g} this asks for more than {_MAX_SAMPLES:.0e} output samples")
         scenario._check_load(v)
-        # Built once here, so a bad pressure section, trace file or external force fails now, not at run time.
-        ext = spec["load"].get("external_force")
-        object.__setattr__(scenario, "_source", scenario._build_source(v))
-        object.__setattr__(scenario, "_external_force",
-                           signal_from_table(v, "load.external_force", ext, "_N", 1.0, Path(base_dir)) if ext else None)
-        stops = EndStops.from_parameters(params)
-        if not stops.x_low_m <= x0 <= stops.x_high_m:
-            v.fail("simulation.initial_contraction_m", x0, f"must lie between the stops, 0 and {stops.x_high_m:.4f} m")
-        try:
-            object.__setattr__(scenario, "_static_force", scenario._build_static_force())
-        except ValueError as exc:  # an implicit model that cannot be tabulated over the muscle's range
-            v.fail("model.static_force", model["static_force"], str(exc))
-        object.__setattr__(scenario, "_added", added_components(v, spec.get("component", [])))
-        if scenario._added:
-            check_wiring(scenario, ScenarioError)
+        scenario._build_elements(v, x0)
         return scenario
 
     def with_changes(self, changes: Mapping[str, Mapping[str, Any]], name: str | None = None) -> "Scenario":
@@ -175,21 +123,25 @@ class Scenario:
         """
         spec = copy.deepcopy(dict(self.spec))
         for section, values in changes.items():
-            old = spec.get(section, {})
-            if section == "pressure" and "source" in values and values["source"] != old.get("source"):
-                old = {}
-            if section == "model" and ({"muscle", "parameter_set"} & set(values)):
-                old = {k: v for k, v in old.items() if k not in ("muscle", "parameter_set")}
-                if "static_force" not in values and old.get("static_force") == self.muscle.default_static_force:
-                    old.pop("static_force", None)
-                    old.pop("static_force_variant", None)
-            spec[section] = {**old, **copy.deepcopy(dict(values))}
-            for pair in (("weight_N", "mass_kg"), ("supply_gauge_bar", "supply_gauge_Pa")):
-                given = [k for k in pair if k in values]
-                for k in pair:
-                    if given and k not in given:
-                        spec[section].pop(k, None)
+            spec[section] = self._changed_section(section, spec.get(section, {}), values)
         return Scenario._from_own_dict(spec, name or self.name, self.base_dir, self.origin)
+
+    def _changed_section(self, section: str, old: dict, values: Mapping[str, Any]) -> dict:
+        """The table ``old`` of ``section`` with ``values`` merged in, less the keys they replace."""
+        if section == "pressure" and "source" in values and values["source"] != old.get("source"):
+            old = {}
+        if section == "model" and ({"muscle", "parameter_set"} & set(values)):
+            old = self._model_without_muscle(old, values)
+        return _without_alternatives({**old, **copy.deepcopy(dict(values))}, values)
+
+    def _model_without_muscle(self, model: dict, values: Mapping[str, Any]) -> dict:
+        """``[model]`` less its muscle, and less its static force if that is the old muscle's default and
+        ``values`` names none (the new muscle then takes its own default)."""
+        model = {k: v for k, v in model.items() if k not in ("muscle", "parameter_set")}
+        if "static_force" not in values and model.get("static_force") == self.muscle.default_static_force:
+            model.pop("static_force", None)
+            model.pop("static_force_variant", None)
+        return model
 
     # ------------------------------------------------------------ model build
     @property
@@ -217,56 +169,92 @@ class Scenario:
         if why:
             v.fail(f"load.{key}", value, f"the mass {self.mass_kg:g} kg {why} kg")
 
+    def _build_elements(self, v: "_Validator", x0: float) -> None:
+        """Build the pressure source, external force, static force and added components once, here, so that
+        a bad pressure section, trace file or external force fails now, not at run time."""
+        ext = self.spec["load"].get("external_force")
+        object.__setattr__(self, "_source", self._build_source(v))
+        object.__setattr__(self, "_external_force",
+                           signal_from_table(v, "load.external_force", ext, "_N", 1.0, self.base_dir) if ext else None)
+        stops = EndStops.from_parameters(self.parameters)
+        if not stops.x_low_m <= x0 <= stops.x_high_m:
+            v.fail("simulation.initial_contraction_m", x0, f"must lie between the stops, 0 and {stops.x_high_m:.4f} m")
+        try:
+            object.__setattr__(self, "_static_force", self._build_static_force())
+        except ValueError as exc:  # an implicit model that cannot be tabulated over the muscle's range
+            v.fail("model.static_force", self.spec["model"]["static_force"], str(exc))
+        object.__setattr__(self, "_added", added_components(v, self.spec.get("component", [])))
+        if self._added:
+            check_wiring(self, ScenarioError)
+
     def _build_source(self, v: "_Validator"):
         pr = self.spec["pressure"]
-        p = self.parameters
         source = v.required(pr, "source", prefix="pressure.")
         if not isinstance(source, str):
             v.fail("pressure.source", source, "must be a string", choices=("valve", "prescribed"))
-        rating = p["rated_pressure_gauge_Pa"]
         if source == "valve":
-            v.allowed("pressure", pr, {"source", "supply_gauge_bar", "supply_gauge_Pa", "valve_open_time_s",
-                                       "command", "initial_gauge_bar"})
-            if ("supply_gauge_bar" in pr) == ("supply_gauge_Pa" in pr):
-                raise ScenarioError(f"{self.origin}: [pressure] needs exactly one of supply_gauge_bar or supply_gauge_Pa")
-            key = "supply_gauge_bar" if "supply_gauge_bar" in pr else "supply_gauge_Pa"
-            supply = v.number(f"pressure.{key}", pr[key]) * (PA_PER_BAR if key.endswith("bar") else 1.0)
-            if supply < 0:
-                v.fail(f"pressure.{key}", pr[key], "must not be negative")
-            if supply > rating:
-                v.fail(f"pressure.{key}", pr[key], f"exceeds the muscle's rating of {rating / PA_PER_BAR:g} bar "
-                       f"(parameter rated_pressure_gauge_Pa: {self.parameters.entries['rated_pressure_gauge_Pa'].source})")
-            if "initial_gauge_bar" in pr:
-                p0 = v.number("pressure.initial_gauge_bar", pr["initial_gauge_bar"]) * PA_PER_BAR
-                if not 0.0 <= p0 <= rating:
-                    v.fail("pressure.initial_gauge_bar", pr["initial_gauge_bar"],
-                           f"must lie between 0 and the rating, {rating / PA_PER_BAR:g} bar")
-            if ("command" in pr) == ("valve_open_time_s" in pr):
-                raise ScenarioError(f"{self.origin}: [pressure] needs exactly one of valve_open_time_s or [pressure.command]")
-            if "command" in pr:
-                command = signal_from_table(v, "pressure.command", pr["command"], "", 1.0, self.base_dir)
-                lo, hi = signal_range(command)
-                if lo < -1 or hi > 1:
-                    v.fail("pressure.command", f"{lo:g}..{hi:g}", "valve command must stay within [-1, 1]")
-            else:
-                t_open = v.number("pressure.valve_open_time_s", pr["valve_open_time_s"])
-                if t_open < 0:
-                    v.fail("pressure.valve_open_time_s", t_open, "must not be negative")
-                command = Step(t_open, 0.0, 1.0)
-            return ValveChamberSource(ProportionalValve33(Iso6358Orifice.from_parameters(p)),
-                                      MuscleChamber.from_parameters(p), Constant(supply), command,
-                                      p["T_supply_K"], p["p_atm_Pa"])
+            return self._valve_source(v, pr)
         if source == "prescribed":
-            v.allowed("pressure", pr, {"source", "prescribed"})
-            sig = signal_from_table(v, "pressure.prescribed", v.required(pr, "prescribed", prefix="pressure."),
-                                    "_gauge_bar", PA_PER_BAR, self.base_dir, alt_suffix=("_gauge_Pa", 1.0))
-            lo, hi = signal_range(sig)
-            if hi > rating:
-                v.fail("pressure.prescribed", f"{hi / PA_PER_BAR:g} bar", f"exceeds the muscle's rating of {rating / PA_PER_BAR:g} bar")
-            if lo < -p["p_atm_Pa"]:
-                v.fail("pressure.prescribed", f"{lo / PA_PER_BAR:g} bar", "is below vacuum")
-            return PrescribedPressure(sig)
+            return self._prescribed_source(v, pr)
         v.fail("pressure.source", source, "unknown source", choices=("valve", "prescribed"))
+
+    def _valve_source(self, v: "_Validator", pr: Mapping[str, Any]) -> ValveChamberSource:
+        p = self.parameters
+        v.allowed("pressure", pr, {"source", "supply_gauge_bar", "supply_gauge_Pa", "valve_open_time_s",
+                                   "command", "initial_gauge_bar"})
+        supply = self._supply_gauge_Pa(v, pr)
+        if "initial_gauge_bar" in pr:
+            rating = p["rated_pressure_gauge_Pa"]
+            p0 = v.number("pressure.initial_gauge_bar", pr["initial_gauge_bar"]) * PA_PER_BAR
+            if not 0.0 <= p0 <= rating:
+                v.fail("pressure.initial_gauge_bar", pr["initial_gauge_bar"],
+                       f"must lie between 0 and the rating, {rating / PA_PER_BAR:g} bar")
+        command = self._valve_command(v, pr)
+        return ValveChamberSource(ProportionalValve33(Iso6358Orifice.from_parameters(p)),
+                                  MuscleChamber.from_parameters(p), Constant(supply), command,
+                                  p["T_supply_K"], p["p_atm_Pa"])
+
+    def _supply_gauge_Pa(self, v: "_Validator", pr: Mapping[str, Any]) -> float:
+        """The valve's supply pressure [Pa gauge], given in bar or in Pa, within the muscle's rating."""
+        if ("supply_gauge_bar" in pr) == ("supply_gauge_Pa" in pr):
+            raise ScenarioError(f"{self.origin}: [pressure] needs exactly one of supply_gauge_bar or supply_gauge_Pa")
+        key = "supply_gauge_bar" if "supply_gauge_bar" in pr else "supply_gauge_Pa"
+        supply = v.number(f"pressure.{key}", pr[key]) * (PA_PER_BAR if key.endswith("bar") else 1.0)
+        if supply < 0:
+            v.fail(f"pressure.{key}", pr[key], "must not be negative")
+        rating = self.parameters["rated_pressure_gauge_Pa"]
+        if supply > rating:
+            v.fail(f"pressure.{key}", pr[key], f"exceeds the muscle's rating of {rating / PA_PER_BAR:g} bar "
+                   f"(parameter rated_pressure_gauge_Pa: {self.parameters.entries['rated_pressure_gauge_Pa'].source})")
+        return supply
+
+    def _valve_command(self, v: "_Validator", pr: Mapping[str, Any]):
+        """The valve's command: a ``[pressure.command]`` signal within [-1, 1], or a full opening at
+        ``valve_open_time_s``."""
+        if ("command" in pr) == ("valve_open_time_s" in pr):
+            raise ScenarioError(f"{self.origin}: [pressure] needs exactly one of valve_open_time_s or [pressure.command]")
+        if "command" in pr:
+            command = signal_from_table(v, "pressure.command", pr["command"], "", 1.0, self.base_dir)
+            lo, hi = signal_range(command)
+            if lo < -1 or hi > 1:
+                v.fail("pressure.command", f"{lo:g}..{hi:g}", "valve command must stay within [-1, 1]")
+            return command
+        t_open = v.number("pressure.valve_open_time_s", pr["valve_open_time_s"])
+        if t_open < 0:
+            v.fail("pressure.valve_open_time_s", t_open, "must not be negative")
+        return Step(t_open, 0.0, 1.0)
+
+    def _prescribed_source(self, v: "_Validator", pr: Mapping[str, Any]) -> PrescribedPressure:
+        v.allowed("pressure", pr, {"source", "prescribed"})
+        sig = signal_from_table(v, "pressure.prescribed", v.required(pr, "prescribed", prefix="pressure."),
+                                "_gauge_bar", PA_PER_BAR, self.base_dir, alt_suffix=("_gauge_Pa", 1.0))
+        lo, hi = signal_range(sig)
+        rating = self.parameters["rated_pressure_gauge_Pa"]
+        if hi > rating:
+            v.fail("pressure.prescribed", f"{hi / PA_PER_BAR:g} bar", f"exceeds the muscle's rating of {rating / PA_PER_BAR:g} bar")
+        if lo < -self.parameters["p_atm_Pa"]:
+            v.fail("pressure.prescribed", f"{lo / PA_PER_BAR:g} bar", "is below vacuum")
+        return PrescribedPressure(sig)
 
     def static_model(self):
         """The library model the scenario names, built for its muscle, raw (unclipped, untabulated)."""
@@ -362,12 +350,94 @@ def _muscle(v: "_Validator", model: dict) -> Muscle:
     return muscle
 
 
+_ALTERNATIVES = (("weight_N", "mass_kg"), ("supply_gauge_bar", "supply_gauge_Pa"))
+"""Pairs of keys of which a table gives one."""
+
+
+def _without_alternatives(table: dict, values: Mapping[str, Any]) -> dict:
+    """``table`` less the other key of each pair of :data:`_ALTERNATIVES` that ``values`` names one of."""
+    for pair in _ALTERNATIVES:
+        if any(k in values for k in pair):
+            for k in pair:
+                if k not in values:
+                    table.pop(k, None)
+    return table
+
+
+def _default_choices(v: "_Validator", model: dict) -> None:
+    """Fill in the element choices ``[model]`` leaves out, and refuse an unknown one."""
+    for key, registry, default in (("friction", FRICTION_MODELS, "load_dependent"),
+                                   ("damping", DAMPING_MODELS, "paper"),
+                                   ("friction_negative_level", NEGATIVE_LEVEL_CHOICES, "clamp"),
+                                   ("static_force_negative", NEGATIVE_FORCE_CHOICES, "clip")):
+        choice = model.setdefault(key, default)
+        if choice not in registry:
+            v.fail(f"model.{key}", choice, "unknown choice", choices=registry)
+
+
 def _key(kind: str, name: str) -> str:
     return {"parameter": f"parameters.{name}", "model": "model.static_force",
             "variant": "model.static_force_variant"}[kind]
 
 
+# ---------------------------------------------------------------- simulation and solver sections
+def _simulation(v: "_Validator", sim: dict) -> tuple[float, float, float]:
+    """``[simulation]``'s duration [s], output rate [Hz] and initial contraction [m] (checked against the
+    stops once the muscle's end stops are built)."""
+    duration = v.positive("simulation.duration_s", v.required(sim, "duration_s", prefix="simulation."))
+    sample_rate = v.positive("simulation.sample_rate_Hz", sim.get("sample_rate_Hz", 1000.0))
+    x0 = v.number("simulation.initial_contraction_m", sim.get("initial_contraction_m", 0.0))
+    return duration, sample_rate, x0
+
+
+def _solver_options(v: "_Validator", solver: dict, duration: float, sample_rate: float) -> SolverOptions:
+    """``[solver]`` with its defaults, each value checked."""
+    method = solver.get("method", "LSODA")
+    if method not in _METHODS:
+        v.fail("solver.method", method, "unknown method", choices=_METHODS)
+    rtol = v.number("solver.rtol", solver.get("rtol", 1e-6))
+    if not 1e-13 <= rtol <= 1e-2:
+        v.fail("solver.rtol", rtol, "must lie in [1e-13, 1e-2]")
+    max_events = solver.get("max_events", 20000)
+    if max_events < 1:
+        v.fail("solver.max_events", max_events, "must be at least 1")
+    max_step = v.positive("solver.max_step_s", solver.get("max_step_s", math.inf))
+    smallest_step = max(MIN_MAX_STEP_S, duration / MAX_STEPS)
+    if max_step < smallest_step:
+        v.fail("solver.max_step_s", max_step, f"must be at least {smallest_step:.3g} s (1 us, and no more than "
+               f"{MAX_STEPS:.0e} steps over duration_s = {duration:g} s)")
+    return SolverOptions(method=method, rtol=rtol, sample_rate_Hz=sample_rate, max_events=int(max_events),
+                         max_step_s=max_step)
+
+
+def _checked_name(v: "_Validator", name: str) -> str:
+    if any(bad in name for bad in ("/", "\\", "..", "\0")):
+        # The name is the stem of the output files: it must not lead out of the output folder.
+        v.fail("name", name, "must be a plain file name stem, without path separators or '..'")
+    return name
+
+
 # ---------------------------------------------------------------- validation
+def _check_sections(v: "_Validator", spec: dict) -> None:
+    """Every table's keys and types, and the sections a scenario cannot do without."""
+    v.check_table("", spec)
+    for section in ("model", "load", "pressure", "simulation", "solver", "measured"):
+        if section in spec:
+            v.check_table(section, spec[section])
+    if "measured" in spec:
+        _check_measured(v, spec["measured"])
+    for section in ("load", "pressure", "simulation"):
+        if section not in spec:
+            raise ScenarioError(f"{v.origin}: missing section [{section}]")
+
+
+def _check_measured(v: "_Validator", table: dict) -> None:
+    """``[measured] steady_state``: a set of measured steady states that pamsim ships."""
+    measured = v.required(table, "steady_state", prefix="measured.")
+    if measured not in STEADY_STATE_SETS:
+        v.fail("measured.steady_state", measured, "unknown measured steady states", choices=STEADY_STATE_SETS)
+
+
 class _Validator(TableChecker):
     """The scenario file's checks; ``error`` (a :class:`ScenarioError`) also serves helpers such as
     :mod:`pamsim.signal_tables`.  Its numbers say what type they must be, and ``positive`` takes inf."""
