@@ -30,6 +30,7 @@ import numpy as np
 from scipy.optimize import differential_evolution, least_squares
 
 from ..errors import InputError
+from ..parameters import ParameterSet
 from ..scenario import Scenario
 from .choices import DYNAMIC_BACKENDS, DYNAMIC_DEFAULT_FREE, FD_RELATIVE_STEP
 from .columns import TraceData
@@ -227,30 +228,9 @@ def make_problem(scenario: Scenario, traces: Sequence[TraceData], free: Sequence
         raise InputError("fit dynamic: give at least one trace")
     free = tuple(free) if free else DYNAMIC_DEFAULT_FREE
     params = scenario.parameters
-    for n in free:
-        if n not in params:
-            raise InputError(f"--free: {n!r} is not a parameter of the scenario's parameter set {params.name!r}")
-    if len(set(free)) != len(free):
-        raise InputError(f"--free = {','.join(free)}: a name appears twice")
-    if loads_N is not None and len(loads_N) != len(traces):
-        raise InputError(f"--load-N: {len(loads_N)} values for {len(traces)} traces")
-    loads = []
-    for i, tr in enumerate(traces):
-        given = loads_N[i] if loads_N is not None else None
-        w = given if given is not None else tr.weight_N
-        if w is None:
-            w = scenario.mass_kg * params["g_m_s2"]
-        if not w > 0:
-            raise InputError(f"--load-N = {w!r}: must be positive")
-        loads.append(float(w))
-    windows = []
-    for tr in traces:
-        t0, t1 = window_s if window_s is not None else (tr.t_s[0], tr.t_s[-1])
-        mask = tr.window(t0, t1)
-        if mask.sum() < len(free) + 1:
-            raise InputError(f"--window = {t0:g}:{t1:g}: only {int(mask.sum())} samples of {tr.origin} inside "
-                             f"(trace spans {tr.t_s[0]:g}..{tr.t_s[-1]:g} s)")
-        windows.append(mask)
+    _check_free(free, params)
+    loads = _trace_loads(scenario, traces, loads_N)
+    windows = [_window(tr, window_s, len(free)) for tr in traces]
     if not knot_tolerance_Pa > 0:
         raise InputError(f"--knot-tolerance-Pa = {knot_tolerance_Pa!r}: must be positive")
     lower = np.array([params.entries[n].lower for n in free], dtype=float)
@@ -258,6 +238,42 @@ def make_problem(scenario: Scenario, traces: Sequence[TraceData], free: Sequence
     inputs = tuple(None if tr.p_gauge_Pa is None else thinned_input(tr.t_s, tr.p_gauge_Pa, knot_tolerance_Pa)
                    for tr in traces)
     return DynamicProblem(scenario, tuple(traces), tuple(loads), tuple(windows), free, (lower, upper), inputs)
+
+
+def _check_free(free: tuple[str, ...], params: ParameterSet) -> None:
+    for n in free:
+        if n not in params:
+            raise InputError(f"--free: {n!r} is not a parameter of the scenario's parameter set {params.name!r}")
+    if len(set(free)) != len(free):
+        raise InputError(f"--free = {','.join(free)}: a name appears twice")
+
+
+def _trace_loads(scenario: Scenario, traces: Sequence[TraceData],
+                 loads_N: Sequence[float | None] | None) -> list[float]:
+    """The hung weight of each trace [N]: given, else the trace's ``weight_N`` column, else the scenario's load."""
+    if loads_N is not None and len(loads_N) != len(traces):
+        raise InputError(f"--load-N: {len(loads_N)} values for {len(traces)} traces")
+    loads = []
+    for i, tr in enumerate(traces):
+        given = loads_N[i] if loads_N is not None else None
+        w = given if given is not None else tr.weight_N
+        if w is None:
+            w = scenario.mass_kg * scenario.parameters["g_m_s2"]
+        if not w > 0:
+            raise InputError(f"--load-N = {w!r}: must be positive")
+        loads.append(float(w))
+    return loads
+
+
+def _window(trace: TraceData, window_s: tuple[float, float] | None, n_free: int) -> np.ndarray:
+    """The trace's samples inside the window (its whole span without one), which must outnumber the free
+    coefficients."""
+    t0, t1 = window_s if window_s is not None else (trace.t_s[0], trace.t_s[-1])
+    mask = trace.window(t0, t1)
+    if mask.sum() < n_free + 1:
+        raise InputError(f"--window = {t0:g}:{t1:g}: only {int(mask.sum())} samples of {trace.origin} inside "
+                         f"(trace spans {trace.t_s[0]:g}..{trace.t_s[-1]:g} s)")
+    return mask
 
 
 def _rms_per_trace(problem: DynamicProblem, sims: Sequence[np.ndarray]) -> list[float]:
