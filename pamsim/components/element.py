@@ -30,23 +30,33 @@ STRUCTURAL = ("name", "negative_level")
 """Fields that are choices or metadata, never parameters."""
 
 
+@functools.lru_cache(maxsize=None)
+def _field_names(cls: type) -> tuple[str, ...]:
+    # dataclasses.fields() rebuilds its tuple at every call; components are made per run, many per sweep.
+    return tuple(f.name for f in dataclasses.fields(cls))
+
+
+def _is_instance_of_dataclass(value) -> bool:
+    return not isinstance(value, type) and hasattr(type(value), "__dataclass_fields__")
+
+
 def _numbers(element, out: dict[str, float], path: str) -> None:
-    for f in dataclasses.fields(element):
-        value = getattr(element, f.name)
-        if f.name in STRUCTURAL:
+    for name in _field_names(type(element)):
+        value = getattr(element, name)
+        if name in STRUCTURAL:
             continue
-        if dataclasses.is_dataclass(value):
-            _numbers(value, out, f"{path}{f.name}.")
+        if _is_instance_of_dataclass(value):
+            _numbers(value, out, f"{path}{name}.")
         elif _is_number(value):
             # A nested element's number keeps its plain name unless another number has it already.
-            out[f.name if f.name not in out else f"{path}{f.name}"] = float(value)
+            out[name if name not in out else f"{path}{name}"] = float(value)
 
 
 def element_parameters(element) -> dict[str, float]:
     """``{name: value}`` of every number of a dataclass ``element`` (nested elements included), named
     by field; a field name met twice is qualified by its path (``orifice.C_m3_per_s_Pa``)."""
     out: dict[str, float] = {}
-    if dataclasses.is_dataclass(element):
+    if _is_instance_of_dataclass(element):
         _numbers(element, out, "")
     return out
 
@@ -79,12 +89,12 @@ def structure_key(element, baked: bool = False) -> tuple:
     values, so they share one generated model.  ``baked``: the numbers are constants of the generated
     code (an element called on floats, or numbers :func:`symbolic` does not replace), so they count.
     """
-    if dataclasses.is_dataclass(element):
+    if _is_instance_of_dataclass(element):
         items = []
-        for f in dataclasses.fields(element):
-            value = getattr(element, f.name)
-            if f.name in STRUCTURAL or baked or not _is_number(value):
-                items.append((f.name, _stable(value, baked or f.name in STRUCTURAL)))
+        for name in _field_names(type(element)):
+            value = getattr(element, name)
+            if name in STRUCTURAL or baked or not _is_number(value):
+                items.append((name, _stable(value, baked or name in STRUCTURAL)))
         return (type(element).__module__, type(element).__qualname__, tuple(items))
     return _stable(element, True)
 
@@ -107,7 +117,7 @@ def _stable(value, baked: bool):
         return (type(value).__name__, tuple(_stable(v, True) for v in value))
     if isinstance(value, np.ndarray):
         return ("ndarray", value.shape, str(value.dtype), hashlib.sha256(np.ascontiguousarray(value).tobytes()).hexdigest())
-    if dataclasses.is_dataclass(value):
+    if _is_instance_of_dataclass(value):
         return structure_key(value, baked)
     if isinstance(value, Mapping):
         return ("mapping", tuple(sorted((str(k), _stable(v, True)) for k, v in value.items())))
