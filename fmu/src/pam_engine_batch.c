@@ -12,6 +12,8 @@
 
 #include <stdint.h>
 
+#include "pam_gauss.h"
+
 #if defined(__GNUC__)
 #define PAM_EXPORT __attribute__((visibility("default")))
 #else
@@ -50,11 +52,6 @@ typedef struct {
     double *extremes;             /* out: n_cases x 2 PM_NY: each output's largest, then its smallest value */
     char *messages;               /* out: n_cases x PAM_ENGINE_MSG, the first error */
 } PamEngineBatch;
-
-/* 5-point Gauss-Legendre nodes on [0, 1] (the quadrature polynomial of a step, below). */
-#define GL_N 5
-static const double GL_NODE[GL_N] = {0.046910077030668004, 0.23076534494715845, 0.5, 0.76923465505284155,
-                                     0.953089922969332};
 
 typedef struct {
     PamEngine engine;
@@ -130,24 +127,6 @@ typedef struct {
     double t0, span, c[PM_NQ > 0 ? PM_NQ : 1][GL_N]; /* Q(t) - Q(t0) = sum_j c[k][j] phi^(j+1) */
     int moving;                                      /* 0: the quadratures do not change in this step */
 } QuadPoly;
-
-/* A[k][j]: coefficient of phi^(j+1) in the integral from 0 to phi of node k's Lagrange polynomial. */
-static void gauss_primitives(double A[GL_N][GL_N]) {
-    int k, m, j;
-    for (k = 0; k < GL_N; k++) {
-        double L[GL_N] = {1.0}; /* L[j]: coefficient of phi^j, built one factor at a time */
-        int deg = 0;
-        for (m = 0; m < GL_N; m++) {
-            double scale;
-            if (m == k) continue;
-            scale = 1.0 / (GL_NODE[k] - GL_NODE[m]);
-            for (j = deg + 1; j >= 0; j--)
-                L[j] = ((j > 0 ? L[j - 1] : 0.0) - GL_NODE[m] * (j <= deg ? L[j] : 0.0)) * scale;
-            deg++;
-        }
-        for (j = 0; j < GL_N; j++) A[k][j] = L[j] / (double)(j + 1);
-    }
-}
 
 static void quad_poly(const Run *run, const DensePoly *d, int moving, double ta, double tb, QuadPoly *w) {
     double y[PM_NX], P[GL_N][PM_NQ > 0 ? PM_NQ : 1];

@@ -7,17 +7,13 @@
 #include "pam_core.c"
 
 #include "pam_native.h"
+#include "pam_gauss.h"
 
 /* Order of segment_u, as pamsim.native.library.INPUTS. */
 static const int INPUT_R[PAM_NATIVE_NU] = {R_valve_command, R_supply_pressure_gauge_Pa,
                                            R_prescribed_pressure_gauge_Pa, R_load_mass_kg, R_external_force_N};
 
 enum { W_MUSCLE, E_FRICTION, E_DAMPING, W_EXTERNAL, N_WORK };
-
-/* 5-point Gauss-Legendre nodes on [0, 1] (the work polynomial of a step, below). */
-#define GL_N 5
-static const double GL_NODE[GL_N] = {0.046910077030668004, 0.23076534494715845, 0.5, 0.76923465505284155,
-                                     0.953089922969332};
 
 typedef struct {
     PamCore core;
@@ -90,24 +86,6 @@ typedef struct {
     double t0, span, c[N_WORK][GL_N]; /* W(t) - W(t0) = sum_j c[k][j] phi^(j+1) */
     int moving;                       /* 0: no work in this step (c is zero) */
 } WorkPoly;
-
-/* A[k][j]: coefficient of phi^(j+1) in the integral from 0 to phi of node k's Lagrange polynomial. */
-static void gauss_primitives(double A[GL_N][GL_N]) {
-    int k, m, j;
-    for (k = 0; k < GL_N; k++) {
-        double L[GL_N] = {1.0}; /* L[j]: coefficient of phi^j, built one factor at a time */
-        int deg = 0;
-        for (m = 0; m < GL_N; m++) {
-            double scale;
-            if (m == k) continue;
-            scale = 1.0 / (GL_NODE[k] - GL_NODE[m]);
-            for (j = deg + 1; j >= 0; j--)
-                L[j] = ((j > 0 ? L[j - 1] : 0.0) - GL_NODE[m] * (j <= deg ? L[j] : 0.0)) * scale;
-            deg++;
-        }
-        for (j = 0; j < GL_N; j++) A[k][j] = L[j] / (double)(j + 1);
-    }
-}
 
 static void work_poly(const PamCore *c, const DensePoly *d, double A[GL_N][GL_N], int moving, double ta,
                       double tb, WorkPoly *w) {

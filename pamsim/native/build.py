@@ -22,7 +22,7 @@ from ..fmu.build import c_compiler, shared_library_suffix
 from ..fmu.force_table import EMPTY_HEADER
 from ..fmu.generate import c_header, c_source_dir
 
-SOURCES = ("pam_native.c", "pam_native.h", "pam_core.c", "pam_core.h", "pam_dopri.h", "pam_shared.h")
+SOURCES = ("pam_native.c", "pam_native.h", "pam_core.c", "pam_core.h", "pam_dopri.h", "pam_gauss.h", "pam_shared.h")
 """The C files the library is built from (pam_native.c includes pam_core.c: one translation unit)."""
 FLAGS = ("-shared", "-fPIC", "-O3", "-std=c99", "-Wall", "-fvisibility=hidden")
 LIBRARY_NAME = "libpamsim_native"

@@ -30,7 +30,7 @@ from ..fmu.generate import c_source_dir
 from ..modeling import code_cache
 from .build import FLAGS, cache_root, compile_library, compiler
 
-ENGINE_SOURCES = ("pam_engine_batch.c", "pam_engine_session.c", "pam_engine.c", "pam_engine.h", "pam_dopri.h")
+ENGINE_SOURCES = ("pam_engine_batch.c", "pam_engine_session.c", "pam_engine.c", "pam_engine.h", "pam_dopri.h", "pam_gauss.h")
 LAYOUT = ("nx", "nq", "nu", "np", "ny", "nz", "nmodes", "ns", "event_columns", "message_bytes", "batch_bytes")
 """What ``pam_engine_layout(k)`` returns, by k."""
 STATUS = ("ok", "bad input", "solver failed", "event buffer full")
