@@ -259,7 +259,7 @@ typedef struct {
  * of everything before it.  A state is for the build that wrote it (the token), whose layout of r[]
  * and i[] it shares. */
 static const char SERIAL_MAGIC[8] = {'P', 'A', 'M', 'S', 'T', 'A', 'T', 'E'};
-#define SERIAL_VERSION 1u
+#define SERIAL_VERSION 2u
 
 typedef struct {
     unsigned char *bytes; /* NULL: only count */
@@ -281,39 +281,14 @@ static void take(Reader *r, void *value, size_t size) {
     r->at += size;
 }
 
-/* Each field the state holds, written or read in one order; `dir` is put or take. */
-#define SERIAL_FIELDS(dir, io, snap)                                                          \
-    do {                                                                                      \
-        int32_t mode_ = (int32_t)(snap)->core.mode, changed_ = (snap)->core.inputs_changed;  \
-        int32_t edge_ = (snap)->core.table_edge_logged, state_ = (snap)->state;              \
-        int64_t steps_ = (snap)->core.n_steps, rhs_ = (snap)->core.n_rhs;                    \
-        int64_t events_ = (snap)->core.n_events;                                             \
-        uint32_t set_ = (snap)->core.inputs_set;                                             \
-        dir(io, (snap)->core.r, sizeof (snap)->core.r);                                      \
-        dir(io, (snap)->core.i, sizeof (snap)->core.i);                                      \
-        dir(io, &(snap)->core.time_s, sizeof(double));                                       \
-        dir(io, &mode_, sizeof mode_);                                                       \
-        dir(io, &(snap)->core.braid_b_m, sizeof(double));                                    \
-        dir(io, &(snap)->core.braid_turns, sizeof(double));                                  \
-        dir(io, &(snap)->core.x_low_m, sizeof(double));                                      \
-        dir(io, &(snap)->core.x_high_m, sizeof(double));                                     \
-        dir(io, &changed_, sizeof changed_);                                                 \
-        dir(io, &(snap)->core.h_s, sizeof(double));                                          \
-        dir(io, &steps_, sizeof steps_);                                                     \
-        dir(io, &rhs_, sizeof rhs_);                                                         \
-        dir(io, &events_, sizeof events_);                                                   \
-        dir(io, &edge_, sizeof edge_);                                                       \
-        dir(io, &(snap)->core.event_time_s, sizeof(double));                                 \
-        dir(io, &set_, sizeof set_);                                                         \
-        dir(io, &state_, sizeof state_);                                                     \
-        (snap)->core.mode = mode_;                                                           \
-        (snap)->core.inputs_changed = changed_;                                              \
-        (snap)->core.table_edge_logged = edge_;                                              \
-        (snap)->core.n_steps = (long)steps_;                                                 \
-        (snap)->core.n_rhs = (long)rhs_;                                                     \
-        (snap)->core.n_events = (long)events_;                                               \
-        (snap)->core.inputs_set = set_;                                                      \
-        (snap)->state = state_;                                                              \
+/* Each field the state holds, written or read in one order; `dir` is put or take: the core's
+ * (PAM_CORE_SERIAL_FIELDS of its header), then the state-machine state. */
+#define SERIAL_FIELDS(dir, io, snap)                          \
+    do {                                                      \
+        int32_t state_ = (snap)->state;                       \
+        PAM_CORE_SERIAL_FIELDS(dir, io, &(snap)->core);       \
+        dir(io, &state_, sizeof state_);                      \
+        (snap)->state = state_;                               \
     } while (0)
 
 static uint64_t fnv1a64(const unsigned char *bytes, size_t size) {
@@ -355,19 +330,10 @@ int fmu_get_fmu_state(FmuInstance *in, const char *function, void **s) {
 }
 
 int fmu_set_fmu_state(FmuInstance *in, const char *function, const void *s) {
-    PamCore mine;
     if (!fmu_allowed(in, function, FMU_ANY) || !s) return -1;
     /* The values are the state's; the table, the logger and the callbacks are this instance's. */
-    mine = in->core;
-    in->core = ((const Snapshot *)s)->core;
+    pam_adopt_state(&in->core, &((const Snapshot *)s)->core);
     in->state = ((const Snapshot *)s)->state;
-    in->core.log = mine.log;
-    in->core.log_env = mine.log_env;
-    in->core.on_event = mine.on_event;
-    in->core.event_env = mine.event_env;
-    in->core.on_step = mine.on_step;
-    in->core.step_env = mine.step_env;
-    in->core.table = mine.table;
     return 0;
 }
 
@@ -407,13 +373,9 @@ int fmu_serialize_fmu_state(FmuInstance *in, const char *function, const void *s
 
 /* The reason a deserialized state cannot be this FMU's, or NULL. */
 static const char *invalid_state(const Snapshot *snap) {
-    const PamCore *c = &snap->core;
     int known = snap->state > 0 && (snap->state & FMU_ANY) == snap->state && (snap->state & (snap->state - 1)) == 0;
     if (!known) return "its state-machine state is not one of this FMU's";
-    if (c->mode < PAM_SLIP_DOWN || c->mode > PAM_STOP_HIGH) return "its load mode is not one of -1, 0, 1, 2, 3";
-    if (!isfinite(c->time_s) || !(c->h_s > 0.0) || !isfinite(c->h_s)) return "its time or step is not finite";
-    if (c->n_steps < 0 || c->n_rhs < 0 || c->n_events < 0) return "a count is negative";
-    return NULL;
+    return pam_state_invalid(&snap->core);
 }
 
 int fmu_deserialize_fmu_state(FmuInstance *in, const char *function, const void *bytes, size_t size, void **s) {
@@ -528,8 +490,7 @@ int fmu_get_derivatives(FmuInstance *in, const char *function, double dx[], size
 }
 
 int fmu_get_event_indicators(FmuInstance *in, const char *function, double z[], size_t nz) {
-    static const int indicators[PAM_NZ] = {R_event_indicator_1, R_event_indicator_2};
-    return get_vector(in, function, indicators, z, nz, PAM_NZ, in ? in->flavour->derivatives_evaluate_in : 0);
+    return get_vector(in, function, PAM_INDICATOR_R, z, nz, PAM_NZ, in ? in->flavour->derivatives_evaluate_in : 0);
 }
 
 int fmu_get_nominals(FmuInstance *in, const char *function, double nominals[], size_t nx) {

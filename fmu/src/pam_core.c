@@ -21,16 +21,6 @@
 
 enum { X = 0, V = 1, P = 2, M = 3 };
 
-void pam_logf(PamCore *c, int level, const char *fmt, ...) {
-    char buf[512];
-    va_list ap;
-    if (!c->log) return;
-    va_start(ap, fmt);
-    vsnprintf(buf, sizeof buf, fmt, ap);
-    va_end(ap);
-    c->log(c->log_env, level, buf);
-}
-
 static const PamTable BUILT_IN_TABLE = {PAM_FT_NX, PAM_FT_NP, PAM_FT_X0, PAM_FT_DX, PAM_FT_P0, PAM_FT_DP, PAM_FT};
 
 void pam_reset(PamCore *c) {
@@ -48,105 +38,6 @@ void pam_reset(PamCore *c) {
     c->table_edge_logged = 0;
     c->event_time_s = 0.0;
     c->inputs_set = 0;
-}
-
-/* ------------------------------------------------------------ the scenario's input signals */
-
-static int scheduled(const PamCore *c) {
-    return PAM_NSIG > 0 && c->i[I_input_source] == PAM_INPUT_SOURCE_SCENARIO;
-}
-
-/* pamsim.fmu.preset.InputSignal: knots interpolated as numpy.interp does and held outside them, a knot
- * time given twice being a step; or a step through a first-order lag (pamsim.signals.FirstOrderLag).
- * `left`: the value from the left of t, which the integrator takes up to a breakpoint. */
-static double signal_value(const PamSignal *s, double t, int left) {
-    int lo = 0, hi = s->n, k;
-    if (s->n == 0) {
-        if (t < s->time_s) return s->initial;
-        return s->final + (s->initial - s->final) * exp(-(t - s->time_s) / s->tau_s);
-    }
-    while (lo < hi) { /* lo: the knots before t (left) or at or before it (right) */
-        int mid = (lo + hi) / 2;
-        if (left ? s->t_s[mid] < t : s->t_s[mid] <= t) lo = mid + 1;
-        else hi = mid;
-    }
-    k = lo - 1;
-    if (k < 0) return s->value[0];
-    if (k == s->n - 1) return s->value[k];
-    return (s->value[k + 1] - s->value[k]) / (s->t_s[k + 1] - s->t_s[k]) * (t - s->t_s[k]) + s->value[k];
-}
-
-/* The signals at t_s, but for the inputs in `keep` (bit k: signal k). */
-static void apply_signals(PamCore *c, double t_s, int left, unsigned keep) {
-    int k;
-    if (!scheduled(c)) return;
-    for (k = 0; k < PAM_NSIG; k++)
-        if (!(keep >> k & 1u)) c->r[PAM_SIGNALS[k].r] = signal_value(&PAM_SIGNALS[k], t_s, left);
-}
-
-void pam_inputs_at(PamCore *c, double t_s, int left) { apply_signals(c, t_s, left, 0u); }
-
-void pam_mark_input_set(PamCore *c, unsigned vr) {
-    int k;
-    for (k = 0; k < PAM_NSIG; k++)
-        if (PAM_SIGNALS[k].vr == vr) c->inputs_set |= 1u << k;
-}
-
-int pam_input_scheduled(const PamCore *c, unsigned vr, double *value) {
-    int k;
-    if (!scheduled(c)) return 0;
-    for (k = 0; k < PAM_NSIG; k++)
-        if (PAM_SIGNALS[k].vr == vr) {
-            *value = signal_value(&PAM_SIGNALS[k], c->time_s, 0);
-            return 1;
-        }
-    return 0;
-}
-
-double pam_next_breakpoint(const PamCore *c, double t_s) {
-    double next = HUGE_VAL;
-    int k, j;
-    if (!scheduled(c)) return next;
-    for (k = 0; k < PAM_NSIG; k++) {
-        const PamSignal *s = &PAM_SIGNALS[k];
-        if (s->n == 0 && s->time_s > t_s) next = fmin(next, s->time_s);
-        for (j = 0; j < s->n; j++)
-            if (s->t_s[j] > t_s) {
-                next = fmin(next, s->t_s[j]);
-                break;
-            }
-    }
-    return next;
-}
-
-static int at_breakpoint(const PamCore *c, double t_s) {
-    int k, j;
-    if (!scheduled(c)) return 0;
-    for (k = 0; k < PAM_NSIG; k++) {
-        const PamSignal *s = &PAM_SIGNALS[k];
-        if (s->n == 0 && s->time_s == t_s) return 1;
-        for (j = 0; j < s->n; j++)
-            if (s->t_s[j] == t_s) return 1;
-    }
-    return 0;
-}
-
-/* 1 if no input changes from t_s to the next breakpoint: a held load whose chamber does not change then
- * stays as it is until there. */
-static int inputs_constant(const PamCore *c, double t_s) {
-    int k;
-    if (!scheduled(c)) return 1;
-    for (k = 0; k < PAM_NSIG; k++) {
-        const PamSignal *s = &PAM_SIGNALS[k];
-        if (s->n == 0) {
-            if (t_s >= s->time_s && s->initial != s->final) return 0;
-        } else {
-            int j = 0;
-            while (j < s->n && s->t_s[j] <= t_s) j++;
-            if (j > 0 && j < s->n && s->value[j - 1] != s->value[j]) return 0;
-        }
-    }
-    return 1;
 }
 
 /* ------------------------------------------------------------ elements */
@@ -352,34 +243,12 @@ static void put_states(PamCore *c, const double *y) {
 
 /* ------------------------------------------------------------ checks */
 
-/* pamsim.parameters.Parameter.violation: 1 and the reason in `why` if `value` is outside the
- * generated range of `info`, else 0. */
-static int range_violation(const PamVarInfo *info, double value, char *why, size_t size) {
-    int low_bad = info->lower_open ? value <= info->lower : value < info->lower;
-    int high_bad = info->upper_open ? value >= info->upper : value > info->upper;
-    if (!low_bad && !high_bad) return 0;
-    if (isinf(info->upper)) snprintf(why, size, "must be %s %g", info->lower_open ? ">" : ">=", info->lower);
-    else if (isinf(info->lower)) snprintf(why, size, "must be %s %g", info->upper_open ? "<" : "<=", info->upper);
-    else
-        snprintf(why, size, "must lie in %c%g, %g%c", info->lower_open ? '(' : '[', info->lower, info->upper,
-                 info->upper_open ? ')' : ']');
-    return 1;
-}
-
 int pam_check_value(PamCore *c, unsigned vr, double value) {
     const PamVarInfo *info;
-    char why[160];
+    /* An input's own range, generated from pamsim/fmu/variables.py (load_mass_kg: pamsim.parameters.LOAD_MASS). */
+    if (pam_check_own_range(c, vr, value)) return -1;
     if (vr < 1 || vr > PAM_NVARS) return 0;
     info = &PAM_VARS[vr - 1];
-    if (!isfinite(value)) {
-        pam_logf(c, PAM_LOG_ERROR, "%s = %g: must be a finite number", info->name, value);
-        return -1;
-    }
-    /* An input's own range, generated from pamsim/fmu/variables.py (load_mass_kg: pamsim.parameters.LOAD_MASS). */
-    if (info->causality == PAM_INPUT && range_violation(info, value, why, sizeof why)) {
-        pam_logf(c, PAM_LOG_ERROR, "%s = %g: %s", info->name, value, why);
-        return -1;
-    }
     if ((vr == VR_supply_pressure_gauge_Pa || vr == VR_prescribed_pressure_gauge_Pa)
         && value > c->r[R_rated_pressure_gauge_Pa]) {
         pam_logf(c, PAM_LOG_ERROR, "%s = %g Pa: exceeds the muscle's rating rated_pressure_gauge_Pa = %g Pa",
@@ -438,64 +307,12 @@ static int check_table_covers(PamCore *c) {
     return bad;
 }
 
-/* input_source = scenario: the FMU has signals, and each stays in its input's range at every knot
- * (the rating and the other parameters may have been changed since the build). */
-static int check_signals(PamCore *c) {
-    int k, j, bad = 0;
-    if (PAM_NSIG == 0) {
-        pam_logf(c, PAM_LOG_ERROR, "invalid parameters: input_source = 1 (scenario): this FMU was built without a "
-                 "scenario (build it with pamsim fmu build --scenario)");
-        return -1;
-    }
-    for (k = 0; k < PAM_NSIG; k++) {
-        const PamSignal *s = &PAM_SIGNALS[k];
-        double now = signal_value(s, c->time_s, 0);
-        if ((c->inputs_set >> k & 1u) && c->r[s->r] != now) {
-            pam_logf(c, PAM_LOG_ERROR, "invalid parameters: %s = %g, set by the importer: this FMU's inputs follow "
-                     "the signals of the scenario it was built from (input_source = scenario; %g at t = %g s); set "
-                     "input_source = importer (0) to drive them", PAM_VARS[s->vr - 1].name, c->r[s->r], now,
-                     c->time_s);
-            bad = -1;
-        }
-    }
-    for (k = 0; k < PAM_NSIG; k++) {
-        const PamSignal *s = &PAM_SIGNALS[k];
-        int n = s->n ? s->n : 2;
-        for (j = 0; j < n; j++) {
-            double value = s->n ? s->value[j] : j ? s->final : s->initial;
-            if (pam_check_value(c, s->vr, value)) {
-                pam_logf(c, PAM_LOG_ERROR, "invalid parameters: input_source = 1 (scenario): the scenario's signal "
-                         "of %s leaves the input's range", PAM_VARS[s->vr - 1].name);
-                bad = -1;
-                break;
-            }
-        }
-    }
-    return bad;
-}
-
 int pam_check_parameters(PamCore *c) {
     const double *r = c->r;
     int bad = 0, k;
     double b, n, x_high;
-    char why[160];
-    for (k = 0; k < PAM_NVARS; k++)
-        if (PAM_VARS[k].kind == 'r' && PAM_VARS[k].causality <= PAM_INPUT && !isfinite(r[PAM_VARS[k].index])) {
-            pam_logf(c, PAM_LOG_ERROR, "invalid parameters: %s is not finite", PAM_VARS[k].name);
-            bad = -1;
-        }
-    if (bad) return -1;
     /* Each parameter's own range, generated from pamsim/fmu/variables.py (the Python Parameter bounds). */
-    for (k = 0; k < PAM_NVARS; k++) {
-        const PamVarInfo *info = &PAM_VARS[k];
-        double value = info->kind == 'r' ? r[info->index] : (double)c->i[info->index];
-        if (info->causality == PAM_PARAMETER && range_violation(info, value, why, sizeof why)) {
-            if (info->kind == 'r') pam_logf(c, PAM_LOG_ERROR, "invalid parameters: %s = %g: %s", info->name, value, why);
-            else pam_logf(c, PAM_LOG_ERROR, "invalid parameters: %s = %ld: %s", info->name, (long)c->i[info->index], why);
-            bad = -1;
-        }
-    }
-    if (bad) return -1;
+    if (pam_check_parameter_ranges(c)) return -1;
     /* Checks between parameters (ParameterSet.violations) and of the FMU's own parameters. */
     for (k = 0; k < PAM_N_ORDER_CHECKS; k++) {
         double a = named_real(c, PAM_ORDER_CHECKS[k][0]), below = named_real(c, PAM_ORDER_CHECKS[k][1]);
@@ -516,7 +333,7 @@ int pam_check_parameters(PamCore *c) {
         bad = -1;
     }
     if (table_guarded(c) && check_table_covers(c)) bad = -1;
-    if (c->i[I_input_source] == PAM_INPUT_SOURCE_SCENARIO && check_signals(c)) bad = -1;
+    if (c->i[I_input_source] == PAM_INPUT_SOURCE_SCENARIO && pam_check_signals(c)) bad = -1;
     if (!(r[R_initial_pressure_gauge_Pa] <= r[R_rated_pressure_gauge_Pa])) {
         pam_logf(c, PAM_LOG_ERROR,
                  "invalid parameters: initial_pressure_gauge_Pa = %g: must be at most rated_pressure_gauge_Pa = %g",
@@ -592,7 +409,7 @@ static void derive_start(PamCore *c) {
 
 void pam_initialize(PamCore *c) {
     double y[PAM_NX];
-    apply_signals(c, c->time_s, 0, c->inputs_set); /* the ones the importer set are checked equal */
+    pam_apply_signals(c, c->time_s, 0, c->inputs_set); /* the ones the importer set are checked equal */
     derive_start(c);
     get_states(c, y);
     c->table_edge_logged = 0; /* a run starts */
@@ -800,7 +617,7 @@ int pam_do_step(PamCore *c, double t_end) {
     int zero_length = 0, n;
     get_states(c, y);
     pam_inputs_at(c, t, 0);
-    if (c->inputs_changed || at_breakpoint(c, t)) recheck_held(c, y);
+    if (c->inputs_changed || pam_at_breakpoint(c, t)) recheck_held(c, y);
     c->inputs_changed = 0;
     rhs(c, c->mode, y, s.k[0]);
     t_piece = piece_end(c, t, t_end);
@@ -822,7 +639,7 @@ int pam_do_step(PamCore *c, double t_end) {
         /* A held load whose chamber does not change stays as it is while the inputs are held:
          * the solution is constant, however long the step. */
         for (n = 0; n < PAM_NX && at_rest; n++) at_rest = s.k[0][n] == 0.0;
-        if (at_rest && inputs_constant(c, t)) {
+        if (at_rest && pam_inputs_constant(c, t)) {
             if (c->on_step) c->on_step(c->step_env, t, t_piece, 0.0, y, NULL);
             t = t_piece;
             continue;
@@ -951,4 +768,25 @@ int pam_directional_derivative(PamCore *c, const unsigned *unknowns, int n_unkno
         *c = saved_core;
     }
     return 0;
+}
+
+/* ------------------------------------------------------------ FMU state */
+
+const char *pam_state_invalid(const PamCore *c) {
+    if (c->mode < PAM_SLIP_DOWN || c->mode > PAM_STOP_HIGH) return "its load mode is not one of -1, 0, 1, 2, 3";
+    if (!isfinite(c->time_s) || !(c->h_s > 0.0) || !isfinite(c->h_s)) return "its time or step is not finite";
+    if (c->n_steps < 0 || c->n_rhs < 0 || c->n_events < 0) return "a count is negative";
+    return NULL;
+}
+
+void pam_adopt_state(PamCore *c, const PamCore *from) {
+    PamCore mine = *c;
+    *c = *from;
+    c->log = mine.log;
+    c->log_env = mine.log_env;
+    c->on_event = mine.on_event;
+    c->event_env = mine.event_env;
+    c->on_step = mine.on_step;
+    c->step_env = mine.step_env;
+    c->table = mine.table;
 }

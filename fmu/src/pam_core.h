@@ -15,6 +15,7 @@
 #include <stdint.h>
 #include "pam_variables.h"
 #include "pam_shared.h" /* constants and choices shared with Python, generated */
+#include "pam_log.h"
 
 /* Only the FMI functions leave the shared library (also when it is rebuilt by fmpy or cmake
  * without -fvisibility=hidden). */
@@ -22,9 +23,6 @@
 #pragma GCC visibility push(hidden)
 #endif
 
-enum { PAM_LOG_INFO = 0, PAM_LOG_WARNING = 1, PAM_LOG_ERROR = 2 };
-
-typedef void (*PamLogFn)(void *env, int level, const char *message);
 /* Called by pam_do_step at each located event that changed the mode or the states: the time, the
  * mode before and after, and the states just before and just after the jump (NULL for the FMU). */
 /* Called by pam_do_step for each accepted step from t0_s to t1_s, before any event at t1_s: y0 and
@@ -65,41 +63,24 @@ typedef struct PamCore {
     unsigned inputs_set;   /* before the end of initialisation: the signals (bit k) whose input the importer set */
 } PamCore;
 
-void pam_reset(PamCore *c);
-/* Rejects a value (NaN, negative mass, pressure above rating, ...) with a logged message: returns -1. */
-int pam_check_value(PamCore *c, unsigned vr, double value);
-int pam_check_parameters(PamCore *c);
-/* Initial state from the parameters: load at rest, chamber at initial_pressure_gauge_Pa. */
-void pam_initialize(PamCore *c);
-/* Derivatives, outputs and event indicators from the states, inputs and mode. */
-void pam_evaluate(PamCore *c);
-/* Reports once (a warning) a state outside the built-in force table, whose edge value the static force
- * then takes: at each solution point (an accepted step, an event), not at an integrator's trial points. */
-void pam_note_table_edge(PamCore *c);
-/* Model-exchange event update: apply one mode transition; returns 1 if x or v jumped. */
-int pam_event_update(PamCore *c);
-/* Co-simulation: integrate to t_end, the inputs held or following their signals; 0 on success, -1 on
- * failure (logged), which leaves time_s, the states, the mode and the outputs at the last instant reached. */
-int pam_do_step(PamCore *c, double t_end);
-/* Directional derivative d(unknowns)/d(knowns) * seed: a central difference per known, mode held;
- * `initializing`: the states, geometry and stops derived again from the parameters on each side. */
-int pam_directional_derivative(PamCore *c, const unsigned *unknowns, int n_unknowns, const unsigned *knowns,
-                               int n_knowns, const double *seed, double *sensitivity, int initializing);
-void pam_logf(PamCore *c, int level, const char *fmt, ...);
-/* With input_source = scenario, the inputs follow the signals the FMU was built with (PAM_SIGNALS of
- * pam_variables.h); otherwise these do nothing.  pam_inputs_at sets them at t_s, their values from the
- * left of t_s (left != 0: the end of an interval) or from the right (an event, a start). */
-void pam_inputs_at(PamCore *c, double t_s, int left);
-/* 1 if input `vr` follows a signal, its value now (from the right) in *value; else 0. */
-int pam_input_scheduled(const PamCore *c, unsigned vr, double *value);
-/* Before the end of initialisation the importer may still choose input_source: an input it sets is
- * marked here, keeps its value, and is checked against its signal by pam_check_parameters. */
-void pam_mark_input_set(PamCore *c, unsigned vr);
-/* The first breakpoint (knot, step, a lag's start) of the signals after t_s, or HUGE_VAL if none. */
-double pam_next_breakpoint(const PamCore *c, double t_s);
+/* The values a serialized FMU state holds (fmi_shell.c): those of pam_fmu_common.h, then the geometry
+ * and stops derived at initialisation and the table edge's note. */
+#define PAM_CORE_SERIAL_FIELDS(dir, io, core)                                              \
+    do {                                                                                   \
+        int32_t edge_ = (core)->table_edge_logged;                                         \
+        PAM_COMMON_SERIAL_FIELDS(dir, io, core);                                           \
+        dir(io, &(core)->braid_b_m, sizeof(double));                                       \
+        dir(io, &(core)->braid_turns, sizeof(double));                                     \
+        dir(io, &(core)->x_low_m, sizeof(double));                                         \
+        dir(io, &(core)->x_high_m, sizeof(double));                                        \
+        dir(io, &edge_, sizeof edge_);                                                     \
+        (core)->table_edge_logged = edge_;                                                 \
+    } while (0)
 
 #if defined(__GNUC__)
 #pragma GCC visibility pop
 #endif
+
+#include "pam_fmu_common.h" /* the API the FMI shell calls */
 
 #endif

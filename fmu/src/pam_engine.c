@@ -25,6 +25,22 @@ static void engine_logf(PamEngine *e, int level, const char *fmt, ...) {
 
 static int held(const PamEngine *e) { return PM_MODE_HELD[e->mode]; }
 
+/* The inputs at t_s (from the left of t_s if `left`) when they follow signals; else they stay as set. */
+static void inputs_at(PamEngine *e, double t_s, int left) {
+    if (e->inputs) e->inputs->at(e->inputs->env, t_s, left, e->u);
+}
+
+/* The end of the piece of [t_s, t_end] the integrator crosses next: t_end, or the first breakpoint of
+ * the signals before it (they are smooth in between). */
+static double piece_end(const PamEngine *e, double t_s, double t_end) {
+    return e->inputs ? fmin(t_end, e->inputs->next_breakpoint(e->inputs->env, t_s)) : t_end;
+}
+
+/* 1 if no input changes from t_s to the end of its piece. */
+static int inputs_constant(const PamEngine *e, double t_s) {
+    return !e->inputs || e->inputs->constant_after(e->inputs->env, t_s);
+}
+
 static void rhs(PamEngine *e, const double *y, double *dy) {
     e->n_rhs++;
     pm_f(e->mode, y, e->u, e->p, dy);
@@ -96,8 +112,12 @@ void pam_engine_initialize(PamEngine *e) {
     e->inputs_changed = 0;
 }
 
-/* One trial step; returns the scaled RMS error norm.  k[0] must hold f(y0). */
-static double dp_step(PamEngine *e, const double *y0, double h, PamStages *s, double *y1) {
+/* The nodes of the tableau of pam_dopri.h, where inputs that follow signals are evaluated. */
+static const double DP_NODE[7] = {0.0, 1.0 / 5, 3.0 / 10, 4.0 / 5, 8.0 / 9, 1.0, 1.0};
+
+/* One trial step from t0; returns the scaled RMS error norm.  k[0] must hold f(y0).  Inputs that
+ * follow signals are left at their values from the left of t0 + h. */
+static double dp_step(PamEngine *e, double t0, const double *y0, double h, PamStages *s, double *y1) {
     double yt[PM_NX], err = 0.0, rtol = e->rtol;
     int st, j, n;
     for (st = 1; st < 7; st++) {
@@ -106,6 +126,7 @@ static double dp_step(PamEngine *e, const double *y0, double h, PamStages *s, do
             for (j = 0; j < st; j++) acc += DP_A[st][j] * s->k[j][n];
             yt[n] = y0[n] + h * acc;
         }
+        inputs_at(e, t0 + DP_NODE[st] * h, 1);
         rhs(e, yt, s->k[st]);
     }
     for (n = 0; n < PM_NX; n++) {
@@ -137,12 +158,13 @@ static void dp_dense(const PamStages *s, const double *y0, double h, double th, 
  * against a sign change and back).  A held model's step is not limited by max_step_s (its states
  * approach their sources monotonically, so its force margins seldom turn back), so a long one is
  * also checked at PAM_ENGINE_HELD_CHECKS points of its dense output. */
-static int first_crossing(const PamEngine *e, const PamStages *s, const double *y, const double *y1, double h,
-                          double *lo, double *hi) {
+static int first_crossing(PamEngine *e, const PamStages *s, double t, const double *y, const double *y1,
+                          double h, double *lo, double *hi) {
     int n = (held(e) && h > e->max_step_s) ? PAM_ENGINE_HELD_CHECKS : 1, k;
     double ye[PM_NX];
     for (k = 1; k <= n; k++) {
         if (k < n) dp_dense(s, y, h, (double)k / n, ye);
+        inputs_at(e, t + (double)k / n * h, 1);
         if (min_indicator(e, k < n ? ye : y1) <= 0.0) {
             *lo = (double)(k - 1) / n;
             *hi = (double)k / n;
@@ -195,36 +217,55 @@ static int at_event(PamEngine *e, double t, double *y, int *zero_length) {
     return 0;
 }
 
-/* Integrate to t_end with the inputs held; 0 on success, -1 on failure (logged), which leaves
- * time_s, the states and the mode at the last instant reached. */
+/* A held model's mode decided again where its inputs jump or reach a breakpoint. */
+static void recheck_held(PamEngine *e, const double *y) {
+    int old = e->mode;
+    if (!held(e)) return;
+    e->mode = rest_mode(e, e->mode, y);
+    if (e->mode != old) e->n_events++;
+}
+
+static int at_breakpoint(const PamEngine *e, double t_s) {
+    return e->inputs && e->inputs->next_breakpoint(e->inputs->env, nextafter(t_s, -HUGE_VAL)) == t_s;
+}
+
+/* Integrate to t_end, the inputs held or following their signals; 0 on success, -1 on failure (logged),
+ * which leaves time_s, the states and the mode at the last instant reached. */
 int pam_engine_do_step(PamEngine *e, double t_end) {
-    double y[PM_NX], y1[PM_NX], t = e->time_s, h_max = e->max_step_s;
+    double y[PM_NX], y1[PM_NX], t = e->time_s, h_max = e->max_step_s, t_piece;
     PamStages s;
     long steps = 0;
     int zero_length = 0, n;
     memcpy(y, e->x, sizeof y);
-    if (e->inputs_changed && held(e)) {
-        /* a held model is re-checked where its inputs jump */
-        int old = e->mode;
-        e->mode = rest_mode(e, e->mode, y);
-        if (e->mode != old) e->n_events++;
-    }
+    inputs_at(e, t, 0);
+    if (e->inputs_changed || at_breakpoint(e, t)) recheck_held(e, y);
     e->inputs_changed = 0;
     rhs(e, y, s.k[0]);
+    t_piece = piece_end(e, t, t_end);
     /* A remainder below the time resolution (left by an event located just before t_end) is not a step. */
     while (t_end - t > 1e-13 * fmax(1.0, fabs(t_end))) {
         double h, err, factor, lo = 0.0, hi = 1.0;
         int last, at_rest = held(e);
+        if (t_piece - t <= 1e-13 * fmax(1.0, fabs(t_piece))) {
+            /* A breakpoint of the signals: they take their values from the right. */
+            t = t_piece;
+            inputs_at(e, t, 0);
+            recheck_held(e, y);
+            rhs(e, y, s.k[0]);
+            t_piece = piece_end(e, t, t_end);
+            continue;
+        }
+        inputs_at(e, t, 0); /* a rejected trial step left them at its end */
         if (settle(e, y)) rhs(e, y, s.k[0]);
         /* A held model whose states do not change stays as it is while the inputs are held. */
         for (n = 0; n < PM_NX && at_rest; n++) at_rest = s.k[0][n] == 0.0;
-        if (at_rest) {
-            if (e->on_step) e->on_step(e->step_env, t, t_end, 0.0, y, NULL);
-            t = t_end;
-            break;
+        if (at_rest && inputs_constant(e, t)) {
+            if (e->on_step) e->on_step(e->step_env, t, t_piece, 0.0, y, NULL);
+            t = t_piece;
+            continue;
         }
-        h = fmin(held(e) ? e->h_s : fmin(e->h_s, h_max), t_end - t);
-        last = h >= t_end - t;
+        h = fmin(held(e) ? e->h_s : fmin(e->h_s, h_max), t_piece - t);
+        last = h >= t_piece - t;
         if (++steps > e->max_steps) {
             engine_logf(e, PAM_ENGINE_ERROR, "more than %ld internal steps between t = %.9g s and %.9g s",
                         e->max_steps, e->time_s, t_end);
@@ -234,28 +275,30 @@ int pam_engine_do_step(PamEngine *e, double t_end) {
             engine_logf(e, PAM_ENGINE_ERROR, "step size underflow at t = %.9g s", t);
             return step_failed(e, t, y);
         }
-        err = dp_step(e, y, h, &s, y1);
+        err = dp_step(e, t, y, h, &s, y1);
         if (!(err <= 1.0)) {
             e->h_s = h * (isfinite(err) ? fmax(0.2, 0.9 * pow(err, -0.2)) : 0.1);
             continue;
         }
         factor = err == 0.0 ? 10.0 : fmin(10.0, fmax(0.2, 0.9 * pow(err, -0.2)));
         e->n_steps++;
-        if (first_crossing(e, &s, y, y1, h, &lo, &hi)) {
+        if (first_crossing(e, &s, t, y, y1, h, &lo, &hi)) {
             /* Locate the first crossing on the dense output; keep the far side so that the event test holds. */
             double ye[PM_NX], t_event;
             int it;
             for (it = 0; it < 100 && (hi - lo) * h > 1e-15 * fmax(1.0, fabs(t)); it++) {
                 double mid = 0.5 * (lo + hi);
                 dp_dense(&s, y, h, mid, ye);
+                inputs_at(e, t + mid * h, 1);
                 if (min_indicator(e, ye) <= 0.0) hi = mid;
                 else lo = mid;
             }
             if (hi < 1.0) dp_dense(&s, y, h, hi, ye);
             else memcpy(ye, y1, sizeof ye);
-            t_event = hi < 1.0 ? t + hi * h : (last ? t_end : t + h);
+            t_event = hi < 1.0 ? t + hi * h : (last ? t_piece : t + h);
             if (e->on_step) e->on_step(e->step_env, t, t_event, h, y, &s);
             t = t_event;
+            inputs_at(e, t, 1);
             memcpy(y, ye, sizeof y);
             memcpy(e->x, y, sizeof y);
             if (at_event(e, t, y, &zero_length)) return step_failed(e, t, y);
@@ -263,13 +306,14 @@ int pam_engine_do_step(PamEngine *e, double t_end) {
             rhs(e, y, s.k[0]);
             continue;
         }
-        if (e->on_step) e->on_step(e->step_env, t, last ? t_end : t + h, h, y, &s);
-        t = last ? t_end : t + h;
+        if (e->on_step) e->on_step(e->step_env, t, last ? t_piece : t + h, h, y, &s);
+        t = last ? t_piece : t + h;
         memcpy(y, y1, sizeof y);
         memcpy(s.k[0], s.k[6], sizeof s.k[0]);
         if (!last || factor < 1.0) e->h_s = h * factor;
     }
     e->time_s = t_end;
+    inputs_at(e, t_end, 0);
     memcpy(e->x, y, sizeof y);
     return 0;
 }

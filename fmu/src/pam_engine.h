@@ -4,8 +4,8 @@
  * PM_NQ quadratures, PM_NU inputs, PM_NP parameters, PM_NY outputs, PM_NZ event indicators,
  * PM_NMODES modes) and, per mode, the right-hand side, the indicators, the jump at an event, the mode
  * decided at rest and the settling of a held model.  The engine holds the inputs constant over a call
- * of pam_engine_do_step and integrates with Dormand-Prince 5(4), locating each event on the dense
- * output and switching modes there.
+ * of pam_engine_do_step, or with an input function sets them at every time it evaluates the model, and
+ * integrates with Dormand-Prince 5(4), locating each event on the dense output and switching modes there.
  */
 #ifndef PAM_ENGINE_H
 #define PAM_ENGINE_H
@@ -25,6 +25,15 @@ typedef void (*PamEngineStepFn)(void *env, double t0_s, double t1_s, double h_s,
                                 const PamStages *stages);
 /* Each event that changed the mode or the states: the time, the mode indices before and after, the
  * indicators that fired (bit k for indicator k), and the states before and after the jump. */
+/* Inputs that follow signals: sets u at t_s, from the left of t_s if `left` (the end of an interval), else
+ * from the right; next_breakpoint gives the first time after t_s where a signal is not smooth (HUGE_VAL if
+ * none), and constant_after whether no input changes from t_s to there. */
+typedef struct {
+    void (*at)(void *env, double t_s, int left, double *u);
+    double (*next_breakpoint)(void *env, double t_s);
+    int (*constant_after)(void *env, double t_s);
+    void *env;
+} PamEngineInputs;
 typedef void (*PamEngineEventFn)(void *env, double t_s, int from, int to, unsigned fired, const double *x_before,
                                  const double *x_after);
 
@@ -47,6 +56,7 @@ typedef struct {
     void *step_env;
     PamEngineEventFn on_event;
     void *event_env;
+    const PamEngineInputs *inputs; /* NULL: the inputs u are held over each call of pam_engine_do_step */
 } PamEngine;
 
 #endif

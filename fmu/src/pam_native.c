@@ -5,6 +5,7 @@
  * interface or keeping a second copy of any equation.  Only the PAM_EXPORT functions leave it.
  */
 #include "pam_core.c"
+#include "pam_fmu_common.c"
 
 #include "pam_native.h"
 #include "pam_gauss.h"

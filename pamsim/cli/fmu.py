@@ -17,12 +17,14 @@ def register(sub) -> None:
     b = fsub.add_parser("build", help="compile and pack the FMU",
                         description="Generate the sources and model description, compile them and write the .fmu.")
     b.add_argument("-o", "--output", default=None,
-                   help="FMU file to write (default: pamsim_muscle_fmi<version>.fmu in the current folder)")
+                   help="FMU file to write (default: pamsim_muscle_fmi<version>.fmu in the current folder, or "
+                        "pamsim_assembly_fmi<version>.fmu for a scenario that adds components)")
     b.add_argument("--fmi", default="2", help="FMI version: 2 (FMI 2.0) or 3 (FMI 3.0); default 2")
     b.add_argument("--scenario", default=None,
                    help="build the FMU for this scenario: its muscle's and its own values (parameters, choices, "
                         "initial state, input signals, run) are the FMU's start values, and a static force other "
-                        "than the ACRA 2012 polynomial is baked in as a force table")
+                        "than the ACRA 2012 polynomial is baked in as a force table; a scenario that adds components "
+                        "([[component]]) gives the FMU generated from its assembly, with structured names")
     b.add_argument("--muscle", default=None,
                    help="build the FMU for this muscle (shipped name or TOML path): its parameters are the FMU's "
                         "start values, and its static force is baked in as a force table")
@@ -62,6 +64,17 @@ def run_build(args: argparse.Namespace) -> int:
         given = "--static-force" if args.static_force is not None else "--static-force-variant"
         raise InputError(f"--muscle: needed with {given}")
     preset = None
+    if args.scenario:
+        from ..scenario import load_scenario
+
+        scenario = load_scenario(args.scenario)
+        if scenario.added_components:
+            from ..fmu import build_assembly
+
+            path = build_assembly(scenario, args.output, int(args.fmi))
+            print(f"wrote {path} (FMI {args.fmi}.0, Model Exchange and Co-Simulation, generated from the assembly "
+                  f"of scenario {scenario.name}: structured variable names such as load.x_m)")
+            return 0
     if args.scenario or by_muscle:
         from ..fmu import preset as presets
         from ..scenario import load_scenario

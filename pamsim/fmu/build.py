@@ -20,8 +20,9 @@ from pathlib import Path
 
 from ..errors import InputError
 from .force_table import ForceTable
-from .generate import (MODEL_IDENTIFIER, compiled_sources, generation_date, model_description, write_documentation,
-                       write_sources)
+from .generate import (MODEL_IDENTIFIER, WRAPPERS, generation_date, one_muscle_spec, spec_model_description,
+                       write_spec_documentation, write_spec_sources)
+from .spec import FmuSpec
 
 FMI_VERSIONS = (2, 3)
 
@@ -97,22 +98,32 @@ def build(output_path: str | os.PathLike | None = None, fmi_version: int = 2,
             raise ValueError("give the force table in the preset, not beside it")
         force_table = preset.table
     out = Path(output_path) if output_path else default_output(fmi_version)
+    return build_spec(out, one_muscle_spec(fmi_version, force_table, preset))
+
+
+def build_spec(out: Path, spec: FmuSpec) -> Path:
+    """Generate, compile and zip the FMU ``spec`` describes into ``out`` (a ``.fmu`` path); return ``out``.
+
+    Raises :class:`~pamsim.errors.InputError` for a missing C compiler or a failed compilation.
+    """
+    out = Path(out)
+    fmi_version = spec.fmi_version
     if out.suffix != ".fmu":
         raise InputError(f"{out}: the FMU file name must end in .fmu")
     compiler = c_compiler("pamsim fmu build")
     with tempfile.TemporaryDirectory(prefix="pamsim-fmu-") as tmp:
         root = Path(tmp)
         src = root / "sources"
-        write_sources(src, fmi_version, force_table, preset)
-        (root / "modelDescription.xml").write_text(model_description(fmi_version, force_table, preset))
+        write_spec_sources(src, spec)
+        (root / "modelDescription.xml").write_text(spec_model_description(spec))
         bin_dir = root / "binaries" / platform_folder(fmi_version)
         bin_dir.mkdir(parents=True)
-        lib = bin_dir / (MODEL_IDENTIFIER + shared_library_suffix())
-        write_documentation(root / "documentation", fmi_version, force_table, preset)
+        lib = bin_dir / (spec.identifier + shared_library_suffix())
+        write_spec_documentation(root / "documentation", spec)
         # Only the FMI functions are exported; relative source paths keep the temporary folder's name
         # out of the binary, so that the same sources give the same archive.
         cmd = [compiler, "-shared", "-fPIC", "-O2", "-std=c99", "-Wall", "-fvisibility=hidden", "-I", ".",
-               *compiled_sources(fmi_version), "-o", str(lib), "-lm"]
+               *spec.compiled(), WRAPPERS[fmi_version], "-o", str(lib), "-lm"]
         proc = subprocess.run(cmd, capture_output=True, text=True, cwd=src)
         if proc.returncode != 0:
             raise InputError(f"compiling the FMU failed ({' '.join(cmd[:2])} ...): {proc.stderr.strip()}")
@@ -128,3 +139,19 @@ def build(output_path: str | os.PathLike | None = None, fmi_version: int = 2,
                     zf.writestr(info, path.read_bytes())
         os.replace(partial, out)
     return out
+
+
+def build_assembly(scenario, output_path: str | os.PathLike | None = None, fmi_version: int = 2) -> Path:
+    """Generate, compile and zip the FMU of ``scenario``'s assembly of components
+    (:mod:`pamsim.fmu.assembly_fmu`): namespaced variables, every equation generated; return its path
+    (default ``pamsim_assembly_fmi<version>.fmu``).
+
+    Raises :class:`~pamsim.errors.InputError` for an unknown FMI version, a scenario the FMU cannot
+    carry, a missing C compiler or a failed compilation.
+    """
+    from .assembly_fmu import assembly_spec
+
+    if fmi_version not in FMI_VERSIONS:
+        raise InputError(f"FMI version must be 2 or 3, not {fmi_version!r}")
+    spec = assembly_spec(scenario, fmi_version)
+    return build_spec(Path(output_path) if output_path else Path(f"{spec.identifier}_fmi{fmi_version}.fmu"), spec)

@@ -22,15 +22,19 @@ from .. import __version__
 from ..references import REFERENCES
 from .units import base_unit
 from .force_table import EMPTY_HEADER, ForceTable
-from .variables import (BY_NAME, EVENT_INDICATORS, INPUT_SOURCE_CHOICES, INPUTS, STATES, VARIABLES,
-                        value_reference, with_preset)
+from .spec import FmuSpec
+from .variables import (EVENT_INDICATORS, INPUT_SOURCE_CHOICES, INPUTS, STATES, VARIABLES, value_reference,
+                        with_preset)
 
 MODEL_NAME = "pamsim_muscle"
 MODEL_IDENTIFIER = "pamsim_muscle"
 C_DIR = Path(__file__).resolve().parents[2] / "fmu"  # the source tree; an installed wheel has pamsim.fmu.csrc
-CORE_SOURCES = ("pam_core.c", "pam_core.h", "pam_dopri.h", "pam_shared.h", "fmi_shell.c", "fmi_shell.h")
-"""The hand-written C sources (pam_shared.h is generated but committed); ``pam_variables.h`` and
-``pam_force_table.h`` are generated at build time."""
+CORE_SOURCES = ("pam_core.c", "pam_core.h", "pam_dopri.h", "pam_shared.h", "pam_log.h", "pam_fmu_common.c",
+                "pam_fmu_common.h", "fmi_shell.c", "fmi_shell.h")
+"""The hand-written C sources (pam_shared.h is generated but committed); ``pam_variables.h``,
+``pam_force_table.h`` and ``pam_fmu_core.h`` are generated at build time."""
+CORE_HEADER = '#include "pam_core.h" /* the one-muscle core written by hand */\n'
+"""``pam_fmu_core.h``: the core the FMI shell runs on."""
 WRAPPERS = {2: "fmi2_wrapper.c", 3: "fmi3_wrapper.c"}
 HEADERS = {2: ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h"),
            3: ("fmi3Functions.h", "fmi3FunctionTypes.h", "fmi3PlatformTypes.h")}
@@ -86,11 +90,6 @@ def generation_date() -> str | None:
     return stamp.strftime("%Y-%m-%dT%H:%M:%SZ")
 
 
-def compiled_sources(fmi_version: int) -> tuple[str, ...]:
-    """The C files the FMU's binary is compiled from (as listed in the XML and by ``build``)."""
-    return tuple(n for n in CORE_SOURCES if n.endswith(".c")) + (WRAPPERS[fmi_version],)
-
-
 def c_source_dir() -> Path:
     """The folder holding ``src/`` and ``include/`` of the C model."""
     if (C_DIR / "src" / "pam_core.c").is_file():
@@ -123,18 +122,27 @@ def token(fmi_version: int, table: ForceTable | None = None, preset=None) -> str
     return "{" + str(uuid.UUID(bytes=h.digest()[:16])) + "}"
 
 
+def one_muscle_spec(fmi_version: int, table: ForceTable | None = None, preset=None) -> FmuSpec:
+    """The :class:`~pamsim.fmu.spec.FmuSpec` of the one-muscle FMU (its core written by hand), built with a
+    force ``table`` and for a ``preset``, if any."""
+    variables = with_preset(VARIABLES, table, preset)
+    return FmuSpec(
+        variables, {v.name: value_reference(v.name) for v in variables}, STATES, EVENT_INDICATORS, INPUTS,
+        MODEL_NAME, MODEL_IDENTIFIER, "flat", description(table, preset), CORE_SOURCES,
+        {"pam_force_table.h": table.c_header() if table is not None else EMPTY_HEADER, "pam_fmu_core.h": CORE_HEADER},
+        signals=preset.signals if preset is not None else {},
+        experiment=preset.experiment if preset is not None else None, token=token(fmi_version, table, preset),
+        fmi_version=fmi_version, usage=_usage(table, preset))
+
+
 def _num(x) -> str:
     return repr(float(x)) if isinstance(x, float) else str(x)
 
 
-def _units() -> list[str]:
-    return sorted({v.unit for v in VARIABLES if v.unit})
-
-
-def _unit_definitions() -> list[str]:
+def _unit_definitions(variables) -> list[str]:
     """``<UnitDefinitions>`` with each unit's SI ``<BaseUnit>`` (the same element in FMI 2.0 and 3.0)."""
     lines = ["  <UnitDefinitions>"]
-    for u in _units():
+    for u in sorted({v.unit for v in variables if v.unit}):
         factor, exponents = base_unit(u)
         base = _attrs(**exponents, factor=repr(factor) if factor != 1.0 else None)
         lines.append(f"    <Unit{_attrs(name=u)}>\n      <BaseUnit{base}/>\n    </Unit>")
@@ -146,9 +154,9 @@ def enumeration_type(v) -> str:
     return "".join(part.capitalize() for part in v.name.split("_"))
 
 
-def _type_definitions(fmi_version: int) -> list[str]:
+def _type_definitions(fmi_version: int, variables) -> list[str]:
     lines = ["  <TypeDefinitions>"]
-    for v in VARIABLES:
+    for v in variables:
         if not v.choices:
             continue
         items = [f'      <Item{_attrs(name=c, value=i)}/>' for i, c in enumerate(v.choices)]
@@ -166,9 +174,8 @@ LOG_CATEGORIES = (("logStatusOK", "informative messages (only with debug logging
 """The categories the C code logs under (fmi_shell.c, level_category)."""
 
 
-def _common_elements(preset=None) -> list[str]:
+def _common_elements(run=None) -> list[str]:
     """Log categories and the DefaultExperiment: a scenario's run, else the paper's 8 s tests."""
-    run = preset.experiment if preset is not None and preset.experiment is not None else None
     stop, tolerance, step = (run.stop_time_s, run.tolerance, run.step_size_s) if run else (8.0, 1e-6, DEFAULT_STEP_S)
     lines = ["  <LogCategories>"]
     lines += [f"    <Category{_attrs(name=n, description=d)}/>" for n, d in LOG_CATEGORIES]
@@ -198,44 +205,49 @@ def _dependencies(names, key) -> dict[str, str]:
     return {"dependencies": " ".join(str(key(n)) for n in sorted(names, key=key))}
 
 
-def _header(fmi_version: int, table: ForceTable | None, preset) -> str:
+def _header(spec: FmuSpec) -> str:
+    fmi_version = spec.fmi_version
     token_attr = "guid" if fmi_version == 2 else "instantiationToken"
-    attrs = _attrs(modelName=MODEL_NAME, **{token_attr: token(fmi_version, table, preset)},
-                   description=description(table, preset),
+    attrs = _attrs(modelName=spec.model_name, **{token_attr: spec.token},
+                   description=spec.description,
                    author=AUTHOR,
                    version=__version__, license=LICENSE, generationTool="pamsim.fmu",
-                   generationDateAndTime=generation_date(), variableNamingConvention="flat")
-    extra = ' numberOfEventIndicators="2"' if fmi_version == 2 else ""
+                   generationDateAndTime=generation_date(), variableNamingConvention=spec.naming)
+    extra = f' numberOfEventIndicators="{len(spec.event_indicators)}"' if fmi_version == 2 else ""
     return f'<fmiModelDescription fmiVersion="{fmi_version}.0"{attrs}{extra}>'
 
 
 def model_description(fmi_version: int, table: ForceTable | None = None, preset=None) -> str:
     """``modelDescription.xml``; ``table``: the force table the FMU is built with, if any; ``preset``: the
     :class:`pamsim.fmu.preset.Preset` of the muscle or scenario it is built for, if any."""
-    if fmi_version == 2:
-        return _fmi2(table, preset)
-    if fmi_version == 3:
-        return _fmi3(table, preset)
-    raise ValueError(f"FMI version must be 2 or 3, not {fmi_version!r}")
+    if fmi_version not in (2, 3):
+        raise ValueError(f"FMI version must be 2 or 3, not {fmi_version!r}")
+    return spec_model_description(one_muscle_spec(fmi_version, table, preset))
+
+
+def spec_model_description(spec: FmuSpec) -> str:
+    """``modelDescription.xml`` of the FMU ``spec`` describes."""
+    return _fmi2(spec) if spec.fmi_version == 2 else _fmi3(spec)
 
 
 def _attrs(**kw) -> str:
     return "".join(f" {k}={quoteattr(str(v))}" for k, v in kw.items() if v is not None)
 
 
-def _fmi2(table: ForceTable | None, preset) -> str:
-    variables = with_preset(VARIABLES, table, preset)
-    src_files = "".join(f'\n      <File name="{n}"/>' for n in compiled_sources(2))
-    lines = ['<?xml version="1.0" encoding="UTF-8"?>', _header(2, table, preset),
-             f'  <ModelExchange modelIdentifier="{MODEL_IDENTIFIER}" canGetAndSetFMUstate="true"'
+def _fmi2(spec: FmuSpec) -> str:
+    variables, value_reference, by_name = spec.variables, spec.vr, spec.by_name
+    src_files = "".join(f'\n      <File name="{n}"/>' for n in spec.compiled() + (WRAPPERS[2],))
+    lines = ['<?xml version="1.0" encoding="UTF-8"?>', _header(spec),
+             f'  <ModelExchange modelIdentifier="{spec.identifier}" canGetAndSetFMUstate="true"'
              ' canSerializeFMUstate="true" providesDirectionalDerivative="true"'
              ' canNotUseMemoryManagementFunctions="true">',
              f'    <SourceFiles>{src_files}\n    </SourceFiles>', '  </ModelExchange>',
-             f'  <CoSimulation modelIdentifier="{MODEL_IDENTIFIER}" canHandleVariableCommunicationStepSize="true"'
+             f'  <CoSimulation modelIdentifier="{spec.identifier}" canHandleVariableCommunicationStepSize="true"'
              ' canGetAndSetFMUstate="true" canSerializeFMUstate="true" providesDirectionalDerivative="true"'
              ' canNotUseMemoryManagementFunctions="true">',
              f'    <SourceFiles>{src_files}\n    </SourceFiles>', '  </CoSimulation>']
-    lines += _unit_definitions() + _type_definitions(2) + _common_elements(preset) + ['  <ModelVariables>']
+    lines += (_unit_definitions(variables) + _type_definitions(2, variables) + _common_elements(spec.experiment)
+              + ['  <ModelVariables>'])
     index = {v.name: i for i, v in enumerate(variables, start=1)}  # FMI 2.0 refers to variables by position
     for v in variables:
         head = _attrs(name=v.name, valueReference=value_reference(v.name), description=v.description,
@@ -252,7 +264,7 @@ def _fmi2(table: ForceTable | None, preset) -> str:
     lines.append('  </ModelVariables>')
     outputs = [v for v in variables if v.causality == "output"]
     derivs = [v for v in variables if v.derivative_of]
-    states = [BY_NAME[s] for s in STATES]
+    states = [by_name[s] for s in spec.states]
     initial = sorted({v.name: v for v in outputs + derivs + states}.values(), key=lambda v: index[v.name])
 
     def unknown(v, deps):
@@ -268,14 +280,14 @@ def _fmi2(table: ForceTable | None, preset) -> str:
     return "\n".join(lines)
 
 
-def _fmi3(table: ForceTable | None, preset) -> str:
-    variables = with_preset(VARIABLES, table, preset)
-    lines = ['<?xml version="1.0" encoding="UTF-8"?>', _header(3, table, preset),
-             f'  <ModelExchange modelIdentifier="{MODEL_IDENTIFIER}" needsCompletedIntegratorStep="true"'
+def _fmi3(spec: FmuSpec) -> str:
+    variables, value_reference, by_name = spec.variables, spec.vr, spec.by_name
+    lines = ['<?xml version="1.0" encoding="UTF-8"?>', _header(spec),
+             f'  <ModelExchange modelIdentifier="{spec.identifier}" needsCompletedIntegratorStep="true"'
              ' canGetAndSetFMUState="true" canSerializeFMUState="true" providesDirectionalDerivatives="true"/>',
-             f'  <CoSimulation modelIdentifier="{MODEL_IDENTIFIER}" canHandleVariableCommunicationStepSize="true"'
+             f'  <CoSimulation modelIdentifier="{spec.identifier}" canHandleVariableCommunicationStepSize="true"'
              ' canGetAndSetFMUState="true" canSerializeFMUState="true" providesDirectionalDerivatives="true"/>']
-    lines += _unit_definitions() + _type_definitions(3) + _common_elements(preset)
+    lines += _unit_definitions(variables) + _type_definitions(3, variables) + _common_elements(spec.experiment)
     lines += ['  <ModelVariables>',
               '    <Float64 name="time" valueReference="0" causality="independent" variability="continuous"'
               ' description="simulation time [s]" unit="s"/>']
@@ -296,7 +308,7 @@ def _fmi3(table: ForceTable | None, preset) -> str:
     lines.append('  </ModelVariables>')
     outputs = [v for v in variables if v.causality == "output"]
     derivs = [v for v in variables if v.derivative_of]
-    states = [BY_NAME[s] for s in STATES]
+    states = [by_name[s] for s in spec.states]
     initial = sorted({v.name: v for v in outputs + derivs + states}.values(), key=lambda v: value_reference(v.name))
     lines.append('  <ModelStructure>')
     lines += [f'    <Output valueReference="{value_reference(v.name)}"'
@@ -306,17 +318,17 @@ def _fmi3(table: ForceTable | None, preset) -> str:
     lines += [f'    <InitialUnknown valueReference="{value_reference(v.name)}"'
               f'{_attrs(**_dependencies(v.initial_depends_on, value_reference))}/>' for v in initial]
     lines += [f'    <EventIndicator valueReference="{value_reference(n)}"'
-              f'{_attrs(**_dependencies(BY_NAME[n].depends_on, value_reference))}/>' for n in EVENT_INDICATORS]
+              f'{_attrs(**_dependencies(by_name[n].depends_on, value_reference))}/>' for n in spec.event_indicators]
     lines += ['  </ModelStructure>', '</fmiModelDescription>', '']
     return "\n".join(lines)
 
 
-def build_description(fmi_version: int) -> str:
+def build_description(spec: FmuSpec) -> str:
     """The FMU's ``buildDescription.xml``: its C sources and include folders, for importers that compile it."""
-    files = "".join(f'\n      <SourceFile name="{n}"/>' for n in compiled_sources(fmi_version))
+    files = "".join(f'\n      <SourceFile name="{n}"/>' for n in spec.compiled() + (WRAPPERS[spec.fmi_version],))
     return ('<?xml version="1.0" encoding="UTF-8"?>\n'
             '<fmiBuildDescription fmiVersion="3.0">\n'
-            f'  <BuildConfiguration modelIdentifier="{MODEL_IDENTIFIER}">\n'
+            f'  <BuildConfiguration modelIdentifier="{spec.identifier}">\n'
             f'    <SourceFileSet language="C99">{files}\n    </SourceFileSet>\n'
             '  </BuildConfiguration>\n</fmiBuildDescription>\n')
 
@@ -329,19 +341,24 @@ def _c_bound(x: float) -> str:
 
 
 def c_header(fmi_version: int, table: ForceTable | None = None, preset=None) -> str:
+    """``pam_variables.h`` of the one-muscle FMU (:func:`spec_c_header`)."""
+    return spec_c_header(one_muscle_spec(fmi_version, table, preset))
+
+
+def spec_c_header(spec: FmuSpec) -> str:
     """``pam_variables.h``: indices into the value arrays, value references, start values, the token, and
-    the input signals of the scenario the FMU is built for (``preset``), if any."""
-    variables = with_preset(VARIABLES, table, preset)
+    the input signals of the scenario the FMU is built for, if any."""
+    variables, value_reference, by_name = spec.variables, spec.vr, spec.by_name
     reals = [v for v in variables if v.kind == "real"]
     ints = [v for v in variables if v.kind == "integer"]
     n_slots = max(value_reference(v.name) for v in variables)
     kinds = {"parameter": "PAM_PARAMETER", "input": "PAM_INPUT", "output": "PAM_OUTPUT", "local": "PAM_LOCAL"}
-    out = ["/* Generated by pamsim.fmu.generate from pamsim/fmu/variables.py. Do not edit. */",
+    out = ["/* Generated by pamsim.fmu.generate. Do not edit. */",
            "#ifndef PAM_VARIABLES_H", "#define PAM_VARIABLES_H", "", "#include <math.h>", "",
-           f'#define PAM_TOKEN "{token(fmi_version, table, preset)}"', f"#define PAM_NR {len(reals)}",
+           f'#define PAM_TOKEN "{spec.token}"', f"#define PAM_NR {len(reals)}",
            f"#define PAM_NI {len(ints)}",
-           f"#define PAM_NVARS {n_slots}", f"#define PAM_NX {len(STATES)}",
-           f"#define PAM_NZ {len(EVENT_INDICATORS)}", ""]
+           f"#define PAM_NVARS {n_slots}", f"#define PAM_NX {len(spec.states)}",
+           f"#define PAM_NZ {len(spec.event_indicators)}", ""]
     out += [f"#define R_{v.c_name} {i}" for i, v in enumerate(reals)]
     out += [f"#define I_{v.c_name} {i}" for i, v in enumerate(ints)]
     out += [f"#define VR_{v.c_name} {value_reference(v.name)}u" for v in variables]
@@ -367,18 +384,22 @@ def c_header(fmi_version: int, table: ForceTable | None = None, preset=None) -> 
             f'    {{"{v.name}", {kind}, {idx}, {kinds[v.causality]}, {start}, {_c_bound(v.lower)}, '
             f'{_c_bound(v.upper)}, {int(v.lower_open)}, {int(v.upper_open)}}},')
     out += slots
+    derivative = {v.derivative_of: v for v in variables if v.derivative_of}
     out += ["};", "", "/* Continuous states and their derivatives, in state-vector order (indices into r[]). */",
-            "static const int PAM_STATE_R[PAM_NX] = {" + ", ".join(f"R_{BY_NAME[s].c_name}" for s in STATES) + "};",
+            "static const int PAM_STATE_R[PAM_NX] = {" + ", ".join(f"R_{by_name[s].c_name}" for s in spec.states) + "};",
             "static const int PAM_DERIV_R[PAM_NX] = {"
-            + ", ".join(f"R_{v.c_name}" for v in variables if v.derivative_of) + "};",
+            + ", ".join(f"R_{derivative[s].c_name}" for s in spec.states) + "};",
             "static const double PAM_NOMINAL[PAM_NX] = {"
-            + ", ".join(repr(float(BY_NAME[s].nominal)) for s in STATES) + "};", ""]
-    out += _c_signals(preset.signals if preset is not None else {})
-    return "\n".join(out + ["", "#endif", ""])
+            + ", ".join(repr(float(by_name[s].nominal)) for s in spec.states) + "};",
+            "static const int PAM_INDICATOR_R[" + str(max(1, len(spec.event_indicators))) + "] = {"
+            + (", ".join(f"R_{by_name[n].c_name}" for n in spec.event_indicators) or "0") + "};", ""]
+    out += _c_signals(spec)
+    return "\n".join(out + list(spec.c_extra) + ["", "#endif", ""])
 
 
-def _c_signals(signals) -> list[str]:
-    """The input signals (:class:`pamsim.fmu.preset.InputSignal`) for ``pam_core.c``, in :data:`INPUTS` order."""
+def _c_signals(spec: FmuSpec) -> list[str]:
+    """The input signals (:class:`pamsim.fmu.preset.InputSignal`) for the C core, in the order of the inputs."""
+    signals, by_name = spec.signals, spec.by_name
     out = ["/* input_source (pamsim.fmu.variables.INPUT_SOURCE_CHOICES) */",
            "enum { " + ", ".join(f"PAM_INPUT_SOURCE_{c.upper()} = {i}" for i, c in enumerate(INPUT_SOURCE_CHOICES))
            + " };",
@@ -389,8 +410,8 @@ def _c_signals(signals) -> list[str]:
            "/* The signals of the scenario this FMU was built for (none: PAM_NSIG 0). */",
            f"#define PAM_NSIG {len(signals)}"]
     rows = []
-    for k, name in enumerate(n for n in INPUTS if n in signals):
-        sig, c = signals[name], BY_NAME[name].c_name
+    for k, name in enumerate(n for n in spec.inputs if n in signals):
+        sig, c = signals[name], by_name[name].c_name
         if sig.lag is not None:
             rows.append(f"    {{R_{c}, VR_{c}, 0, 0, 0, " + ", ".join(repr(float(x)) for x in sig.lag) + "},")
             continue
@@ -405,21 +426,28 @@ def _c_signals(signals) -> list[str]:
 
 
 def write_sources(dest: Path, fmi_version: int, table: ForceTable | None = None, preset=None) -> list[str]:
-    """Write the sources an FMU ships (C files, generated header, FMI headers, licence) into ``dest``."""
+    """Write the sources the one-muscle FMU ships into ``dest`` (:func:`write_spec_sources`)."""
+    return write_spec_sources(dest, one_muscle_spec(fmi_version, table, preset))
+
+
+def write_spec_sources(dest: Path, spec: FmuSpec) -> list[str]:
+    """Write the sources an FMU ships (C files, generated headers, FMI headers, licence) into ``dest``."""
     dest.mkdir(parents=True, exist_ok=True)
     root = c_source_dir()
     names = []
-    for name in CORE_SOURCES + (WRAPPERS[fmi_version],):
+    fmi_version = spec.fmi_version
+    for name in spec.sources + (WRAPPERS[fmi_version],):
         (dest / name).write_bytes((root / "src" / name).read_bytes())
         names.append(name)
     for name in HEADERS[fmi_version]:
         (dest / name).write_bytes((root / "include" / f"fmi{fmi_version}" / name).read_bytes())
         names.append(name)
     (dest / "FMI_HEADERS_LICENSE.txt").write_bytes((root / "include" / "LICENSE.txt").read_bytes())
-    (dest / "pam_variables.h").write_text(c_header(fmi_version, table, preset))
-    (dest / "pam_force_table.h").write_text(table.c_header() if table is not None else EMPTY_HEADER)
-    (dest / "buildDescription.xml").write_text(build_description(fmi_version))
-    return names + ["pam_variables.h", "pam_force_table.h", "buildDescription.xml"]
+    (dest / "pam_variables.h").write_text(spec_c_header(spec))
+    for name, text in spec.generated.items():
+        (dest / name).write_text(text)
+    (dest / "buildDescription.xml").write_text(build_description(spec))
+    return names + ["pam_variables.h", *spec.generated, "buildDescription.xml"]
 
 
 def range_text(v) -> str:
@@ -465,17 +493,8 @@ USAGE = (
 """The usage page in the FMU's documentation/index.html."""
 
 
-def documentation_html(fmi_version: int, table: ForceTable | None = None, preset=None) -> str:
-    """``documentation/index.html``: a short usage page and the variable table."""
-    variables = with_preset(VARIABLES, table, preset)
-    rows = []
-    for v in variables:
-        cells = (str(value_reference(v.name)), v.name, v.causality, v.kind, v.unit or "",
-                 "" if v.start is None else f"{v.start:g}" if isinstance(v.start, float) else str(v.start),
-                 range_text(v), ", ".join(f"{i} = {c}" for i, c in enumerate(v.choices or ())), v.description)
-        rows.append("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in cells) + "</tr>")
-    head = "".join(f"<th>{h}</th>" for h in ("value reference", "name", "causality", "type", "unit", "start",
-                                              "range", "choices", "description"))
+def _usage(table: ForceTable | None, preset) -> tuple[tuple[str, str], ...]:
+    """The usage page of the one-muscle FMU: :data:`USAGE` for what it was built with and for."""
     usage = (("What it is", description(table, preset) + USAGE[0][1][len(DESCRIPTION):]),) + USAGE[1:]
     if preset is not None:  # its start values are not the Shadow muscle's
         usage = usage[:1] + (("Driving it", f"Set the parameters before the end of initialisation; the defaults are "
@@ -484,17 +503,41 @@ def documentation_html(fmi_version: int, table: ForceTable | None = None, preset
                               + (" As built, the inputs follow the scenario's signals (input_source = scenario), "
                                  "exactly within each step; set input_source = importer to drive them."
                                  if preset.signals else "")),) + usage[2:]
-    sections = "".join(f"<h2>{html.escape(t)}</h2>\n<p>{html.escape(p)}</p>\n" for t, p in usage)
-    return (f'<!DOCTYPE html>\n<html lang="en">\n<head><meta charset="utf-8"><title>{MODEL_NAME} (FMI '
-            f'{fmi_version}.0)</title></head>\n<body>\n<h1>{MODEL_NAME}: pamsim {__version__}, FMI {fmi_version}.0'
-            f'</h1>\n{sections}<h2>Variables</h2>\n<table>\n<tr>{head}</tr>\n' + "\n".join(rows)
+    return usage
+
+
+def documentation_html(fmi_version: int, table: ForceTable | None = None, preset=None) -> str:
+    """``documentation/index.html`` of the one-muscle FMU (:func:`spec_documentation_html`)."""
+    return spec_documentation_html(one_muscle_spec(fmi_version, table, preset))
+
+
+def spec_documentation_html(spec: FmuSpec) -> str:
+    """``documentation/index.html``: a short usage page and the variable table."""
+    rows = []
+    for v in spec.variables:
+        cells = (str(spec.vr(v.name)), v.name, v.causality, v.kind, v.unit or "",
+                 "" if v.start is None else f"{v.start:g}" if isinstance(v.start, float) else str(v.start),
+                 range_text(v), ", ".join(f"{i} = {c}" for i, c in enumerate(v.choices or ())), v.description)
+        rows.append("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in cells) + "</tr>")
+    head = "".join(f"<th>{h}</th>" for h in ("value reference", "name", "causality", "type", "unit", "start",
+                                              "range", "choices", "description"))
+    sections = "".join(f"<h2>{html.escape(t)}</h2>\n<p>{html.escape(p)}</p>\n" for t, p in spec.usage)
+    fmi_version = spec.fmi_version
+    return (f'<!DOCTYPE html>\n<html lang="en">\n<head><meta charset="utf-8"><title>{spec.model_name} (FMI '
+            f'{fmi_version}.0)</title></head>\n<body>\n<h1>{spec.model_name}: pamsim {__version__}, FMI '
+            f'{fmi_version}.0</h1>\n{sections}<h2>Variables</h2>\n<table>\n<tr>{head}</tr>\n' + "\n".join(rows)
             + "\n</table>\n</body>\n</html>\n")
 
 
 def write_documentation(dest: Path, fmi_version: int, table: ForceTable | None = None, preset=None) -> None:
-    """Write the FMU's ``documentation/`` folder into ``dest``."""
+    """Write the one-muscle FMU's ``documentation/`` folder into ``dest``."""
+    write_spec_documentation(dest, one_muscle_spec(fmi_version, table, preset))
+
+
+def write_spec_documentation(dest: Path, spec: FmuSpec) -> None:
+    """Write an FMU's ``documentation/`` folder into ``dest``."""
     dest.mkdir(parents=True, exist_ok=True)
-    (dest / "index.html").write_text(documentation_html(fmi_version, table, preset))
+    (dest / "index.html").write_text(spec_documentation_html(spec))
 
 
 def shared_header() -> str:

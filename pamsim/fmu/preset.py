@@ -163,6 +163,37 @@ def for_muscle(scenario: Scenario) -> Preset:
     return Preset(f"muscle {model['muscle']}", starts, sources, table, static_force=model["static_force"])
 
 
+SIGNAL_UNITS = {"valve_command": "", "supply_pressure_gauge_Pa": "Pa", "prescribed_pressure_gauge_Pa": "Pa",
+                "load_mass_kg": "kg", "external_force_N": "N"}
+"""The unit of each input a scenario can drive, as the signals' descriptions show it."""
+
+
+def scenario_signals(scenario: Scenario, names) -> dict[str, InputSignal]:
+    """The scenario's signals of the inputs ``names`` (of :data:`SIGNAL_UNITS`), as the FMU carries them.
+
+    Raises
+    ------
+    InputError
+        For an input signal the FMU cannot carry, naming the input.
+    """
+    inputs = ScenarioInputs(scenario)
+    model = inputs.model
+    raw = {"valve_command": Constant(0.0), "supply_pressure_gauge_Pa": Constant(0.0),
+           "prescribed_pressure_gauge_Pa": Constant(0.0), "load_mass_kg": Constant(scenario.mass_kg),
+           "external_force_N": model.load.external_force_N or Constant(0.0)}
+    if inputs.valve:
+        raw["valve_command"], raw["supply_pressure_gauge_Pa"] = model.source.command, model.source.supply_gauge_Pa
+    else:
+        raw["prescribed_pressure_gauge_Pa"] = model.source.p_gauge_Pa
+    signals = {}
+    for name in names:
+        try:
+            signals[name] = input_signal(raw[name], SIGNAL_UNITS[name])
+        except InputError as exc:
+            raise InputError(f"{scenario.origin}: input {name}: {exc}") from None
+    return signals
+
+
 def for_scenario(scenario: Scenario) -> Preset:
     """The preset of ``pamsim fmu build --scenario S``: the muscle's parameters, the scenario's
     choices, initial state and margins, its inputs as signals and its run.
@@ -183,23 +214,8 @@ def for_scenario(scenario: Scenario) -> Preset:
         if name not in starts:
             starts[name] = value
             sources[name] = where
-    inputs = ScenarioInputs(scenario)
-    model = inputs.model
-    units = {"valve_command": "", "supply_pressure_gauge_Pa": "Pa", "prescribed_pressure_gauge_Pa": "Pa",
-             "load_mass_kg": "kg", "external_force_N": "N"}
-    raw = {"valve_command": Constant(0.0), "supply_pressure_gauge_Pa": Constant(0.0),
-           "prescribed_pressure_gauge_Pa": Constant(0.0), "load_mass_kg": Constant(scenario.mass_kg),
-           "external_force_N": model.load.external_force_N or Constant(0.0)}
-    if inputs.valve:
-        raw["valve_command"], raw["supply_pressure_gauge_Pa"] = model.source.command, model.source.supply_gauge_Pa
-    else:
-        raw["prescribed_pressure_gauge_Pa"] = model.source.p_gauge_Pa
-    signals = {}
+    signals = scenario_signals(scenario, INPUTS)
     for name in INPUTS:
-        try:
-            signals[name] = input_signal(raw[name], units[name])
-        except InputError as exc:
-            raise InputError(f"{scenario.origin}: input {name}: {exc}") from None
         starts[name] = signals[name](0.0)
         sources[name] = f"{where} at t = 0 s; with input_source = scenario it follows {signals[name].text}"
     starts["input_source"] = INPUT_SOURCE_CHOICES.index("scenario")

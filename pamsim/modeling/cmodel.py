@@ -17,7 +17,10 @@ function       arguments                   results
 ``y``          x, u, p                     the outputs (x: every state, quadratures included)
 =============  ==========================  =====================================================
 
-and, once, ``x0(u, p) -> (x, q0)``.  The integrated states are those that are not quadratures
+and, once, ``x0(u, p) -> (x, q0)``.  With ``jacobians``, also the exact Jacobians an FMU's directional
+derivatives are taken from: per mode ``jac(x, u, p)``, the derivatives of every state then the outputs
+by every state, input and parameter, and once ``jx0(u, p)``, the initial states by the inputs and
+parameters (dense, column-major).  The integrated states are those that are not quadratures
 (:meth:`pamsim.modeling.flat.FlatModel.quadratures`): the engine computes the quadratures from its
 dense output, outside its error control.  A mode is *held* when the hybrid component's own states do
 not move in it (their derivatives are structurally zero); the engine caps its steps only while
@@ -52,7 +55,7 @@ class CModel:
     hybrid component is supported; a model without one has a single mode, value 0).
     """
 
-    def __init__(self, assembly, component: str | None = None):
+    def __init__(self, assembly, component: str | None = None, jacobians: bool = False):
         import casadi as ca
 
         full = assembly.flatten()
@@ -76,10 +79,15 @@ class CModel:
         for k, value in enumerate(self.mode_values):
             m = assembly.flatten({self.component: value}) if self.component else full
             self.functions += self._mode_functions(ca, m, k)
+            if jacobians:
+                self.functions.append(_jacobian(ca, f"pm_jac{k}", [m.x, m.u, m.p], m.f + m.y))
             self.held.append(bool(own) and all(ca.SX(m.f[i]).is_zero() for i in own))
             self.quad_zero.append(all(ca.SX(m.f[i]).is_zero() for i in self.quadratures))
         col = lambda es: ca.vertcat(*es) if es else ca.SX(0, 1)  # noqa: E731
         self.functions.append(_dense(ca, "pm_x0_fn", [col(full.u), col(full.p)], [full.x0, full.q0]))
+        self.jacobians = jacobians
+        if jacobians:
+            self.functions.append(_jacobian(ca, "pm_jx0_fn", [full.u, full.p], full.x0))
 
     def _mode_functions(self, ca, m, k: int) -> list:
         col = lambda es: ca.vertcat(*es) if es else ca.SX(0, 1)  # noqa: E731
@@ -166,7 +174,25 @@ class CModel:
                   "    const double *arg[PM_SZ_ARG]; double *res[PM_SZ_RES]; long long iw[PM_SZ_IW]; double w[PM_SZ_W];",
                   "    arg[0] = u; arg[1] = p; res[0] = x; res[1] = q0;",
                   "    pm_x0_fn(arg, res, iw, w, 0);", "}", ""]
+        if self.jacobians:
+            lines += ["static void pm_jac(int k, const double *x, const double *u, const double *p, double *out) {",
+                      "    const double *arg[PM_SZ_ARG]; double *res[PM_SZ_RES]; long long iw[PM_SZ_IW]; "
+                      "double w[PM_SZ_W];", "    arg[0] = x; arg[1] = u; arg[2] = p; res[0] = out;", "    switch (k) {"]
+            lines += [f"    case {k}: pm_jac{k}(arg, res, iw, w, 0); break;" for k in modes]
+            lines += ["    default: break;", "    }", "}", "",
+                      "static void pm_jx0(const double *u, const double *p, double *out) {",
+                      "    const double *arg[PM_SZ_ARG]; double *res[PM_SZ_RES]; long long iw[PM_SZ_IW]; "
+                      "double w[PM_SZ_W];", "    arg[0] = u; arg[1] = p; res[0] = out;",
+                      "    pm_jx0_fn(arg, res, iw, w, 0);", "}", ""]
         return "\n".join(lines)
+
+
+def _jacobian(ca, name: str, wrt: list, exprs: list):
+    """A CasADi Function of ``wrt`` (lists of symbols) giving the dense Jacobian of ``exprs`` by all of them."""
+    col = lambda es: ca.vertcat(*es) if es else ca.SX(0, 1)  # noqa: E731
+    args = [col(list(w)) for w in wrt]
+    jac = ca.jacobian(col(list(exprs)), ca.vertcat(*args))
+    return ca.Function(name, args, [ca.cse(ca.densify(jac))])
 
 
 def _dense(ca, name: str, args: list, outs: list):

@@ -20,10 +20,12 @@ from pathlib import Path
 from ..errors import InputError
 from ..fmu.build import c_compiler, shared_library_suffix
 from ..fmu.force_table import EMPTY_HEADER
-from ..fmu.generate import c_header, c_source_dir
+from ..fmu.generate import CORE_HEADER, c_header, c_source_dir
 
-SOURCES = ("pam_native.c", "pam_native.h", "pam_core.c", "pam_core.h", "pam_dopri.h", "pam_gauss.h", "pam_shared.h")
-"""The C files the library is built from (pam_native.c includes pam_core.c: one translation unit)."""
+SOURCES = ("pam_native.c", "pam_native.h", "pam_core.c", "pam_core.h", "pam_dopri.h", "pam_gauss.h", "pam_shared.h",
+           "pam_log.h", "pam_fmu_common.c", "pam_fmu_common.h")
+"""The C files the library is built from (pam_native.c includes pam_core.c and pam_fmu_common.c: one
+translation unit)."""
 FLAGS = ("-shared", "-fPIC", "-O3", "-std=c99", "-Wall", "-fvisibility=hidden")
 LIBRARY_NAME = "libpamsim_native"
 CACHE_ENV = "PAMSIM_NATIVE_CACHE"
@@ -70,6 +72,7 @@ def library_path() -> Path:
         (work / "pam_variables.h").write_text(c_header(2))
         # No force table: the library runs the polynomial; other static forces are refused before a run.
         (work / "pam_force_table.h").write_text(EMPTY_HEADER)
+        (work / "pam_fmu_core.h").write_text(CORE_HEADER)
         os.replace(compile_library(cc, "pam_native.c", work, path.name, "the native library"), path)
     return path
 

@@ -1,0 +1,294 @@
+/* The FMU core of a generated assembly; see pam_gcore.h.  A unity build: the engine, and through it the
+ * generated model, are compiled into this file. */
+#include "pam_engine.c"
+#include "pam_gauss.h"
+#include "pam_fmu_core.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define PAM_ARRAY(n) ((n) > 0 ? (n) : 1)
+
+/* ------------------------------------------------------------ the model's vectors in r[] */
+
+static void gather_all(const PamCore *c, double *x, double *u, double *p) {
+    int k;
+    for (k = 0; k < PM_NS; k++) x[k] = c->r[PAM_STATE_R[k]];
+    for (k = 0; k < PM_NU; k++) u[k] = c->r[PAM_U_R[k]];
+    for (k = 0; k < PM_NP; k++) p[k] = c->r[PAM_P_R[k]];
+}
+
+static int scheduled(const PamCore *c) {
+    return PAM_NSIG > 0 && c->i[I_input_source] == PAM_INPUT_SOURCE_SCENARIO;
+}
+
+void pam_reset(PamCore *c) {
+    int k;
+    for (k = 0; k < PAM_NVARS; k++) {
+        if (PAM_VARS[k].kind == 'r') c->r[PAM_VARS[k].index] = PAM_VARS[k].start;
+        else if (PAM_VARS[k].kind) c->i[PAM_VARS[k].index] = (int32_t)PAM_VARS[k].start;
+    }
+    c->time_s = 0.0;
+    c->mode = 0;
+    c->inputs_changed = 0;
+    c->h_s = 1e-4;
+    c->n_steps = c->n_rhs = c->n_events = 0;
+    c->event_time_s = 0.0;
+    c->inputs_set = 0;
+}
+
+int pam_check_value(PamCore *c, unsigned vr, double value) { return pam_check_own_range(c, vr, value); }
+
+int pam_check_parameters(PamCore *c) {
+    int bad = 0, k;
+    if (pam_check_parameter_ranges(c)) return -1;
+    if (c->i[I_input_source] == PAM_INPUT_SOURCE_SCENARIO && pam_check_signals(c)) bad = -1;
+    for (k = 0; k < PAM_NVARS; k++)
+        if (PAM_VARS[k].causality == PAM_INPUT && pam_check_value(c, (unsigned)k + 1, c->r[PAM_VARS[k].index])) bad = -1;
+    return bad;
+}
+
+/* ------------------------------------------------------------ the engine's view of the core */
+
+/* The engine and what its callbacks need: the core it reads its signals from, and the quadratures. */
+typedef struct {
+    PamEngine e;
+    PamCore *core;
+    PamEngineInputs inputs;
+    double quad[PAM_ARRAY(PM_NQ)];
+    double gl_weight[GL_N];
+} EngineRun;
+
+static void run_inputs_at(void *env, double t_s, int left, double *u) {
+    EngineRun *run = (EngineRun *)env;
+    int k;
+    pam_inputs_at(run->core, t_s, left);
+    for (k = 0; k < PM_NU; k++) u[k] = run->core->r[PAM_U_R[k]];
+}
+
+static double run_next_breakpoint(void *env, double t_s) {
+    return pam_next_breakpoint(((EngineRun *)env)->core, t_s);
+}
+
+static int run_constant_after(void *env, double t_s) { return pam_inputs_constant(((EngineRun *)env)->core, t_s); }
+
+/* Each accepted step adds its quadratures (the work integrals, outside the engine's error control): a
+ * 5-point Gauss rule on the step's dense output, the inputs at each node. */
+static void run_quadrature(void *env, double t0, double t1, double h, const double *y0, const PamStages *s) {
+    EngineRun *run = (EngineRun *)env;
+    PamEngine *e = &run->e;
+    double span = t1 - t0, y[PAM_ARRAY(PM_NX)], dq[PAM_ARRAY(PM_NQ)];
+    int k, q;
+    if (PM_NQ == 0 || !(span > 0.0) || PM_MODE_QUAD_ZERO[e->mode]) return;
+    for (k = 0; k < GL_N; k++) {
+        double tau = t0 + GL_NODE[k] * span;
+        if (s) dp_dense(s, y0, h, (tau - t0) / h, y);
+        else memcpy(y, y0, sizeof y);
+        inputs_at(e, tau, 1);
+        pm_fq(e->mode, y, e->u, e->p, dq);
+        for (q = 0; q < PM_NQ; q++) run->quad[q] += span * run->gl_weight[k] * dq[q];
+    }
+}
+
+static void engine_load(PamCore *c, EngineRun *run) {
+    PamEngine *e = &run->e;
+    double x[PAM_ARRAY(PM_NS)], A[GL_N][GL_N];
+    int k, j;
+    pam_engine_reset(e);
+    gather_all(c, x, e->u, e->p);
+    for (k = 0; k < PM_NX; k++) e->x[k] = x[PM_DYNAMIC[k]];
+    for (k = 0; k < PM_NQ; k++) run->quad[k] = x[PM_QUADRATURE[k]];
+    e->mode = c->mode;
+    e->time_s = c->time_s;
+    e->rtol = c->r[R_cs_relative_tolerance];
+    e->max_step_s = c->r[R_cs_max_step_s];
+    e->max_steps = c->i[I_cs_max_internal_steps];
+    e->h_s = c->h_s;
+    e->inputs_changed = c->inputs_changed;
+    e->n_steps = c->n_steps;
+    e->n_rhs = c->n_rhs;
+    e->n_events = c->n_events;
+    e->log = c->log;
+    e->log_env = c->log_env;
+    run->core = c;
+    run->inputs.at = run_inputs_at;
+    run->inputs.next_breakpoint = run_next_breakpoint;
+    run->inputs.constant_after = run_constant_after;
+    run->inputs.env = run;
+    e->inputs = scheduled(c) ? &run->inputs : NULL;
+    e->on_step = run_quadrature;
+    e->step_env = run;
+    gauss_primitives(A);
+    for (k = 0; k < GL_N; k++)
+        for (run->gl_weight[k] = 0.0, j = 0; j < GL_N; j++) run->gl_weight[k] += A[k][j];
+}
+
+static void engine_store(PamCore *c, const EngineRun *run) {
+    const PamEngine *e = &run->e;
+    int k;
+    for (k = 0; k < PM_NX; k++) c->r[PAM_STATE_R[PM_DYNAMIC[k]]] = e->x[k];
+    for (k = 0; k < PM_NQ; k++) c->r[PAM_STATE_R[PM_QUADRATURE[k]]] = run->quad[k];
+    for (k = 0; k < PM_NU; k++) c->r[PAM_U_R[k]] = e->u[k];
+    c->mode = e->mode;
+    c->h_s = e->h_s;
+    c->inputs_changed = e->inputs_changed;
+    c->n_steps = e->n_steps;
+    c->n_rhs = e->n_rhs;
+    c->n_events = e->n_events;
+}
+
+/* ------------------------------------------------------------ evaluation */
+
+void pam_evaluate(PamCore *c) {
+    double x[PAM_ARRAY(PM_NS)], u[PAM_ARRAY(PM_NU)], p[PAM_ARRAY(PM_NP)], xd[PAM_ARRAY(PM_NX)];
+    double f[PAM_ARRAY(PM_NX)], fq[PAM_ARRAY(PM_NQ)], z[PAM_ARRAY(PM_NZ)], y[PAM_ARRAY(PM_NY)];
+    int k;
+    gather_all(c, x, u, p);
+    for (k = 0; k < PM_NX; k++) xd[k] = x[PM_DYNAMIC[k]];
+    pm_f(c->mode, xd, u, p, f);
+    pm_fq(c->mode, xd, u, p, fq);
+    pm_z(c->mode, xd, u, p, z);
+    pm_y(c->mode, x, u, p, y);
+    for (k = 0; k < PM_NX; k++) c->r[PAM_DERIV_R[PM_DYNAMIC[k]]] = f[k];
+    for (k = 0; k < PM_NQ; k++) c->r[PAM_DERIV_R[PM_QUADRATURE[k]]] = fq[k];
+    for (k = 0; k < PM_NZ; k++) c->r[PAM_INDICATOR_R[k]] = z[k];
+    /* An output that is also a state or a parameter is that variable (PAM_Y_R -1). */
+    for (k = 0; k < PM_NY; k++)
+        if (PAM_Y_R[k] >= 0) c->r[PAM_Y_R[k]] = y[k];
+    if (PAM_I_MODE >= 0) c->i[PAM_I_MODE] = PM_MODE_VALUE[c->mode];
+}
+
+/* The initial states and mode from the parameters and the inputs as they are. */
+static void derive_start(PamCore *c) {
+    EngineRun run;
+    int k;
+    engine_load(c, &run);
+    pam_engine_initialize(&run.e);
+    for (k = 0; k < PM_NS; k++) c->r[PAM_STATE_R[k]] = run.e.q_start[k];
+    c->mode = run.e.mode;
+    c->inputs_changed = 0;
+    pam_evaluate(c);
+}
+
+void pam_initialize(PamCore *c) {
+    pam_apply_signals(c, c->time_s, 0, c->inputs_set); /* the ones the importer set are checked equal */
+    derive_start(c);
+}
+
+void pam_note_table_edge(PamCore *c) { (void)c; }
+
+int pam_event_update(PamCore *c) {
+    EngineRun run;
+    int old = c->mode, jumped;
+    engine_load(c, &run);
+    jumped = transition(&run.e, run.e.x, fired_indicators(&run.e, run.e.x));
+    if (jumped || run.e.mode != old) run.e.n_events++;
+    engine_store(c, &run);
+    c->inputs_changed = 0;
+    pam_evaluate(c);
+    return jumped;
+}
+
+int pam_do_step(PamCore *c, double t_end) {
+    EngineRun run;
+    int failed;
+    engine_load(c, &run);
+    failed = pam_engine_do_step(&run.e, t_end);
+    engine_store(c, &run);
+    c->time_s = run.e.time_s;
+    if (!failed) c->time_s = t_end;
+    pam_inputs_at(c, c->time_s, 0);
+    pam_evaluate(c);
+    return failed ? -1 : 0;
+}
+
+/* ------------------------------------------------------------ directional derivatives */
+
+/* Where variable `vr` sits in the exact Jacobians of pam_model.c: PAM_DD_KIND (PAM_DD_STATE, ...) and
+ * its place in its vector (PAM_DD_INDEX); 0 for a variable that is none of these. */
+static int dd_kind(unsigned vr) { return vr >= 1 && vr <= PAM_NVARS ? PAM_DD_KIND[vr - 1] : PAM_DD_NONE; }
+
+/* The column of a known in [x; u; p]. */
+static int known_column(unsigned vr, int initializing) {
+    int kind = dd_kind(vr), at = kind == PAM_DD_NONE ? 0 : PAM_DD_INDEX[vr - 1];
+    if (kind == PAM_DD_STATE && !initializing) return at;
+    if (kind == PAM_DD_INPUT) return PM_NS + at;
+    if (kind == PAM_DD_PARAMETER && initializing) return PM_NS + PM_NU + at;
+    return -1;
+}
+
+/* The row of an unknown in [der(x); y], or -2 - k for state k (its own derivative is the identity, or in
+ * initialisation its initial value's). */
+static int unknown_row(unsigned vr) {
+    int kind = dd_kind(vr), at = kind == PAM_DD_NONE ? 0 : PAM_DD_INDEX[vr - 1];
+    if (kind == PAM_DD_DERIVATIVE) return at;
+    if (kind == PAM_DD_OUTPUT) return PM_NS + at;
+    if (kind == PAM_DD_STATE) return -2 - at;
+    return -1;
+}
+
+#define JROWS (PM_NS + PM_NY)
+#define JCOLS (PM_NS + PM_NU + PM_NP)
+
+int pam_directional_derivative(PamCore *c, const unsigned *unknowns, int n_unknowns, const unsigned *knowns,
+                               int n_knowns, const double *seed, double *sensitivity, int initializing) {
+    double x[PAM_ARRAY(PM_NS)], u[PAM_ARRAY(PM_NU)], p[PAM_ARRAY(PM_NP)], dx0[PAM_ARRAY(PM_NS)];
+    double *J = (double *)malloc(sizeof(double) * JROWS * JCOLS), *J0 = NULL;
+    int k, a, s, status = 0;
+    if (!J) return -1;
+    if (initializing) {
+        J0 = (double *)malloc(sizeof(double) * PAM_ARRAY(PM_NS * (PM_NU + PM_NP)));
+        if (!J0) {
+            free(J);
+            return -1;
+        }
+    }
+    gather_all(c, x, u, p);
+    pm_jac(c->mode, x, u, p, J); /* column-major: J[col * JROWS + row] */
+    if (initializing) pm_jx0(u, p, J0); /* d x0 / d [u; p], column-major */
+    for (a = 0; a < n_unknowns; a++) sensitivity[a] = 0.0;
+    for (k = 0; k < n_knowns && status == 0; k++) {
+        int col = known_column(knowns[k], initializing);
+        if (col < 0) status = -1;
+    }
+    for (a = 0; a < n_unknowns && status == 0; a++)
+        if (unknown_row(unknowns[a]) == -1) status = -1;
+    for (k = 0; k < n_knowns && status == 0; k++) {
+        int col = known_column(knowns[k], initializing);
+        if (seed[k] == 0.0) continue;
+        /* In initialisation the states follow the parameters and inputs: dx0 = d x0 / d known. */
+        for (s = 0; s < PM_NS; s++)
+            dx0[s] = initializing ? J0[(col - PM_NS) * PM_NS + s] : (s == col ? 1.0 : 0.0);
+        for (a = 0; a < n_unknowns; a++) {
+            int row = unknown_row(unknowns[a]);
+            double d = 0.0;
+            if (row <= -2) d = dx0[-2 - row];
+            else {
+                d = J[col * JROWS + row];
+                for (s = 0; s < PM_NS && initializing; s++) d += J[s * JROWS + row] * dx0[s];
+            }
+            sensitivity[a] += seed[k] * d;
+        }
+    }
+    free(J);
+    free(J0);
+    return status;
+}
+
+/* ------------------------------------------------------------ FMU state */
+
+const char *pam_state_invalid(const PamCore *c) {
+    if (c->mode < 0 || c->mode >= PM_NMODES) return "its mode is not one of this model's";
+    if (!isfinite(c->time_s) || !(c->h_s > 0.0) || !isfinite(c->h_s)) return "its time or step is not finite";
+    if (c->n_steps < 0 || c->n_rhs < 0 || c->n_events < 0) return "a count is negative";
+    return NULL;
+}
+
+void pam_adopt_state(PamCore *c, const PamCore *from) {
+    PamLogFn log = c->log;
+    void *env = c->log_env;
+    *c = *from;
+    c->log = log;
+    c->log_env = env;
+}

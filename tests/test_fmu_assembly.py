@@ -1,0 +1,201 @@
+"""The FMU of an assembly of components (pamsim.fmu.assembly_fmu): built by ``pamsim fmu build
+--scenario`` for a scenario that adds a component, it validates, runs in plain fmpy as the scenario's
+run, and its directional derivatives and ModelStructure are the exact Jacobians of the flat model."""
+
+from __future__ import annotations
+
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+fmpy = pytest.importorskip("fmpy")
+from fmpy.fmi2 import FMU2Slave  # noqa: E402
+from fmpy.validation import validate_fmu  # noqa: E402
+
+import pamsim  # noqa: E402
+from pamsim.assemblies.one_muscle import scenario_assembly  # noqa: E402
+
+SCENARIO = Path(__file__).resolve().parents[1] / "scenarios" / "parallel_spring.toml"
+
+
+@pytest.fixture(scope="module")
+def built(tmp_path_factory):
+    """The FMI 2.0 and 3.0 FMUs of the spring scenario, built as a user builds them."""
+    out = tmp_path_factory.mktemp("assembly_fmu")
+    paths = {}
+    for version in (2, 3):
+        path = out / f"spring{version}.fmu"
+        proc = subprocess.run([sys.executable, "-m", "pamsim", "fmu", "build", "--scenario", str(SCENARIO),
+                               "--fmi", str(version), "-o", str(path)], capture_output=True, text=True)
+        assert proc.returncode == 0, proc.stderr
+        assert "generated from the assembly" in proc.stdout
+        paths[version] = str(path)
+    return paths
+
+
+@pytest.fixture(scope="module")
+def python_run():
+    return pamsim.run(pamsim.load_scenario(SCENARIO))
+
+
+@pytest.fixture(scope="module")
+def flat():
+    return scenario_assembly(pamsim.load_scenario(SCENARIO)).flatten()
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_it_validates(built, version):
+    assert validate_fmu(built[version]) == []
+
+
+# Co-simulation runs the engine at the scenario's tolerance (its DefaultExperiment), model exchange
+# fmpy's CVode at its own default: each bound is a few times the difference measured.
+@pytest.mark.parametrize("version, kind, bound_mm", [(2, "CoSimulation", 2e-4), (3, "CoSimulation", 2e-4),
+                                                     (2, "ModelExchange", 2e-3), (3, "ModelExchange", 2e-3)])
+def test_plain_fmpy_runs_the_scenario(built, python_run, version, kind, bound_mm):
+    r = fmpy.simulate_fmu(built[version], fmi_type=kind, output=["load.x_m", "load.mode", "spring.F_spring_N"])
+    x_mm = r["load.x_m"] * 1e3
+    result = python_run.result
+    assert abs(x_mm[-1] - result.x_m[-1] * 1e3) < bound_mm
+    # The whole trajectory, at fmpy's output times (a subset of the python run's samples).
+    assert np.max(np.abs(x_mm - np.interp(r["time"], result.t_s, result.x_m) * 1e3)) < bound_mm
+    assert x_mm.max() > 40.0  # it did lift the load
+    assert r["load.mode"][-1] == 0  # held at the end, as the python run
+    assert r["time"][-1] == pytest.approx(pamsim.load_scenario(SCENARIO).duration_s)
+
+
+def test_model_structure_is_the_jacobians_sparsity(built, flat):
+    md = fmpy.read_model_description(built[2])
+    by_name = {v.name: v for v in md.modelVariables}
+    sp = flat.sparsity()
+    xs = [v.name for v in flat.states]
+    us = [v.name for v in flat.inputs]
+    for unknown in md.derivatives:
+        i = xs.index(unknown.variable.name[4:-1])
+        want = {xs[j] for j in sp["A"][i]} | {us[j] for j in sp["B"][i]}
+        assert {d.name for d in unknown.dependencies} == want, unknown.variable.name
+    ys = [v.name for v in flat.outputs]
+    checked = 0
+    for unknown in md.outputs:
+        name = unknown.variable.name
+        if name in xs or name not in ys:
+            continue
+        i = ys.index(name)
+        want = {xs[j] for j in sp["C"][i]} | {us[j] for j in sp["D"][i]}
+        assert {d.name for d in unknown.dependencies} == want, name
+        checked += 1
+    assert checked >= 10 and "spring.F_spring_N" in by_name
+
+
+def _instance(path, md):
+    unzipped = fmpy.extract(path)
+    fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzipped, modelIdentifier=md.coSimulation.modelIdentifier,
+                    instanceName="t")
+    fmu.instantiate()
+    fmu.setupExperiment(startTime=0.0)
+    return fmu
+
+
+def _sliding(path):
+    """A co-simulation instance stepped until its load slides (mode 1), and its model description."""
+    md = fmpy.read_model_description(path)
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    fmu = _instance(path, md)
+    fmu.enterInitializationMode()
+    fmu.exitInitializationMode()
+    t = 0.0
+    while fmu.getInteger([vr["load.mode"]])[0] != 1:
+        fmu.doStep(t, 1e-3)
+        t += 1e-3
+        assert t < 2.0, "the load never slid"
+    return fmu, md, vr
+
+
+def _exact(flat, fmu, vr):
+    """The flat model's exact Jacobian [A B; C D] at the FMU's state, inputs, parameters and mode."""
+    x = fmu.getReal([vr[v.name] for v in flat.states])
+    u = fmu.getReal([vr[v.name] for v in flat.inputs])
+    p = fmu.getReal([vr[v.name] for v in flat.parameters])
+    q = [float(fmu.getInteger([vr["load.mode"]])[0])]
+    A, B, C, D = (np.array(m) for m in flat.function("jacobian")(x, u, p, q))
+    return np.block([[A, B], [C, D]])
+
+
+@pytest.mark.parametrize("n_knowns", [1, 2, "all"])
+def test_directional_derivatives_are_the_exact_jacobian(built, flat, n_knowns):
+    fmu, md, vr = _sliding(built[2])
+    J = _exact(flat, fmu, vr)
+    xs, us, ys = [v.name for v in flat.states], [v.name for v in flat.inputs], [v.name for v in flat.outputs]
+    knowns = xs + us
+    unknown_rows = {f"der({n})": i for i, n in enumerate(xs)}
+    unknown_rows.update({n: len(xs) + i for i, n in enumerate(ys) if n not in xs and n in vr and n not in
+                         {v.name for v in flat.parameters}})
+    rng = np.random.default_rng(7)
+    chosen = knowns if n_knowns == "all" else list(rng.choice(knowns, n_knowns, replace=False))
+    seed = rng.normal(size=len(chosen))
+    names = list(unknown_rows)
+    got = fmu.getDirectionalDerivative([vr[n] for n in names], [vr[k] for k in chosen], list(seed))
+    cols = [knowns.index(k) for k in chosen]
+    want = J[[unknown_rows[n] for n in names]][:, cols] @ seed
+    scale = np.abs(J[[unknown_rows[n] for n in names]][:, cols]) @ np.abs(seed) + 1e-300
+    assert np.all(np.abs(np.array(got) - want) <= 1e-12 * scale + 1e-300), (names, got, want)
+    assert np.count_nonzero(want) > 3  # a sliding load: the derivatives do depend on the knowns
+    fmu.terminate()
+    fmu.freeInstance()
+
+
+def test_initialisation_derivatives_follow_the_start(built, flat):
+    md = fmpy.read_model_description(built[2])
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    fmu = _instance(built[2], md)
+    fmu.enterInitializationMode()
+    d_x = fmu.getDirectionalDerivative([vr["load.x_m"]], [vr["load.initial_contraction_m"]], [1.0])
+    assert d_x[0] == pytest.approx(1.0, abs=1e-15)
+    # The initial air mass against a central difference of the generated initial state.
+    x0 = flat.function("x0")
+    p = np.array(fmu.getReal([vr[v.name] for v in flat.parameters]))
+    u = fmu.getReal([vr[v.name] for v in flat.inputs])
+    k = [v.name for v in flat.parameters].index("chamber.initial_pressure_gauge_Pa")
+    m = [v.name for v in flat.states].index("chamber.air_mass_kg")
+    h = 1e3
+    hi, lo = p.copy(), p.copy()
+    hi[k] += h
+    lo[k] -= h
+    fd = (float(x0(u, hi)[0][m]) - float(x0(u, lo)[0][m])) / (2 * h)
+    got = fmu.getDirectionalDerivative([vr["chamber.air_mass_kg"]], [vr["chamber.initial_pressure_gauge_Pa"]], [1.0])
+    assert got[0] == pytest.approx(fd, rel=1e-9)
+    fmu.freeInstance()
+
+
+def test_a_serialized_state_continues_in_another_instance(built):
+    fmu, md, vr = _sliding(built[2])
+    state = fmu.serializeFMUstate(fmu.getFMUstate())
+    other = _instance(built[2], md)
+    other.enterInitializationMode()
+    other.exitInitializationMode()
+    other.setFMUstate(other.deSerializeFMUstate(state))
+    names = [vr["load.x_m"], vr["load.v_m_s"], vr["chamber.p_abs_Pa"], vr["spring.W_spring_J"]]
+    assert other.getReal(names) == fmu.getReal(names)
+    broken = bytearray(state)
+    broken[len(broken) // 2] ^= 1
+    with pytest.raises(Exception):
+        other.deSerializeFMUstate(bytes(broken))
+    for inst in (fmu, other):
+        inst.terminate()
+        inst.freeInstance()
+
+
+@pytest.mark.parametrize("name, value", [("valve_command", 2.0), ("spring.k_N_per_m", math.nan)])
+def test_bad_values_are_refused(built, name, value):
+    md = fmpy.read_model_description(built[2])
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    fmu = _instance(built[2], md)
+    with pytest.raises(Exception):
+        fmu.setReal([vr[name]], [value])
+        fmu.enterInitializationMode()
+        fmu.exitInitializationMode()
+    fmu.freeInstance()
