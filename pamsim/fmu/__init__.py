@@ -6,7 +6,8 @@ generated from a scenario's assembly of components;
 ``simulate_fmu()`` runs a :class:`~pamsim.scenario.Scenario` through fmpy.
 """
 
-from .build import build, build_assembly
+from .assembly_fmu import build_assembly
+from .build import build
 from .runner import simulate_fmu
 
 __all__ = ["build", "build_assembly", "simulate_fmu"]

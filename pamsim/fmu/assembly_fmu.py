@@ -18,11 +18,14 @@ whose variable names predate components.
 from __future__ import annotations
 
 import hashlib
+import os
 import uuid
 from dataclasses import replace
+from pathlib import Path
 
 from .. import __version__
 from ..errors import InputError
+from .build import FMI_VERSIONS, build_spec
 from .generate import WRAPPERS, c_source_dir
 from .preset import Experiment, scenario_signals
 from .spec import FmuSpec
@@ -193,3 +196,17 @@ def _token(spec: FmuSpec) -> str:
     h.update(repr(sorted(spec.signals.items())).encode())
     h.update(f"{spec.fmi_version} {__version__} {spec.experiment!r}".encode())
     return "{" + str(uuid.UUID(bytes=h.digest()[:16])) + "}"
+
+
+def build_assembly(scenario, output_path: str | os.PathLike | None = None, fmi_version: int = 2) -> Path:
+    """Generate, compile and zip the FMU of ``scenario``'s assembly of components
+    (:mod:`pamsim.fmu.assembly_fmu`): namespaced variables, every equation generated; return its path
+    (default ``pamsim_assembly_fmi<version>.fmu``).
+
+    Raises :class:`~pamsim.errors.InputError` for an unknown FMI version, a scenario the FMU cannot
+    carry, a missing C compiler or a failed compilation.
+    """
+    if fmi_version not in FMI_VERSIONS:
+        raise InputError(f"FMI version must be 2 or 3, not {fmi_version!r}")
+    spec = assembly_spec(scenario, fmi_version)
+    return build_spec(Path(output_path) if output_path else Path(f"{spec.identifier}_fmi{fmi_version}.fmu"), spec)

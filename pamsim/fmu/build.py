@@ -140,18 +140,3 @@ def build_spec(out: Path, spec: FmuSpec) -> Path:
         os.replace(partial, out)
     return out
 
-
-def build_assembly(scenario, output_path: str | os.PathLike | None = None, fmi_version: int = 2) -> Path:
-    """Generate, compile and zip the FMU of ``scenario``'s assembly of components
-    (:mod:`pamsim.fmu.assembly_fmu`): namespaced variables, every equation generated; return its path
-    (default ``pamsim_assembly_fmi<version>.fmu``).
-
-    Raises :class:`~pamsim.errors.InputError` for an unknown FMI version, a scenario the FMU cannot
-    carry, a missing C compiler or a failed compilation.
-    """
-    from .assembly_fmu import assembly_spec
-
-    if fmi_version not in FMI_VERSIONS:
-        raise InputError(f"FMI version must be 2 or 3, not {fmi_version!r}")
-    spec = assembly_spec(scenario, fmi_version)
-    return build_spec(Path(output_path) if output_path else Path(f"{spec.identifier}_fmi{fmi_version}.fmu"), spec)
