@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from typing import Any, Callable, Mapping
 
+from .elements.stops import EndStops
 from .errors import InputError
 from .muscles import Muscle, load_muscle
 from .parameter_schema import KNOWN, ParameterSet, known_parameter
@@ -107,3 +108,22 @@ def prepare(muscle: str, model: str | None = None, overrides: Mapping[str, Any] 
         raise InputError(f"muscle {m.name!r}: {why} (its gaps: `pamsim muscles`; or give them with --set)")
     spec = applicable_model(model or m.default_static_force, variant, m, inputs, fail, key)
     return m, params, spec.build(inputs, variant)
+
+
+def end_stops(muscle: Muscle, params: Mapping[str, float], model, choice: str | None = None,
+              key: str = "upper_stop") -> EndStops:
+    """The end stops of static ``model`` on ``muscle`` (with ``params``, as :func:`prepare` returns them):
+    the upper stop where ``choice`` (:data:`pamsim.elements.stops.UPPER_STOPS`) puts it, by default the
+    muscle file's choice.
+
+    Raises
+    ------
+    InputError
+        When the choice cannot be met (:meth:`pamsim.elements.stops.EndStops.for_model`), naming ``key`` and
+        the choice, or the muscle and its own choice.
+    """
+    try:
+        return EndStops.for_model(params, model.domain.x_max_m, choice or muscle.upper_stop)
+    except ValueError as exc:
+        where = f"{key} {choice}" if choice else f"muscle {muscle.name!r}: its upper stop {muscle.upper_stop!r}"
+        raise InputError(f"{where}: {exc}") from None

@@ -75,6 +75,8 @@ KNOWN = MappingProxyType({
     "n_fibres": _pos("number of braid fibres (strands)"),
     "fibre_area_m2": _pos("cross-sectional area of one braid fibre"),
     "fibre_radius_m": _pos("radius of one braid fibre (strand)"),
+    "fibre_width_m": _pos("width of one braid fibre across the braid's surface (a flat yarn's; a round strand's "
+                          "is twice fibre_radius_m)"),
     "braid_area_fraction": Known("fraction of the cross-section taken by the braid material", 0.0, 1.0, True),
     "E_braid_Pa": _pos("Young's modulus of the braid fibres"),
     "E_bladder_Pa": _nonneg("Young's modulus of the bladder"),
@@ -162,6 +164,25 @@ KNOWN = MappingProxyType({
     "stop_restitution": Known("coefficient of restitution of both stops", 0.0, 1.0),
 })
 """name -> :class:`Known` for every parameter a muscle file may give."""
+
+UPPER_STOPS = {
+    "auto": "the braid's jam angle if the muscle gives its fibres' width and count, else the end of the "
+            "static model's domain",
+    "jam": "the braid's jam angle, where neighbouring fibres touch (needs n_fibres and fibre_width_m or "
+           "fibre_radius_m), or the end of the static model's domain if that comes first",
+    "domain_end": "the end of the static model's domain (the braid lock if the domain has no finite end)",
+    "braid_lock": "the braid-lock angle 54.7356 deg, where Gaylord's ideal force vanishes",
+}
+"""Choice of where the upper stop stands -> where that is: a muscle file's ``[upper_stop] at``, a scenario's
+``[model] upper_stop``, ``pamsim static --upper-stop`` (:meth:`pamsim.elements.stops.EndStops.for_model`)."""
+
+UPPER_BASES = {"jam": "the braid's jam angle", "domain_end": "the end of the static model's domain",
+               "braid_lock": "the braid lock, 54.7356 deg"}
+"""What placed an upper stop (:attr:`pamsim.elements.stops.EndStops.upper_basis`), in words."""
+
+UPPER_STOP_DEFAULT = "auto"
+"""The choice of a muscle file that names none."""
+
 
 FILE_INPUTS = ("force_map_file",)
 """Model inputs that are files, not numbers (given by a muscle file's top-level ``force_map`` key)."""

@@ -163,6 +163,11 @@ class Result:
         return abs(self.v_m_s[-1]) < REST_SPEED_M_S and abs(net) <= level + 1e-3
 
     @property
+    def on_stop(self) -> str | None:
+        """``"upper"`` or ``"lower"`` when the run ends held on that end stop, else None."""
+        return {Mode.STOP_HIGH: "upper", Mode.STOP_LOW: "lower"}.get(self.final_mode)
+
+    @property
     def peak_contraction_m(self) -> float:
         """Largest contraction of the run: of the integrated solution where known, else of the samples."""
         return float(max(self.peaks.get("x_m", -np.inf), self.x_m.max()))
@@ -219,6 +224,7 @@ class Result:
             "peak_pressure_gauge_Pa": float(max(self.peaks.get("p_gauge_Pa", -np.inf), self.p_gauge_Pa.max())),
             "final_mode": self.final_mode.label,
             "at_rest_at_end": bool(self.at_rest_at_end),
+            "on_stop": self.on_stop,
             "final_net_force_N": float(self.final_rest_forces_N[0]),
             "final_coulomb_level_N": float(self.final_rest_forces_N[1]),
             "events": int(self.stats["events"]),

@@ -25,7 +25,7 @@ from .elements.load import HangingLoad
 from .elements.pressure_source import PrescribedPressure, ValveChamberSource
 from .elements.force_clip import NEGATIVE_FORCE_CHOICES
 from .elements.static_force import STATIC_FORCE_MODELS
-from .elements.stops import EndStops
+from .elements.stops import UPPER_STOPS, EndStops
 from .elements.valve import Iso6358Orifice, ProportionalValve33
 from .model import FitRange, MuscleModel
 from .muscle_setup import applicable_model, model_inputs, with_overrides
@@ -45,7 +45,8 @@ _SCHEMA: dict[str, dict[str, Any]] = {
     "": {"name": str, "description": str, "model": dict, "parameters": dict, "load": dict, "pressure": dict,
          "simulation": dict, "solver": dict, "controller": dict, "component": list, "measured": dict},
     "model": {"muscle": str, "parameter_set": str, "static_force": str, "static_force_variant": str,
-              "static_force_negative": str, "friction": str, "damping": str, "friction_negative_level": str},
+              "static_force_negative": str, "friction": str, "damping": str, "friction_negative_level": str,
+              "upper_stop": str},
     "load": {"weight_N": float, "mass_kg": float, "external_force": dict},
     "pressure": {"source": str, "supply_gauge_bar": float, "supply_gauge_Pa": float, "valve_open_time_s": float,
                  "command": dict, "prescribed": dict, "initial_gauge_bar": float},
@@ -176,7 +177,8 @@ class Scenario:
         object.__setattr__(self, "_source", self._build_source(v))
         object.__setattr__(self, "_external_force",
                            signal_from_table(v, "load.external_force", ext, "_N", 1.0, self.base_dir) if ext else None)
-        stops = EndStops.from_parameters(self.parameters)
+        stops = self._end_stops(v)
+        object.__setattr__(self, "_stops", stops)
         if not stops.x_low_m <= x0 <= stops.x_high_m:
             v.fail("simulation.initial_contraction_m", x0, f"must lie between the stops, 0 and {stops.x_high_m:.4f} m")
         try:
@@ -186,6 +188,21 @@ class Scenario:
         object.__setattr__(self, "_added", added_components(v, self.spec.get("component", [])))
         if self._added:
             check_wiring(self, ScenarioError)
+
+    @property
+    def upper_stop(self) -> str:
+        """Where the upper stop stands (:data:`pamsim.elements.stops.UPPER_STOPS`): ``[model] upper_stop``,
+        else the muscle file's choice."""
+        return self.spec["model"].get("upper_stop", self.muscle.upper_stop)
+
+    def _end_stops(self, v: "_Validator") -> EndStops:
+        """The stops of the scenario's muscle and static model; a choice that cannot be met fails naming its key."""
+        try:
+            return EndStops.for_model(self.parameters, self.static_model().domain.x_max_m, self.upper_stop)
+        except ValueError as exc:
+            if "upper_stop" in self.spec["model"]:
+                v.fail("model.upper_stop", self.upper_stop, str(exc))
+            v.fail("model.muscle", self.spec["model"]["muscle"], f"its upper stop ({self.upper_stop}): {exc}")
 
     def _build_source(self, v: "_Validator"):
         pr = self.spec["pressure"]
@@ -264,7 +281,8 @@ class Scenario:
 
     def _build_static_force(self):
         m = self.spec["model"]
-        return STATIC_FORCE_MODELS[m["static_force"]](model_inputs(self.muscle, self.parameters), m)
+        return STATIC_FORCE_MODELS[m["static_force"]](model_inputs(self.muscle, self.parameters),
+                                                      {**m, "upper_stop": self.upper_stop})
 
     def build_model(self) -> MuscleModel:
         """Compose the elements this scenario names into a :class:`MuscleModel`."""
@@ -276,7 +294,7 @@ class Scenario:
             friction=FRICTION_MODELS[m["friction"]](p, m),
             damping=DAMPING_MODELS[m["damping"]](p, m),
             load=HangingLoad(self.mass_kg, p["g_m_s2"], self._external_force),
-            stops=EndStops.from_parameters(p),
+            stops=self._stops,
             source=self._source,
             fit_range=FitRange(domain.x_min_m, domain.x_max_m, domain.p_max_Pa),
         )
@@ -373,6 +391,9 @@ def _default_choices(v: "_Validator", model: dict) -> None:
         choice = model.setdefault(key, default)
         if choice not in registry:
             v.fail(f"model.{key}", choice, "unknown choice", choices=registry)
+    # No default is filled in: without the key the muscle file chooses, and the FMU refuses the key.
+    if "upper_stop" in model and model["upper_stop"] not in UPPER_STOPS:
+        v.fail("model.upper_stop", model["upper_stop"], "unknown choice", choices=UPPER_STOPS)
 
 
 def _key(kind: str, name: str) -> str:

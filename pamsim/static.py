@@ -78,22 +78,38 @@ def friction_band_m(static_force, friction, p_gauge_Pa: float, mass_kg: float, g
     return edge(+1.0), edge(-1.0)
 
 
-def static_report(params: Mapping[str, float], static_force, p_gauge_Pa: float, load_N: float) -> dict:
+def static_report(params: Mapping[str, float], static_force, p_gauge_Pa: float, load_N: float,
+                  stops: EndStops | None = None) -> dict:
     """The figures ``pamsim static`` prints.
 
     ``static_force`` is a library model (:mod:`pamsim.static_models`): its
     valid domain bounds the force capability (beyond it a fitted model
     extrapolates and says nothing about what the muscle can hold) and decides
-    ``within_fit_range``.
+    ``within_fit_range``.  ``stops`` are the muscle's end stops
+    (:func:`pamsim.muscle_setup.end_stops`, or a scenario's ``build_model().stops``);
+    without them the upper stop is the braid lock of ``params``' geometry, where
+    pamsim put it before the stop became a choice.  ``on_stop`` is ``"upper"``
+    or ``"lower"`` when the load rests on that stop, else None.
     """
-    x_hi = EndStops.from_parameters(params).x_high_m
-    x_eq = equilibrium_contraction_m(static_force, p_gauge_Pa, load_N, x_hi)
     d = static_force.domain
-    at_stop = x_eq == x_hi and float(static_force.force_N(x_hi, p_gauge_Pa)) > load_N
+    stops = EndStops.from_parameters(params) if stops is None else stops
+    x_hi = stops.x_high_m
+    x_eq = equilibrium_contraction_m(static_force, p_gauge_Pa, load_N, x_hi)
+    on_stop = stop_at(static_force, p_gauge_Pa, load_N, x_eq, x_hi)
     note = ("held at the upper stop: the model still pulls harder than the load there, "
-            "so no equilibrium lies before it") if at_stop else ""
+            "so no equilibrium lies before it") if on_stop == "upper" else ""
     return {"pressure_gauge_Pa": p_gauge_Pa, "load_N": load_N, "equilibrium_contraction_m": x_eq,
-            "equilibrium_note": note,
+            "equilibrium_note": note, "on_stop": on_stop,
             "max_load_N": max_load_N(static_force, p_gauge_Pa, min(x_hi, d.x_max_m)), "lifts_load": x_eq > 0.0,
-            "upper_stop_m": x_hi,
+            "upper_stop_m": x_hi, "upper_stop_basis": stops.upper_basis,
             "within_fit_range": bool(d.x_min_m <= x_eq <= d.x_max_m and d.p_min_Pa <= p_gauge_Pa <= d.p_max_Pa)}
+
+
+def stop_at(static_force, p_gauge_Pa: float, load_N: float, x_eq_m: float, x_high_m: float) -> str | None:
+    """``"upper"`` or ``"lower"`` when the equilibrium ``x_eq_m`` of
+    :func:`equilibrium_contraction_m` is a stop that holds the load, else None (a free equilibrium)."""
+    if x_eq_m >= x_high_m and float(static_force.force_N(x_high_m, p_gauge_Pa)) > load_N:
+        return "upper"
+    if x_eq_m <= 0.0 and float(static_force.force_N(0.0, p_gauge_Pa)) < load_N:
+        return "lower"
+    return None

@@ -194,11 +194,17 @@ def test_table_error_is_the_bilinear_bound():
 @pytest.mark.parametrize("muscle, model", [("kothera2009_5a", "kothera_energy"), ("mpam_survey_45mm", "chou_hannaford"),
                                            ("kothera2009_5a", "kothera_force_balance_thickness")])
 def test_default_table_is_within_0p1_percent_of_the_blocked_force(muscle, model):
+    """Judged by the force the dynamics apply, max(F, 0): the upper stop of a muscle without fibre data is
+    the end of its model's domain, where a bladder model's push diverges (-1.2e5 N for kothera_energy on
+    5a at 0.999 of it) and no polynomial interpolant follows it."""
     p = dynamics_parameters(load_muscle(muscle).parameters)
     m = REGISTRY[model].build(p)
     x_hi = pamsim.Scenario.from_dict(_spec(muscle, model)).build_model().stops.x_high_m
     t = tabulate(m, (0.0, x_hi), (0.0, p["rated_pressure_gauge_Pa"]))
-    assert table_error(m, t) <= 1e-3 * float(m.force_N(0.0, p["rated_pressure_gauge_Pa"]))
+    x, p_grid = t.x_grid_m, t.p_grid_Pa
+    X, P = np.meshgrid(0.5 * (x[1:] + x[:-1]), 0.5 * (p_grid[1:] + p_grid[:-1]), indexing="ij")  # cell centres
+    applied = np.abs(ClippedStaticForce(m).force_N(X, P) - ClippedStaticForce(t).force_N(X, P))
+    assert applied.max() <= 1e-3 * float(m.force_N(0.0, p["rated_pressure_gauge_Pa"]))
 
 
 def test_tables_are_cached_per_model_and_parameters(monkeypatch):

@@ -22,6 +22,23 @@ def add_arguments(parser: argparse.ArgumentParser, model: bool = True) -> None:
                         help="override a muscle parameter, in the unit of its name (repeatable)")
 
 
+def add_upper_stop_argument(parser: argparse.ArgumentParser) -> None:
+    """Add ``--upper-stop CHOICE`` (where the upper stop stands; default: the muscle file's choice)."""
+    from ..parameter_schema import UPPER_STOPS
+
+    parser.add_argument("--upper-stop", choices=tuple(UPPER_STOPS), default=None,
+                        help="where the upper stop stands: " + "; ".join(f"{k}: {v}" for k, v in UPPER_STOPS.items())
+                        + " (default: the muscle file's choice)")
+
+
+def end_stops(args: argparse.Namespace, muscle, params, model):
+    """The stops of ``model`` on ``muscle`` with ``--upper-stop`` or the muscle's choice
+    (:func:`pamsim.muscle_setup.end_stops`)."""
+    from ..muscle_setup import end_stops as stops_of
+
+    return stops_of(muscle, params, model, args.upper_stop, key="--upper-stop")
+
+
 def _key(kind: str, name: str) -> str:
     return {"parameter": f"--set {name}", "model": "--model", "variant": "--variant"}[kind]
 

@@ -18,14 +18,17 @@ def register(sub) -> None:
     p.add_argument("--pressure-bar", type=finite_float, required=True, help="gauge pressure [bar]")
     p.add_argument("--load-N", type=finite_float, required=True, help="hanging weight [N], holder included")
     muscle_args.add_arguments(p)
+    muscle_args.add_upper_stop_argument(p)
     p.add_argument("--json", action="store_true", help="print JSON")
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
-    """``pamsim static``: print the static equilibrium contraction under the load and the largest load held
-    above the lower stop at the pressure (as JSON with ``--json``); exit code 0.
+    """``pamsim static``: print the static equilibrium contraction under the load, the stop it rests on if any,
+    the largest load held above the lower stop at the pressure and the upper stop (as JSON with ``--json``);
+    exit code 0.
     """
+    from ..elements.stops import UPPER_BASES
     from ..static import static_report
 
     muscle, params, model = muscle_args.resolve(args)
@@ -35,7 +38,9 @@ def run(args: argparse.Namespace) -> int:
                          "(the muscle's rating)")
     if args.load_N <= 0:
         raise InputError(f"--load-N = {args.load_N:g}: must be positive")
-    report = static_report(params, model, args.pressure_bar * PA_PER_BAR, args.load_N)
+    stops = muscle_args.end_stops(args, muscle, params, model)
+    report = static_report(params, model, args.pressure_bar * PA_PER_BAR, args.load_N, stops)
+    report["upper_stop"] = args.upper_stop or muscle.upper_stop
     report["muscle"] = muscle.name
     report["model"] = model.name
     if args.json:
@@ -43,9 +48,11 @@ def run(args: argparse.Namespace) -> int:
         return 0
     x = report["equilibrium_contraction_m"]
     print(f"muscle {muscle.name}, model {model.name}, {args.pressure_bar:g} bar, {args.load_N:g} N")
-    why = report["equilibrium_note"] or ("" if x > 0 else "cannot lift it off the lower stop")
+    why = report["equilibrium_note"] or ("cannot lift it off the lower stop" if report["on_stop"] == "lower" else "")
     print(f"  equilibrium contraction: {x * 1e3:.3f} mm" + (f" ({why})" if why else ""))
     print(f"  force capability (max load held above the lower stop): {report['max_load_N']:.2f} N")
+    print(f"  upper stop: {report['upper_stop_m'] * 1e3:.3f} mm ({UPPER_BASES[report['upper_stop_basis']]}; "
+          f"choice {report['upper_stop']})")
     if not report["within_fit_range"]:
         print("  warning: outside the model's valid domain")
     return 0

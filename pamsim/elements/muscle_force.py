@@ -18,7 +18,7 @@ from .force_table import cache_key, tabulate
 
 
 def dynamics_static_force(model: str, params: Mapping[str, float], x_range_m: tuple[float, float],
-                          variant: str | None = None, negative: str = "clip"):
+                          variant: str | None = None, negative: str = "clip", built=None):
     """Build library model ``model`` for ``params`` as the ODE evaluates it.
 
     Parameters
@@ -30,9 +30,10 @@ def dynamics_static_force(model: str, params: Mapping[str, float], x_range_m: tu
         rated pressure.
     variant : the model's variant (None: its default).
     negative : ``"clip"`` or ``"keep"`` (:mod:`pamsim.elements.force_clip`).
+    built : the library model already built from ``params`` and ``variant`` (built here if None).
     """
     spec = get(model)
-    built = spec.build(params, variant)
+    built = spec.build(params, variant) if built is None else built
     p_range = (0.0, params["rated_pressure_gauge_Pa"])
     if spec.kind == "implicit":
         built = tabulate(built, x_range_m, p_range, key=cache_key(model, variant, params))

@@ -5,7 +5,8 @@ static-model library :mod:`pamsim.static_models` (one registry); any of them
 meets :class:`pamsim.elements.contracts.StaticForce`.  ``STATIC_FORCE_MODELS``
 is a read-only view of that registry which maps a scenario's ``static_force``
 key to a builder ``builder(params, options)`` of the force as the dynamics
-apply it (:func:`pamsim.elements.muscle_force.dynamics_static_force`: tabulated
+apply it, over the contractions between the stops that ``options["upper_stop"]``
+chooses (:func:`pamsim.elements.muscle_force.dynamics_static_force`: tabulated
 if implicit, clipped at zero unless ``static_force_negative = "keep"``).
 Whether a model applies to a muscle is checked where the muscle is known
 (:func:`pamsim.muscle_setup.applicable_model`).
@@ -20,7 +21,7 @@ from ..static_models import REGISTRY
 from ..static_models.acra2012 import Acra2012Polynomial
 from .contracts import NO_OPTIONS, Builder, ElementOptions, StaticForce
 from .muscle_force import dynamics_static_force
-from .stops import EndStops
+from .stops import UPPER_STOP_DEFAULT, EndStops
 
 __all__ = ["Acra2012Polynomial", "STATIC_FORCE_MODELS"]
 
@@ -33,9 +34,11 @@ class _Builders(Mapping[str, Builder[StaticForce]]):
             raise KeyError(name)
 
         def build(params: Mapping[str, float], options: ElementOptions = NO_OPTIONS) -> StaticForce:
-            return dynamics_static_force(name, params, (0.0, EndStops.from_parameters(params).x_high_m),
-                                         options.get("static_force_variant"),
-                                         options.get("static_force_negative", "clip"))
+            variant = options.get("static_force_variant")
+            raw = REGISTRY[name].build(params, variant)
+            stops = EndStops.for_model(params, raw.domain.x_max_m, options.get("upper_stop", UPPER_STOP_DEFAULT))
+            return dynamics_static_force(name, params, (0.0, stops.x_high_m), variant,
+                                         options.get("static_force_negative", "clip"), built=raw)
         return build
 
     def __iter__(self) -> Iterator[str]:

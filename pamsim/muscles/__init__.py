@@ -15,6 +15,7 @@ from importlib import resources
 from pathlib import Path
 from typing import Any, Mapping
 
+from ..elements.stops import UPPER_STOP_DEFAULT, UPPER_STOPS
 from ..errors import InputError
 from ..parameter_schema import KNOWN, LOCK_DEG, Parameter, ParameterSet, unit_of
 from ..static_models import REGISTRY, StaticForce
@@ -27,8 +28,12 @@ class MuscleError(InputError):
 
 
 TOP_KEYS = ("name", "description", "citation", "default_static_force", "rated_pressure_gauge_Pa", "gaps",
-            "force_map", "parameters", "data")
+            "force_map", "parameters", "data", "upper_stop")
 ENTRY_KEYS = ("value", "source", "description", "unit")
+UPPER_STOP_KEYS = ("at", "source")
+DEFAULT_UPPER_STOP_SOURCE = ("pamsim default (the file names none): the jam angle where the muscle gives its "
+                             "fibres' width and count, else the end of the static model's domain")
+"""Provenance of the upper-stop choice of a muscle file without an ``[upper_stop]`` table."""
 
 
 @dataclass(frozen=True)
@@ -44,6 +49,8 @@ class Muscle:
     gaps : values the source does not give (said, not invented).
     data_file : measured points shipped with the muscle, or None.
     force_map_file : measured F(x, p) table for the ``force_map`` model, or None.
+    upper_stop, upper_stop_source : where the upper stop stands (a choice of
+        :data:`pamsim.elements.stops.UPPER_STOPS`) and why.
     """
 
     name: str
@@ -55,6 +62,8 @@ class Muscle:
     gaps: tuple[str, ...] = ()
     data_file: Path | None = field(default=None)
     force_map_file: Path | None = field(default=None)
+    upper_stop: str = UPPER_STOP_DEFAULT
+    upper_stop_source: str = DEFAULT_UPPER_STOP_SOURCE
 
     def model_inputs(self) -> dict:
         """What a static model is built from: the parameter values and, if any, the force-map file."""
@@ -191,7 +200,24 @@ def muscle_from_dict(raw: Mapping[str, Any], origin: str | Path = "<dict>") -> M
             raise fail("data.file", data["file"], f"no such file next to the muscle file ({data_file})")
     params = ParameterSet(strings["name"], strings["citation"], entries)
     return Muscle(strings["name"], strings["description"], strings["citation"], model, params, origin,
-                  tuple(gaps), data_file, force_map_file)
+                  tuple(gaps), data_file, force_map_file, *_upper_stop(fail, raw.get("upper_stop")))
+
+
+def _upper_stop(fail, table: Any) -> tuple[str, str]:
+    """``(choice, source)`` of an ``[upper_stop]`` table (``at``, ``source``), or the default without one."""
+    if table is None:
+        return UPPER_STOP_DEFAULT, DEFAULT_UPPER_STOP_SOURCE
+    if not isinstance(table, dict):
+        raise fail("upper_stop", table, 'must be a table: at = "CHOICE", source = "where it comes from"')
+    for k in table:
+        if k not in UPPER_STOP_KEYS:
+            raise fail(f"upper_stop.{k}", table[k], "unknown key" + did_you_mean(k, UPPER_STOP_KEYS))
+    at, source = table.get("at"), table.get("source")
+    if at not in UPPER_STOPS:
+        raise fail("upper_stop.at", at, f"must be one of {', '.join(UPPER_STOPS)}")
+    if not isinstance(source, str) or not source.strip():
+        raise fail("upper_stop.source", source, 'required: why the stop stands there (or "assumed: <reason>")')
+    return at, source
 
 
 def _entry(fail, origin: Path, name: str, table: Any) -> Parameter:

@@ -65,6 +65,31 @@ class Braid:
         """Contraction at the Gaylord kinematic limit, where ``3 cos^2(theta) = 1``."""
         return self.L0 - self.b / math.sqrt(BRAID_LOCK_SEC2)
 
+    def x_jam_m(self, fibre_width_m: float, n_fibres: float) -> float:
+        """Contraction [m] at the braid's jam angle, where neighbouring fibres of one helix touch.
+
+        ``n_fibres`` fibres in all, half of them in each helix sense, each ``fibre_width_m`` wide on the
+        braid's surface.  At braid angle ``theta`` the radius is ``r = r_max sin(theta)`` with
+        ``r_max = b / (2 pi N)``, and the gap between neighbours of one sense, measured square to them, is
+        ``4 pi r cos(theta) / n - w``; it closes where ``sin(2 theta) = n w / (2 pi r_max)``.  Of the two
+        roots the one above 45 deg is where a shortening braid jams (the one below is Davis' ``theta_min``,
+        MPAM survey eq. 10, where a lengthening braid jams).
+
+        Raises
+        ------
+        ValueError
+            If the fibres are so wide or so many that they would touch at the rest angle already, or at
+            every angle.
+        """
+        cover = n_fibres * fibre_width_m * self.N / self.b  # n w / (2 pi r_max)
+        if cover >= 1.0:
+            raise ValueError("the fibres would cover the braid at every angle: the braid could not move")
+        half = 0.5 * math.asin(cover)
+        if not half <= self.theta0 <= 0.5 * math.pi - half:
+            raise ValueError(f"the fibres would touch at the rest braid angle {math.degrees(self.theta0):g} deg "
+                             f"(they fit only between {math.degrees(half):.4g} and {90.0 - math.degrees(half):.4g} deg)")
+        return self.L0 - self.b * math.cos(0.5 * math.pi - half)
+
     @property
     def q1(self) -> float:
         """``3 / tan^2(theta0)``, the first constant of Gaylord's normalised law."""
