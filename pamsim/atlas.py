@@ -19,9 +19,10 @@ import numpy as np
 
 from .atomic import atomic_outputs
 from .constants import PA_PER_BAR
+from .elements.stops import EndStops
 from .errors import InputError
 from .figure_style import check_format
-from .muscle_setup import end_stops, model_inputs, muscle_parameters, prepare
+from .muscle_setup import model_inputs, muscle_parameters, prepare
 from .muscles import Muscle
 from .static_models import REGISTRY
 from .table_checks import LENGTH_UNITS_M, PRESSURE_UNITS_PA, unit_column
@@ -220,13 +221,6 @@ def default_pressures_Pa(measured: np.ndarray, rating_Pa: float) -> tuple[float,
     return tuple(f * rating_Pa for f in RATING_FRACTIONS)
 
 
-def _upper_stop_m(muscle: Muscle, params: Mapping[str, float], model) -> float:
-    """The muscle's upper stop for ``model`` [m] (its file's choice), or inf for a muscle without a braid."""
-    if not {"L0_m", "r0_m", "theta0_deg"} <= set(params):
-        return math.inf
-    return end_stops(muscle, params, model).x_high_m
-
-
 def build_atlas(muscle: str, models: Sequence[str] | None = None, pressures_bar: Sequence[float] | None = None,
                 overrides: Mapping[str, float] | None = None, n_points: int = N_POINTS) -> Atlas:
     """Curves of ``models`` (default: every model whose parameters the muscle gives) at ``pressures_bar``.
@@ -250,11 +244,12 @@ def build_atlas(muscle: str, models: Sequence[str] | None = None, pressures_bar:
         pressures = tuple(float(p) * PA_PER_BAR for p in pressures_bar)
     else:
         pressures = default_pressures_Pa(measured, rating)
+    x_stop = EndStops.from_parameters(params).x_high_m if {"L0_m", "r0_m", "theta0_deg"} <= set(params) else math.inf
     curves, skipped = [], {}
     for name in names:
         model = REGISTRY[name].build(model_inputs(m, params))
         d = model.domain
-        x_lo, x_hi = max(d.x_min_m, 0.0), min(d.x_max_m, _upper_stop_m(m, params, model))
+        x_lo, x_hi = max(d.x_min_m, 0.0), min(d.x_max_m, x_stop)
         if not math.isfinite(x_hi) or x_hi <= x_lo:
             skipped[name] = f"no finite contraction range (domain {d.x_min_m:g} .. {d.x_max_m:g} m)"
             continue
