@@ -15,9 +15,8 @@ from importlib import resources
 from pathlib import Path
 from typing import Any, Mapping
 
-from ..elements.stops import UPPER_STOP_DEFAULT, UPPER_STOPS
 from ..errors import InputError
-from ..parameter_schema import KNOWN, LOCK_DEG, Parameter, ParameterSet, unit_of
+from ..parameter_schema import KNOWN, LOCK_DEG, UPPER_STOP_DEFAULT, UPPER_STOPS, Parameter, ParameterSet, unit_of
 from ..static_models import REGISTRY, StaticForce
 from ..static_models import get as get_model
 from ..table_checks import did_you_mean
