@@ -3,7 +3,8 @@
  * A unity build: this file includes the engine, which includes the generated model, so the model's
  * functions can be inlined into the integrator.  Only the PAM_EXPORT functions leave the library
  * (pamsim/native/engine.py mirrors these layouts).  Each case runs from the model's initial state,
- * with inputs held constant over given segments, and is sampled on a uniform grid: every state
+ * with inputs given over segments (held, or each following a line and a first-order lag in closed form
+ * inside its segment), and is sampled on a uniform grid: every state
  * (the quadratures from each step's dense output), the mode, the events, and the extremes of every
  * output over every step end and event.  pam_engine_session.c, included at the end, runs one case
  * step by step instead.
@@ -40,7 +41,10 @@ typedef struct {
     const int64_t *n_segments;    /* n_cases: input segments; the first starts at 0 */
     const int64_t *segment_offset;
     const double *segment_t_s;    /* start of each segment */
-    const double *segment_u;      /* PM_NU inputs held over each segment */
+    const double *segment_u;      /* PM_NU inputs at the start of each segment */
+    const double *segment_du;     /* PM_NU x 3 per segment, or NULL (every input held): input k follows
+                                   * u_k + b (t - t0) + c (exp(-(t - t0) / tau) - 1) over its segment
+                                   * from t0, (b, c, tau) its three numbers (tau 0: no lag) */
     const int64_t *event_capacity;
     const int64_t *event_offset;
     double *samples;              /* out: per case a PM_NS x n_samples block (column-major), every state */
@@ -63,6 +67,10 @@ typedef struct {
     double quad[PM_NQ > 0 ? PM_NQ : 1]; /* the quadratures at the end of the last step */
     double gauss[GL_N][GL_N];
     double *y_max, *y_min;
+    /* The segment being integrated: its start, inputs there and their change (segment_du), or NULL. */
+    double seg_t0;
+    const double *seg_u0, *seg_du;
+    PamEngineInputs inputs;
 } Run;
 
 static void keep_first_error(void *env, int level, const char *message) {
@@ -128,7 +136,7 @@ typedef struct {
     int moving;                                      /* 0: the quadratures do not change in this step */
 } QuadPoly;
 
-static void quad_poly(const Run *run, const DensePoly *d, int moving, double ta, double tb, QuadPoly *w) {
+static void quad_poly(Run *run, const DensePoly *d, int moving, double ta, double tb, QuadPoly *w) {
     double y[PM_NX], P[GL_N][PM_NQ > 0 ? PM_NQ : 1];
     int q, k, j;
     w->t0 = ta;
@@ -138,6 +146,7 @@ static void quad_poly(const Run *run, const DensePoly *d, int moving, double ta,
     if (!w->moving) return;
     for (q = 0; q < GL_N; q++) {
         state_at(d, ta + GL_NODE[q] * w->span, y);
+        inputs_at(&run->engine, ta + GL_NODE[q] * w->span, 1); /* inputs that follow a signal, there */
         pm_fq(run->engine.mode, y, run->engine.u, run->engine.p, P[q]);
     }
     for (k = 0; k < PM_NQ; k++)
@@ -195,6 +204,7 @@ static void on_step(void *env, double t0, double t1, double h, const double *y0,
     }
     quad_at(&w, t1, run->quad, run->quad);
     state_at(&d, t1, y);
+    inputs_at(&run->engine, t1, 1);
     note_extremes(run, run->engine.mode, y, run->quad);
 }
 
@@ -233,11 +243,57 @@ static int set_inputs(Run *run, const double *u) {
     return 0;
 }
 
+/* The inputs of the current segment at t_s: each in closed form, so the integrator sees them exactly. */
+static void segment_inputs_at(void *env, double t_s, int left, double *u) {
+    const Run *run = (const Run *)env;
+    double dt = t_s - run->seg_t0;
+    int k;
+    (void)left; /* continuous inside a segment: its ends are the segments' boundaries */
+    for (k = 0; k < PM_NU; k++) {
+        const double *d = run->seg_du + 3 * k;
+        u[k] = run->seg_u0[k] + d[0] * dt + (d[2] > 0.0 ? d[1] * expm1(-dt / d[2]) : 0.0);
+    }
+}
+
+/* A segment ends where do_step is asked to stop: no breakpoint inside it. */
+static double segment_next_breakpoint(void *env, double t_s) {
+    (void)env;
+    (void)t_s;
+    return HUGE_VAL;
+}
+
+static int segment_constant(void *env, double t_s) {
+    const Run *run = (const Run *)env;
+    int k;
+    (void)t_s;
+    for (k = 0; k < PM_NU; k++)
+        if (run->seg_du[3 * k] != 0.0 || (run->seg_du[3 * k + 2] > 0.0 && run->seg_du[3 * k + 1] != 0.0)) return 0;
+    return 1;
+}
+
+/* The segment from seg_t (its start) with inputs seg_u there and their change seg_du (NULL: held). */
+static int enter_segment(Run *run, double seg_t, const double *seg_u, const double *seg_du) {
+    PamEngine *e = &run->engine;
+    int k;
+    if (set_inputs(run, seg_u)) return -1;
+    run->seg_t0 = seg_t;
+    run->seg_u0 = seg_u;
+    run->seg_du = seg_du;
+    for (k = 0; seg_du && k < 3 * PM_NU; k++)
+        if (!isfinite(seg_du[k]) || (k % 3 == 2 && seg_du[k] < 0.0)) {
+            snprintf(run->message, PAM_ENGINE_MSG, "%s: a segment's change is not finite", PM_INPUTS_NAMES[k / 3]);
+            return -1;
+        }
+    e->inputs = seg_du ? &run->inputs : NULL;
+    return 0;
+}
+
 static int run_case(const PamEngineBatch *b, int64_t i) {
     Run run;
     PamEngine *e = &run.engine;
     const double *seg_t = b->segment_t_s + b->segment_offset[i];
     const double *seg_u = b->segment_u + PM_NU * b->segment_offset[i];
+    const double *seg_du = b->segment_du ? b->segment_du + 3 * PM_NU * b->segment_offset[i] : NULL;
     double quad0[PM_NQ > 0 ? PM_NQ : 1];
     int64_t n_seg = b->n_segments[i], j;
     int k;
@@ -271,7 +327,11 @@ static int run_case(const PamEngineBatch *b, int64_t i) {
     e->max_steps = (long)b->max_steps[i];
     e->log = keep_first_error;
     e->log_env = &run;
-    if (set_inputs(&run, seg_u)) return ENGINE_BAD_INPUT;
+    run.inputs.at = segment_inputs_at;
+    run.inputs.next_breakpoint = segment_next_breakpoint;
+    run.inputs.constant_after = segment_constant;
+    run.inputs.env = &run;
+    if (enter_segment(&run, seg_t[0], seg_u, seg_du)) return ENGINE_BAD_INPUT;
     pam_engine_initialize(e);
     for (k = 0; k < PM_NQ; k++) quad0[k] = e->q_start[PM_QUADRATURE[k]];
     memcpy(run.quad, quad0, sizeof run.quad);
@@ -290,7 +350,8 @@ static int run_case(const PamEngineBatch *b, int64_t i) {
             record(&run, e->x, run.quad);
         if (j < n_seg) {
             /* the next segment sees the inputs' new values; a held model is re-checked */
-            if (set_inputs(&run, seg_u + PM_NU * j)) return ENGINE_BAD_INPUT;
+            if (enter_segment(&run, seg_t[j], seg_u + PM_NU * j, seg_du ? seg_du + 3 * PM_NU * j : NULL))
+                return ENGINE_BAD_INPUT;
             e->inputs_changed = 1;
         }
     }

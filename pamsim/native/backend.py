@@ -17,9 +17,12 @@ Differences from the Python backend, all documented in ``docs/scaling.md``:
   table of the model (:func:`force_table`), not the model itself;
 - the work integrals are Gauss-Legendre quadratures of each step's dense output
   (the Python backend integrates them as states);
-- a signal that is neither constant nor a step nor steps (ramp, lag, trace, external
-  force) is held at its midpoint value over intervals of at most
-  :func:`hold_interval_s`, a second-order approximation.
+- on the generic engine every input signal the FMU can carry (constant, step, steps, ramp,
+  lag, trace) is exact: the run is cut at its knots and lag starts, and inside each piece the
+  integrator evaluates it in closed form (:func:`exact_segments`); a case with a force table on
+  the hand-written core, or a signal of another kind, holds a signal that is neither constant
+  nor a step nor steps at its midpoint value over intervals of at most :func:`hold_interval_s`,
+  a second-order approximation.
 """
 
 from __future__ import annotations
@@ -39,6 +42,7 @@ from ..core_table import C_CHOICES, SCENARIO_KEYS, unimplemented_choice
 from ..elements.pressure_source import ValveChamberSource
 from ..errors import InputError, SolverFailure
 from ..fmu.force_table import ForceTable
+from ..fmu.preset import input_signal
 from ..fmu.runner import REPRESENTED, tabulate_model
 from ..model import Mode, MuscleModel
 from ..result import Result, TransitionEvent
@@ -87,15 +91,18 @@ class CaseInputs:
     model: MuscleModel
     table: ForceTable | None = None
     assembly: object | None = None
+    segment_du: np.ndarray | None = None  # exact inputs (EngineCase.segment_du), in segment_u's columns
 
     def engine_case(self, library, capacity: int) -> EngineCase:
         """This case as the generic engine takes it: the flat model's parameters and inputs."""
         names = library.names["inputs"]
-        u = self.segment_u[:, [lib.INPUTS.index(n) for n in names]]
+        columns = [lib.INPUTS.index(n) for n in names]
+        u = self.segment_u[:, columns]
+        du = None if self.segment_du is None else self.segment_du[:, columns, :]
         return EngineCase(np.array(self.assembly.parameter_values()), float(self.reals[lib.REAL_INDEX["cs_relative_tolerance"]]),
                           float(self.reals[lib.REAL_INDEX["cs_max_step_s"]]),
                           int(self.ints[lib.INT_INDEX["cs_max_internal_steps"]]), self.duration_s, self.n_samples,
-                          self.segment_t_s, u, int(capacity))
+                          self.segment_t_s, u, int(capacity), du)
 
 
 def engine_assembly(scenario: Scenario, model: MuscleModel | None = None):
@@ -182,11 +189,50 @@ def hold_interval_s(signals, sample_interval_s: float) -> float:
     return hold
 
 
-def case_inputs(scenario: Scenario, model: MuscleModel | None = None) -> CaseInputs:
+def exact_segments(signals, duration_s: float):
+    """The signals (None where an input has none) cut at every knot and lag start before
+    ``duration_s``: ``(starts, u, du)`` with each signal's value at each piece's start and its change
+    over the piece (:class:`pamsim.native.engine.EngineCase`), exactly; None if a signal is of a kind
+    the FMU cannot carry (a Python callable), which is then held piecewise instead."""
+    pieces = []
+    for sig in signals:
+        try:
+            pieces.append(None if sig is None else input_signal(sig, ""))
+        except InputError:
+            return None
+    bounds = {0.0}
+    for piece in pieces:
+        if piece is not None:
+            times = (piece.lag[0],) if piece.lag is not None else piece.knots_t_s
+            bounds |= {float(t) for t in times if 0.0 < t < duration_s}
+    starts = np.array(sorted(bounds))
+    u, du = np.zeros((len(starts), len(pieces))), np.zeros((len(starts), len(pieces), 3))
+    for k, piece in enumerate(pieces):
+        for j, t0 in enumerate(starts if piece is not None else ()):
+            u[j, k] = piece(t0)
+            du[j, k] = _change_after(piece, t0)
+    return starts, u, du
+
+
+def _change_after(piece, t0: float) -> tuple[float, float, float]:
+    """(slope, lag amplitude, lag time constant) of ``piece`` from ``t0`` to its next knot or lag start."""
+    if piece.lag is not None:
+        time_s, initial, final, tau_s = piece.lag
+        return (0.0, 0.0, 0.0) if t0 < time_s else (0.0, (initial - final) * math.exp(-(t0 - time_s) / tau_s), tau_s)
+    ts, vs = piece.knots_t_s, piece.knots
+    k = int(np.searchsorted(ts, t0, side="right")) - 1
+    if 0 <= k < len(ts) - 1 and ts[k + 1] > ts[k]:
+        return ((vs[k + 1] - vs[k]) / (ts[k + 1] - ts[k]), 0.0, 0.0)
+    return (0.0, 0.0, 0.0)
+
+
+def case_inputs(scenario: Scenario, model: MuscleModel | None = None, exact: bool = True) -> CaseInputs:
     """The library's inputs for ``scenario``; refuses (``InputError``) what the backend cannot honour.
 
     ``model`` is ``scenario.build_model()`` (built here if not given), or that model with its pressure
     source replaced (a fit drives it with a recorded pressure): the source choice follows the model.
+    ``exact``: a case the generic engine runs takes its signals exactly (:func:`exact_segments`);
+    otherwise, and always for a case with a force table, they are held piecewise.
     """
     refuse_unsupported(scenario)
     model = scenario.build_model() if model is None else model
@@ -219,6 +265,11 @@ def case_inputs(scenario: Scenario, model: MuscleModel | None = None) -> CaseInp
     ints[lib.INT_INDEX["static_force_model"]] = C_CHOICES["static_force_model"].index(
         "acra2012_polynomial" if table is None else "table")
     signals = _signals(model)
+    pieces = exact_segments(signals, T) if assembly is not None and exact else None
+    if pieces is not None:
+        starts, u, du = pieces
+        u[:, lib.INPUTS.index("load_mass_kg")] = model.load.mass_kg
+        return CaseInputs(reals, ints, T, n_samples, starts, u, opts.max_events, model, table, assembly, du)
     hold = hold_interval_s(signals, T / max(n_samples - 1, 1))
     bounds = {0.0} | {float(b) for b in model.breakpoints if 0.0 < b < T}
     if math.isfinite(hold):

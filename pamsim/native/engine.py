@@ -47,7 +47,8 @@ class EngineBatch(ctypes.Structure):
 
     _fields_ = [("n_cases", ctypes.c_int64), ("params", _D), ("rtol", _D), ("max_step_s", _D), ("max_steps", _I64),
                 ("duration_s", _D), ("n_samples", _I64), ("sample_offset", _I64), ("n_segments", _I64),
-                ("segment_offset", _I64), ("segment_t_s", _D), ("segment_u", _D), ("event_capacity", _I64),
+                ("segment_offset", _I64), ("segment_t_s", _D), ("segment_u", _D), ("segment_du", _D),
+                ("event_capacity", _I64),
                 ("event_offset", _I64), ("samples", _D), ("modes", _I32), ("events", _D), ("n_events", _I64),
                 ("stats", _I64), ("status", _I32), ("extremes", _D), ("messages", ctypes.c_char_p)]
 
@@ -55,7 +56,10 @@ class EngineBatch(ctypes.Structure):
 @dataclass(frozen=True)
 class EngineCase:
     """One run of an assembly: its parameter vector, solver settings, sample grid and input segments
-    (``segment_u``: one row per segment, the flat model's inputs in its order)."""
+    (``segment_u``: one row per segment, the flat model's inputs in its order at the segment's start;
+    ``segment_du``: per segment and input the slope b, lag amplitude c and lag time constant tau (0: no
+    lag) of ``u + b (t - t0) + c (exp(-(t - t0) / tau) - 1)`` from the segment's start t0, or None for
+    inputs held over each segment)."""
 
     params: np.ndarray
     rtol: float
@@ -66,6 +70,7 @@ class EngineCase:
     segment_t_s: np.ndarray
     segment_u: np.ndarray
     event_capacity: int
+    segment_du: np.ndarray | None = None
 
 
 class EngineLibrary:
@@ -122,6 +127,11 @@ class EngineLibrary:
             "segment_t_s": c(np.concatenate([k.segment_t_s for k in cases]), np.float64),
             "segment_u": c(np.concatenate([np.asarray(k.segment_u, float).reshape(-1, L["nu"]) for k in cases]),
                            np.float64)}
+        exact = any(k.segment_du is not None for k in cases)
+        if exact:  # a case with held inputs among them: no change over its segments
+            arrays["segment_du"] = c(np.concatenate([
+                np.zeros((len(k.segment_t_s), L["nu"], 3)) if k.segment_du is None
+                else np.asarray(k.segment_du, float).reshape(-1, L["nu"], 3) for k in cases]), np.float64)
         out = {"sample_offset": offsets(n_samples), "event_offset": offsets(capacity),
                "samples": np.empty(int(n_samples.sum()) * L["ns"]),
                "modes": np.empty(int(n_samples.sum()), dtype=np.int32),
@@ -134,7 +144,8 @@ class EngineLibrary:
         batch = EngineBatch(n, p(arrays["params"], _D), p(arrays["rtol"], _D), p(arrays["max_step_s"], _D),
                             p(arrays["max_steps"], _I64), p(arrays["duration_s"], _D), p(n_samples, _I64),
                             p(out["sample_offset"], _I64), p(n_segments, _I64), p(segment_offset, _I64),
-                            p(arrays["segment_t_s"], _D), p(arrays["segment_u"], _D), p(capacity, _I64),
+                            p(arrays["segment_t_s"], _D), p(arrays["segment_u"], _D),
+                            p(arrays["segment_du"], _D) if exact else None, p(capacity, _I64),
                             p(out["event_offset"], _I64), p(out["samples"], _D), p(out["modes"], _I32),
                             p(out["events"], _D), p(out["n_events"], _I64), p(out["stats"], _I64),
                             p(out["status"], _I32), p(out["extremes"], _D), ctypes.cast(messages, ctypes.c_char_p))
