@@ -31,6 +31,16 @@ def option_error(key: str, value: Any, why: str, choices=None) -> NoReturn:
     raise InputError(f"{key} = {value!r}: {why}" + (did_you_mean(value, choices) if choices else ""))
 
 
+_TYPE_PHRASES = {bool: "true or false", int: "an integer", float: "a decimal number", str: "a string",
+                 dict: "a table", list: "a list"}
+
+
+def type_phrase(kind: type) -> str:
+    """How a message names a value's type: ``an integer``, ``a table``, ``a decimal number`` (TOML's names)."""
+    name = kind.__name__
+    return _TYPE_PHRASES.get(kind, f"an {name}" if name[:1].lower() in "aeiou" else f"a {name}")
+
+
 class TableChecker:
     """The checks of the tables of one file: a mistake raises ``error`` naming ``origin``, the key and the value.
 
@@ -71,7 +81,7 @@ class TableChecker:
         if kind is float:
             return self.number(key, value)
         if not isinstance(value, kind):
-            self.fail(key, value, f"must be a {kind.__name__}, not {type(value).__name__}")
+            self.fail(key, value, f"must be {type_phrase(kind)}, not {type_phrase(type(value))}")
         return value
 
     def number(self, key: str, value: Any) -> float:

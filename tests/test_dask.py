@@ -136,7 +136,6 @@ def test_a_process_pool_worker_killed_mid_sweep_fails_its_chunks_and_the_sweep_c
             assert all(_same(row[k], ref[k]) for k in ref)
 
 
-@pytest.mark.filterwarnings("ignore:Port 8787 is already in use")  # the module's cluster holds it
 @pytest.mark.parametrize("preload", [None, "/nonexistent/pamsim_test_preload.py", "hang"],
                          ids=["no worker", "failed start", "hung start"])
 def test_a_local_cluster_whose_workers_never_start_fails_the_runs_instead_of_waiting(spec, monkeypatch, tmp_path,
@@ -200,8 +199,6 @@ def test_unreachable_scheduler_is_one_line_exit_2(tmp_path, monkeypatch, capsys)
     assert not (tmp_path / "out").exists()
 
 
-# The CLI's LocalCluster asks for the default dashboard port; another Dask on the machine may hold it.
-@pytest.mark.filterwarnings("ignore:Port 8787 is already in use")
 def test_cli_dask_local_writes_the_same_tables_as_the_serial_api(tmp_path):
     (tmp_path / "s.toml").write_text(
         f'base_scenario = "{FIG4}"\n[axes]\npressure_bar = [3.6]\nweight_N = [12.74, 22.74]\n'
@@ -264,3 +261,24 @@ def test_local_workers_keep_the_malloc_defaults_and_use_the_preloaded_fork_serve
     assert {k: dask.config.get(k) for k in before} == before
     assert dict(os.environ) == {**environ, "PAMSIM_TEST_OTHER": "kept"}
     del os.environ["PAMSIM_TEST_OTHER"]
+
+
+def test_local_cluster_serves_no_dashboard_and_leaves_port_8787_alone(client):
+    """``--dask-local`` starts a cluster for one sweep: no dashboard (Dask's default serves one on 8787, and
+    warns when another program holds that port).  Dask always starts the scheduler's HTTP server: it
+    listens on a free local port and answers every page with 404."""
+    import urllib.error
+    import urllib.request
+
+    link = client.dashboard_link
+    assert ":8787/" not in link and link.startswith("http://127.0.0.1:"), link
+    for page in ("/status", "/health", "/"):
+        with pytest.raises(urllib.error.HTTPError, match="404"):
+            urllib.request.urlopen(link.replace("/status", page), timeout=10)
+
+
+def test_chunk_size_zero_names_the_option_and_the_value(tmp_path, capsys):
+    with pytest.raises(SystemExit) as exc:
+        cli_main(["sweep", "x.toml", "-o", str(tmp_path / "out"), "--chunk-size", "0"])
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert exc.value.code == 2 and "--chunk-size" in err and "'0'" in err and "worker" not in err, err

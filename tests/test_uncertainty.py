@@ -209,3 +209,11 @@ def test_cli_refuses_a_bad_table_with_one_line_and_writes_nothing(tmp_path):
     lines = proc.stderr.strip().splitlines()
     assert len(lines) == 1 and "s.toml" in lines[0] and "uncertainty.parameters.N0_N_per_bar.lower = 100.0" in lines[0]
     assert not (tmp_path / "out").exists()
+
+
+def test_a_decimal_sample_count_is_named_in_plain_words(tmp_path):
+    spec = {"base_scenario": str(FIG4), "uncertainty": {"samples": 1e12, "seed": 1, "parameters": {
+        "N0_N_per_bar": {"distribution": "uniform", "lower": 6.0, "upper": 7.0}}}}
+    with pytest.raises(SweepError, match=r"uncertainty.samples = 1000000000000.0: must be an integer, not a "
+                                         r"decimal number"):
+        sweep_from_dict(spec)

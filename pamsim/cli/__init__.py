@@ -71,6 +71,20 @@ def main(argv: list[str] | None = None) -> int:
         return 130
 
 
+def int_at_least(minimum: int):
+    """argparse type: an integer of at least ``minimum``; the message quotes the value, and argparse names
+    the option."""
+    def parse(text: str) -> int:
+        try:
+            n = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
+        if n < minimum:
+            raise argparse.ArgumentTypeError(f"{text!r}: must be at least {minimum}")
+        return n
+    return parse
+
+
 def finite_float(text: str) -> float:
     """argparse type: a finite number."""
     import math

@@ -10,7 +10,7 @@ from pathlib import Path
 
 from ..atomic import OutputError, ensure_output_dir
 from ..identification import choices
-from . import figure_args, finite_float
+from . import figure_args, finite_float, int_at_least
 
 # The numerical modules (numpy, scipy, matplotlib) are imported by the run functions, not here:
 # `pamsim --help` must not load them.
@@ -33,21 +33,8 @@ def _columns(text: str) -> dict[str, str]:
     return out
 
 
-def _int_at_least(minimum: int):
-    """argparse type: an integer of at least ``minimum``."""
-    def parse(text: str) -> int:
-        try:
-            n = int(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
-        if n < minimum:
-            raise argparse.ArgumentTypeError(f"{text!r}: must be at least {minimum}")
-        return n
-    return parse
-
-
-_count = _int_at_least(0)
-_workers = _int_at_least(1)
+_count = int_at_least(0)
+_workers = int_at_least(1)
 
 
 def _window(text: str) -> tuple[float, float]:

@@ -12,17 +12,10 @@ from pathlib import Path
 
 from ..atomic import output_folder
 from ..backends import BACKENDS
-from . import figure_args
+from . import figure_args, int_at_least
 
 
-def _workers(text: str) -> int:
-    try:
-        n = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
-    if n < 1:
-        raise argparse.ArgumentTypeError(f"{text!r}: need at least one worker")
-    return n
+_workers = int_at_least(1)
 
 
 def register(sub) -> None:

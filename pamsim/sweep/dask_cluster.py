@@ -67,11 +67,18 @@ LOCAL_CLUSTER_CONFIG = {
     # The workers start while the sweep prepares its tasks (local_client): should none start, the
     # tasks fail after this long (failed rows, the sweep completes) instead of waiting for ever.
     "distributed.scheduler.no-workers-timeout": "30s",
+    # The scheduler always starts an HTTP server (its default port is the dashboard's 8787, with a warning
+    # when another program holds it); a cluster that lives for one sweep serves no pages (LOCAL_SCHEDULER).
+    "distributed.scheduler.http.routes": [],
 }
 """Dask settings of the ``LocalCluster`` that ``--dask-local`` starts (a pamsim choice; a cluster
 of your own keeps its configuration).  With runs of about a millisecond (the native backend),
 Dask's own work shows; ``benchmarks/bench_dask.py`` measures the cluster against a process pool
 (figures in ``docs/scaling.md``)."""
+
+LOCAL_SCHEDULER = {"dashboard": False, "dashboard_address": "127.0.0.1:0"}
+"""The local cluster's scheduler: no dashboard, and its HTTP server (which Dask always starts) on a free
+port of this machine only, so it never takes port 8787 or warns that another program holds it."""
 
 WORKER_START_TIMEOUT_S = 30.0
 """How long a local worker may take to start and reach the scheduler before it gives up [s]."""
@@ -167,6 +174,7 @@ def local_client(workers: int) -> Iterator:
             stack.enter_context(_local_cluster_settings())
             cluster = stack.enter_context(distributed.LocalCluster(
                 n_workers=0, threads_per_worker=1, processes=True, dashboard_address=None,
+                scheduler_kwargs=LOCAL_SCHEDULER,
                 # A worker whose start hangs gives up after this long, so closing the cluster cannot hang.
                 death_timeout=WORKER_START_TIMEOUT_S,
                 # Workers log a lost heartbeat as an error while the cluster shuts down; not the user's concern.
