@@ -282,3 +282,75 @@ def test_chunk_size_zero_names_the_option_and_the_value(tmp_path, capsys):
         cli_main(["sweep", "x.toml", "-o", str(tmp_path / "out"), "--chunk-size", "0"])
     err = capsys.readouterr().err.strip().splitlines()[-1]
     assert exc.value.code == 2 and "--chunk-size" in err and "'0'" in err and "worker" not in err, err
+
+
+def _cli_in_thread(argv, timeout_s=30.0):
+    """(exit code, seconds taken) of ``pamsim ARGV`` run in a daemon thread, so that a hang fails the test
+    instead of stopping the suite."""
+    out = {}
+
+    def target():
+        t0 = time.perf_counter()
+        out["code"] = cli_main([str(a) for a in argv])
+        out["s"] = time.perf_counter() - t0
+
+    thread = threading.Thread(target=target, daemon=True)
+    thread.start()
+    thread.join(timeout_s)
+    assert "code" in out, f"pamsim {' '.join(map(str, argv))} still running after {timeout_s} s"
+    return out["code"], out["s"]
+
+
+def _free_port() -> int:
+    import socket
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@pytest.fixture
+def tiny_sweep(tmp_path):
+    (tmp_path / "s.toml").write_text(f'base_scenario = "{FIG4}"\n[axes]\npressure_bar = [3.6]\nweight_N = [22.74]\n')
+    return tmp_path / "s.toml"
+
+
+def test_a_refused_connection_is_reported_at_once(tiny_sweep, tmp_path, capsys):
+    code, took_s = _cli_in_thread(["sweep", tiny_sweep, "-o", tmp_path / "out", "--dask",
+                                   f"tcp://127.0.0.1:{_free_port()}"])
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(lines) == 1 and "refused" in lines[0], lines
+    assert took_s < 3.0, took_s
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("server", ["http", "replies at once"])
+def test_a_port_that_is_not_a_dask_scheduler_is_one_line_within_seconds(tiny_sweep, tmp_path, capsys, server):
+    """An HTTP server waits for a request, which Dask's client never sends (the sweep hung); a server that
+    speaks first had its reply read as the length of a message (a 3 EiB allocation and a traceback)."""
+    import http.server
+    import socketserver
+
+    class SpeaksFirst(socketserver.BaseRequestHandler):
+        def handle(self):
+            self.request.sendall(b"HTTP/1.0 400 Bad request\r\n\r\n")
+
+    if server == "http":
+        srv = http.server.ThreadingHTTPServer(("127.0.0.1", 0), http.server.SimpleHTTPRequestHandler)
+    else:
+        srv = socketserver.ThreadingTCPServer(("127.0.0.1", 0), SpeaksFirst)
+    threading.Thread(target=srv.serve_forever, daemon=True).start()
+    try:
+        address = f"tcp://127.0.0.1:{srv.server_address[1]}"
+        code, took_s = _cli_in_thread(["sweep", tiny_sweep, "-o", tmp_path / "out", "--dask", address])
+    finally:
+        srv.shutdown()
+        srv.server_close()
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(lines) == 1 and "not a Dask scheduler" in lines[0] and address in lines[0], lines
+    assert took_s < dask_cluster.HANDSHAKE_TIMEOUT_S + 3.0, took_s
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_running_scheduler_passes_the_handshake_check(client):
+    dask_cluster.check_scheduler(client.scheduler.address)  # raises if the real thing is refused

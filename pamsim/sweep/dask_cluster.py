@@ -30,6 +30,13 @@ EXTRA = "pamsim[dask]"
 CONNECT_TIMEOUT_S = 10.0
 """How long to wait for a scheduler before reporting the address as unreachable."""
 
+HANDSHAKE_TIMEOUT_S = 3.0
+"""How long a server that accepted the connection may take to send Dask's handshake [s]: a scheduler sends
+it at once, unasked."""
+
+MAX_HANDSHAKE_BYTES = 1 << 20
+"""A first message longer than this is not a scheduler's handshake (which is a few hundred bytes)."""
+
 
 class DaskUnavailable(InputError):
     """Dask (``distributed``) is not installed: the message names the extra to install."""
@@ -208,9 +215,52 @@ def dask_executor(address: str | None = None, local_workers: int | None = None) 
             yield client.get_executor(pure=False), f"Dask LocalCluster of {local_workers} worker process(es)"
         return
     distributed = _distributed()
+    check_scheduler(address)
     try:
         client = distributed.Client(address, timeout=CONNECT_TIMEOUT_S)
-    except (OSError, TimeoutError, ValueError) as exc:
+    except (OSError, TimeoutError, ValueError, MemoryError) as exc:
         raise DaskConnectionError(f"--dask {address}: cannot reach the scheduler: {exc}") from None
     with client:
         yield client.get_executor(pure=False), f"Dask scheduler {address}"
+
+
+def check_scheduler(address: str) -> None:
+    """Raise :class:`DaskConnectionError` unless a Dask scheduler answers at ``address`` (``tcp://`` or no
+    scheme; other schemes are left to Dask's client).
+
+    Dask's client retries a refused connection until its timeout, waits without a limit for a server that
+    accepts the connection but never speaks (an HTTP server), and reads the reply of one that speaks first
+    as the length of a message (an allocation of exabytes).  A scheduler sends its handshake as soon as it
+    accepts a connection: eight bytes giving the length of a small message.  So a plain socket tells, in
+    at most :data:`HANDSHAKE_TIMEOUT_S`, whether one is there.
+    """
+    import socket
+
+    from distributed.comm import parse_address, parse_host_port
+
+    def fail(why: str):
+        raise DaskConnectionError(f"--dask {address}: {why}")
+
+    try:
+        scheme, location = parse_address(address)
+        host, port = parse_host_port(location)
+    except (ValueError, TypeError) as exc:
+        fail(f"not a scheduler address ({exc}); write tcp://HOST:PORT")
+    if scheme != "tcp":
+        return
+    try:
+        sock = socket.create_connection((host, port), timeout=CONNECT_TIMEOUT_S)
+    except ConnectionRefusedError:
+        fail("connection refused: no scheduler listens there")
+    except OSError as exc:  # a timeout, an unknown host, no route
+        fail(f"cannot reach the scheduler: {exc.strerror or exc or 'no answer'}")
+    with sock:
+        sock.settimeout(HANDSHAKE_TIMEOUT_S)
+        try:
+            first = sock.recv(8, socket.MSG_WAITALL)
+        except OSError:  # the timeout, or a reset
+            first = b""
+    if len(first) < 8:
+        fail(f"not a Dask scheduler: it sent no handshake within {HANDSHAKE_TIMEOUT_S:g} s")
+    if int.from_bytes(first, "little") > MAX_HANDSHAKE_BYTES:
+        fail(f"not a Dask scheduler: it answered {first!r}")
