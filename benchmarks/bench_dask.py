@@ -153,8 +153,8 @@ def main() -> None:
         same_tables = all((Path(tmp) / "pool" / t).read_bytes() == (Path(tmp) / "dask" / t).read_bytes()
                           for t in UNCERTAINTY_TABLES)
     (_, pool_result), (_, dask_result) = (min(runs, key=lambda r: r[0]) for runs in (pools, dasks))
-    identical = all(_same(a, b) for f in pool_result.uncertainty.outputs
-                    for a, b in zip(dask_result.uncertainty.outputs[f], pool_result.uncertainty.outputs[f]))
+    identical = all(_same(a, b) for a, b in zip(dask_result.uncertainty.sample_rows(),
+                                                pool_result.uncertainty.sample_rows()))
     _table(f"the command, pamsim sweep {STUDY.name} -o DIR, end to end", n, args.backend,
            command["pool"], command["dask"])
     _table("the sweep call, pamsim.sweep(spec, executor), executor start included", n, args.backend,

@@ -41,8 +41,8 @@ out = Path(tempfile.mkdtemp(prefix="pamsim_uq_"))
 result.write(out)
 for name in ("uncertainty_histograms.png", "uncertainty_ecdf.png"):
     shutil.copy(out / name, name)
-runs = sum(len(outputs) for outputs in result.uncertainty.outputs.values())
-print(f"{runs} runs, {sum(map(result.uncertainty.failed, result.uncertainty.outputs))} failed")
+models = result.uncertainty.friction_models
+print(f"{len(models) * spec.uncertainty.samples} runs, {sum(map(result.uncertainty.failed, models))} failed")
 
 # %%
 # The quantiles of each quantity (``uncertainty_summary.csv``; contractions in mm, times in s):

@@ -1,4 +1,4 @@
-"""Error types the CLI maps to exit codes: user input -> 2, solver -> 3."""
+"""Error types the CLI maps to exit codes: user input -> 2, solver and run failures -> 3."""
 
 
 class InputError(ValueError):
@@ -14,3 +14,8 @@ class InputError(ValueError):
 
 class SolverFailure(RuntimeError):
     """The integrator failed or the event logic exceeded its bounds; exit code 3."""
+
+
+class RunFailure(RuntimeError):
+    """The runs could not all be done (a cluster or its workers lost, runs lost to the executor), so
+    nothing is reported from them; exit code 3."""

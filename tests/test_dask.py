@@ -42,9 +42,8 @@ def _assert_identical(result, reference):
     assert [r.keys() for r in result.rows] == [r.keys() for r in reference.rows]
     for row, ref in zip(result.rows, reference.rows):
         assert all(_same(row[k], ref[k]) for k in ref), (row, ref)
-    for f, outs in reference.uncertainty.outputs.items():
-        for o, ref in zip(result.uncertainty.outputs[f], outs):
-            assert all(_same(o[k], ref[k]) for k in ref if k != "wall_time_s"), (o, ref)
+    for row, ref in zip(result.uncertainty.sample_rows(), reference.uncertainty.sample_rows(), strict=True):
+        assert all(_same(row[k], ref[k]) for k in ref), (row, ref)
 
 
 @pytest.fixture(scope="module")
@@ -91,7 +90,8 @@ def test_automatic_chunk_size_amortises_large_sweeps():
 def test_a_worker_killed_mid_sweep_is_retried_and_the_sweep_completes(spec, serial, client):
     pids = set(client.run(os.getpid).values())
     with ThreadPoolExecutor(1) as outer:  # bound the wait: a hung sweep fails the test, not the session
-        running = outer.submit(pamsim.sweep, spec, client.get_executor(pure=False), chunk_size=1)
+        running = outer.submit(pamsim.sweep, spec, client.get_executor(pure=False), chunk_size=1,
+                               allow_incomplete=True)
         deadline = time.monotonic() + 60
         busy = []
         while not busy and time.monotonic() < deadline:
@@ -110,30 +110,51 @@ def test_a_worker_killed_mid_sweep_is_retried_and_the_sweep_completes(spec, seri
     for row, ref in ok:
         assert all(_same(row[k], ref[k]) for k in ref)
     for r in failed:
-        assert "KilledWorker" in r["failure"] + r["constant_failure"]
+        assert "lost: KilledWorker" in r["failure"] + r["constant_failure"]
     client.wait_for_workers(2, timeout=60)  # the nanny restarts it for the tests that follow
 
 
-def test_a_process_pool_worker_killed_mid_sweep_fails_its_chunks_and_the_sweep_completes(spec, serial, tmp_path):
-    with ProcessPoolExecutor(max_workers=2) as pool, ThreadPoolExecutor(1) as outer:
-        running = outer.submit(pamsim.sweep, spec, pool, chunk_size=1)
+def _sweep_killing_a_pool_worker(spec, pool, **options):
+    """``pamsim.sweep(spec, pool, chunk_size=1, **options)`` with one of the pool's workers killed at once."""
+    with ThreadPoolExecutor(1) as outer:
+        running = outer.submit(pamsim.sweep, spec, pool, chunk_size=1, **options)
         deadline = time.monotonic() + 60
         while not pool._processes and time.monotonic() < deadline:  # CPython's pool keeps {pid: process}
             time.sleep(0.02)
         # Killed at once: the 14 runs take about 0.2 s on 2 workers, and a worker that dies at any
         # moment before the last result breaks the pool (an earlier 0.2 s wait sometimes missed it).
         os.kill(next(iter(pool._processes)), signal.SIGKILL)
-        result = running.result(timeout=240)
+        return running.result(timeout=240)
+
+
+def test_a_process_pool_worker_killed_mid_sweep_stops_the_sweep(spec):
+    """Runs lost to the executor stop the sweep (it used to complete, its lost runs failed rows and its
+    quantiles taken from the runs that were left)."""
+    with ProcessPoolExecutor(max_workers=2) as pool:
+        with pytest.raises(pamsim.errors.RunFailure, match=r"runs lost to the executor \(BrokenProcessPool.*the "
+                                                          r"sweep stopped after \d+ of 14 runs"):
+            _sweep_killing_a_pool_worker(spec, pool)
+
+
+def test_a_process_pool_worker_killed_mid_sweep_fails_its_chunks_when_incomplete_is_allowed(spec, serial, tmp_path):
+    with ProcessPoolExecutor(max_workers=2) as pool:
+        result = _sweep_killing_a_pool_worker(spec, pool, allow_incomplete=True)
         # The broken pool cannot draw the figures either: they are drawn here, and everything is written.
         names = result.write(tmp_path / "out", pool)
     assert sorted(p.name for p in (tmp_path / "out").iterdir()) == sorted(names)
     assert all((tmp_path / "out" / n).stat().st_size > 0 for n in names)
     assert len(result.rows) == len(serial.rows)
     errors = [r["failure"] + r["constant_failure"] for r in result.rows]
-    assert any("BrokenProcessPool" in e for e in errors)
+    assert any("lost: BrokenProcessPool" in e for e in errors)
     for row, ref, e in zip(result.rows, serial.rows, errors):
         if not e:
             assert all(_same(row[k], ref[k]) for k in ref)
+    # The uncertainty study says that its sample is incomplete, in the report and in the summary table.
+    lost = result.uncertainty.lost()
+    if lost:
+        assert f"Incomplete sample: {lost} of 6 runs were lost" in (tmp_path / "out" / "uncertainty.md").read_text()
+    summary = (tmp_path / "out" / "uncertainty_summary.csv").read_text().splitlines()
+    assert summary[0].startswith("friction_model,quantity,runs,failed,lost,")
 
 
 @pytest.mark.parametrize("preload", [None, "/nonexistent/pamsim_test_preload.py", "hang"],
@@ -157,7 +178,7 @@ def test_a_local_cluster_whose_workers_never_start_fails_the_runs_instead_of_wai
     def sweep():
         with dask.config.set({"distributed.worker.preload": [preload] if preload else []}):
             with dask_cluster.local_client(0 if preload is None else 2) as c:
-                out["result"] = pamsim.sweep(spec, c.get_executor(pure=False))
+                out["result"] = pamsim.sweep(spec, c.get_executor(pure=False), allow_incomplete=True)
         out["closed"] = True
 
     # In a daemon thread, so that a hang fails this test instead of stopping the suite.
@@ -354,3 +375,84 @@ def test_a_port_that_is_not_a_dask_scheduler_is_one_line_within_seconds(tiny_swe
 
 def test_a_running_scheduler_passes_the_handshake_check(client):
     dask_cluster.check_scheduler(client.scheduler.address)  # raises if the real thing is refused
+
+
+@pytest.fixture
+def own_cluster(tmp_path):
+    """A scheduler and one worker without a nanny, each a process of its own (as on a cluster of your
+    own): ``(address, {"scheduler": Popen, "worker": Popen})``; a test kills one of them."""
+    import subprocess
+
+    file = tmp_path / "scheduler.json"
+    dask_cli = [sys.executable, "-m", "dask"]
+    procs = {"scheduler": subprocess.Popen([*dask_cli, "scheduler", "--port", "0", "--no-dashboard",
+                                            "--scheduler-file", str(file)], stderr=subprocess.DEVNULL)}
+    try:
+        deadline = time.monotonic() + 60
+        while not file.exists() and time.monotonic() < deadline:
+            time.sleep(0.05)
+        procs["worker"] = subprocess.Popen([*dask_cli, "worker", "--scheduler-file", str(file), "--nthreads", "1",
+                                            "--no-nanny", "--no-dashboard"], stderr=subprocess.DEVNULL)
+        with distributed.Client(scheduler_file=str(file), timeout=60) as c:
+            c.wait_for_workers(1, timeout=60)
+            address = c.scheduler.address
+        yield address, procs
+    finally:
+        for p in procs.values():
+            p.kill()
+            p.wait(timeout=30)
+
+
+def _slow_study(tmp_path, samples=2000):
+    """A study of ``samples`` Python-backend runs: seconds of work for one worker."""
+    (tmp_path / "slow.toml").write_text(
+        f'base_scenario = "{FIG4}"\nbackend = "python"\n[uncertainty]\nsamples = {samples}\nseed = 3\n'
+        '[uncertainty.parameters.N0_N_per_bar]\ndistribution = "uniform"\nrelative = true\nlower = 0.9\n'
+        'upper = 1.1\n')
+    return tmp_path / "slow.toml"
+
+
+def test_a_scheduler_that_dies_mid_sweep_stops_it_with_one_line_and_writes_nothing(own_cluster, tmp_path):
+    """It used to exit 0 with a CancelledError line per lost run and quantiles from part of the sample."""
+    import subprocess
+
+    address, procs = own_cluster
+    sweep = subprocess.Popen([sys.executable, "-m", "pamsim", "sweep", str(_slow_study(tmp_path)), "-o",
+                              str(tmp_path / "out"), "--dask", address, "--chunk-size", "10"],
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        # The progress bar on stderr shows the first chunks done: the sweep is under way.
+        seen = ""
+        while not any(f" {n}/2000 " in seen for n in range(10, 2000, 10)):
+            char = sweep.stderr.read(1)
+            assert char, seen
+            seen += char
+        procs["scheduler"].kill()
+        killed = time.monotonic()
+        out, err = sweep.communicate(timeout=60)
+    finally:
+        sweep.kill()
+    took_s = time.monotonic() - killed
+    last = [line for line in (seen + err).replace("\r", "\n").splitlines() if line.strip()][-1]
+    assert sweep.returncode == 3, seen + err
+    assert last.startswith("pamsim: error: ") and "scheduler" in last and "of 2000 runs" in last, last
+    assert err.count("CancelledError") <= 1 and "Traceback" not in err, err
+    assert took_s < dask_cluster.SCHEDULER_LOST_S + dask_cluster.CLOSE_TIMEOUT_S + 2, took_s
+    assert not (tmp_path / "out").exists()
+
+
+def test_losing_the_last_worker_stops_the_sweep_within_seconds(own_cluster, tmp_path, monkeypatch):
+    """A scheduler of your own holds the tasks for ever once its last worker is gone: the sweep hung."""
+    monkeypatch.setattr(dask_cluster, "LAST_WORKER_LOST_S", 1.0)
+    address, procs = own_cluster
+    spec = pamsim.sweep.load_sweep(_slow_study(tmp_path))
+    with distributed.Client(address, timeout=30) as c, ThreadPoolExecutor(1) as outer:
+        running = outer.submit(pamsim.sweep, spec, c.get_executor(pure=False), chunk_size=10)
+        while not c.processing() or not any(c.processing().values()):
+            time.sleep(0.05)
+        procs["worker"].kill()
+        killed = time.monotonic()
+        with pytest.raises(pamsim.errors.RunFailure, match="lost its last worker for 1 s; the sweep stopped"):
+            running.result(timeout=60)
+    # The client hears of the workers every 2 s, then the sweep waits LAST_WORKER_LOST_S.
+    assert time.monotonic() - killed < 2 + 1 + 3

@@ -134,7 +134,7 @@ def test_example_study_gives_the_same_numbers_twice_and_they_follow_the_samples(
     spec, first, second = small_study
     assert first.failures == [] and first.rows == []
     assert first.uncertainty.quantile_rows() == second.uncertainty.quantile_rows()
-    outs = first.uncertainty.outputs["load_dependent"]
+    outs = [first.uncertainty.output("load_dependent", k) for k in range(4)]
     samples = first.uncertainty.samples
     # Each run used its sample: re-simulating sample 2 by hand gives the same final contraction.
     overrides = dict(zip(samples.names, map(float, samples.values[2])))

@@ -12,7 +12,7 @@ import importlib
 import os
 import sys
 
-from ..errors import InputError, SolverFailure
+from ..errors import InputError, RunFailure, SolverFailure
 
 COMMANDS = (
     "pamsim.cli.run",
@@ -46,7 +46,8 @@ def main(argv: list[str] | None = None) -> int:
 
     0 on success (1 for a closed-loop run that misses its specification); a user mistake
     (:class:`~pamsim.errors.InputError`, or a file that cannot be read or written) prints one ``pamsim: error:``
-    line and returns 2, a :class:`~pamsim.errors.SolverFailure` returns 3, an interrupt 130.
+    line and returns 2, a :class:`~pamsim.errors.SolverFailure` or :class:`~pamsim.errors.RunFailure` returns 3,
+    an interrupt 130.
     """
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -57,6 +58,9 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     except SolverFailure as exc:
         print(f"pamsim: solver failure: {exc}", file=sys.stderr)
+        return 3
+    except RunFailure as exc:
+        print(f"pamsim: error: {exc}", file=sys.stderr)
         return 3
     except OSError as exc:
         if isinstance(exc, BrokenPipeError):  # output piped into `head` and the like: not an error of ours

@@ -17,6 +17,9 @@ from . import figure_args, int_at_least
 
 _workers = int_at_least(1)
 
+MAX_FAILURE_LINES = 10
+"""Failed runs named one per line on stderr; the tables hold them all."""
+
 
 def register(sub) -> None:
     """Add ``pamsim sweep`` and its options to ``sub``, the subparsers of :func:`pamsim.cli.build_parser`."""
@@ -37,6 +40,10 @@ def register(sub) -> None:
                         "backend, 1000 with native)")
     p.add_argument("--backend", choices=sorted(BACKENDS), default=None,
                    help="backend of every run (default: the sweep file's backend key, else python)")
+    p.add_argument("--allow-incomplete", action="store_true",
+                   help="keep going when runs are lost to the executor (a worker or cluster gone): write what "
+                        "finished, the lost runs as failed rows and the uncertainty summary marked incomplete "
+                        "(default: stop with exit code 3 and write nothing)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
     figure_args.add_arguments(p)
     p.set_defaults(func=run)
@@ -44,7 +51,8 @@ def register(sub) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """``pamsim sweep``: run the sweep file's cases on worker processes or a Dask cluster and write the summary,
-    report and figures into ``--output``; exit code 0 (a failed run is a warning on stderr).
+    report and figures into ``--output``; exit code 0 (a failed run is a warning on stderr), 3 when runs are
+    lost to the executor (unless ``--allow-incomplete``) or the cluster goes away.
     """
     from ..sweep.dask_cluster import dask_executor, start_worker_server
 
@@ -69,12 +77,16 @@ def run(args: argparse.Namespace) -> int:
             where = f"{workers} worker processes"
         with output_folder(args.output) as out:  # checked before the runs; removed again if nothing gets written
             result = run_sweep(spec, executor, progress=not args.no_progress, backend=args.backend,
-                               chunk_size=args.chunk_size)
+                               chunk_size=args.chunk_size, allow_incomplete=args.allow_incomplete)
             names = result.write(out, executor, fmt, dpi)
-    for failure in result.failures:
+    for failure in result.failures[:MAX_FAILURE_LINES]:
         print(f"pamsim: warning: failed run {failure}", file=sys.stderr)
+    if len(result.failures) > MAX_FAILURE_LINES:
+        print(f"pamsim: warning: {len(result.failures) - MAX_FAILURE_LINES} more failed runs (every one is a row "
+              "with its message in the tables)", file=sys.stderr)
     samples = f", {spec.uncertainty.samples} uncertainty samples" if spec.uncertainty is not None else ""
-    print(f"{spec.name}: {len(result.rows)} cases{samples}, {len(result.failures)} failed runs, "
+    lost = f" ({result.lost} lost: an incomplete sweep)" if result.lost else ""
+    print(f"{spec.name}: {len(result.rows)} cases{samples}, {len(result.failures)} failed runs{lost}, "
           f"{result.wall_time_s:.2f} s on {where}")
     print(f"wrote {', '.join(str(Path(args.output) / n) for n in names)}")
     return 0

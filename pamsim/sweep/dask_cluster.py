@@ -20,8 +20,9 @@ import contextlib
 import importlib.util
 import logging
 import os
+import time
 from concurrent.futures import Executor
-from typing import Iterator
+from typing import Callable, Iterator
 
 from ..errors import InputError
 from .gc_control import paused_gc
@@ -29,6 +30,9 @@ from .gc_control import paused_gc
 EXTRA = "pamsim[dask]"
 CONNECT_TIMEOUT_S = 10.0
 """How long to wait for a scheduler before reporting the address as unreachable."""
+
+CLOSE_TIMEOUT_S = 2.0
+"""How long closing the client of a scheduler may take [s]."""
 
 HANDSHAKE_TIMEOUT_S = 3.0
 """How long a server that accepted the connection may take to send Dask's handshake [s]: a scheduler sends
@@ -220,8 +224,30 @@ def dask_executor(address: str | None = None, local_workers: int | None = None) 
         client = distributed.Client(address, timeout=CONNECT_TIMEOUT_S)
     except (OSError, TimeoutError, ValueError, MemoryError) as exc:
         raise DaskConnectionError(f"--dask {address}: cannot reach the scheduler: {exc}") from None
-    with client:
-        yield client.get_executor(pure=False), f"Dask scheduler {address}"
+    with _quiet_dask_logs():
+        try:
+            yield client.get_executor(pure=False), f"Dask scheduler {address}"
+        finally:
+            # A client whose scheduler is gone would go on trying to reach it while it closes.
+            with contextlib.suppress(Exception):
+                client.close(timeout=CLOSE_TIMEOUT_S)
+
+
+@contextlib.contextmanager
+def _quiet_dask_logs() -> Iterator[None]:
+    """Dask's own log records below CRITICAL kept off stderr inside the block: a lost scheduler is one line
+    from the sweep (:func:`executor_watch`), where Dask's client logs each reconnection attempt and a
+    traceback when it is closed in the middle of one."""
+    # Dask's logging configuration gives some of its loggers a level of their own ("distributed.client").
+    names = ["distributed", *(n for n in logging.root.manager.loggerDict if n.startswith("distributed."))]
+    levels = {name: logging.getLogger(name).level for name in names}
+    for name in names:
+        logging.getLogger(name).setLevel(logging.CRITICAL)
+    try:
+        yield
+    finally:
+        for name, level in levels.items():
+            logging.getLogger(name).setLevel(level)
 
 
 def check_scheduler(address: str) -> None:
@@ -264,3 +290,63 @@ def check_scheduler(address: str) -> None:
         fail(f"not a Dask scheduler: it sent no handshake within {HANDSHAKE_TIMEOUT_S:g} s")
     if int.from_bytes(first, "little") > MAX_HANDSHAKE_BYTES:
         fail(f"not a Dask scheduler: it answered {first!r}")
+
+
+SCHEDULER_LOST_S = 5.0
+"""How long a sweep waits for its client to get back its connection to the scheduler before it stops [s]
+(Dask's client would try for ``distributed.comm.timeouts.connect``, then cancel every task)."""
+
+LAST_WORKER_LOST_S = 10.0
+"""How long a sweep waits, once its cluster has had a worker, for one to come back after the last has
+gone before it stops [s] (a local cluster's nanny restarts a dead worker within seconds; a scheduler of
+your own waits for ever)."""
+
+NO_WORKER_S = 30.0
+"""How long a sweep waits for the first worker of a cluster [s] (a local cluster's start, or a scheduler
+whose workers have not connected yet)."""
+
+
+def executor_watch(executor: Executor) -> Callable[[], str | None] | None:
+    """A check of the cluster behind a Dask executor (``Client.get_executor()``), or None for any other.
+
+    Calling it returns None while the cluster can run the sweep's tasks, and a message once the client has
+    lost its scheduler for :data:`SCHEDULER_LOST_S` or the scheduler has had no worker for
+    :data:`LAST_WORKER_LOST_S` (:data:`NO_WORKER_S` before the first arrived): the sweep then stops
+    instead of waiting for ever.  It reads what the client last heard from the scheduler (updated every
+    2 s), so a call costs nothing.
+    """
+    client = getattr(executor, "_client", None)
+    if client is None or not type(executor).__module__.startswith("distributed"):
+        return None
+    return _ClusterWatch(client)
+
+
+class _ClusterWatch:
+    """:func:`executor_watch` of one client: when each trouble began, and whether a worker was ever seen."""
+
+    def __init__(self, client):
+        self.client = client
+        self.since: dict[str, float] = {"workers": time.monotonic()}
+        self.had_worker = False
+
+    def _lasted(self, trouble: str, now: float, present: bool) -> float:
+        """How long ``trouble`` has been present [s] (0 when it is not)."""
+        if not present:
+            self.since.pop(trouble, None)
+            return 0.0
+        return now - self.since.setdefault(trouble, now)
+
+    def __call__(self) -> str | None:
+        now = time.monotonic()
+        address = getattr(self.client.scheduler, "address", None) or "the scheduler"
+        if self._lasted("scheduler", now, self.client.status != "running") > SCHEDULER_LOST_S:
+            return f"lost the Dask scheduler {address} (client {self.client.status} for {SCHEDULER_LOST_S:g} s)"
+        workers = (getattr(self.client, "_scheduler_identity", None) or {}).get("n_workers")
+        if workers is None:
+            return None
+        self.had_worker = self.had_worker or workers > 0
+        limit = LAST_WORKER_LOST_S if self.had_worker else NO_WORKER_S
+        if self._lasted("workers", now, workers == 0) > limit:
+            what = "lost its last worker" if self.had_worker else "has had no worker"
+            return f"the Dask scheduler {address} {what} for {limit:g} s"
+        return None

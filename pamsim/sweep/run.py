@@ -7,27 +7,30 @@ recorded, not raised.  :meth:`SweepResult.write` writes ``summary.csv``,
 from __future__ import annotations
 
 import csv
+import itertools
 import math
+import os
 import sys
 import time
-from concurrent.futures import Executor, as_completed
+from concurrent.futures import FIRST_COMPLETED, CancelledError, Executor, wait
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 
 from ..atomic import atomic_outputs
 from ..constants import PA_PER_BAR
-from ..errors import InputError
+from ..errors import InputError, RunFailure
 from ..figure_style import check_format
 from ..oscillation import estimate_oscillation
 from ..scenario import Scenario
 from ..static import friction_band_m, static_report
 from .figures import SWEEP_FIGURES, UNCERTAINTY_FIGURES
-from .gc_control import frozen_gc, paused_gc
+from .gc_control import frozen_gc
 from .spec import SweepCase, SweepSpec, load_sweep
-from .uncertainty import Samples, UncertaintyResult
+from .dask_cluster import executor_watch
+from .uncertainty import LOST, RunColumns, Samples, UncertaintyResult
 
 SETTLED_FRACTION = 0.05
 """The pressure counts as settled once it stays within 5 % of its step of its final value; the
@@ -201,6 +204,8 @@ class SweepResult:
     wall_time_s: float
     failures: list[str] = field(default_factory=list)
     uncertainty: UncertaintyResult | None = None
+    lost: int = 0
+    """Runs the executor lost (only with ``allow_incomplete``): rows whose failure begins ``lost:``."""
 
     def columns(self) -> list[str]:
         """Column names of ``summary.csv``."""
@@ -271,7 +276,8 @@ def _fmt(value: Any) -> Any:
 
 
 def run_sweep(spec: SweepSpec | str | Path, executor: Executor | None = None, progress: bool = False,
-              backend: str | None = None, chunk_size: int | None = None) -> SweepResult:
+              backend: str | None = None, chunk_size: int | None = None,
+              allow_incomplete: bool = False) -> SweepResult:
     """Run every case of a sweep under every friction model, and the frequency and response studies.
 
     Parameters
@@ -291,28 +297,99 @@ def run_sweep(spec: SweepSpec | str | Path, executor: Executor | None = None, pr
         Runs sent to the executor as one task (default :func:`auto_chunk_size`).
         Larger chunks amortise the per-task cost of a cluster scheduler; smaller
         ones balance the load better.  Ignored without an executor.
+    allow_incomplete : bool
+        Runs lost to the executor (a worker or cluster gone, so no result at all) stop the sweep with
+        :class:`~pamsim.errors.RunFailure` unless this is true; then they become failed rows whose
+        message begins ``lost:``, and the uncertainty study says that its sample is incomplete.
 
     Returns
     -------
     SweepResult
         Failed runs appear as rows with an ``error`` message and NaN numbers.
+
+    Raises
+    ------
+    InputError
+        An uncertainty study too large for this machine's memory (:func:`check_memory`), or a bad chunk size.
+    RunFailure
+        Runs lost (unless ``allow_incomplete``), a Dask cluster whose scheduler or last worker went away.
     """
     if not isinstance(spec, SweepSpec):
         spec = load_sweep(spec)
     backend = backend or spec.backend
     check_backend(spec, backend)
-    tasks = _study_tasks(spec, backend)
+    _check_chunk_size(chunk_size)
+    check_memory(spec)
     start = time.perf_counter()
     samples = spec.uncertainty.draw() if spec.uncertainty is not None else None
-    if samples is not None:
-        tasks += _sample_tasks(spec, samples, backend)
-    _check_chunk_size(chunk_size)
+    tasks = _Tasks(_study_tasks(spec, backend), spec, samples, backend)
+    kept = _Kept(tasks)
     from tqdm import tqdm
 
     with tqdm(total=len(tasks), unit="run", desc=spec.name, file=sys.stderr, disable=not progress,
               dynamic_ncols=True) as bar:
-        outputs = _execute(tasks, executor, bar, chunk_size or auto_chunk_size(len(tasks), backend))
-    return _result(spec, tasks, outputs, samples, time.perf_counter() - start)
+        _execute(tasks, executor, _Progress(kept, bar), chunk_size or auto_chunk_size(len(tasks), backend),
+                 allow_incomplete)
+    return _result(spec, kept, samples, time.perf_counter() - start)
+
+
+BYTES_PER_SAMPLE_RUN = 32
+"""Memory an uncertainty study keeps per sample and friction model (:class:`.uncertainty.RunColumns`)."""
+
+BYTES_PER_SAMPLE_VALUE = 40
+"""Memory per sample and sampled parameter while the samples are drawn: the uniform numbers, the values
+and numpy's temporaries of the transform (the values are kept for the tables)."""
+
+MEMORY_SHARE = 0.8
+"""The share of the memory available at the start that a study may plan to use."""
+
+
+def sample_memory_bytes(spec: SweepSpec) -> int:
+    """Memory the uncertainty study of ``spec`` keeps while it runs [bytes]: its samples and, per friction
+    model, the kept outputs of every run (0 without a study)."""
+    study = spec.uncertainty
+    if study is None:
+        return 0
+    per_sample = BYTES_PER_SAMPLE_VALUE * len(study.parameters) + BYTES_PER_SAMPLE_RUN * len(spec.friction_models)
+    return study.samples * per_sample
+
+
+def available_memory_bytes() -> int | None:
+    """Memory available to new work on this machine [bytes] (``MemAvailable`` of ``/proc/meminfo``, else the
+    free physical pages), or None where neither can be read."""
+    try:
+        with open("/proc/meminfo") as fh:
+            for line in fh:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    try:
+        return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (ValueError, OSError, AttributeError):
+        return None
+
+
+def check_memory(spec: SweepSpec) -> None:
+    """Raise ``InputError`` naming ``uncertainty.samples`` when the study would need more than
+    :data:`MEMORY_SHARE` of the memory available now (before anything is drawn or run)."""
+    need = sample_memory_bytes(spec)
+    have = available_memory_bytes()
+    if have is None or need <= MEMORY_SHARE * have:
+        return
+    raise InputError(f"{spec.origin}: uncertainty.samples = {spec.uncertainty.samples}: the study needs about "
+                     f"{_bytes(need)} of memory and {_bytes(have)} is available; take at most "
+                     f"{int(MEMORY_SHARE * have / (need / spec.uncertainty.samples)):,} samples or split the study "
+                     "(different seeds)")
+
+
+def _bytes(n: float) -> str:
+    """``n`` bytes in words: ``29.1 TB``, ``512 MB``."""
+    for unit in ("B", "kB", "MB", "GB", "TB", "PB"):
+        if n < 1000 or unit == "PB":
+            return f"{n:.3g} {unit}"
+        n /= 1000
+    raise AssertionError("unreachable")
 
 
 def _study_tasks(spec: SweepSpec, backend: str) -> list[_Task]:
@@ -328,40 +405,95 @@ def _study_tasks(spec: SweepSpec, backend: str) -> list[_Task]:
     return tasks
 
 
-def _sample_tasks(spec: SweepSpec, samples: Samples, backend: str) -> list[_Task]:
-    """One run per uncertainty sample and friction model, each carrying its parameter values."""
-    tasks = []
-    # Thousands of small objects that live until the end: no garbage for the collector to find.
-    with paused_gc():
-        for f in spec.friction_models:
-            base = spec.base.with_changes({"model": {"friction": f}})
-            tasks += [_task("sample", (k, f), base, backend=backend,
-                            parameters=tuple(zip(samples.names, map(float, values))))
-                      for k, values in enumerate(samples.values)]
-    return tasks
+class _Tasks(Sequence):
+    """The runs of a sweep in order: its study's tasks, then one per uncertainty sample under each friction
+    model (friction by friction).  A sample's task is made when its chunk is sent, so a study of millions
+    of samples never holds its tasks at once."""
+
+    def __init__(self, study: list[_Task], spec: SweepSpec, samples: Samples | None, backend: str):
+        self.study = study
+        self.samples = samples
+        self.frictions = list(spec.friction_models) if samples is not None else []
+        self.backend = backend
+        self.n_samples = len(samples.values) if samples is not None else 0
+        # Every sample's task carries its friction model's base scenario (pickled once per chunk).
+        self.bases = [spec.base.with_changes({"model": {"friction": f}}) for f in self.frictions]
+
+    def __len__(self) -> int:
+        return len(self.study) + self.n_samples * len(self.frictions)
+
+    def __getitem__(self, index):
+        if isinstance(index, slice):
+            return [self[i] for i in range(*index.indices(len(self)))]
+        if index < len(self.study):
+            return self.study[index]
+        f, k = divmod(index - len(self.study), self.n_samples)
+        values = self.samples.values[k]
+        return _task("sample", (k, self.frictions[f]), self.bases[f], backend=self.backend,
+                     parameters=tuple(zip(self.samples.names, map(float, values))))
 
 
-def _result(spec: SweepSpec, tasks: list[_Task], outputs: list[dict], samples: Samples | None,
-            wall_time_s: float) -> SweepResult:
-    """The sweep's tables from its runs' outputs (``outputs[k]`` is the output of ``tasks[k]``)."""
-    by_key = {(t.kind, t.key): o for t, o in zip(tasks, outputs)}
+class _Kept:
+    """What a sweep keeps of its runs as they finish: the study's outputs whole (few, and the case rows,
+    frequency study and responses need them), the uncertainty samples' in columns (:class:`RunColumns`)."""
+
+    def __init__(self, tasks: _Tasks):
+        self.tasks = tasks
+        self.study: list[dict | None] = [None] * len(tasks.study)
+        self.runs = {f: RunColumns.empty(tasks.n_samples) for f in tasks.frictions}
+
+    def put(self, i: int, output: dict) -> None:
+        """Keep the output of run ``i`` (its index in :class:`_Tasks`)."""
+        if i < len(self.study):
+            self.study[i] = output
+            return
+        f, k = divmod(i - len(self.study), self.tasks.n_samples)
+        self.runs[self.tasks.frictions[f]].put(k, output)
+
+    def failures(self) -> list[str]:
+        """The message of every failed run, naming its scenario (and its sample), in the order of the runs."""
+        out = [f"{t.scenario.name}: {o['error']}" for t, o in zip(self.tasks.study, self.study) if o["error"]]
+        for base, runs in zip(self.tasks.bases, self.runs.values()):
+            out += [f"{base.name} sample {k}: {e}" for k, e in sorted(runs.errors.items())]
+        return out
+
+
+@dataclass
+class _Progress:
+    """Hands each finished chunk's outputs to :class:`_Kept` and advances the tqdm ``bar``."""
+
+    kept: _Kept
+    bar: Any
+    failed: int = 0
+    done: int = 0
+
+    def record(self, start: int, outputs: Sequence[dict]) -> None:
+        """Keep the outputs of the runs from index ``start`` on."""
+        for j, output in enumerate(outputs):
+            self.kept.put(start + j, output)
+        self.failed += sum(bool(o["error"]) for o in outputs)
+        self.done += len(outputs)
+        self.bar.set_postfix(failed=self.failed, refresh=False)
+        self.bar.update(len(outputs))
+
+
+def _result(spec: SweepSpec, kept: _Kept, samples: Samples | None, wall_time_s: float) -> SweepResult:
+    """The sweep's tables from its kept outputs."""
+    tasks = kept.tasks.study
+    by_key = {(t.kind, t.key): o for t, o in zip(tasks, kept.study)}
     case_scenarios = {t.key: t.scenario for t in tasks if t.kind == "case"}
     rows = [_case_row(spec, i, case, by_key, case_scenarios) for i, case in enumerate(spec.cases)]
     responses = {s.name: {f: by_key[("response", (s.name, f))] for f in spec.friction_models}
                  for s in spec.time_responses}
-    return SweepResult(spec, rows, _frequency_rows(spec, by_key), responses, wall_time_s, _failures(tasks, outputs),
-                       _uncertainty_result(spec, samples, by_key))
+    study = UncertaintyResult(spec.uncertainty, samples, kept.runs) if samples is not None else None
+    lost = sum(o["error"].startswith(LOST) for o in kept.study) + (study.lost() if study is not None else 0)
+    return SweepResult(spec, rows, _frequency_rows(spec, by_key), responses, wall_time_s, kept.failures(), study,
+                       lost)
 
 
 def _check_chunk_size(chunk_size: Any) -> None:
     if chunk_size is not None and (isinstance(chunk_size, bool) or not isinstance(chunk_size, int) or chunk_size < 1):
         raise InputError(f"chunk_size = {chunk_size!r}: must be a positive integer")
-
-
-def _failures(tasks: list[_Task], outputs: list[dict]) -> list[str]:
-    """The message of every failed run, naming its scenario (and its sample)."""
-    return [f"{t.scenario.name}{f' sample {t.key[0]}' if t.kind == 'sample' else ''}: {o['error']}"
-            for t, o in zip(tasks, outputs) if o["error"]]
 
 
 _FREQUENCY_COLUMNS = ("frequency_Hz", "damping_ratio", "n_half_cycles", "half_period_asymmetry",
@@ -382,14 +514,6 @@ def _frequency_rows(spec: SweepSpec, by_key: Mapping) -> list[dict]:
     return rows
 
 
-def _uncertainty_result(spec: SweepSpec, samples: Samples | None, by_key: Mapping) -> UncertaintyResult | None:
-    """The uncertainty study's outputs, sample by sample for each friction model (None without a study)."""
-    if samples is None:
-        return None
-    return UncertaintyResult(spec.uncertainty, samples, {
-        f: [by_key[("sample", (k, f))] for k in range(len(samples.values))] for f in spec.friction_models})
-
-
 def check_backend(spec: SweepSpec, backend: str) -> None:
     """Raise ``InputError`` naming the first setting of the sweep that ``backend`` cannot honour.
 
@@ -406,37 +530,77 @@ def check_backend(spec: SweepSpec, backend: str) -> None:
             check_scenario(backend, scenario.with_changes({"model": {"friction": friction}}))
 
 
-def _execute(tasks: list[_Task], executor: Executor | None, bar, chunk_size: int = 1) -> list[dict]:
-    """Run the tasks (here, or on ``executor`` in chunks of ``chunk_size``), advancing the tqdm ``bar``
-    by one per finished run."""
-    outputs: list[dict | None] = [None] * len(tasks)
-    failed = 0
+MAX_IN_FLIGHT = 64
+"""Chunks sent to an executor ahead of their results: enough to keep 32 workers busy with a chunk queued
+behind each, few enough that the tasks and the outputs not yet kept stay small however long the sweep."""
+
+WATCH_INTERVAL_S = 0.5
+"""How often the sweep looks at a Dask cluster's health while it waits for chunks [s]."""
+
+
+def _execute(tasks: _Tasks, executor: Executor | None, progress: _Progress, chunk_size: int = 1,
+             allow_incomplete: bool = False) -> None:
+    """Run the tasks (here, or on ``executor`` in chunks of ``chunk_size``), handing each chunk's outputs to
+    ``progress`` as it finishes."""
     if executor is None:
         # In batches of NATIVE_BATCH, as a worker runs its chunk (the native backend's runs share library calls).
         for i in range(0, len(tasks), NATIVE_BATCH):
-            chunk = run_chunk(tasks[i:i + NATIVE_BATCH])
-            outputs[i:i + len(chunk)] = chunk
-            failed += sum(bool(o["error"]) for o in chunk)
-            bar.set_postfix(failed=failed, refresh=False)
-            bar.update(len(chunk))
-        return outputs
-    starts = range(0, len(tasks), chunk_size)
+            progress.record(i, run_chunk(tasks[i:i + NATIVE_BATCH]))
+        return
     # The tasks, the imported modules and a local cluster's scheduler stay out of the collector's
     # passes while this process waits on the workers and serves the scheduler.
     with frozen_gc():
-        futures = {executor.submit(run_chunk, tasks[i:i + chunk_size]): i for i in starts}
-        for fut in as_completed(futures):
-            i = futures[fut]
-            n = min(chunk_size, len(tasks) - i)
-            try:
-                chunk = fut.result()
-            except Exception as exc:  # noqa: BLE001 -- a dead worker fails its chunk's cases, not the sweep
-                chunk = [{"error": f"{type(exc).__name__}: {exc}"}] * n
-            outputs[i:i + n] = chunk
-            failed += sum(bool(o["error"]) for o in chunk)
-            bar.set_postfix(failed=failed, refresh=False)
-            bar.update(n)
-    return outputs
+        _execute_on(executor, tasks, progress, chunk_size, allow_incomplete)
+
+
+def _execute_on(executor: Executor, tasks: _Tasks, progress: _Progress, chunk_size: int,
+                allow_incomplete: bool) -> None:
+    """:func:`_execute` on an executor: at most :data:`MAX_IN_FLIGHT` chunks sent ahead, and a Dask
+    cluster's health checked every :data:`WATCH_INTERVAL_S` while the sweep waits."""
+    watch = executor_watch(executor)
+    starts = iter(range(0, len(tasks), chunk_size))
+    pending: dict = {}
+    try:
+        while True:
+            for i in itertools.islice(starts, MAX_IN_FLIGHT - len(pending)):
+                pending[executor.submit(run_chunk, tasks[i:i + chunk_size])] = i
+            if not pending:
+                return
+            done, _ = wait(pending, timeout=WATCH_INTERVAL_S, return_when=FIRST_COMPLETED)
+            for fut in done:
+                i = pending.pop(fut)
+                n = min(chunk_size, len(tasks) - i)
+                progress.record(i, _chunk_outputs(fut, n, allow_incomplete, progress, len(tasks)))
+            problem = watch() if watch is not None else None
+            if problem:
+                raise RunFailure(f"{problem}; {_stopped(progress, len(tasks))}")
+    finally:
+        for fut in pending:  # an error or an interrupt: what has not started never will
+            fut.cancel()
+
+
+def _chunk_outputs(fut, n: int, allow_incomplete: bool, progress: _Progress, total: int) -> Sequence[dict]:
+    """The outputs of a finished chunk of ``n`` runs; a chunk the executor lost stops the sweep, or with
+    ``allow_incomplete`` gives ``n`` failed rows marked :data:`~.uncertainty.LOST`."""
+    try:
+        return fut.result()
+    except Exception as exc:  # noqa: BLE001 -- a worker or cluster lost: run_chunk itself catches every run's error
+        why = _lost_reason(exc)
+    if not allow_incomplete:
+        raise RunFailure(f"{n} runs lost to the executor ({why}); {_stopped(progress, total)}; rerun, or allow "
+                         "an incomplete sweep (--allow-incomplete) to keep the runs that finished") from None
+    return [{"error": LOST + why}] * n
+
+
+def _lost_reason(exc: BaseException) -> str:
+    """One line on why a chunk has no result; Dask's cancelled tasks carry no message."""
+    if isinstance(exc, CancelledError):
+        return "CancelledError: the executor shut down or lost its scheduler"
+    return f"{type(exc).__name__}: {exc}".splitlines()[0]
+
+
+def _stopped(progress: _Progress, total: int) -> str:
+    return f"the sweep stopped after {progress.done} of {total} runs and wrote nothing"
 
 
 _RUN_COLUMNS = ("final_contraction_m", "peak_contraction_m", "error_m", "at_rest", "final_mode",

@@ -17,9 +17,10 @@ from __future__ import annotations
 
 import csv
 import inspect
+import itertools
 import math
-from dataclasses import dataclass
-from typing import Any, Mapping
+from dataclasses import dataclass, field
+from typing import Any, Iterator, Mapping
 
 import numpy as np
 
@@ -135,6 +136,11 @@ class UncertaintySpec:
 
 
 # ---------------------------------------------------------------- reading the table
+def _sampling_name(sampling: str) -> str:
+    """The sampling's name in a sentence: ``latin hypercube``, ``random sample``."""
+    return "Latin hypercube" if sampling == "latin_hypercube" else "random sample"
+
+
 def parse_uncertainty(check: TableChecker, table: Any, base: Scenario) -> UncertaintySpec:
     """Validate an ``[uncertainty]`` table against the base scenario's parameter set.
 
@@ -206,57 +212,121 @@ def _distribution(check: TableChecker, where: str, name: str, entry: Any, base: 
 
 
 # ---------------------------------------------------------------- results
+KEPT = (*QUANTITIES, "at_rest")
+"""What a study keeps of each run: the summarised quantities and whether it ended at rest."""
+
+LOST = "lost: "
+"""How the error of a run that the executor lost (its worker or cluster gone) begins: it has no result,
+and the study is incomplete."""
+
+
+@dataclass
+class RunColumns:
+    """One friction model's runs of a study, as columns: ``values[key][k]`` is run ``k``'s ``key`` (a float:
+    NaN where the run failed; ``at_rest`` 1.0 or 0.0), ``errors[k]`` the message of a failed run.
+
+    Columns rather than a dict per run: a run's dict of outputs and its task took about 1.7 kB, the columns
+    take 32 bytes, so a study of millions of samples fits in memory.
+    """
+
+    values: dict[str, np.ndarray]
+    errors: dict[int, str] = field(default_factory=dict)
+
+    @classmethod
+    def empty(cls, n: int) -> "RunColumns":
+        """Room for ``n`` runs, every value NaN."""
+        return cls({key: np.full(n, math.nan) for key in KEPT})
+
+    def put(self, k: int, output: Mapping) -> None:
+        """Keep run ``k``'s output (a run's dict, with its ``error`` message, empty if it succeeded)."""
+        if output["error"]:
+            self.errors[k] = output["error"]
+        for key in KEPT:
+            self.values[key][k] = output.get(key, math.nan)
+
+    def output(self, k: int) -> dict:
+        """Run ``k`` as the dict of what was kept: the quantities, ``at_rest`` and ``error``."""
+        out = {key: float(self.values[key][k]) for key in QUANTITIES}
+        at_rest = self.values["at_rest"][k]
+        out["at_rest"] = math.nan if math.isnan(at_rest) else bool(at_rest)
+        out["error"] = self.errors.get(k, "")
+        return out
+
+    def lost(self) -> int:
+        """Runs the executor lost (no result at all, as opposed to a run that failed)."""
+        return sum(e.startswith(LOST) for e in self.errors.values())
+
+
 @dataclass
 class UncertaintyResult:
-    """The runs of an uncertainty study: ``outputs[friction][k]`` is sample ``k``'s run."""
+    """The runs of an uncertainty study: ``runs[friction]`` holds every sample's run under ``friction``."""
 
     spec: UncertaintySpec
     samples: Samples
-    outputs: Mapping[str, list[dict]]
+    runs: Mapping[str, RunColumns]
+
+    @property
+    def friction_models(self) -> list[str]:
+        """The friction models, in the sweep's order."""
+        return list(self.runs)
+
+    def output(self, friction: str, k: int) -> dict:
+        """What the study kept of sample ``k``'s run under ``friction`` (:meth:`RunColumns.output`)."""
+        return self.runs[friction].output(k)
 
     def values(self, friction: str, quantity: str) -> np.ndarray:
         """``quantity`` of every successful run of ``friction`` (failed runs left out)."""
-        v = np.array([o.get(quantity, math.nan) for o in self.outputs[friction] if not o["error"]], dtype=float)
+        runs = self.runs[friction]
+        ok = np.ones(len(self.samples.values), dtype=bool)
+        ok[list(runs.errors)] = False
+        v = runs.values[quantity][ok]
         return v[np.isfinite(v)]
 
     def failed(self, friction: str) -> int:
-        """Number of failed runs under ``friction``."""
-        return sum(bool(o["error"]) for o in self.outputs[friction])
+        """Number of failed runs under ``friction`` (the lost ones included)."""
+        return len(self.runs[friction].errors)
+
+    def lost(self) -> int:
+        """Runs that the executor lost, under every friction model: the sample is incomplete if any."""
+        return sum(r.lost() for r in self.runs.values())
 
     def quantile_rows(self) -> list[dict]:
-        """One row per friction model and quantity: count, mean, standard deviation and quantiles."""
+        """One row per friction model and quantity: count, failed and lost runs, mean, standard deviation and
+        quantiles (of the successful runs)."""
         rows = []
-        for f in self.outputs:
+        for f in self.runs:
             for q in QUANTITIES:
                 v = self.values(f, q)
                 row = {"friction_model": f, "quantity": q, "runs": int(v.size), "failed": self.failed(f),
-                       "mean": float(v.mean()) if v.size else math.nan,
+                       "lost": self.runs[f].lost(), "mean": float(v.mean()) if v.size else math.nan,
                        "std": float(v.std(ddof=1)) if v.size > 1 else math.nan}
                 for p in self.spec.quantiles:
                     row[f"q{p:g}"] = float(np.quantile(v, p)) if v.size else math.nan
                 rows.append(row)
         return rows
 
-    def sample_rows(self) -> list[dict]:
-        """One row per run: sample number, friction model, parameter values and outputs."""
-        rows = []
-        for f, outs in self.outputs.items():
-            for k, o in enumerate(outs):
+    def sample_rows(self) -> Iterator[dict]:
+        """One row per run, made as they are read: sample number, friction model, parameter values and
+        outputs."""
+        for f, runs in self.runs.items():
+            for k, values in enumerate(self.samples.values):
                 row = {"sample": k, "friction_model": f}
-                row.update(zip(self.samples.names, map(float, self.samples.values[k])))
-                row.update({q: o.get(q, math.nan) for q in QUANTITIES})
-                row["at_rest"] = o.get("at_rest", math.nan)
+                row.update(zip(self.samples.names, map(float, values)))
+                o = runs.output(k)
+                row.update({q: o[q] for q in QUANTITIES})
+                row["at_rest"] = o["at_rest"]
                 row["failure"] = o["error"]
-                rows.append(row)
-        return rows
+                yield row
 
     def write_tables(self, samples_path, summary_path) -> None:
-        """Write the per-run and the quantile tables as CSV (the caller stages them atomically)."""
-        for path, rows in ((samples_path, self.sample_rows()), (summary_path, self.quantile_rows())):
+        """Write the per-run and the quantile tables as CSV (the caller stages them atomically); the per-run
+        rows are written as they are made, never all held at once."""
+        for path, rows in ((samples_path, self.sample_rows()), (summary_path, iter(self.quantile_rows()))):
+            first = next(rows)
             with open(path, "w", newline="") as fh:
-                w = csv.DictWriter(fh, fieldnames=list(rows[0]))
+                w = csv.DictWriter(fh, fieldnames=list(first))
                 w.writeheader()
-                for row in rows:
+                for row in itertools.chain([first], rows):
                     w.writerow({k: (f"{v:.9g}" if isinstance(v, float) else v) for k, v in row.items()})
 
     def report(self, sweep_name: str, figure_format: str = "png") -> str:
@@ -264,9 +334,10 @@ class UncertaintyResult:
         s = self.spec
         out = [f"# Uncertainty study: {sweep_name}", "",
                f"{s.samples} samples ({s.sampling.replace('_', ' ')}, seed {s.seed}) of {len(s.parameters)} "
-               f"parameters, each run under {', '.join(self.outputs)} friction; distributions truncated to "
+               f"parameters, each run under {', '.join(self.runs)} friction; distributions truncated to "
                "their bounds.", "", "| parameter | distribution |", "|---|---|"]
         out += [f"| {p.name} | {p.describe()} |" for p in s.parameters]
+        out += self._incomplete_note()
         out += ["", "Contractions in mm; the settling time is the first time (from the start of the run) after "
                 "which the contraction stays within 5 % of its change of its final value.", "",
                 "| friction | quantity | runs | failed | mean | std | "
@@ -280,3 +351,14 @@ class UncertaintyResult:
         out += ["", f"![histograms](uncertainty_histograms.{figure_format})", "",
                 f"![ECDF](uncertainty_ecdf.{figure_format})", ""]
         return "\n".join(out)
+
+    def _incomplete_note(self) -> list[str]:
+        """The report's warning that runs were lost, so the quantiles come from part of the sample (nothing if
+        none was)."""
+        lost = self.lost()
+        if not lost:
+            return []
+        total = len(self.samples.values) * len(self.runs)
+        return ["", f"**Incomplete sample: {lost} of {total} runs were lost** (their worker or cluster went away; "
+                    "the `lost` column). The quantiles below come from the runs that finished, which are not the "
+                    f"{_sampling_name(self.spec.sampling)} that was drawn: rerun the study for its quantiles."]

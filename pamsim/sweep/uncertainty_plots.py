@@ -20,7 +20,7 @@ def _panels(result: UncertaintyResult, title: str):
     for ax, (q, label) in zip(axes, QUANTITIES.items()):
         scale = 1e3 if q.endswith("_m") else 1.0
         ax.set_xlabel(label)
-        for k, f in enumerate(result.outputs):
+        for k, f in enumerate(result.runs):
             yield fig, ax, f, series(k), np.sort(result.values(f, q)) * scale
 
 
