@@ -217,3 +217,28 @@ def test_a_decimal_sample_count_is_named_in_plain_words(tmp_path):
     with pytest.raises(SweepError, match=r"uncertainty.samples = 1000000000000.0: must be an integer, not a "
                                          r"decimal number"):
         sweep_from_dict(spec)
+
+
+def test_a_study_too_large_for_the_memory_is_refused_before_anything_runs(tmp_path, capsys):
+    """``samples = 10**12`` drew its Latin hypercube first and ended in a traceback (a 29 TiB array)."""
+    from pamsim.cli import main
+
+    (tmp_path / "huge.toml").write_text(
+        f'base_scenario = "{FIG4}"\n[uncertainty]\nsamples = 1000000000000\nseed = 1\n'
+        '[uncertainty.parameters.N0_N_per_bar]\ndistribution = "uniform"\nlower = 6.0\nupper = 7.0\n')
+    code = main(["sweep", str(tmp_path / "huge.toml"), "-o", str(tmp_path / "out"), "--no-progress"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1, err
+    assert "uncertainty.samples = 1000000000000: the study needs about 72 TB of memory" in err[0], err
+    assert not (tmp_path / "out").exists()
+
+
+def test_the_memory_check_counts_parameters_and_friction_models(monkeypatch):
+    from pamsim.sweep import run
+
+    spec = load_sweep(SCENARIOS / "acra2012_fig4_uncertainty.toml")  # 4 parameters, 1 friction model
+    assert run.sample_memory_bytes(spec) == 10_000 * (4 * run.BYTES_PER_SAMPLE_VALUE + run.BYTES_PER_SAMPLE_RUN)
+    monkeypatch.setattr(run, "available_memory_bytes", lambda: 2_000_000)  # 1.6 MB of it usable
+    with pytest.raises(pamsim.errors.InputError, match=r"needs about 1.92 MB of memory and 2 MB is available; "
+                                                      r"take at most 8,333 samples"):
+        run.check_memory(spec)
