@@ -37,24 +37,42 @@ def ensure_output_dir(directory: str | os.PathLike) -> Path:
     return directory
 
 
+def check_output_dir(directory: str | os.PathLike) -> Path:
+    """Check that files can be written into ``directory`` without creating it: the folder itself if it
+    exists, else its nearest existing parent (where it would be made) is probed."""
+    directory = Path(directory)
+    existing = next(p for p in (directory, *directory.parents) if p.exists() or p.is_symlink())
+    try:
+        if not existing.is_dir():
+            raise NotADirectoryError(20, "Not a directory")
+        fd, probe = tempfile.mkstemp(prefix=".pamsim-probe-", dir=existing)
+        os.close(fd)
+        os.unlink(probe)
+    except OSError as exc:
+        raise OutputError(f"{directory}: cannot write output there: {exc.strerror or exc}") from None
+    return directory
+
+
 @contextlib.contextmanager
 def output_folder(directory: str | os.PathLike):
-    """:func:`ensure_output_dir` for a block of work that may fail: yields the folder.
+    """:func:`check_output_dir` for a block of work that may fail: yields the folder, not yet made.
 
-    If the block raises (an input error found late, a solver failure, a
-    write error, an interrupt), the folders this call created are removed again
-    when they are still empty, so a failed command leaves no trace.
+    The folder is made by the first write into it (:func:`atomic_outputs`), so a process killed before it
+    writes (SIGKILL, which no handler sees) leaves no empty folder behind.  If the block raises (an input
+    error found late, a solver failure, a write error, an interrupt), the folders this call would have
+    made are removed again when they are still empty, so a failed command leaves no trace.
     """
     directory = Path(directory)
     created = [p for p in (directory, *directory.parents) if not p.exists() and not p.is_symlink()]  # deepest first
     try:
-        yield ensure_output_dir(directory)
+        yield check_output_dir(directory)
     except BaseException:
         for folder in created:
             try:
                 folder.rmdir()
-            except OSError:  # not empty (something else wrote there) or already gone
-                break
+            except OSError:  # not empty (something else wrote there), already gone, or never made
+                if folder.exists():
+                    break
         raise
 
 

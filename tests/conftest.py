@@ -96,3 +96,39 @@ def run_main(*args):
 def cli():
     """:func:`run_main`, for tests that take the command line as a fixture."""
     return run_main
+
+
+def start_until_progress(*args, done: int = 10):
+    """Start ``pamsim ARGS`` in a process of its own and return ``(process, stderr so far)`` once its
+    progress bar shows at least ``done`` runs finished (so its workers are busy)."""
+    proc = subprocess.Popen([sys.executable, "-m", "pamsim", *map(str, args)], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    seen = ""
+    try:
+        while True:
+            char = proc.stderr.read(1)
+            assert char, f"pamsim ended before {done} runs: {seen}"
+            seen += char
+            if char in "\r\n" and _runs_done(seen) >= done:
+                return proc, seen
+    except BaseException:
+        proc.kill()
+        raise
+
+
+def _runs_done(progress: str) -> int:
+    """Runs finished in the last line of a tqdm bar (``name:  1%|   | 20/2000 [...]``)."""
+    import re
+
+    found = re.findall(r"\| (\d+)/\d+ \[", progress)
+    return int(found[-1]) if found else 0
+
+
+def slow_study(folder: Path, samples: int = 2000) -> Path:
+    """A sweep file in ``folder`` of an uncertainty study of ``samples`` Python-backend runs of Figure 4
+    (about 15 ms each): seconds of work, to stop in the middle."""
+    path = folder / "slow.toml"
+    path.write_text(f'base_scenario = "{(SCENARIOS / "acra2012_fig4.toml").as_posix()}"\nbackend = "python"\n'
+                    f'[uncertainty]\nsamples = {samples}\nseed = 3\n[uncertainty.parameters.N0_N_per_bar]\n'
+                    'distribution = "uniform"\nrelative = true\nlower = 0.9\nupper = 1.1\n')
+    return path

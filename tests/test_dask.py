@@ -20,6 +20,7 @@ from pamsim.cli import main as cli_main
 from pamsim.sweep import dask_cluster, sweep_from_dict
 from pamsim.sweep.run import UNCERTAINTY_TABLES, auto_chunk_size
 from conftest import run_main as _cli
+from conftest import slow_study, start_until_progress
 
 distributed = pytest.importorskip("distributed", reason="Dask is the optional extra pamsim[dask] (in [test])")
 
@@ -403,30 +404,12 @@ def own_cluster(tmp_path):
             p.wait(timeout=30)
 
 
-def _slow_study(tmp_path, samples=2000):
-    """A study of ``samples`` Python-backend runs: seconds of work for one worker."""
-    (tmp_path / "slow.toml").write_text(
-        f'base_scenario = "{FIG4}"\nbackend = "python"\n[uncertainty]\nsamples = {samples}\nseed = 3\n'
-        '[uncertainty.parameters.N0_N_per_bar]\ndistribution = "uniform"\nrelative = true\nlower = 0.9\n'
-        'upper = 1.1\n')
-    return tmp_path / "slow.toml"
-
-
 def test_a_scheduler_that_dies_mid_sweep_stops_it_with_one_line_and_writes_nothing(own_cluster, tmp_path):
     """It used to exit 0 with a CancelledError line per lost run and quantiles from part of the sample."""
-    import subprocess
-
     address, procs = own_cluster
-    sweep = subprocess.Popen([sys.executable, "-m", "pamsim", "sweep", str(_slow_study(tmp_path)), "-o",
-                              str(tmp_path / "out"), "--dask", address, "--chunk-size", "10"],
-                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    sweep, seen = start_until_progress("sweep", slow_study(tmp_path), "-o", tmp_path / "out", "--dask", address,
+                                       "--chunk-size", "10")
     try:
-        # The progress bar on stderr shows the first chunks done: the sweep is under way.
-        seen = ""
-        while not any(f" {n}/2000 " in seen for n in range(10, 2000, 10)):
-            char = sweep.stderr.read(1)
-            assert char, seen
-            seen += char
         procs["scheduler"].kill()
         killed = time.monotonic()
         out, err = sweep.communicate(timeout=60)
@@ -445,7 +428,7 @@ def test_losing_the_last_worker_stops_the_sweep_within_seconds(own_cluster, tmp_
     """A scheduler of your own holds the tasks for ever once its last worker is gone: the sweep hung."""
     monkeypatch.setattr(dask_cluster, "LAST_WORKER_LOST_S", 1.0)
     address, procs = own_cluster
-    spec = pamsim.sweep.load_sweep(_slow_study(tmp_path))
+    spec = pamsim.sweep.load_sweep(slow_study(tmp_path))
     with distributed.Client(address, timeout=30) as c, ThreadPoolExecutor(1) as outer:
         running = outer.submit(pamsim.sweep, spec, c.get_executor(pure=False), chunk_size=10)
         while not c.processing() or not any(c.processing().values()):

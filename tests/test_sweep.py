@@ -351,3 +351,49 @@ def test_estimator_uses_whole_periods_when_up_and_down_swings_differ(n_half):
     assert osc.frequency_Hz == pytest.approx(1.0 / (t_up + t_down), rel=1e-3)
     mean_half = (t_up + t_down) / 2
     assert osc.half_period_asymmetry == pytest.approx((t_up - t_down) / mean_half, rel=0.05)
+
+
+def _alive(pid: int) -> bool:
+    """The process exists and is not a zombie."""
+    try:
+        with open(f"/proc/{pid}/stat") as fh:
+            return fh.read().rsplit(")", 1)[1].split()[0] != "Z"
+    except FileNotFoundError:
+        return False
+
+
+def _children(pid: int) -> list[int]:
+    with open(f"/proc/{pid}/task/{pid}/children") as fh:
+        return [int(p) for p in fh.read().split()]
+
+
+@pytest.mark.skipif(not Path("/proc/self/task").exists(), reason="reads the process tree from /proc (Linux)")
+def test_sigterm_stops_the_pool_workers_and_leaves_no_output_folder(tmp_path):
+    """SIGTERM killed the command alone: its pool workers ran on, holding its stdout open, and the empty
+    output folder stayed."""
+    import signal
+
+    from conftest import slow_study, start_until_progress
+
+    sweep, _ = start_until_progress("sweep", slow_study(tmp_path), "-o", tmp_path / "out", "--workers", "2",
+                                    "--chunk-size", "10")
+    try:
+        workers = _children(sweep.pid)
+        sweep.send_signal(signal.SIGTERM)
+        _, err = sweep.communicate(timeout=30)  # returns once nothing holds the pipes any more
+    finally:
+        sweep.kill()
+    assert sweep.returncode == 143 and err.rstrip().endswith("pamsim: terminated"), err
+    assert workers and not any(_alive(pid) for pid in workers), workers
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_killed_sweep_leaves_no_empty_output_folder(tmp_path):
+    """The output folder is made when the results are written, not when the command starts."""
+    from conftest import slow_study, start_until_progress
+
+    sweep, _ = start_until_progress("sweep", slow_study(tmp_path), "-o", tmp_path / "out" / "deep", "--workers",
+                                    "1")
+    sweep.kill()
+    sweep.communicate(timeout=30)
+    assert not (tmp_path / "out").exists()

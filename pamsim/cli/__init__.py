@@ -8,9 +8,12 @@ failures with code 3.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import importlib
 import os
+import signal
 import sys
+import threading
 
 from ..errors import InputError, RunFailure, SolverFailure
 
@@ -47,12 +50,13 @@ def main(argv: list[str] | None = None) -> int:
     0 on success (1 for a closed-loop run that misses its specification); a user mistake
     (:class:`~pamsim.errors.InputError`, or a file that cannot be read or written) prints one ``pamsim: error:``
     line and returns 2, a :class:`~pamsim.errors.SolverFailure` or :class:`~pamsim.errors.RunFailure` returns 3,
-    an interrupt 130.
+    an interrupt 130, SIGTERM (handled as an interrupt) 143.
     """
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
-        return int(args.func(args) or 0)
+        with _sigterm_as_interrupt():
+            return int(args.func(args) or 0)
     except InputError as exc:
         print(f"pamsim: error: {exc}", file=sys.stderr)
         return 2
@@ -70,9 +74,35 @@ def main(argv: list[str] | None = None) -> int:
         where = f"{exc.filename}: " if exc.filename else ""
         print(f"pamsim: error: {where}{exc.strerror or exc}", file=sys.stderr)
         return 2
+    except Terminated:
+        print("pamsim: terminated", file=sys.stderr)
+        return 128 + signal.SIGTERM
     except KeyboardInterrupt:
         print("pamsim: interrupted", file=sys.stderr)
         return 130
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, raised where the command is, so that it unwinds as an interrupt (Ctrl-C) does: workers
+    stopped, temporary files and folders that nothing was written to removed."""
+
+
+def _raise_terminated(signum, frame):
+    raise Terminated
+
+
+@contextlib.contextmanager
+def _sigterm_as_interrupt():
+    """SIGTERM raises :class:`Terminated` inside the block (in the main thread only: Python runs signal
+    handlers there); the handler before is put back after."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, _raise_terminated)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
 
 
 def int_at_least(minimum: int):

@@ -21,6 +21,23 @@ MAX_FAILURE_LINES = 10
 """Failed runs named one per line on stderr; the tables hold them all."""
 
 
+@contextlib.contextmanager
+def process_pool(workers: int):
+    """A ``ProcessPoolExecutor`` of ``workers`` processes that, if the block raises (an interrupt, SIGTERM, a
+    lost run), stops its workers at once instead of waiting for their chunks: left running, they outlived
+    the command and kept its stdout open."""
+    pool = ProcessPoolExecutor(max_workers=workers)
+    try:
+        yield pool
+    except BaseException:
+        # CPython's pool keeps {pid: process}; the chunks that have not started are dropped.
+        for process in list((getattr(pool, "_processes", None) or {}).values()):
+            process.terminate()
+        pool.shutdown(wait=True, cancel_futures=True)
+        raise
+    pool.shutdown(wait=True)
+
+
 def register(sub) -> None:
     """Add ``pamsim sweep`` and its options to ``sub``, the subparsers of :func:`pamsim.cli.build_parser`."""
     p = sub.add_parser("sweep", help="run a sweep file (many cases, compared with measurements)",
@@ -73,7 +90,7 @@ def run(args: argparse.Namespace) -> int:
         elif workers == 1:
             executor, where = None, "1 worker"
         else:
-            executor = stack.enter_context(ProcessPoolExecutor(max_workers=workers))
+            executor = stack.enter_context(process_pool(workers))
             where = f"{workers} worker processes"
         with output_folder(args.output) as out:  # checked before the runs; removed again if nothing gets written
             result = run_sweep(spec, executor, progress=not args.no_progress, backend=args.backend,
