@@ -27,13 +27,9 @@ class OutputError(InputError):
 def ensure_output_dir(directory: str | os.PathLike) -> Path:
     """Create ``directory`` if needed and check that files can be created in it."""
     directory = Path(directory)
-    try:
+    with _output_error(directory):
         directory.mkdir(parents=True, exist_ok=True)
-        fd, probe = tempfile.mkstemp(prefix=".pamsim-probe-", dir=directory)
-        os.close(fd)
-        os.unlink(probe)
-    except OSError as exc:
-        raise OutputError(f"{directory}: cannot write output there: {exc.strerror or exc}") from None
+        _probe(directory)
     return directory
 
 
@@ -42,15 +38,27 @@ def check_output_dir(directory: str | os.PathLike) -> Path:
     exists, else its nearest existing parent (where it would be made) is probed."""
     directory = Path(directory)
     existing = next(p for p in (directory, *directory.parents) if p.exists() or p.is_symlink())
-    try:
+    with _output_error(directory):
         if not existing.is_dir():
             raise NotADirectoryError(20, "Not a directory")
-        fd, probe = tempfile.mkstemp(prefix=".pamsim-probe-", dir=existing)
-        os.close(fd)
-        os.unlink(probe)
+        _probe(existing)
+    return directory
+
+
+def _probe(folder: Path) -> None:
+    """Create and remove a file in ``folder`` (an OSError if it cannot be written)."""
+    fd, probe = tempfile.mkstemp(prefix=".pamsim-probe-", dir=folder)
+    os.close(fd)
+    os.unlink(probe)
+
+
+@contextlib.contextmanager
+def _output_error(directory: Path):
+    """An OSError inside the block becomes the :class:`OutputError` naming ``directory``."""
+    try:
+        yield
     except OSError as exc:
         raise OutputError(f"{directory}: cannot write output there: {exc.strerror or exc}") from None
-    return directory
 
 
 @contextlib.contextmanager

@@ -60,11 +60,9 @@ def main(argv: list[str] | None = None) -> int:
     except InputError as exc:
         print(f"pamsim: error: {exc}", file=sys.stderr)
         return 2
-    except SolverFailure as exc:
-        print(f"pamsim: solver failure: {exc}", file=sys.stderr)
-        return 3
-    except RunFailure as exc:
-        print(f"pamsim: error: {exc}", file=sys.stderr)
+    except (SolverFailure, RunFailure) as exc:
+        what = "solver failure" if isinstance(exc, SolverFailure) else "error"
+        print(f"pamsim: {what}: {exc}", file=sys.stderr)
         return 3
     except OSError as exc:
         if isinstance(exc, BrokenPipeError):  # output piped into `head` and the like: not an error of ours
@@ -74,17 +72,17 @@ def main(argv: list[str] | None = None) -> int:
         where = f"{exc.filename}: " if exc.filename else ""
         print(f"pamsim: error: {where}{exc.strerror or exc}", file=sys.stderr)
         return 2
-    except Terminated:
-        print("pamsim: terminated", file=sys.stderr)
-        return 128 + signal.SIGTERM
-    except KeyboardInterrupt:
-        print("pamsim: interrupted", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as exc:  # Ctrl-C, or SIGTERM (Terminated)
+        print(f"pamsim: {getattr(exc, 'what', 'interrupted')}", file=sys.stderr)
+        return getattr(exc, "exit_code", 130)
 
 
 class Terminated(KeyboardInterrupt):
     """SIGTERM, raised where the command is, so that it unwinds as an interrupt (Ctrl-C) does: workers
     stopped, temporary files and folders that nothing was written to removed."""
+
+    what = "terminated"
+    exit_code = 128 + signal.SIGTERM
 
 
 def _raise_terminated(signum, frame):

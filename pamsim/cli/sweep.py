@@ -96,14 +96,21 @@ def run(args: argparse.Namespace) -> int:
             result = run_sweep(spec, executor, progress=not args.no_progress, backend=args.backend,
                                chunk_size=args.chunk_size, allow_incomplete=args.allow_incomplete)
             names = result.write(out, executor, fmt, dpi)
+    _print_outcome(result, where, args.output, names)
+    return 0
+
+
+def _print_outcome(result, where: str, output: str, names: list[str]) -> None:
+    """The failed runs (at most :data:`MAX_FAILURE_LINES` of them) on stderr, the summary line and the files
+    written on stdout."""
     for failure in result.failures[:MAX_FAILURE_LINES]:
         print(f"pamsim: warning: failed run {failure}", file=sys.stderr)
     if len(result.failures) > MAX_FAILURE_LINES:
         print(f"pamsim: warning: {len(result.failures) - MAX_FAILURE_LINES} more failed runs (every one is a row "
               "with its message in the tables)", file=sys.stderr)
+    spec = result.spec
     samples = f", {spec.uncertainty.samples} uncertainty samples" if spec.uncertainty is not None else ""
     lost = f" ({result.lost} lost: an incomplete sweep)" if result.lost else ""
     print(f"{spec.name}: {len(result.rows)} cases{samples}, {len(result.failures)} failed runs{lost}, "
           f"{result.wall_time_s:.2f} s on {where}")
-    print(f"wrote {', '.join(str(Path(args.output) / n) for n in names)}")
-    return 0
+    print(f"wrote {', '.join(str(Path(output) / n) for n in names)}")

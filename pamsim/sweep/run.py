@@ -450,6 +450,10 @@ class _Kept:
         f, k = divmod(i - len(self.study), self.tasks.n_samples)
         self.runs[self.tasks.frictions[f]].put(k, output)
 
+    def lost(self) -> int:
+        """Runs the executor lost (with ``allow_incomplete``: rows whose message begins ``lost:``)."""
+        return sum(o["error"].startswith(LOST) for o in self.study) + sum(r.lost() for r in self.runs.values())
+
     def failures(self) -> list[str]:
         """The message of every failed run, naming its scenario (and its sample), in the order of the runs."""
         out = [f"{t.scenario.name}: {o['error']}" for t, o in zip(self.tasks.study, self.study) if o["error"]]
@@ -486,9 +490,8 @@ def _result(spec: SweepSpec, kept: _Kept, samples: Samples | None, wall_time_s: 
     responses = {s.name: {f: by_key[("response", (s.name, f))] for f in spec.friction_models}
                  for s in spec.time_responses}
     study = UncertaintyResult(spec.uncertainty, samples, kept.runs) if samples is not None else None
-    lost = sum(o["error"].startswith(LOST) for o in kept.study) + (study.lost() if study is not None else 0)
     return SweepResult(spec, rows, _frequency_rows(spec, by_key), responses, wall_time_s, kept.failures(), study,
-                       lost)
+                       kept.lost())
 
 
 def _check_chunk_size(chunk_size: Any) -> None:
