@@ -10,8 +10,9 @@ From Python any ``distributed.Client`` works the same way::
 Dask is the optional extra ``pamsim[dask]``; without it :func:`dask_executor`
 raises :class:`DaskUnavailable` (exit code 2 on the command line).  A worker
 that dies mid-sweep is handled by the scheduler: its tasks run again on another
-worker, and after ``distributed.scheduler.allowed-failures`` deaths the chunk's
-cases become failed rows (``KilledWorker``) while the sweep completes.
+worker; after ``distributed.scheduler.allowed-failures`` deaths the chunk fails
+(``KilledWorker``), which stops the sweep unless it allows an incomplete result.
+:func:`executor_watch` stops a sweep whose scheduler or last worker is gone.
 """
 
 from __future__ import annotations

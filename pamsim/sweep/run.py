@@ -12,10 +12,11 @@ import math
 import os
 import sys
 import time
+from collections.abc import Sequence
 from concurrent.futures import FIRST_COMPLETED, CancelledError, Executor, wait
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable, Mapping, Sequence
+from typing import Any, Mapping
 
 import numpy as np
 
@@ -26,10 +27,10 @@ from ..figure_style import check_format
 from ..oscillation import estimate_oscillation
 from ..scenario import Scenario
 from ..static import friction_band_m, static_report
+from .dask_cluster import executor_watch
 from .figures import SWEEP_FIGURES, UNCERTAINTY_FIGURES
 from .gc_control import frozen_gc
 from .spec import SweepCase, SweepSpec, load_sweep
-from .dask_cluster import executor_watch
 from .uncertainty import LOST, RunColumns, Samples, UncertaintyResult
 
 SETTLED_FRACTION = 0.05
