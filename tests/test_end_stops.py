@@ -59,7 +59,7 @@ def test_survey_muscle_rests_where_eq33_puts_it_not_at_the_braid_lock():
     assert r["on_stop"] is None and r["equilibrium_note"] == ""
 
 
-@pytest.mark.parametrize("backend", ["python", "native"])
+@pytest.mark.parametrize("backend", ["python", "native", "fmu-cs", "fmu-me"])
 def test_a_run_of_the_survey_muscle_comes_to_rest_there(backend):
     sc = pamsim.Scenario.from_dict({
         "model": {"muscle": SURVEY}, "parameters": {"E_bladder_Pa": E_KOTHERA_FIT_PA}, "load": {"weight_N": 0.05},
@@ -68,6 +68,19 @@ def test_a_run_of_the_survey_muscle_comes_to_rest_there(backend):
     s = pamsim.run(sc, backend=backend).result.summary()
     assert s["final_contraction_m"] * 1e3 == pytest.approx(SURVEY_REST_MM, abs=0.01)
     assert s["at_rest_at_end"] and s["on_stop"] is None
+
+
+@pytest.mark.parametrize("backend", ["python", "native", "fmu-cs"])
+def test_the_scenario_key_puts_the_stop_back_at_the_braid_lock(backend):
+    """``upper_stop = "braid_lock"``: every backend holds the survey muscle on the old stop, 12.886 mm."""
+    sc = pamsim.Scenario.from_dict({
+        "model": {"muscle": SURVEY, "upper_stop": "braid_lock"}, "parameters": {"E_bladder_Pa": E_KOTHERA_FIT_PA},
+        "load": {"weight_N": 0.05}, "simulation": {"duration_s": 3.0},
+        "pressure": {"source": "valve", "supply_gauge_bar": 7.58, "valve_open_time_s": 0.1}})
+    s = pamsim.run(sc, backend=backend).result.summary()
+    lock = sc.build_model().stops.x_high_m
+    assert s["final_contraction_m"] == pytest.approx(lock, abs=1e-9) and s["on_stop"] == "upper"
+    assert lock * 1e3 == pytest.approx(12.886, abs=0.001)
 
 
 def test_jam_angle_by_hand():

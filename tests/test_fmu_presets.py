@@ -67,13 +67,7 @@ def scenario_fmus(tmp_path_factory):
     return out
 
 
-FMU_BRAID_LOCK_STOP = pytest.mark.xfail(strict=True, reason=(
-    "the FMU's C core puts the upper stop at the braid lock (54.7 deg) from the geometry, where the python "
-    "model puts it at the muscle's own stop (for the survey muscle the end of eq. 33's domain, 31.95 mm), and "
-    "this load rises past the lock; the FMU needs the stop as a parameter, x_high_m"))
-"""A comparison that waits for the FMU to take the model's upper stop (docs/model.md sec. 5)."""
-
-CASES = [pytest.param(n, v, marks=FMU_BRAID_LOCK_STOP) if n == "survey_45mm" else (n, v)
+CASES = [(n, v)
          for n in ("shadow_fig4", "survey_45mm", "kothera_5a_energy", "lag_and_ramp", "kothera_5a_trace")
          for v in ((2, 3) if n in ("survey_45mm", "lag_and_ramp") else (2,))]
 
@@ -132,7 +126,6 @@ def test_muscle_fmu_starts_with_the_muscle_values_and_its_default_model(tmp_path
     assert f"muscle {muscle}" in md.description
 
 
-@FMU_BRAID_LOCK_STOP
 def test_survey_muscle_fmu_takes_its_own_rating_and_stops_at_its_own_stop(tmp_path):
     """Its own rating (8.27 bar) is accepted, where the Shadow muscle's 4.5 bar refused 7.58 bar, and the
     load comes to rest where the python backend has it (13.55 mm, past the braid lock)."""

@@ -173,7 +173,7 @@ def evaluated():
         code, P, u = generated
         py["rest_mode"][k] = int(code[where].rest_mode(list(y), u, P, ())[0][0])
         py["volume_m3"][k] = volume
-        py["braid_lock_m"][k] = model.stops.x_high_m
+        py["upper_stop_m"][k] = model.stops.x_high_m
     c = native.evaluate(reals, ints, states, mode)
     return {"python": py, "c": c, "mode": mode, "choice": choice, "params": params, "states": states,
             "dp_terms": dp_terms}
@@ -193,7 +193,7 @@ def _size_of_terms(e, name):
         if name == "rhs_v":
             return forces / 0.1  # an acceleration: divided by a mass of at least 0.1 kg
         if name.startswith("indicator"):  # sliding: a speed or a distance to a stop
-            return np.where(np.abs(e["mode"]) == 1, np.abs(v) + py["braid_lock_m"], forces)
+            return np.where(np.abs(e["mode"]) == 1, np.abs(v) + py["upper_stop_m"], forces)
         return forces
     if name in ("valve_flow_kg_s", "rhs_m"):
         # the flow is a product (no cancellation) but its laminar branch scales 1 - p_down/p_up:
@@ -210,7 +210,7 @@ def _size_of_terms(e, name):
 
 QUANTITY_SCALES = ("static_force_N", "coulomb_level_N", "damping_force_N", "valve_flow_kg_s", "pressure_rate_Pa_s",
                    "rhs_x", "rhs_v", "rhs_p", "rhs_m", "indicator_1", "indicator_2", "net_force_N",
-                   "level_at_rest_N", "volume_m3", "braid_lock_m", "pressure_gauge_Pa")
+                   "level_at_rest_N", "volume_m3", "upper_stop_m", "pressure_gauge_Pa")
 
 
 def test_points_cover_every_mode_and_element_choice(evaluated):

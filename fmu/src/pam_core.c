@@ -49,6 +49,15 @@ static void braid_geometry(const double *r, double *b, double *n) {
     *n = *b * sin(theta) / (2.0 * PI * r[R_r0_m]);
 }
 
+/* elements.stops: the upper stop the parameter x_high_m gives (the muscle's own, pamsim.muscle_setup), or
+ * with x_high_m = 0 the braid lock at 54.7 deg from the geometry. */
+static double upper_stop_m(const double *r) {
+    double b, n;
+    if (r[R_x_high_m] > 0.0) return r[R_x_high_m];
+    braid_geometry(r, &b, &n);
+    return r[R_L0_m] - b / sqrt(PAM_BRAID_LOCK_SEC2);
+}
+
 /* elements.chamber.MuscleChamber.volume_m3 / dvolume_dx_m2 */
 static double volume_m3(const PamCore *c, double x) {
     double L = c->r[R_L0_m] - x, b = c->braid_b_m, n = c->braid_turns;
@@ -280,16 +289,14 @@ static double named_real(const PamCore *c, const char *name) {
 static int check_table_covers(PamCore *c) {
     const double *r = c->r;
     const PamTable *T = c->table;
-    double b, n, x_high, x_end = table_x_end_m(T), p_end = table_p_end_Pa(T);
+    double x_high = upper_stop_m(r), x_end = table_x_end_m(T), p_end = table_p_end_Pa(T);
     double x_tol = TABLE_COVER_TOL * (x_end - T->x0), p_tol = TABLE_COVER_TOL * (p_end - T->p0);
     int bad = 0;
-    braid_geometry(r, &b, &n);
-    x_high = r[R_L0_m] - b / sqrt(PAM_BRAID_LOCK_SEC2);
     if (x_high > x_end + x_tol || T->x0 > x_tol) {
-        pam_logf(c, PAM_LOG_ERROR, "invalid parameters: L0_m = %g, theta0_deg = %g: the load's travel, 0 to %.6g m "
-                 "(the braid-lock stop), leaves the force table of %s, which covers contraction %.6g to %.6g m "
+        pam_logf(c, PAM_LOG_ERROR, "invalid parameters: L0_m = %g, theta0_deg = %g, x_high_m = %g: the load's travel, "
+                 "0 to %.6g m (the upper stop), leaves the force table of %s, which covers contraction %.6g to %.6g m "
                  "(a table is built for one muscle: build the FMU for this geometry)", r[R_L0_m], r[R_theta0_deg],
-                 x_high, PAM_FT_MODEL, T->x0, x_end);
+                 r[R_x_high_m], x_high, PAM_FT_MODEL, T->x0, x_end);
         bad = -1;
     }
     if (r[R_rated_pressure_gauge_Pa] > p_end + p_tol) {
@@ -310,7 +317,7 @@ static int check_table_covers(PamCore *c) {
 int pam_check_parameters(PamCore *c) {
     const double *r = c->r;
     int bad = 0, k;
-    double b, n, x_high;
+    double x_high;
     /* Each parameter's own range, generated from pamsim/fmu/variables.py (the Python Parameter bounds). */
     if (pam_check_parameter_ranges(c)) return -1;
     /* Checks between parameters (ParameterSet.violations) and of the FMU's own parameters. */
@@ -343,12 +350,11 @@ int pam_check_parameters(PamCore *c) {
     for (k = 0; k < PAM_NVARS; k++)
         if (PAM_VARS[k].causality == PAM_INPUT && pam_check_value(c, (unsigned)k + 1, r[PAM_VARS[k].index])) bad = -1;
     if (bad) return -1;
-    braid_geometry(r, &b, &n);
-    x_high = r[R_L0_m] - b / sqrt(PAM_BRAID_LOCK_SEC2);
+    x_high = upper_stop_m(r);
     if (!(r[R_initial_contraction_m] >= 0.0 && r[R_initial_contraction_m] <= x_high)) {
         pam_logf(c, PAM_LOG_ERROR,
                  "invalid parameters: initial_contraction_m = %g: must lie between the stops, 0 and %.4f m "
-                 "(the braid-lock contraction)", r[R_initial_contraction_m], x_high);
+                 "(the upper stop)", r[R_initial_contraction_m], x_high);
         return -1;
     }
     return 0;
@@ -391,7 +397,7 @@ static void derive_start(PamCore *c) {
     c->braid_b_m = b;
     c->braid_turns = n;
     c->x_low_m = 0.0;
-    c->x_high_m = c->r[R_L0_m] - b / sqrt(PAM_BRAID_LOCK_SEC2); /* braid lock at 54.7 deg, elements.stops */
+    c->x_high_m = upper_stop_m(c->r);
     if (table_guarded(c)) { /* the table's edge is a stop: the travel within it up to rounding (checked) */
         c->x_low_m = fmax(c->x_low_m, c->table->x0);
         c->x_high_m = fmin(c->x_high_m, table_x_end_m(c->table));

@@ -294,7 +294,7 @@ PAM_EXPORT void pam_native_evaluate(int64_t n, const double *reals, const int32_
         memcpy(c.i, ints + PAM_NI * i, sizeof c.i);
         braid_geometry(c.r, &c.braid_b_m, &c.braid_turns);
         c.x_low_m = 0.0;
-        c.x_high_m = c.r[R_L0_m] - c.braid_b_m / sqrt(PAM_BRAID_LOCK_SEC2);
+        c.x_high_m = upper_stop_m(c.r);
         p = pressure_gauge_Pa(&c, y);
         q[Q_PRESSURE_GAUGE] = p;
         q[Q_STATIC_FORCE] = static_force_N(&c, y[X], p);
@@ -312,7 +312,7 @@ PAM_EXPORT void pam_native_evaluate(int64_t n, const double *reals, const int32_
         rest_forces(&c, y, &q[Q_NET_FORCE], &q[Q_LEVEL_AT_REST]);
         q[Q_REST_MODE] = rest_mode(&c, y, mode == PAM_SLIP_UP || mode == PAM_SLIP_DOWN ? PAM_STICK : mode);
         q[Q_VOLUME] = volume_m3(&c, y[X]);
-        q[Q_BRAID_LOCK] = c.x_high_m;
+        q[Q_UPPER_STOP] = c.x_high_m;
     }
 }
 

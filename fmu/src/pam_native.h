@@ -36,7 +36,7 @@ typedef enum { PAM_OK = 0, PAM_BAD_INPUT = 1, PAM_SOLVER_FAILED = 2, PAM_EVENTS_
 typedef enum {
     Q_STATIC_FORCE, Q_COULOMB_LEVEL, Q_DAMPING_FORCE, Q_VALVE_FLOW, Q_PRESSURE_RATE,
     Q_RHS_X, Q_RHS_V, Q_RHS_P, Q_RHS_M, Q_INDICATOR_1, Q_INDICATOR_2, Q_NET_FORCE, Q_LEVEL_AT_REST,
-    Q_REST_MODE, Q_VOLUME, Q_BRAID_LOCK, Q_PRESSURE_GAUGE
+    Q_REST_MODE, Q_VOLUME, Q_UPPER_STOP, Q_PRESSURE_GAUGE
 } PamQuantity;
 
 /* One call's cases.  Arrays are row-major; the offsets index the flattened per-case blocks. */

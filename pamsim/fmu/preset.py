@@ -27,7 +27,7 @@ from ..errors import InputError
 from ..scenario import Scenario
 from ..signals import Constant, FirstOrderLag, PiecewiseConstant, Ramp, Step, Trace
 from .force_table import ForceTable
-from .runner import ScenarioInputs, force_table_for, start_values
+from .runner import ScenarioInputs, force_table_for, start_values, upper_stop_start
 from .variables import INPUT_SOURCE_CHOICES, INPUTS, VARIABLES
 
 _PARAMETERS = {v.name for v in VARIABLES if v.causality == "parameter" and v.kind == "real"}
@@ -160,6 +160,10 @@ def for_muscle(scenario: Scenario) -> Preset:
     table = force_table_for(scenario)
     starts["static_force_model"] = 1 if table is not None else 0
     sources["static_force_model"] = f"{model['static_force']} of muscle {model['muscle']}"
+    built = scenario.build_model()
+    starts["x_high_m"] = upper_stop_start(built)
+    sources["x_high_m"] = (f"the upper stop of muscle {model['muscle']} with {model['static_force']} "
+                           f"({built.stops.upper_basis})")
     return Preset(f"muscle {model['muscle']}", starts, sources, table, static_force=model["static_force"])
 
 

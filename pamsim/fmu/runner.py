@@ -83,7 +83,7 @@ REPRESENTED = {
     "": {"name", "description", "model", "parameters", "load", "pressure", "simulation", "solver", "controller",
          "measured"},  # [measured] names what the figure draws beside the run, not the model
     "model": {"muscle", "parameter_set", "static_force", "static_force_negative", "friction", "damping",
-              "friction_negative_level"},
+              "friction_negative_level", "upper_stop"},
     "load": {"weight_N", "mass_kg", "external_force"},
     "pressure": {"source", "supply_gauge_bar", "supply_gauge_Pa", "valve_open_time_s", "command", "prescribed",
                  "initial_gauge_bar"},
@@ -118,6 +118,13 @@ def _refuse_unrepresented(scenario: Scenario) -> None:
                          f"(muscle {model['muscle']!r})")
 
 
+def upper_stop_start(model) -> float:
+    """The FMU's ``x_high_m`` for ``model``: its upper stop, or 0 where that is the braid lock, which the FMU
+    then derives from its geometry parameters (so that changing them moves it, as before)."""
+    stops = model.stops
+    return 0.0 if stops.upper_basis == "braid_lock" else float(stops.x_high_m)
+
+
 def start_values(scenario: Scenario) -> dict[str, float | int]:
     """The scenario's parameters and element choices as FMU start values.
 
@@ -136,6 +143,7 @@ def start_values(scenario: Scenario) -> dict[str, float | int]:
     values["pressure_source"] = SOURCE_CHOICES.index(pressure["source"])
     values["initial_contraction_m"] = scenario.initial_contraction_m
     values["initial_pressure_gauge_Pa"] = float(pressure.get("initial_gauge_bar", 0.0)) * PA_PER_BAR
+    values["x_high_m"] = upper_stop_start(scenario.build_model())
     values["stick_margin_N"] = scenario.solver.stick_margin_N
     values["release_margin_N"] = scenario.solver.release_margin_N
     # The runner drives the inputs, also of an FMU built from a scenario (which starts on its signals).

@@ -57,7 +57,7 @@ VALUE_REFERENCES = {
     "friction_model": 33, "damping_model": 34, "pressure_source": 35, "initial_contraction_m": 36,
     "stick_margin_N": 37, "release_margin_N": 38, "cs_relative_tolerance": 39, "cs_max_step_s": 40,
     "friction_negative_level": 41, "initial_pressure_gauge_Pa": 42, "cs_max_internal_steps": 62,
-    "static_force_model": 63, "input_source": 64,
+    "static_force_model": 63, "input_source": 64, "x_high_m": 65,
     # Inputs, states, derivatives, outputs, event indicators.
     "valve_command": 43, "supply_pressure_gauge_Pa": 44, "prescribed_pressure_gauge_Pa": 45, "load_mass_kg": 46,
     "external_force_N": 47, "contraction_m": 48, "velocity_m_s": 49, "chamber_pressure_abs_Pa": 50, "air_mass_kg": 51,
@@ -224,6 +224,10 @@ def _table() -> tuple[Variable, ...]:
         _choice("input_source", "where the inputs come from: {} (the signals of the scenario this FMU was "
                 "built from; an input set to another value than its signal's is then refused)",
                 INPUT_SOURCE_CHOICES),
+        Variable("x_high_m", "real", "parameter", "fixed",
+                 "contraction of the upper end stop: the muscle's own (pamsim.muscle_setup.end_stops: its braid's "
+                 "jam angle, its model's domain end or the braid lock), or 0 for the braid lock at 54.7 deg from "
+                 "L0_m, r0_m and theta0_deg [m]", "m", 0.0, "exact", lower=0.0),
     ]
     return tuple(rows)
 

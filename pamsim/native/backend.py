@@ -43,7 +43,7 @@ from ..elements.pressure_source import ValveChamberSource
 from ..errors import InputError, SolverFailure
 from ..fmu.force_table import ForceTable
 from ..fmu.preset import input_signal
-from ..fmu.runner import REPRESENTED, tabulate_model
+from ..fmu.runner import REPRESENTED, tabulate_model, upper_stop_start
 from ..model import Mode, MuscleModel
 from ..result import Result, TransitionEvent
 from ..scenario import Scenario
@@ -244,7 +244,7 @@ def case_inputs(scenario: Scenario, model: MuscleModel | None = None, exact: boo
     for name, value in scenario.parameters.items():
         if name in lib.REAL_INDEX:  # the others shape the force table (refuse_unsupported)
             reals[lib.REAL_INDEX[name]] = value
-    fmu_own = {"initial_contraction_m": scenario.initial_contraction_m,
+    fmu_own = {"initial_contraction_m": scenario.initial_contraction_m, "x_high_m": upper_stop_start(model),
                "initial_pressure_gauge_Pa": scenario.initial_pressure_gauge_Pa or 0.0,
                "stick_margin_N": opts.stick_margin_N, "release_margin_N": opts.release_margin_N,
                "cs_relative_tolerance": opts.rtol,

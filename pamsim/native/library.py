@@ -24,7 +24,7 @@ EVENT_KINDS = ("velocity_zero", "stop_low", "stop_high", "release_up", "release_
 """``PamEventKind``: the names :mod:`pamsim.simulator` gives its events."""
 QUANTITIES = ("static_force_N", "coulomb_level_N", "damping_force_N", "valve_flow_kg_s", "pressure_rate_Pa_s",
               "rhs_x", "rhs_v", "rhs_p", "rhs_m", "indicator_1", "indicator_2", "net_force_N", "level_at_rest_N",
-              "rest_mode", "volume_m3", "braid_lock_m", "pressure_gauge_Pa")
+              "rest_mode", "volume_m3", "upper_stop_m", "pressure_gauge_Pa")
 """``PamQuantity``: what ``pam_native_evaluate`` returns per point (PAM_NATIVE_NQ)."""
 STATUS = ("ok", "bad input", "solver failed", "event buffer full")
 MESSAGE_BYTES = 256
