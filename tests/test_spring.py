@@ -127,10 +127,6 @@ def test_backends_that_cannot_run_added_components_refuse_them(backend, changes)
 
 
 def test_commands_that_take_the_rig_alone_refuse_added_components(tmp_path):
-    proc = subprocess.run([sys.executable, "-m", "pamsim", "linearize", str(SCENARIOS / "parallel_spring.toml"),
-                           "-o", str(tmp_path / "lin")], capture_output=True, text=True)
-    assert proc.returncode == 2 and "'spring'" in proc.stderr and "Traceback" not in proc.stderr
-    assert not (tmp_path / "lin").exists()
     from pamsim.sweep import load_sweep
 
     sweep = tmp_path / "sweep.toml"
@@ -142,6 +138,62 @@ def test_commands_that_take_the_rig_alone_refuse_added_components(tmp_path):
 
     with pytest.raises(InputError, match="controller design.*'spring'"):
         ControllerConfig.from_scenario(pamsim.load_scenario(SCENARIOS / "parallel_spring.toml"))
+
+
+def _linear(scenario, pull_added=True):
+    from pamsim.control.exact import rest_pull
+    from pamsim.control.linear import linearize
+    from pamsim.control.operating_point import open_valve_equilibrium
+
+    model = scenario.build_model()
+    added = scenario.added_components
+    op = open_valve_equilibrium(model, scenario.final_pressure_gauge_Pa, pull=rest_pull(model, added))
+    return linearize(model, op, added=added, drop_unobservable_air_mass=False), model
+
+
+def test_linearize_takes_the_spring_exactly():
+    """The operating point is where F_static(x, p_supply) = W + k (x - x_free) (root-finding on the static
+    model), and the spring adds -k/m to d(acceleration)/dx and -k to d(tendon force)/dx, nothing else:
+    the rig alone, linearised at the same point, differs by exactly that."""
+    from pamsim.control.linear import linearize
+
+    k, x_free = 300.0, 0.005
+    sc = _scenario(spring={"k_N_per_m": k, "x_free_m": x_free})
+    lin, model = _linear(sc)
+    p = sc.final_pressure_gauge_Pa
+    x_eq = brentq(lambda x: model.static_force.force_N(x, p) - model.load.weight_N - k * (x - x_free), 0.0, 0.07,
+                  xtol=1e-14)
+    assert lin.op.states[0] == pytest.approx(x_eq, abs=1e-9)
+    assert np.max(np.abs(lin.residual[:2])) < 1e-6  # at rest: no acceleration, no velocity
+    alone = linearize(model, lin.op, drop_unobservable_air_mass=False)
+    A, C = np.array(lin.sys.A), np.array(lin.sys.C)
+    dA, dC = A - np.array(alone.sys.A), C - np.array(alone.sys.C)
+    m = model.load.mass_kg
+    assert dA[1, 0] == pytest.approx(-k / m, rel=1e-9) and dC[2, 0] == pytest.approx(-k, rel=1e-9)
+    dA[1, 0] = dC[2, 0] = 0.0
+    assert np.max(np.abs(dA)) <= 1e-9 * np.max(np.abs(A)) and np.max(np.abs(dC)) <= 1e-9 * np.max(np.abs(C))
+    np.testing.assert_array_equal(np.array(lin.sys.B), np.array(alone.sys.B))
+
+
+def test_a_spring_of_no_stiffness_linearises_as_the_rig_alone():
+    from pamsim.control.linear import linearize
+    from pamsim.control.operating_point import open_valve_equilibrium
+
+    sc = _scenario(spring={"k_N_per_m": 0.0})
+    lin, model = _linear(sc)
+    alone = linearize(model, open_valve_equilibrium(model, sc.final_pressure_gauge_Pa),
+                      drop_unobservable_air_mass=False)
+    np.testing.assert_allclose(lin.op.states, alone.op.states, rtol=1e-12)
+    for a, b in zip((lin.sys.A, lin.sys.B, lin.sys.C, lin.sys.D), (alone.sys.A, alone.sys.B, alone.sys.C, alone.sys.D)):
+        np.testing.assert_allclose(np.array(a), np.array(b), rtol=1e-12, atol=0.0)
+
+
+def test_the_cli_linearizes_the_spring_scenario(tmp_path):
+    proc = subprocess.run([sys.executable, "-m", "pamsim", "linearize", str(SCENARIOS / "parallel_spring.toml"),
+                           "-o", str(tmp_path / "lin")], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    assert "Jacobians: exact" in proc.stdout
+    assert (tmp_path / "lin" / "parallel_spring_linear_bode.png").is_file()
 
 
 def test_the_casadi_export_holds_the_added_component():

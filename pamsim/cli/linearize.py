@@ -118,22 +118,22 @@ def run(args: argparse.Namespace) -> int:
 
 def _linearize(scenario, args: argparse.Namespace):
     """Linearise at the operating point the arguments choose: (model, report)."""
+    from ..control.exact import rest_pull
     from ..control.linear import linearize
     from ..control.operating_point import held_equilibrium, open_valve_equilibrium, trajectory_point
     from ..control.system import FrictionTreatment
-    from ..scenario_components import refuse_added
 
-    refuse_added(scenario, "pamsim linearize", InputError)
     model = scenario.build_model()
+    added = scenario.added_components
     supply = scenario.final_pressure_gauge_Pa
     if args.at_time is not None:
         op = trajectory_point(scenario, args.at_time)
     elif args.contraction_mm is not None:
-        op = held_equilibrium(model, args.contraction_mm * 1e-3, supply)
+        op = held_equilibrium(model, args.contraction_mm * 1e-3, supply, pull=rest_pull(model, added))
     else:
-        op = open_valve_equilibrium(model, supply)
+        op = open_valve_equilibrium(model, supply, pull=rest_pull(model, added))
     friction = FrictionTreatment(args.friction, args.friction_velocity_mm_s * 1e-3)
-    lin = linearize(model, op, friction, args.valve_slope)
+    lin = linearize(model, op, friction, args.valve_slope, added=added)
     return lin, report(lin)
 
 

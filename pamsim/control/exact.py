@@ -20,8 +20,12 @@ import numpy as np
 
 from ..assemblies.one_muscle import AddedComponent, one_muscle_assembly
 from ..components.hanging_load import LoadMode
+from ..errors import InputError
 from ..modeling import Component, Equations, Symbols, Var
 from .system import FrictionTreatment
+
+CONTROL_STATES = ("load.x_m", "load.v_m_s", "chamber.p_abs_Pa", "chamber.air_mass_kg")
+"""The control model's states in the assembly (:data:`pamsim.control.system.STATES`)."""
 
 INSIDE_KINK = 1e-300
 """Command [1] just inside either branch of the valve at its kink, 0: a slope, but no flow."""
@@ -59,20 +63,29 @@ class FrictionDirection(Component):
         return Equations(outputs={"direction": direction})
 
 
-def control_functions(model, friction: FrictionTreatment):
+def control_functions(model, friction: FrictionTreatment, added: tuple = ()):
     """CasADi functions ``(x, u) -> (f, y)`` and ``(x, u) -> (df/dx, df/du, dy/dx, dy/du)`` of the four
     control states ``(x_m, v_m_s, p_abs_Pa, air_mass_kg)``, inputs ``(valve_command, supply_gauge_Pa,
     F_ext_N)`` and outputs ``(contraction_m, p_gauge_Pa, F_tendon_N)``, with ``model``'s parameter
-    values as constants."""
+    values as constants.  ``added`` (:class:`~pamsim.assemblies.one_muscle.AddedComponent` s, a
+    scenario's ``[[component]]`` tables) act on the rig too; they may add forces and work integrals,
+    not states of their own.
+
+    Raises
+    ------
+    InputError
+        For an added component with states the control model would have to carry.
+    """
     import casadi as ca
 
-    added = (AddedComponent(FrictionDirection("treatment", friction), {"v_m_s": "load.v_m_s"}),)
-    assembly = one_muscle_assembly(model, added=added, friction_direction="treatment.direction")
+    treatment = (AddedComponent(FrictionDirection("treatment", friction), {"v_m_s": "load.v_m_s"}),)
+    assembly = one_muscle_assembly(model, added=tuple(added) + treatment, friction_direction="treatment.direction")
     flat = assembly.flatten({"load": int(LoadMode.SLIP_UP)})
     if flat.externals:  # an element called on floats: CasADi would take it for a constant
         raise NotImplementedError(f"no exact Jacobian through {', '.join(e.name for e in flat.externals)}")
     names = [v.name for v in flat.states]
-    keep = [names.index(n) for n in ("load.x_m", "load.v_m_s", "chamber.p_abs_Pa", "chamber.air_mass_kg")]
+    keep = [names.index(n) for n in CONTROL_STATES]
+    _refuse_added_states(names, keep, flat.quadratures(), added)
     x = ca.vertcat(*[flat.x[i] for i in keep])
     u = ca.vertcat(*flat.u)
     p = dict(zip([v.name for v in flat.parameters], flat.p))
@@ -89,7 +102,52 @@ def control_functions(model, friction: FrictionTreatment):
     return values_fn, jac
 
 
-def exact_jacobians(model, states, inputs, friction: FrictionTreatment, valve_slope: str):
+def _refuse_added_states(names, keep, quadratures, added) -> None:
+    """The control model carries the rig's four states: an added component's own must be work integrals."""
+    own = {a.component.name for a in added}
+    extra = [names[i] for i in range(len(names)) if i not in keep and i not in quadratures
+             and names[i].split(".", 1)[0] in own]
+    if extra:
+        raise InputError(f"component {extra[0].split('.', 1)[0]!r}: pamsim linearize takes added components that "
+                         f"act on the rig with forces, not ones with states of their own ({', '.join(extra)})")
+
+
+def rest_pull(model, added: tuple):
+    """The force the muscle and the ``added`` components pull the load with at rest, as a static force
+    model (``force_N(x_m, p_gauge_Pa)``, :mod:`pamsim.static`): the muscle's static force plus what
+    the added components exert on the load at rest, from the assembly's generated net force."""
+    return model.static_force if not added else _RestPull(model, tuple(added))
+
+
+class _RestPull:
+    """``force_N(x, p)``: the muscle's static force plus the added components' force on the load at rest."""
+
+    def __init__(self, model, added: tuple):
+        import casadi as ca
+
+        flat = one_muscle_assembly(model, added=added).flatten({"load": int(LoadMode.STICK)})
+        x_sym, p_sym = ca.SX.sym("x"), ca.SX.sym("p")
+        names = [v.name for v in flat.states]
+        values = {"load.x_m": x_sym, "chamber.p_abs_Pa": p_sym + model.source.p_atm_Pa,
+                  "chamber.air_mass_kg": ca.SX(1.0)}  # no force depends on the air mass
+        params = dict(zip([v.name for v in flat.parameters], flat.parameter_values))
+        outputs = {v.name: e for v, e in zip(flat.outputs, flat.y)}
+        # F_net = F_static + F_added - W + F_ext with the external force input at 0.
+        added_N = outputs["load.F_net_N"] - outputs["muscle.F_static_N"] - outputs["load.F_gravity_N"]
+        subs_from = ca.vertcat(*flat.x, *flat.p, *flat.u)
+        subs_to = ca.vertcat(*[values.get(n, ca.SX(0.0)) for n in names],
+                             *[ca.SX(params[v.name]) for v in flat.parameters], *[ca.SX(0.0) for _ in flat.u])
+        self._added = ca.Function("added_force", [x_sym, p_sym], [ca.substitute(added_N, subs_from, subs_to)])
+        self.static_force = model.static_force
+
+    def force_N(self, x_m, p_gauge_Pa):
+        """The pull [N] at contraction ``x_m`` and gauge pressure ``p_gauge_Pa`` (scalars or arrays)."""
+        x = np.asarray(x_m, dtype=float)
+        added = np.vectorize(lambda xi: float(self._added(xi, float(p_gauge_Pa))))(x)
+        return self.static_force.force_N(x_m, p_gauge_Pa) + (added if x.ndim else float(added))
+
+
+def exact_jacobians(model, states, inputs, friction: FrictionTreatment, valve_slope: str, added: tuple = ()):
     """``(A, B, C, D)`` of the control model at ``states``, ``inputs`` (numpy arrays).
 
     Each column is the mean of the analytic derivative just either side of the point, a step of
@@ -101,7 +159,7 @@ def exact_jacobians(model, states, inputs, friction: FrictionTreatment, valve_sl
     """
     from .system import INPUT_SCALES, STATE_SCALES
 
-    _, jac = control_functions(model, friction)
+    _, jac = control_functions(model, friction, added)
     x0 = np.asarray(states, dtype=float)
     u0 = np.asarray(inputs, dtype=float)
 

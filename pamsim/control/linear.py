@@ -38,7 +38,7 @@ import numpy as np
 from ..errors import InputError
 from ..model import MuscleModel
 from .choices import VALVE_SLOPES
-from .exact import exact_jacobians
+from .exact import control_functions, exact_jacobians
 from .operating_point import OperatingPoint
 from .system import INPUT_SCALES, INPUTS, OUTPUTS, STATE_SCALES, STATES, FrictionTreatment, MusclePlant
 
@@ -194,7 +194,7 @@ class LinearModel:
 
 
 def linearize(model: MuscleModel, op: OperatingPoint, friction: FrictionTreatment | None = None,
-              valve_slope: str = "mean", drop_unobservable_air_mass: bool = True) -> LinearModel:
+              valve_slope: str = "mean", drop_unobservable_air_mass: bool = True, added: tuple = ()) -> LinearModel:
     """Linearise ``model`` about ``op``.
 
     Parameters
@@ -213,6 +213,9 @@ def linearize(model: MuscleModel, op: OperatingPoint, friction: FrictionTreatmen
         air; where its column of A and C is zero (closed or filling valve, or
         the chamber at supply pressure) it is an unobservable integrator and
         is dropped, which leaves every transfer function unchanged.
+    added : tuple of AddedComponent, optional
+        Components a scenario adds to the rig (``Scenario.added_components``): forces on the load and
+        work integrals, linearised exactly with the rig (no difference quotients for them).
 
     Returns
     -------
@@ -222,7 +225,8 @@ def linearize(model: MuscleModel, op: OperatingPoint, friction: FrictionTreatmen
     Raises
     ------
     InputError
-        For ``sliding`` at a load at rest, or an unknown choice.
+        For ``sliding`` at a load at rest, an unknown choice, or an added component with states of its
+        own or without exact derivatives.
     """
     friction = friction or FrictionTreatment("dropped")
     v0 = float(op.states[1])
@@ -235,12 +239,15 @@ def linearize(model: MuscleModel, op: OperatingPoint, friction: FrictionTreatmen
     if valve_slope not in VALVE_SLOPES:
         raise InputError(f"valve slope {valve_slope!r}: choose from {', '.join(VALVE_SLOPES)}")
     try:
-        A, B, C, D = exact_jacobians(model, op.states, op.inputs, friction, valve_slope)
+        A, B, C, D = exact_jacobians(model, op.states, op.inputs, friction, valve_slope, added)
         method = "exact"
-    except NotImplementedError:  # an element called on floats
+    except NotImplementedError as exc:  # an element called on floats
+        if added:  # the difference quotients are the composed model's, which has no added components
+            raise InputError(f"pamsim linearize with added components needs exact derivatives: {exc}") from None
         A, B, C, D = jacobians(plant, op, friction, valve_slope)
         method = "central differences"
-    residual = plant.rhs(op.states, op.inputs, friction)
+    residual = (plant.rhs(op.states, op.inputs, friction) if not added
+                else np.asarray(control_functions(model, friction, added)[0](op.states, op.inputs)[0]).ravel())
     keep = list(range(len(STATES)))
     k_m = STATES.index("air_mass_kg")
     dropped: tuple[str, ...] = ()

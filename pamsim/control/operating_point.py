@@ -61,8 +61,12 @@ def _rest_states(model: MuscleModel, x_m: float, p_gauge_Pa: float) -> np.ndarra
     return np.array([x_m, 0.0, *model.source.initial_state(x_m, p_gauge_Pa)], dtype=float)
 
 
-def open_valve_equilibrium(model: MuscleModel, supply_gauge_Pa: float, F_ext_N: float = 0.0) -> OperatingPoint:
+def open_valve_equilibrium(model: MuscleModel, supply_gauge_Pa: float, F_ext_N: float = 0.0,
+                           pull=None) -> OperatingPoint:
     """The load at rest with the valve fully open and the chamber at supply pressure.
+
+    ``pull`` is what pulls the load at rest (``force_N(x_m, p_gauge_Pa)``): the muscle's static force,
+    or with components added to the rig :func:`pamsim.control.exact.rest_pull`.
 
     Raises
     ------
@@ -73,11 +77,12 @@ def open_valve_equilibrium(model: MuscleModel, supply_gauge_Pa: float, F_ext_N: 
     """
     MusclePlant(model)  # checks the source type
     load = _load_N(model, F_ext_N)
+    pull = pull or model.static_force
     x_high = model.stops.x_high_m
-    x_eq = equilibrium_contraction_m(model.static_force, supply_gauge_Pa, load, x_high)
+    x_eq = equilibrium_contraction_m(pull, supply_gauge_Pa, load, x_high)
     bar = supply_gauge_Pa / PA_PER_BAR
     if x_eq <= model.stops.x_low_m:
-        cap = max_load_N(model.static_force, supply_gauge_Pa, x_high)
+        cap = max_load_N(pull, supply_gauge_Pa, x_high)
         raise InputError(f"a load of {load:.2f} N is beyond the muscle's force capability at {bar:g} bar "
                          f"({cap:.2f} N): it rests on the lower stop, no equilibrium to linearise about")
     if x_eq >= x_high:
@@ -94,8 +99,9 @@ def contraction_range_m(model: MuscleModel) -> tuple[float, float]:
     return model.stops.x_low_m, min(model.stops.x_high_m, model.fit_range.x_max_m)
 
 
-def holding_pressure_Pa(model: MuscleModel, x_m: float, load_N: float, p_max_gauge_Pa: float) -> float:
-    """Gauge pressure [Pa] in [0, p_max_gauge_Pa] at which ``F_static(x, p) = load_N``.
+def holding_pressure_Pa(model: MuscleModel, x_m: float, load_N: float, p_max_gauge_Pa: float, pull=None) -> float:
+    """Gauge pressure [Pa] in [0, p_max_gauge_Pa] at which ``F_static(x, p) = load_N`` (``pull``, if given,
+    in place of the static force: see :func:`open_valve_equilibrium`).
 
     Raises
     ------
@@ -103,7 +109,7 @@ def holding_pressure_Pa(model: MuscleModel, x_m: float, load_N: float, p_max_gau
         If the load needs more than ``p_max_gauge_Pa`` there, or the muscle's
         elastic force alone already exceeds it (it would need a vacuum).
     """
-    F = model.static_force.force_N
+    F = (pull or model.static_force).force_N
     lo, hi = F(x_m, 0.0) - load_N, F(x_m, p_max_gauge_Pa) - load_N
     if hi < 0.0:
         raise InputError(f"holding {load_N:.2f} N at {x_m * 1e3:g} mm needs more than the "
@@ -115,8 +121,10 @@ def holding_pressure_Pa(model: MuscleModel, x_m: float, load_N: float, p_max_gau
     return float(brentq(lambda p: F(x_m, p) - load_N, 0.0, p_max_gauge_Pa, xtol=1e-9))
 
 
-def held_equilibrium(model: MuscleModel, x_m: float, supply_gauge_Pa: float, F_ext_N: float = 0.0) -> OperatingPoint:
-    """The load held at contraction ``x_m`` by a closed valve and the pressure that balances it.
+def held_equilibrium(model: MuscleModel, x_m: float, supply_gauge_Pa: float, F_ext_N: float = 0.0,
+                     pull=None) -> OperatingPoint:
+    """The load held at contraction ``x_m`` by a closed valve and the pressure that balances it (``pull``:
+    see :func:`open_valve_equilibrium`).
 
     Raises
     ------
@@ -129,7 +137,7 @@ def held_equilibrium(model: MuscleModel, x_m: float, supply_gauge_Pa: float, F_e
     if not lo < x_m < hi:
         raise InputError(f"contraction {x_m * 1e3:g} mm is outside the model's range ({lo * 1e3:g} mm, "
                          f"{hi * 1e3:g} mm): above the lower stop and within the static polynomial's fitted range")
-    p = holding_pressure_Pa(model, x_m, _load_N(model, F_ext_N), supply_gauge_Pa)
+    p = holding_pressure_Pa(model, x_m, _load_N(model, F_ext_N), supply_gauge_Pa, pull)
     return OperatingPoint(_rest_states(model, x_m, p), np.array([0.0, supply_gauge_Pa, F_ext_N]),
                           "held_pressure", Mode.STICK,
                           f"valve closed, chamber holding {p / PA_PER_BAR:.4f} bar, load "
