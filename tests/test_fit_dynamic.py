@@ -152,8 +152,10 @@ def test_global_search_then_local_fit(scenario, short_pair):
 
 def test_two_traces_pooled(scenario, short_pair):
     """Two loads pooled on the Python backend (the per-trace table is tested on the native backend in
-    test_fit_native.py: the same code, a third of the time)."""
-    fit = fit_dynamic(scenario, [n for n, _ in short_pair], free=["N0_N_per_bar"])
+    test_fit_native.py: the same code, a third of the time).  The pooled cost has a local minimum at
+    N0 = 6.15 N/bar (RMS 0.46 mm, the 12.74 N trace sticking elsewhere), where a single local fit from the
+    paper's 6.87 stops once N0 is bounded below by 0: one extra start (test_fit_dynamic_robust.py)."""
+    fit = fit_dynamic(scenario, [n for n, _ in short_pair], free=["N0_N_per_bar"], n_starts=1)
     assert fit.backend == "python" and len(fit.simulated_m) == 2
     assert fit.parameters["N0_N_per_bar"] == pytest.approx(6.0, rel=0.02)
     for rms in fit.rms_contraction_mm:

@@ -120,7 +120,11 @@ def register(sub) -> None:
     d.add_argument("--columns", type=_columns, default={}, help="map quantities to other column names")
     d.add_argument("--per-trace", action="store_true", help="also fit every trace alone (Table 4 layout)")
     d.add_argument("--global", dest="global_search", action="store_true",
-                   help="differential evolution over start +- 50 %% before the local fit")
+                   help="differential evolution (30 generations) over the start +- its size or typical scale, "
+                        "before the local fits")
+    d.add_argument("--starts", type=_count, default=None,
+                   help="extra local fits from the best of 25 N seeded random points (default 8 with the native "
+                        "backend, 0 with python)")
     d.add_argument("--workers", type=_workers, default=None,
                    help="worker processes for the simulations (default: number of CPUs with the python backend; "
                         "1 with native, whose optimiser steps are too few cases to gain from workers)")
@@ -131,7 +135,7 @@ def register(sub) -> None:
                    help="largest deviation of the thinned measured pressure [Pa] (default 10)")
     d.add_argument("--backend", choices=choices.DYNAMIC_BACKENDS, default="python",
                    help="simulator of the fit: python (default) or native (compiled C, one batch per step)")
-    d.add_argument("--seed", type=_count, default=0, help="seed of --global (default 0)")
+    d.add_argument("--seed", type=_count, default=0, help="seed of --global and --starts (default 0)")
     d.add_argument("-o", "--output", required=True, help="output directory")
     d.add_argument("--json", action="store_true", help="print fit.json to stdout")
     figure_args.add_arguments(d)
@@ -204,7 +208,7 @@ def run_dynamic(args: argparse.Namespace) -> int:
     options = dict(free=args.free, window_s=args.window, loads_N=args.load_N, global_search=args.global_search,
                    per_trace=args.per_trace, seed=args.seed, fd_step=args.fd_step,
                    max_iterations=args.max_iterations, knot_tolerance_Pa=args.knot_tolerance_Pa,
-                   backend=args.backend)
+                   backend=args.backend, n_starts=args.starts)
     if args.workers is None:
         args.workers = 1 if args.backend == "native" else os.cpu_count() or 1
     if args.workers == 1:
@@ -213,6 +217,8 @@ def run_dynamic(args: argparse.Namespace) -> int:
         with ProcessPoolExecutor(max_workers=args.workers) as pool:
             fit = dynamic_fit.fit_dynamic(scenario, traces, executor=pool, **options)
     names = report.write_dynamic_fit(fit, args.output, *figures)
+    for line in fit.warnings:
+        print(f"warning: {line}", file=sys.stderr)
     if args.json:
         print(report.json_text(fit.to_json()), end="")
         return 0

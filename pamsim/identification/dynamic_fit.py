@@ -23,7 +23,8 @@ magnitude more than that noise, while staying small enough for a linear model of
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
+from pathlib import Path
 from typing import Sequence
 
 import numpy as np
@@ -34,6 +35,8 @@ from ..parameters import ParameterSet
 from ..scenario import Scenario
 from .choices import DYNAMIC_BACKENDS, DYNAMIC_DEFAULT_FREE, FD_RELATIVE_STEP
 from .columns import TraceData
+from .dynamic_starts import SCREEN_POINTS_PER_START, global_box, random_points, sign_bounds, typical_scales
+from .fit_quality import noise_level_mm, quality_warnings
 from .pressure_input import KNOT_TOLERANCE_PA, PiecewiseLinearInput, thinned_input
 from .trials import FIT_RTOL, PythonTrials, SimulationTask, run_simulation, trace_scenario
 from .uncertainty import Uncertainty, linearised_uncertainty
@@ -171,6 +174,13 @@ class DynamicFit:
     message: str
     per_trace: list[dict] | None = None
     backend: str = "python"
+    n_starts: int = 0
+    noise_mm: list[float] = field(default_factory=list)
+    """Each trace's contraction noise in the window, estimated from the trace alone (:mod:`.fit_quality`)."""
+    warnings: list[str] = field(default_factory=list)
+    """How the fit misses the noise level; ``success`` is False when there are any."""
+    converged: bool = True
+    """Whether the local optimiser reported convergence."""
 
     @property
     def traces(self) -> tuple[TraceData, ...]:
@@ -210,6 +220,8 @@ class DynamicFit:
                 "rms_contraction_mm": {"per_trace": dict(zip(names, self.rms_contraction_mm)),
                                        "pooled": self.rms_pooled_mm},
                 "n_simulations": self.n_simulations, "wall_time_s": self.wall_time_s, "backend": self.backend,
+                "noise_mm": dict(zip(names, self.noise_mm)), "n_starts": self.n_starts,
+                "warnings": list(self.warnings), "converged": self.converged,
                 "success": self.success, "message": self.message}
         if self.per_trace is not None:
             body["per_trace"] = self.per_trace
@@ -233,7 +245,7 @@ def make_problem(scenario: Scenario, traces: Sequence[TraceData], free: Sequence
     windows = [_window(tr, window_s, len(free)) for tr in traces]
     if not knot_tolerance_Pa > 0:
         raise InputError(f"--knot-tolerance-Pa = {knot_tolerance_Pa!r}: must be positive")
-    lower = np.array([params.entries[n].lower for n in free], dtype=float)
+    lower = sign_bounds(free, [params.entries[n].lower for n in free])
     upper = np.array([params.entries[n].upper for n in free], dtype=float)
     inputs = tuple(None if tr.p_gauge_Pa is None else thinned_input(tr.t_s, tr.p_gauge_Pa, knot_tolerance_Pa)
                    for tr in traces)
@@ -281,9 +293,12 @@ def _rms_per_trace(problem: DynamicProblem, sims: Sequence[np.ndarray]) -> list[
             zip(sims, problem.traces, problem.windows)]
 
 
-def _local(problem: DynamicProblem, theta0: np.ndarray, executor, fd_step: float, max_iterations: int, trials):
+def _local(problem: DynamicProblem, theta0: np.ndarray, executor, fd_step: float, max_iterations: int, trials,
+           typical: np.ndarray | None = None):
     obj = _Objective(problem, executor, fd_step, trials)
-    scale = np.where(np.abs(theta0) > 0, np.abs(theta0), 1.0)
+    # The optimiser works in coefficients over their start values; a start of 0 has no size of its own
+    # and takes its typical scale, so that a unit step means as much for it as for the others.
+    scale = np.where(np.abs(theta0) > 0, np.abs(theta0), 1.0 if typical is None else typical)
     lo, hi = problem.bounds
     res = least_squares(lambda z: obj.residuals(z * scale), np.clip(theta0, lo, hi) / scale,
                         jac=lambda z: obj.jacobian(z * scale) * scale, bounds=(lo / scale, hi / scale),
@@ -293,12 +308,21 @@ def _local(problem: DynamicProblem, theta0: np.ndarray, executor, fd_step: float
     return theta, res, obj, J
 
 
+DEFAULT_STARTS = {"python": 0, "native": 8}
+"""Extra starts of a dynamic fit by backend: on native a local fit takes a few tenths of a second, and
+eight starts found the noise level in every synthetic case of docs/identification.md where the
+scenario's start alone did not; on Python each start costs as much as the whole fit."""
+GLOBAL_POPSIZE = 15
+"""Differential evolution's population per free coefficient (scipy's default)."""
+
+
 def fit_dynamic(scenario: Scenario, traces: Sequence[TraceData], free: Sequence[str] | None = None,
                 window_s: tuple[float, float] | None = None, loads_N: Sequence[float | None] | None = None,
-                executor=None, global_search: bool = False, global_span: float = 0.5,
-                global_iterations: int = 10, per_trace: bool = False, seed: int = 0,
+                executor=None, global_search: bool = False, global_span: float = 1.0,
+                global_iterations: int = 30, per_trace: bool = False, seed: int = 0,
                 fd_step: float = FD_RELATIVE_STEP, max_iterations: int = 30,
-                knot_tolerance_Pa: float = KNOT_TOLERANCE_PA, backend: str = "python") -> DynamicFit:
+                knot_tolerance_Pa: float = KNOT_TOLERANCE_PA, backend: str = "python",
+                n_starts: int | None = None) -> DynamicFit:
     """Fit coefficients (default the paper's D1, D2, N2, N1, N0) to step responses, eq. (13).
 
     Parameters
@@ -316,14 +340,16 @@ def fit_dynamic(scenario: Scenario, traces: Sequence[TraceData], free: Sequence[
     executor : concurrent.futures.Executor, optional
         Runs each iteration's simulations in parallel; None runs them here.
     global_search : bool
-        First run differential evolution over ``start * (1 -+ global_span)`` (within the parameter
-        ranges), seeded with ``seed``, then the local fit from its best point.
+        First run differential evolution (seeded with ``seed``, ``global_iterations`` generations of
+        :data:`GLOBAL_POPSIZE` points per coefficient) over the start plus or minus ``global_span`` times
+        the larger of its size and its typical scale (:mod:`.dynamic_starts`), within the bounds, then the
+        local fit from its best point.
     per_trace : bool
         Also fit every trace alone (the paper's Table 4 layout).
     fd_step : float
         Relative forward-difference step of the Jacobian.
     max_iterations : int
-        Residual evaluations allowed to the local optimiser.
+        Residual evaluations allowed to each local fit.
     knot_tolerance_Pa : float
         Largest deviation [Pa] of the thinned recorded pressure from the recorded one.
     backend : {"python", "native"}
@@ -331,56 +357,112 @@ def fit_dynamic(scenario: Scenario, traces: Sequence[TraceData], free: Sequence[
         differential-evolution generation's too) in one call of the native library, one per worker
         with an executor; it holds a recorded pressure at its midpoint over every output sample (see
         :mod:`.native_fit`) and refuses, before anything runs, a scenario setting it cannot honour.
+    n_starts : int, optional
+        Extra local fits, from the best of ``25 n_starts`` seeded random points (:mod:`.dynamic_starts`);
+        the fit with the lowest cost wins.  Default :data:`DEFAULT_STARTS` of the backend.
+
+    Returns
+    -------
+    DynamicFit
+        ``success`` is False when the optimiser did not converge or when the fit misses the traces'
+        noise level (``warnings`` says how, :mod:`.fit_quality`).
     """
     start_time = time.perf_counter()
+    n_starts = _check_choices(fd_step, max_iterations, n_starts, backend)
+    problem = make_problem(scenario, traces, free, window_s, loads_N, knot_tolerance_Pa)
+    trials = make_trials(problem, backend)
+    theta0 = np.array([scenario.parameters[n] for n in problem.free], dtype=float)
+    scales = typical_scales(problem, theta0)
+    start, n_sim = theta0, 0
+    if global_search:
+        start, n_sim = _global_start(problem, trials, executor, theta0, scales, global_span, global_iterations, seed,
+                                     backend)
+    screened, n_screen = _screened_starts(problem, trials, executor, theta0, scales, n_starts, seed)
+    theta, res, obj, J = _best_local(problem, np.vstack([start, screened]), scales, executor, fd_step,
+                                     max_iterations, trials)
+    n_sim += n_screen
+    n_sim += obj.n_simulations
+    sims = obj.simulate(theta)
+    r = problem.residuals_from(sims)
+    start_sims = trials(theta0, executor)
+    n_sim += len(problem.traces)
+    table, n_table = (_per_trace_table(problem, theta, executor, fd_step, max_iterations, backend)
+                      if per_trace and len(problem.traces) > 1 else (None, 0))
+    rms = _rms_per_trace(problem, sims)
+    pooled = float(np.sqrt(np.mean(r ** 2)))
+    noise = [noise_level_mm(tr.x_m[m]) for tr, m in zip(problem.traces, problem.windows)]
+    flags = quality_warnings([Path(tr.origin).name for tr in problem.traces], rms, noise, pooled)
+    return DynamicFit(problem, theta, theta0, linearised_uncertainty(problem.free, J, r), sims, start_sims, rms,
+                      pooled, n_sim + n_table, time.perf_counter() - start_time, bool(res.success) and not flags,
+                      str(res.message), table, backend, n_starts, noise, flags, bool(res.success))
+
+
+def _check_choices(fd_step: float, max_iterations: int, n_starts: int | None, backend: str) -> int:
+    """Refuse bad options of :func:`fit_dynamic`; the number of extra starts."""
     if not (0 < fd_step < 0.1):
         raise InputError(f"--fd-step = {fd_step!r}: must lie in (0, 0.1)")
     if max_iterations < 1:
         raise InputError(f"--max-iterations = {max_iterations}: must be at least 1")
-    problem = make_problem(scenario, traces, free, window_s, loads_N, knot_tolerance_Pa)
-    trials = make_trials(problem, backend)
-    theta0 = np.array([scenario.parameters[n] for n in problem.free], dtype=float)
-    n_sim = 0
-    start = theta0
-    if global_search:
-        lo, hi = problem.bounds
-        span = global_span * np.maximum(np.abs(theta0), 1e-3)
-        de_bounds = list(zip(np.maximum(theta0 - span, lo), np.minimum(theta0 + span, hi)))
-        if backend == "python":
-            de_workers = executor.map if executor is not None else 1
-            cost, vectorized = _SumOfSquares(problem), False
-        else:
-            # a whole generation per call, one batch (scipy then evaluates in this process)
-            cost, vectorized, de_workers = _PopulationSumOfSquares(problem, trials, executor), True, 1
-        de = differential_evolution(cost, de_bounds, maxiter=global_iterations, popsize=6, seed=seed, polish=False,
-                                    workers=de_workers, updating="deferred", tol=1e-6, x0=theta0,
-                                    vectorized=vectorized)
-        n_sim += cost.n_simulations if vectorized else de.nfev * len(problem.traces)
-        start = de.x
-    theta, res, obj, J = _local(problem, start, executor, fd_step, max_iterations, trials)
-    n_sim += obj.n_simulations
-    sims = obj.simulate(theta)
-    r = problem.residuals_from(sims)
-    unc = linearised_uncertainty(problem.free, J, r)
-    start_sims = trials(theta0, executor)
-    n_sim += len(problem.traces)
-    rms = _rms_per_trace(problem, sims)
-    table = None
-    if per_trace and len(problem.traces) > 1:
-        table = []
-        for i, tr in enumerate(problem.traces):
-            sub = replace(problem, traces=(tr,), loads_N=(problem.loads_N[i],), windows=(problem.windows[i],),
-                          inputs=(problem.inputs[i],))
-            th_i, res_i, obj_i, _ = _local(sub, theta, executor, fd_step, max_iterations, make_trials(sub, backend))
-            n_sim += obj_i.n_simulations
-            table.append({"trace": tr.origin, "load_N": problem.loads_N[i],
-                          "pressure_final_bar": (float(tr.p_gauge_Pa[-1]) / 1e5 if tr.p_gauge_Pa is not None
-                                                 else scenario.final_pressure_gauge_Pa / 1e5),
-                          **dict(zip(problem.free, map(float, th_i))),
-                          "rms_contraction_mm": _rms_per_trace(sub, obj_i.simulate(th_i))[0]})
-    pooled = float(np.sqrt(np.mean(r ** 2)))
-    return DynamicFit(problem, theta, theta0, unc, sims, start_sims, rms, pooled, n_sim,
-                      time.perf_counter() - start_time, bool(res.success), str(res.message), table, backend)
+    if n_starts is None:
+        return DEFAULT_STARTS.get(backend, 0)
+    if n_starts < 0:
+        raise InputError(f"--starts = {n_starts}: must not be negative")
+    return int(n_starts)
+
+
+def _global_start(problem, trials, executor, theta0, scales, span, iterations, seed, backend):
+    """Differential evolution's best point, and the simulations it took."""
+    box = global_box(theta0, scales, problem.bounds, span)
+    if backend == "python":
+        de_workers = executor.map if executor is not None else 1
+        cost, vectorized = _SumOfSquares(problem), False
+    else:
+        # a whole generation per call, one batch (scipy then evaluates in this process)
+        cost, vectorized, de_workers = _PopulationSumOfSquares(problem, trials, executor), True, 1
+    de = differential_evolution(cost, box, maxiter=iterations, popsize=GLOBAL_POPSIZE, seed=seed, polish=False,
+                                workers=de_workers, updating="deferred", tol=1e-6, x0=np.clip(theta0, *zip(*box)),
+                                vectorized=vectorized)
+    return de.x, (cost.n_simulations if vectorized else de.nfev * len(problem.traces))
+
+
+def _screened_starts(problem, trials, executor, theta0, scales, n_starts: int, seed: int) -> tuple[np.ndarray, int]:
+    """The ``n_starts`` lowest-cost of ``25 n_starts`` seeded random points (one batch of simulations), and
+    the simulations it took."""
+    if n_starts == 0:
+        return np.empty((0, len(problem.free))), 0
+    points = random_points(theta0, scales, problem.bounds, SCREEN_POINTS_PER_START * n_starts, seed)
+    cost = _PopulationSumOfSquares(problem, trials, executor)
+    order = np.argsort(cost(points.T), kind="stable")
+    return points[order[:n_starts]], cost.n_simulations
+
+
+def _best_local(problem, starts, scales, executor, fd_step, max_iterations, trials):
+    """The local fit from every start (rows); the lowest cost wins, its objective counting every start's
+    simulations."""
+    best, n_sim = None, 0
+    for theta0 in starts:
+        fit = _local(problem, theta0, executor, fd_step, max_iterations, trials, scales)
+        n_sim += fit[2].n_simulations
+        if best is None or fit[1].cost < best[1].cost:
+            best = fit
+    best[2].n_simulations = n_sim
+    return best
+
+
+def _per_trace_table(problem, theta, executor, fd_step, max_iterations, backend) -> tuple[list[dict], int]:
+    """Each trace fitted alone from the pooled optimum (the paper's Table 4 layout), and the simulations."""
+    table, n_sim = [], 0
+    for i, tr in enumerate(problem.traces):
+        sub = replace(problem, traces=(tr,), loads_N=(problem.loads_N[i],), windows=(problem.windows[i],),
+                      inputs=(problem.inputs[i],))
+        th_i, _, obj_i, _ = _local(sub, theta, executor, fd_step, max_iterations, make_trials(sub, backend))
+        n_sim += obj_i.n_simulations
+        table.append({"trace": tr.origin, "load_N": problem.loads_N[i],
+                      "pressure_final_bar": (float(tr.p_gauge_Pa[-1]) / 1e5 if tr.p_gauge_Pa is not None
+                                             else problem.scenario.final_pressure_gauge_Pa / 1e5),
+                      **dict(zip(problem.free, map(float, th_i))),
+                      "rms_contraction_mm": _rms_per_trace(sub, obj_i.simulate(th_i))[0]})
+    return table, n_sim
 
 
 __all__ = ["fit_dynamic", "DynamicFit", "DynamicProblem", "make_problem", "make_trials", "run_simulation",

@@ -199,10 +199,12 @@ def dynamic_report_md(fit: "DynamicFit", figure_format: str = "png") -> str:
     start = dict(zip(p.free, map(float, fit.start)))
     out = [f"# Dynamic fit (eq. 13) on {len(p.traces)} trace(s), scenario {p.scenario.name}", "",
            f"- pooled RMS contraction error in the window: **{fit.rms_pooled_mm:.4f} mm**",
-           f"- {fit.n_simulations} simulations in {fit.wall_time_s:.2f} s; optimiser: {fit.message}", "",
-           "| trace | load [N] | pressure | RMS [mm] |", "|---|---|---|---|"]
-    out += [f"| {tr.origin} | {w:g} | {'recorded' if tr.p_gauge_Pa is not None else 'scenario valve'} | {r:.4f} |"
-            for tr, w, r in zip(p.traces, p.loads_N, fit.rms_contraction_mm)]
+           f"- {fit.n_simulations} simulations in {fit.wall_time_s:.2f} s, {fit.n_starts} extra start(s); "
+           f"optimiser: {fit.message}", ""]
+    out += [f"**Warning:** {w}." for w in fit.warnings] + ([""] if fit.warnings else [])
+    out += ["| trace | load [N] | pressure | RMS [mm] | noise [mm] |", "|---|---|---|---|---|"]
+    out += [f"| {tr.origin} | {w:g} | {'recorded' if tr.p_gauge_Pa is not None else 'scenario valve'} | {r:.4f} | "
+            f"{n:.4f} |" for tr, w, r, n in zip(p.traces, p.loads_N, fit.rms_contraction_mm, fit.noise_mm)]
     out += ["", "## Coefficients", ""] + parameter_table(p.free, start, fit.parameters, fit.uncertainty) + [""]
     out += correlation_lines(fit.uncertainty)
     if fit.per_trace:
