@@ -1,10 +1,11 @@
-"""Are the static fit's standard errors calibrated?  Coverage of its 95 % Wald intervals.
+"""Are the static fit's intervals calibrated?  Coverage of its 95 % Wald and profile-likelihood intervals.
 
     python benchmarks/coverage_static.py [--datasets N] [--seed S]
 
 For each setting, N synthetic data sets (seeded) are made from known coefficients, each is fitted,
 and the fraction of intervals ``fitted +- 1.96 standard errors`` that hold the truth is counted
-over every coefficient and data set.  Calibrated errors give 0.95 (with N = 200 and six
+over every coefficient and data set; beside it the same with the Student-t quantile (the Wald interval
+``fit.json`` reports) and for the profile-likelihood intervals (``fit.json``'s ``profile``).  Calibrated errors give 0.95 (with N = 200 and six
 coefficients, a binomial standard error of about 0.006 if the coefficients were independent).
 
 Settings (truth: the ACRA 2012 paper's printed coefficients; the 66 (pressure, load) pairs of its
@@ -42,6 +43,9 @@ Z95 = 1.959963984540054
 printed beside it (what calibrated errors from an estimated sigma reach exactly, for a linear model)."""
 
 
+SETTINGS = ("contraction, censored", "contraction, lifted only", "force")
+
+
 def settings(params):
     acra = read_static_data(ROOT / "pamsim" / "data" / "acra2012_steady_state.csv")
     x_max = make_problem(acra, params).x_max_m
@@ -63,21 +67,23 @@ def settings(params):
     }
 
 
-def coverage(make, params, n: int, seed: int) -> tuple[float, float, np.ndarray, int]:
-    """Coverage with the normal and with the Student-t quantile, the normal one per coefficient, and the
-    data sets whose errors were not all finite."""
+def coverage(make, params, n: int, seed: int) -> tuple[float, float, float, np.ndarray, int]:
+    """Coverage with the normal and with the Student-t quantile and of the profile intervals, the normal one
+    per coefficient, and the data sets whose errors were not all finite."""
     hits = np.zeros((n, len(COEFFS)), dtype=bool)
     hits_t = np.zeros((n, len(COEFFS)), dtype=bool)
+    hits_p = np.zeros((n, len(COEFFS)), dtype=bool)
     skipped = 0
     for i in range(n):
         fit = fit_static(make(seed + i), params, cv=None)
+        hits_p[i] = (fit.profile_95[:, 0] <= PRINTED) & (PRINTED <= fit.profile_95[:, 1])
         u = fit.uncertainty
         if not np.all(np.isfinite(u.standard_errors)):
             skipped += 1
         err = np.abs(fit.theta - PRINTED)
         hits[i] = err <= Z95 * u.standard_errors
         hits_t[i] = err <= student_t.ppf(0.975, dof(fit)) * u.standard_errors
-    return float(hits.mean()), float(hits_t.mean()), hits.mean(axis=0), skipped
+    return float(hits.mean()), float(hits_t.mean()), float(hits_p.mean()), hits.mean(axis=0), skipped
 
 
 def dof(fit) -> int:
@@ -89,15 +95,22 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--datasets", type=int, default=200)
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--settings", default=";".join(SETTINGS), help="settings to run, separated by semicolons")
     args = ap.parse_args()
     params = pamsim.get_parameter_set("shadow_6x300_acra2012").with_overrides(dict(zip(COEFFS, PRINTED)))
-    print(f"95 % Wald coverage over {args.datasets} synthetic data sets per setting (seeds from {args.seed})")
-    print(f"{'setting':<26} {'normal':>7} {'t':>6}  " + "  ".join(f"{c[:6]:>6}" for c in COEFFS) + "  not finite")
+    print(f"95 % coverage over {args.datasets} synthetic data sets per setting (seeds from {args.seed}): Wald with "
+          "the normal and the t quantile, profile likelihood")
+    print(f"{'setting':<26} {'normal':>7} {'t':>6} {'profile':>7}  " + "  ".join(f"{c[:6]:>6}" for c in COEFFS)
+          + "  not finite")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
+        chosen = [c.strip() for c in args.settings.split(";")]
         for label, make in settings(params).items():
-            total, total_t, per, skipped = coverage(make, params, args.datasets, args.seed)
-            print(f"{label:<26} {total:7.3f} {total_t:6.3f}  " + "  ".join(f"{c:6.3f}" for c in per) + f"  {skipped}")
+            if label not in chosen:
+                continue
+            total, total_t, total_p, per, skipped = coverage(make, params, args.datasets, args.seed)
+            print(f"{label:<26} {total:7.3f} {total_t:6.3f} {total_p:7.3f}  " + "  ".join(f"{c:6.3f}" for c in per)
+                  + f"  {skipped}", flush=True)
 
 
 if __name__ == "__main__":

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import hashlib
 import io
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Mapping
 
@@ -21,7 +21,10 @@ import numpy as np
 from ..errors import InputError
 from ..table_checks import LENGTH_UNITS_M, PRESSURE_UNITS_PA, unit_column, unit_suffix  # noqa: F401 -- re-exported
 
-QUANTITIES = ("pressure", "contraction", "force", "weight", "time")
+QUANTITIES = ("pressure", "contraction", "force", "weight", "time", "sigma")
+SIGMA_UNITS = {**LENGTH_UNITS_M, "_N": 1.0}
+"""Suffixes of a static file's ``sigma`` column: the standard deviation of each test's contraction (``_mm``,
+``_m``: the contraction objective's residual) or of its force (``_N``: the force objective's)."""
 
 
 class DataError(InputError):
@@ -42,15 +45,21 @@ class StaticData:
     origin: str = "<arrays>"
     sha256: str = ""
     columns: tuple[tuple[str, float], ...] = (("pressure_gauge_Pa", 1.0), ("contraction_m", 1.0), ("load_N", 1.0))
-    """The file's column of the pressure, the contraction and the load, each with its factor to SI."""
+    """The file's column of the pressure, the contraction and the load (and of ``sigma``, if given), each with its
+    factor to SI."""
+    sigma: np.ndarray | None = None
+    """Per test, the standard deviation [m or N, by ``sigma_kind``] of its measurement: the fit weighs each
+    residual by its inverse (weighted least squares; relative, the residual variance scales them)."""
+    sigma_kind: str = ""
+    """``contraction`` or ``force``: what ``sigma`` is the standard deviation of."""
 
     def __len__(self) -> int:
         return len(self.load_N)
 
     def subset(self, rows) -> "StaticData":
         """The tests at ``rows`` (indices or a boolean mask)."""
-        return StaticData(self.pressure_gauge_Pa[rows], self.contraction_m[rows], self.load_N[rows], self.kind,
-                          self.origin, self.sha256, self.columns)
+        return replace(self, pressure_gauge_Pa=self.pressure_gauge_Pa[rows], contraction_m=self.contraction_m[rows],
+                       load_N=self.load_N[rows], sigma=None if self.sigma is None else self.sigma[rows])
 
 
 @dataclass(frozen=True)
@@ -178,7 +187,22 @@ def read_static_data(path: str | Path, columns: Mapping[str, str] | None = None)
     if kind == "weight" and np.any(load <= 0):
         i = int(np.flatnonzero(load <= 0)[0])
         raise DataError(f"{path}: column {l_col}, data row {i + 1}: value {load[i]:g} must be positive")
-    return StaticData(p, x, load, kind, str(path), digest, ((p_col, p_k), (x_col, x_k), (l_col, 1.0)))
+    cols = ((p_col, p_k), (x_col, x_k), (l_col, 1.0))
+    sigma = _unit_column(path, header, "sigma", SIGMA_UNITS, ("sigma",), columns, required=False)
+    if sigma is None:
+        return StaticData(p, x, load, kind, str(path), digest, cols)
+    values = _positive(path, sigma[0], _finite(path, sigma[0], rows[:, header.index(sigma[0])]))
+    return StaticData(p, x, load, kind, str(path), digest, (*cols, sigma), values * sigma[1],
+                      "force" if sigma[0].endswith("_N") else "contraction")
+
+
+def _positive(path: Path, name: str, values: np.ndarray) -> np.ndarray:
+    """``values``, refused where one is not positive (a standard deviation is)."""
+    bad = np.flatnonzero(~(values > 0))
+    if bad.size:
+        raise DataError(f"{path}: column {name}, data row {int(bad[0]) + 1}: value {values[bad[0]]:g} must be "
+                        "positive (a standard deviation)")
+    return values
 
 
 def read_trace(path: str | Path, columns: Mapping[str, str] | None = None) -> TraceData:

@@ -66,7 +66,8 @@ def plot_static_residuals(fit: "StaticFit", path=None, dpi: int | None = None) -
     ax1.legend(fontsize=8)
     ax2.scatter(p, fit.residuals, c=d.load_N, cmap="viridis")
     ax2.axhline(0.0, color="k", lw=0.8)
-    ax2.set_ylabel(f"objective residual [{'N' if fit.problem.objective == 'force' else 'mm'}]")
+    unit = "N" if fit.problem.objective == "force" else "mm"
+    ax2.set_ylabel(f"objective residual [{unit}]" if fit.problem.weights is None else "objective residual / sigma")
     ax2.set_xlabel("gauge pressure [bar] (colour: load)")
     for ax in (ax1, ax2):
         ax.grid(alpha=0.3)
@@ -96,7 +97,8 @@ def plot_comparison(rows: Sequence[dict], path=None, dpi: int | None = None) -> 
     ax.bar(idx - 0.2, [r["rms_contraction_mm"] for r in rows], 0.4, label="fit RMS")
     ax.bar(idx + 0.2, [r["cv_rms_contraction_mm"] for r in rows], 0.4, label="cross-validated RMS", hatch="//",
            edgecolor="white")  # hatched: told apart in grey print too
-    ax.set_xticks(idx, [f"{r['model']}\n({r['n_free']} free)" for r in rows], fontsize=8)
+    ax.set_xticks(idx, [f"{r['model']}\n({r['n_free']} free, Akaike weight {r['akaike_weight']:.2g})" for r in rows],
+                  fontsize=8)
     ax.set_ylabel("contraction error RMS [mm]")
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3, axis="y")

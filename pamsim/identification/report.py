@@ -49,15 +49,30 @@ def provenance(origin: str, sha256: str, objective: str, rms_text: str) -> dict:
             "objective": objective, "fit quality": rms_text}
 
 
-def parameter_table(names: Sequence[str], start: dict, fitted: dict, unc) -> list[str]:
+def parameter_table(names: Sequence[str], start: dict, fitted: dict, unc, intervals: dict | None = None) -> list[str]:
     """Markdown rows: coefficient, start value, fitted value, standard error ("not identified" where
-    the data carry no information on the coefficient)."""
+    the data carry no information on the coefficient) and, with ``intervals`` (a static fit's
+    ``intervals_json()``), the 95 % Wald and profile-likelihood intervals."""
     errors = dict(zip(unc.names, map(float, unc.standard_errors)))
     blind = set(unc.not_identified())
-    out = ["| coefficient | start | fitted | standard error |", "|---|---|---|---|"]
-    out += [f"| {n} | {_f(start[n])} | {_f(fitted[n])} | {'not identified' if n in blind else _f(errors[n])} |"
-            for n in names]
+    head, rule = "| coefficient | start | fitted | standard error |", "|---|---|---|---|"
+    if intervals is not None:
+        head, rule = head + " 95 % Wald | 95 % profile |", rule + "---|---|"
+    out = [head, rule]
+    for n in names:
+        row = f"| {n} | {_f(start[n])} | {_f(fitted[n])} | {'not identified' if n in blind else _f(errors[n])} |"
+        if intervals is not None:
+            row += f" {_interval(intervals[n]['wald'])} | {_interval(intervals[n]['profile'])} |"
+        out.append(row)
     return out
+
+
+def _interval(ends) -> str:
+    """``[lo, hi]`` for a report; an end the data do not set is an infinity, no interval is n/a."""
+    if ends is None or all(e is None for e in ends):
+        return "n/a"
+    lo, hi = ("-inf" if ends[0] is None else _f(ends[0])), ("inf" if ends[1] is None else _f(ends[1]))
+    return f"[{lo}, {hi}]"
 
 
 def correlation_lines(fit_unc) -> list[str]:
@@ -92,17 +107,24 @@ def static_report_md(fit: "StaticFit", compare: Sequence[dict] | None, figure_fo
            f"- RMS force error over the lifted tests: {_f(fit.rms_force_N, '.3f')} N",
            f"- AIC {_f(fit.aic, '.2f')}, BIC {_f(fit.bic, '.2f')}; optimiser: {fit.message} ({fit.nfev} evaluations)",
            "", "## Coefficients", ""]
-    out += parameter_table(p.free, start, fit.parameters, fit.uncertainty) + [""]
-    out += ["Standard errors come from the Jacobian at the optimum (linearised, residual variance from the fit).",
+    out += parameter_table(p.free, start, fit.parameters, fit.uncertainty, fit.intervals_json()) + [""]
+    out += ["Standard errors come from the Jacobian at the optimum (linearised, residual variance from the fit); "
+            "the Wald interval is the fitted value plus or minus the Student-t quantile times the standard error. "
+            "The profile interval holds the values at which the sum of squares, the other coefficients refitted, "
+            "stays within that quantile squared times the residual variance of its minimum: it follows the "
+            "model's curvature where the Wald interval cannot (computed with the linear loss only).",
             ""] + correlation_lines(fit.uncertainty)
     ext = figure_format
     out += ["## Figures", "", f"![measured and fitted](fit.{ext})", "", f"![residuals](residuals.{ext})", "",
             f"![correlation](correlation.{ext})", ""]
     if compare:
-        out += ["## Model comparison", "", "| model | free | RMS [mm] | CV RMS [mm] | AIC | BIC |", "|---|---|---|---|---|---|"]
-        out += [f"| {r['model']} | {r['n_free']} | {_f(r['rms_contraction_mm'], '.3f')} | "
-                f"{_f(r['cv_rms_contraction_mm'], '.3f')} | {_f(r['aic'], '.2f')} | {_f(r['bic'], '.2f')} |"
-                for r in compare]
+        out += ["## Model comparison", "", "Ranked by AIC; the Akaike weight is the relative likelihood of each "
+                "model being the best of those compared, on these tests and this objective.", "",
+                "| rank | model | free | RMS [mm] | CV RMS [mm] | AIC | ΔAIC | Akaike weight | BIC |",
+                "|---|---|---|---|---|---|---|---|---|"]
+        out += [f"| {r['rank']} | {r['model']} | {r['n_free']} | {_f(r['rms_contraction_mm'], '.3f')} | "
+                f"{_f(r['cv_rms_contraction_mm'], '.3f')} | {_f(r['aic'], '.2f')} | {_f(r['delta_aic'], '.2f')} | "
+                f"{_f(r['akaike_weight'], '.3g')} | {_f(r['bic'], '.2f')} |" for r in compare]
         out += ["", f"![comparison](compare.{ext})", ""]
     return "\n".join(out)
 

@@ -36,6 +36,7 @@ from .crossval import cross_validate
 from .equilibrium import equilibrium_m, slope_N_per_m
 from .models import build_static, check_model, default_free, missing_inputs, optional_defaults, static_parameters
 from .plausibility import check_static_data, duplicate_groups
+from .profile import profile_intervals, t_quantile
 from .uncertainty import Uncertainty, information_criteria, linearised_uncertainty
 
 _FD_REL = 1e-6
@@ -58,6 +59,15 @@ class StaticProblem:
     censor_threshold_m: float
     x_max_m: float
     bounds: tuple[np.ndarray, np.ndarray]
+
+    @cached_property
+    def weights(self) -> np.ndarray | None:
+        """Per test, the inverse of its standard deviation in the residual's unit (mm or N), or None
+        without a ``sigma`` column."""
+        d = self.data
+        if d.sigma is None:
+            return None
+        return 1.0 / (d.sigma * (1e3 if self.objective == "contraction" else 1.0))
 
     @property
     def censored(self) -> np.ndarray:
@@ -115,7 +125,8 @@ class StaticProblem:
                 r = 1e3 * np.where(cens, np.maximum(x - self.censor_threshold_m, 0.0), x - d.contraction_m)
         except ArithmeticError:  # a Python float overflowing in a model's formula
             return np.full(len(d), _PENALTY)
-        return np.where(np.isfinite(r), r, _PENALTY)
+        r = np.where(np.isfinite(r), r, _PENALTY)
+        return r if self.weights is None else r * self.weights
 
     def jacobian(self, theta: np.ndarray) -> np.ndarray:
         """d residual / d theta (physical units).
@@ -145,13 +156,16 @@ class StaticProblem:
         cens = self.censored
         if self.objective == "force":
             active = ~cens | (f0 - d.load_N > 0.0)
-            return J * active[:, None]
+            return self._weighted(J * active[:, None])
         inside = (base_x > 0.0) & (base_x < self.x_max_m)
         slope = slope_N_per_m(self.force(theta).force_N, base_x, d.pressure_gauge_Pa)
         with np.errstate(divide="ignore", invalid="ignore"):
             dx = np.where(inside[:, None], -J / slope[:, None], 0.0)
         active = ~cens | (base_x > self.censor_threshold_m)
-        return 1e3 * dx * active[:, None]
+        return self._weighted(1e3 * dx * active[:, None])
+
+    def _weighted(self, J: np.ndarray) -> np.ndarray:
+        return J if self.weights is None else J * self.weights[:, None]
 
 
 @dataclass
@@ -179,6 +193,16 @@ class StaticFit:
     wall_time_s: float
     muscle: str = ""
     extra: dict = field(default_factory=dict)
+    profile_95: np.ndarray | None = None
+    """``(k, 2)``: each coefficient's 95 % profile-likelihood interval (:mod:`.profile`); None when not
+    computed (a robust loss, whose optimum is not the sum of squares', or ``intervals=False``)."""
+
+    @property
+    def wald_95(self) -> np.ndarray:
+        """``(k, 2)``: each coefficient's 95 % Wald interval, ``theta +- t se`` with the Student quantile of the
+        fit's degrees of freedom (NaN where the standard error is)."""
+        half = t_quantile(self.uncertainty.dof) * self.uncertainty.standard_errors
+        return np.column_stack([self.theta - half, self.theta + half])
 
     @property
     def parameters(self) -> dict[str, float]:
@@ -213,11 +237,24 @@ class StaticFit:
                 "censor_threshold_mm": self.problem.censor_threshold_m * 1e3,
                 "aic": _num(self.aic), "bic": _num(self.bic), "loss": self.loss, "n_starts": self.n_starts,
                 "success": self.success, "message": self.message, "nfev": self.nfev,
-                "wall_time_s": self.wall_time_s, **self.extra}
+                "wall_time_s": self.wall_time_s, "intervals_95": self.intervals_json(), **self.extra}
+
+    def intervals_json(self) -> dict:
+        """``{name: {"wald": [lo, hi], "profile": [lo, hi]}}``: an interval that was not computed or that the
+        data give none of (not identified, no degrees of freedom) is null, an end the data do not set is
+        null in the pair."""
+        prof = np.full_like(self.wald_95, math.nan) if self.profile_95 is None else self.profile_95
+        return {n: {"wald": _pair(w), "profile": _pair(pr)}
+                for n, w, pr in zip(self.problem.free, self.wald_95, prof)}
 
 
 def _num(v: float):
     return None if not math.isfinite(v) else float(v)
+
+
+def _pair(ends: np.ndarray) -> list | None:
+    """An interval for JSON: null when it is undefined (NaN), its infinite ends null."""
+    return None if np.isnan(ends).any() else [_num(v) for v in ends]
 
 
 def make_problem(data: StaticData, params: ParameterSet, model: str = "acra2012_polynomial",
@@ -250,6 +287,7 @@ def make_problem(data: StaticData, params: ParameterSet, model: str = "acra2012_
         raise InputError(f"--objective = {objective!r}: choose from {', '.join(OBJECTIVES)}")
     if not censor_threshold_m >= 0.0:
         raise InputError(f"--censor-threshold-mm = {censor_threshold_m * 1e3:g}: must not be negative")
+
     x_max = EndStops.from_parameters(params).x_high_m
     params = with_optional(params, {k: v for k, v in optional.items() if k in free}, model)
     params = _independent(params, free, model)
@@ -312,6 +350,15 @@ def check_information(problem: StaticProblem, exact: bool = False) -> None:
                          "a fit needs more tests than coefficients to say how far to trust it")
 
 
+def check_sigma(problem: StaticProblem) -> None:
+    """Refuse a ``sigma`` column of the other objective's quantity (a contraction's for the force objective)."""
+    d = problem.data
+    if d.sigma is not None and d.sigma_kind != problem.objective:
+        raise InputError(f"{d.origin}: column {d.columns[3][0]} is the standard deviation of each test's "
+                         f"{d.sigma_kind}, but the {problem.objective} objective's residuals are "
+                         f"{'forces: give sigma_N' if problem.objective == 'force' else 'contractions: give sigma_mm'}")
+
+
 def check_data(data: StaticData, params: ParameterSet, model: str) -> list[str]:
     """Refuse static tests no rig can give for this muscle; return one-line warnings on implausible ones
     (:func:`pamsim.identification.plausibility.check_static_data`, on the scale of the starting muscle)."""
@@ -345,7 +392,7 @@ def fit_static(data: StaticData, params: ParameterSet, model: str = "acra2012_po
                free: Sequence[str] | None = None, objective: str | None = None, loss: str = "linear",
                f_scale: float = 1.0, n_starts: int = 0, seed: int = 0,
                censor_threshold_m: float = CENSOR_THRESHOLD_M, cv: str | None = "auto", k_folds: int = 10,
-               muscle_label: str = "", exact: bool = False) -> StaticFit:
+               muscle_label: str = "", exact: bool = False, intervals: bool = True) -> StaticFit:
     """Fit the free coefficients of a static force model to static tests.
 
     Parameters
@@ -374,16 +421,23 @@ def fit_static(data: StaticData, params: ParameterSet, model: str = "acra2012_po
         Accept as many tests as free coefficients (the ACRA paper's training approach): the fit then
         passes through the tests and gives no standard errors.  Without it such data are refused, as
         are fewer tests than coefficients and data where no test lifted its load.
+    intervals : bool
+        Also compute each coefficient's 95 % profile-likelihood interval (:mod:`.profile`; with the linear
+        loss only), about as many refits per coefficient as the fit took evaluations.
+
+    Returns
+    -------
+    StaticFit
     """
     # A trial point far from the data may overflow in a model's formula; it is a bad point (its
     # residuals become the penalty), not something to tell the user about.
     with np.errstate(all="ignore"):
         return _fit_static(data, params, model, free, objective, loss, f_scale, n_starts, seed, censor_threshold_m,
-                           cv, k_folds, muscle_label, exact)
+                           cv, k_folds, muscle_label, exact, intervals)
 
 
 def _fit_static(data, params, model, free, objective, loss, f_scale, n_starts, seed, censor_threshold_m, cv,
-                k_folds, muscle_label, exact) -> StaticFit:
+                k_folds, muscle_label, exact, intervals) -> StaticFit:
     start = time.perf_counter()
     if loss not in LOSSES:
         raise InputError(f"--loss = {loss!r}: choose from {', '.join(LOSSES)}")
@@ -393,6 +447,7 @@ def _fit_static(data, params, model, free, objective, loss, f_scale, n_starts, s
         raise InputError(f"--starts = {n_starts}: must not be negative")
     problem = make_problem(data, params, model, free, objective, censor_threshold_m)
     check_information(problem, exact)
+    check_sigma(problem)
     theta0 = np.array([problem.base[n] for n in problem.free], dtype=float)
     theta, res = _solve(problem, theta0, loss, f_scale)
     nfev = res.nfev
@@ -419,7 +474,14 @@ def _fit_static(data, params, model, free, objective, loss, f_scale, n_starts, s
                      float(np.sqrt(np.mean(err_mm ** 2))),
                      float(np.sqrt(np.mean(cv_err ** 2))) * 1e3 if cv_err.size else math.nan, cv_kind,
                      cv_err * 1e3, aic, bic, loss, n_starts, bool(res.success), str(res.message), int(nfev),
-                     time.perf_counter() - start, muscle_label)
+                     time.perf_counter() - start, muscle_label,
+                     profile_95=_profile(problem, theta, unc) if intervals and loss == "linear" else None)
+
+
+def _profile(problem: StaticProblem, theta: np.ndarray, unc: Uncertainty) -> np.ndarray:
+    """The 95 % profile-likelihood intervals of the fit's coefficients."""
+    return profile_intervals(problem.residuals, problem.jacobian, theta, unc.standard_errors, unc.correlation,
+                             problem.bounds, unc.dof)
 
 
 def _restrict(problem: StaticProblem, rows: np.ndarray) -> StaticProblem:
