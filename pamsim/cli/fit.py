@@ -205,6 +205,8 @@ def run_dynamic(args: argparse.Namespace) -> int:
     scenario = load_scenario(args.scenario)
     traces = [read_trace(t, args.columns) for t in args.traces]
     check_output_dir(args.output)
+    for line in dynamic_fit.check_data(scenario, traces, args.load_N):
+        print(f"warning: {line}", file=sys.stderr)
     options = dict(free=args.free, window_s=args.window, loads_N=args.load_N, global_search=args.global_search,
                    per_trace=args.per_trace, seed=args.seed, fd_step=args.fd_step,
                    max_iterations=args.max_iterations, knot_tolerance_Pa=args.knot_tolerance_Pa,

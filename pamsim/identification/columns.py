@@ -72,6 +72,8 @@ class TraceData:
     weight_N: float | None
     origin: str = "<arrays>"
     sha256: str = ""
+    columns: tuple[tuple[str, float], ...] = (("t_s", 1.0), ("x_m", 1.0), ("p_gauge_Pa", 1.0))
+    """The file's column of the time, the contraction and the pressure, each with its factor to SI."""
 
     def window(self, t0_s: float, t1_s: float) -> np.ndarray:
         """Boolean mask of the samples inside ``[t0_s, t1_s]``."""
@@ -234,7 +236,8 @@ def read_trace(path: str | Path, columns: Mapping[str, str] | None = None) -> Tr
             raise DataError(f"{path}: column {w[0]}: value {values[0]:g}: the hung weight must be one positive "
                             "value for the whole trace")
         weight = float(values[0])
-    return TraceData(t, x, p_Pa, weight, str(path), digest)
+    cols = ((t_col, 1.0), (x_col, x_k), (p if p is not None else ("p_gauge_Pa", 1.0)))
+    return TraceData(t, x, p_Pa, weight, str(path), digest, cols)
 
 
 def write_trace_csv(trace: TraceData, path: str | Path) -> None:

@@ -22,6 +22,7 @@ magnitude more than that noise, while staying small enough for a linear model of
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -30,6 +31,7 @@ from typing import Sequence
 import numpy as np
 from scipy.optimize import differential_evolution, least_squares
 
+from ..elements.stops import EndStops
 from ..errors import InputError
 from ..parameters import ParameterSet
 from ..scenario import Scenario
@@ -37,6 +39,7 @@ from .choices import DYNAMIC_BACKENDS, DYNAMIC_DEFAULT_FREE, FD_RELATIVE_STEP
 from .columns import TraceData
 from .dynamic_starts import SCREEN_POINTS_PER_START, global_box, random_points, sign_bounds, typical_scales
 from .fit_quality import noise_level_mm, quality_warnings
+from .plausibility import check_trace
 from .pressure_input import KNOT_TOLERANCE_PA, PiecewiseLinearInput, thinned_input
 from .trials import FIT_RTOL, PythonTrials, SimulationTask, run_simulation, trace_scenario
 from .uncertainty import Uncertainty, linearised_uncertainty
@@ -252,6 +255,25 @@ def make_problem(scenario: Scenario, traces: Sequence[TraceData], free: Sequence
     return DynamicProblem(scenario, tuple(traces), tuple(loads), tuple(windows), free, (lower, upper), inputs)
 
 
+def check_data(scenario: Scenario, traces: Sequence[TraceData],
+               loads_N: Sequence[float | None] | None = None) -> list[str]:
+    """Refuse step responses no rig can give for the scenario's muscle; return one-line warnings on implausible
+    ones (:func:`pamsim.identification.plausibility.check_trace`, on the scale of the scenario's muscle: its rest
+    length, upper stop, rating and blocked force)."""
+    params = scenario.parameters
+    loads = _trace_loads(scenario, traces, loads_N)
+    x_max = EndStops.from_parameters(params).x_high_m
+    rated = params["rated_pressure_gauge_Pa"] if "rated_pressure_gauge_Pa" in params else math.inf
+    static = scenario.build_model().static_force
+
+    def blocked(p_gauge_Pa):
+        return static.force_N(0.0, scenario.final_pressure_gauge_Pa if p_gauge_Pa is None else p_gauge_Pa)
+
+    with np.errstate(all="ignore"):  # a force table or polynomial far outside its range: a number, not a warning
+        return [line for tr, w in zip(traces, loads) for line in check_trace(tr, w, params["L0_m"], x_max, rated,
+                                                                               blocked)]
+
+
 def _check_free(free: tuple[str, ...], params: ParameterSet) -> None:
     for n in free:
         if n not in params:
@@ -370,6 +392,7 @@ def fit_dynamic(scenario: Scenario, traces: Sequence[TraceData], free: Sequence[
     start_time = time.perf_counter()
     n_starts = _check_choices(fd_step, max_iterations, n_starts, backend)
     problem = make_problem(scenario, traces, free, window_s, loads_N, knot_tolerance_Pa)
+    check_data(scenario, traces, loads_N)  # refuses the impossible; the command line prints the warnings
     trials = make_trials(problem, backend)
     theta0 = np.array([scenario.parameters[n] for n in problem.free], dtype=float)
     scales = typical_scales(problem, theta0)
@@ -465,5 +488,5 @@ def _per_trace_table(problem, theta, executor, fd_step, max_iterations, backend)
     return table, n_sim
 
 
-__all__ = ["fit_dynamic", "DynamicFit", "DynamicProblem", "make_problem", "make_trials", "run_simulation",
+__all__ = ["fit_dynamic", "check_data", "DynamicFit", "DynamicProblem", "make_problem", "make_trials", "run_simulation",
            "SimulationTask", "trace_scenario", "DYNAMIC_BACKENDS", "DYNAMIC_DEFAULT_FREE", "FD_RELATIVE_STEP"]
