@@ -150,6 +150,12 @@ def _print_warnings(uncertainty) -> None:
         print(f"  warning: {a} and {b} are correlated (r = {r:+.3f}): the data do not separate them")
 
 
+def _warn(lines) -> None:
+    """One ``warning:`` line on stderr for each of ``lines``."""
+    for line in lines:
+        print(f"warning: {line}", file=sys.stderr)
+
+
 def run_static(args: argparse.Namespace) -> int:
     """``pamsim fit static``: fit the static force model to the static tests of ``DATA.csv`` (and compare models
     with ``--compare``), write the fit, the muscle file, the report and the figures; exit code 0.
@@ -162,8 +168,7 @@ def run_static(args: argparse.Namespace) -> int:
     model = args.model or muscle_model
     check_output_dir(args.output)
     data = read_static_data(args.data, args.columns)
-    for line in static_fit.check_data(data, params, model):
-        print(f"warning: {line}", file=sys.stderr)
+    _warn(static_fit.check_data(data, params, model))
     options = dict(objective=args.objective, loss=args.loss, f_scale=args.f_scale, n_starts=args.starts,
                    seed=args.seed, censor_threshold_m=args.censor_threshold_mm * 1e-3, cv=args.cv,
                    k_folds=args.folds)
@@ -205,8 +210,7 @@ def run_dynamic(args: argparse.Namespace) -> int:
     scenario = load_scenario(args.scenario)
     traces = [read_trace(t, args.columns) for t in args.traces]
     check_output_dir(args.output)
-    for line in dynamic_fit.check_data(scenario, traces, args.load_N):
-        print(f"warning: {line}", file=sys.stderr)
+    _warn(dynamic_fit.check_data(scenario, traces, args.load_N))
     options = dict(free=args.free, window_s=args.window, loads_N=args.load_N, global_search=args.global_search,
                    per_trace=args.per_trace, seed=args.seed, fd_step=args.fd_step,
                    max_iterations=args.max_iterations, knot_tolerance_Pa=args.knot_tolerance_Pa,
@@ -219,8 +223,7 @@ def run_dynamic(args: argparse.Namespace) -> int:
         with ProcessPoolExecutor(max_workers=args.workers) as pool:
             fit = dynamic_fit.fit_dynamic(scenario, traces, executor=pool, **options)
     names = report.write_dynamic_fit(fit, args.output, *figures)
-    for line in fit.warnings:
-        print(f"warning: {line}", file=sys.stderr)
+    _warn(fit.warnings)
     if args.json:
         print(report.json_text(fit.to_json()), end="")
         return 0

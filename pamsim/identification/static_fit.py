@@ -475,11 +475,14 @@ def _fit_static(data, params, model, free, objective, loss, f_scale, n_starts, s
                      float(np.sqrt(np.mean(cv_err ** 2))) * 1e3 if cv_err.size else math.nan, cv_kind,
                      cv_err * 1e3, aic, bic, loss, n_starts, bool(res.success), str(res.message), int(nfev),
                      time.perf_counter() - start, muscle_label,
-                     profile_95=_profile(problem, theta, unc) if intervals and loss == "linear" else None)
+                     profile_95=_profile(problem, theta, unc, intervals, loss))
 
 
-def _profile(problem: StaticProblem, theta: np.ndarray, unc: Uncertainty) -> np.ndarray:
-    """The 95 % profile-likelihood intervals of the fit's coefficients."""
+def _profile(problem: StaticProblem, theta: np.ndarray, unc: Uncertainty, wanted: bool, loss: str) -> np.ndarray | None:
+    """The 95 % profile-likelihood intervals of the fit's coefficients; None unless ``wanted``, or with a robust
+    loss (its optimum is not the sum of squares' minimum the profile starts from)."""
+    if not wanted or loss != "linear":
+        return None
     return profile_intervals(problem.residuals, problem.jacobian, theta, unc.standard_errors, unc.correlation,
                              problem.bounds, unc.dof)
 
