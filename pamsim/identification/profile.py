@@ -84,10 +84,10 @@ def _far_end(excess: Callable[[float], float], centre: float, step: float, limit
         outer = centre + step
         if (outer - limit) * np.sign(step) >= 0:
             if math.isfinite(limit) and excess(limit) > 0:
-                return brentq(excess, inner, limit, xtol=1e-4 * abs(step))
+                return brentq(excess, inner, limit, xtol=1e-3 * abs(step))
             return limit if math.isfinite(limit) else math.copysign(math.inf, step)
         if excess(outer) > 0:
-            return brentq(excess, inner, outer, xtol=1e-4 * abs(step))
+            return brentq(excess, inner, outer, xtol=1e-3 * abs(step))
         inner, step = outer, 2.0 * step
     return math.copysign(math.inf, step)
 

@@ -4,6 +4,7 @@
     python -m pamsim.identification.studies dynamic   # synthetic recovery and FD steps, minutes
     python -m pamsim.identification.studies inputs    # thinning of a recorded pressure, seconds
     python -m pamsim.identification.studies native    # the fits on the native backend, seconds
+    python -m pamsim.identification.studies starts    # multistart and global search on native, a minute or two
 
 Run from the repository root (the dynamic study reads scenarios/acra2012_fig4.toml; ``--scenario``
 names another).
@@ -13,6 +14,7 @@ Everything is seeded; the tables in the docs are this output.
 from __future__ import annotations
 
 import argparse
+import os
 from concurrent.futures import ProcessPoolExecutor
 from importlib import resources
 
@@ -208,20 +210,48 @@ def native_study(scenario_path: str) -> None:
     _recovery(sc, [12.74, 22.74, 32.74], 8.0, None, "native")
 
 
+STARTS_SETS = {"recovery study": tuple(TRUTH.values()), "B": (0.8, 0.3, 50.0, -20.0, 3.0),
+               "C": (-1.5, 3.0, 400.0, -150.0, 10.0), "D": (2.0, 0.5, 0.0, 20.0, 2.0)}
+"""Hidden coefficients (D1, D2, N2, N1, N0) of the multistart study: positive and negative D1, a small and a large
+Coulomb level, a level that rises along the travel (N1 > 0)."""
+
+
+def starts_study(scenario_path: str) -> None:
+    """Native fits of the five coefficients to three synthetic loads (2.5 s, 0.05 mm noise, seeds 0-2) from the
+    scenario's values and from zero friction and damping: one start, the default starts, the global search."""
+    from ..scenario import load_scenario
+
+    sc = load_scenario(scenario_path)
+    free = tuple(TRUTH)
+    runs = {"one start": {"n_starts": 0}, "8 starts (default)": {}, "--global, one start": {"n_starts": 0,
+                                                                                           "global_search": True}}
+    print("\n| hidden set | start | RMS at the truth [mm] | " + " | ".join(f"{r}: RMS [mm], s" for r in runs)
+          + " |\n|---|---|---|" + "---|" * len(runs))
+    for label, values in STARTS_SETS.items():
+        truth = dict(zip(free, values))
+        noisy = [synthetic_trace(sc, truth, w, seed=i, duration_s=2.5)[0] for i, w in enumerate((12.74, 22.74, 32.74))]
+        for start_label, start in (("scenario", sc), ("zero", sc.with_changes({"parameters": dict.fromkeys(free, 0.0)}))):
+            prob = make_problem(start, noisy, free=free)
+            at_truth = float(np.sqrt(np.mean(prob.residuals_from(make_trials(prob, "native")(np.array(values))) ** 2)))
+            cells = []
+            for options in runs.values():
+                fit = fit_dynamic(start, noisy, free=free, backend="native", **options)
+                cells.append(f"{fit.rms_pooled_mm:.4f}{'' if fit.success else ' (flagged)'}, {fit.wall_time_s:.1f}")
+            print(f"| {label} {values} | {start_label} | {at_truth:.4f} | " + " | ".join(cells) + " |")
+    print(f"\nload average {os.getloadavg()[0]:.1f} on {os.cpu_count()} CPUs")
+
+
+STUDIES = {"static": lambda scenario: static_study(), "dynamic": dynamic_study, "inputs": inputs_study,
+           "native": native_study, "starts": starts_study}
+
+
 def main() -> None:
-    """``python -m pamsim.identification.studies static|dynamic|inputs|native [--scenario S]``."""
+    """``python -m pamsim.identification.studies static|dynamic|inputs|native|starts [--scenario S]``."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("which", choices=("static", "dynamic", "inputs", "native"))
+    parser.add_argument("which", choices=tuple(STUDIES))
     parser.add_argument("--scenario", default="scenarios/acra2012_fig4.toml")
     args = parser.parse_args()
-    if args.which == "static":
-        static_study()
-    elif args.which == "inputs":
-        inputs_study(args.scenario)
-    elif args.which == "native":
-        native_study(args.scenario)
-    else:
-        dynamic_study(args.scenario)
+    STUDIES[args.which](args.scenario)
 
 
 if __name__ == "__main__":
