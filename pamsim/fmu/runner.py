@@ -297,23 +297,35 @@ def run_me(scenario: Scenario, fmi_version: int = 2, fmu_path: Path | None = Non
     return out
 
 
+N_WORK_STATES = 4
+"""The work integrals after the states: the muscle's, friction's, damping's and the external force's."""
+
+
 def to_result(scenario: Scenario, trace: dict[str, np.ndarray], wall_time_s: float, backend: str) -> Result:
-    """A :class:`Result` from an FMU trace, with the Python model's force breakdown."""
+    """A :class:`Result` from an FMU trace: its forces are the assembly's generated outputs at the FMU's
+    states and modes (:class:`pamsim.assemblies.one_muscle.RigOutputs`, as the python and native
+    backends' are), and its work integrals the trapezoidal integrals of their powers at the samples
+    (the FMU does not carry them)."""
+    from ..assemblies.one_muscle import RigOutputs, scenario_assembly
+
     model = ScenarioInputs(scenario).model
     t = trace["t_s"]
     states = [trace["contraction_m"], trace["velocity_m_s"]]
     if model.n_source:
         states += [trace["chamber_pressure_abs_Pa"], trace["air_mass_kg"]]
     modes = trace["friction_mode"].astype(int)
-    sig = model.breakdown(t, np.array(states), modes)
+    Y = np.vstack([np.array(states), np.zeros((N_WORK_STATES, len(t)))])
+    outputs = RigOutputs(scenario_assembly(scenario, model), model, t, Y, modes)
+    sig = outputs.sampled()
     v = trace["velocity_m_s"]
+    # the rates of the work integrals (pamsim.components): W_muscle, E_friction, E_damping, W_external
     power = [sig["F_static_N"] * v, -sig["F_friction_N"] * v, -sig["F_damping_N"] * v, sig["F_external_N"] * v]
-    work = [np.concatenate([[0.0], np.cumsum(0.5 * (p[1:] + p[:-1]) * np.diff(t))]) for p in power]
-    Y = np.array(states + work)
+    for k, pw in enumerate(power):
+        Y[len(states) + k] = np.concatenate([[0.0], np.cumsum(0.5 * (pw[1:] + pw[:-1]) * np.diff(t))])
     n_events = int(np.count_nonzero(np.diff(modes)))
     stats = {"rhs_evaluations": 0, "events": n_events, "segments": n_events + 1, "method": backend,
              "rtol": scenario.solver.rtol}
-    return Result.from_trace(model, scenario.name, t, Y, modes, [], [], stats, wall_time_s)
+    return Result.from_trace(model, scenario.name, t, Y, modes, [], [], stats, wall_time_s, outputs=outputs)
 
 
 def simulate_fmu(scenario: Scenario, interface: str = "cs", fmi_version: int = 2) -> Result:
