@@ -397,3 +397,22 @@ def test_a_killed_sweep_leaves_no_empty_output_folder(tmp_path):
     sweep.kill()
     sweep.communicate(timeout=30)
     assert not (tmp_path / "out").exists()
+
+
+def test_the_static_equilibrium_stands_at_the_muscles_own_stop(tmp_path):
+    """A sweep over the survey's 45 mm muscle at 7.58 bar and 0.05 N: its static equilibrium is the
+    muscle's own (the rest of eq. 33, 13.255 mm with the muscle file's bladder), past the 54.7 deg braid
+    lock at 12.886 mm, where the sweep once stopped it; the run ends there too."""
+    from pamsim.sweep import run_sweep
+
+    base = tmp_path / "survey.toml"
+    base.write_text('[model]\nmuscle = "mpam_survey_45mm"\n[load]\nweight_N = 0.05\n'
+                    '[pressure]\nsource = "valve"\nsupply_gauge_bar = 7.58\nvalve_open_time_s = 0.1\n'
+                    '[simulation]\nduration_s = 3.0\n')
+    spec = sweep_from_dict({"base_scenario": str(base), "friction_models": ["load_dependent"],
+                            "case": [{"weight_N": 0.05, "pressure_bar": 7.58}]}, base_dir=tmp_path)
+    (row,) = run_sweep(spec).rows
+    lock = pamsim.load_scenario(base).with_changes({"model": {"upper_stop": "braid_lock"}}).build_model().stops.x_high_m
+    assert row["equilibrium_contraction_m"] * 1e3 == pytest.approx(13.255, abs=0.001)
+    assert lock * 1e3 == pytest.approx(12.886, abs=0.001)
+    assert row["final_contraction_m"] == pytest.approx(row["equilibrium_contraction_m"], abs=2e-5)

@@ -621,7 +621,7 @@ def _case_row(spec: SweepSpec, i: int, case: SweepCase, by_key: Mapping, scenari
     models = {f: scenarios[(i, f)].build_model() for f in spec.friction_models}
     model = models[spec.friction_models[0]]
     p_Pa = case.pressure_bar * PA_PER_BAR
-    x_eq = static_report(params, model.static_force, p_Pa, case.weight_N)["equilibrium_contraction_m"]
+    x_eq = static_report(params, model.static_force, p_Pa, case.weight_N, model.stops)["equilibrium_contraction_m"]
     row = {"case": case.name, "weight_N": case.weight_N, "pressure_bar": case.pressure_bar,
            "pressure_step_bar": case.pressure_step_bar, "pressure_stable_bar": case.pressure_stable_bar,
            "measured_contraction_m": case.measured_contraction_m, "equilibrium_contraction_m": x_eq,
