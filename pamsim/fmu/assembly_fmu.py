@@ -52,44 +52,10 @@ class AssemblyVariables:
     def __init__(self, cmodel, parameter_values, input_starts):
         flat = cmodel.full
         self.cmodel, self.flat = cmodel, flat
-        sp = flat.sparsity()
-        x_names = [v.name for v in flat.states]
-        u_names = [v.name for v in flat.inputs]
-        p_names = [v.name for v in flat.parameters]
-        y_outputs = {v.name for v in flat.outputs}
+        self._sparsity = flat.sparsity()
         self.places: dict[str, tuple[str, int]] = {}
-        rows = []
-        for k, v in enumerate(flat.parameters):
-            rows.append(_real(v.name, "parameter", "fixed", f"{v.description} [{v.unit}]", v.unit,
-                              start=float(parameter_values[k]), initial="exact"))
-            self.places[v.name] = ("PARAMETER", k)
-        rows += [BY_NAME[n] for n in OWN_PARAMETERS]
-        for k, v in enumerate(flat.inputs):
-            known = BY_NAME.get(v.name)
-            base = known or _real(v.name, "input", "continuous", f"{v.description} [{v.unit}]", v.unit)
-            rows.append(replace(base, start=float(input_starts.get(v.name, 0.0))))
-            self.places[v.name] = ("INPUT", k)
-        deps = lambda row, block_x, block_u: tuple([x_names[i] for i in sp[block_x][row]]  # noqa: E731
-                                                  + [u_names[i] for i in sp[block_u][row]])
-        for k, v in enumerate(flat.states):
-            rows.append(_real(v.name, "output" if v.name in y_outputs else "local", "continuous",
-                              f"{v.description} [{v.unit}]", v.unit, initial="calculated", nominal=float(v.nominal),
-                              depends_on=(v.name,)))
-            self.places[v.name] = ("STATE", k)
-        for k, v in enumerate(flat.states):
-            rows.append(_real(f"der({v.name})", "local", "continuous", f"d {v.name} / dt", _per_s(v.unit),
-                              initial="calculated", derivative_of=v.name, depends_on=deps(k, "A", "B")))
-            self.places[f"der({v.name})"] = ("DERIVATIVE", k)
-        taken = set(x_names) | set(p_names)
-        self.y_vars: list[str | None] = []
-        for k, v in enumerate(flat.outputs):
-            if v.name in taken:  # the state or parameter of that name is this output
-                self.y_vars.append(None)
-                continue
-            rows.append(_real(v.name, "output", "continuous", f"{v.description} [{v.unit}]", v.unit,
-                              initial="calculated", depends_on=deps(k, "C", "D")))
-            self.places[v.name] = ("OUTPUT", k)
-            self.y_vars.append(v.name)
+        rows = (self._parameters(parameter_values) + [BY_NAME[n] for n in OWN_PARAMETERS]
+                + self._inputs(input_starts) + self._states() + self._derivatives() + self._outputs())
         self.mode = f"{cmodel.component}.mode" if cmodel.component else None
         if self.mode:
             values = ", ".join(str(v) for v in cmodel.mode_values)
@@ -101,6 +67,53 @@ class AssemblyVariables:
                        None, initial="calculated") for n in self.indicators]
         self.variables = tuple(rows)
         self.value_references = {v.name: k for k, v in enumerate(rows, start=1)}
+
+    def _placed(self, kind: str, rows: list[Variable]) -> list[Variable]:
+        """``rows``, each noted as entry k of the model's vector of ``kind`` (:data:`DD_KINDS`)."""
+        for k, v in enumerate(rows):
+            self.places[v.name] = (kind, k)
+        return rows
+
+    def _depends(self, row: int, block_x: str, block_u: str) -> tuple[str, ...]:
+        """The states and inputs row ``row`` of the Jacobian blocks ``block_x``, ``block_u`` depends on."""
+        flat, sp = self.flat, self._sparsity
+        return tuple([flat.states[i].name for i in sp[block_x][row]] + [flat.inputs[i].name for i in sp[block_u][row]])
+
+    def _parameters(self, values) -> list[Variable]:
+        return self._placed("PARAMETER", [
+            _real(v.name, "parameter", "fixed", f"{v.description} [{v.unit}]", v.unit, start=float(values[k]),
+                  initial="exact") for k, v in enumerate(self.flat.parameters)])
+
+    def _inputs(self, starts) -> list[Variable]:
+        """The model inputs, as the one-muscle FMU declares those it has (ranges, descriptions)."""
+        return self._placed("INPUT", [
+            replace(BY_NAME.get(v.name) or _real(v.name, "input", "continuous", f"{v.description} [{v.unit}]", v.unit),
+                    start=float(starts.get(v.name, 0.0))) for v in self.flat.inputs])
+
+    def _states(self) -> list[Variable]:
+        outputs = {v.name for v in self.flat.outputs}
+        return self._placed("STATE", [
+            _real(v.name, "output" if v.name in outputs else "local", "continuous", f"{v.description} [{v.unit}]",
+                  v.unit, initial="calculated", nominal=float(v.nominal), depends_on=(v.name,))
+            for v in self.flat.states])
+
+    def _derivatives(self) -> list[Variable]:
+        return self._placed("DERIVATIVE", [
+            _real(f"der({v.name})", "local", "continuous", f"d {v.name} / dt", _per_s(v.unit), initial="calculated",
+                  derivative_of=v.name, depends_on=self._depends(k, "A", "B")) for k, v in enumerate(self.flat.states)])
+
+    def _outputs(self) -> list[Variable]:
+        """Every output but one named as a state or a parameter, which is that variable (``y_vars`` None)."""
+        flat = self.flat
+        taken = {v.name for v in flat.states} | {v.name for v in flat.parameters}
+        self.y_vars: list[str | None] = [None if v.name in taken else v.name for v in flat.outputs]
+        rows = []
+        for k, v in enumerate(flat.outputs):
+            if self.y_vars[k] is not None:
+                rows.append(_real(v.name, "output", "continuous", f"{v.description} [{v.unit}]", v.unit,
+                                  initial="calculated", depends_on=self._depends(k, "C", "D")))
+                self.places[v.name] = ("OUTPUT", k)
+        return rows
 
     def c_lines(self) -> list[str]:
         """What ``pam_gcore.c`` needs beyond the variable table: the model's vectors in ``r[]``, the mode's
@@ -115,14 +128,17 @@ class AssemblyVariables:
                + (", ".join(f"R_{c[n]}" if n else "-1" for n in self.y_vars) or "0") + "};",
                f"#define PAM_I_MODE {'I_' + c[self.mode] if self.mode else -1}",
                "enum { " + ", ".join(f"PAM_DD_{k} = {i}" for i, k in enumerate(DD_KINDS)) + " };"]
+        return out + self._jacobian_places()
+
+    def _jacobian_places(self) -> list[str]:
+        """``PAM_DD_KIND`` and ``PAM_DD_INDEX``, by value reference: each variable's place in the Jacobians."""
         n = max(self.value_references.values())
         kinds, index = ["PAM_DD_NONE"] * n, ["0"] * n
         for name, (kind, k) in self.places.items():
             kinds[self.value_references[name] - 1] = f"PAM_DD_{kind}"
             index[self.value_references[name] - 1] = str(k)
-        out += [f"static const int PAM_DD_KIND[PAM_NVARS] = {{{', '.join(kinds)}}};",
+        return [f"static const int PAM_DD_KIND[PAM_NVARS] = {{{', '.join(kinds)}}};",
                 f"static const int PAM_DD_INDEX[PAM_NVARS] = {{{', '.join(index)}}};"]
-        return out
 
 
 def _per_s(unit: str) -> str:
