@@ -58,36 +58,32 @@ class CModel:
     def __init__(self, assembly, component: str | None = None, jacobians: bool = False):
         import casadi as ca
 
-        full = assembly.flatten()
-        if full.externals:
-            raise NotImplementedError(f"{full.name}: no C for the external functions "
-                                      f"{', '.join(ext.name for ext in full.externals)} (Python-only physics)")
+        full = self.full = _runnable(assembly.flatten(), component)
         hybrid = [name for name, _ in full.modes]
-        if len(hybrid) > 1 or (component is not None and hybrid != [component]):
-            raise NotImplementedError(f"{full.name}: the C engine runs models with at most one hybrid component "
-                                      f"(this one has {', '.join(hybrid) or 'none'})")
-        self.full = full
         self.component = hybrid[0] if hybrid else None
-        enum = full.modes[0][1] if hybrid else None
-        self.mode_values = [int(m) for m in enum] if enum is not None else [0]
+        self.mode_values = [int(m) for m in full.modes[0][1]] if hybrid else [0]
         self.quadratures = full.quadratures()
         self.dynamic = [i for i in range(len(full.states)) if i not in self.quadratures]
-        own = [i for i, v in enumerate(full.states) if self.component and v.name.startswith(self.component + ".")]
+        self.jacobians = jacobians
         self.functions: list = []
         self.held: list[bool] = []
         self.quad_zero: list[bool] = []
         for k, value in enumerate(self.mode_values):
-            m = assembly.flatten({self.component: value}) if self.component else full
-            self.functions += self._mode_functions(ca, m, k)
-            if jacobians:
-                self.functions.append(_jacobian(ca, f"pm_jac{k}", [m.x, m.u, m.p], m.f + m.y))
-            self.held.append(bool(own) and all(ca.SX(m.f[i]).is_zero() for i in own))
-            self.quad_zero.append(all(ca.SX(m.f[i]).is_zero() for i in self.quadratures))
+            self._add_mode(ca, assembly.flatten({self.component: value}) if self.component else full, k)
         col = lambda es: ca.vertcat(*es) if es else ca.SX(0, 1)  # noqa: E731
         self.functions.append(_dense(ca, "pm_x0_fn", [col(full.u), col(full.p)], [full.x0, full.q0]))
-        self.jacobians = jacobians
         if jacobians:
             self.functions.append(_jacobian(ca, "pm_jx0_fn", [full.u, full.p], full.x0))
+
+    def _add_mode(self, ca, m, k: int) -> None:
+        """Mode ``k``'s functions (flat model ``m``, the mode fixed), and whether it is held and its
+        quadratures stand still."""
+        own = [i for i, v in enumerate(m.states) if self.component and v.name.startswith(self.component + ".")]
+        self.functions += self._mode_functions(ca, m, k)
+        if self.jacobians:
+            self.functions.append(_jacobian(ca, f"pm_jac{k}", [m.x, m.u, m.p], m.f + m.y))
+        self.held.append(bool(own) and all(ca.SX(m.f[i]).is_zero() for i in own))
+        self.quad_zero.append(all(ca.SX(m.f[i]).is_zero() for i in self.quadratures))
 
     def _mode_functions(self, ca, m, k: int) -> list:
         col = lambda es: ca.vertcat(*es) if es else ca.SX(0, 1)  # noqa: E731
@@ -185,6 +181,19 @@ class CModel:
                       "double w[PM_SZ_W];", "    arg[0] = u; arg[1] = p; res[0] = out;",
                       "    pm_jx0_fn(arg, res, iw, w, 0);", "}", ""]
         return "\n".join(lines)
+
+
+def _runnable(full, component: str | None):
+    """``full``, a flat model the C engine can run: no Python-only functions, at most one hybrid
+    component (``component``, if given).  Else :class:`NotImplementedError`, saying why."""
+    if full.externals:
+        raise NotImplementedError(f"{full.name}: no C for the external functions "
+                                  f"{', '.join(ext.name for ext in full.externals)} (Python-only physics)")
+    hybrid = [name for name, _ in full.modes]
+    if len(hybrid) > 1 or (component is not None and hybrid != [component]):
+        raise NotImplementedError(f"{full.name}: the C engine runs models with at most one hybrid component "
+                                  f"(this one has {', '.join(hybrid) or 'none'})")
+    return full
 
 
 def _jacobian(ca, name: str, wrt: list, exprs: list):
