@@ -31,6 +31,10 @@ def register(sub) -> None:
     b.add_argument("--static-force", default=None,
                    help="with --muscle: the library static force model (default: the muscle's default_static_force)")
     b.add_argument("--static-force-variant", default=None, help="variant of that model (default: its default)")
+    b.add_argument("--generated", action="store_true",
+                   help="with --scenario: the FMU generated from the scenario's assembly of components (structured "
+                        "names such as load.x_m, exact directional derivatives), as a scenario that adds components "
+                        "always gets, rather than the one-muscle FMU with its own variable names")
     b.set_defaults(func=run_build)
 
 
@@ -64,11 +68,13 @@ def run_build(args: argparse.Namespace) -> int:
         given = "--static-force" if args.static_force is not None else "--static-force-variant"
         raise InputError(f"--muscle: needed with {given}")
     preset = None
+    if args.generated and not args.scenario:
+        raise InputError("--generated: needs --scenario (the FMU is generated from the scenario's assembly)")
     if args.scenario:
         from ..scenario import load_scenario
 
         scenario = load_scenario(args.scenario)
-        if scenario.added_components:
+        if scenario.added_components or args.generated:
             from ..fmu import build_assembly
 
             path = build_assembly(scenario, args.output, int(args.fmi))
