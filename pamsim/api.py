@@ -65,21 +65,18 @@ def run(scenario: "Scenario | str | os.PathLike", backend: str = "python",
         progress: "Callable[[float], None] | None" = None) -> ScenarioRun:
     """Run ``scenario`` on ``backend`` (a name of :data:`pamsim.backends.BACKENDS`).
 
-    A scenario with a ``[controller]`` table runs with its controller
-    (python backend only: the FMU has no controller, and running it open
-    loop would silently give a different system).  ``progress`` receives the
-    simulated time reached (python backend; the FMU backends do not report it).
+    A scenario with a ``[controller]`` table runs with its controller on every backend: the controller
+    is a component of the run's assembly, which the native backend runs on the generic C engine and the
+    FMU backends through the FMU generated from it.  ``progress`` receives the simulated time reached
+    (python backend; the others do not report it).
     """
     scenario = as_scenario(scenario)
     if backend not in BACKENDS:
         raise InputError(f"unknown backend {backend!r} (choose from {', '.join(sorted(BACKENDS))})")
     if "controller" in scenario.spec:
-        if backend != "python":
-            raise InputError(f"{scenario.origin}: controller: the {backend} backend has no controller; "
-                             "run this scenario with --backend python")
         from .control.closed_loop import run_closed_loop
 
-        loop = run_closed_loop(scenario, progress=progress)
+        loop = run_closed_loop(scenario, progress=progress, backend=backend)
         return ScenarioRun(loop.result, backend, loop)
     return ScenarioRun(simulate(scenario, backend, progress), backend, measured=scenario.measured_steady_state())
 

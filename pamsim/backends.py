@@ -15,6 +15,7 @@ import os
 from typing import TYPE_CHECKING, Callable
 
 if TYPE_CHECKING:
+    from .model import MuscleModel
     from .result import Result
     from .scenario import Scenario
 
@@ -82,7 +83,7 @@ def as_scenario(scenario: "Scenario | str | os.PathLike") -> "Scenario":
 
 
 def simulate(scenario: "Scenario | str | os.PathLike", backend: str = "python",
-             progress: "Callable[[float], None] | None" = None) -> "Result":
+             progress: "Callable[[float], None] | None" = None, model: "MuscleModel | None" = None) -> "Result":
     """Run ``scenario`` (a :class:`Scenario` or a scenario file's path) and return its :class:`Result`.
 
     Parameters
@@ -95,10 +96,15 @@ def simulate(scenario: "Scenario | str | os.PathLike", backend: str = "python",
         backend cannot honour raises :class:`~pamsim.errors.InputError` naming it.
     progress : callable, optional
         Called with the simulated time reached (python backend; the others do not report it).
+    model : MuscleModel, optional
+        The scenario's model with its pressure source replaced (a controller's,
+        :func:`pamsim.control.closed_loop.closed_loop_model`), run on every backend as its assembly of
+        components; None runs the scenario's own model.
     """
     scenario = as_scenario(scenario)
     if backend == "python":
         from .simulator import simulate_python
 
-        return simulate_python(scenario, progress)
-    return get_backend(backend)(scenario)
+        return simulate_python(scenario, progress, model)
+    run = get_backend(backend)
+    return run(scenario) if model is None else run(scenario, model=model)

@@ -82,12 +82,14 @@ _MAX_ZERO_LENGTH = 30
 """Zero-length segments in a row (the last hold is then 2**29 ns, about 0.5 s) before it is a solver failure."""
 
 
-def simulate_python(scenario, progress: Callable[[float], None] | None = None) -> Result:
+def simulate_python(scenario, progress: Callable[[float], None] | None = None,
+                    model: MuscleModel | None = None) -> Result:
     """Backend ``python``: integrate a :class:`~pamsim.scenario.Scenario` with ``scipy.integrate.solve_ivp``.
 
     ``scenario`` is not annotated: :mod:`pamsim.scenario` imports this module, so this one cannot import it.
+    ``model``: the scenario's model with its pressure source replaced (a controller's); None: its own.
     """
-    return simulate_model(scenario.build_model(), scenario.duration_s, scenario.solver,
+    return simulate_model(model or scenario.build_model(), scenario.duration_s, scenario.solver,
                           x0_m=scenario.initial_contraction_m, name=scenario.name,
                           p0_gauge_Pa=scenario.initial_pressure_gauge_Pa, progress=progress,
                           added=scenario.added_components)

@@ -22,6 +22,7 @@ from ..components import (CoulombFriction, ExternalForce, HangingLoad, MuscleSta
 from ..elements.pressure_source import PrescribedPressure, ValveChamberSource
 from ..modeling import Assembly
 from ..modeling.pygen import compiled_by_mode, outputs_by_mode
+from ..signals import Constant
 
 
 
@@ -115,6 +116,15 @@ def _source_parts(src, p0_gauge_Pa: float | None) -> SourceParts:
             return SOURCE_PARTS[cls](src, p0_gauge_Pa)
     raise TypeError(f"no components for the pressure source {type(src).__name__} "
                     f"(pamsim.assemblies.one_muscle.register_source names them)")
+
+
+def input_signals(model) -> dict:
+    """The signals of the model inputs of ``model``'s assembly, by the flat model's names and in its order:
+    the pressure source's (its ``signals``, named by its :class:`SourceParts`), then the external force."""
+    names = _source_parts(model.source, None).inputs
+    external = model.load.external_force_N
+    return {**dict(zip(names, model.source.signals)),
+            "external_force_N": external if external is not None else Constant(0.0)}
 
 
 RIG_COMPONENTS = frozenset({"load", "muscle", "friction", "damping", "external", "chamber", "valve", "pressure",

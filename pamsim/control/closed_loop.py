@@ -45,7 +45,7 @@ from ..result import Result
 from ..scenario import Scenario, load_scenario
 from ..scenario_components import refuse_added
 from ..signals import Step
-from ..simulator import simulate_model
+from ..backends import simulate
 from .linear import LinearModel, linearize
 from .operating_point import held_equilibrium, holding_pressure_Pa
 from .system import FrictionTreatment, MusclePlant
@@ -203,6 +203,11 @@ class ClosedLoopValveSource:
     def inputs(self, t_s) -> tuple:
         """``(reference [m], feedforward gauge pressure [Pa], supply gauge pressure [Pa])`` at ``t_s`` [s]."""
         return self.reference_m(t_s), self.feedforward_gauge_Pa(t_s), self.plant.supply_gauge_Pa(t_s)
+
+    @property
+    def signals(self) -> tuple:
+        """The signals of :meth:`inputs`, in its order: reference [m], feedforward and supply gauge pressures [Pa]."""
+        return self.reference_m, self.feedforward_gauge_Pa, self.plant.supply_gauge_Pa
 
     def pressure_gauge_Pa(self, s, inputs):
         """Gauge pressure [Pa] of the chamber: its absolute pressure state less the ambient pressure."""
@@ -443,8 +448,46 @@ class ClosedLoopRun:
                 "events": int(self.result.stats["events"]), "wall_time_s": float(self.result.wall_time_s)}
 
 
+@dataclass(frozen=True)
+class ClosedLoopDesign:
+    """A scenario's controller: its ``[controller]`` table, the LQR design, and the scenario's model
+    with its valve driven by the controller (:func:`closed_loop_model`)."""
+
+    scenario: Scenario
+    config: ControllerConfig
+    design: LqrDesign
+    model: MuscleModel
+
+
+def design_closed_loop(scenario: Scenario | str, overrides: Mapping[str, Any] | None = None) -> ClosedLoopDesign:
+    """Read the ``[controller]`` table of ``scenario`` (with ``overrides``), design the controller and
+    put it in the scenario's model.
+
+    Parameters
+    ----------
+    scenario : Scenario or path
+        A scenario with a valve source and a ``[controller]`` table.
+    overrides : mapping, optional
+        Replacement ``[controller]`` keys.
+
+    Raises
+    ------
+    InputError
+        For a bad ``[controller]`` table, a source other than a valve or an unreachable target.
+    """
+    if not isinstance(scenario, Scenario):
+        scenario = load_scenario(scenario)
+    if overrides:
+        spec = dict(scenario.spec)
+        spec["controller"] = {**spec.get("controller", {}), **overrides}
+        scenario = Scenario.from_dict(spec, scenario.name, scenario.base_dir, scenario.origin)
+    config = ControllerConfig.from_scenario(scenario)
+    design = design_lqr(scenario.build_model(), config, scenario.final_pressure_gauge_Pa)
+    return ClosedLoopDesign(scenario, config, design, closed_loop_model(scenario, config, design))
+
+
 def run_closed_loop(scenario: Scenario | str, overrides: Mapping[str, Any] | None = None,
-                    progress: Callable[[float], None] | None = None) -> ClosedLoopRun:
+                    progress: Callable[[float], None] | None = None, backend: str = "python") -> ClosedLoopRun:
     """Design the controller of ``scenario`` and run it on the hybrid model.
 
     Parameters
@@ -455,20 +498,14 @@ def run_closed_loop(scenario: Scenario | str, overrides: Mapping[str, Any] | Non
         Replacement ``[controller]`` keys (e.g. ``{"integrator_deadband_mm": 0}``
         to see the friction limit cycle).
     progress : callable, optional
-        Called with the simulated time reached (see :func:`~pamsim.simulator.simulate_model`).
+        Called with the simulated time reached (python backend, see :func:`~pamsim.simulator.simulate_model`).
+    backend : str
+        A name of :data:`pamsim.backends.BACKENDS`: each runs the same assembly, controller included
+        (the native backend on the generic C engine, the FMU backends through the FMU of the assembly).
     """
-    if not isinstance(scenario, Scenario):
-        scenario = load_scenario(scenario)
-    if overrides:
-        spec = dict(scenario.spec)
-        spec["controller"] = {**spec.get("controller", {}), **overrides}
-        scenario = Scenario.from_dict(spec, scenario.name, scenario.base_dir, scenario.origin)
-    config = ControllerConfig.from_scenario(scenario)
-    model = scenario.build_model()
-    design = design_lqr(model, config, scenario.final_pressure_gauge_Pa)
-    cl_model = closed_loop_model(scenario, config, design)
-    result = simulate_model(cl_model, scenario.duration_s, scenario.solver, x0_m=scenario.initial_contraction_m,
-                            name=scenario.name, progress=progress)
+    loop = design_closed_loop(scenario, overrides)
+    scenario, config, design = loop.scenario, loop.config, loop.design
+    result = simulate(scenario, backend, progress, model=loop.model)
     x0 = scenario.initial_contraction_m
     band = config.spec.get("settling_band_mm", 0.5) * 1e-3
     metrics = step_metrics(result.t_s, result.x_m, config.step_time_s, x0, config.target_contraction_m, band)

@@ -46,6 +46,11 @@ class ValveChamberSource:
         """The source's inputs at time t: (valve command [-], supply gauge pressure [Pa])."""
         return self.command(t_s), self.supply_gauge_Pa(t_s)
 
+    @property
+    def signals(self) -> tuple:
+        """The signals of :meth:`inputs`, in its order: valve command, supply gauge pressure [Pa]."""
+        return self.command, self.supply_gauge_Pa
+
     def pressure_gauge_Pa(self, s, inputs):
         """Gauge pressure [Pa] of the chamber: its absolute pressure state less the ambient pressure."""
         return s[0] - self.p_atm_Pa
@@ -107,6 +112,11 @@ class PrescribedPressure:
     def inputs(self, t_s) -> tuple:
         """The source's input at time t: (gauge pressure [Pa],)."""
         return (self.p_gauge_Pa(t_s),)
+
+    @property
+    def signals(self) -> tuple:
+        """The signal of :meth:`inputs`: the gauge pressure [Pa]."""
+        return (self.p_gauge_Pa,)
 
     def pressure_gauge_Pa(self, s, inputs):
         """The prescribed gauge pressure [Pa], the source's only input."""

@@ -36,10 +36,10 @@ from typing import Sequence
 import numpy as np
 
 from ..assemblies import scenario_assembly
-from ..assemblies.one_muscle import RigOutputs
+from ..assemblies.one_muscle import RigOutputs, input_signals
 from ..components.hanging_load import event_name
 from ..core_table import C_CHOICES, SCENARIO_KEYS, unimplemented_choice
-from ..elements.pressure_source import ValveChamberSource
+from ..elements.pressure_source import PrescribedPressure, ValveChamberSource
 from ..errors import InputError, SolverFailure
 from ..fmu.force_table import ForceTable
 from ..fmu.preset import input_signal
@@ -92,11 +92,12 @@ class CaseInputs:
     table: ForceTable | None = None
     assembly: object | None = None
     segment_du: np.ndarray | None = None  # exact inputs (EngineCase.segment_du), in segment_u's columns
+    input_names: tuple[str, ...] = lib.INPUTS  # segment_u's columns
 
     def engine_case(self, library, capacity: int) -> EngineCase:
         """This case as the generic engine takes it: the flat model's parameters and inputs."""
         names = library.names["inputs"]
-        columns = [lib.INPUTS.index(n) for n in names]
+        columns = [self.input_names.index(n) for n in names]
         u = self.segment_u[:, columns]
         du = None if self.segment_du is None else self.segment_du[:, columns, :]
         return EngineCase(np.array(self.assembly.parameter_values()), float(self.reals[lib.REAL_INDEX["cs_relative_tolerance"]]),
@@ -168,12 +169,17 @@ def force_table(scenario: Scenario) -> ForceTable:
     return _tables[key]
 
 
-def _signals(model: MuscleModel) -> tuple:
-    """The input signals in :data:`library.INPUTS` order (None where a source has no such input)."""
+def _signals(model: MuscleModel) -> tuple[tuple[str, ...], tuple]:
+    """The inputs' names and signals: the C core's inputs (:data:`library.INPUTS`, None where a source has
+    no such input) for the sources the core has, else the flat model's (a source only the generic engine
+    runs, such as a controller's)."""
     src = model.source
     if isinstance(src, ValveChamberSource):
-        return src.command, src.supply_gauge_Pa, None, None, model.load.external_force_N
-    return None, None, src.p_gauge_Pa, None, model.load.external_force_N
+        return lib.INPUTS, (src.command, src.supply_gauge_Pa, None, None, model.load.external_force_N)
+    if isinstance(src, PrescribedPressure):
+        return lib.INPUTS, (None, None, src.p_gauge_Pa, None, model.load.external_force_N)
+    named = input_signals(model)
+    return tuple(named), tuple(named.values())
 
 
 def hold_interval_s(signals, sample_interval_s: float) -> float:
@@ -261,27 +267,38 @@ def case_inputs(scenario: Scenario, model: MuscleModel | None = None, exact: boo
     for name, (key, value) in choices.items():
         if value in C_CHOICES[key]:  # the core's choices (the engine reads none of them)
             ints[lib.INT_INDEX[name]] = C_CHOICES[key].index(value)
+    names, signals = _signals(model)
+    if assembly is None and names != lib.INPUTS:
+        raise InputError(f"{scenario.origin}: model.static_force = {spec['model']['static_force']!r}: the "
+                         f"{type(model.source).__name__} runs natively only with a static force written in "
+                         "symbols (this one runs as a force table on the hand-written C core, which has no such "
+                         "source); run it with the python backend")
     table = force_table(scenario) if assembly is None else None
     ints[lib.INT_INDEX["static_force_model"]] = C_CHOICES["static_force_model"].index(
         "acra2012_polynomial" if table is None else "table")
-    signals = _signals(model)
     pieces = exact_segments(signals, T) if assembly is not None and exact else None
     if pieces is not None:
         starts, u, du = pieces
-        u[:, lib.INPUTS.index("load_mass_kg")] = model.load.mass_kg
-        return CaseInputs(reals, ints, T, n_samples, starts, u, opts.max_events, model, table, assembly, du)
+        _set_mass(u, names, model)
+        return CaseInputs(reals, ints, T, n_samples, starts, u, opts.max_events, model, table, assembly, du, names)
     hold = hold_interval_s(signals, T / max(n_samples - 1, 1))
     bounds = {0.0} | {float(b) for b in model.breakpoints if 0.0 < b < T}
     if math.isfinite(hold):
         bounds |= set(np.linspace(0.0, T, int(math.ceil(T / hold)) + 1)[:-1].tolist())
     starts = np.array(sorted(bounds))
     mid = 0.5 * (starts + np.append(starts[1:], T))  # a step's value is constant inside its segment
-    u = np.zeros((len(starts), len(lib.INPUTS)))
+    u = np.zeros((len(starts), len(names)))
     for k, sig in enumerate(signals):
         if sig is not None:
             u[:, k] = sig(mid)
-    u[:, lib.INPUTS.index("load_mass_kg")] = model.load.mass_kg
-    return CaseInputs(reals, ints, T, n_samples, starts, u, opts.max_events, model, table, assembly)
+    _set_mass(u, names, model)
+    return CaseInputs(reals, ints, T, n_samples, starts, u, opts.max_events, model, table, assembly, None, names)
+
+
+def _set_mass(u: np.ndarray, names: Sequence[str], model: MuscleModel) -> None:
+    """The load's mass in the C core's input column of it (the flat model has it as a parameter)."""
+    if "load_mass_kg" in names:
+        u[:, list(names).index("load_mass_kg")] = model.load.mass_kg
 
 
 def _run(cases: Sequence[CaseInputs], capacity: Sequence[int]) -> list[tuple[dict, int]]:
@@ -398,7 +415,8 @@ def _sample_grids(cases: Sequence[CaseInputs]) -> list[np.ndarray]:
     return [grids[(c.duration_s, c.n_samples)] for c in cases]
 
 
-def simulate_batch(scenarios: Sequence[Scenario], return_exceptions: bool = False) -> list:
+def simulate_batch(scenarios: Sequence[Scenario], return_exceptions: bool = False,
+                   models: Sequence[MuscleModel | None] | None = None) -> list:
     """Run many scenarios in one library call and return their :class:`Result` s, in order.
 
     Parameters
@@ -408,8 +426,10 @@ def simulate_batch(scenarios: Sequence[Scenario], return_exceptions: bool = Fals
         :class:`~pamsim.errors.InputError` naming it, before anything runs.
     return_exceptions : bool
         Put a failed case's exception in its place in the list instead of raising it.
+    models : sequence of MuscleModel or None, optional
+        Each scenario's model, as :func:`case_inputs` takes it (None: the scenario's own).
     """
-    cases = [case_inputs(s) for s in scenarios]
+    cases = [case_inputs(s, m) for s, m in zip(scenarios, models or [None] * len(scenarios))]
     wall0 = time.perf_counter()
     found = _run(cases, [event_capacity(c.max_events) for c in cases])
     wall = (time.perf_counter() - wall0) / max(len(cases), 1)
@@ -429,6 +449,10 @@ def simulate_batch(scenarios: Sequence[Scenario], return_exceptions: bool = Fals
     return results
 
 
-def simulate(scenario: Scenario) -> Result:
-    """Backend ``native``: run ``scenario`` with the C core and return its :class:`Result`."""
-    return simulate_batch([scenario])[0]
+def simulate(scenario: Scenario, model: MuscleModel | None = None) -> Result:
+    """Backend ``native``: run ``scenario`` with the C core and return its :class:`Result`.
+
+    ``model``: the scenario's model with its pressure source replaced (a controller's), as
+    :func:`case_inputs` takes it; None runs the scenario's own.
+    """
+    return simulate_batch([scenario], models=[model])[0]

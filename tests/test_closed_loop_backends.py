@@ -1,0 +1,70 @@
+"""The closed-loop scenario on every backend: the controller is a component of the run's assembly, so the
+native backend runs it on the generic C engine and the FMU backends through the FMU generated from that
+assembly.  Each must give the python backend's response: the same step metrics, final position and
+specification check."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+import pamsim
+
+from conftest import SCENARIOS
+
+CLOSED_LOOP = SCENARIOS / "closed_loop_position.toml"
+SAMPLE_S = 1e-3
+"""The scenario's output interval: the metrics' times are sample times, so one sample is their resolution."""
+
+
+@pytest.fixture(scope="module")
+def python_run():
+    return pamsim.run(CLOSED_LOOP)
+
+
+@pytest.fixture(scope="module")
+def native_run():
+    return pamsim.run(CLOSED_LOOP, backend="native")
+
+
+def assert_same_response(run, reference, final_um: float) -> None:
+    """Step metrics within one sample (times), 0.1 % (overshoot) and ``final_um`` (steady-state error,
+    final position) of ``reference``'s; the specification met on both."""
+    m, ref = run.closed_loop.metrics, reference.closed_loop.metrics
+    for key in ("rise_time_s", "settling_time_s"):
+        assert abs(m[key] - ref[key]) <= SAMPLE_S + 1e-12, key
+    assert abs(m["overshoot_percent"] - ref["overshoot_percent"]) <= 0.1
+    assert abs(m["steady_state_error_mm"] - ref["steady_state_error_mm"]) * 1e3 <= final_um
+    assert abs(run.result.x_m[-1] - reference.result.x_m[-1]) * 1e6 <= final_um
+    assert run.failures == [] and reference.failures == []
+    assert run.summary()["controller"]["meets_spec"] is True
+
+
+def test_native_runs_the_closed_loop_as_python_does(native_run, python_run):
+    assert native_run.backend == "native" and native_run.result.stats["method"].startswith("native")
+    assert_same_response(native_run, python_run, final_um=1.0)
+    # The controller ran in C: its states and the valve command it gave are the python run's.
+    for column in ("valve_command", "z_error_integral_m_s", "reference_m", "feedforward_gauge_Pa"):
+        assert column in native_run.result.signals
+    u_native, u_python = native_run.result.signals["valve_command"], python_run.result.signals["valve_command"]
+    assert np.max(u_native) == 1.0 and np.mean(np.abs(u_native - u_python)) < 1e-3
+    assert [e.kind for e in native_run.result.transitions] == [e.kind for e in python_run.result.transitions]
+
+
+def test_native_closed_loop_writes_what_python_writes(tmp_path, cli):
+    outputs = {}
+    for backend in ("python", "native"):
+        proc = cli("run", CLOSED_LOOP, "--backend", backend, "-o", tmp_path / backend, "--no-progress")
+        assert proc.returncode == 0, proc.stderr
+        outputs[backend] = sorted(p.name for p in (tmp_path / backend).iterdir())
+        header = (tmp_path / backend / "closed_loop_position.csv").read_text().splitlines()[0]
+        outputs[backend + " columns"] = header
+        summary = json.loads((tmp_path / backend / "closed_loop_position.json").read_text())
+        outputs[backend + " keys"] = sorted(summary)
+        assert summary["backend"] == backend and summary["controller"]["meets_spec"] is True
+    assert outputs["native"] == outputs["python"] == ["closed_loop_position.csv", "closed_loop_position.json",
+                                                      "closed_loop_position.png"]
+    assert outputs["native columns"] == outputs["python columns"]
+    assert outputs["native keys"] == outputs["python keys"]
