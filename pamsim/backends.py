@@ -28,6 +28,15 @@ BACKENDS: dict[str, str] = {
 }
 
 
+# name -> "module:function" that runs a scenario with a model in its place (a controller's), as its
+# assembly: the one-muscle FMU has no controller, so the FMU backends run the FMU generated from it.
+MODEL_BACKENDS: dict[str, str] = {
+    "native": "pamsim.native:simulate",
+    "fmu-cs": "pamsim.fmu.assembly_runner:simulate_cs",
+    "fmu-me": "pamsim.fmu.assembly_runner:simulate_me",
+}
+
+
 DESCRIPTIONS: dict[str, str] = {
     "python": "scipy's solve_ivp (default)",
     "native": "the C core as a shared library, built on first use (needs a C compiler)",
@@ -106,5 +115,8 @@ def simulate(scenario: "Scenario | str | os.PathLike", backend: str = "python",
         from .simulator import simulate_python
 
         return simulate_python(scenario, progress, model)
-    run = get_backend(backend)
-    return run(scenario) if model is None else run(scenario, model=model)
+    if model is None:
+        return get_backend(backend)(scenario)
+    get_backend(backend)  # an unknown name refused as such
+    module, func = MODEL_BACKENDS[backend].split(":")
+    return getattr(importlib.import_module(module), func)(scenario, model)

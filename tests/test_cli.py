@@ -242,13 +242,6 @@ def test_run_a_folder_runs_every_scenario_and_the_controller(tmp_path, cli):
     assert csv[0, 1] == pytest.approx(0.020)  # held at the initial contraction, not dropped
 
 
-def test_controller_scenario_on_an_fmu_backend_is_refused(tmp_path, cli):
-    code, err = _code_err(cli, "run", SCENARIOS / "closed_loop_position.toml", "-o", tmp_path / "o",
-                                "--backend", "fmu-cs")
-    assert code == 2 and "controller" in err and len(err.strip().splitlines()) == 1
-    assert not (tmp_path / "o").exists()
-
-
 def test_two_scenarios_with_one_name_are_refused(tmp_path, cli):
     for stem in ("a", "b"):
         (tmp_path / f"{stem}.toml").write_text('name = "same"\n' + BASE)

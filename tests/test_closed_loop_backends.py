@@ -11,8 +11,9 @@ import numpy as np
 import pytest
 
 import pamsim
+from pamsim.errors import InputError
 
-from conftest import SCENARIOS
+from conftest import SCENARIOS, run_cli
 
 CLOSED_LOOP = SCENARIOS / "closed_loop_position.toml"
 SAMPLE_S = 1e-3
@@ -68,3 +69,65 @@ def test_native_closed_loop_writes_what_python_writes(tmp_path, cli):
                                                       "closed_loop_position.png"]
     assert outputs["native columns"] == outputs["python columns"]
     assert outputs["native keys"] == outputs["python keys"]
+
+
+# ---------------------------------------------------------------- the FMU of the assembly, controller included
+@pytest.fixture(scope="module")
+def fmu_runs():
+    pytest.importorskip("fmpy")
+    return {backend: pamsim.run(CLOSED_LOOP, backend=backend) for backend in ("fmu-cs", "fmu-me")}
+
+
+@pytest.mark.parametrize("backend", ["fmu-cs", "fmu-me"])
+def test_fmu_backends_run_the_closed_loop_as_python_does(fmu_runs, python_run, backend):
+    run = fmu_runs[backend]
+    assert run.backend == backend and run.result.stats["method"] == backend
+    assert_same_response(run, python_run, final_um=1.0)
+    assert np.max(run.result.signals["valve_command"]) == 1.0  # the controller in the FMU saturated the valve
+    assert run.summary()["controller"]["events"] == python_run.summary()["controller"]["events"]
+
+
+@pytest.fixture(scope="module")
+def built_fmu(tmp_path_factory):
+    """The closed-loop scenario's FMU (FMI 3.0), built as a user builds it."""
+    pytest.importorskip("fmpy")
+    path = tmp_path_factory.mktemp("closed_loop_fmu") / "closed_loop.fmu"
+    proc = run_cli("fmu", "build", "--scenario", CLOSED_LOOP, "--fmi", "3", "-o", path)
+    assert proc.returncode == 0, proc.stderr
+    assert "with its controller" in proc.stdout
+    return path
+
+
+@pytest.mark.parametrize("kind", ["CoSimulation", "ModelExchange"])
+def test_plain_fmpy_runs_the_closed_loop_fmu_as_python_does(built_fmu, python_run, kind):
+    """No start values, no inputs: the FMU contains the controller, its reference and feedforward follow
+    the scenario's steps, and its DefaultExperiment is the scenario's run."""
+    import fmpy
+
+    from pamsim.control.closed_loop import step_metrics
+
+    md = fmpy.read_model_description(str(built_fmu))
+    inputs = {v.name: float(v.start) for v in md.modelVariables if v.causality == "input"}
+    assert inputs["reference_m"] == pytest.approx(0.020)
+    assert "controller.Kx_per_m" in {v.name for v in md.modelVariables}
+    r = fmpy.simulate_fmu(str(built_fmu), fmi_type=kind, output_interval=SAMPLE_S, output=["load.x_m", "load.mode"])
+    last = np.r_[r["time"][1:] != r["time"][:-1], True]  # after the event where fmpy records both sides
+    t, x = r["time"][last], r["load.x_m"][last]
+    assert t[-1] == pytest.approx(3.0)
+    config = python_run.closed_loop.config
+    m = step_metrics(t, x, config.step_time_s, 0.020, config.target_contraction_m, config.spec["settling_band_mm"] * 1e-3)
+    ref = python_run.closed_loop.metrics
+    for key in ("rise_time_s", "settling_time_s"):
+        assert abs(m[key] - ref[key]) <= SAMPLE_S + 1e-12, key
+    assert m["overshoot_percent"] == pytest.approx(ref["overshoot_percent"], abs=0.1)
+    assert abs(x[-1] - python_run.result.x_m[-1]) < 1e-6
+
+
+def test_the_one_muscle_fmu_still_refuses_a_controller():
+    from pamsim.fmu.assembly_fmu import assembly_spec
+    from pamsim.fmu.preset import for_scenario
+
+    scenario = pamsim.load_scenario(CLOSED_LOOP)
+    for build in (for_scenario, assembly_spec):
+        with pytest.raises(InputError, match="pamsim fmu build --scenario"):
+            build(scenario)

@@ -53,6 +53,22 @@ def _muscle_scenario(args: argparse.Namespace):
     return Scenario.from_dict(spec, name="fmu_force_table", origin="pamsim fmu build --muscle")
 
 
+def _build_assembly(scenario, args: argparse.Namespace) -> int:
+    """The FMU generated from the scenario's assembly: its added components, or its controller (designed
+    here, as ``pamsim run`` designs it), in the FMU; exit code 0."""
+    from ..fmu import build_assembly
+
+    model, what = None, ""
+    if "controller" in scenario.spec:
+        from ..control.closed_loop import design_closed_loop
+
+        model, what = design_closed_loop(scenario).model, " with its controller"
+    path = build_assembly(scenario, args.output, int(args.fmi), model)
+    print(f"wrote {path} (FMI {args.fmi}.0, Model Exchange and Co-Simulation, generated from the assembly "
+          f"of scenario {scenario.name}{what}: structured variable names such as load.x_m)")
+    return 0
+
+
 def run_build(args: argparse.Namespace) -> int:
     """``pamsim fmu build``: compile the FMU (FMI 2.0 or 3.0), with the static force of ``--scenario`` or of
     ``--muscle`` and ``--static-force`` baked in as a table when given; exit code 0.
@@ -74,13 +90,8 @@ def run_build(args: argparse.Namespace) -> int:
         from ..scenario import load_scenario
 
         scenario = load_scenario(args.scenario)
-        if scenario.added_components or args.generated:
-            from ..fmu import build_assembly
-
-            path = build_assembly(scenario, args.output, int(args.fmi))
-            print(f"wrote {path} (FMI {args.fmi}.0, Model Exchange and Co-Simulation, generated from the assembly "
-                  f"of scenario {scenario.name}: structured variable names such as load.x_m)")
-            return 0
+        if scenario.added_components or args.generated or "controller" in scenario.spec:
+            return _build_assembly(scenario, args)
     if args.scenario or by_muscle:
         from ..fmu import preset as presets
         from ..scenario import load_scenario

@@ -145,31 +145,35 @@ def _per_s(unit: str) -> str:
     return {"m": "m/s", "m/s": "m/s^2", "1": "1/s"}.get(unit, f"{unit}/s")
 
 
-def assembly_spec(scenario, fmi_version: int = 2) -> FmuSpec:
+def assembly_spec(scenario, fmi_version: int = 2, model=None) -> FmuSpec:
     """The :class:`~pamsim.fmu.spec.FmuSpec` of the FMU of ``scenario``'s assembly: its components'
     parameters at the scenario's values, its inputs following the scenario's signals, its run as the
     ``DefaultExperiment``.
 
+    ``model`` is the scenario's model with its pressure source replaced: for a scenario with a
+    ``[controller]``, the model with the controller (:func:`pamsim.control.closed_loop.design_closed_loop`),
+    which the FMU then contains, its inputs the controller's reference and feedforward signals.
+
     Raises
     ------
     InputError
-        For a scenario with a controller (the FMU would run it open loop), or whose model has no C
-        (a static force computed by Python alone), or whose signals the FMU cannot carry.
+        For a scenario with a controller but no ``model`` (the FMU would run it open loop), or whose
+        model has no C (a static force computed by Python alone), or whose signals the FMU cannot carry.
     """
     from ..assemblies.one_muscle import scenario_assembly
     from ..modeling.cmodel import CModel
 
-    if "controller" in scenario.spec:
-        raise InputError(f"{scenario.origin}: controller: the FMU has no controller, so it would run this scenario "
-                         "open loop; drive its inputs from your own controller, or build it from the scenario "
-                         "without its [controller] table")
-    assembly = scenario_assembly(scenario)
+    if "controller" in scenario.spec and model is None:
+        raise InputError(f"{scenario.origin}: controller: without the controller's model the FMU would run this "
+                         "scenario open loop; build it with pamsim fmu build --scenario, which designs the "
+                         "controller and puts it in the FMU")
+    assembly = scenario_assembly(scenario, model)
     try:
         cmodel = CModel(assembly, jacobians=True)
     except NotImplementedError as exc:
         raise InputError(f"{scenario.origin}: the FMU of this assembly needs C for every component: {exc}") from None
     names = [v.name for v in cmodel.full.inputs]
-    signals = scenario_signals(scenario, names)
+    signals = scenario_signals(scenario, names, model)
     table = AssemblyVariables(cmodel, assembly.parameter_values(), {n: s(0.0) for n, s in signals.items()})
     variables = tuple(replace(v, start=INPUT_SOURCE_CHOICES.index("scenario")) if v.name == "input_source" else v
                       for v in table.variables)
@@ -214,15 +218,16 @@ def _token(spec: FmuSpec) -> str:
     return "{" + str(uuid.UUID(bytes=h.digest()[:16])) + "}"
 
 
-def build_assembly(scenario, output_path: str | os.PathLike | None = None, fmi_version: int = 2) -> Path:
+def build_assembly(scenario, output_path: str | os.PathLike | None = None, fmi_version: int = 2,
+                   model=None) -> Path:
     """Generate, compile and zip the FMU of ``scenario``'s assembly of components
     (:mod:`pamsim.fmu.assembly_fmu`): namespaced variables, every equation generated; return its path
-    (default ``pamsim_assembly_fmi<version>.fmu``).
+    (default ``pamsim_assembly_fmi<version>.fmu``).  ``model``: as :func:`assembly_spec` takes it.
 
     Raises :class:`~pamsim.errors.InputError` for an unknown FMI version, a scenario the FMU cannot
     carry, a missing C compiler or a failed compilation.
     """
     if fmi_version not in FMI_VERSIONS:
         raise InputError(f"FMI version must be 2 or 3, not {fmi_version!r}")
-    spec = assembly_spec(scenario, fmi_version)
+    spec = assembly_spec(scenario, fmi_version, model)
     return build_spec(Path(output_path) if output_path else Path(f"{spec.identifier}_fmi{fmi_version}.fmu"), spec)

@@ -23,6 +23,7 @@ from typing import Mapping
 
 import numpy as np
 
+from ..assemblies.one_muscle import input_signals
 from ..errors import InputError
 from ..scenario import Scenario
 from ..signals import Constant, FirstOrderLag, PiecewiseConstant, Ramp, Step, Trace
@@ -168,12 +169,16 @@ def for_muscle(scenario: Scenario) -> Preset:
 
 
 SIGNAL_UNITS = {"valve_command": "", "supply_pressure_gauge_Pa": "Pa", "prescribed_pressure_gauge_Pa": "Pa",
-                "load_mass_kg": "kg", "external_force_N": "N"}
-"""The unit of each input a scenario can drive, as the signals' descriptions show it."""
+                "load_mass_kg": "kg", "external_force_N": "N", "reference_m": "m", "feedforward_gauge_Pa": "Pa"}
+"""The unit of each input a scenario can drive, as the signals' descriptions show it (the last two: a
+position controller's, :mod:`pamsim.control.closed_loop`)."""
 
 
-def scenario_signals(scenario: Scenario, names) -> dict[str, InputSignal]:
+def scenario_signals(scenario: Scenario, names, model=None) -> dict[str, InputSignal]:
     """The scenario's signals of the inputs ``names`` (of :data:`SIGNAL_UNITS`), as the FMU carries them.
+
+    ``model``: the scenario's model with its pressure source replaced (a controller's), whose assembly's
+    inputs (:func:`pamsim.assemblies.one_muscle.input_signals`) take the place of the scenario's.
 
     Raises
     ------
@@ -181,14 +186,9 @@ def scenario_signals(scenario: Scenario, names) -> dict[str, InputSignal]:
         For an input signal the FMU cannot carry, naming the input.
     """
     inputs = ScenarioInputs(scenario)
-    model = inputs.model
     raw = {"valve_command": Constant(0.0), "supply_pressure_gauge_Pa": Constant(0.0),
-           "prescribed_pressure_gauge_Pa": Constant(0.0), "load_mass_kg": Constant(scenario.mass_kg),
-           "external_force_N": model.load.external_force_N or Constant(0.0)}
-    if inputs.valve:
-        raw["valve_command"], raw["supply_pressure_gauge_Pa"] = model.source.command, model.source.supply_gauge_Pa
-    else:
-        raw["prescribed_pressure_gauge_Pa"] = model.source.p_gauge_Pa
+           "prescribed_pressure_gauge_Pa": Constant(0.0), "load_mass_kg": Constant(scenario.mass_kg)}
+    raw.update(input_signals(inputs.model if model is None else model))
     signals = {}
     for name in names:
         try:
@@ -209,9 +209,9 @@ def for_scenario(scenario: Scenario) -> Preset:
         signal it cannot carry.
     """
     if "controller" in scenario.spec:
-        raise InputError(f"{scenario.origin}: controller: the FMU has no controller, so it would run this scenario "
-                         "open loop; drive its inputs from your own controller, or build it from the scenario "
-                         "without its [controller] table")
+        raise InputError(f"{scenario.origin}: controller: the one-muscle FMU has no controller, so it would run "
+                         "this scenario open loop; pamsim fmu build --scenario builds the FMU of its assembly, "
+                         "controller included")
     where = f"scenario {scenario.name} ({scenario.origin})"
     starts, sources = _parameter_starts(scenario)
     for name, value in start_values(scenario).items():

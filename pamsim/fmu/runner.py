@@ -286,11 +286,7 @@ def run_me(scenario: Scenario, fmi_version: int = 2, fmu_path: Path | None = Non
     except Exception as exc:
         raise SolverFailure(f"FMU model exchange failed: {exc}") from None
     t = res["time"]
-    # fmpy records both sides of an event; keep the last sample at each time (after the event).
-    last = np.r_[t[1:] != t[:-1], True]
-    idx = np.flatnonzero(last)
-    ticks = t[idx] / dt
-    on_grid = idx[np.abs(ticks - np.round(ticks)) < 1e-6]
+    on_grid = grid_rows(t, dt)
     out = {name: np.asarray(res[name][on_grid], dtype=float) for name in OUTPUTS}
     out["t_s"] = np.asarray(t[on_grid], dtype=float)
     out["friction_mode"] = np.asarray(res["friction_mode"][on_grid], dtype=int)
@@ -299,6 +295,23 @@ def run_me(scenario: Scenario, fmi_version: int = 2, fmu_path: Path | None = Non
 
 N_WORK_STATES = 4
 """The work integrals after the states: the muscle's, friction's, damping's and the external force's."""
+
+
+def grid_rows(t_s: np.ndarray, dt_s: float) -> np.ndarray:
+    """The rows of an fmpy result (times ``t_s`` [s]) on the output grid of interval ``dt_s`` [s].
+
+    fmpy records both sides of an event at one time: the last row of each time is kept (after the event).
+    """
+    idx = np.flatnonzero(np.r_[t_s[1:] != t_s[:-1], True])
+    ticks = t_s[idx] / dt_s
+    return idx[np.abs(ticks - np.round(ticks)) < 1e-6]
+
+
+def trace_stats(modes: np.ndarray, backend: str, rtol: float) -> dict:
+    """A Result's solver statistics from an FMU trace: events counted as the mode changes between samples
+    (the FMU does not report its events), no right-hand-side count."""
+    n_events = int(np.count_nonzero(np.diff(modes)))
+    return {"rhs_evaluations": 0, "events": n_events, "segments": n_events + 1, "method": backend, "rtol": rtol}
 
 
 def to_result(scenario: Scenario, trace: dict[str, np.ndarray], wall_time_s: float, backend: str) -> Result:
@@ -322,9 +335,7 @@ def to_result(scenario: Scenario, trace: dict[str, np.ndarray], wall_time_s: flo
     power = [sig["F_static_N"] * v, -sig["F_friction_N"] * v, -sig["F_damping_N"] * v, sig["F_external_N"] * v]
     for k, pw in enumerate(power):
         Y[len(states) + k] = np.concatenate([[0.0], np.cumsum(0.5 * (pw[1:] + pw[:-1]) * np.diff(t))])
-    n_events = int(np.count_nonzero(np.diff(modes)))
-    stats = {"rhs_evaluations": 0, "events": n_events, "segments": n_events + 1, "method": backend,
-             "rtol": scenario.solver.rtol}
+    stats = trace_stats(modes, backend, scenario.solver.rtol)
     return Result.from_trace(model, scenario.name, t, Y, modes, [], [], stats, wall_time_s, outputs=outputs)
 
 
