@@ -54,6 +54,18 @@ def test_native_runs_the_closed_loop_as_python_does(native_run, python_run):
     assert [e.kind for e in native_run.result.transitions] == [e.kind for e in python_run.result.transitions]
 
 
+def test_native_refuses_a_controller_on_the_hand_written_core(monkeypatch):
+    """A static force the engine cannot run (one called on floats) runs as a force table on the
+    hand-written core, which has no controller: refused by name, not run open loop."""
+    from pamsim.native import backend
+
+    monkeypatch.setattr(backend, "engine_assembly", lambda scenario, model=None: None)
+    with pytest.raises(InputError, match="ClosedLoopValveSource runs natively only with a static force written in "
+                                         "symbols") as err:
+        pamsim.run(CLOSED_LOOP, backend="native")
+    assert "\n" not in str(err.value)
+
+
 def test_native_closed_loop_writes_what_python_writes(tmp_path, cli):
     outputs = {}
     for backend in ("python", "native"):

@@ -77,8 +77,8 @@ def force_table_for(scenario: Scenario) -> ForceTable | None:
 # The scenario keys the FMU represents, by section; any other key is refused (InputError) rather
 # than dropped, so a setting added to scenarios later cannot silently run a different model.
 # [solver] sets the Python integrator: the FMU's integrators are CVode at solver.rtol (ME) and its
-# own Dormand-Prince 5(4) (CS).  [controller] is read by ``pamsim control-example`` only, as with
-# the python backend.
+# own Dormand-Prince 5(4) (CS).  [controller] is read by pamsim.control, which designs the controller
+# and runs its model through the FMU of its assembly (pamsim.fmu.assembly_runner), not this FMU.
 REPRESENTED = {
     "": {"name", "description", "model", "parameters", "load", "pressure", "simulation", "solver", "controller",
          "measured"},  # [measured] names what the figure draws beside the run, not the model
