@@ -18,13 +18,14 @@ def register(sub) -> None:
                         description="Generate the sources and model description, compile them and write the .fmu.")
     b.add_argument("-o", "--output", default=None,
                    help="FMU file to write (default: pamsim_muscle_fmi<version>.fmu in the current folder, or "
-                        "pamsim_assembly_fmi<version>.fmu for a scenario that adds components)")
+                        "pamsim_assembly_fmi<version>.fmu for a scenario that adds components or has a controller)")
     b.add_argument("--fmi", default="2", help="FMI version: 2 (FMI 2.0) or 3 (FMI 3.0); default 2")
     b.add_argument("--scenario", default=None,
                    help="build the FMU for this scenario: its muscle's and its own values (parameters, choices, "
                         "initial state, input signals, run) are the FMU's start values, and a static force other "
                         "than the ACRA 2012 polynomial is baked in as a force table; a scenario that adds components "
-                        "([[component]]) gives the FMU generated from its assembly, with structured names")
+                        "([[component]]) or has a [controller] gives the FMU generated from its assembly, with "
+                        "structured names (the controller, designed as pamsim run designs it, inside)")
     b.add_argument("--muscle", default=None,
                    help="build the FMU for this muscle (shipped name or TOML path): its parameters are the FMU's "
                         "start values, and its static force is baked in as a force table")
