@@ -115,6 +115,8 @@ def simulate(scenario: "Scenario | str | os.PathLike", backend: str = "python",
         from .simulator import simulate_python
 
         return simulate_python(scenario, progress, model)
+    if model is None and scenario.added_components and backend in ("fmu-cs", "fmu-me"):
+        model = scenario.build_model()  # the one-muscle FMU has the rig alone: the assembly's FMU carries them
     if model is None:
         return get_backend(backend)(scenario)
     get_backend(backend)  # an unknown name refused as such

@@ -117,13 +117,23 @@ def test_the_cli_refuses_with_exit_2_and_writes_nothing(tmp_path):
 
 
 @pytest.mark.parametrize("backend, changes", [
-    ("fmu-cs", {}),
     ("native", {"model": {"muscle": "mpam_survey_45mm", "static_force": "mpam_two_phase"},
                 "parameters": {"E_nylon_Pa": 3e9}}),  # nylon 6: 2-4 GPa; an implicit model, tabulated
 ])
 def test_backends_that_cannot_run_added_components_refuse_them(backend, changes):
     with pytest.raises(InputError, match="component"):
         pamsim.simulate(_scenario(changes), backend=backend)
+
+
+@pytest.mark.parametrize("backend, bound_m", [("fmu-cs", 2e-7), ("fmu-me", 1e-6)])
+def test_the_fmu_backends_run_the_assembly_fmu(backend, bound_m):
+    """The one-muscle FMU has the rig alone: the FMU backends run the FMU generated from the assembly,
+    spring included, and meet the python run (co-simulation at the scenario's rtol, model exchange
+    with CVode at it)."""
+    sc = pamsim.load_scenario(SCENARIOS / "parallel_spring.toml")
+    fmu, py = pamsim.simulate(sc, backend=backend), pamsim.simulate(sc)
+    assert np.max(np.abs(fmu.x_m - py.x_m)) < bound_m
+    np.testing.assert_allclose(fmu.signals["spring.F_spring_N"], py.signals["spring.F_spring_N"], atol=300 * bound_m)
 
 
 def test_commands_that_take_the_rig_alone_refuse_added_components(tmp_path):
