@@ -56,7 +56,7 @@ CASES = {
 
 def _core(scenario):
     """The hand-written C core's run of ``scenario`` (the native backend's, before the engine)."""
-    case = backend.case_inputs(scenario, exact=False)  # the core holds its inputs piecewise
+    case = backend.case_inputs(scenario)
     out = backend._run_core([case], [backend.event_capacity(case.max_events)])
     assert out["status"][0] == 0, out["messages"][0]
     n = case.n_samples
@@ -65,28 +65,16 @@ def _core(scenario):
     return S, events, out["peaks"][0]
 
 
-def _held_engine_run(scenario):
-    """The engine's run of ``scenario`` with its inputs held as the core holds them."""
-    case = backend.case_inputs(scenario, exact=False)
-    ((out, i),) = backend._run([case], [backend.event_capacity(case.max_events)])
-    return backend._result(scenario, case, out, i, 0.0)
-
-
 PRESCRIBED = {"prescribed step"}
 """Cases whose step sequence differs: the hand-written core carries the chamber's two states with zero
 derivatives when the pressure is prescribed, so its RMS error norm is over 4 states where the engine's
 is over the 2 there are; their steps differ, and so do their results, at the tolerance's level."""
 
 
-HELD = {"valve opened, then vented"}
-"""Cases with a ramp: the engine takes it exactly, the core holds it at its midpoint over each output
-sample; the engine then runs with the core's held inputs."""
-
-
 @pytest.mark.parametrize("name", list(CASES))
 def test_the_engine_agrees_with_the_hand_written_core(name):
     scenario = CASES[name]
-    res = _held_engine_run(scenario) if name in HELD else pamsim.simulate(scenario, backend="native")
+    res = pamsim.simulate(scenario, backend="native")
     S, events, (x_max, x_min, p_max) = _core(scenario)
     kinds = [library.EVENT_KINDS[int(e[1])] for e in events]
     assert [e.kind for e in res.transitions] == kinds

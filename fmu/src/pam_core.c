@@ -40,6 +40,18 @@ void pam_reset(PamCore *c) {
     c->inputs_set = 0;
 }
 
+/* ------------------------------------------------------------ inputs */
+
+/* The inputs at t_s: a driver's closed form (inputs_fn), or the scenario's signals the FMU carries. */
+static void core_inputs_at(PamCore *c, double t_s, int left) {
+    if (c->inputs_fn) c->inputs_fn(c->inputs_env, c, t_s);
+    else pam_inputs_at(c, t_s, left);
+}
+
+static int core_inputs_constant(const PamCore *c, double t_s) {
+    return c->inputs_fn ? c->inputs_constant_fn(c->inputs_env) : pam_inputs_constant(c, t_s);
+}
+
 /* ------------------------------------------------------------ elements */
 
 /* pamsim.static_models.geometry.Braid (b, N) */
@@ -514,7 +526,7 @@ static double dp_step(PamCore *c, double t0, const double *y0, double h, DpStage
             for (j = 0; j < st; j++) acc += DP_A[st][j] * s->k[j][n];
             yt[n] = y0[n] + h * acc;
         }
-        pam_inputs_at(c, t0 + DP_C[st] * h, 1);
+        core_inputs_at(c, t0 + DP_C[st] * h, 1);
         rhs(c, c->mode, yt, s->k[st]);
     }
     for (n = 0; n < PAM_NX; n++) {
@@ -561,7 +573,7 @@ static int first_crossing(PamCore *c, const DpStages *s, double t, const double 
     double ye[PAM_NX];
     for (k = 1; k <= n; k++) {
         if (k < n) dp_dense(s, y, h, (double)k / n, ye);
-        pam_inputs_at(c, k < n ? t + (double)k / n * h : t + h, 1);
+        core_inputs_at(c, k < n ? t + (double)k / n * h : t + h, 1);
         if (min_indicator(c, k < n ? ye : y1) <= 0.0) {
             *lo = (double)(k - 1) / n;
             *hi = (double)k / n;
@@ -596,7 +608,7 @@ static int settle_chamber(PamCore *c, double *y) {
 /* Leaves the instance at the last instant reached (time, states, mode and outputs agree) and fails. */
 static int step_failed(PamCore *c, double t, const double *y) {
     c->time_s = t;
-    pam_inputs_at(c, t, 0);
+    core_inputs_at(c, t, 0);
     put_states(c, y);
     pam_evaluate(c);
     return -1;
@@ -622,7 +634,7 @@ int pam_do_step(PamCore *c, double t_end) {
     long steps = 0, max_steps = c->i[I_cs_max_internal_steps];
     int zero_length = 0, n;
     get_states(c, y);
-    pam_inputs_at(c, t, 0);
+    core_inputs_at(c, t, 0);
     if (c->inputs_changed || pam_at_breakpoint(c, t)) recheck_held(c, y);
     c->inputs_changed = 0;
     rhs(c, c->mode, y, s.k[0]);
@@ -634,18 +646,18 @@ int pam_do_step(PamCore *c, double t_end) {
         if (t_piece - t <= 1e-13 * fmax(1.0, fabs(t_piece))) {
             /* A breakpoint of the signals: they take their values from the right. */
             t = t_piece;
-            pam_inputs_at(c, t, 0);
+            core_inputs_at(c, t, 0);
             recheck_held(c, y);
             rhs(c, c->mode, y, s.k[0]);
             t_piece = piece_end(c, t, t_end);
             continue;
         }
-        pam_inputs_at(c, t, 0); /* a rejected trial step left them at its end */
+        core_inputs_at(c, t, 0); /* a rejected trial step left them at its end */
         if (settle_chamber(c, y)) rhs(c, c->mode, y, s.k[0]);
         /* A held load whose chamber does not change stays as it is while the inputs are held:
          * the solution is constant, however long the step. */
         for (n = 0; n < PAM_NX && at_rest; n++) at_rest = s.k[0][n] == 0.0;
-        if (at_rest && pam_inputs_constant(c, t)) {
+        if (at_rest && core_inputs_constant(c, t)) {
             if (c->on_step) c->on_step(c->step_env, t, t_piece, 0.0, y, NULL);
             t = t_piece;
             continue;
@@ -675,7 +687,7 @@ int pam_do_step(PamCore *c, double t_end) {
             for (it = 0; it < 100 && (hi - lo) * h > 1e-15 * fmax(1.0, fabs(t)); it++) {
                 double mid = 0.5 * (lo + hi);
                 dp_dense(&s, y, h, mid, ye);
-                pam_inputs_at(c, t + mid * h, 1);
+                core_inputs_at(c, t + mid * h, 1);
                 if (min_indicator(c, ye) <= 0.0) hi = mid;
                 else lo = mid;
             }
@@ -683,7 +695,7 @@ int pam_do_step(PamCore *c, double t_end) {
             else memcpy(ye, y1, sizeof ye);
             if (c->on_step) c->on_step(c->step_env, t, hi < 1.0 ? t + hi * h : (last ? t_piece : t + h), h, y, &s);
             t = hi < 1.0 ? t + hi * h : (last ? t_piece : t + h);
-            pam_inputs_at(c, t, 1);
+            core_inputs_at(c, t, 1);
             memcpy(y, ye, sizeof y);
             put_states(c, y);
             note_table_edge(c, t, y);
@@ -715,7 +727,7 @@ int pam_do_step(PamCore *c, double t_end) {
         if (!last || factor < 1.0) c->h_s = h * factor;
     }
     c->time_s = t_end;
-    pam_inputs_at(c, t_end, 0);
+    core_inputs_at(c, t_end, 0);
     put_states(c, y);
     pam_evaluate(c);
     note_table_edge(c, t_end, y);
@@ -795,4 +807,7 @@ void pam_adopt_state(PamCore *c, const PamCore *from) {
     c->on_step = mine.on_step;
     c->step_env = mine.step_env;
     c->table = mine.table;
+    c->inputs_fn = mine.inputs_fn;
+    c->inputs_constant_fn = mine.inputs_constant_fn;
+    c->inputs_env = mine.inputs_env;
 }

@@ -61,6 +61,11 @@ typedef struct PamCore {
     int table_edge_logged; /* the built-in table's edge has been reached (logged once) */
     double event_time_s;   /* model exchange: the last event, where continuous time starts from */
     unsigned inputs_set;   /* before the end of initialisation: the signals (bit k) whose input the importer set */
+    /* Inputs that a driver sets in closed form inside its segments (the native library; NULL in the FMU):
+     * inputs_fn writes them into r[] at t_s, inputs_constant_fn says whether they stay as they are. */
+    void (*inputs_fn)(void *env, struct PamCore *c, double t_s);
+    int (*inputs_constant_fn)(void *env);
+    void *inputs_env;
 } PamCore;
 
 /* The values a serialized FMU state holds (fmi_shell.c): those of pam_fmu_common.h, then the geometry

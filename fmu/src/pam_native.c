@@ -27,7 +27,33 @@ typedef struct {
     double gauss[GL_N][GL_N];
     double x_max, x_min, p_max; /* over every step end and event (simulator: Result.peaks) */
     PamTable table;             /* the case's static force table, if it has one */
+    double seg_t0;              /* the segment being integrated: its start, inputs there, their change */
+    const double *seg_u0, *seg_du;
 } Run;
+
+/* The inputs of the current segment at t_s, in closed form (PamBatch.segment_du). */
+static void segment_inputs_at(void *env, PamCore *c, double t_s) {
+    const Run *run = (const Run *)env;
+    double dt = t_s - run->seg_t0;
+    int k;
+    for (k = 0; k < PAM_NATIVE_NU; k++) {
+        const double *d = run->seg_du + 3 * k;
+        c->r[INPUT_R[k]] = run->seg_u0[k] + d[0] * dt + (d[2] > 0.0 ? d[1] * expm1(-dt / d[2]) : 0.0);
+    }
+}
+
+static int segment_constant(void *env) {
+    const Run *run = (const Run *)env;
+    int k;
+    for (k = 0; k < PAM_NATIVE_NU; k++)
+        if (run->seg_du[3 * k] != 0.0 || (run->seg_du[3 * k + 2] > 0.0 && run->seg_du[3 * k + 1] != 0.0)) return 0;
+    return 1;
+}
+
+/* Inputs that follow their segment's closed form, at t_s; held ones stay as they are. */
+static void inputs_now(Run *run, double t_s) {
+    if (run->core.inputs_fn) run->core.inputs_fn(run, &run->core, t_s);
+}
 
 static void note_peaks(Run *run, const double *y) {
     double p = pressure_gauge_Pa(&run->core, y);
@@ -88,8 +114,8 @@ typedef struct {
     int moving;                       /* 0: no work in this step (c is zero) */
 } WorkPoly;
 
-static void work_poly(const PamCore *c, const DensePoly *d, double A[GL_N][GL_N], int moving, double ta,
-                      double tb, WorkPoly *w) {
+static void work_poly(Run *run, const DensePoly *d, double A[GL_N][GL_N], int moving, double ta, double tb,
+                      WorkPoly *w) {
     double y[PAM_NX], P[GL_N][N_WORK];
     int q, k, j;
     w->t0 = ta;
@@ -99,7 +125,8 @@ static void work_poly(const PamCore *c, const DensePoly *d, double A[GL_N][GL_N]
     if (!w->moving) return; /* a held load does no work */
     for (q = 0; q < GL_N; q++) {
         state_at(d, ta + GL_NODE[q] * w->span, y);
-        powers_W(c, y, P[q]);
+        inputs_now(run, ta + GL_NODE[q] * w->span);
+        powers_W(&run->core, y, P[q]);
     }
     for (k = 0; k < N_WORK; k++)
         for (j = 0; j < GL_N; j++) {
@@ -148,7 +175,7 @@ static void on_step(void *env, double t0, double t1, double h, const double *y0,
     double y[PAM_NX], work[N_WORK];
     int moving = stages != NULL && sliding(run->core.mode);
     dense_poly(&d, (const DpStages *)stages, y0, t0, h);
-    work_poly(&run->core, &d, run->gauss, moving, t0, t1, &w);
+    work_poly(run, &d, run->gauss, moving, t0, t1, &w);
     while (run->next_sample < run->n_samples && sample_time(run, run->next_sample) <= t1) {
         double t = sample_time(run, run->next_sample);
         state_at(&d, t, y);
@@ -157,6 +184,7 @@ static void on_step(void *env, double t0, double t1, double h, const double *y0,
     }
     work_at(&w, t1, run->work, run->work);
     state_at(&d, t1, y);
+    inputs_now(run, t1);
     note_peaks(run, y);
 }
 
@@ -201,11 +229,30 @@ static int set_inputs(PamCore *c, const double *u) {
     return 0;
 }
 
+/* The segment from seg_t with inputs seg_u there and their change seg_du (NULL: held); -1 if refused. */
+static int enter_segment(Run *run, double seg_t, const double *seg_u, const double *seg_du) {
+    int k;
+    if (set_inputs(&run->core, seg_u)) return -1;
+    for (k = 0; seg_du && k < 3 * PAM_NATIVE_NU; k++)
+        if (!isfinite(seg_du[k]) || (k % 3 == 2 && seg_du[k] < 0.0)) {
+            snprintf(run->message, PAM_NATIVE_MSG, "a segment's change of input %d is not finite", k / 3);
+            return -1;
+        }
+    run->seg_t0 = seg_t;
+    run->seg_u0 = seg_u;
+    run->seg_du = seg_du;
+    run->core.inputs_fn = seg_du ? segment_inputs_at : NULL;
+    run->core.inputs_constant_fn = segment_constant;
+    run->core.inputs_env = run;
+    return 0;
+}
+
 static int run_case(const PamBatch *b, int64_t i) {
     Run run;
     PamCore *c = &run.core;
     const double *seg_t = b->segment_t_s + b->segment_offset[i];
     const double *seg_u = b->segment_u + PAM_NATIVE_NU * b->segment_offset[i];
+    const double *seg_du = b->segment_du ? b->segment_du + 3 * PAM_NATIVE_NU * b->segment_offset[i] : NULL;
     double y[PAM_NX];
     int64_t n_seg = b->n_segments[i], j;
 
@@ -236,7 +283,7 @@ static int run_case(const PamBatch *b, int64_t i) {
         run.table.nodes = (const double(*)[4])(b->table_nodes + 4 * b->table_offset[b->table_index[i]]);
         c->table = &run.table;
     }
-    if (set_inputs(c, seg_u) || pam_check_parameters(c)) return PAM_BAD_INPUT;
+    if (enter_segment(&run, seg_t[0], seg_u, seg_du) || pam_check_parameters(c)) return PAM_BAD_INPUT;
     pam_initialize(c);
     c->on_event = on_event;
     c->event_env = &run;
@@ -256,7 +303,8 @@ static int run_case(const PamBatch *b, int64_t i) {
             record(&run, y, run.work);
         if (j < n_seg) {
             /* simulator: the next segment sees the inputs' new values; a held load is re-checked */
-            if (set_inputs(c, seg_u + PAM_NATIVE_NU * j)) return PAM_BAD_INPUT;
+            if (enter_segment(&run, seg_t[j], seg_u + PAM_NATIVE_NU * j, seg_du ? seg_du + 3 * PAM_NATIVE_NU * j : NULL))
+                return PAM_BAD_INPUT;
             c->inputs_changed = 1;
         }
     }

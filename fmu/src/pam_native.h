@@ -50,7 +50,9 @@ typedef struct {
     const int64_t *n_segments;    /* n_cases: input segments; the first starts at 0 */
     const int64_t *segment_offset;
     const double *segment_t_s;    /* start of each segment */
-    const double *segment_u;      /* PAM_NATIVE_NU values held over each segment */
+    const double *segment_u;      /* PAM_NATIVE_NU values at the start of each segment */
+    const double *segment_du;     /* PAM_NATIVE_NU x 3 per segment, or NULL (held): input k follows
+                                   * u_k + b (t - t0) + c (exp(-(t - t0) / tau) - 1) from the segment's start t0 */
     const int64_t *event_capacity; /* n_cases: rows available in events */
     const int64_t *event_offset;
     const int64_t *table_index;   /* n_cases: the case's static force table, or -1 (the core's built-in, none) */

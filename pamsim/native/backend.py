@@ -17,12 +17,11 @@ Differences from the Python backend, all documented in ``docs/scaling.md``:
   table of the model (:func:`force_table`), not the model itself;
 - the work integrals are Gauss-Legendre quadratures of each step's dense output
   (the Python backend integrates them as states);
-- on the generic engine every input signal the FMU can carry (constant, step, steps, ramp,
-  lag, trace) is exact: the run is cut at its knots and lag starts, and inside each piece the
-  integrator evaluates it in closed form (:func:`exact_segments`); a case with a force table on
-  the hand-written core, or a signal of another kind, holds a signal that is neither constant
-  nor a step nor steps at its midpoint value over intervals of at most :func:`hold_interval_s`,
-  a second-order approximation.
+- every input signal the FMU can carry (constant, step, steps, ramp, lag, trace) is exact, on
+  the generic engine and on the hand-written core alike: the run is cut at its knots and lag
+  starts, and inside each piece the integrator evaluates it in closed form
+  (:func:`exact_segments`); a signal of another kind (a Python function) is held at its midpoint
+  value over intervals of at most :func:`hold_interval_s`, a second-order approximation.
 """
 
 from __future__ import annotations
@@ -232,13 +231,11 @@ def _change_after(piece, t0: float) -> tuple[float, float, float]:
     return (0.0, 0.0, 0.0)
 
 
-def case_inputs(scenario: Scenario, model: MuscleModel | None = None, exact: bool = True) -> CaseInputs:
+def case_inputs(scenario: Scenario, model: MuscleModel | None = None) -> CaseInputs:
     """The library's inputs for ``scenario``; refuses (``InputError``) what the backend cannot honour.
 
     ``model`` is ``scenario.build_model()`` (built here if not given), or that model with its pressure
     source replaced (a fit drives it with a recorded pressure): the source choice follows the model.
-    ``exact``: a case the generic engine runs takes its signals exactly (:func:`exact_segments`);
-    otherwise, and always for a case with a force table, they are held piecewise.
     """
     refuse_unsupported(scenario)
     model = scenario.build_model() if model is None else model
@@ -276,7 +273,7 @@ def case_inputs(scenario: Scenario, model: MuscleModel | None = None, exact: boo
     table = force_table(scenario) if assembly is None else None
     ints[lib.INT_INDEX["static_force_model"]] = C_CHOICES["static_force_model"].index(
         "acra2012_polynomial" if table is None else "table")
-    pieces = exact_segments(signals, T) if assembly is not None and exact else None
+    pieces = exact_segments(signals, T)
     if pieces is not None:
         starts, u, du = pieces
         _set_mass(u, names, model)
@@ -333,7 +330,15 @@ def _run_core(cases: Sequence[CaseInputs], capacity: Sequence[int]) -> dict:
                          np.array([len(c.segment_t_s) for c in cases]),
                          np.concatenate([c.segment_t_s for c in cases]), np.concatenate([c.segment_u for c in cases]),
                          np.asarray(capacity), tables,
-                         np.array([-1 if c.table is None else index[id(c.table)] for c in cases]))
+                         np.array([-1 if c.table is None else index[id(c.table)] for c in cases]), _segment_du(cases))
+
+
+def _segment_du(cases: Sequence[CaseInputs]) -> np.ndarray | None:
+    """The cases' inputs' change over each segment (zeros for held ones), or None if every one is held."""
+    if all(c.segment_du is None for c in cases):
+        return None
+    return np.concatenate([np.zeros((len(c.segment_t_s), len(lib.INPUTS), 3)) if c.segment_du is None
+                           else c.segment_du for c in cases])
 
 
 _MODE_LABELS = {int(m): m.label for m in Mode}

@@ -48,7 +48,8 @@ class PamBatch(ctypes.Structure):
 
     _fields_ = [("n_cases", ctypes.c_int64), ("reals", _D), ("ints", _I32), ("duration_s", _D),
                 ("n_samples", _I64), ("sample_offset", _I64), ("n_segments", _I64), ("segment_offset", _I64),
-                ("segment_t_s", _D), ("segment_u", _D), ("event_capacity", _I64), ("event_offset", _I64),
+                ("segment_t_s", _D), ("segment_u", _D), ("segment_du", _D), ("event_capacity", _I64),
+                ("event_offset", _I64),
                 ("table_index", _I64), ("table_grid", _D), ("table_offset", _I64), ("table_nodes", _D),
                 ("samples", _D), ("modes", _I32), ("events", _D), ("n_events", _I64), ("stats", _I64),
                 ("status", _I32), ("peaks", _D), ("messages", ctypes.c_char_p)]
@@ -77,7 +78,7 @@ def _ptr(array: np.ndarray, kind):
 
 
 def run_batch(reals, ints, duration_s, n_samples, segment_counts, segment_t_s, segment_u, event_capacity,
-              tables: Sequence = (), table_index=None) -> dict:
+              tables: Sequence = (), table_index=None, segment_du=None) -> dict:
     """Run cases in one library call.
 
     Parameters
@@ -89,13 +90,16 @@ def run_batch(reals, ints, duration_s, n_samples, segment_counts, segment_t_s, s
     segment_counts : ndarray
         Per case: its number of input segments.
     segment_t_s, segment_u : ndarray
-        All cases' segments, concatenated: start time [s] and the :data:`INPUTS` held over it.
+        All cases' segments, concatenated: start time [s] and the :data:`INPUTS` at it.
     event_capacity : ndarray
         Per case: how many events to keep.
     tables : sequence of pamsim.fmu.force_table.ForceTable
         The static force tables the cases use (``static_force_model = table``).
     table_index : ndarray, optional
         Per case: its table in ``tables``, or -1 (none; the default for every case).
+    segment_du : ndarray, optional
+        Per segment and input, the slope, lag amplitude and lag time constant of the input over the
+        segment (:class:`pamsim.native.engine.EngineCase`); None: every input held over its segment.
 
     Returns
     -------
@@ -127,9 +131,11 @@ def run_batch(reals, ints, duration_s, n_samples, segment_counts, segment_t_s, s
     table_offset = c(np.concatenate([[0], np.cumsum([t.shape[0] * t.shape[1] for t in tables])[:-1]])
                      if tables else np.zeros(1), np.int64)
     segment_offset = offsets(segment_counts)
+    du = None if segment_du is None else c(segment_du, np.float64).reshape(-1, len(INPUTS), 3)
     batch = PamBatch(n, _ptr(reals, _D), _ptr(ints, _I32), _ptr(duration_s, _D), _ptr(n_samples, _I64),
                      _ptr(out["sample_offset"], _I64), _ptr(segment_counts, _I64), _ptr(segment_offset, _I64),
-                     _ptr(segment_t_s, _D), _ptr(segment_u, _D), _ptr(event_capacity, _I64),
+                     _ptr(segment_t_s, _D), _ptr(segment_u, _D), _ptr(du, _D) if du is not None else None,
+                     _ptr(event_capacity, _I64),
                      _ptr(out["event_offset"], _I64), _ptr(table_index, _I64), _ptr(grid, _D),
                      _ptr(table_offset, _I64), _ptr(nodes, _D), _ptr(out["samples"], _D), _ptr(out["modes"], _I32),
                      _ptr(out["events"], _D), _ptr(out["n_events"], _I64), _ptr(out["stats"], _I64),
