@@ -175,6 +175,23 @@ def _cut_at(sol, named, fired, lo: float, hi: float):
                            y_events=[np.array([y_event] if k == k_event else []) for k in range(len(named))])
 
 
+BREAK_RESOLUTION = 1e-12
+"""Breakpoints closer than this fraction of their time (at least of 1 s) are one: a segment between them
+would be shorter than the integrator can step (knots at 0.1 + 0.2 and 0.3 s, 5.6e-17 s apart, made
+LSODA fail)."""
+
+
+def _distinct_breaks(breakpoints, duration_s: float) -> list[float]:
+    """The inputs' breakpoints inside the run, each once (see :data:`BREAK_RESOLUTION`), and its end."""
+    out: list[float] = []
+    for b in sorted({float(b) for b in breakpoints if 0.0 < b < duration_s}):
+        if not out or b - out[-1] > BREAK_RESOLUTION * max(1.0, b):
+            out.append(b)
+    if out and duration_s - out[-1] <= BREAK_RESOLUTION * max(1.0, duration_s):
+        out.pop()
+    return out + [duration_s]
+
+
 class _Generated:
     """The one-muscle model's generated code for one run, one set of functions per mode of the load
     (:func:`pamsim.modeling.pygen.compiled_by_mode`, shared by runs of the same structure), with the
@@ -375,7 +392,7 @@ class _Run:
                  p0_gauge_Pa: float | None, progress: Callable[[float], None] | None, added: tuple = ()):
         self.model, self.opts, self.progress = model, opts, progress
         self.grid = np.linspace(0.0, duration_s, n_samples(duration_s, opts.sample_rate_Hz))
-        self.breaks = sorted({b for b in model.breakpoints if 0.0 < b < duration_s} | {duration_s})
+        self.breaks = _distinct_breaks(model.breakpoints, duration_s)
         self.gen = _Generated(model, opts, x0_m, p0_gauge_Pa, added)
         self.atol = opts.rtol * self.gen.nominal
         self.held_max_step = min(opts.held_max_step_s, model.max_input_step_s)

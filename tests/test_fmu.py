@@ -373,6 +373,9 @@ def test_out_of_range_parameters_are_refused_by_fmu_and_scenario_alike(unzipped,
      "initial_pressure_gauge_Pa = 500000: must be at most rated_pressure_gauge_Pa = 450000"),
     ({"initial_contraction_m": 0.12}, "initial_contraction_m = 0.12: must lie between the stops, 0 and 0.1157 m"),
     ({"initial_contraction_m": -1e-3}, "initial_contraction_m = -0.001: must lie between the stops"),
+    ({"x_high_m": 0.5}, "x_high_m = 0.5: the upper stop must be below the rest length L0_m = 0.3"),
+    ({"x_high_m": 0.05, "initial_contraction_m": 0.06}, "initial_contraction_m = 0.06: must lie between the stops, "
+     "0 and 0.0500 m"),
 ])
 def test_invalid_fmu_parameters_fail_initialisation(unzipped, version, values, message, capfd):
     capfd.readouterr()

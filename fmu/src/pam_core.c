@@ -362,6 +362,11 @@ int pam_check_parameters(PamCore *c) {
     for (k = 0; k < PAM_NVARS; k++)
         if (PAM_VARS[k].causality == PAM_INPUT && pam_check_value(c, (unsigned)k + 1, r[PAM_VARS[k].index])) bad = -1;
     if (bad) return -1;
+    if (r[R_x_high_m] > 0.0 && !(r[R_x_high_m] < r[R_L0_m])) {
+        pam_logf(c, PAM_LOG_ERROR, "invalid parameters: x_high_m = %g: the upper stop must be below the rest length "
+                 "L0_m = %g (x_high_m = 0: the braid lock from the geometry)", r[R_x_high_m], r[R_L0_m]);
+        return -1;
+    }
     x_high = upper_stop_m(r);
     if (!(r[R_initial_contraction_m] >= 0.0 && r[R_initial_contraction_m] <= x_high)) {
         pam_logf(c, PAM_LOG_ERROR,

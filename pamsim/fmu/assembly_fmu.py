@@ -85,10 +85,11 @@ class AssemblyVariables:
                   initial="exact") for k, v in enumerate(self.flat.parameters)])
 
     def _inputs(self, starts) -> list[Variable]:
-        """The model inputs, as the one-muscle FMU declares those it has (ranges, descriptions)."""
+        """The model inputs, with the ranges the one-muscle FMU declares for those it has."""
         return self._placed("INPUT", [
-            replace(BY_NAME.get(v.name) or _real(v.name, "input", "continuous", f"{v.description} [{v.unit}]", v.unit),
-                    start=float(starts.get(v.name, 0.0))) for v in self.flat.inputs])
+            replace(BY_NAME.get(v.name) or _real(v.name, "input", "continuous", "", v.unit),
+                    description=f"{v.description or 'model input'} [{v.unit}]", start=float(starts.get(v.name, 0.0)))
+            for v in self.flat.inputs])
 
     def _states(self) -> list[Variable]:
         outputs = {v.name for v in self.flat.outputs}
