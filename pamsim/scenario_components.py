@@ -60,6 +60,9 @@ def added_components(v, entries: list) -> tuple[AddedComponent, ...]:
                        choices=declared)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
                 v.fail(f"{where}.{key}", value, "must be a finite number")
+            why = next(p for p in cls.parameters if p.name == key).violation(float(value))
+            if why:
+                v.fail(f"{where}.{key}", value, why)
             values[key] = float(value)
         for key in declared:
             if key not in values:

@@ -189,15 +189,21 @@ def test_a_serialized_state_continues_in_another_instance(built):
         inst.freeInstance()
 
 
-@pytest.mark.parametrize("name, value", [("valve_command", 2.0), ("spring.k_N_per_m", math.nan)])
-def test_bad_values_are_refused(built, name, value):
+@pytest.mark.parametrize("name, value", [("valve_command", 2.0), ("spring.k_N_per_m", math.nan),
+                                         ("load.mass_kg", -1.0), ("load.restitution", 2.0),
+                                         ("spring.k_N_per_m", -1.0), ("chamber.T_initial_K", -1.0)])
+def test_bad_values_are_refused(built, name, value, capfd):
+    """Refused when set (an input) or at the end of initialisation (a parameter), naming it: the ranges
+    the components declare (a mass, a temperature above zero, a restitution in [0, 1])."""
     md = fmpy.read_model_description(built[2])
     vr = {v.name: v.valueReference for v in md.modelVariables}
     fmu = _instance(built[2], md)
+    capfd.readouterr()
     with pytest.raises(Exception):
         fmu.setReal([vr[name]], [value])
         fmu.enterInitializationMode()
         fmu.exitInitializationMode()
+    assert f"{name} = {value:g}" in capfd.readouterr().out
     fmu.freeInstance()
 
 

@@ -99,6 +99,13 @@ def test_a_bad_component_table_is_refused_naming_it(entry, key, why):
     assert key in str(err.value) and why in str(err.value)
 
 
+def test_a_parameter_outside_its_range_is_refused():
+    spec = copy.deepcopy(SPEC)
+    spec["component"][0]["k_N_per_m"] = -200.0
+    with pytest.raises(InputError, match=r"component\[0\]\.k_N_per_m = -200.*must be >= 0"):
+        pamsim.Scenario.from_dict(spec)
+
+
 def test_a_missing_parameter_is_refused():
     spec = copy.deepcopy(SPEC)
     del spec["component"][0]["x_free_m"]

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ..modeling import PNEUMATIC, Component, Equations, Port, Symbols, Var
+from ..modeling import PNEUMATIC, Component, Equations, Port, Symbols, Var, non_negative, positive
 from ..modeling.smath import if_else
 from .element import ElementParameters
 
@@ -33,9 +33,9 @@ class PolytropicChamber(ElementParameters, Component):
     outputs = (Var("p_gauge_Pa", "Pa", "chamber gauge pressure"), Var("p_abs_Pa", "Pa", "absolute chamber pressure"),
                Var("gas_temperature_K", "K", "chamber gas temperature p V / (m R)"),
                Var("volume_m3", "m^3", "chamber volume"))
-    extra_parameters = (Var("p_atm_Pa", "Pa", "ambient pressure"),
-                        Var("initial_pressure_gauge_Pa", "Pa", "chamber gauge pressure at the start"),
-                        Var("T_initial_K", "K", "gas temperature at the start"))
+    extra_parameters = (positive("p_atm_Pa", "Pa", "ambient pressure"),
+                        non_negative("initial_pressure_gauge_Pa", "Pa", "chamber gauge pressure at the start"),
+                        positive("T_initial_K", "K", "gas temperature at the start"))
 
     def __init__(self, name: str, element, p_atm_Pa: float, initial_pressure_gauge_Pa: float, T_initial_K: float):
         values = self.wrap(element, _volume_m3, PROBE_POINTS, required="chamber")

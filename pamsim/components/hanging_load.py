@@ -13,7 +13,7 @@ from __future__ import annotations
 from enum import IntEnum
 
 from ..core_table import EVENT_V_TOL_M_S, EVENT_X_TOL_M
-from ..modeling import TRANSLATIONAL, Component, Equations, Port, Symbols, Var
+from ..modeling import TRANSLATIONAL, Component, Equations, Port, Symbols, Var, non_negative, positive
 from ..modeling.smath import if_else
 
 
@@ -75,14 +75,16 @@ class HangingLoad(Component):
 
     modes = LoadMode
     n_indicators = 2
-    parameters = (Var("mass_kg", "kg", "hanging mass, holder included"),
-                  Var("g_m_s2", "m/s^2", "gravitational acceleration"),
-                  Var("x_low_m", "m", "lower stop"), Var("x_high_m", "m", "upper stop"),
-                  Var("restitution", "1", "coefficient of restitution at the stops"),
-                  Var("min_rebound_speed_m_s", "m/s", "a slower rebound off a stop is none: the load stays on it"),
-                  Var("stick_margin_N", "N", "a stopping load is held unless the net force beats friction by more"),
-                  Var("release_margin_N", "N", "a held load is released when the net force beats friction by this"),
-                  Var("initial_contraction_m", "m", "contraction at the start, load at rest"))
+    parameters = (positive("mass_kg", "kg", "hanging mass, holder included"),
+                  positive("g_m_s2", "m/s^2", "gravitational acceleration"),
+                  non_negative("x_low_m", "m", "lower stop"), positive("x_high_m", "m", "upper stop"),
+                  Var("restitution", "1", "coefficient of restitution at the stops", lower=0.0, upper=1.0),
+                  non_negative("min_rebound_speed_m_s", "m/s",
+                               "a slower rebound off a stop is none: the load stays on it"),
+                  non_negative("stick_margin_N", "N",
+                               "a stopping load is held unless the net force beats friction by more"),
+                  positive("release_margin_N", "N", "a held load is released when the net force beats friction by this"),
+                  non_negative("initial_contraction_m", "m", "contraction at the start, load at rest"))
     ports = (Port("flange", TRANSLATIONAL, "node"),)
     inputs = (Var("friction_level_N", "N", "Coulomb friction level"),
               Var("F_external_N", "N", "external force on the load along x"))

@@ -6,7 +6,7 @@ return spring, a compliant mounting), so its stiffness comes from its data sheet
 
 from __future__ import annotations
 
-from ..modeling import TRANSLATIONAL, Component, Equations, Port, Symbols, Var
+from ..modeling import TRANSLATIONAL, Component, Equations, Port, Symbols, Var, non_negative
 
 
 class LinearSpring(Component):
@@ -16,7 +16,7 @@ class LinearSpring(Component):
     State ``W_spring_J``: the work the spring does on the load, the integral of ``F v``.
     """
 
-    parameters = (Var("k_N_per_m", "N/m", "stiffness"),
+    parameters = (non_negative("k_N_per_m", "N/m", "stiffness"),
                   Var("x_free_m", "m", "contraction at which the spring carries no force"))
     ports = (Port("flange", TRANSLATIONAL, "branch"),)
     states = (Var("W_spring_J", "J", "work done by the spring on the load", 0.1),)

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ..modeling import PNEUMATIC, Component, Equations, Port, Symbols, Var
+from ..modeling import PNEUMATIC, Component, Equations, Port, Symbols, Var, positive
 from ..modeling.smath import if_else
 from .element import ElementParameters
 
@@ -30,9 +30,9 @@ class ProportionalValve(ElementParameters, Component):
               Var("supply_gauge_Pa", "Pa", "supply gauge pressure"))
     outputs = (Var("mass_flow_kg_s", "kg/s", "mass flow into the port"),
                Var("p_settle_abs_Pa", "Pa", "port pressure at which the flow stops"))
-    extra_parameters = (Var("T_supply_K", "K", "supply air temperature"),
-                        Var("p_atm_Pa", "Pa", "ambient (exhaust) pressure"),
-                        Var("R_J_per_kg_K", "J/(kg K)", "specific gas constant of air"))
+    extra_parameters = (positive("T_supply_K", "K", "supply air temperature"),
+                        positive("p_atm_Pa", "Pa", "ambient (exhaust) pressure"),
+                        positive("R_J_per_kg_K", "J/(kg K)", "specific gas constant of air"))
 
     def __init__(self, name: str, element, T_supply_K: float, p_atm_Pa: float, R_J_per_kg_K: float):
         values = self.wrap(element, _inflow_kg_s, PROBE_POINTS, required="valve")

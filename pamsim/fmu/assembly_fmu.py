@@ -82,7 +82,8 @@ class AssemblyVariables:
     def _parameters(self, values) -> list[Variable]:
         return self._placed("PARAMETER", [
             _real(v.name, "parameter", "fixed", f"{v.description} [{v.unit}]", v.unit, start=float(values[k]),
-                  initial="exact") for k, v in enumerate(self.flat.parameters)])
+                  initial="exact", lower=v.lower, upper=v.upper, lower_open=v.lower_open, upper_open=v.upper_open)
+            for k, v in enumerate(self.flat.parameters)])
 
     def _inputs(self, starts) -> list[Variable]:
         """The model inputs, with the ranges the one-muscle FMU declares for those it has."""

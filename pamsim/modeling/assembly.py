@@ -10,7 +10,7 @@ whose equations are CasADi expressions of the states, inputs, parameters and mod
 from __future__ import annotations
 
 from collections import defaultdict
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Mapping, Sequence
 
 from .component import Component, Equations, Symbols, quiet_numpy_on_symbols
@@ -263,7 +263,7 @@ class Assembly:
             return ca.substitute([ca.SX(expr)], list(resolved), list(resolved.values()))[0] if resolved else ca.SX(expr)
 
         comps = self.components
-        fv = lambda c, v: Var(f"{c.name}.{v.name}", v.unit, v.description, v.nominal)  # noqa: E731
+        fv = lambda c, v: replace(v, name=f"{c.name}.{v.name}")  # noqa: E731
         out_vars = [fv(c, v) for c in comps for v in c.outputs]
         hybrid = [c for c in comps if c.modes is not None]
         free = [c for c in hybrid if c.name not in modes]

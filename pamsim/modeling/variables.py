@@ -10,17 +10,47 @@ by hand.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 
 @dataclass(frozen=True)
 class Var:
-    """A named variable with its unit, meaning and nominal scale (the integrator's absolute scale)."""
+    """A named variable with its unit, meaning and nominal scale (the integrator's absolute scale), and
+    for a parameter the range its value must lie in (``lower``/``upper``; ``*_open``: the bound excluded),
+    which a scenario and an FMU check."""
 
     name: str
     unit: str
     description: str = ""
     nominal: float = 1.0
+    lower: float = -math.inf
+    upper: float = math.inf
+    lower_open: bool = False
+    upper_open: bool = False
+
+    def violation(self, value: float) -> str | None:
+        """Why ``value`` is outside the range, or None."""
+        low = value <= self.lower if self.lower_open else value < self.lower
+        high = value >= self.upper if self.upper_open else value > self.upper
+        if not (low or high):
+            return None
+        if math.isinf(self.upper):
+            return f"must be {'>' if self.lower_open else '>='} {self.lower:g}"
+        if math.isinf(self.lower):
+            return f"must be {'<' if self.upper_open else '<='} {self.upper:g}"
+        return (f"must lie in {'(' if self.lower_open else '['}{self.lower:g}, {self.upper:g}"
+                f"{')' if self.upper_open else ']'}")
+
+
+def positive(name: str, unit: str, description: str) -> Var:
+    """A parameter that must be above zero (a mass, a temperature, an absolute pressure)."""
+    return Var(name, unit, description, lower=0.0, lower_open=True)
+
+
+def non_negative(name: str, unit: str, description: str) -> Var:
+    """A parameter that must not be negative (a stiffness, a distance from a stop, a margin)."""
+    return Var(name, unit, description, lower=0.0)
 
 
 @dataclass(frozen=True)
