@@ -40,38 +40,50 @@ def added_components(v, entries: list) -> tuple[AddedComponent, ...]:
         where = f"component[{i}]"
         if not isinstance(entry, dict):
             v.fail(where, entry, "must be a table ([[component]])")
-        name = entry.get("name")
-        if not isinstance(name, str) or not name.isidentifier():
-            v.fail(f"{where}.name", name, "must be a name made of letters, digits and underscores")
-        if name in RIG_COMPONENTS or name in names:
-            v.fail(f"{where}.name", name, "is taken (by the rig's own components or an earlier [[component]])")
+        name = _component_name(v, where, entry, names)
         names.add(name)
         kind = entry.get("type")
         if kind not in COMPONENT_TYPES:
             v.fail(f"{where}.type", kind, "unknown component type", choices=sorted(COMPONENT_TYPES))
         cls = COMPONENT_TYPES[kind]
-        declared = [p.name for p in cls.parameters]
-        values: dict[str, float] = {}
-        for key, value in entry.items():
-            if key in RESERVED_KEYS:
-                continue
-            if key not in declared:
-                v.fail(f"{where}.{key}", value, f"not a parameter of {kind}" + did_you_mean(key, declared),
-                       choices=declared)
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-                v.fail(f"{where}.{key}", value, "must be a finite number")
-            why = next(p for p in cls.parameters if p.name == key).violation(float(value))
-            if why:
-                v.fail(f"{where}.{key}", value, why)
-            values[key] = float(value)
-        for key in declared:
-            if key not in values:
-                v.fail(f"{where}.{key}", None, f"missing: {kind} needs {', '.join(declared)}")
+        values = _component_values(v, where, kind, cls.parameters, entry)
         connect = entry.get("connect", {})
         if not isinstance(connect, dict) or not all(isinstance(t, str) for t in connect.values()):
             v.fail(f"{where}.connect", connect, 'must be a table of its ports and inputs, e.g. {flange = "load.flange"}')
         out.append(AddedComponent(cls(name, values), dict(connect)))
     return tuple(out)
+
+
+def _component_name(v, where: str, entry: dict, taken: set) -> str:
+    """The entry's name: an identifier, not the rig's own components' nor an earlier entry's."""
+    name = entry.get("name")
+    if not isinstance(name, str) or not name.isidentifier():
+        v.fail(f"{where}.name", name, "must be a name made of letters, digits and underscores")
+    if name in RIG_COMPONENTS or name in taken:
+        v.fail(f"{where}.name", name, "is taken (by the rig's own components or an earlier [[component]])")
+    return name
+
+
+def _component_values(v, where: str, kind: str, parameters, entry: dict) -> dict[str, float]:
+    """The entry's parameter values: each declared, a finite number in its range, none missing."""
+    declared = {p.name: p for p in parameters}
+    values: dict[str, float] = {}
+    for key, value in entry.items():
+        if key in RESERVED_KEYS:
+            continue
+        if key not in declared:
+            v.fail(f"{where}.{key}", value, f"not a parameter of {kind}" + did_you_mean(key, list(declared)),
+                   choices=list(declared))
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+            v.fail(f"{where}.{key}", value, "must be a finite number")
+        why = declared[key].violation(float(value))
+        if why:
+            v.fail(f"{where}.{key}", value, why)
+        values[key] = float(value)
+    for key in declared:
+        if key not in values:
+            v.fail(f"{where}.{key}", None, f"missing: {kind} needs {', '.join(declared)}")
+    return values
 
 
 def refuse_added(scenario: Any, what: str, error: type[Exception]) -> None:
