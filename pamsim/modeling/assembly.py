@@ -82,20 +82,24 @@ class Assembly:
 
     def _nets(self) -> list[list[_Endpoint]]:
         """Connected ports grouped into nets, each checked for one kind and exactly one node."""
-        parent: dict[str, str] = {}
-        ends: dict[str, _Endpoint] = {}
+        ends = {f"{c.name}.{p.name}": _Endpoint(c, p.name, "port") for c in self.components for p in c.ports}
+        parent = {label: label for label in ends}
+        for a, b in self._port_connections():
+            parent[_root(parent, a.label)] = _root(parent, b.label)
+        nets, unconnected = [], []
+        for members in self._groups(ends, parent):
+            lone = _lone_port(members)
+            if lone:
+                unconnected.append(lone)
+            else:
+                nets.append(_with_one_node(members))
+        if unconnected:
+            raise AssemblyError(f"port{'s' if len(unconnected) > 1 else ''} {', '.join(unconnected)} "
+                                f"{'are' if len(unconnected) > 1 else 'is'} not connected")
+        return nets
 
-        def find(k):
-            while parent[k] != k:
-                parent[k] = parent[parent[k]]
-                k = parent[k]
-            return k
-
-        for c in self.components:
-            for p in c.ports:
-                ep = _Endpoint(c, p.name, "port")
-                parent[ep.label] = ep.label
-                ends[ep.label] = ep
+    def _port_connections(self):
+        """The connections of two ports, as endpoints, checked one by one as they are read (a signal is skipped)."""
         for a_ref, b_ref in self.connections:
             a, b = self._endpoint(a_ref), self._endpoint(b_ref)
             if (a.kind == "port") != (b.kind == "port"):
@@ -107,7 +111,10 @@ class Assembly:
             if ka != kb:
                 raise AssemblyError(f"cannot connect port {a.label} ({ka.name}) to port {b.label} ({kb.name}): "
                                     "the kinds differ")
-            parent[find(a.label)] = find(b.label)
+            yield a, b
+
+    def _groups(self, ends: dict[str, _Endpoint], parent: dict[str, str]) -> list[list[_Endpoint]]:
+        """The ports of each net (by union-find root), the nets in order of their first member."""
         # A net's branches in the order they were first connected: the node sums their through
         # variables in that order, so a floating-point sum is the same whatever the component order.
         first = {}
@@ -116,24 +123,8 @@ class Assembly:
                 first.setdefault(ref, i)
         groups: dict[str, list[_Endpoint]] = defaultdict(list)
         for label, ep in sorted(ends.items(), key=lambda item: first.get(item[0], len(self.connections))):
-            groups[find(label)].append(ep)
-        nets, unconnected = [], []
-        for members in groups.values():
-            nodes = [e for e in members if e.component.port(e.name).role == "node"]
-            if len(members) == 1:
-                port = members[0].component.port(members[0].name)
-                if port.role == "branch" or not port.optional:
-                    unconnected.append(f"{members[0].label} ({port.kind.name} {port.role})")
-                    continue
-            if len(nodes) != 1:
-                labels = ", ".join(e.label for e in members)
-                raise AssemblyError(f"ports {labels} form a net with {len(nodes)} nodes; it needs exactly one "
-                                    "(a body or a volume that the others act on)")
-            nets.append(members)
-        if unconnected:
-            raise AssemblyError(f"port{'s' if len(unconnected) > 1 else ''} {', '.join(unconnected)} "
-                                f"{'are' if len(unconnected) > 1 else 'is'} not connected")
-        return nets
+            groups[_root(parent, label)].append(ep)
+        return list(groups.values())
 
     def _signal_sources(self) -> dict[str, tuple[str, str]]:
         """``{"comp.input": ("output", "comp.output") or ("input", model input name)}``, every input bound once."""
@@ -302,6 +293,39 @@ class Assembly:
 
 def _var(vs: Sequence[Var], name: str) -> Var:
     return next(v for v in vs if v.name == name)
+
+
+def _root(parent: dict[str, str], k: str) -> str:
+    """The union-find root of ``k``, halving the path to it on the way."""
+    while parent[k] != k:
+        parent[k] = parent[parent[k]]
+        k = parent[k]
+    return k
+
+
+def _nodes(members: list[_Endpoint]) -> list[_Endpoint]:
+    """The node ports among a net's members."""
+    return [e for e in members if e.component.port(e.name).role == "node"]
+
+
+def _with_one_node(members: list[_Endpoint]) -> list[_Endpoint]:
+    """A net's members, refused unless exactly one of them is a node."""
+    nodes = _nodes(members)
+    if len(nodes) != 1:
+        labels = ", ".join(e.label for e in members)
+        raise AssemblyError(f"ports {labels} form a net with {len(nodes)} nodes; it needs exactly one "
+                            "(a body or a volume that the others act on)")
+    return members
+
+
+def _lone_port(members: list[_Endpoint]) -> str | None:
+    """A port alone in its net that must be connected (any branch, a node unless optional), described; else None."""
+    if len(members) != 1:
+        return None
+    port = members[0].component.port(members[0].name)
+    if port.role == "branch" or not port.optional:
+        return f"{members[0].label} ({port.kind.name} {port.role})"
+    return None
 
 
 def _checked(c: Component, eq: Equations) -> Equations:
