@@ -186,109 +186,175 @@ class Assembly:
         """
         import casadi as ca
 
-        modes = dict(modes or {})
         nets = self._nets()
         signal_sources = self._signal_sources()
         model_inputs = {name: ca.SX.sym(name) for name in self.inputs}
-        params, states, placeholders = [], [], {}
-        symbols: dict[str, Symbols] = {}
-        mode_syms = {}
-        fired_syms: tuple = ()
-        externals: list[External] = []
-        tol = ca.SX.sym("tol")
+        work = _Flattening(ca, self.components, dict(modes or {}))
+        bindings = _signal_bindings(signal_sources, model_inputs, work.equations)
+        bindings.update(_net_bindings(ca, nets, work.equations))
+        work.substitute(_resolve(work.placeholders, bindings))
+        return work.flat_model(self.name, self._input_vars(), list(model_inputs.values()))
 
-        def external(component: Component):
-            def call(name: str, fn, *args):
-                sym = ca.SX.sym(f"{component.name}.{name}#{len(externals)}")
-                externals.append(External(f"{component.name}.{name}", fn, sym, [ca.SX(a) for a in args]))
-                return sym
-            return call
-        for c in self.components:
-            p = {v.name: ca.SX.sym(f"{c.name}.{v.name}") for v in c.parameter_vars()}
-            x = {v.name: ca.SX.sym(f"{c.name}.{v.name}") for v in c.states}
-            u = {v.name: ca.SX.sym(f"{c.name}.{v.name}") for v in c.inputs}
-            port = {}
-            for pt in c.ports:
-                read = pt.kind.through if pt.role == "node" else pt.kind.across
-                port[pt.name] = {v.name: ca.SX.sym(f"{c.name}.{pt.name}.{v.name}") for v in read}
-            mode = None
-            if c.name in modes:
-                mode = float(c.modes(modes[c.name]))
-            elif c.modes is not None:
-                mode = mode_syms[c.name] = ca.SX.sym(f"{c.name}.mode")
-            fired = ()
-            if c.modes is not None:
-                fired = tuple(ca.SX.sym(f"{c.name}.fired{k}") for k in range(c.n_indicators))
-                fired_syms += fired
-            symbols[c.name] = Symbols(p, x, u, port, mode, fired, external(c), tol)
-            params += [(c, v, p[v.name]) for v in c.parameter_vars()]
-            states += [(c, v, x[v.name]) for v in c.states]
-            placeholders.update({f"{c.name}.{k}": s for k, s in u.items()})
-            for pt_name, vs in port.items():
-                placeholders.update({f"{c.name}.{pt_name}.{k}": s for k, s in vs.items()})
+    def _input_vars(self) -> list[Var]:
+        """The model's inputs, each with the unit of the (first) component input it drives."""
+        return [Var(n, _var(self._endpoint(refs[0]).component.inputs, self._endpoint(refs[0]).name).unit)
+                for n, refs in self.inputs.items()]
+
+
+class _Flattening:
+    """One flattening: the components' symbols and equations, then their expressions in the flat model's terms.
+
+    Symbols are made in the components' order, which is the flat model's order of states, parameters,
+    modes and event flags.
+    """
+
+    def __init__(self, ca, components: Sequence[Component], modes: dict[str, int]):
+        self.ca, self.components, self.modes = ca, components, modes
+        self.params, self.states, self.placeholders = [], [], {}
+        self.symbols: dict[str, Symbols] = {}
+        self.mode_syms = {}
+        self.fired_syms: tuple = ()
+        self.externals: list[External] = []
+        self.tol = ca.SX.sym("tol")
+        self.resolved: dict = {}
+        for c in components:
+            self._declare(c)
         with quiet_numpy_on_symbols():
-            equations = {c.name: _checked(c, c.equations(symbols[c.name])) for c in self.components}
+            self.equations = {c.name: _checked(c, c.equations(self.symbols[c.name])) for c in components}
 
-        bindings: dict[str, object] = {}
-        for label, (kind, source) in signal_sources.items():
-            if kind == "input":
-                bindings[label] = model_inputs[source]
-            else:
-                comp, out = source.split(".", 1)
-                bindings[label] = equations[comp].outputs[out]
-        for members in nets:
-            node = next(e for e in members if e.component.port(e.name).role == "node")
-            kind = node.component.port(node.name).kind
-            branches = [e for e in members if e is not node]
-            for v in kind.across:
-                for b in branches:
-                    bindings[f"{b.label}.{v.name}"] = equations[node.component.name].port[node.name][v.name]
-            for v in kind.through:
-                total = ca.SX(0.0)
-                for b in branches:
-                    total = total + equations[b.component.name].port[b.name][v.name]
-                bindings[f"{node.label}.{v.name}"] = total
-        resolved = _resolve(placeholders, bindings)
+    def _syms(self, c: Component, vs, infix: str = "") -> dict:
+        """A symbol for each variable, named ``component.[infix]variable``."""
+        return {v.name: self.ca.SX.sym(f"{c.name}.{infix}{v.name}") for v in vs}
 
-        def flat(expr):
-            return ca.substitute([ca.SX(expr)], list(resolved), list(resolved.values()))[0] if resolved else ca.SX(expr)
+    def _declare(self, c: Component) -> None:
+        """Make the component's symbols and note its parameters, states and placeholders."""
+        p, x, u = self._syms(c, c.parameter_vars()), self._syms(c, c.states), self._syms(c, c.inputs)
+        # A node reads the sum of its branches' through variables, a branch its node's across ones.
+        port = {pt.name: self._syms(c, pt.kind.through if pt.role == "node" else pt.kind.across, f"{pt.name}.")
+                for pt in c.ports}
+        mode, fired = self._mode(c)
+        self.symbols[c.name] = Symbols(p, x, u, port, mode, fired, self._external(c), self.tol)
+        self.params += [(c, v, p[v.name]) for v in c.parameter_vars()]
+        self.states += [(c, v, x[v.name]) for v in c.states]
+        self.placeholders.update({f"{c.name}.{k}": s for k, s in u.items()})
+        for pt_name, vs in port.items():
+            self.placeholders.update({f"{c.name}.{pt_name}.{k}": s for k, s in vs.items()})
 
-        comps = self.components
-        fv = lambda c, v: replace(v, name=f"{c.name}.{v.name}")  # noqa: E731
-        out_vars = [fv(c, v) for c in comps for v in c.outputs]
-        hybrid = [c for c in comps if c.modes is not None]
-        free = [c for c in hybrid if c.name not in modes]
+    def _mode(self, c: Component) -> tuple:
+        """The component's mode (a number if fixed, a symbol if free, None without modes) and its event flags."""
+        mode = None
+        if c.name in self.modes:
+            mode = float(c.modes(self.modes[c.name]))
+        elif c.modes is not None:
+            mode = self.mode_syms[c.name] = self.ca.SX.sym(f"{c.name}.mode")
+        fired = ()
+        if c.modes is not None:
+            fired = tuple(self.ca.SX.sym(f"{c.name}.fired{k}") for k in range(c.n_indicators))
+            self.fired_syms += fired
+        return mode, fired
 
-        def mode_of(c):
-            return mode_syms[c.name] if c.name in mode_syms else float(c.modes(modes[c.name]))
+    def _external(self, component: Component):
+        """The component's :attr:`Symbols.external`: a symbol for each call, noted with its function and arguments."""
+        def call(name: str, fn, *args):
+            sym = self.ca.SX.sym(f"{component.name}.{name}#{len(self.externals)}")
+            self.externals.append(External(f"{component.name}.{name}", fn, sym, [self.ca.SX(a) for a in args]))
+            return sym
+        return call
 
-        initial = _initial_states(states, {c.name: equations[c.name].initial for c in comps}, flat)
-        transition_x = [flat(equations[c.name].transition.get(v.name, sym)) for c, v, sym in states]
-        settle_x = [flat(equations[c.name].settle.get(v.name, sym)) for c, v, sym in states]
-        return FlatModel(
-            name=self.name,
-            states=[fv(c, v) for c, v, _ in states],
-            inputs=[Var(n, _var(self._endpoint(refs[0]).component.inputs, self._endpoint(refs[0]).name).unit)
-                    for n, refs in self.inputs.items()],
-            outputs=out_vars,
-            parameters=[fv(c, v) for c, v, _ in params],
-            parameter_values=[float(c.values[v.name]) for c, v, _ in params],
-            modes=[(c.name, c.modes) for c in hybrid],
-            x=[s for _, _, s in states], u=list(model_inputs.values()), p=[s for _, _, s in params],
-            q=[mode_syms[c.name] for c in free], e=list(fired_syms),
-            f=[flat(equations[c.name].der[v.name]) for c, v, _ in states],
-            y=[flat(equations[c.name].outputs[v.name]) for c in comps for v in c.outputs],
-            z=[flat(z) for c in hybrid for z in equations[c.name].indicators],
-            z_margin=[flat(m) for c in hybrid for m in (equations[c.name].indicator_margins
-                                                         or (0.0,) * c.n_indicators)],
-            transition_x=transition_x, settle_x=settle_x, tol=tol,
-            transition_q=[flat(equations[c.name].transition.get("mode", mode_of(c))) for c in hybrid],
-            rest_q=[flat(equations[c.name].rest_mode) for c in hybrid],
-            x0=initial,
-            q0=[flat(ca.substitute([ca.SX(equations[c.name].initial.get("mode", 0.0))],
-                                   [sym for _, _, sym in states], initial)[0]) for c in hybrid],
-            externals=[External(e.name, e.fn, e.symbol, [flat(a) for a in e.args]) for e in externals],
-        )
+    def substitute(self, resolved: dict) -> None:
+        """From now on :meth:`_flat` replaces each placeholder by its resolved expression."""
+        self.resolved = resolved
+
+    def _flat(self, expr):
+        """``expr`` with no placeholder left: in states, inputs, parameters and modes only."""
+        ca, resolved = self.ca, self.resolved
+        return ca.substitute([ca.SX(expr)], list(resolved), list(resolved.values()))[0] if resolved else ca.SX(expr)
+
+    def _mode_of(self, c: Component):
+        """The mode a component keeps when no event moves it: its symbol if free, else its fixed value."""
+        return self.mode_syms[c.name] if c.name in self.mode_syms else float(c.modes(self.modes[c.name]))
+
+    def flat_model(self, name: str, inputs: list[Var], u: list) -> FlatModel:
+        """The flat model (``inputs``: the model's input variables, ``u``: their symbols)."""
+        hybrid = [c for c in self.components if c.modes is not None]
+        # Made in the order the flat model lists them, as they always were, so that nothing that may follow
+        # the order in which CasADi's nodes are made can change the generated code.
+        state_exprs = self._state_expressions()
+        outputs = [self._flat(self.equations[c.name].outputs[v.name]) for c in self.components for v in c.outputs]
+        mode_exprs = self._mode_expressions(hybrid, state_exprs["x0"])
+        externals = [External(e.name, e.fn, e.symbol, [self._flat(a) for a in e.args]) for e in self.externals]
+        return FlatModel(name=name, inputs=inputs, u=u, y=outputs, tol=self.tol, externals=externals,
+                         **self._variables(), **self._symbol_lists(hybrid), **state_exprs, **mode_exprs)
+
+    def _symbol_lists(self, hybrid: list[Component]) -> dict:
+        """The hybrid components with their modes, and the state, parameter, mode and event flag symbols."""
+        return {"modes": [(c.name, c.modes) for c in hybrid], "x": [s for _, _, s in self.states],
+                "p": [s for _, _, s in self.params],
+                "q": [self.mode_syms[c.name] for c in hybrid if c.name not in self.modes], "e": list(self.fired_syms)}
+
+    def _variables(self) -> dict:
+        """The flat model's states, outputs and parameters (namespaced) and the parameters' values."""
+        return {"states": [_namespaced(c, v) for c, v, _ in self.states],
+                "outputs": [_namespaced(c, v) for c in self.components for v in c.outputs],
+                "parameters": [_namespaced(c, v) for c, v, _ in self.params],
+                "parameter_values": [float(c.values[v.name]) for c, v, _ in self.params]}
+
+    def _state_expressions(self) -> dict:
+        """Per state: its initial value, its value after an event and settled, and its derivative."""
+        eq, states = self.equations, self.states
+        initial = _initial_states(states, {c.name: eq[c.name].initial for c in self.components}, self._flat)
+        return {"x0": initial,
+                "transition_x": [self._flat(eq[c.name].transition.get(v.name, sym)) for c, v, sym in states],
+                "settle_x": [self._flat(eq[c.name].settle.get(v.name, sym)) for c, v, sym in states],
+                "f": [self._flat(eq[c.name].der[v.name]) for c, v, _ in states]}
+
+    def _mode_expressions(self, hybrid: list[Component], initial: list) -> dict:
+        """Per hybrid component: its indicators and their margins, its mode after an event, at rest and at the start."""
+        ca, eq, flat = self.ca, self.equations, self._flat
+        out = {"z": [flat(z) for c in hybrid for z in eq[c.name].indicators],
+               "z_margin": [flat(m) for c in hybrid
+                            for m in (eq[c.name].indicator_margins or (0.0,) * c.n_indicators)],
+               "transition_q": [flat(eq[c.name].transition.get("mode", self._mode_of(c))) for c in hybrid],
+               "rest_q": [flat(eq[c.name].rest_mode) for c in hybrid]}
+        out["q0"] = [flat(ca.substitute([ca.SX(eq[c.name].initial.get("mode", 0.0))],
+                                        [sym for _, _, sym in self.states], initial)[0]) for c in hybrid]
+        return out
+
+
+def _signal_bindings(signal_sources: dict[str, tuple[str, str]], model_inputs: dict, equations: dict) -> dict:
+    """Each component input's placeholder name -> the model input or the component output that drives it."""
+    bindings: dict[str, object] = {}
+    for label, (kind, source) in signal_sources.items():
+        if kind == "input":
+            bindings[label] = model_inputs[source]
+        else:
+            comp, out = source.split(".", 1)
+            bindings[label] = equations[comp].outputs[out]
+    return bindings
+
+
+def _net_bindings(ca, nets: list[list[_Endpoint]], equations: dict) -> dict:
+    """Each port variable's placeholder name -> its value: a branch reads its node's across variables,
+    a node the sum of its branches' through variables, in the net's order."""
+    bindings: dict[str, object] = {}
+    for members in nets:
+        node = _nodes(members)[0]
+        kind = node.component.port(node.name).kind
+        branches = [e for e in members if e is not node]
+        for v in kind.across:
+            for b in branches:
+                bindings[f"{b.label}.{v.name}"] = equations[node.component.name].port[node.name][v.name]
+        for v in kind.through:
+            total = ca.SX(0.0)
+            for b in branches:
+                total = total + equations[b.component.name].port[b.name][v.name]
+            bindings[f"{node.label}.{v.name}"] = total
+    return bindings
+
+
+def _namespaced(c: Component, v: Var) -> Var:
+    """The component's variable under its flat model name, ``component.variable``."""
+    return replace(v, name=f"{c.name}.{v.name}")
 
 
 def _var(vs: Sequence[Var], name: str) -> Var:
