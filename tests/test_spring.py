@@ -219,3 +219,24 @@ def test_the_casadi_export_holds_the_added_component():
     flat = casadi_model(pamsim.load_scenario(SCENARIOS / "parallel_spring.toml"))._assembly.flatten()
     assert "spring.W_spring_J" in [v.name for v in flat.states]
     assert "spring.F_spring_N" in [v.name for v in flat.outputs]
+
+
+@pytest.mark.parametrize("k_N_per_m, x_free_m, share", [
+    # A spring free at 50 mm pulls 2000 * 0.045 = 90 N at 5 mm, the unpressurised muscle nothing there.
+    (2000.0, 0.05, "where the muscle pulls 0.00 N and component 'spring' 90.00 N"),
+    # A stiff spring free at 0 resists 20000 * 0.005 = 100 N at 5 mm, more than the muscle gives at 3.6 bar.
+    (20000.0, 0.0, "component 'spring' -100.00 N"),
+])
+def test_linearize_says_what_the_spring_pulls_when_no_pressure_can_hold_the_load(k_N_per_m, x_free_m, share):
+    """Where no gauge pressure in [0, supply] holds the load, the message names the spring and its share,
+    rather than laying the whole pull on the muscle."""
+    from pamsim.control.exact import rest_pull
+    from pamsim.control.operating_point import held_equilibrium
+
+    scenario = _scenario(spring={"k_N_per_m": k_N_per_m, "x_free_m": x_free_m})
+    model = scenario.build_model()
+    added = scenario.added_components
+    with pytest.raises(InputError) as err:
+        held_equilibrium(model, 0.005, scenario.final_pressure_gauge_Pa, pull=rest_pull(model, added))
+    assert "muscle with component 'spring'" in str(err.value)
+    assert share in str(err.value)

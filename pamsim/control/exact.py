@@ -139,12 +139,18 @@ class _RestPull:
                              *[ca.SX(params[v.name]) for v in flat.parameters], *[ca.SX(0.0) for _ in flat.u])
         self._added = ca.Function("added_force", [x_sym, p_sym], [ca.substitute(added_N, subs_from, subs_to)])
         self.static_force = model.static_force
+        names = [repr(a.component.name) for a in added]
+        self.added_names = f"component{'s' if len(names) > 1 else ''} {', '.join(names)}"
+
+    def added_N(self, x_m, p_gauge_Pa):
+        """What the added components alone pull the load with at rest [N] (scalars or arrays)."""
+        x = np.asarray(x_m, dtype=float)
+        added = np.vectorize(lambda xi: float(self._added(xi, float(p_gauge_Pa))))(x)
+        return added if x.ndim else float(added)
 
     def force_N(self, x_m, p_gauge_Pa):
         """The pull [N] at contraction ``x_m`` and gauge pressure ``p_gauge_Pa`` (scalars or arrays)."""
-        x = np.asarray(x_m, dtype=float)
-        added = np.vectorize(lambda xi: float(self._added(xi, float(p_gauge_Pa))))(x)
-        return self.static_force.force_N(x_m, p_gauge_Pa) + (added if x.ndim else float(added))
+        return self.static_force.force_N(x_m, p_gauge_Pa) + self.added_N(x_m, p_gauge_Pa)
 
 
 def exact_jacobians(model, states, inputs, friction: FrictionTreatment, valve_slope: str, added: tuple = ()):

@@ -57,6 +57,22 @@ def _load_N(model: MuscleModel, F_ext_N: float) -> float:
     return model.load.weight_N - F_ext_N
 
 
+def _who(pull) -> str:
+    """What pulls the load at rest, for a message: the muscle, or the muscle with the added components
+    (:func:`pamsim.control.exact.rest_pull`), so that a spring's pull is not laid on the muscle."""
+    added = getattr(pull, "added_names", None)
+    return "the muscle" if added is None else f"the muscle with {added}"
+
+
+def _shares(pull, x_m: float, p_gauge_Pa: float) -> str:
+    """``, where the muscle pulls a N and component 'spring' b N``: each puller's share at ``x_m``,
+    ``p_gauge_Pa``, with components added; nothing for the muscle alone."""
+    if getattr(pull, "added_names", None) is None:
+        return ""
+    muscle = float(pull.static_force.force_N(x_m, p_gauge_Pa))
+    return f", where the muscle pulls {muscle:.2f} N and {pull.added_names} {float(pull.added_N(x_m, p_gauge_Pa)):.2f} N"
+
+
 def _rest_states(model: MuscleModel, x_m: float, p_gauge_Pa: float) -> np.ndarray:
     return np.array([x_m, 0.0, *model.source.initial_state(x_m, p_gauge_Pa)], dtype=float)
 
@@ -83,11 +99,12 @@ def open_valve_equilibrium(model: MuscleModel, supply_gauge_Pa: float, F_ext_N: 
     bar = supply_gauge_Pa / PA_PER_BAR
     if x_eq <= model.stops.x_low_m:
         cap = max_load_N(pull, supply_gauge_Pa, x_high)
-        raise InputError(f"a load of {load:.2f} N is beyond the muscle's force capability at {bar:g} bar "
+        raise InputError(f"a load of {load:.2f} N is beyond the force capability of {_who(pull)} at {bar:g} bar "
                          f"({cap:.2f} N): it rests on the lower stop, no equilibrium to linearise about")
     if x_eq >= x_high:
-        raise InputError(f"at {bar:g} bar the muscle out-pulls {load:.2f} N up to its upper stop "
-                         f"({x_high * 1e3:.1f} mm): no free equilibrium to linearise about")
+        raise InputError(f"at {bar:g} bar {_who(pull)} out-pulls {load:.2f} N up to its upper stop "
+                         f"({x_high * 1e3:.1f} mm{_shares(pull, x_high, supply_gauge_Pa)}): "
+                         "no free equilibrium to linearise about")
     return OperatingPoint(_rest_states(model, x_eq, supply_gauge_Pa), np.array([1.0, supply_gauge_Pa, F_ext_N]),
                           "open_valve", Mode.STICK,
                           f"valve open, chamber at the {bar:g} bar supply, load {load:.2f} N at rest at "
@@ -109,14 +126,17 @@ def holding_pressure_Pa(model: MuscleModel, x_m: float, load_N: float, p_max_gau
         If the load needs more than ``p_max_gauge_Pa`` there, or the muscle's
         elastic force alone already exceeds it (it would need a vacuum).
     """
-    F = (pull or model.static_force).force_N
+    pull = pull or model.static_force
+    F = pull.force_N
     lo, hi = F(x_m, 0.0) - load_N, F(x_m, p_max_gauge_Pa) - load_N
     if hi < 0.0:
         raise InputError(f"holding {load_N:.2f} N at {x_m * 1e3:g} mm needs more than the "
-                         f"{p_max_gauge_Pa / PA_PER_BAR:g} bar supply (the muscle can hold {F(x_m, p_max_gauge_Pa):.2f} N "
-                         "there): the load is beyond its force capability at this contraction")
+                         f"{p_max_gauge_Pa / PA_PER_BAR:g} bar supply ({_who(pull)} can hold "
+                         f"{F(x_m, p_max_gauge_Pa):.2f} N there{_shares(pull, x_m, p_max_gauge_Pa)}): the load is beyond "
+                         "its force capability at this contraction")
     if lo > 0.0:
-        raise InputError(f"at {x_m * 1e3:g} mm the unpressurised muscle already pulls {F(x_m, 0.0):.2f} N, "
+        raise InputError(f"at {x_m * 1e3:g} mm {_who(pull).replace('the muscle', 'the unpressurised muscle', 1)} "
+                         f"already pulls {F(x_m, 0.0):.2f} N{_shares(pull, x_m, 0.0)}, "
                          f"more than the {load_N:.2f} N load: it cannot be held there at a gauge pressure >= 0")
     return float(brentq(lambda p: F(x_m, p) - load_N, 0.0, p_max_gauge_Pa, xtol=1e-9))
 
