@@ -466,6 +466,12 @@ def test_fmu_state_get_set_and_serialise_repeat_a_step(fmus, version):
     api.step(0.3, 0.4)
     assert api.get("contraction_m", "velocity_m_s", "p_gauge_Pa") == first
     fmu.terminate()
+    # As in the standard's Reference FMUs, a state may be set in any state, Terminated included: it
+    # brings back the state machine's state with the values, so the run resumes where it was saved.
+    put(state)
+    api.step(0.3, 0.4)
+    assert api.get("contraction_m", "velocity_m_s", "p_gauge_Pa") == first
+    fmu.terminate()
     fmu.freeInstance()
 
 
