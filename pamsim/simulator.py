@@ -133,7 +133,8 @@ def _from_start(fun, t0: float, y0: np.ndarray):
 
 LONG_STEP_S = 0.01
 """A step longer than this [s] is checked inside for a crossing that its two ends do not show (the C
-engine's default longest step while the load slides, the FMU's ``cs_max_step_s``)."""
+engine's default longest step while the load slides, the FMU's ``cs_max_step_s``).  So is a step of any
+length in which the load turns back (:func:`_steps_to_check`)."""
 LONG_STEP_CHECKS = 16
 """Points of a long step's dense output checked for a crossing (as the C engine checks a held load's)."""
 
@@ -148,13 +149,30 @@ def _with_missed_crossing(sol, named):
     dense output is checked at :data:`LONG_STEP_CHECKS` points.  Ordinary steps are far shorter, and a
     run without a long step is left exactly as it was."""
     t = sol.t
-    for i in np.flatnonzero(np.diff(t) > LONG_STEP_S):
+    for i in _steps_to_check(sol):
         taus = np.linspace(t[i], t[i + 1], LONG_STEP_CHECKS + 1)
         for lo, hi in zip(taus[:-2], taus[1:-1]):  # the step's end is what solve_ivp checked
             fired = [k for k, (_, fun, _) in enumerate(named) if fun(hi, sol.sol(hi)) < 0.0]
             if fired:
                 return _cut_at(sol, named, fired, lo, hi)
     return sol
+
+
+_V_ROW = 1
+"""Row of the load's velocity in the state vector (``MuscleModel.state_names`` begins ``x_m, v_m_s``)."""
+
+
+def _steps_to_check(sol) -> np.ndarray:
+    """Indices of the steps checked inside for a crossing: those longer than :data:`LONG_STEP_S`, and
+    those in which the load's velocity changes sign.
+
+    A position indicator (a stop) can go below zero and back within one step only if the load turns
+    back inside it, whatever the step's length, so a fixed length alone would miss a fast, stiff
+    swing's turn at a stop in a short step.  Where a velocity event ends the segment (a load with
+    friction) no step inside it turns, so this costs nothing there."""
+    v = sol.y[_V_ROW]
+    turning = np.signbit(v[:-1]) != np.signbit(v[1:])
+    return np.flatnonzero((np.diff(sol.t) > LONG_STEP_S) | turning)
 
 
 def _cut_at(sol, named, fired, lo: float, hi: float):

@@ -424,3 +424,26 @@ def test_breakpoints_a_rounding_apart_are_one():
     sc = pamsim.Scenario.from_dict(spec, name="knots")
     py, nat = pamsim.simulate(sc), pamsim.simulate(sc, backend="native")
     assert abs(py.x_m[-1] - nat.x_m[-1]) < 5e-6
+
+
+def test_a_crossing_inside_a_short_step_where_the_load_turns_is_not_missed():
+    """A swing that turns 0.1 um beyond a stop inside one 5 ms step: both step ends are below the stop, the
+    step is shorter than ``LONG_STEP_S``, and the crossing is still found, at its analytic time."""
+    from types import SimpleNamespace
+
+    from pamsim.simulator import LONG_STEP_S, _with_missed_crossing
+
+    a, t_turn, x_turn, over = 10.0, 0.0124, 0.05, 1e-7  # deceleration [m/s2], turn [s], [m], overshoot [m]
+    x_stop = x_turn - over
+
+    def y(t):
+        return np.array([x_turn - 0.5 * a * (t - t_turn) ** 2, -a * (t - t_turn)])
+
+    t = np.arange(0.0, 0.0251, 0.005)
+    assert np.diff(t).max() < LONG_STEP_S
+    sol = SimpleNamespace(t=t, y=np.column_stack([y(ti) for ti in t]), sol=y, status=0, nfev=0)
+    assert (y(t)[0] < x_stop).all()  # the ends show nothing
+    named = [("upper_stop", lambda tt, yy: x_stop - yy[0], None)]
+    cut = _with_missed_crossing(sol, named)
+    assert cut.status == 1
+    np.testing.assert_allclose(cut.t[-1], t_turn - np.sqrt(2 * over / a), rtol=0, atol=1e-12)
