@@ -249,3 +249,45 @@ def test_a_supply_a_rounding_off_the_chamber_runs_on(built, python_run):
                           output=["load.x_m", "chamber.air_mass_kg"])
     assert np.isfinite(r["chamber.air_mass_kg"]).all()
     assert abs(r["load.x_m"][-1] - python_run.result.x_m[-1]) < 2e-7
+
+
+def test_the_generated_code_kept_per_structure_gives_the_spec_generated_afresh():
+    """A scenario of the same structure with other values reuses the kept C; its FMU description, sources
+    and token equal those generated with nothing kept, and differ from the first scenario's."""
+    from pamsim.fmu import assembly_fmu
+
+    sc = pamsim.load_scenario(SCENARIO)
+    other = sc.with_changes({"load": {"weight_N": 30.0}})
+    first = assembly_fmu.assembly_spec(sc)
+    kept = assembly_fmu.assembly_spec(other)
+    assembly_fmu._GENERATED.clear()
+    afresh = assembly_fmu.assembly_spec(other)
+    assert kept == afresh and kept.token == afresh.token
+    assert first.token != kept.token and first.generated == kept.generated
+
+
+def test_the_temporary_fmu_folder_keeps_the_recently_used(tmp_path, monkeypatch):
+    """Beyond TEMP_FMUS_KEPT entries the least recently used idle ones go; recently used ones stay."""
+    import importlib
+    import os
+    import time
+
+    build = importlib.import_module("pamsim.fmu.build")  # the package's `build` is the function
+
+    root = tmp_path / "pamsim-fmu"
+    monkeypatch.setattr(build, "temp_fmu_root", lambda: root)
+    now = time.time()
+    for k in range(build.TEMP_FMUS_KEPT + 6):  # entry 0 the newest, all idle for over an hour
+        (root / f"old{k}").mkdir(parents=True)
+        os.utime(root / f"old{k}", (now - 3600 - k, now - 3600 - k))
+    for k in range(3):
+        (root / f"busy{k}").mkdir()  # used a minute ago: never removed, though the oldest would go first
+        os.utime(root / f"busy{k}", (now - 60, now - 60))
+
+    made = []
+    path = build.temp_fmu("{new}", "m.fmu", lambda p: (p.parent.mkdir(parents=True), p.write_text("x"), made.append(p)))
+    assert path == root / "new" / "m.fmu" and path.is_file() and made == [path]
+    names = {p.name for p in root.iterdir()}
+    assert {"new", "busy0", "busy1", "busy2"} <= names and len(names) == build.TEMP_FMUS_KEPT
+    assert {f"old{k}" for k in range(build.TEMP_FMUS_KEPT - 4)} <= names  # the newest idle kept
+    assert build.temp_fmu("{new}", "m.fmu", lambda p: made.append(p)) == path and len(made) == 1  # built once

@@ -20,6 +20,7 @@ from __future__ import annotations
 import hashlib
 import os
 import uuid
+from collections import OrderedDict
 from dataclasses import replace
 from pathlib import Path
 
@@ -163,7 +164,6 @@ def assembly_spec(scenario, fmi_version: int = 2, model=None) -> FmuSpec:
         model has no C (a static force computed by Python alone), or whose signals the FMU cannot carry.
     """
     from ..assemblies.one_muscle import scenario_assembly
-    from ..modeling.cmodel import CModel
 
     if "controller" in scenario.spec and model is None:
         raise InputError(f"{scenario.origin}: controller: without the controller's model the FMU would run this "
@@ -171,7 +171,7 @@ def assembly_spec(scenario, fmi_version: int = 2, model=None) -> FmuSpec:
                          "controller and puts it in the FMU")
     assembly = scenario_assembly(scenario, model)
     try:
-        cmodel = CModel(assembly, jacobians=True)
+        cmodel, model_c = _generated(assembly)
     except NotImplementedError as exc:
         raise InputError(f"{scenario.origin}: the FMU of this assembly needs C for every component: {exc}") from None
     names = [v.name for v in cmodel.full.inputs]
@@ -179,7 +179,6 @@ def assembly_spec(scenario, fmi_version: int = 2, model=None) -> FmuSpec:
     table = AssemblyVariables(cmodel, assembly.parameter_values(), {n: s(0.0) for n, s in signals.items()})
     variables = tuple(replace(v, start=INPUT_SOURCE_CHOICES.index("scenario")) if v.name == "input_source" else v
                       for v in table.variables)
-    model_c = cmodel.sources()["pam_model.c"]
     opts = scenario.solver
     experiment = Experiment(scenario.duration_s, 1.0 / opts.sample_rate_Hz, opts.rtol)
     where = f"scenario {scenario.name} ({scenario.origin})"
@@ -190,6 +189,29 @@ def assembly_spec(scenario, fmi_version: int = 2, model=None) -> FmuSpec:
                    {"pam_model.c": model_c, "pam_fmu_core.h": CORE_HEADER}, tuple(table.c_lines()), signals,
                    experiment, fmi_version=fmi_version, usage=_usage(table, where), included=("pam_engine.c",))
     return replace(spec, token=_token(spec))
+
+
+_GENERATED: "OrderedDict[tuple, tuple]" = OrderedDict()
+GENERATED_KEPT = 16
+"""Generated C models kept per process, by structure: runs of one scenario, or of a sweep over its
+values, generate their C once (about 0.2 s) and only recompute the token."""
+
+
+def _generated(assembly):
+    """The :class:`~pamsim.modeling.cmodel.CModel` of ``assembly`` with exact Jacobians and its
+    ``pam_model.c``, shared by assemblies of one structure: the code depends on nothing else (the
+    parameter values are the FMU's start values, written apart from it)."""
+    from ..modeling.cmodel import CModel
+
+    key = assembly.structure_key()
+    if key in _GENERATED:
+        _GENERATED.move_to_end(key)
+        return _GENERATED[key]
+    cmodel = CModel(assembly, jacobians=True)
+    _GENERATED[key] = cmodel, cmodel.sources()["pam_model.c"]
+    while len(_GENERATED) > GENERATED_KEPT:
+        _GENERATED.popitem(last=False)
+    return _GENERATED[key]
 
 
 def _usage(table: AssemblyVariables, where: str) -> tuple[tuple[str, str], ...]:

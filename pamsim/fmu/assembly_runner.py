@@ -12,7 +12,6 @@ between samples, as for the one-muscle FMU.
 from __future__ import annotations
 
 import math
-import tempfile
 import time
 from pathlib import Path
 
@@ -22,7 +21,7 @@ from ..assemblies.one_muscle import RigOutputs, scenario_assembly
 from ..errors import InputError, SolverFailure
 from ..result import Result
 from .assembly_fmu import assembly_spec
-from .build import build_spec
+from .build import build_spec, temp_fmu
 from .runner import grid_rows, trace_stats
 
 KINDS = {"cs": "CoSimulation", "me": "ModelExchange"}
@@ -33,9 +32,7 @@ def cached_assembly_fmu(scenario, model, fmi_version: int = 2) -> tuple[Path, tu
     """The FMU of the assembly of ``scenario`` with ``model`` (:func:`~pamsim.fmu.assembly_fmu.assembly_spec`),
     built on first use and kept in the temporary folder under its token, and the names of its states."""
     spec = assembly_spec(scenario, fmi_version, model)
-    path = Path(tempfile.gettempdir()) / "pamsim-fmu" / spec.token.strip("{}") / f"{spec.identifier}_fmi{fmi_version}.fmu"
-    if not path.is_file():
-        build_spec(path, spec)
+    path = temp_fmu(spec.token, f"{spec.identifier}_fmi{fmi_version}.fmu", lambda out: build_spec(out, spec))
     return path, spec.states
 
 

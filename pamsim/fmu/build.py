@@ -15,8 +15,10 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import time
 import zipfile
 from pathlib import Path
+from typing import Callable
 
 from ..errors import InputError
 from .force_table import ForceTable
@@ -140,3 +142,43 @@ def build_spec(out: Path, spec: FmuSpec) -> Path:
         os.replace(partial, out)
     return out
 
+
+
+TEMP_FMUS_KEPT = 64
+"""FMUs the backends keep in the temporary folder (``pamsim-fmu``): a sweep on an FMU backend builds one per
+scenario value set, so older entries are removed (:func:`temp_fmu`)."""
+TEMP_FMU_IDLE_S = 600.0
+"""An entry unused for less than this [s] is never removed: another process may be about to run it."""
+
+
+def temp_fmu_root() -> Path:
+    """The folder the FMU backends keep their FMUs in."""
+    return Path(tempfile.gettempdir()) / "pamsim-fmu"
+
+
+def temp_fmu(token: str, file_name: str, make: Callable[[Path], object]) -> Path:
+    """The FMU kept under ``token`` in :func:`temp_fmu_root`, made by ``make(path)`` on first use.
+
+    Each use marks the entry as used; beyond :data:`TEMP_FMUS_KEPT` entries, the least recently used
+    ones idle for :data:`TEMP_FMU_IDLE_S` are removed, so the folder does not grow with every value set.
+    """
+    folder = temp_fmu_root() / token.strip("{}")
+    path = folder / file_name
+    if not path.is_file():
+        make(path)
+        _prune(temp_fmu_root(), keep=folder)
+    os.utime(folder)
+    return path
+
+
+def _prune(root: Path, keep: Path) -> None:
+    entries = []
+    for entry in root.iterdir():
+        try:
+            entries.append((entry.stat().st_mtime, entry))
+        except FileNotFoundError:  # removed meanwhile by another process
+            continue
+    now = time.time()
+    for mtime, entry in sorted(entries, reverse=True)[TEMP_FMUS_KEPT:]:
+        if entry != keep and entry.is_dir() and now - mtime > TEMP_FMU_IDLE_S:
+            shutil.rmtree(entry, ignore_errors=True)

@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import math
 import shutil
-import tempfile
 import time
 from pathlib import Path
 from typing import Sequence
@@ -30,7 +29,7 @@ from ..elements.pressure_source import ValveChamberSource
 from ..errors import InputError, SolverFailure
 from ..result import Result
 from ..scenario import Scenario
-from .build import build
+from .build import build, temp_fmu
 from .force_table import DEFAULT_POINTS, ForceTable, tabulate
 from .generate import token
 from .variables import (BY_NAME, DAMPING_CHOICES, FRICTION_CHOICES, INPUT_SOURCE_CHOICES, INPUTS, NEGATIVE_LEVEL,
@@ -41,11 +40,8 @@ OUTPUTS = ("contraction_m", "velocity_m_s", "p_gauge_Pa", "chamber_pressure_abs_
 
 def cached_fmu(fmi_version: int = 2, force_table: ForceTable | None = None) -> Path:
     """An FMU built from the current sources (and ``force_table``), kept in the temp folder under its token."""
-    folder = Path(tempfile.gettempdir()) / "pamsim-fmu" / token(fmi_version, force_table).strip("{}")
-    path = folder / f"pamsim_muscle_fmi{fmi_version}.fmu"
-    if not path.is_file():
-        build(path, fmi_version, force_table)
-    return path
+    return temp_fmu(token(fmi_version, force_table), f"pamsim_muscle_fmi{fmi_version}.fmu",
+                    lambda path: build(path, fmi_version, force_table))
 
 
 def tabulate_model(scenario: Scenario, points: tuple[int, int] = DEFAULT_POINTS) -> ForceTable:
