@@ -1,6 +1,6 @@
 """How accurate each backend and method is at a given tolerance, against a converged run.
 
-    python benchmarks/accuracy.py
+    python benchmarks/accuracy.py [--no-paper]
 
 The test case is the hardest the rig offers an integrator: no Coulomb friction, no damping and a
 prescribed 3.6 bar step at 1 s (no valve to damp it), so the load swings freely and bounces on its
@@ -12,21 +12,35 @@ errors are printed per run:
 - the largest error over the whole run, which after 37 impacts measures how the bounce sequence
   amplifies any difference (an impact a hair earlier changes every later one), not the error control.
 
-Also the number of events (37 where nothing was missed) and the wall time of the run.
+Also the number of events (37 where nothing was missed) and the wall time of the run.  The native
+backend runs at each ``rtol`` twice: at that tolerance (``solver.native_rtol_factor = 1``, like for like
+with the python methods) and at its default, ``rtol`` times ``pamsim.simulator.NATIVE_RTOL_FACTOR``.
+
+Then the paper's cases (unless ``--no-paper``): the five figure scenarios and the 66 steady-state cases
+of ``acra2012_grid.toml`` (its first friction model), each at its own ``rtol`` (1e-6), against the
+python backend's DOP853 at rtol 1e-12: the largest contraction error over the run of the python default
+(LSODA) and of the native backend at factors 1, 0.1 and its default, and the native wall time of the
+66 cases in one ``simulate_batch`` call (best of 3).
 """
 
 from __future__ import annotations
 
+import argparse
 import time
 from pathlib import Path
 
 import numpy as np
 
 import pamsim
+from pamsim.native import simulate_batch
+from pamsim.simulator import NATIVE_RTOL_FACTOR
 
 ROOT = Path(__file__).resolve().parents[1]
-RUNS = (("native", "DOPRI5(4)"), ("python", "LSODA"), ("python", "RK45"), ("python", "DOP853"))
+RUNS = (("native", "DOPRI5(4)", 1.0), ("native", "default", NATIVE_RTOL_FACTOR), ("python", "LSODA", None),
+        ("python", "RK45", None), ("python", "DOP853", None))
 RTOLS = (1e-6, 1e-8, 1e-10)
+FIGURES = ("acra2012_fig3", "acra2012_fig4", "acra2012_fig5", "acra2012_fig6a", "acra2012_fig6b")
+CONVERGED = {"rtol": 1e-12, "method": "DOP853"}
 
 
 def free_swing():
@@ -36,23 +50,91 @@ def free_swing():
         "pressure": {"source": "prescribed", "prescribed": {"kind": "step", "time_s": 1.0, "final_gauge_bar": 3.6}}})
 
 
-def main() -> None:
+def free_swing_table() -> None:
+    """The free swing at each backend, method and rtol."""
     base = free_swing()
-    ref = pamsim.simulate(base.with_changes({"solver": {"rtol": 1e-12, "method": "DOP853"}}))
+    ref = pamsim.simulate(base.with_changes({"solver": CONVERGED}))
     first = next(e.t_s for e in ref.transitions if e.kind == "stop_high")
     swing = ref.t_s < first
     print(f"reference: python DOP853 at rtol 1e-12, {len(ref.transitions)} events, first impact at {first:.4f} s")
-    print(f"{'backend':8} {'method':10} {'rtol':>6} {'swing error mm':>15} {'whole run mm':>13} {'events':>7} {'time s':>7}")
-    for backend, method in RUNS:
+    print(f"{'backend':8} {'method':10} {'rtol':>6} {'its rtol':>8} {'swing error mm':>15} {'whole run mm':>13} "
+          f"{'events':>7} {'time s':>7}")
+    for backend, method, factor in RUNS:
         for rtol in RTOLS:
-            changes = {"rtol": rtol} if backend == "native" else {"rtol": rtol, "method": method}
+            changes = {"rtol": rtol, "method": method} if factor is None else {"rtol": rtol, "native_rtol_factor": factor}
             t0 = time.perf_counter()
             run = pamsim.simulate(base.with_changes({"solver": changes}), backend=backend)
             wall = time.perf_counter() - t0
             swing_mm = np.max(np.abs(run.x_m[swing] - ref.x_m[swing])) * 1e3
             whole_mm = np.max(np.abs(run.x_m - ref.x_m)) * 1e3
-            print(f"{backend:8} {method:10} {rtol:6.0e} {swing_mm:15.2e} {whole_mm:13.2e} {len(run.transitions):7d} "
-                  f"{wall:7.3f}")
+            print(f"{backend:8} {method:10} {rtol:6.0e} {rtol * (factor or 1.0):8.0e} {swing_mm:15.2e} {whole_mm:13.2e} "
+                  f"{len(run.transitions):7d} {wall:7.3f}")
+
+
+def error_mm(run, ref) -> float:
+    """The largest contraction difference over the run [mm]."""
+    return float(np.max(np.abs(run.x_m - ref.x_m))) * 1e3
+
+
+def paper_errors(scenarios, factors) -> tuple[dict[str, list[float]], list[bool]]:
+    """Per run (python LSODA, then the native backend at each factor), the error of each scenario
+    [mm] against its converged run; and whether each scenario's load moves at all."""
+    runs = {f: simulate_batch([s.with_changes({"solver": {"native_rtol_factor": f}}) for s in scenarios])
+            for f in factors}
+    errors = {"python LSODA": [], **{f"native x{f:g}" + (" (default)" if f == NATIVE_RTOL_FACTOR else ""): []
+                                     for f in factors}}
+    moving = []  # the cases whose load leaves its lower stop (the others stay there, exactly, on every run)
+    for i, s in enumerate(scenarios):
+        ref = pamsim.simulate(s.with_changes({"solver": CONVERGED}))
+        moving.append(bool(np.ptp(ref.x_m) > 0.0))
+        for name, run in zip(errors, (pamsim.simulate(s), *(runs[f][i] for f in factors))):
+            errors[name].append(error_mm(run, ref))
+    return errors, moving
+
+
+def _row(label: str, values, fmt: str = "26.2e") -> str:
+    return f"{label:16}" + "".join(f"{v:{fmt}}" for v in values)
+
+
+def paper_table() -> None:
+    """The paper's figures and cases: the python default's and the native backend's error, and its time."""
+    from pamsim.sweep import load_sweep
+
+    figures = [pamsim.load_scenario(ROOT / "scenarios" / f"{name}.toml") for name in FIGURES]
+    grid = load_sweep(ROOT / "scenarios" / "acra2012_grid.toml")
+    cases = [grid.case_scenario(c, grid.friction_models[0]) for c in grid.cases]
+    factors = tuple(sorted({1.0, 0.1, NATIVE_RTOL_FACTOR}, reverse=True))
+    errors, moving = paper_errors(figures + cases, factors)
+    print(f"\npaper cases at their rtol ({figures[0].solver.rtol:g}), largest contraction error [mm] against "
+          "python DOP853 at rtol 1e-12")
+    print(f"{'case':16}" + "".join(f"{name:>26}" for name in errors))
+    for i, s in enumerate(figures):
+        print(_row(s.name, (e[i] for e in errors.values())))
+    grid_errors = [np.array(e[len(figures):]) for e in errors.values()]
+    moves = np.array(moving[len(figures):])
+    print(_row("66 cases, max", (e.max() for e in grid_errors)))
+    print(_row(f"median of {moves.sum()}", (np.median(e[moves]) for e in grid_errors))
+          + "  (the cases whose load moves)")
+    print(_row("66: above LSODA", (int(np.sum(e > grid_errors[0])) for e in grid_errors), "26d"))
+    for f in factors:
+        batch = [s.with_changes({"solver": {"native_rtol_factor": f}}) for s in cases]
+        best = min(_timed(lambda: simulate_batch(batch)) for _ in range(3))
+        print(f"native factor {f:g}: the 66 cases in one simulate_batch call, best of 3: {best * 1e3:.1f} ms")
+
+
+def _timed(fn) -> float:
+    t0 = time.perf_counter()
+    fn()
+    return time.perf_counter() - t0
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--no-paper", action="store_true", help="only the free swing")
+    args = parser.parse_args()
+    free_swing_table()
+    if not args.no_paper:
+        paper_table()
 
 
 if __name__ == "__main__":

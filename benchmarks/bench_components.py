@@ -16,9 +16,13 @@ Rows:
   second process that finds the first one's code on disk (``pamsim.modeling.code_cache``);
 - ``pamsim --help``: a fresh process, best of N;
 - fig4 on the native backend (median of 20 N calls after 3 warm-up calls) and the 66 paper cases in
-  one native batch (best of 4 N); the first native fig4 call of a process with empty caches (this
-  checkout generates the model's C and compiles the engine, the baseline compiles its C core), then
-  in a second process that finds the library on disk;
+  one native batch (best of 4 N), at the scenario's ``rtol`` in both checkouts (a checkout whose
+  native backend scales it by ``solver.native_rtol_factor`` runs these rows at factor 1, so that the
+  ratio compares the code, not the tolerance); the first native fig4 call of a process with empty
+  caches (this checkout generates the model's C and compiles the engine, the baseline compiles its C
+  core), then in a second process that finds the library on disk;
+- the same two native rows at this checkout's default factor, if it has one, with their cost against
+  factor 1 (the price of the default tolerance, not of the code);
 - this checkout only: flattening and generating the one-muscle model's Python (every function and
   the five per-mode sets), generating its C and compiling it with the system's C compiler, and one
   right-hand-side evaluation of the generated Python against the composed model's elements.
@@ -60,21 +64,33 @@ for _ in range(int(sys.argv[2])):
     for c in cases:
         pamsim.simulate(c)
     grid.append(time.perf_counter() - t)
+import dataclasses
 from pamsim.native import simulate_batch
+from pamsim.simulator import SolverOptions
+# Like for like: the native backend at the scenario's rtol in both checkouts (a checkout that scales it
+# by solver.native_rtol_factor runs at factor 1 here; its default is measured on its own below).
+scaled = "native_rtol_factor" in {f.name for f in dataclasses.fields(SolverOptions)}
+at_rtol = {"solver": {"native_rtol_factor": 1.0}}
+def like(s): return s.with_changes(at_rtol) if scaled else s
+def native_times(fig, batch_cases):
+    for _ in range(3):
+        pamsim.simulate(fig, backend="native")
+    one = []
+    for _ in range(int(sys.argv[2]) * 20):
+        t = time.perf_counter(); pamsim.simulate(fig, backend="native"); one.append(time.perf_counter() - t)
+    many = []
+    for _ in range(int(sys.argv[2]) * 4):
+        t = time.perf_counter(); simulate_batch(batch_cases); many.append(time.perf_counter() - t)
+    return statistics.median(one), min(many)
 t = time.perf_counter()
-pamsim.simulate(sc, backend="native")
+pamsim.simulate(like(sc), backend="native")
 native_first = time.perf_counter() - t
-for _ in range(3):
-    pamsim.simulate(sc, backend="native")
-native = []
-for _ in range(int(sys.argv[2]) * 20):
-    t = time.perf_counter(); pamsim.simulate(sc, backend="native"); native.append(time.perf_counter() - t)
-batch = []
-for _ in range(int(sys.argv[2]) * 4):
-    t = time.perf_counter(); simulate_batch(cases); batch.append(time.perf_counter() - t)
+native, batch = native_times(like(sc), [like(c) for c in cases])
+default = native_times(sc, cases) if scaled else (None, None)
 print(json.dumps({"fig4_s": statistics.median(runs), "grid_s": min(grid), "first_s": first,
-                  "import_s": t1 - t0, "native_fig4_s": statistics.median(native), "native_grid_s": min(batch),
-                  "native_first_s": native_first}))
+                  "import_s": t1 - t0, "native_fig4_s": native, "native_grid_s": batch,
+                  "native_first_s": native_first, "native_default_fig4_s": default[0],
+                  "native_default_grid_s": default[1]}))
 """
 
 
@@ -154,6 +170,12 @@ print(json.dumps({"import_casadi_pamsim_s": t1 - t0, "flatten_s": t2 - t1, "pyth
 """
 
 
+def _best(values):
+    """The smallest of the measurements, or None where the checkout has no such row."""
+    values = [v for v in values if v is not None]
+    return min(values) if values else None
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--baseline", type=Path, help="a checkout of the commit to compare with")
@@ -167,8 +189,8 @@ def main(argv=None) -> int:
         nows.append(measure(HERE, args.repeat))
         if args.baseline:
             befores.append(measure(args.baseline, args.repeat))
-    now = {k: min(m[k] for m in nows) for k in nows[0]}
-    before = {k: min(m[k] for m in befores) for k in befores[0]} if befores else None
+    now = {k: _best(m[k] for m in nows) for k in nows[0]}
+    before = {k: _best(m[k] for m in befores) for k in befores[0]} if befores else None
     print(f"{'measure':34s} {'this checkout':>14s}" + (f" {'baseline':>10s} {'ratio':>6s}" if before else ""))
     rows = (("fig4, python backend [ms]", "fig4_s", 1e3), ("66 paper cases, python [s]", "grid_s", 1.0),
             ("first fig4 call of a process [s]", "first_s", 1.0),
@@ -182,6 +204,12 @@ def main(argv=None) -> int:
         if before:
             line += f" {before[key] * scale:10.3f} {now[key] / before[key]:6.2f}"
         print(line)
+    if now["native_default_fig4_s"] is not None:
+        print("(the native rows run at the scenario's rtol; at this checkout's default, rtol times "
+              "solver.native_rtol_factor:)")
+        for label, key, like in (("fig4, native default [ms]", "native_default_fig4_s", "native_fig4_s"),
+                                 ("66 paper cases, native default [ms]", "native_default_grid_s", "native_grid_s")):
+            print(f"{label:34s} {now[key] * 1e3:14.3f}   {now[key] / now[like]:.2f} x factor 1")
     with tempfile.TemporaryDirectory() as cache:  # an empty code cache: everything is generated
         env = {**os.environ, "PYTHONPATH": str(HERE), "PAMSIM_CODE_CACHE": cache}
         gen = json.loads(subprocess.run([sys.executable, "-c", GENERATE, str(HERE)], check=True, capture_output=True,

@@ -36,7 +36,7 @@ from .scenario_components import added_components, check_wiring
 from .static_models import REGISTRY
 from .signal_tables import signal_from_table, signal_range
 from .signals import Constant, Step
-from .simulator import MIN_MAX_STEP_S, SolverOptions
+from .simulator import MIN_MAX_STEP_S, MIN_RTOL, NATIVE_RTOL_FACTOR, SolverOptions
 from .table_checks import TableChecker, choices_hint, did_you_mean
 
 
@@ -51,7 +51,7 @@ _SCHEMA: dict[str, dict[str, Any]] = {
     "pressure": {"source": str, "supply_gauge_bar": float, "supply_gauge_Pa": float, "valve_open_time_s": float,
                  "command": dict, "prescribed": dict, "initial_gauge_bar": float},
     "simulation": {"duration_s": float, "sample_rate_Hz": float, "initial_contraction_m": float},
-    "solver": {"method": str, "rtol": float, "max_events": int, "max_step_s": float},
+    "solver": {"method": str, "rtol": float, "max_events": int, "max_step_s": float, "native_rtol_factor": float},
     "measured": {"steady_state": str},
 }
 _MAX_SAMPLES = 1e7  # 8 s at 1 kHz is 8,001; beyond this the output would not fit in memory comfortably
@@ -417,8 +417,8 @@ def _solver_options(v: "_Validator", solver: dict, duration: float, sample_rate:
     if method not in _METHODS:
         v.fail("solver.method", method, "unknown method", choices=_METHODS)
     rtol = v.number("solver.rtol", solver.get("rtol", 1e-6))
-    if not 1e-13 <= rtol <= 1e-2:
-        v.fail("solver.rtol", rtol, "must lie in [1e-13, 1e-2]")
+    if not MIN_RTOL <= rtol <= 1e-2:
+        v.fail("solver.rtol", rtol, f"must lie in [{MIN_RTOL:g}, 1e-2]")
     max_events = solver.get("max_events", 20000)
     if max_events < 1:
         v.fail("solver.max_events", max_events, "must be at least 1")
@@ -428,7 +428,15 @@ def _solver_options(v: "_Validator", solver: dict, duration: float, sample_rate:
         v.fail("solver.max_step_s", max_step, f"must be at least {smallest_step:.3g} s (1 us, and no more than "
                f"{MAX_STEPS:.0e} steps over duration_s = {duration:g} s)")
     return SolverOptions(method=method, rtol=rtol, sample_rate_Hz=sample_rate, max_events=int(max_events),
-                         max_step_s=max_step)
+                         max_step_s=max_step, native_rtol_factor=_native_rtol_factor(v, solver))
+
+
+def _native_rtol_factor(v: "_Validator", solver: dict) -> float:
+    """``solver.native_rtol_factor``, in (0, 1]."""
+    factor = v.number("solver.native_rtol_factor", solver.get("native_rtol_factor", NATIVE_RTOL_FACTOR))
+    if not 0.0 < factor <= 1.0:
+        v.fail("solver.native_rtol_factor", factor, "must lie in (0, 1]")
+    return factor
 
 
 def _checked_name(v: "_Validator", name: str) -> str:

@@ -73,7 +73,10 @@ is over the 2 there are; their steps differ, and so do their results, at the tol
 
 @pytest.mark.parametrize("name", list(CASES))
 def test_the_engine_agrees_with_the_hand_written_core(name):
-    scenario = CASES[name]
+    # Two implementations of one algorithm, compared at the scenario's rtol (1e-6), where they take the
+    # same steps.  At the native default (rtol 1e-8) their step sequences part by rounding (fig3 at
+    # 1.18 s), and they end 2e-9 m apart, an error of the tolerance's size.
+    scenario = CASES[name].with_changes({"solver": {"native_rtol_factor": 1.0}})
     res = pamsim.simulate(scenario, backend="native")
     S, events, (x_max, x_min, p_max) = _core(scenario)
     kinds = [library.EVENT_KINDS[int(e[1])] for e in events]

@@ -558,31 +558,52 @@ static void dp_dense(const DpStages *s, const double *y0, double h, double th, d
     }
 }
 
-static double min_indicator(const PamCore *c, const double *y) {
-    double z[PAM_NZ];
+/* The smallest of the indicators in `which` (bit k: indicator k) at y. */
+static double min_indicator_of(const PamCore *c, const double *y, unsigned which) {
+    double z[PAM_NZ], m = INFINITY;
+    int k;
     indicators(c, c->mode, y, z);
-    return fmin(z[0], z[1]);
+    for (k = 0; k < PAM_NZ; k++)
+        if ((which >> k) & 1u) m = fmin(m, z[k]);
+    return m;
+}
+
+static double min_indicator(const PamCore *c, const double *y) { return min_indicator_of(c, y, ~0u); }
+
+/* The indicators at or below zero at y (bit k: indicator k). */
+static unsigned crossed_indicators(const PamCore *c, const double *y) {
+    double z[PAM_NZ];
+    unsigned crossed = 0;
+    int k;
+    indicators(c, c->mode, y, z);
+    for (k = 0; k < PAM_NZ; k++)
+        if (z[k] <= 0.0) crossed |= 1u << k;
+    return crossed;
 }
 
 static int sliding(int mode) { return mode == PAM_SLIP_UP || mode == PAM_SLIP_DOWN; }
 
 /* Where an indicator first reaches zero over an accepted step, as a fraction of the step in
- * (lo, hi], or 0 if none does.  A sliding step is checked at its end (cs_max_step_s keeps it short
- * against a sign change and back).  A held load's step is not limited by cs_max_step_s (its chamber
- * pressure moves monotonically toward its source, so its force margins seldom turn back), so a long
- * one is also checked at HELD_CHECKS points of its dense output. */
+ * (lo, hi], and which indicators are at or below zero at hi (0 if none is).  A sliding step is
+ * checked at its end (cs_max_step_s keeps it short against a sign change and back).  A held load's
+ * step is not limited by cs_max_step_s (its chamber pressure moves monotonically toward its source,
+ * so its force margins seldom turn back), so a long one is also checked at HELD_CHECKS points of its
+ * dense output.  An indicator crosses where its sign changes between two checked points, as in the
+ * generic engine (pam_engine.c, which says why). */
 #define HELD_CHECKS 16
-static int first_crossing(PamCore *c, const DpStages *s, double t, const double *y, const double *y1, double h,
-                          double *lo, double *hi) {
+static unsigned first_crossing(PamCore *c, const DpStages *s, double t, const double *y, const double *y1,
+                               double h, double *lo, double *hi) {
     int n = (!sliding(c->mode) && h > c->r[R_cs_max_step_s]) ? HELD_CHECKS : 1, k;
     double ye[PAM_NX];
     for (k = 1; k <= n; k++) {
+        unsigned crossed;
         if (k < n) dp_dense(s, y, h, (double)k / n, ye);
         core_inputs_at(c, k < n ? t + (double)k / n * h : t + h, 1);
-        if (min_indicator(c, k < n ? ye : y1) <= 0.0) {
+        crossed = crossed_indicators(c, k < n ? ye : y1);
+        if (crossed) {
             *lo = (double)(k - 1) / n;
             *hi = (double)k / n;
-            return 1;
+            return crossed;
         }
     }
     return 0;
@@ -647,6 +668,7 @@ int pam_do_step(PamCore *c, double t_end) {
     /* A remainder below the time resolution (left by an event located just before t_end) is not a step. */
     while (t_end - t > 1e-13 * fmax(1.0, fabs(t_end))) {
         double h, err, factor, lo = 0.0, hi = 1.0;
+        unsigned crossed;
         int last, at_rest = !sliding(c->mode);
         if (t_piece - t <= 1e-13 * fmax(1.0, fabs(t_piece))) {
             /* A breakpoint of the signals: they take their values from the right. */
@@ -685,15 +707,16 @@ int pam_do_step(PamCore *c, double t_end) {
         }
         factor = err == 0.0 ? 10.0 : fmin(10.0, fmax(0.2, 0.9 * pow(err, -0.2)));
         c->n_steps++;
-        if (first_crossing(c, &s, t, y, y1, h, &lo, &hi)) {
-            /* Locate the first crossing on the dense output; keep the far side so that the event test holds. */
+        if ((crossed = first_crossing(c, &s, t, y, y1, h, &lo, &hi)) != 0) {
+            /* Locate the first crossing of the indicators that crossed on the dense output; keep the
+             * far side so that the event test holds. */
             double ye[PAM_NX];
             int it;
             for (it = 0; it < 100 && (hi - lo) * h > 1e-15 * fmax(1.0, fabs(t)); it++) {
                 double mid = 0.5 * (lo + hi);
                 dp_dense(&s, y, h, mid, ye);
                 core_inputs_at(c, t + mid * h, 1);
-                if (min_indicator(c, ye) <= 0.0) hi = mid;
+                if (min_indicator_of(c, ye, crossed) <= 0.0) hi = mid;
                 else lo = mid;
             }
             if (hi < 1.0) dp_dense(&s, y, h, hi, ye);

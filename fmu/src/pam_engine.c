@@ -46,14 +46,18 @@ static void rhs(PamEngine *e, const double *y, double *dy) {
     pm_f(e->mode, y, e->u, e->p, dy);
 }
 
-static double min_indicator(const PamEngine *e, const double *y) {
+/* The smallest of the indicators in `which` (bit k: indicator k) at y. */
+static double min_indicator_of(const PamEngine *e, const double *y, unsigned which) {
     double z[PM_NZ > 0 ? PM_NZ : 1], m = INFINITY;
     int k;
     if (PM_NZ == 0) return m;
     pm_z(e->mode, y, e->u, e->p, z);
-    for (k = 0; k < PM_NZ; k++) m = fmin(m, z[k]);
+    for (k = 0; k < PM_NZ; k++)
+        if ((which >> k) & 1u) m = fmin(m, z[k]);
     return m;
 }
+
+static double min_indicator(const PamEngine *e, const double *y) { return min_indicator_of(e, y, ~0u); }
 
 static int mode_of(double value) {
     int k = pm_mode_index(value);
@@ -154,21 +158,28 @@ static void dp_dense(const PamStages *s, const double *y0, double h, double th, 
 }
 
 /* Where an indicator first reaches zero over an accepted step, as a fraction of the step in
- * (lo, hi], or 0 if none does.  A moving step is checked at its end (max_step_s keeps it short
- * against a sign change and back).  A held model's step is not limited by max_step_s (its states
- * approach their sources monotonically, so its force margins seldom turn back), so a long one is
- * also checked at PAM_ENGINE_HELD_CHECKS points of its dense output. */
-static int first_crossing(PamEngine *e, const PamStages *s, double t, const double *y, const double *y1,
-                          double h, double *lo, double *hi) {
+ * (lo, hi], and which indicators are at or below zero at hi (0 if none is).  A moving step is checked
+ * at its end (max_step_s keeps it short against a sign change and back).  A held model's step is not
+ * limited by max_step_s (its states approach their sources monotonically, so its force margins seldom
+ * turn back), so a long one is also checked at PAM_ENGINE_HELD_CHECKS points of its dense output.
+ * As in solve_ivp and CVODE, an indicator crosses where its sign changes between two checked points:
+ * one that dips below zero and back between them is no event, even where another indicator's
+ * crossing brings the bisection there.  A free swing that turns back at its stop, grazing it, so
+ * records the turn (the stop, if the turn lies beyond it, as at_event decides) where the dense output
+ * puts it, instead of an impact whose time moves with the square root of the integration error. */
+static unsigned first_crossing(PamEngine *e, const PamStages *s, double t, const double *y, const double *y1,
+                               double h, double *lo, double *hi) {
     int n = (held(e) && h > e->max_step_s) ? PAM_ENGINE_HELD_CHECKS : 1, k;
     double ye[PM_NX];
     for (k = 1; k <= n; k++) {
+        unsigned fired;
         if (k < n) dp_dense(s, y, h, (double)k / n, ye);
         inputs_at(e, t + (double)k / n * h, 1);
-        if (min_indicator(e, k < n ? ye : y1) <= 0.0) {
+        fired = fired_indicators(e, k < n ? ye : y1);
+        if (fired) {
             *lo = (double)(k - 1) / n;
             *hi = (double)k / n;
-            return 1;
+            return fired;
         }
     }
     return 0;
@@ -245,6 +256,7 @@ int pam_engine_do_step(PamEngine *e, double t_end) {
     /* A remainder below the time resolution (left by an event located just before t_end) is not a step. */
     while (t_end - t > 1e-13 * fmax(1.0, fabs(t_end))) {
         double h, err, factor, lo = 0.0, hi = 1.0;
+        unsigned crossed;
         int last, at_rest = held(e);
         if (t_piece - t <= 1e-13 * fmax(1.0, fabs(t_piece))) {
             /* A breakpoint of the signals: they take their values from the right. */
@@ -282,15 +294,16 @@ int pam_engine_do_step(PamEngine *e, double t_end) {
         }
         factor = err == 0.0 ? 10.0 : fmin(10.0, fmax(0.2, 0.9 * pow(err, -0.2)));
         e->n_steps++;
-        if (first_crossing(e, &s, t, y, y1, h, &lo, &hi)) {
-            /* Locate the first crossing on the dense output; keep the far side so that the event test holds. */
+        if ((crossed = first_crossing(e, &s, t, y, y1, h, &lo, &hi)) != 0) {
+            /* Locate the first crossing of the indicators that crossed on the dense output; keep the
+             * far side so that the event test holds. */
             double ye[PM_NX], t_event;
             int it;
             for (it = 0; it < 100 && (hi - lo) * h > 1e-15 * fmax(1.0, fabs(t)); it++) {
                 double mid = 0.5 * (lo + hi);
                 dp_dense(&s, y, h, mid, ye);
                 inputs_at(e, t + mid * h, 1);
-                if (min_indicator(e, ye) <= 0.0) hi = mid;
+                if (min_indicator_of(e, ye, crossed) <= 0.0) hi = mid;
                 else lo = mid;
             }
             if (hi < 1.0) dp_dense(&s, y, h, hi, ye);

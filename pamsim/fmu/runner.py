@@ -73,7 +73,7 @@ def force_table_for(scenario: Scenario) -> ForceTable | None:
 # The scenario keys the FMU represents, by section; any other key is refused (InputError) rather
 # than dropped, so a setting added to scenarios later cannot silently run a different model.
 # [solver] sets the Python integrator: the FMU's integrators are CVode at solver.rtol (ME) and its
-# own Dormand-Prince 5(4) (CS).  [controller] is read by pamsim.control, which designs the controller
+# own Dormand-Prince 5(4) (CS), at solver.rtol (native_rtol_factor is the native backend's alone).  [controller] is read by pamsim.control, which designs the controller
 # and runs its model through the FMU of its assembly (pamsim.fmu.assembly_runner), not this FMU.
 REPRESENTED = {
     "": {"name", "description", "model", "parameters", "load", "pressure", "simulation", "solver", "controller",
@@ -84,7 +84,7 @@ REPRESENTED = {
     "pressure": {"source", "supply_gauge_bar", "supply_gauge_Pa", "valve_open_time_s", "command", "prescribed",
                  "initial_gauge_bar"},
     "simulation": {"duration_s", "sample_rate_Hz", "initial_contraction_m"},
-    "solver": {"method", "rtol", "max_events", "max_step_s"},
+    "solver": {"method", "rtol", "max_events", "max_step_s", "native_rtol_factor"},
 }
 
 

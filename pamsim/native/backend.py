@@ -10,8 +10,9 @@ core (:mod:`pamsim.native.library`).
 
 Differences from the Python backend, all documented in ``docs/scaling.md``:
 
-- the integrator is the core's Dormand-Prince 5(4) at the scenario's ``rtol``
-  (``solver.method`` may be ``LSODA``, the automatic choice, or ``RK45``, the
+- the integrator is the core's Dormand-Prince 5(4) at the scenario's ``rtol`` times
+  ``solver.native_rtol_factor`` (:func:`native_rtol`; 0.01 unless the scenario says otherwise, so that
+  it meets LSODA's accuracy at ``rtol``) (``solver.method`` may be ``LSODA``, the automatic choice, or ``RK45``, the
   same method; the implicit ones are refused);
 - a static force other than the ACRA 2012 polynomial is the FMU's bicubic force
   table of the model (:func:`force_table`), not the model itself;
@@ -47,7 +48,7 @@ from ..model import Mode, MuscleModel
 from ..result import Result, TransitionEvent
 from ..scenario import Scenario
 from ..signals import Constant, FirstOrderLag, PiecewiseConstant, Step
-from ..simulator import too_many_events
+from ..simulator import MIN_RTOL, too_many_events
 from . import library as lib
 from .engine import EngineCase, engine_library
 
@@ -56,6 +57,13 @@ METHODS = ("LSODA", "RK45")
 LSODA is the automatic choice of a non-stiff method for this non-stiff model.  Others are refused."""
 BATCH_EVENT_CAPACITY = 1024
 """Events kept per case in a batch; a case with more is run again alone, with room for ``max_events``."""
+
+
+def native_rtol(opts) -> float:
+    """The relative tolerance the native backend integrates at: the scenario's ``solver.rtol`` times
+    ``solver.native_rtol_factor`` (:data:`pamsim.simulator.NATIVE_RTOL_FACTOR`), and no finer than the
+    finest ``solver.rtol`` a scenario may ask for (:data:`pamsim.simulator.MIN_RTOL`)."""
+    return max(opts.rtol * opts.native_rtol_factor, MIN_RTOL)
 
 
 def event_capacity(max_events):
@@ -250,7 +258,7 @@ def case_inputs(scenario: Scenario, model: MuscleModel | None = None) -> CaseInp
     fmu_own = {"initial_contraction_m": scenario.initial_contraction_m, "x_high_m": upper_stop_start(model),
                "initial_pressure_gauge_Pa": scenario.initial_pressure_gauge_Pa or 0.0,
                "stick_margin_N": opts.stick_margin_N, "release_margin_N": opts.release_margin_N,
-               "cs_relative_tolerance": opts.rtol,
+               "cs_relative_tolerance": native_rtol(opts),
                "cs_max_step_s": opts.max_step_s if math.isfinite(opts.max_step_s) else _DEFAULT_MAX_STEP_S}
     for name, value in fmu_own.items():
         reals[lib.REAL_INDEX[name]] = value
@@ -362,7 +370,7 @@ def _result(scenario: Scenario, case: CaseInputs, out: dict, i: int, wall_time_s
     if t is None:
         t = np.linspace(0.0, case.duration_s, case.n_samples)
     stats = {"rhs_evaluations": int(out["stats"][i][0]), "segments": int(out["stats"][i][2]),
-             "method": METHOD_LABEL, "rtol": scenario.solver.rtol}
+             "method": METHOD_LABEL, "rtol": native_rtol(scenario.solver)}
     if "library" in out:
         return _engine_result(scenario, case, out, i, wall_time_s, t, stats)
     model = case.model
