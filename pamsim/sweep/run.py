@@ -370,19 +370,26 @@ the quantiles and the figures (:class:`.uncertainty.RunColumns`); the rest of ea
 
 BYTES_PER_SAMPLE_VALUE = 40
 """Memory per sample and sampled parameter while the samples are drawn: the uniform numbers, the values
-and numpy's temporaries of the transform (the values are kept for the tables)."""
+and numpy's temporaries of the Latin hypercube (the values, 8 bytes, are kept for the table's rows)."""
+
+BYTES_PER_SAMPLE_DRAW = 64
+"""Memory per sample, whatever the parameter count, while the samples are drawn: the temporaries of one
+parameter's transform (a draw of 1,000,000 samples peaked at 58 + 16 x parameters bytes per sample in
+``tracemalloc``; see ``benchmarks/bench_uncertainty_memory.py`` for the whole study's)."""
 
 MEMORY_SHARE = 0.8
 """The share of the memory available at the start that a study may plan to use."""
 
 
 def sample_memory_bytes(spec: SweepSpec) -> int:
-    """Memory the uncertainty study of ``spec`` keeps while it runs [bytes]: its samples and, per friction
-    model, the kept outputs of every run (0 without a study)."""
+    """Memory the uncertainty study of ``spec`` needs that grows with its sample count [bytes]: drawing the
+    samples and, per friction model, the summarised quantities of every run (0 without a study).  The chunks
+    out on the executor add a constant (:func:`chunks_in_flight`)."""
     study = spec.uncertainty
     if study is None:
         return 0
-    per_sample = BYTES_PER_SAMPLE_VALUE * len(study.parameters) + BYTES_PER_SAMPLE_RUN * len(spec.friction_models)
+    per_sample = BYTES_PER_SAMPLE_VALUE * len(study.parameters) + BYTES_PER_SAMPLE_DRAW \
+        + BYTES_PER_SAMPLE_RUN * len(spec.friction_models)
     return study.samples * per_sample
 
 
