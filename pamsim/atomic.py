@@ -37,12 +37,18 @@ def check_output_dir(directory: str | os.PathLike) -> Path:
     """Check that files can be written into ``directory`` without creating it: the folder itself if it
     exists, else its nearest existing parent (where it would be made) is probed."""
     directory = Path(directory)
-    existing = next(p for p in (directory, *directory.parents) if p.exists() or p.is_symlink())
+    existing = existing_folder(directory)
     with _output_error(directory):
         if not existing.is_dir():
             raise NotADirectoryError(20, "Not a directory")
         _probe(existing)
     return directory
+
+
+def existing_folder(directory: str | os.PathLike) -> Path:
+    """``directory`` if it exists, else its nearest existing parent: where it would be made."""
+    directory = Path(directory)
+    return next(p for p in (directory, *directory.parents) if p.exists() or p.is_symlink())
 
 
 def _probe(folder: Path) -> None:

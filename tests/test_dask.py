@@ -439,3 +439,16 @@ def test_losing_the_last_worker_stops_the_sweep_within_seconds(own_cluster, tmp_
             running.result(timeout=60)
     # The client hears of the workers every 2 s, then the sweep waits LAST_WORKER_LOST_S.
     assert time.monotonic() - killed < 2 + 1 + 3
+
+
+def test_a_dask_sweep_keeps_four_chunks_out_per_worker_of_the_cluster(client):
+    """The chunks sent ahead follow the cluster's workers as the scheduler reports them (at least 8)."""
+    from pamsim.sweep.dask_cluster import executor_workers
+    from pamsim.sweep.run import chunks_in_flight
+
+    executor = client.get_executor(pure=False)
+    deadline = time.monotonic() + 10  # the client hears from the scheduler every 2 s
+    while executor_workers(executor) != 2 and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert executor_workers(executor) == 2
+    assert chunks_in_flight(executor) == 8

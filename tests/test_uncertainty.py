@@ -229,7 +229,9 @@ def test_a_study_too_large_for_the_memory_is_refused_before_anything_runs(tmp_pa
     code = main(["sweep", str(tmp_path / "huge.toml"), "-o", str(tmp_path / "out"), "--no-progress"])
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 2 and len(err) == 1, err
-    assert "uncertainty.samples = 1000000000000: the study needs about 72 TB of memory" in err[0], err
+    # 1e12 x (40 B of its one parameter and 64 B while drawn + 3 quantities x 8 B of its one friction model's
+    # run)
+    assert "uncertainty.samples = 1000000000000: the study needs about 128 TB of memory" in err[0], err
     assert not (tmp_path / "out").exists()
 
 
@@ -237,8 +239,10 @@ def test_the_memory_check_counts_parameters_and_friction_models(monkeypatch):
     from pamsim.sweep import run
 
     spec = load_sweep(SCENARIOS / "acra2012_fig4_uncertainty.toml")  # 4 parameters, 1 friction model
-    assert run.sample_memory_bytes(spec) == 10_000 * (4 * run.BYTES_PER_SAMPLE_VALUE + run.BYTES_PER_SAMPLE_RUN)
+    assert run.sample_memory_bytes(spec) == 10_000 * (4 * run.BYTES_PER_SAMPLE_VALUE + run.BYTES_PER_SAMPLE_DRAW
+                                                      + run.BYTES_PER_SAMPLE_RUN)
     monkeypatch.setattr(run, "available_memory_bytes", lambda: 2_000_000)  # 1.6 MB of it usable
-    with pytest.raises(pamsim.errors.InputError, match=r"needs about 1.92 MB of memory and 2 MB is available; "
-                                                      r"take at most 8,333 samples"):
+    # 10,000 x (4 x 40 + 64 + 3 x 8) = 2.48 MB; 1.6 MB / 248 B = 6,451 samples
+    with pytest.raises(pamsim.errors.InputError, match=r"needs about 2.48 MB of memory and 2 MB is available; "
+                                                      r"take at most 6,451 samples"):
         run.check_memory(spec)

@@ -94,8 +94,9 @@ def run(args: argparse.Namespace) -> int:
             where = f"{workers} worker processes"
         with output_folder(args.output) as out:  # checked before the runs; removed again if nothing gets written
             result = run_sweep(spec, executor, progress=not args.no_progress, backend=args.backend,
-                               chunk_size=args.chunk_size, allow_incomplete=args.allow_incomplete)
-            names = result.write(out, executor, fmt, dpi)
+                               chunk_size=args.chunk_size, allow_incomplete=args.allow_incomplete, output_dir=out)
+            with result:  # the samples table's temporary file goes once the outputs are written, or not
+                names = result.write(out, executor, fmt, dpi)
     _print_outcome(result, where, args.output, names)
     return 0
 
@@ -105,12 +106,12 @@ def _print_outcome(result, where: str, output: str, names: list[str]) -> None:
     written on stdout."""
     for failure in result.failures[:MAX_FAILURE_LINES]:
         print(f"pamsim: warning: failed run {failure}", file=sys.stderr)
-    if len(result.failures) > MAX_FAILURE_LINES:
-        print(f"pamsim: warning: {len(result.failures) - MAX_FAILURE_LINES} more failed runs (every one is a row "
+    if result.failed_runs > MAX_FAILURE_LINES:
+        print(f"pamsim: warning: {result.failed_runs - MAX_FAILURE_LINES} more failed runs (every one is a row "
               "with its message in the tables)", file=sys.stderr)
     spec = result.spec
     samples = f", {spec.uncertainty.samples} uncertainty samples" if spec.uncertainty is not None else ""
     lost = f" ({result.lost} lost: an incomplete sweep)" if result.lost else ""
-    print(f"{spec.name}: {len(result.rows)} cases{samples}, {len(result.failures)} failed runs{lost}, "
+    print(f"{spec.name}: {len(result.rows)} cases{samples}, {result.failed_runs} failed runs{lost}, "
           f"{result.wall_time_s:.2f} s on {where}")
     print(f"wrote {', '.join(str(Path(output) / n) for n in names)}")

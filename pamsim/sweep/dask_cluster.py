@@ -316,10 +316,25 @@ def executor_watch(executor: Executor) -> Callable[[], str | None] | None:
     instead of waiting for ever.  It reads what the client last heard from the scheduler (updated every
     2 s), so a call costs nothing.
     """
+    client = _dask_client(executor)
+    return None if client is None else _ClusterWatch(client)
+
+
+def _dask_client(executor: Executor):
+    """The ``distributed.Client`` behind a Dask executor, or None for any other executor."""
     client = getattr(executor, "_client", None)
-    if client is None or not type(executor).__module__.startswith("distributed"):
-        return None
-    return _ClusterWatch(client)
+    return client if client is not None and type(executor).__module__.startswith("distributed") else None
+
+
+def executor_workers(executor: Executor) -> int | None:
+    """Workers (threads) that run ``executor``'s tasks: a process or thread pool's, or the threads of a Dask
+    cluster's workers as the scheduler last reported them (0 before any has connected); None for any other
+    executor."""
+    client = _dask_client(executor)
+    if client is not None:
+        return int((getattr(client, "_scheduler_identity", None) or {}).get("total_threads") or 0)
+    workers = getattr(executor, "_max_workers", None)
+    return workers if isinstance(workers, int) else None
 
 
 class _ClusterWatch:

@@ -63,7 +63,7 @@ def _introduction(result: "SweepResult", n_within: int, n_measured: int) -> list
         out += [spec.description, ""]
     thr_mm = spec.capability_min_equilibrium_m * 1e3
     return out + [f"Sweep file `{spec.origin}`, base scenario `{spec.base.origin}`; {len(result.rows)} cases, "
-                  f"friction models: {', '.join(spec.friction_models)}; {len(result.failures)} failed runs; "
+                  f"friction models: {', '.join(spec.friction_models)}; {result.failed_runs} failed runs; "
                   f"wall time {result.wall_time_s:.2f} s.", "",
                   f"*Within force capability* means the static equilibrium contraction is at least {thr_mm:g} mm "
                   f"({n_within} of the {n_measured} measured cases). Errors are model minus measurement.", ""]
@@ -167,7 +167,9 @@ def _responses(result: "SweepResult") -> list[str]:
 def _failures(result: "SweepResult") -> list[str]:
     if not result.failures:
         return []
-    return ["## Failed runs", ""] + [f"- {m}" for m in result.failures] + [""]
+    more = result.failed_runs - len(result.failures)
+    tail = [f"- and {more} more failed samples (every failed run is a row of uncertainty_samples.csv)"] if more else []
+    return ["## Failed runs", ""] + [f"- {m}" for m in result.failures] + tail + [""]
 
 
 def _figures(ext: str) -> list[str]:

@@ -7,31 +7,33 @@ recorded, not raised.  :meth:`SweepResult.write` writes ``summary.csv``,
 from __future__ import annotations
 
 import csv
-import itertools
 import math
 import os
+import shutil
 import sys
+import tempfile
 import time
 from collections.abc import Sequence
-from concurrent.futures import FIRST_COMPLETED, CancelledError, Executor, wait
+from concurrent.futures import FIRST_COMPLETED, CancelledError, Executor, Future, wait
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping
 
 import numpy as np
 
-from ..atomic import atomic_outputs
+from ..atomic import atomic_outputs, check_output_dir, existing_folder
 from ..constants import PA_PER_BAR
 from ..errors import InputError, RunFailure
 from ..figure_style import check_format
 from ..oscillation import estimate_oscillation
 from ..scenario import Scenario
 from ..static import friction_band_m, static_report
-from .dask_cluster import executor_watch
+from .dask_cluster import executor_watch, executor_workers
 from .figures import SWEEP_FIGURES, UNCERTAINTY_FIGURES
 from .gc_control import frozen_gc
 from .spec import SweepCase, SweepSpec, load_sweep
-from .uncertainty import LOST, RunColumns, Samples, UncertaintyResult
+from .sample_table import ChunkOrder, SampleTable, row_bytes
+from .uncertainty import LOST, QUANTITIES, RunColumns, Samples, UncertaintyResult
 
 SETTLED_FRACTION = 0.05
 """The pressure counts as settled once it stays within 5 % of its step of its final value; the
@@ -207,6 +209,9 @@ class SweepResult:
     uncertainty: UncertaintyResult | None = None
     lost: int = 0
     """Runs the executor lost (only with ``allow_incomplete``): rows whose failure begins ``lost:``."""
+    failed_runs: int = 0
+    """Failed runs, the lost ones included: ``failures`` names at most
+    :data:`~.uncertainty.MAX_KEPT_MESSAGES` of an uncertainty study's per friction model."""
 
     def columns(self) -> list[str]:
         """Column names of ``summary.csv``."""
@@ -258,6 +263,17 @@ class SweepResult:
                 tmp[name].write_bytes(data)
         return names
 
+    def close(self) -> None:
+        """Remove the temporary file of the uncertainty study's samples table (once written, or not wanted)."""
+        if self.uncertainty is not None:
+            self.uncertainty.close()
+
+    def __enter__(self) -> "SweepResult":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
     def to_csv(self, path: str | Path) -> None:
         """Write the per-case table (not atomic on its own; :meth:`write` stages it)."""
         cols = self.columns()
@@ -278,7 +294,7 @@ def _fmt(value: Any) -> Any:
 
 def run_sweep(spec: SweepSpec | str | Path, executor: Executor | None = None, progress: bool = False,
               backend: str | None = None, chunk_size: int | None = None,
-              allow_incomplete: bool = False) -> SweepResult:
+              allow_incomplete: bool = False, output_dir: str | Path | None = None) -> SweepResult:
     """Run every case of a sweep under every friction model, and the frequency and response studies.
 
     Parameters
@@ -302,16 +318,23 @@ def run_sweep(spec: SweepSpec | str | Path, executor: Executor | None = None, pr
         Runs lost to the executor (a worker or cluster gone, so no result at all) stop the sweep with
         :class:`~pamsim.errors.RunFailure` unless this is true; then they become failed rows whose
         message begins ``lost:``, and the uncertainty study says that its sample is incomplete.
+    output_dir : str or Path, optional
+        The folder the results will be written to (:meth:`SweepResult.write`).  An uncertainty study writes
+        its per-run table to disk as its runs finish, into a hidden temporary file there (in the folder it
+        will be made in while it does not exist), removed again if the sweep stops.  Default: the
+        system's temporary folder (the table is then copied when written elsewhere).
 
     Returns
     -------
     SweepResult
-        Failed runs appear as rows with an ``error`` message and NaN numbers.
+        Failed runs appear as rows with an ``error`` message and NaN numbers.  With an uncertainty study,
+        :meth:`SweepResult.close` (or leaving its ``with`` block) removes the table's temporary file.
 
     Raises
     ------
     InputError
-        An uncertainty study too large for this machine's memory (:func:`check_memory`), or a bad chunk size.
+        An uncertainty study too large for this machine's memory (:func:`check_memory`) or for the disk of
+        ``output_dir`` (:func:`check_disk`), an output folder that cannot be written, or a bad chunk size.
     RunFailure
         Runs lost (unless ``allow_incomplete``), a Dask cluster whose scheduler or last worker went away.
     """
@@ -321,37 +344,52 @@ def run_sweep(spec: SweepSpec | str | Path, executor: Executor | None = None, pr
     check_backend(spec, backend)
     _check_chunk_size(chunk_size)
     check_memory(spec)
+    folder = check_output_dir(tempfile.gettempdir() if output_dir is None else output_dir)
+    check_disk(spec, folder)
     start = time.perf_counter()
     samples = spec.uncertainty.draw() if spec.uncertainty is not None else None
     tasks = _Tasks(_study_tasks(spec, backend), spec, samples, backend)
-    kept = _Kept(tasks)
+    kept = _Kept(tasks, folder)
     from tqdm import tqdm
 
-    with tqdm(total=len(tasks), unit="run", desc=spec.name, file=sys.stderr, disable=not progress,
-              dynamic_ncols=True) as bar:
-        _execute(tasks, executor, _Progress(kept, bar), chunk_size or auto_chunk_size(len(tasks), backend),
-                 allow_incomplete)
+    try:
+        with tqdm(total=len(tasks), unit="run", desc=spec.name, file=sys.stderr, disable=not progress,
+                  dynamic_ncols=True) as bar:
+            _execute(tasks, executor, _Progress(kept, bar), chunk_size or auto_chunk_size(len(tasks), backend),
+                     allow_incomplete)
+        kept.finish()
+    except BaseException:  # an error or an interrupt: no samples table, not even its temporary file
+        kept.discard()
+        raise
     return _result(spec, kept, samples, time.perf_counter() - start)
 
 
-BYTES_PER_SAMPLE_RUN = 32
-"""Memory an uncertainty study keeps per sample and friction model (:class:`.uncertainty.RunColumns`)."""
+BYTES_PER_SAMPLE_RUN = 8 * len(QUANTITIES)
+"""Memory an uncertainty study keeps per sample and friction model: a float of each summarised quantity, for
+the quantiles and the figures (:class:`.uncertainty.RunColumns`); the rest of each run is on disk."""
 
 BYTES_PER_SAMPLE_VALUE = 40
 """Memory per sample and sampled parameter while the samples are drawn: the uniform numbers, the values
-and numpy's temporaries of the transform (the values are kept for the tables)."""
+and numpy's temporaries of the Latin hypercube (the values, 8 bytes, are kept for the table's rows)."""
+
+BYTES_PER_SAMPLE_DRAW = 64
+"""Memory per sample, whatever the parameter count, while the samples are drawn: the temporaries of one
+parameter's transform (a draw of 1,000,000 samples peaked at 58 + 16 x parameters bytes per sample in
+``tracemalloc``; see ``benchmarks/bench_uncertainty_memory.py`` for the whole study's)."""
 
 MEMORY_SHARE = 0.8
 """The share of the memory available at the start that a study may plan to use."""
 
 
 def sample_memory_bytes(spec: SweepSpec) -> int:
-    """Memory the uncertainty study of ``spec`` keeps while it runs [bytes]: its samples and, per friction
-    model, the kept outputs of every run (0 without a study)."""
+    """Memory the uncertainty study of ``spec`` needs that grows with its sample count [bytes]: drawing the
+    samples and, per friction model, the summarised quantities of every run (0 without a study).  The chunks
+    out on the executor add a constant (:func:`chunks_in_flight`)."""
     study = spec.uncertainty
     if study is None:
         return 0
-    per_sample = BYTES_PER_SAMPLE_VALUE * len(study.parameters) + BYTES_PER_SAMPLE_RUN * len(spec.friction_models)
+    per_sample = BYTES_PER_SAMPLE_VALUE * len(study.parameters) + BYTES_PER_SAMPLE_DRAW \
+        + BYTES_PER_SAMPLE_RUN * len(spec.friction_models)
     return study.samples * per_sample
 
 
@@ -382,6 +420,33 @@ def check_memory(spec: SweepSpec) -> None:
                      f"{_bytes(need)} of memory and {_bytes(have)} is available; take at most "
                      f"{int(MEMORY_SHARE * have / (need / spec.uncertainty.samples)):,} samples or split the study "
                      "(different seeds)")
+
+
+def sample_table_bytes(spec: SweepSpec) -> int:
+    """Most disk the samples table of the uncertainty study of ``spec`` takes if every run succeeds [bytes]
+    (:func:`.sample_table.row_bytes` per run; 0 without a study)."""
+    study = spec.uncertainty
+    if study is None:
+        return 0
+    return study.samples * sum(row_bytes(study.samples, len(study.parameters), f) for f in spec.friction_models)
+
+
+def free_disk_bytes(folder: str | Path) -> int:
+    """Disk space free to this user in ``folder``, or in the folder it will be made in [bytes]."""
+    return shutil.disk_usage(existing_folder(folder)).free
+
+
+def check_disk(spec: SweepSpec, folder: str | Path) -> None:
+    """Raise ``InputError`` naming ``uncertainty.samples`` when the study's samples table would not fit in the
+    disk space free in ``folder`` (or the folder it will be made in), before anything is drawn or run."""
+    need = sample_table_bytes(spec)
+    have = free_disk_bytes(folder)
+    if need <= have:
+        return
+    n = spec.uncertainty.samples
+    raise InputError(f"{spec.origin}: uncertainty.samples = {n}: the samples table needs up to {_bytes(need)} of "
+                     f"disk in {folder} and {_bytes(have)} is free; take at most {int(have / (need / n)):,} "
+                     "samples, split the study (different seeds) or write elsewhere")
 
 
 def _bytes(n: float) -> str:
@@ -436,27 +501,56 @@ class _Tasks(Sequence):
 
 class _Kept:
     """What a sweep keeps of its runs as they finish: the study's outputs whole (few, and the case rows,
-    frequency study and responses need them), the uncertainty samples' in columns (:class:`RunColumns`)."""
+    frequency study and responses need them), the uncertainty samples' quantities in columns
+    (:class:`RunColumns`) and their rows in the samples table on disk (:class:`.sample_table.SampleTable`, made
+    in ``folder``), in the order of the runs (:class:`.sample_table.ChunkOrder`)."""
 
-    def __init__(self, tasks: _Tasks):
+    def __init__(self, tasks: _Tasks, folder: Path):
         self.tasks = tasks
         self.study: list[dict | None] = [None] * len(tasks.study)
         self.runs = {f: RunColumns.empty(tasks.n_samples) for f in tasks.frictions}
+        self.order = ChunkOrder()
+        self.table = SampleTable(folder, tasks.samples.names) if tasks.samples is not None else None
 
-    def put(self, i: int, output: dict) -> None:
-        """Keep the output of run ``i`` (its index in :class:`_Tasks`)."""
-        if i < len(self.study):
-            self.study[i] = output
-            return
-        f, k = divmod(i - len(self.study), self.tasks.n_samples)
-        self.runs[self.tasks.frictions[f]].put(k, output)
+    def record(self, start: int, outputs: Sequence[dict]) -> None:
+        """Keep the outputs of the runs from index ``start`` on (their indices in :class:`_Tasks`); their rows
+        reach the samples table once every earlier run's have."""
+        rows = []
+        for i, output in enumerate(outputs, start):
+            if i < len(self.study):
+                self.study[i] = output
+                continue
+            f, k = divmod(i - len(self.study), self.tasks.n_samples)
+            self.runs[self.tasks.frictions[f]].put(k, output)
+            rows.append((k, self.tasks.frictions[f], self.tasks.samples.values[k], output))
+        for text in self.order.add(start, len(outputs), SampleTable.rows_text(rows) if rows else ""):
+            if text:
+                self.table.write(text)
+
+    def finish(self) -> None:
+        """Close the samples table, every run recorded."""
+        if self.order.next != len(self.tasks):
+            raise RuntimeError(f"the sweep recorded runs up to {self.order.next} of {len(self.tasks)} in order")
+        if self.table is not None:
+            self.table.finish()
+
+    def discard(self) -> None:
+        """Remove the samples table's temporary file (the sweep stopped)."""
+        if self.table is not None:
+            self.table.discard()
 
     def lost(self) -> int:
         """Runs the executor lost (with ``allow_incomplete``: rows whose message begins ``lost:``)."""
         return sum(o["error"].startswith(LOST) for o in self.study) + sum(r.lost() for r in self.runs.values())
 
+    def failed(self) -> int:
+        """Failed runs, the lost ones included."""
+        return sum(bool(o["error"]) for o in self.study) + sum(r.n_failed for r in self.runs.values())
+
     def failures(self) -> list[str]:
-        """The message of every failed run, naming its scenario (and its sample), in the order of the runs."""
+        """The message of every failed run of the study and of the first failed samples
+        (:data:`~.uncertainty.MAX_KEPT_MESSAGES` per friction model), naming its scenario (and its sample), in
+        the order of the runs."""
         out = [f"{t.scenario.name}: {o['error']}" for t, o in zip(self.tasks.study, self.study) if o["error"]]
         for base, runs in zip(self.tasks.bases, self.runs.values()):
             out += [f"{base.name} sample {k}: {e}" for k, e in sorted(runs.errors.items())]
@@ -474,8 +568,7 @@ class _Progress:
 
     def record(self, start: int, outputs: Sequence[dict]) -> None:
         """Keep the outputs of the runs from index ``start`` on."""
-        for j, output in enumerate(outputs):
-            self.kept.put(start + j, output)
+        self.kept.record(start, outputs)
         self.failed += sum(bool(o["error"]) for o in outputs)
         self.done += len(outputs)
         self.bar.set_postfix(failed=self.failed, refresh=False)
@@ -490,9 +583,9 @@ def _result(spec: SweepSpec, kept: _Kept, samples: Samples | None, wall_time_s: 
     rows = [_case_row(spec, i, case, by_key, case_scenarios) for i, case in enumerate(spec.cases)]
     responses = {s.name: {f: by_key[("response", (s.name, f))] for f in spec.friction_models}
                  for s in spec.time_responses}
-    study = UncertaintyResult(spec.uncertainty, samples, kept.runs) if samples is not None else None
+    study = UncertaintyResult(spec.uncertainty, samples, kept.runs, kept.table) if samples is not None else None
     return SweepResult(spec, rows, _frequency_rows(spec, by_key), responses, wall_time_s, kept.failures(), study,
-                       kept.lost())
+                       kept.lost(), kept.failed())
 
 
 def _check_chunk_size(chunk_size: Any) -> None:
@@ -534,9 +627,15 @@ def check_backend(spec: SweepSpec, backend: str) -> None:
             check_scenario(backend, scenario.with_changes({"model": {"friction": friction}}))
 
 
+IN_FLIGHT_PER_WORKER = 4
+"""Chunks a sweep keeps out per worker of its executor: one running and three queued behind it, so a worker
+never waits for the sweep's process, which records each chunk as it comes back."""
+
+MIN_IN_FLIGHT = 8
+"""Chunks kept out while a Dask cluster reports fewer than 2 workers (none connected yet, say)."""
+
 MAX_IN_FLIGHT = 64
-"""Chunks sent to an executor ahead of their results: enough to keep 32 workers busy with a chunk queued
-behind each, few enough that the tasks and the outputs not yet kept stay small however long the sweep."""
+"""Most chunks kept out (16 workers' worth), and the number for an executor whose workers are not known."""
 
 WATCH_INTERVAL_S = 0.5
 """How often the sweep looks at a Dask cluster's health while it waits for chunks [s]."""
@@ -557,17 +656,50 @@ def _execute(tasks: _Tasks, executor: Executor | None, progress: _Progress, chun
         _execute_on(executor, tasks, progress, chunk_size, allow_incomplete)
 
 
+def chunks_in_flight(executor: Executor) -> int:
+    """Chunks a sweep keeps out on ``executor``: :data:`IN_FLIGHT_PER_WORKER` per worker, between
+    :data:`MIN_IN_FLIGHT` and :data:`MAX_IN_FLIGHT` (a Dask cluster's workers as it last reported them, so the
+    number follows workers that come and go)."""
+    workers = executor_workers(executor)
+    if workers is None:
+        return MAX_IN_FLIGHT
+    return min(MAX_IN_FLIGHT, max(MIN_IN_FLIGHT, IN_FLIGHT_PER_WORKER * workers))
+
+
+def _submit_window(executor: Executor, tasks: _Tasks, first: int, chunk_size: int, order: ChunkOrder,
+                   pending: dict) -> int:
+    """Send the chunks from index ``first`` on that fit in the window of :func:`chunks_in_flight` chunks from the
+    first run not yet recorded in order (``order.next``): the chunks running and those finished but held back
+    for the samples table together stay within it.  Returns the index of the first chunk not sent."""
+    end = min(len(tasks), order.next + chunks_in_flight(executor) * chunk_size)
+    for i in range(first, end, chunk_size):
+        pending[_submit(executor, tasks[i:i + chunk_size])] = i
+        first = i + chunk_size
+    return first
+
+
+def _submit(executor: Executor, chunk: list[_Task]) -> Future:
+    """The future of ``chunk`` run on ``executor``; an executor that refuses it (a process pool broken by a
+    worker that died) gives a future holding its error, so the chunk counts as lost like the chunks that
+    were running."""
+    try:
+        return executor.submit(run_chunk, chunk)
+    except Exception as exc:  # noqa: BLE001 -- whatever the executor raises, the chunk has no result
+        future = Future()
+        future.set_exception(exc)
+        return future
+
+
 def _execute_on(executor: Executor, tasks: _Tasks, progress: _Progress, chunk_size: int,
                 allow_incomplete: bool) -> None:
-    """:func:`_execute` on an executor: at most :data:`MAX_IN_FLIGHT` chunks sent ahead, and a Dask
+    """:func:`_execute` on an executor: a window of :func:`chunks_in_flight` chunks sent ahead, and a Dask
     cluster's health checked every :data:`WATCH_INTERVAL_S` while the sweep waits."""
     watch = executor_watch(executor)
-    starts = iter(range(0, len(tasks), chunk_size))
+    first = 0
     pending: dict = {}
     try:
         while True:
-            for i in itertools.islice(starts, MAX_IN_FLIGHT - len(pending)):
-                pending[executor.submit(run_chunk, tasks[i:i + chunk_size])] = i
+            first = _submit_window(executor, tasks, first, chunk_size, progress.kept.order, pending)
             if not pending:
                 return
             done, _ = wait(pending, timeout=WATCH_INTERVAL_S, return_when=FIRST_COMPLETED)

@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import csv
 import inspect
-import itertools
 import math
 from dataclasses import dataclass, field
 from typing import Any, Iterator, Mapping
@@ -212,58 +211,65 @@ def _distribution(check: TableChecker, where: str, name: str, entry: Any, base: 
 
 
 # ---------------------------------------------------------------- results
-KEPT = (*QUANTITIES, "at_rest")
-"""What a study keeps of each run: the summarised quantities and whether it ended at rest."""
-
 LOST = "lost: "
 """How the error of a run that the executor lost (its worker or cluster gone) begins: it has no result,
 and the study is incomplete."""
 
+MAX_KEPT_MESSAGES = 10
+"""Failed runs' messages a study keeps in memory per friction model (those of the lowest sample numbers);
+the samples table holds every one."""
+
 
 @dataclass
 class RunColumns:
-    """One friction model's runs of a study, as columns: ``values[key][k]`` is run ``k``'s ``key`` (a float:
-    NaN where the run failed; ``at_rest`` 1.0 or 0.0), ``errors[k]`` the message of a failed run.
+    """What a study keeps in memory of one friction model's runs: the summarised quantities as columns of
+    floats (``values[quantity][k]`` is run ``k``'s, NaN where the run failed), the number of failed and of
+    lost runs, and the first :data:`MAX_KEPT_MESSAGES` failures' messages (``errors[k]``).
 
-    Columns rather than a dict per run: a run's dict of outputs and its task took about 1.7 kB, the columns
-    take 32 bytes, so a study of millions of samples fits in memory.
+    The quantiles and the figures need every value, 8 bytes per run and quantity (24 bytes per run); the rest
+    of each run goes to the samples table on disk (:mod:`.sample_table`).
     """
 
     values: dict[str, np.ndarray]
     errors: dict[int, str] = field(default_factory=dict)
+    n_failed: int = 0
+    n_lost: int = 0
 
     @classmethod
     def empty(cls, n: int) -> "RunColumns":
         """Room for ``n`` runs, every value NaN."""
-        return cls({key: np.full(n, math.nan) for key in KEPT})
+        return cls({key: np.full(n, math.nan) for key in QUANTITIES})
 
     def put(self, k: int, output: Mapping) -> None:
         """Keep run ``k``'s output (a run's dict, with its ``error`` message, empty if it succeeded)."""
-        if output["error"]:
-            self.errors[k] = output["error"]
-        for key in KEPT:
-            self.values[key][k] = output.get(key, math.nan)
+        error = output["error"]
+        if error:
+            self.n_failed += 1
+            self.n_lost += error.startswith(LOST)
+            self.errors[k] = error
+            if len(self.errors) > MAX_KEPT_MESSAGES:  # the chunks finish in any order: keep the first samples'
+                del self.errors[max(self.errors)]
+        for key in QUANTITIES:
+            self.values[key][k] = math.nan if error else output.get(key, math.nan)
 
     def output(self, k: int) -> dict:
-        """Run ``k`` as the dict of what was kept: the quantities, ``at_rest`` and ``error``."""
-        out = {key: float(self.values[key][k]) for key in QUANTITIES}
-        at_rest = self.values["at_rest"][k]
-        out["at_rest"] = math.nan if math.isnan(at_rest) else bool(at_rest)
-        out["error"] = self.errors.get(k, "")
-        return out
+        """Run ``k``'s summarised quantities (NaN where it failed)."""
+        return {key: float(self.values[key][k]) for key in QUANTITIES}
 
     def lost(self) -> int:
         """Runs the executor lost (no result at all, as opposed to a run that failed)."""
-        return sum(e.startswith(LOST) for e in self.errors.values())
+        return self.n_lost
 
 
 @dataclass
 class UncertaintyResult:
-    """The runs of an uncertainty study: ``runs[friction]`` holds every sample's run under ``friction``."""
+    """The runs of an uncertainty study: ``runs[friction]`` holds what is kept in memory of every sample's run
+    under ``friction``, ``table`` the per-run table on disk (a :class:`.sample_table.SampleTable`, finished)."""
 
     spec: UncertaintySpec
     samples: Samples
     runs: Mapping[str, RunColumns]
+    table: Any = None
 
     @property
     def friction_models(self) -> list[str]:
@@ -271,20 +277,17 @@ class UncertaintyResult:
         return list(self.runs)
 
     def output(self, friction: str, k: int) -> dict:
-        """What the study kept of sample ``k``'s run under ``friction`` (:meth:`RunColumns.output`)."""
+        """Sample ``k``'s summarised quantities under ``friction`` (:meth:`RunColumns.output`)."""
         return self.runs[friction].output(k)
 
     def values(self, friction: str, quantity: str) -> np.ndarray:
-        """``quantity`` of every successful run of ``friction`` (failed runs left out)."""
-        runs = self.runs[friction]
-        ok = np.ones(len(self.samples.values), dtype=bool)
-        ok[list(runs.errors)] = False
-        v = runs.values[quantity][ok]
+        """``quantity`` of every successful run of ``friction`` (failed runs, NaN in the columns, left out)."""
+        v = self.runs[friction].values[quantity]
         return v[np.isfinite(v)]
 
     def failed(self, friction: str) -> int:
         """Number of failed runs under ``friction`` (the lost ones included)."""
-        return len(self.runs[friction].errors)
+        return self.runs[friction].n_failed
 
     def lost(self) -> int:
         """Runs that the executor lost, under every friction model: the sample is incomplete if any."""
@@ -306,28 +309,29 @@ class UncertaintyResult:
         return rows
 
     def sample_rows(self) -> Iterator[dict]:
-        """One row per run, made as they are read: sample number, friction model, parameter values and
-        outputs."""
-        for f, runs in self.runs.items():
-            for k, values in enumerate(self.samples.values):
-                row = {"sample": k, "friction_model": f}
-                row.update(zip(self.samples.names, map(float, values)))
-                o = runs.output(k)
-                row.update({q: o[q] for q in QUANTITIES})
-                row["at_rest"] = o["at_rest"]
-                row["failure"] = o["error"]
-                yield row
+        """The rows of the samples table as read back from its file (strings), one at a time."""
+        with open(self.table.path, newline="") as fh:
+            yield from csv.DictReader(fh)
 
     def write_tables(self, samples_path, summary_path) -> None:
-        """Write the per-run and the quantile tables as CSV (the caller stages them atomically); the per-run
-        rows are written as they are made, never all held at once."""
-        for path, rows in ((samples_path, self.sample_rows()), (summary_path, iter(self.quantile_rows()))):
-            first = next(rows)
-            with open(path, "w", newline="") as fh:
-                w = csv.DictWriter(fh, fieldnames=list(first))
-                w.writeheader()
-                for row in itertools.chain([first], rows):
-                    w.writerow({k: (f"{v:.9g}" if isinstance(v, float) else v) for k, v in row.items()})
+        """Publish the per-run table as ``samples_path`` and write the quantile table as CSV (the caller stages
+        them atomically)."""
+        self.table.publish(samples_path)
+        rows = self.quantile_rows()
+        with open(summary_path, "w", newline="") as fh:
+            w = csv.DictWriter(fh, fieldnames=list(rows[0]))
+            w.writeheader()
+            for row in rows:
+                w.writerow({k: (f"{v:.9g}" if isinstance(v, float) else v) for k, v in row.items()})
+
+    def __getstate__(self) -> dict:
+        # A worker that draws the figures gets the columns, not the table (an open file's object).
+        return {**self.__dict__, "table": None}
+
+    def close(self) -> None:
+        """Remove the per-run table's temporary file (once it is published, or not wanted)."""
+        if self.table is not None:
+            self.table.discard()
 
     def report(self, sweep_name: str, figure_format: str = "png") -> str:
         """The markdown text of ``uncertainty.md``, its figures linked as ``figure_format`` files."""
