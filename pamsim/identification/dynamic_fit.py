@@ -377,8 +377,8 @@ def fit_dynamic(scenario: Scenario, traces: Sequence[TraceData], free: Sequence[
     backend : {"python", "native"}
         Simulator of the fit.  ``native`` runs each optimiser step's simulations (each
         differential-evolution generation's too) in one call of the native library, one per worker
-        with an executor; it holds a recorded pressure at its midpoint over every output sample (see
-        :mod:`.native_fit`) and refuses, before anything runs, a scenario setting it cannot honour.
+        with an executor; it follows a recorded pressure exactly, as the Python backend does (see
+        :mod:`.native_fit`), and refuses, before anything runs, a scenario setting it cannot honour.
     n_starts : int, optional
         Extra local fits, from the best of ``25 n_starts`` seeded random points (:mod:`.dynamic_starts`);
         the fit with the lowest cost wins.  Default :data:`DEFAULT_STARTS` of the backend.

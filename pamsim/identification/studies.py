@@ -181,14 +181,14 @@ def dynamic_study(scenario_path: str) -> None:
 
 
 def _input_hold(sc: Scenario) -> None:
-    """Native against Python contraction at the truth, recorded pressure (held per output sample on the
-    native backend) and valve (held exactly, a step), at several output sample rates."""
+    """Native against Python contraction at the truth, recorded pressure (the thinned polyline, exact on both
+    backends) and valve (a step), at several output sample rates."""
     noisy, _ = synthetic_trace(sc, TRUTH, 22.74, seed=0)
     by_valve = TraceData(noisy.t_s, noisy.x_m, None, 22.74)
     theta = np.array(list(TRUTH.values()))
-    print("\n| output sample rate [Hz] (hold interval) | largest contraction difference, recorded pressure [mm] | "
+    print("\n| output sample rate [Hz] | largest contraction difference, recorded pressure [mm] | "
           "same, valve [mm] |\n|---|---|---|")
-    for rate in (500.0, 1000.0, 2000.0, 4000.0):
+    for rate in (10.0, 100.0, 1000.0, 4000.0):
         rated = sc.with_changes({"simulation": {"sample_rate_Hz": rate}})
         diff = []
         for tr in (noisy, by_valve):
@@ -196,7 +196,7 @@ def _input_hold(sc: Scenario) -> None:
             x_py, = make_trials(prob, "python")(theta)
             x_nat, = make_trials(prob, "native")(theta)
             diff.append(np.max(np.abs(x_nat - x_py)) * 1e3)
-        print(f"| {rate:g} ({1e3 / rate:g} ms) | {diff[0]:.2e} | {diff[1]:.2e} |")
+        print(f"| {rate:g} | {diff[0]:.2e} | {diff[1]:.2e} |")
 
 
 def native_study(scenario_path: str) -> None:
