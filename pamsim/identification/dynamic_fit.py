@@ -31,7 +31,6 @@ from typing import Sequence
 import numpy as np
 from scipy.optimize import differential_evolution, least_squares
 
-from ..elements.stops import EndStops
 from ..errors import InputError
 from ..parameters import ParameterSet
 from ..scenario import Scenario
@@ -262,9 +261,10 @@ def check_data(scenario: Scenario, traces: Sequence[TraceData],
     length, upper stop, rating and blocked force)."""
     params = scenario.parameters
     loads = _trace_loads(scenario, traces, loads_N)
-    x_max = EndStops.from_parameters(params).x_high_m
+    model = scenario.build_model()
+    x_max = model.stops.x_high_m  # where the scenario's simulations stop, not the braid lock
     rated = params["rated_pressure_gauge_Pa"] if "rated_pressure_gauge_Pa" in params else math.inf
-    static = scenario.build_model().static_force
+    static = model.static_force
 
     def blocked(p_gauge_Pa):
         return static.force_N(0.0, scenario.final_pressure_gauge_Pa if p_gauge_Pa is None else p_gauge_Pa)
