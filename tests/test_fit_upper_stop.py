@@ -160,3 +160,22 @@ def test_a_fit_of_a_muscle_whose_stop_cannot_stand_is_refused_in_one_line(tmp_pa
     assert proc.stderr.strip().splitlines() == [
         "pamsim: error: muscle 'mpam_survey_45mm': its upper stop 'auto': fibre_radius_m = 0.0002 with "
         "n_fibres = 30: the fibres would cover the braid at every angle: the braid could not move"]
+
+
+def test_the_jacobian_of_a_test_on_the_stop_is_the_stops_own_derivative(jam_muscle, jam_fit):
+    """With the rest length free the jam moves with it: each row of the analytic Jacobian, a test resting
+    freely or on the jam, is the central difference of the residuals (equilibria found again each time)."""
+    from pamsim.identification.static_fit import make_problem
+
+    x, on_stop, fit = jam_fit
+    params, model = load_muscle_parameters(str(jam_muscle))
+    problem = make_problem(fit.problem.data, params.with_overrides({"E_bladder_Pa": E_TRUE_PA}, source="test"), model,
+                           free=["E_bladder_Pa", "L0_m"], upper_stop=load_upper_stop(str(jam_muscle)))
+    theta = problem.start
+    J = problem.jacobian(theta)
+    h = 1e-6 * np.abs(theta)
+    numeric = np.column_stack([(problem.residuals(theta + e) - problem.residuals(theta - e)) / (2 * e @ np.ones(2))
+                               for e in np.diag(h)])
+    on = np.array([s == "upper" for s in on_stop])
+    assert on.any() and np.all(np.abs(J[on, 1]) > 100.0)  # the jam moves with L0 [mm per m]
+    np.testing.assert_allclose(J, numeric, rtol=1e-4, atol=1e-6 * np.abs(numeric).max())
