@@ -32,6 +32,7 @@ from pamsim.elements.static_force import Acra2012Polynomial
 from pamsim.identification import fit_static, read_static_data
 from pamsim.identification.columns import StaticData
 from pamsim.identification.equilibrium import equilibrium_m
+from pamsim.identification.muscle_file import upper_stop_table
 from pamsim.identification.static_fit import make_problem
 from pamsim.identification.synthetic import synthetic_static
 
@@ -44,11 +45,14 @@ printed beside it (what calibrated errors from an estimated sigma reach exactly,
 
 
 SETTINGS = ("contraction, censored", "contraction, lifted only", "force")
+SHADOW_STOP = upper_stop_table(pamsim.load_muscle("shadow_6x300_acra2012"))
+"""The paper's muscle's ``[upper_stop]`` (its braid lock), where its equilibria end."""
 
 
 def settings(params):
     acra = read_static_data(ROOT / "pamsim" / "data" / "acra2012_steady_state.csv")
-    x_max = make_problem(acra, params).x_max_m
+    problem = make_problem(acra, params, upper_stop=SHADOW_STOP)
+    x_max = problem.stops(problem.start).x_high_m
     force = Acra2012Polynomial(*PRINTED).force_N
     lifted = equilibrium_m(force, acra.pressure_gauge_Pa, acra.load_N, x_max) >= 5e-3
     p_bar = np.repeat(np.linspace(0.5, 4.0, 8), 10)
@@ -75,7 +79,7 @@ def coverage(make, params, n: int, seed: int) -> tuple[float, float, float, np.n
     hits_p = np.zeros((n, len(COEFFS)), dtype=bool)
     skipped = 0
     for i in range(n):
-        fit = fit_static(make(seed + i), params, cv=None)
+        fit = fit_static(make(seed + i), params, cv=None, upper_stop=SHADOW_STOP)
         hits_p[i] = (fit.profile_95[:, 0] <= PRINTED) & (PRINTED <= fit.profile_95[:, 1])
         u = fit.uncertainty
         if not np.all(np.isfinite(u.standard_errors)):

@@ -19,6 +19,7 @@ from pamsim.identification.synthetic import synthetic_trace
 
 from conftest import ROOT, SCENARIOS
 from conftest import run_cli, run_main as pamsim_cli
+from test_fit_static_limits import check_fitted_muscle_loads
 
 DATA = ROOT / "pamsim" / "data" / "acra2012_steady_state.csv"
 FIT_KEYS = {"model", "muscle", "objective", "parameters", "standard_errors", "correlation", "rms_force_N",
@@ -129,6 +130,10 @@ def test_fitted_muscle_works_as_muscle_everywhere(static_out):
                                     "pressure": {"source": "valve", "supply_gauge_bar": p_bar, "valve_open_time_s": 1.0},
                                     "simulation": {"duration_s": 1.0}})
     assert sc.parameters["C1_N_per_bar"] == c["C1_N_per_bar"]
+    # ...with the source muscle's upper stop, the braid lock its file names (not the default it would get
+    # without the table: the end of the polynomial's fitted range).
+    check_fitted_muscle_loads(out, pamsim.load_muscle("shadow_6x300_acra2012"))
+    assert sc.build_model().stops.upper_basis == "braid_lock"
 
 
 def test_the_fit_command_module_imports_no_numerical_code():

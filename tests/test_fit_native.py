@@ -2,8 +2,8 @@
 synthetic traces (those of tests/synthetic_fit.py: 2.5 s, 3.6 bar valve step recorded, 0.05 mm
 noise), against the truth with the Python tests' own bounds, and from the command line.
 
-The native path differs from the Python one by its input hold: the recorded pressure, linear between
-knots, is held at its midpoint value over every output sample (1 ms).  Both integrate to rtol 1e-8.
+Both backends follow the recorded pressure, linear between its knots, exactly (the native one cuts the
+run at every knot); they differ by their integrators, both at rtol 1e-8.
 """
 
 from __future__ import annotations
@@ -32,11 +32,11 @@ from test_fit_dynamic import test_single_trace_recovers_the_noise_free_trajector
 from test_fit_dynamic import test_single_trace_says_which_coefficients_it_cannot_separate as check_single_pairs
 
 LOADS_N = (12.74, 22.74, 32.74)
-HOLD_TOL_MM = 0.005
-"""Largest native - Python residual difference at the same coefficients [mm]: a tenth of the 0.05 mm
-noise.  The midpoint hold over 1 ms errs by the pressure's curvature times (1 ms)^2 / 24 (its mean over
-the interval is exact where the pressure is linear), a few pascals at the valve's opening; measured:
-1.8 um at most over the three traces."""
+INTEGRATORS_TOL_MM = 1e-4
+"""Largest native - Python contraction difference at the same coefficients and inputs [mm]: the two
+integrators' agreement at rtol 1e-8 (measured 1.5e-5 mm on the 8 s trace at every output rate, 2e-5 mm
+driven by the valve; docs/identification.md), 1/500 of the 0.05 mm noise.  Holding the recorded pressure
+at its midpoint over each 1 ms output sample, as the native fit did before, left 8e-4 mm there."""
 
 
 @pytest.fixture(scope="module")
@@ -86,9 +86,8 @@ def test_native_residuals_at_the_truth_agree_with_python(pooled, python_at_nativ
     sims, _ = python_at_native_optimum
     r_py = fit.problem.residuals_from(sims[0])
     r_nat = fit.problem.residuals_from(make_trials(fit.problem, "native")(_truth_vector()))
-    assert np.max(np.abs(r_nat - r_py)) < HOLD_TOL_MM
-    # ...and the difference is the input hold: the same traces driven by the valve, which the core
-    # holds exactly (a step), agree to the integrators' tolerance.
+    assert np.max(np.abs(r_nat - r_py)) < INTEGRATORS_TOL_MM
+    # ...as the same traces driven by the valve (a step) do.
     by_valve = [TraceData(tr.t_s, tr.x_m, None, tr.weight_N, tr.origin) for tr in fit.problem.traces[1:2]]
     prob = make_problem(fit.problem.scenario, by_valve, free=FREE)
     x_py, = make_trials(prob, "python")(_truth_vector())
@@ -98,33 +97,73 @@ def test_native_residuals_at_the_truth_agree_with_python(pooled, python_at_nativ
 
 def test_native_and_python_fits_agree_within_a_standard_error(pooled, python_at_native_optimum):
     """Where the Python fit would go from the native optimum: one Gauss-Newton step with the Python
-    residuals and Jacobian there.  To first order the two optima differ by J+ dr (dr: the residual
-    difference), whose i-th entry is at most se_i |dr| / s (Cauchy-Schwarz; se_i = s sqrt((J'J)^-1_ii),
-    s the residual RMS); |dr| / s is below 1, so the fits agree within one standard error."""
+    residuals and Jacobian there.  The residuals differ by the integrators' agreement, 1 % of the noise
+    (|dr| / s below 0.02; its share of the step, J+ dr, is at most se_i |dr| / s by Cauchy-Schwarz), so the
+    step is mostly the two Jacobians' difference applied to the noise: measured 0.022 standard errors at
+    most, and the fits agree within a tenth of one."""
     _, fit = pooled
     sims, steps = python_at_native_optimum
     r0 = fit.problem.residuals_from(sims[1])
     J = np.column_stack([(fit.problem.residuals_from(s) - r0) / h for s, h in zip(sims[2:], steps)])
     step = -np.linalg.lstsq(J, r0, rcond=None)[0]
     r_nat = fit.problem.residuals_from(fit.simulated_m)
-    ratio = np.linalg.norm(r0 - r_nat) / np.sqrt(np.mean(r_nat ** 2))
-    assert ratio < 1.0
+    assert np.linalg.norm(r0 - r_nat) / np.sqrt(np.mean(r_nat ** 2)) < 0.02
     se = fit.uncertainty.standard_errors
-    assert np.all(np.abs(step) <= 1.1 * ratio * se), step / se  # 10 %: the bound is first order
+    assert np.all(np.abs(step) <= 0.1 * se), step / se
     # The Python fit's cost at the native optimum is the noise's, as the native one's.
     assert np.sqrt(np.mean(r0 ** 2)) == pytest.approx(NOISE_M * 1e3, rel=0.1)
 
 
-def test_input_hold_error_is_second_order_in_the_sample_interval(scenario):
+def _knots_scenario(scenario, sig, folder, rate_Hz: float):
+    """``scenario`` driven by a trace scenario of the knots of ``sig`` (a fit's recorded pressure), written
+    to a CSV in ``folder`` to the last digit, at output rate ``rate_Hz``."""
+    path = folder / "knots.csv"
+    path.write_text("t_s,p_gauge_Pa\n" + "".join(f"{float(t)!r},{float(p)!r}\n" for t, p in zip(sig.t_s, sig.values)))
+    return scenario.with_changes({"pressure": {"source": "prescribed",
+                                               "prescribed": {"kind": "trace", "file": str(path)}},
+                                  "simulation": {"sample_rate_Hz": rate_Hz}})
+
+
+@pytest.mark.parametrize("rate_Hz", [10.0, 1000.0])
+def test_a_recorded_pressure_is_followed_exactly_at_any_output_rate(scenario, tmp_path, rate_Hz):
+    """A native trial follows the recorded pressure's polyline exactly: it is ``pamsim.simulate`` of a trace
+    scenario of the polyline's knots on the native backend to 1e-12 m, and the Python backend's trial to the
+    integrators' agreement, even at 10 Hz output, where holding the pressure at its midpoint over each
+    output sample moved the contraction 7.99 mm from the Python backend's (0.0008 mm at 1 kHz)."""
     noisy, _ = _traces(scenario, [22.74])[0]
-    diff = {}
-    for rate in (1000.0, 2000.0):
-        prob = make_problem(scenario.with_changes({"simulation": {"sample_rate_Hz": rate}}), [noisy], free=FREE)
-        x_py, = make_trials(prob, "python")(_truth_vector())
-        x_nat, = make_trials(prob, "native")(_truth_vector())
-        diff[rate] = np.max(np.abs(x_nat - x_py))
-    assert diff[1000.0] < HOLD_TOL_MM * 1e-3
-    assert diff[2000.0] < 0.35 * diff[1000.0]  # halving the hold: a quarter of the error (second order)
+    rated = scenario.with_changes({"simulation": {"sample_rate_Hz": rate_Hz}})
+    prob = make_problem(rated, [noisy], free=FREE)
+    x_nat, = make_trials(prob, "native")(_truth_vector())
+    x_py, = make_trials(prob, "python")(_truth_vector())
+    assert np.max(np.abs(x_nat - x_py)) < INTEGRATORS_TOL_MM * 1e-3
+    sc = trace_scenario(_knots_scenario(scenario, prob.inputs[0], tmp_path, rate_Hz), dict(zip(FREE, _truth_vector())),
+                        22.74, float(noisy.t_s[-1] - noisy.t_s[0]))
+    ref = pamsim.simulate(sc, backend="native")
+    assert np.max(np.abs(x_nat - np.interp(noisy.t_s - noisy.t_s[0], ref.t_s, ref.x_m))) <= 1e-12
+
+
+def test_a_recorded_pressure_is_followed_exactly_on_the_core_too():
+    """The implicit two-phase model runs as a force table on the hand-written core, which takes the recorded
+    pressure exactly as well: at 10 Hz output the trial is the one at 1 kHz, and the Python backend's to the
+    table's error (midpoint holds over 100 ms moved it 1.55 mm)."""
+    two_phase = pamsim.Scenario.from_dict({
+        "model": {"muscle": "mpam_survey_45mm", "static_force": "mpam_two_phase"}, "parameters": {"E_nylon_Pa": 3e9},
+        "load": {"weight_N": 0.05}, "pressure": {"source": "valve", "supply_gauge_bar": 7.0, "valve_open_time_s": 0.2},
+        "simulation": {"duration_s": 2.0}})
+    t = np.linspace(0.0, 2.0, 2001)
+    p = 7e5 * (1.0 - np.exp(-np.maximum(t - 0.2, 0.0) / 0.3))  # a valve's first-order rise, recorded
+    trace = TraceData(t, np.zeros_like(t), p, 0.05)
+    sims = {}
+    for rate in (10.0, 1000.0):
+        prob = make_problem(two_phase.with_changes({"simulation": {"sample_rate_Hz": rate}}), [trace],
+                            free=("N0_N_per_bar",))
+        trials = NativeTrials(prob, FIT_RTOL)
+        assert trials.chunk(np.array([prob.scenario.parameters["N0_N_per_bar"]])).segment_du is not None
+        sims[rate] = trials(np.array([prob.scenario.parameters["N0_N_per_bar"]]))[0]
+    grid = np.arange(0, 2001, 100)  # the 10 Hz output's samples
+    assert np.max(np.abs(sims[10.0][grid] - sims[1000.0][grid])) < 1e-9
+    x_py, = make_trials(prob, "python")(np.array([prob.scenario.parameters["N0_N_per_bar"]]))
+    assert np.max(np.abs(sims[1000.0] - x_py)) < 1e-6
 
 
 def test_trial_cases_are_the_native_backends_own_cases_with_the_coefficients_changed(scenario, pooled):

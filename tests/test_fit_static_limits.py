@@ -37,11 +37,14 @@ def readme_muscle(tmp_path):
     return path
 
 
-def check_fitted_muscle_loads(out):
-    """Every fit output loads back as a muscle, with only independent values written."""
+def check_fitted_muscle_loads(out, source=None):
+    """Every fit output loads back as a muscle, with only independent values written, and with the upper stop
+    of the ``source`` muscle it was fitted from (its ``[upper_stop]`` table, or none)."""
     muscle = pamsim.muscles.load_muscle(out / "muscle.toml")
     written = tomllib.loads((out / "muscle.toml").read_text())["parameters"]
     assert not [k for k, v in written.items() if v["source"].startswith("derived")]
+    if source is not None:
+        assert (muscle.upper_stop, muscle.upper_stop_source) == (source.upper_stop, source.upper_stop_source)
     return muscle
 
 
@@ -51,7 +54,7 @@ def test_readme_muscle_fit_keeps_its_geometry_physical(tmp_path, readme_muscle):
     out = tmp_path / "fit"
     proc = pamsim_cli("fit", "static", data, "--muscle", readme_muscle, "-o", out)
     assert proc.returncode == 0, proc.stderr
-    muscle = check_fitted_muscle_loads(out)
+    muscle = check_fitted_muscle_loads(out, pamsim.load_muscle(readme_muscle))
     v = muscle.parameters
     assert 0.0 < v["wall_thickness_m"] < v["r0_m"] < v["L0_m"]
     assert 0.0 < v["theta0_deg"] < LOCK_DEG
@@ -72,7 +75,7 @@ def test_fitted_muscle_with_wall_loads_back(tmp_path, readme_muscle, free):
     out = tmp_path / "fit"
     proc = pamsim_cli("fit", "static", data, "--muscle", readme_muscle, "--free", free, "-o", out)
     assert proc.returncode == 0, proc.stderr
-    fitted = check_fitted_muscle_loads(out).parameters
+    fitted = check_fitted_muscle_loads(out, pamsim.load_muscle(readme_muscle)).parameters
     assert fitted["r0_m"] - fitted["ri0_m"] == pytest.approx(fitted["wall_thickness_m"], rel=1e-9)
 
 

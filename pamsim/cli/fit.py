@@ -150,6 +150,14 @@ def _print_warnings(uncertainty) -> None:
         print(f"  warning: {a} and {b} are correlated (r = {r:+.3f}): the data do not separate them")
 
 
+def _print_stop(stop: dict) -> None:
+    """The tests a static fit predicts on the upper stop, below its summary."""
+    on = stop["tests_on_stop"]
+    if on:
+        print(f"  {len(on)} test(s) predicted on the upper stop ({stop['x_m'] * 1e3:.4g} mm, {stop['at']}): "
+              f"{', '.join(str(i) for i in on)} (counted from 0 in the data's order)")
+
+
 def _warn(lines) -> None:
     """One ``warning:`` line on stderr for each of ``lines``."""
     for line in lines:
@@ -165,13 +173,14 @@ def run_static(args: argparse.Namespace) -> int:
 
     figures = figure_args.options(args)
     params, muscle_model = muscle_file.load_muscle_parameters(args.muscle)
+    upper_stop = muscle_file.load_upper_stop(args.muscle)
     model = args.model or muscle_model
     check_output_dir(args.output)
     data = read_static_data(args.data, args.columns)
-    _warn(static_fit.check_data(data, params, model))
+    _warn(static_fit.check_data(data, params, model, upper_stop))
     options = dict(objective=args.objective, loss=args.loss, f_scale=args.f_scale, n_starts=args.starts,
                    seed=args.seed, censor_threshold_m=args.censor_threshold_mm * 1e-3, cv=args.cv,
-                   k_folds=args.folds)
+                   k_folds=args.folds, upper_stop=upper_stop)
     fit = static_fit.fit_static(data, params, model=model, free=args.free, muscle_label=args.muscle, **options)
     compared = None
     if args.compare:
@@ -191,6 +200,7 @@ def run_static(args: argparse.Namespace) -> int:
     print(f"{model} on {args.data}: RMS contraction {fit.rms_contraction_mm:.3f} mm "
           f"(cross-validated {cv}, {fit.cv_kind}), "
           f"{fit.n_points} tests, {fit.n_censored} censored")
+    _print_stop(fit.upper_stop_json())
     _print_warnings(fit.uncertainty)
     print(f"wrote {', '.join(str(Path(args.output) / n) for n in names)}")
     return 0

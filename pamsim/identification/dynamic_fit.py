@@ -31,7 +31,6 @@ from typing import Sequence
 import numpy as np
 from scipy.optimize import differential_evolution, least_squares
 
-from ..elements.stops import EndStops
 from ..errors import InputError
 from ..parameters import ParameterSet
 from ..scenario import Scenario
@@ -262,9 +261,10 @@ def check_data(scenario: Scenario, traces: Sequence[TraceData],
     length, upper stop, rating and blocked force)."""
     params = scenario.parameters
     loads = _trace_loads(scenario, traces, loads_N)
-    x_max = EndStops.from_parameters(params).x_high_m
+    model = scenario.build_model()
+    x_max = model.stops.x_high_m  # where the scenario's simulations stop, not the braid lock
     rated = params["rated_pressure_gauge_Pa"] if "rated_pressure_gauge_Pa" in params else math.inf
-    static = scenario.build_model().static_force
+    static = model.static_force
 
     def blocked(p_gauge_Pa):
         return static.force_N(0.0, scenario.final_pressure_gauge_Pa if p_gauge_Pa is None else p_gauge_Pa)
@@ -377,8 +377,8 @@ def fit_dynamic(scenario: Scenario, traces: Sequence[TraceData], free: Sequence[
     backend : {"python", "native"}
         Simulator of the fit.  ``native`` runs each optimiser step's simulations (each
         differential-evolution generation's too) in one call of the native library, one per worker
-        with an executor; it holds a recorded pressure at its midpoint over every output sample (see
-        :mod:`.native_fit`) and refuses, before anything runs, a scenario setting it cannot honour.
+        with an executor; it follows a recorded pressure exactly, as the Python backend does (see
+        :mod:`.native_fit`), and refuses, before anything runs, a scenario setting it cannot honour.
     n_starts : int, optional
         Extra local fits, from the best of ``25 n_starts`` seeded random points (:mod:`.dynamic_starts`);
         the fit with the lowest cost wins.  Default :data:`DEFAULT_STARTS` of the backend.

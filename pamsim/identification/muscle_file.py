@@ -1,8 +1,8 @@
 """The fitted muscle as a ``muscle.toml`` file in the format :func:`pamsim.load_muscle` reads
 (top-level ``name``, ``description``, ``citation``, ``default_static_force``, one
-``[parameters.NAME]`` table per parameter with ``value``, ``source`` and ``description``, and an
-optional ``[data]`` table naming the measured points relative to the file), and the reading of
-``--muscle`` arguments.
+``[parameters.NAME]`` table per parameter with ``value``, ``source`` and ``description``, the source
+muscle's ``[upper_stop]`` table if it has one, and an optional ``[data]`` table naming the measured points
+relative to the file), and the reading of ``--muscle`` arguments.
 """
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ import json
 import math
 from typing import Mapping
 
-from ..muscles import DERIVED, load_muscle
+from ..muscles import DEFAULT_UPPER_STOP_SOURCE, DERIVED, Muscle, load_muscle
 from ..parameters import DYNAMICS_DEFAULTS, ParameterSet, dynamics_parameters
 
 
@@ -26,8 +26,10 @@ def _v(value: float) -> str:
 
 
 def muscle_toml(params: ParameterSet, name: str, description: str, citation: str, static_force: str,
-                provenance: Mapping[str, object], data_file: str | None = None) -> str:
-    """Text of a muscle file holding the parameters of ``params``.
+                provenance: Mapping[str, object], data_file: str | None = None,
+                upper_stop: tuple[str, str] | None = None) -> str:
+    """Text of a muscle file holding the parameters of ``params``, and ``upper_stop`` (``(at, source)``)
+    as its ``[upper_stop]`` table unless None.
 
     Dynamics values that are still the defaults every muscle gets (same value and source as
     :data:`pamsim.parameters.DYNAMICS_DEFAULTS`) are left out, as in the shipped files.
@@ -44,9 +46,19 @@ def muscle_toml(params: ParameterSet, name: str, description: str, citation: str
             continue
         lines += [f"[parameters.{key}]", f"value = {_v(entry.value)}", f"source = {_s(entry.source)}",
                   f"description = {_s(entry.description)}", ""]
+    if upper_stop is not None:
+        lines += ["[upper_stop]", f"at = {_s(upper_stop[0])}", f"source = {_s(upper_stop[1])}", ""]
     if data_file:
         lines += ["[data]", f"file = {_s(data_file)}", ""]
     return "\n".join(lines)
+
+
+def upper_stop_table(muscle: Muscle) -> tuple[str, str] | None:
+    """``(at, source)`` of ``muscle``'s ``[upper_stop]`` table, or None if its file names none (it then
+    takes the default choice, which a fitted file without the table takes again)."""
+    if muscle.upper_stop_source == DEFAULT_UPPER_STOP_SOURCE:
+        return None
+    return muscle.upper_stop, muscle.upper_stop_source
 
 
 def load_muscle_parameters(name_or_path: str) -> tuple[ParameterSet, str]:
@@ -54,3 +66,17 @@ def load_muscle_parameters(name_or_path: str) -> tuple[ParameterSet, str]:
     dynamics' defaults) and the muscle's own static force model."""
     muscle = load_muscle(name_or_path)
     return dynamics_parameters(muscle.parameters), muscle.default_static_force
+
+
+def scenario_upper_stop(scenario) -> tuple[str, str] | None:
+    """The ``[upper_stop]`` table a muscle fitted with ``scenario`` carries: the scenario's ``[model]
+    upper_stop`` if it sets one (the stop the fit simulated with), else its muscle's table (or None)."""
+    at = scenario.spec["model"].get("upper_stop")
+    if at is not None:
+        return at, f"the [model] upper_stop of scenario {scenario.name!r}, with which it was fitted"
+    return upper_stop_table(scenario.muscle)
+
+
+def load_upper_stop(name_or_path: str) -> tuple[str, str] | None:
+    """The ``[upper_stop]`` table of the muscle named by ``--muscle`` (:func:`upper_stop_table`)."""
+    return upper_stop_table(load_muscle(name_or_path))

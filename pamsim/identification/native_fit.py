@@ -36,13 +36,13 @@ own checks.
 of every variable, so a trial is that vector with them replaced, and the load mass, an input of the
 core, is recomputed from the trial's ``g_m_s2``.
 
-What this approximates (docs/identification.md has the measured effect on a fit): the native
-backend holds its inputs constant over segments, so the recorded pressure, linear between its knots,
-is held at its midpoint value over every output-sample interval
-(:func:`pamsim.native.backend.hold_interval_s`; a knot inside an interval is passed over, a turning
-knot is a segment boundary).  Over an interval with no knot inside, the midpoint value is the
-interval's mean pressure, a second-order approximation; the Python backend follows the polyline
-exactly.
+**The recorded pressure** is a trace of its knots (:class:`.pressure_input.PiecewiseLinearInput`), which
+the backend takes as it takes a scenario's trace, on the engine and on the core alike: the run is cut at
+every knot and the integrator evaluates the line between two knots exactly
+(:func:`pamsim.native.backend.exact_segments`), so a trial's contraction is ``pamsim.simulate`` of the
+trace's scenario with that trace on the native backend, and the output sample rate changes nothing but
+the grid the contraction is interpolated from (docs/identification.md has the measured agreement with
+the Python backend).
 """
 
 from __future__ import annotations
@@ -58,7 +58,7 @@ from ..assemblies import scenario_assembly
 from ..elements.pressure_source import PrescribedPressure
 from ..errors import InputError
 from ..native import library as lib
-from ..native.backend import CaseInputs, case_inputs, event_capacity, outgrew_batch
+from ..native.backend import CaseInputs, case_inputs, event_capacity, outgrew_batch, segment_changes
 from ..native.engine import EngineCase, EngineLibrary, engine_library
 from ..static_models import get as get_static_model
 from .trials import trace_scenario
@@ -103,6 +103,7 @@ class Chunk:
     segment_counts: np.ndarray
     segment_t_s: np.ndarray
     segment_u: np.ndarray
+    segment_du: np.ndarray | None
     max_events: np.ndarray
     sample_t_s: tuple[np.ndarray, ...]
     tables: tuple = ()
@@ -113,8 +114,9 @@ class Chunk:
     def sub(self, a: int, b: int) -> "Chunk":
         """Cases ``a`` to ``b - 1``."""
         seg = np.concatenate([[0], np.cumsum(self.segment_counts)])
+        du = None if self.segment_du is None else self.segment_du[seg[a]:seg[b]]
         return Chunk(self.reals[a:b], self.ints[a:b], self.duration_s[a:b], self.n_samples[a:b],
-                     self.segment_counts[a:b], self.segment_t_s[seg[a]:seg[b]], self.segment_u[seg[a]:seg[b]],
+                     self.segment_counts[a:b], self.segment_t_s[seg[a]:seg[b]], self.segment_u[seg[a]:seg[b]], du,
                      self.max_events[a:b], self.sample_t_s[a:b], self.tables)
 
     def run(self) -> list[np.ndarray]:
@@ -134,7 +136,7 @@ def _run(chunk: Chunk, capacity: np.ndarray) -> dict:
     """One call of the C core; the cases share the fit's one force table."""
     return lib.run_batch(chunk.reals, chunk.ints, chunk.duration_s, chunk.n_samples, chunk.segment_counts,
                          chunk.segment_t_s, chunk.segment_u, capacity, chunk.tables,
-                         np.zeros(len(chunk), dtype=np.int64) if chunk.tables else None)
+                         np.zeros(len(chunk), dtype=np.int64) if chunk.tables else None, chunk.segment_du)
 
 
 class _CoreTrials:
@@ -159,7 +161,7 @@ class _CoreTrials:
         u[:, _MASS] = np.repeat(np.tile(self.weights_N, len(thetas)) / reals[:, _G], counts)
         return Chunk(reals, np.array([c.ints for c in cases]), np.array([c.duration_s for c in cases]),
                      np.array([c.n_samples for c in cases], dtype=np.int64), counts,
-                     np.concatenate([c.segment_t_s for c in cases]), u,
+                     np.concatenate([c.segment_t_s for c in cases]), u, segment_changes(cases),
                      np.array([c.max_events for c in cases], dtype=np.int64), tuple(self.samples * len(thetas)),
                      self.tables)
 

@@ -30,6 +30,7 @@ def plot_static_fit(fit: "StaticFit", path=None, dpi: int | None = None) -> Figu
     fig = Figure(figsize=(8, 5.5), constrained_layout=True)
     ax = fig.subplots()
     force = fit.problem.force(fit.theta).force_N
+    x_high = fit.problem.stops(fit.theta).x_high_m
     p_grid = np.linspace(0.0, max(d.pressure_gauge_Pa.max(), 1.0) * 1.05, 200)
     loads = np.unique(np.round(d.load_N, 6))
     for i, w in enumerate(loads):
@@ -40,7 +41,7 @@ def plot_static_fit(fit: "StaticFit", path=None, dpi: int | None = None) -> Figu
         ax.plot(d.pressure_gauge_Pa[rows & ~cens] / PA_PER_BAR, d.contraction_m[rows & ~cens] * 1e3, "o",
                 color=color, label=f"{w:g} N measured")
         ax.plot(d.pressure_gauge_Pa[cens] / PA_PER_BAR, d.contraction_m[cens] * 1e3, "x", color=color)
-        x_fit = equilibrium_m(force, p_grid, np.full_like(p_grid, w), fit.problem.x_max_m)
+        x_fit = equilibrium_m(force, p_grid, np.full_like(p_grid, w), x_high)
         ax.plot(p_grid / PA_PER_BAR, x_fit * 1e3, lw=1.2, **style)
     ax.set_xlabel("gauge pressure [bar]")
     ax.set_ylabel("contraction [mm]")

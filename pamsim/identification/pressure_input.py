@@ -7,31 +7,29 @@ Thinning the trace to the knots of a piecewise-linear approximation within a tol
 (Ramer-Douglas-Peucker) and declaring the knots where the polyline turns (rising to falling or
 back) breakpoints makes the input monotonic between breakpoints, so the cap is not needed: the same
 input to within the tolerance, a few restarts of the integrator instead of one step per sample.
+
+The input is a :class:`pamsim.signals.Trace` of its knots, so the native backend takes it as it takes a
+scenario's trace: cut at every knot and evaluated exactly inside the integrator
+(:func:`pamsim.native.backend.exact_segments`).
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
+from ..signals import Trace
 from .choices import KNOT_TOLERANCE_PA
 
 
 @dataclass(frozen=True)
-class PiecewiseLinearInput:
-    """A signal linear between its knots ``(t_s, values)``, constant outside them."""
+class PiecewiseLinearInput(Trace):
+    """A trace linear between its knots ``(t_s, values)``, constant outside them, whose turning knots are
+    breakpoints, so the Python backend's step is not capped at the knot spacing."""
 
-    t_s: np.ndarray = field(repr=False)
-    values: np.ndarray = field(repr=False)
-    source: str = ""
     max_step_s = math.inf
-
-    def __call__(self, t):
-        if isinstance(t, float):
-            return float(np.interp(t, self.t_s, self.values))
-        return np.interp(t, self.t_s, self.values)
 
     @property
     def breakpoints(self) -> tuple[float, ...]:
@@ -39,11 +37,6 @@ class PiecewiseLinearInput:
         s = np.sign(np.diff(self.values))
         turns = np.flatnonzero(s[1:] != s[:-1]) + 1
         return tuple(float(t) for t in self.t_s[turns])
-
-    @property
-    def final_value(self) -> float:
-        """The last knot's value."""
-        return float(self.values[-1])
 
 
 def knots(t_s: np.ndarray, values: np.ndarray, tolerance: float) -> np.ndarray:

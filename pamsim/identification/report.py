@@ -14,8 +14,9 @@ from typing import TYPE_CHECKING, Sequence
 
 from ..atomic import atomic_outputs
 from ..figure_style import check_format
+from ..parameter_schema import UPPER_BASES
 from .compare import comparison_rows, write_comparison_csv
-from .muscle_file import muscle_toml
+from .muscle_file import muscle_toml, scenario_upper_stop
 from .plots import plot_comparison, plot_correlation, plot_dynamic_fit, plot_static_fit, plot_static_residuals
 
 if TYPE_CHECKING:
@@ -93,6 +94,16 @@ def correlation_lines(fit_unc) -> list[str]:
     return out
 
 
+def upper_stop_line(stop: dict) -> str:
+    """The report's line on the fitted muscle's upper stop (:meth:`StaticFit.upper_stop_json`)."""
+    line = f"- upper stop: {stop['x_m'] * 1e3:.4g} mm, {UPPER_BASES[stop['basis']]} (choice {stop['at']!r})"
+    on = stop["tests_on_stop"]
+    if on:
+        line += (f"; **{len(on)} test(s) predicted on it** (tests {', '.join(str(i) for i in on)}, counted from 0 "
+                 "in the data's order): the fitted model still pulls harder than the load there")
+    return line
+
+
 def static_report_md(fit: "StaticFit", compare: Sequence[dict] | None, figure_format: str = "png") -> str:
     """The static fit's report in Markdown: errors, coefficients, correlations, the compared models and
     figures.
@@ -106,7 +117,7 @@ def static_report_md(fit: "StaticFit", compare: Sequence[dict] | None, figure_fo
            f"cross-validated ({fit.cv_kind}): **{_f(fit.cv_rms_contraction_mm, '.3f')} mm**",
            f"- RMS force error over the lifted tests: {_f(fit.rms_force_N, '.3f')} N",
            f"- AIC {_f(fit.aic, '.2f')}, BIC {_f(fit.bic, '.2f')}; optimiser: {fit.message} ({fit.nfev} evaluations)",
-           "", "## Coefficients", ""]
+           upper_stop_line(fit.upper_stop_json()), "", "## Coefficients", ""]
     out += parameter_table(p.free, start, fit.parameters, fit.uncertainty, fit.intervals_json()) + [""]
     out += ["Standard errors come from the Jacobian at the optimum (linearised, residual variance from the fit); "
             "the Wald interval is the fitted value plus or minus the Student-t quantile times the standard error. "
@@ -155,7 +166,8 @@ def write_static_fit(fit: "StaticFit", directory, compare: Sequence["StaticFit"]
             description=f"{fit.fitted.name} with {', '.join(p.free)} fitted by pamsim fit static "
                         f"({p.objective} objective, {rms}) on {Path(p.data.origin).name} "
                         f"(sha256 {p.data.sha256})",
-            citation=fit.fitted.citation, static_force=p.model, provenance=prov, data_file="data.csv" if has_file else None))
+            citation=fit.fitted.citation, static_force=p.model, provenance=prov, data_file="data.csv" if has_file else None,
+            upper_stop=p.upper_stop))
         if has_file:
             shutil.copyfile(p.data.origin, out["data.csv"])
         out["report.md"].write_text(static_report_md(fit, rows, ext))
@@ -265,7 +277,8 @@ def write_dynamic_fit(fit: "DynamicFit", directory, figure_format: str = "png", 
         out["muscle.toml"].write_text(muscle_toml(
             fitted, name=f"{fitted.name}_dynamic_fit",
             description=f"{fitted.name} with {', '.join(p.free)} fitted by pamsim fit dynamic ({rms})",
-            citation=fitted.citation, static_force=p.scenario.spec["model"]["static_force"], provenance=prov))
+            citation=fitted.citation, static_force=p.scenario.spec["model"]["static_force"], provenance=prov,
+            upper_stop=scenario_upper_stop(p.scenario)))
         out["scenario.toml"].write_text(scenario_toml(spec, [f"{k}: {v}" for k, v in prov.items()]))
         out["report.md"].write_text(dynamic_report_md(fit, ext))
         plot_dynamic_fit(fit, out[f"fit.{ext}"], dpi)

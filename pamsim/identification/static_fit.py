@@ -28,7 +28,7 @@ from scipy.optimize import least_squares
 from ..elements.stops import EndStops
 from ..errors import InputError
 from ..muscles import DERIVED, WALL_PAIR, geometry_violation, rederive
-from ..parameter_schema import LOCK_DEG
+from ..parameter_schema import LOCK_DEG, UPPER_STOP_DEFAULT
 from ..parameters import ParameterSet, dynamics_parameters, known_parameter
 from .choices import CENSOR_THRESHOLD_M, LOSSES, OBJECTIVES
 from .columns import StaticData
@@ -57,7 +57,9 @@ class StaticProblem:
     free: tuple[str, ...]
     objective: str
     censor_threshold_m: float
-    x_max_m: float
+    upper_stop: tuple[str, str] | None
+    """``(at, source)`` of the muscle file's ``[upper_stop]`` table, or None where it names none (the default
+    choice, :data:`pamsim.parameter_schema.UPPER_STOP_DEFAULT`)."""
     bounds: tuple[np.ndarray, np.ndarray]
 
     @cached_property
@@ -86,6 +88,11 @@ class StaticProblem:
         """Whether the base parameter set derives a parameter from others (so the fit re-derives it)."""
         return any(p.source.startswith(DERIVED) for p in self.base.entries.values())
 
+    @property
+    def start(self) -> np.ndarray:
+        """The free coefficients' starting values."""
+        return np.array([self.base[n] for n in self.free], dtype=float)
+
     def params(self, theta: np.ndarray) -> dict[str, float]:
         """The parameters with the coefficients ``theta`` (in the order of ``free``) in place."""
         return dict(self.parameter_set(theta))
@@ -94,34 +101,57 @@ class StaticProblem:
         """The static force model with the coefficients ``theta``."""
         return build_static(self.model, self.params(theta))
 
-    def feasible_force(self, theta: np.ndarray):
-        """The model at ``theta``, or None where the geometry is impossible or the model cannot be built."""
+    def stops(self, theta: np.ndarray) -> EndStops:
+        """The end stops of the muscle at ``theta`` with the fit's static model, the upper one where the
+        muscle's choice puts it, as in a simulation of the muscle (:meth:`EndStops.for_model`; a
+        ValueError if the choice cannot be met there)."""
+        values = self.params(theta)
+        return self._stops(values, build_static(self.model, values))
+
+    @property
+    def upper_stop_choice(self) -> str:
+        """Where the muscle's upper stop stands (:data:`pamsim.parameter_schema.UPPER_STOPS`)."""
+        return UPPER_STOP_DEFAULT if self.upper_stop is None else self.upper_stop[0]
+
+    def _stops(self, values: Mapping[str, float], model) -> EndStops:
+        return EndStops.for_model(values, model.domain.x_max_m, self.upper_stop_choice)
+
+    def feasible(self, theta: np.ndarray):
+        """``(model, upper stop [m])`` at ``theta``, or None where the geometry is impossible, the model cannot
+        be built or the muscle's upper stop cannot stand."""
         values = self.params(theta)
         if geometry_violation(values):
             return None
         try:
-            return build_static(self.model, values)
+            model = build_static(self.model, values)
+            return model, self._stops(values, model).x_high_m
         except (ValueError, ArithmeticError):  # a model refusing its inputs: a bad trial point, not an error
             return None
 
+    def feasible_force(self, theta: np.ndarray):
+        """The model at ``theta``, or None where :meth:`feasible` finds none."""
+        found = self.feasible(theta)
+        return None if found is None else found[0]
+
     def predict_m(self, theta: np.ndarray, data: StaticData | None = None) -> np.ndarray:
-        """Equilibrium contraction [m] of each test under its load."""
+        """Equilibrium contraction [m] of each test under its load, up to the upper stop at ``theta``."""
         d = self.data if data is None else data
-        return equilibrium_m(self.force(theta).force_N, d.pressure_gauge_Pa, d.load_N, self.x_max_m)
+        return equilibrium_m(self.force(theta).force_N, d.pressure_gauge_Pa, d.load_N, self.stops(theta).x_high_m)
 
     def residuals(self, theta: np.ndarray) -> np.ndarray:
         """The objective's residuals (contraction in mm, force in N)."""
         d = self.data
         cens = self.censored
-        model = self.feasible_force(theta)
-        if model is None:
+        found = self.feasible(theta)
+        if found is None:
             return np.full(len(d), _PENALTY)
+        model, x_high = found
         try:
             if self.objective == "force":
                 r = model.force_N(d.contraction_m, d.pressure_gauge_Pa) - d.load_N
                 r = np.where(cens, np.maximum(r, 0.0), r)
             else:
-                x = equilibrium_m(model.force_N, d.pressure_gauge_Pa, d.load_N, self.x_max_m)
+                x = equilibrium_m(model.force_N, d.pressure_gauge_Pa, d.load_N, x_high)
                 r = 1e3 * np.where(cens, np.maximum(x - self.censor_threshold_m, 0.0), x - d.contraction_m)
         except ArithmeticError:  # a Python float overflowing in a model's formula
             return np.full(len(d), _PENALTY)
@@ -132,37 +162,44 @@ class StaticProblem:
         """d residual / d theta (physical units).
 
         Force: forward differences of the force.  Contraction: the implicit-function derivative
-        ``dx*/dtheta = -(dF/dtheta) / (dF/dx)`` at the equilibrium, zero where the equilibrium sits
-        on a stop, so no root finding enters a difference quotient.
+        ``dx*/dtheta = -(dF/dtheta) / (dF/dx)`` at the equilibrium, the stop's own derivative where the
+        equilibrium sits on the upper stop (nonzero only when a free coefficient moves the stop), zero on the
+        lower one, so no root finding enters a difference quotient.
         """
         d = self.data
         if self.objective == "force":
-            x, base_x = d.contraction_m, None
-        else:
-            base_x = self.predict_m(theta)
-            x = base_x
-        f0 = self.force(theta).force_N(x, d.pressure_gauge_Pa)
-        J = np.empty((len(d), len(theta)))
+            J, _ = self._differences(theta, d.contraction_m)
+            active = ~self.censored | (self.force(theta).force_N(d.contraction_m, d.pressure_gauge_Pa) - d.load_N > 0.0)
+            return self._weighted(J * active[:, None])
+        base_x = self.predict_m(theta)
+        J, stop_slopes = self._differences(theta, base_x)
+        x_high = self.stops(theta).x_high_m
+        inside = (base_x > 0.0) & (base_x < x_high)
+        slope = slope_N_per_m(self.force(theta).force_N, base_x, d.pressure_gauge_Pa)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            dx = np.where(inside[:, None], -J / slope[:, None], np.where(base_x[:, None] >= x_high, stop_slopes, 0.0))
+        active = ~self.censored | (base_x > self.censor_threshold_m)
+        return self._weighted(1e3 * dx * active[:, None])
+
+    def _differences(self, theta: np.ndarray, x_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Forward differences in each coefficient of the force at contractions ``x_m`` [N per unit] and of the
+        upper stop [m per unit]; backward where the forward step leaves the feasible coefficients."""
+        d = self.data
+        f0 = self.force(theta).force_N(x_m, d.pressure_gauge_Pa)
+        x_high = self.stops(theta).x_high_m
+        J, stop = np.empty((len(d), len(theta))), np.empty(len(theta))
         for j in range(len(theta)):
             h = _FD_REL * max(abs(theta[j]), 1.0)
             t = theta.copy()
             t[j] += h
-            model = self.feasible_force(t)
-            if model is None:  # the optimum sits at the edge of the geometry: difference backwards
+            found = self.feasible(t)
+            if found is None:  # the optimum sits at the edge of the geometry: difference backwards
                 h = -h
                 t[j] = theta[j] + h
-                model = self.force(t)
-            J[:, j] = (model.force_N(x, d.pressure_gauge_Pa) - f0) / h
-        cens = self.censored
-        if self.objective == "force":
-            active = ~cens | (f0 - d.load_N > 0.0)
-            return self._weighted(J * active[:, None])
-        inside = (base_x > 0.0) & (base_x < self.x_max_m)
-        slope = slope_N_per_m(self.force(theta).force_N, base_x, d.pressure_gauge_Pa)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            dx = np.where(inside[:, None], -J / slope[:, None], 0.0)
-        active = ~cens | (base_x > self.censor_threshold_m)
-        return self._weighted(1e3 * dx * active[:, None])
+                found = self.force(t), self.stops(t).x_high_m
+            J[:, j] = (found[0].force_N(x_m, d.pressure_gauge_Pa) - f0) / h
+            stop[j] = (found[1] - x_high) / h
+        return J, stop
 
     def _weighted(self, J: np.ndarray) -> np.ndarray:
         return J if self.weights is None else J * self.weights[:, None]
@@ -237,7 +274,21 @@ class StaticFit:
                 "censor_threshold_mm": self.problem.censor_threshold_m * 1e3,
                 "aic": _num(self.aic), "bic": _num(self.bic), "loss": self.loss, "n_starts": self.n_starts,
                 "success": self.success, "message": self.message, "nfev": self.nfev,
-                "wall_time_s": self.wall_time_s, "intervals_95": self.intervals_json(), **self.extra}
+                "wall_time_s": self.wall_time_s, "intervals_95": self.intervals_json(),
+                "upper_stop": self.upper_stop_json(), **self.extra}
+
+    @property
+    def on_upper_stop(self) -> np.ndarray:
+        """Indices (in the data's order) of the tests whose predicted equilibrium sits on the upper stop: the
+        fitted model still pulls harder than the load there (``on_stop = "upper"`` of ``pamsim static``)."""
+        return np.flatnonzero(self.predicted_m >= self.problem.stops(self.theta).x_high_m)
+
+    def upper_stop_json(self) -> dict:
+        """The fitted muscle's upper stop: the choice, where it stands [m], what placed it, and the tests
+        predicted on it."""
+        stops = self.problem.stops(self.theta)
+        return {"at": self.problem.upper_stop_choice, "x_m": stops.x_high_m, "basis": stops.upper_basis,
+                "tests_on_stop": self.on_upper_stop.tolist()}
 
     def intervals_json(self) -> dict:
         """``{name: {"wald": [lo, hi], "profile": [lo, hi]}}``: an interval that was not computed or that the
@@ -259,13 +310,17 @@ def _pair(ends: np.ndarray) -> list | None:
 
 def make_problem(data: StaticData, params: ParameterSet, model: str = "acra2012_polynomial",
                  free: Sequence[str] | None = None, objective: str | None = None,
-                 censor_threshold_m: float = CENSOR_THRESHOLD_M) -> StaticProblem:
+                 censor_threshold_m: float = CENSOR_THRESHOLD_M,
+                 upper_stop: tuple[str, str] | None = None) -> StaticProblem:
     """Check the choices of a static fit and bundle them.
 
     ``params`` may be a muscle's own parameters (``pamsim.load_muscle(path).parameters``): what the
     dynamics need and it does not give takes pamsim's defaults, as ``pamsim fit static --muscle`` does.
     ``objective`` defaults to ``contraction`` for hanging-weight data and ``force`` for force data.
-    The search for the equilibrium ends at the muscle's upper stop (braid lock).
+    The search for the equilibrium ends at the muscle's upper stop, where ``upper_stop`` (the muscle file's
+    ``[upper_stop]`` table as ``(at, source)``, :func:`.muscle_file.upper_stop_table`; None: the file names
+    none) puts it for the fit's static model, as in a simulation of the muscle; a choice the muscle cannot
+    meet is refused (``InputError``).
     """
     params = dynamics_parameters(params)
     check_model(model)
@@ -274,6 +329,27 @@ def make_problem(data: StaticData, params: ParameterSet, model: str = "acra2012_
         raise InputError(f"--model = {model!r}: muscle {params.name!r} does not give {', '.join(missing)}")
     free = tuple(free) if free else default_free(model)
     optional = optional_defaults(model)
+    _check_free(free, params, model, optional)
+    objective = objective or ("contraction" if data.kind == "weight" else "force")
+    if objective not in OBJECTIVES:
+        raise InputError(f"--objective = {objective!r}: choose from {', '.join(OBJECTIVES)}")
+    if not censor_threshold_m >= 0.0:
+        raise InputError(f"--censor-threshold-mm = {censor_threshold_m * 1e3:g}: must not be negative")
+
+    params = with_optional(params, {k: v for k, v in optional.items() if k in free}, model)
+    params = _independent(params, free, model)
+    lower = np.array([params.entries[n].lower for n in free], dtype=float)
+    upper = np.array([params.entries[n].upper for n in free], dtype=float)
+    for i, name in enumerate(free):
+        lower[i], upper[i] = _physical_bounds(name, params, free, lower[i], upper[i])
+    problem = StaticProblem(data, model, params, free, objective, censor_threshold_m, upper_stop, (lower, upper))
+    _check_upper_stop(problem)
+    return problem
+
+
+def _check_free(free: tuple[str, ...], params: ParameterSet, model: str, optional: Mapping[str, float]) -> None:
+    """Refuse a free name that is neither the muscle's parameter nor an optional coefficient of ``model`` with a
+    finite default, and a name given twice."""
     for name in free:
         if name not in params and name not in optional:
             raise InputError(f"--free: {name!r} is not a parameter of muscle {params.name!r} nor an optional "
@@ -282,20 +358,14 @@ def make_problem(data: StaticData, params: ParameterSet, model: str = "acra2012_
             raise InputError(f"--free: {name!r} of {model!r} has no finite default to start from")
     if len(set(free)) != len(free):
         raise InputError(f"--free = {','.join(free)}: a name appears twice")
-    objective = objective or ("contraction" if data.kind == "weight" else "force")
-    if objective not in OBJECTIVES:
-        raise InputError(f"--objective = {objective!r}: choose from {', '.join(OBJECTIVES)}")
-    if not censor_threshold_m >= 0.0:
-        raise InputError(f"--censor-threshold-mm = {censor_threshold_m * 1e3:g}: must not be negative")
 
-    x_max = EndStops.from_parameters(params).x_high_m
-    params = with_optional(params, {k: v for k, v in optional.items() if k in free}, model)
-    params = _independent(params, free, model)
-    lower = np.array([params.entries[n].lower for n in free], dtype=float)
-    upper = np.array([params.entries[n].upper for n in free], dtype=float)
-    for i, name in enumerate(free):
-        lower[i], upper[i] = _physical_bounds(name, params, free, lower[i], upper[i])
-    return StaticProblem(data, model, params, free, objective, censor_threshold_m, x_max, (lower, upper))
+
+def _check_upper_stop(problem: StaticProblem) -> None:
+    """Refuse a muscle whose upper stop cannot stand where its choice puts it, at the starting values."""
+    try:
+        problem.stops(problem.start)
+    except ValueError as exc:
+        raise InputError(f"muscle {problem.base.name!r}: its upper stop {problem.upper_stop_choice!r}: {exc}") from None
 
 
 def _independent(params: ParameterSet, free: Sequence[str], model: str) -> ParameterSet:
@@ -359,15 +429,17 @@ def check_sigma(problem: StaticProblem) -> None:
                          f"{'forces: give sigma_N' if problem.objective == 'force' else 'contractions: give sigma_mm'}")
 
 
-def check_data(data: StaticData, params: ParameterSet, model: str) -> list[str]:
+def check_data(data: StaticData, params: ParameterSet, model: str, upper_stop: tuple[str, str] | None = None) -> list[str]:
     """Refuse static tests no rig can give for this muscle; return one-line warnings on implausible ones
-    (:func:`pamsim.identification.plausibility.check_static_data`, on the scale of the starting muscle)."""
-    problem = make_problem(data, params, model, objective="contraction" if data.kind == "weight" else "force")
+    (:func:`pamsim.identification.plausibility.check_static_data`, on the scale of the starting muscle;
+    ``upper_stop`` as :func:`make_problem` takes it)."""
+    problem = make_problem(data, params, model, objective="contraction" if data.kind == "weight" else "force",
+                           upper_stop=upper_stop)
     with np.errstate(all="ignore"):
-        force = problem.feasible_force(np.array([problem.base[n] for n in problem.free], dtype=float))
+        force = problem.feasible_force(problem.start)
     rated = params["rated_pressure_gauge_Pa"] if "rated_pressure_gauge_Pa" in params else math.inf
     blocked = (lambda p: 0.0) if force is None else (lambda p: force.force_N(0.0, p))
-    return check_static_data(data, params["L0_m"], problem.x_max_m, rated, blocked)
+    return check_static_data(data, params["L0_m"], problem.stops(problem.start).x_high_m, rated, blocked)
 
 
 def with_optional(params: ParameterSet, optional: Mapping[str, float], model: str) -> ParameterSet:
@@ -392,7 +464,8 @@ def fit_static(data: StaticData, params: ParameterSet, model: str = "acra2012_po
                free: Sequence[str] | None = None, objective: str | None = None, loss: str = "linear",
                f_scale: float = 1.0, n_starts: int = 0, seed: int = 0,
                censor_threshold_m: float = CENSOR_THRESHOLD_M, cv: str | None = "auto", k_folds: int = 10,
-               muscle_label: str = "", exact: bool = False, intervals: bool = True) -> StaticFit:
+               muscle_label: str = "", exact: bool = False, intervals: bool = True,
+               upper_stop: tuple[str, str] | None = None) -> StaticFit:
     """Fit the free coefficients of a static force model to static tests.
 
     Parameters
@@ -424,6 +497,10 @@ def fit_static(data: StaticData, params: ParameterSet, model: str = "acra2012_po
     intervals : bool
         Also compute each coefficient's 95 % profile-likelihood interval (:mod:`.profile`; with the linear
         loss only), about as many refits per coefficient as the fit took evaluations.
+    upper_stop : (str, str), optional
+        The muscle file's ``[upper_stop]`` table as ``(at, source)`` (:func:`.muscle_file.upper_stop_table`);
+        None: the file names none, so the default choice.  The equilibria end at the upper stop it puts for
+        the fit's model, as a simulation's do; the fitted muscle file carries the table.
 
     Returns
     -------
@@ -433,11 +510,11 @@ def fit_static(data: StaticData, params: ParameterSet, model: str = "acra2012_po
     # residuals become the penalty), not something to tell the user about.
     with np.errstate(all="ignore"):
         return _fit_static(data, params, model, free, objective, loss, f_scale, n_starts, seed, censor_threshold_m,
-                           cv, k_folds, muscle_label, exact, intervals)
+                           cv, k_folds, muscle_label, exact, intervals, upper_stop)
 
 
 def _fit_static(data, params, model, free, objective, loss, f_scale, n_starts, seed, censor_threshold_m, cv,
-                k_folds, muscle_label, exact, intervals) -> StaticFit:
+                k_folds, muscle_label, exact, intervals, upper_stop) -> StaticFit:
     start = time.perf_counter()
     if loss not in LOSSES:
         raise InputError(f"--loss = {loss!r}: choose from {', '.join(LOSSES)}")
@@ -445,10 +522,10 @@ def _fit_static(data, params, model, free, objective, loss, f_scale, n_starts, s
         raise InputError(f"--f-scale = {f_scale!r}: must be a positive number")
     if n_starts < 0:
         raise InputError(f"--starts = {n_starts}: must not be negative")
-    problem = make_problem(data, params, model, free, objective, censor_threshold_m)
+    problem = make_problem(data, params, model, free, objective, censor_threshold_m, upper_stop)
     check_information(problem, exact)
     check_sigma(problem)
-    theta0 = np.array([problem.base[n] for n in problem.free], dtype=float)
+    theta0 = problem.start
     theta, res = _solve(problem, theta0, loss, f_scale)
     nfev = res.nfev
     rng = np.random.default_rng(seed)
@@ -488,5 +565,4 @@ def _profile(problem: StaticProblem, theta: np.ndarray, unc: Uncertainty, wanted
 
 
 def _restrict(problem: StaticProblem, rows: np.ndarray) -> StaticProblem:
-    return StaticProblem(problem.data.subset(rows), problem.model, problem.base, problem.free, problem.objective,
-                         problem.censor_threshold_m, problem.x_max_m, problem.bounds)
+    return replace(problem, data=problem.data.subset(rows))

@@ -338,10 +338,10 @@ def _run_core(cases: Sequence[CaseInputs], capacity: Sequence[int]) -> dict:
                          np.array([len(c.segment_t_s) for c in cases]),
                          np.concatenate([c.segment_t_s for c in cases]), np.concatenate([c.segment_u for c in cases]),
                          np.asarray(capacity), tables,
-                         np.array([-1 if c.table is None else index[id(c.table)] for c in cases]), _segment_du(cases))
+                         np.array([-1 if c.table is None else index[id(c.table)] for c in cases]), segment_changes(cases))
 
 
-def _segment_du(cases: Sequence[CaseInputs]) -> np.ndarray | None:
+def segment_changes(cases: Sequence[CaseInputs]) -> np.ndarray | None:
     """The cases' inputs' change over each segment (zeros for held ones), or None if every one is held."""
     if all(c.segment_du is None for c in cases):
         return None
