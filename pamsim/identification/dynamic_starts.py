@@ -9,8 +9,8 @@ weight over the motion the traces show (its *typical scale*), with either sign t
 points are screened by their cost, one batch of simulations, and the local fit runs from the best of
 them.  Then it *hops*: local fits from seeded points near the best fit so far (30 % of each
 coefficient), which escape the shallow minima next to the best one far more often than random points
-do (docs/identification.md: 5 and 2 of 12 hops from two such minima reached the truth, against 1 and
-0 of 40 random points).
+do (``python benchmarks/bench_multistart.py``: 3 of 12 hops from each of two such minima reached the
+truth, against 1 and 0 of 12 random points).
 """
 
 from __future__ import annotations
