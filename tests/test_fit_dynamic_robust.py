@@ -69,7 +69,7 @@ def test_the_native_default_multistart_reaches_the_noise_from_zero_friction(from
 
 
 def test_the_global_search_reaches_the_noise_from_zero_friction(scenario):
-    """A parameter set where the best of eight starts from zero stops at 1.22 times the truth's RMS (a
+    """A parameter set where eight screened random starts from zero stop at 1.22 times the truth's RMS (a
     minimum behind a low ridge of the stick/slip events); differential evolution over the typical
     scales finds the truth."""
     truth = dict(zip(FREE, (0.8, 0.3, 50.0, -20.0, 3.0)))
