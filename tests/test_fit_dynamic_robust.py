@@ -69,7 +69,7 @@ def test_the_native_default_multistart_reaches_the_noise_from_zero_friction(from
 
 
 def test_the_global_search_reaches_the_noise_from_zero_friction(scenario):
-    """A parameter set where the best of eight starts from zero stops at 1.22 times the truth's RMS (a
+    """A parameter set where eight screened random starts from zero stop at 1.22 times the truth's RMS (a
     minimum behind a low ridge of the stick/slip events); differential evolution over the typical
     scales finds the truth."""
     truth = dict(zip(FREE, (0.8, 0.3, 50.0, -20.0, 3.0)))
@@ -94,14 +94,18 @@ def test_noise_level_of_a_trace_from_its_second_differences(scenario):
 
 def test_quality_warnings_against_hand_counts():
     names = ["a.csv", "b.csv"]
-    assert quality_warnings(names, [0.05, 0.06], [0.05, 0.05], 0.0552) == []
-    # pooled 0.36 mm against a pooled noise of 0.05 mm: 7.2 times; traces 10 x and 1 x their noise
+    # pooled sqrt((0.05^2 + 0.052^2) / 2) = 0.05101 mm: 1.02 times the noise, traces 1.0 and 1.04 x their noise
+    assert quality_warnings(names, [0.05, 0.052], [0.05, 0.05], 0.05101) == []
+    # pooled 0.36 mm against a pooled noise of 0.05 mm: 7.11 times; traces 10 x and 1 x their noise
     lines = quality_warnings(names, [0.5, 0.05], [0.05, 0.05], float(np.sqrt((0.25 + 0.0025) / 2)))
     assert len(lines) == 2
-    assert "7.1 times" in lines[0] and "a.csv" in lines[0]
+    assert "7.11 times" in lines[0] and "a.csv" in lines[0]
     assert "a.csv 0.5 mm (10.0 x its noise) against b.csv 0.05 mm (1.0 x)" in lines[1]
-    # within twice the noise, but one trace four times worse relative to its noise than the other
-    lines = quality_warnings(names, [0.08, 0.02], [0.05, 0.05], float(np.sqrt((0.0064 + 0.0004) / 2)))
+    # 1.10 times the noise in both traces: above the pooled threshold 1.08, evenly
+    lines = quality_warnings(names, [0.055, 0.055], [0.05, 0.05], 0.055)
+    assert len(lines) == 1 and "1.10 times" in lines[0]
+    # pooled sqrt((0.056^2 + 0.045^2) / 2) = 0.0508 mm (1.016 times), but 1.12 x against 0.9 x: 1.24 > 1.2
+    lines = quality_warnings(names, [0.056, 0.045], [0.05, 0.05], float(np.sqrt((0.056 ** 2 + 0.045 ** 2) / 2)))
     assert len(lines) == 1 and "unevenly" in lines[0]
 
 

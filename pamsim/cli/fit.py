@@ -123,8 +123,8 @@ def register(sub) -> None:
                    help="differential evolution (30 generations) over the start +- its size or typical scale, "
                         "before the local fits")
     d.add_argument("--starts", type=_count, default=None,
-                   help="extra local fits from the best of 25 N seeded random points (default 8 with the native "
-                        "backend, 0 with python)")
+                   help="extra local fits: half from the best of 25 times as many seeded random points, half "
+                        "from points near the best fit so far (default 16 with the native backend, 0 with python)")
     d.add_argument("--workers", type=_workers, default=None,
                    help="worker processes for the simulations (default: number of CPUs with the python backend; "
                         "1 with native, whose optimiser steps are too few cases to gain from workers)")

@@ -24,7 +24,7 @@ from ..backends import simulate
 from ..parameters import get_parameter_set
 from ..scenario import Scenario
 from .columns import TraceData, read_static_data
-from .dynamic_fit import _Objective, fit_dynamic, make_problem, make_trials
+from .dynamic_fit import DEFAULT_STARTS, _Objective, fit_dynamic, make_problem, make_trials
 from .models import build_static
 from .static_fit import fit_static
 from .static_fit import make_problem as make_static_problem
@@ -223,8 +223,8 @@ def starts_study(scenario_path: str) -> None:
 
     sc = load_scenario(scenario_path)
     free = tuple(TRUTH)
-    runs = {"one start": {"n_starts": 0}, "8 starts (default)": {}, "--global, one start": {"n_starts": 0,
-                                                                                           "global_search": True}}
+    runs = {"one start": {"n_starts": 0}, f"{DEFAULT_STARTS['native']} starts (default)": {},
+            "--global, one start": {"n_starts": 0, "global_search": True}}
     print("\n| hidden set | start | RMS at the truth [mm] | " + " | ".join(f"{r}: RMS [mm], s" for r in runs)
           + " |\n|---|---|---|" + "---|" * len(runs))
     for label, values in STARTS_SETS.items():

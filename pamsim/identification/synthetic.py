@@ -26,10 +26,15 @@ def synthetic_trace(scenario: Scenario, truth: Mapping[str, float], weight_N: fl
     if duration_s is not None:
         changes["simulation"] = {"duration_s": duration_s}
     res = simulate(scenario.with_changes(changes))
-    noise = np.random.default_rng(seed).normal(0.0, noise_m, res.x_m.shape)
-    label = f"synthetic {weight_N:g} N"
-    clean = TraceData(res.t_s, res.x_m, res.p_gauge_Pa, weight_N, label)
-    return TraceData(res.t_s, res.x_m + noise, res.p_gauge_Pa, weight_N, label), clean
+    clean = TraceData(res.t_s, res.x_m, res.p_gauge_Pa, weight_N, f"synthetic {weight_N:g} N")
+    return with_noise(clean, noise_m, seed), clean
+
+
+def with_noise(clean: TraceData, noise_m: float, seed: int) -> TraceData:
+    """``clean`` with seeded Gaussian noise of standard deviation ``noise_m`` [m] on the contraction, drawn
+    from ``numpy.random.default_rng(seed)`` (the noise of :func:`synthetic_trace`)."""
+    noise = np.random.default_rng(seed).normal(0.0, noise_m, clean.x_m.shape)
+    return TraceData(clean.t_s, clean.x_m + noise, clean.p_gauge_Pa, clean.weight_N, clean.origin)
 
 
 def synthetic_static(force_N, p_gauge_Pa: np.ndarray, load_N: np.ndarray, x_max_m: float, noise_m: float,
