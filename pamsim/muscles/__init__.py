@@ -157,6 +157,28 @@ def muscle_from_dict(raw: Mapping[str, Any], origin: str | Path = "<dict>") -> M
     for key in raw:
         if key not in TOP_KEYS:
             raise fail(key, raw[key], "unknown key" + did_you_mean(key, TOP_KEYS))
+    strings = _strings(fail, raw)
+    model = strings["default_static_force"]
+    gaps = raw.get("gaps", [])
+    if not isinstance(gaps, list) or not all(isinstance(g, str) for g in gaps):
+        raise fail("gaps", gaps, "must be a list of strings")
+    entries = _entries(fail, origin, raw)
+    force_map_file = _force_map_file(fail, origin, raw)
+    data_file = _data_file(fail, origin, raw)
+    params = ParameterSet(strings["name"], strings["citation"], entries)
+    return Muscle(strings["name"], strings["description"], strings["citation"], model, params, origin,
+                  tuple(gaps), data_file, force_map_file, *_upper_stop(fail, raw.get("upper_stop")))
+
+
+def _strings(fail, raw: Mapping[str, Any]) -> dict[str, str]:
+    """The file's name, description, citation and default static force, each a non-empty string; the model
+    one of the library's.
+
+    Raises
+    ------
+    MuscleError
+        (made by ``fail``) The first of them missing or blank, or an unknown model.
+    """
     strings = {}
     for key in ("name", "description", "citation", "default_static_force"):
         value = raw.get(key)
@@ -166,9 +188,18 @@ def muscle_from_dict(raw: Mapping[str, Any], origin: str | Path = "<dict>") -> M
     model = strings["default_static_force"]
     if model not in REGISTRY:
         raise fail("default_static_force", model, "unknown static model" + did_you_mean(model, REGISTRY))
-    gaps = raw.get("gaps", [])
-    if not isinstance(gaps, list) or not all(isinstance(g, str) for g in gaps):
-        raise fail("gaps", gaps, "must be a list of strings")
+    return strings
+
+
+def _entries(fail, origin: Path, raw: Mapping[str, Any]) -> dict[str, Parameter]:
+    """The ``[parameters.NAME]`` tables and a top-level rating as :class:`Parameter` s, a radial braid angle
+    converted, the bladder wall completed and the geometry checked.
+
+    Raises
+    ------
+    MuscleError
+        A table or value that is wrong, a rating given twice, or geometry that does not hold together.
+    """
     tables = raw.get("parameters", {})
     if not isinstance(tables, dict):
         raise fail("parameters", tables, "must be a table of [parameters.NAME] tables")
@@ -183,23 +214,42 @@ def muscle_from_dict(raw: Mapping[str, Any], origin: str | Path = "<dict>") -> M
     _convert_radial_angle(fail, entries)
     _complete_wall(fail, entries)
     _check_geometry(fail, entries)
-    force_map_file = None
-    if "force_map" in raw:
-        fm = raw["force_map"]
-        if not isinstance(fm, str) or not (origin.parent / fm).is_file():
-            raise fail("force_map", fm, "must name a CSV file next to the muscle file")
-        force_map_file = (origin.parent / fm).resolve()
-    data_file = None
-    if "data" in raw:
-        data = raw["data"]
-        if not isinstance(data, dict) or set(data) != {"file"} or not isinstance(data["file"], str):
-            raise fail("data", data, 'must be a table with one key, file = "NAME.csv"')
-        data_file = (origin.parent / data["file"]).resolve()
-        if not data_file.is_file():
-            raise fail("data.file", data["file"], f"no such file next to the muscle file ({data_file})")
-    params = ParameterSet(strings["name"], strings["citation"], entries)
-    return Muscle(strings["name"], strings["description"], strings["citation"], model, params, origin,
-                  tuple(gaps), data_file, force_map_file, *_upper_stop(fail, raw.get("upper_stop")))
+    return entries
+
+
+def _force_map_file(fail, origin: Path, raw: Mapping[str, Any]) -> Path | None:
+    """The measured force map named by ``force_map`` (a CSV file next to the muscle file), or None.
+
+    Raises
+    ------
+    MuscleError
+        (made by ``fail``) A name that is not a string or not a file next to the muscle file.
+    """
+    if "force_map" not in raw:
+        return None
+    fm = raw["force_map"]
+    if not isinstance(fm, str) or not (origin.parent / fm).is_file():
+        raise fail("force_map", fm, "must name a CSV file next to the muscle file")
+    return (origin.parent / fm).resolve()
+
+
+def _data_file(fail, origin: Path, raw: Mapping[str, Any]) -> Path | None:
+    """The measured points named by ``[data] file`` (next to the muscle file), or None.
+
+    Raises
+    ------
+    MuscleError
+        (made by ``fail``) A table other than ``{file = "NAME.csv"}``, or no such file.
+    """
+    if "data" not in raw:
+        return None
+    data = raw["data"]
+    if not isinstance(data, dict) or set(data) != {"file"} or not isinstance(data["file"], str):
+        raise fail("data", data, 'must be a table with one key, file = "NAME.csv"')
+    data_file = (origin.parent / data["file"]).resolve()
+    if not data_file.is_file():
+        raise fail("data.file", data["file"], f"no such file next to the muscle file ({data_file})")
+    return data_file
 
 
 def _upper_stop(fail, table: Any) -> tuple[str, str]:
