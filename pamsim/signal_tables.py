@@ -100,29 +100,72 @@ def _steps(v, where: str, spec: Mapping, suffixes) -> PiecewiseConstant:
 
 
 def _trace(v, where: str, spec: Mapping, suffixes, base_dir: Path) -> Trace:
+    """A measured signal from a CSV file: its time column and the first value column in a known unit.
+
+    Parameters
+    ----------
+    v : the validator of the file the table is in.
+    where : the table's key (``pressure.prescribed``).
+    spec : the table: ``file``, optional ``time_column`` (default ``t_s``) and ``value_column``.
+    suffixes : ``[(unit suffix, factor to SI), ...]`` that a value column's name may end in.
+    base_dir : where a relative file name is found.
+    """
+    name, path = _trace_file(v, where, spec, base_dir)
+    time_col = spec.get("time_column", "t_s")
+    header, data = _read_trace(v, where, name, path)
+    if time_col not in header:
+        v.fail(f"{where}.time_column", time_col, f"no such column in {name} (columns: {', '.join(header)})")
+    col, unit = _value_column(v, where, spec, name, header, time_col, suffixes)
+    t = data[:, header.index(time_col)]
+    y = data[:, header.index(col)] * unit
+    _check_samples(v, where, name, t, y)
+    return Trace(t, y, str(path))
+
+
+def _trace_file(v, where: str, spec: Mapping, base_dir: Path) -> tuple[str, Path]:
+    """``(name as given, path)`` of a trace's file, relative names under ``base_dir``; it must exist."""
     name = v.required(spec, "file", prefix=f"{where}.")
     if not isinstance(name, str):
         v.fail(f"{where}.file", name, "must be a string (a CSV path)")
     path = (base_dir / name) if not Path(name).is_absolute() else Path(name)
     if not path.is_file():
         v.fail(f"{where}.file", name, f"trace file not found at {path}")
-    time_col = spec.get("time_column", "t_s")
+    return name, path
+
+
+def _read_trace(v, where: str, name: str, path: Path) -> tuple[list[str], np.ndarray]:
+    """The header row's column names and the numbers below it (one row per line)."""
     try:
         with open(path) as fh:
             header = fh.readline().strip().split(",")
         data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
     except (ValueError, OSError) as exc:
         v.fail(f"{where}.file", name, f"cannot read as CSV with a header row: {exc}")
-    value_cols = [spec["value_column"]] if "value_column" in spec else [c for c in header if c != time_col]
-    if time_col not in header:
-        v.fail(f"{where}.time_column", time_col, f"no such column in {name} (columns: {', '.join(header)})")
-    col = next((c for c in value_cols if c in header), None)
-    unit = next((k for s, k in suffixes if col and col.endswith(s)), None)
+    return header, data
+
+
+def _value_column(v, where: str, spec: Mapping, name: str, header: list[str], time_col: str,
+                  suffixes) -> tuple[str, float]:
+    """``(column, factor to SI)``: ``value_column`` if given, else the first column other than the time's;
+    its name must end in one of the unit ``suffixes``."""
+    if "value_column" in spec:
+        col = spec["value_column"] if spec["value_column"] in header else None
+    else:
+        col = next((c for c in header if c != time_col), None)
+    unit = _suffix_factor(col, suffixes)
     if col is None or unit is None:
         want = " or ".join(f"a column ending in {s}" for s, _ in suffixes)
         v.fail(f"{where}.value_column", spec.get("value_column", col), f"{name} needs {want}")
-    t = data[:, header.index(time_col)]
-    y = data[:, header.index(col)] * unit
+    return col, unit
+
+
+def _suffix_factor(col: str | None, suffixes) -> float | None:
+    """The factor to SI of the first unit suffix that column ``col`` ends in, or None."""
+    return next((k for s, k in suffixes if col and col.endswith(s)), None)
+
+
+def _check_samples(v, where: str, name: str, t: np.ndarray, y: np.ndarray) -> None:
+    """At least two rows, every value finite and the time increasing strictly (naming the first bad line)."""
     if len(t) < 2:
         v.fail(f"{where}.file", name, "a trace needs at least two rows")
     if not (np.all(np.isfinite(t)) and np.all(np.isfinite(y))):
@@ -132,7 +175,6 @@ def _trace(v, where: str, spec: Mapping, suffixes, base_dir: Path) -> Trace:
     if bad.size:
         v.fail(f"{where}.file", name, f"time must increase strictly; line {int(bad[0]) + 3} has t = {t[bad[0] + 1]:g} "
                f"after {t[bad[0]]:g}")
-    return Trace(t, y, str(path))
 
 
 def signal_range(sig) -> tuple[float, float]:
