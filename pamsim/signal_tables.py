@@ -36,6 +36,16 @@ def signal_from_table(v, where: str, spec: Any, suffix: str, scale: float, base_
     if not isinstance(kind, str) or kind not in SIGNAL_KINDS:
         v.fail(f"{where}.kind", kind, "unknown signal kind", choices=SIGNAL_KINDS)
     suffixes = [(suffix, scale)] + ([alt_suffix] if alt_suffix else [])
+    _check_keys(v, where, spec, kind, suffixes)
+    if kind == "steps":
+        return _steps(v, where, spec, suffixes)
+    if kind == "trace":
+        return _trace(v, where, spec, suffixes, base_dir)
+    return _SHAPES[kind](_Entries(v, where, spec, suffixes))
+
+
+def _check_keys(v, where: str, spec: Mapping, kind: str, suffixes) -> None:
+    """Refuse a key that signal ``kind`` does not take (with the value keys in each of the ``suffixes``)."""
     times, values = SIGNAL_KINDS[kind]
     known = ["kind", *times, *(f"{n}{s}" for n in values for s, _ in suffixes)]
     for key in spec:
@@ -43,37 +53,62 @@ def signal_from_table(v, where: str, spec: Any, suffix: str, scale: float, base_
             raise v.error(f"{v.origin}: unknown key {where}.{key} for kind = {kind!r}"
                           + choices_hint(key, known, "known:"))
 
-    def val(name: str, default: float | None = None) -> float:
-        for s, k in suffixes:
-            if f"{name}{s}" in spec:
-                return v.number(f"{where}.{name}{s}", spec[f"{name}{s}"]) * k
+
+class _Entries:
+    """The entries of one signal table, read as they are asked for (so the first mistake asked is reported)."""
+
+    def __init__(self, v, where: str, spec: Mapping, suffixes):
+        self.v, self.where, self.spec, self.suffixes = v, where, spec, suffixes
+
+    def value(self, name: str, default: float | None = None) -> float:
+        """``name<suffix>`` in SI, in the first of the suffixes it is given with; ``default`` if none (None:
+        required)."""
+        for s, k in self.suffixes:
+            if f"{name}{s}" in self.spec:
+                return self.v.number(f"{self.where}.{name}{s}", self.spec[f"{name}{s}"]) * k
         if default is None:
-            raise v.error(f"{v.origin}: missing key {where}.{name}{suffixes[0][0]}")
+            raise self.v.error(f"{self.v.origin}: missing key {self.where}.{name}{self.suffixes[0][0]}")
         return default
 
-    def t(name: str) -> float:
-        value = v.number(f"{where}.{name}", v.required(spec, name, prefix=f"{where}."))
+    def time(self, name: str) -> float:
+        """Required time ``name`` [s], not negative."""
+        value = self.v.number(f"{self.where}.{name}", self.v.required(self.spec, name, prefix=f"{self.where}."))
         if value < 0:
-            v.fail(f"{where}.{name}", value, "must not be negative")
+            self.v.fail(f"{self.where}.{name}", value, "must not be negative")
         return value
 
-    if kind == "steps":
-        return _steps(v, where, spec, suffixes)
-    if kind == "constant":
-        return Constant(val("value"))
-    if kind == "step":
-        return Step(t("time_s"), val("initial", 0.0), val("final"))
-    if kind == "ramp":
-        start, end = t("start_s"), t("end_s")
+    def after(self, name: str, start_name: str, start: float) -> float:
+        """Required time ``name`` [s], after ``start`` (time ``start_name``)."""
+        end = self.time(name)
         if end <= start:
-            v.fail(f"{where}.end_s", end, f"must be after start_s = {start}")
-        return Ramp(start, end, val("initial", 0.0), val("final"))
-    if kind == "lag":
-        tau = t("tau_s")
+            self.v.fail(f"{self.where}.{name}", end, f"must be after {start_name} = {start}")
+        return end
+
+    def positive_time(self, name: str) -> float:
+        """Required time ``name`` [s], above zero."""
+        tau = self.time(name)
         if tau <= 0:
-            v.fail(f"{where}.tau_s", tau, "must be positive")
-        return FirstOrderLag(t("time_s"), val("initial", 0.0), val("final"), tau)
-    return _trace(v, where, spec, suffixes, base_dir)
+            self.v.fail(f"{self.where}.{name}", tau, "must be positive")
+        return tau
+
+
+def _ramp(e: _Entries) -> Ramp:
+    start = e.time("start_s")
+    return Ramp(start, e.after("end_s", "start_s", start), e.value("initial", 0.0), e.value("final"))
+
+
+def _lag(e: _Entries) -> FirstOrderLag:
+    tau = e.positive_time("tau_s")  # read before time_s: the order the mistakes were always reported in
+    return FirstOrderLag(e.time("time_s"), e.value("initial", 0.0), e.value("final"), tau)
+
+
+# The signals of a few entries each, by kind (steps and trace read lists and files of their own).
+_SHAPES = {
+    "constant": lambda e: Constant(e.value("value")),
+    "step": lambda e: Step(e.time("time_s"), e.value("initial", 0.0), e.value("final")),
+    "ramp": _ramp,
+    "lag": _lag,
+}
 
 
 def _numbers(v, key: str, value: Any) -> list[float]:
