@@ -272,6 +272,32 @@ def _upper_stop(fail, table: Any) -> tuple[str, str]:
 def _entry(fail, origin: Path, name: str, table: Any) -> Parameter:
     """One ``[parameters.NAME]`` table -> :class:`Parameter` with the known unit and bounds."""
     key = f"parameters.{name}"
+    _check_entry_table(fail, origin, name, table)
+    value = _entry_value(fail, key, table)
+    source = table.get("source")
+    if not isinstance(source, str) or not source.strip():
+        raise fail(f"{key}.source", source, 'required: where the value comes from (paper + table/equation, or "assumed: <reason>")')
+    unit = unit_of(name)
+    if "unit" in table and table["unit"] != unit:
+        raise fail(f"{key}.unit", table["unit"], f"does not match the unit of the name's suffix ({unit!r})")
+    known, description = _entry_description(fail, key, name, table)
+    param = Parameter(value, unit, source, description, known.lower, known.upper, known.lower_open, known.upper_open)
+    why = param.violation(value)
+    if why:
+        raise fail(key, value, why)
+    return param
+
+
+def _check_entry_table(fail, origin: Path, name: str, table: Any) -> None:
+    """A known parameter's name (or ``alpha_radial_deg``), its table a table of known keys.
+
+    Raises
+    ------
+    MuscleError
+        An unknown name (its table not quoted: the name is the mistake), a value that is not a table, or an
+        unknown key in it.
+    """
+    key = f"parameters.{name}"
     if name not in KNOWN and name != "alpha_radial_deg":  # the name is the mistake: its table is not quoted
         raise MuscleError(f"{origin}: {key}: unknown parameter"
                           + did_you_mean(name, list(KNOWN) + ["alpha_radial_deg"]))
@@ -280,32 +306,30 @@ def _entry(fail, origin: Path, name: str, table: Any) -> Parameter:
     for k in table:
         if k not in ENTRY_KEYS:
             raise fail(f"{key}.{k}", table[k], "unknown key" + did_you_mean(k, ENTRY_KEYS))
+
+
+def _entry_value(fail, key: str, table: Mapping[str, Any]) -> float:
+    """The entry's ``value``, a finite number (a bool is not one)."""
     value = table.get("value")
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise fail(f"{key}.value", value, "required, a number")
     value = float(value)
     if not math.isfinite(value):
         raise fail(f"{key}.value", value, "must be a finite number")
-    source = table.get("source")
-    if not isinstance(source, str) or not source.strip():
-        raise fail(f"{key}.source", source, 'required: where the value comes from (paper + table/equation, or "assumed: <reason>")')
-    unit = unit_of(name)
-    if "unit" in table and table["unit"] != unit:
-        raise fail(f"{key}.unit", table["unit"], f"does not match the unit of the name's suffix ({unit!r})")
+    return value
+
+
+def _entry_description(fail, key: str, name: str, table: Mapping[str, Any]):
+    """``(known parameter, description)``: the file's description, else the known one's.
+
+    A radial-plane braid angle takes the bounds of ``theta0_deg``, which it becomes (both lie in (0, 90) deg).
+    """
     description = table.get("description", "")
     if not isinstance(description, str):
         raise fail(f"{key}.description", description, "must be a string")
     if name == "alpha_radial_deg":
-        known = KNOWN["theta0_deg"]
-        description = description or "braid angle from the plane normal to the axis (Kothera's convention)"
-    else:
-        known = KNOWN[name]
-        description = description or known.description
-    param = Parameter(value, unit, source, description, known.lower, known.upper, known.lower_open, known.upper_open)
-    why = param.violation(value)
-    if why:
-        raise fail(key, value, why)
-    return param
+        return KNOWN["theta0_deg"], description or "braid angle from the plane normal to the axis (Kothera's convention)"
+    return KNOWN[name], description or KNOWN[name].description
 
 
 def _convert_radial_angle(fail, entries: dict[str, Parameter]) -> None:
