@@ -196,6 +196,21 @@ def measured_points(path: Path | None) -> np.ndarray:
     header = [h.strip() for h in reader.fieldnames or []]
     reader.fieldnames = header
     rows = list(reader)
+    found = _point_columns(path, header)
+    try:
+        return np.array([[float(r[name]) * k for name, k in found] for r in rows], dtype=float).reshape(-1, 3)
+    except (TypeError, ValueError):
+        raise InputError(f"{path}: a measured point is not a number (columns {', '.join(n for n, _ in found)})") from None
+
+
+def _point_columns(path: Path, header: list[str]) -> list[tuple[str, float]]:
+    """``[(column, factor to SI)]`` of the pressure, contraction and force in a measured-point file's header.
+
+    Raises
+    ------
+    InputError
+        Naming every quantity without a column, and the columns there are.
+    """
     found = [unit_column(header, stems, units) for _, stems, units in _POINT_COLUMNS]
     if _PREFERRED_PRESSURE in header:
         found[0] = (_PREFERRED_PRESSURE, PA_PER_BAR)
@@ -203,10 +218,7 @@ def measured_points(path: Path | None) -> np.ndarray:
                for (what, stems, units), col in zip(_POINT_COLUMNS, found) if col is None]
     if missing:
         raise InputError(f"{path}: no measured points: need {', '.join(missing)} (columns: {', '.join(header)})")
-    try:
-        return np.array([[float(r[name]) * k for name, k in found] for r in rows], dtype=float).reshape(-1, 3)
-    except (TypeError, ValueError):
-        raise InputError(f"{path}: a measured point is not a number (columns {', '.join(n for n, _ in found)})") from None
+    return found
 
 
 def default_pressures_Pa(measured: np.ndarray, rating_Pa: float) -> tuple[float, ...]:
