@@ -2,8 +2,8 @@
 mistakes is the one reported.
 
 The tables hold the exact messages (the scenario's ``[controller]``, the RL environment's arguments, a
-force-map CSV, ``pamsim atlas``'s muscle, models and pressures, a muscle file, a trace CSV and an assembly's
-signal wiring), so a change in what is checked, in which order, or in how it is said fails here.  The
+force-map CSV, ``pamsim atlas``'s muscle, models and pressures, a measured-point file, a muscle file and its
+parameter entries, a signal table, a trace CSV and an assembly's signal wiring), so a change in what is checked, in which order, or in how it is said fails here.  The
 messages are those that were given before the checks were split into small functions; the other test files
 check parts of most of them.
 """
@@ -18,7 +18,7 @@ import pytest
 
 import pamsim
 from conftest import SCENARIOS
-from pamsim.atlas import build_atlas
+from pamsim.atlas import build_atlas, measured_points
 from pamsim.control.closed_loop import ControllerConfig
 from pamsim.errors import InputError
 from pamsim.modeling import Assembly, AssemblyError, Var
@@ -237,6 +237,22 @@ def test_an_atlas_leaves_out_the_pressures_outside_a_models_domain(force_map_mus
     assert curve.blocked_force_N == pytest.approx(1.0, abs=1e-12)
 
 
+@pytest.mark.parametrize("text, message", [
+    ("pressure_bar,contraction_mm,force_N\n1,x,3\n",
+     "a measured point is not a number (columns pressure_bar, contraction_mm, force_N)"),
+    ("pressure_bar,contraction_mm,force_N\n1,2\n",
+     "a measured point is not a number (columns pressure_bar, contraction_mm, force_N)"),
+    ("pressure_atm,contraction_mm\n1,2\n", "no measured points: need a pressure column (pressure* or p_* ending in "
+     "_gauge_Pa / _Pa / _kPa / _gauge_bar / _bar / _psi), a force or hung weight column (force* or weight* or load* "
+     "ending in _N) (columns: pressure_atm, contraction_mm)"),
+])
+def test_a_bad_measured_point_file_is_refused(tmp_path, text, message):
+    (tmp_path / "points.csv").write_text(text)
+    with pytest.raises(InputError) as err:
+        measured_points(tmp_path / "points.csv")
+    assert _message(err, tmp_path) == f"TMP/points.csv: {message}"
+
+
 # ----------------------------------------------------------------------------- muscle file
 def _muscle(**changes) -> pamsim.muscles.Muscle:
     raw = copy.deepcopy(SHADOW)
@@ -279,12 +295,72 @@ def test_a_bad_muscle_file_is_refused_with_its_first_mistake(changes, message):
     assert _message(err) == f"dir/bad.toml: {message}"
 
 
+@pytest.mark.parametrize("name, table, message", [
+    ("L0_m", 3, "parameters.L0_m = 3: must be a table with value and source"),
+    ("colour", {"value": 1}, "parameters.colour: unknown parameter"),
+    ("L0_m", {"value": "x", "source": 3, "zz": 1}, "parameters.L0_m.zz = 1: unknown key"),
+    ("L0_m", {"value": math.nan, "source": 3}, "parameters.L0_m.value = nan: must be a finite number"),
+    ("L0_m", {"value": 0.3, "source": 3}, "parameters.L0_m.source = 3: required: where the value comes from (paper + "
+     "table/equation, or \"assumed: <reason>\")"),
+    ("L0_m", {"value": 0.3, "source": "x", "unit": "mm", "description": 3},
+     "parameters.L0_m.unit = 'mm': does not match the unit of the name's suffix ('m')"),
+    ("L0_m", {"value": -0.3, "source": "x", "description": 3}, "parameters.L0_m.description = 3: must be a string"),
+    ("L0_m", {"value": 0, "source": "x"}, "parameters.L0_m = 0.0: must be > 0"),
+    ("alpha_radial_deg", {"value": 95.0, "source": "x"}, "parameters.alpha_radial_deg = 95.0: must lie in (0, 90)"),
+])
+def test_a_bad_parameter_entry_is_refused_with_its_first_mistake(name, table, message):
+    with pytest.raises(MuscleError) as err:
+        _muscle(parameters={**SHADOW["parameters"], name: table})
+    assert _message(err) == f"dir/bad.toml: {message}"
+
+
 def test_a_top_level_rating_is_a_parameter_with_its_origin_as_source():
     params = {k: v for k, v in SHADOW["parameters"].items() if k != "rated_pressure_gauge_Pa"}
     muscle = _muscle(parameters=params, rated_pressure_gauge_Pa=4e5, upper_stop={"at": "jam", "source": "s"})
     rating = muscle.parameters.entries["rated_pressure_gauge_Pa"]
     assert (rating.value, rating.source) == (4e5, "bad.toml: top-level rating (no source given)")
     assert (muscle.upper_stop, muscle.upper_stop_source, muscle.data_file) == ("jam", "s", None)
+
+
+# ----------------------------------------------------------------------------- signal tables
+def _prescribed(table):
+    spec = copy.deepcopy(FIG4)
+    spec["pressure"] = {"source": "prescribed", "prescribed": table}
+    return pamsim.Scenario.from_dict(spec, base_dir=SCENARIOS, origin="s.toml")
+
+
+@pytest.mark.parametrize("table, message", [
+    ({"kind": "stp"}, "pressure.prescribed.kind = 'stp': unknown signal kind (did you mean 'step'?)"),
+    ({"kind": 3}, "pressure.prescribed.kind = 3: unknown signal kind (choose from constant, step, ramp, lag, trace, "
+     "steps)"),
+    ({"kind": "constant", "value": 1.0}, "unknown key pressure.prescribed.value for kind = 'constant' (known: kind, "
+     "value_gauge_bar, value_gauge_Pa)"),
+    ({"kind": "step", "time_s": 1, "final_gauge_bar": 2, "tau_s": 1}, "unknown key pressure.prescribed.tau_s for "
+     "kind = 'step' (known: kind, time_s, initial_gauge_bar, initial_gauge_Pa, final_gauge_bar, final_gauge_Pa)"),
+    ({"kind": "constant"}, "missing key pressure.prescribed.value_gauge_bar"),
+    ({"kind": "step", "time_s": -1.0}, "pressure.prescribed.time_s = -1.0: must not be negative"),
+    ({"kind": "ramp", "start_s": 0.5, "end_s": 0.5, "final_gauge_bar": 2.0},
+     "pressure.prescribed.end_s = 0.5: must be after start_s = 0.5"),
+    ({"kind": "ramp", "end_s": 0.1}, "missing key pressure.prescribed.start_s"),
+    # a lag's time constant is read before its time
+    ({"kind": "lag", "time_s": -0.1, "tau_s": 0.0}, "pressure.prescribed.tau_s = 0.0: must be positive"),
+    ({"kind": "lag", "time_s": 0.1, "tau_s": 0.2}, "missing key pressure.prescribed.final_gauge_bar"),
+    ({"kind": "steps", "times_s": [0, 1], "values_gauge_bar": [1]},
+     "pressure.prescribed.values_gauge_bar = '1 values': must be as many as times_s (2)"),
+])
+def test_a_bad_signal_table_is_refused_naming_the_key(table, message):
+    with pytest.raises(InputError) as err:
+        _prescribed(table)
+    assert _message(err) == f"s.toml: {message}"
+
+
+def test_a_signal_table_takes_its_values_in_either_unit():
+    # bar first: 3 bar = 3e5 Pa; the step starts at 1 Pa given in Pa
+    step = _prescribed({"kind": "step", "time_s": 0.5, "initial_gauge_Pa": 1.0, "final_gauge_bar": 3.0})
+    signal = step.build_model().source.p_gauge_Pa
+    assert (signal.time_s, signal.initial, signal.final) == (0.5, 1.0, 3e5)
+    lag = _prescribed({"kind": "lag", "time_s": 0.1, "tau_s": 0.2, "final_gauge_Pa": 2e5}).build_model().source.p_gauge_Pa
+    assert (lag.time_s, lag.initial, lag.final, lag.tau_s) == (0.1, 0.0, 2e5, 0.2)
 
 
 # ----------------------------------------------------------------------------- trace CSV
