@@ -8,6 +8,7 @@ mistake names that file, the key and the value.
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 from typing import Any, Mapping
 
@@ -151,8 +152,8 @@ def _trace(v, where: str, spec: Mapping, suffixes, base_dir: Path) -> Trace:
     if time_col not in header:
         v.fail(f"{where}.time_column", time_col, f"no such column in {name} (columns: {', '.join(header)})")
     col, unit = _value_column(v, where, spec, name, header, time_col, suffixes)
-    t = data[:, header.index(time_col)]
-    y = data[:, header.index(col)] * unit
+    t = _column(v, where, name, header, data, time_col)
+    y = _column(v, where, name, header, data, col) * unit
     _check_samples(v, where, name, t, y)
     return Trace(t, y, str(path))
 
@@ -169,14 +170,34 @@ def _trace_file(v, where: str, spec: Mapping, base_dir: Path) -> tuple[str, Path
 
 
 def _read_trace(v, where: str, name: str, path: Path) -> tuple[list[str], np.ndarray]:
-    """The header row's column names and the numbers below it (one row per line)."""
+    """The header row's column names and the numbers below it (one row per line; no rows: as many columns
+    as the header)."""
     try:
         with open(path) as fh:
             header = fh.readline().strip().split(",")
-        data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", UserWarning)  # no rows: refused below as too few rows, in one line
+            data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
     except (ValueError, OSError) as exc:
         v.fail(f"{where}.file", name, f"cannot read as CSV with a header row: {exc}")
+    if data.size == 0:  # numpy gives no rows one column: give them the header's, so the row count is what fails
+        data = np.empty((0, len(header)))
     return header, data
+
+
+def _column(v, where: str, name: str, header: list[str], data: np.ndarray, column: str) -> np.ndarray:
+    """The values of ``column`` (a name in the header); the rows must reach it.
+
+    Raises
+    ------
+    InputError
+        (through ``v``) Rows with fewer numbers than the header has names, up to ``column``.
+    """
+    i = header.index(column)
+    if i >= data.shape[1]:
+        v.fail(f"{where}.file", name, f"cannot read as CSV with a header row: its rows have {data.shape[1]} "
+               f"column(s), too few to hold {column!r} (column {i + 1} of its header)")
+    return data[:, i]
 
 
 def _value_column(v, where: str, spec: Mapping, name: str, header: list[str], time_col: str,

@@ -399,6 +399,32 @@ def test_a_bad_trace_is_refused_naming_key_and_line(tmp_path, text, table, messa
     assert _message(err, tmp_path) == f"s.toml: pressure.prescribed.{message}"
 
 
+@pytest.mark.parametrize("text, message", [
+    ("t_s,p_gauge_bar\n", "a trace needs at least two rows"),
+    ("t_s,p_gauge_bar\n0\n1\n", "cannot read as CSV with a header row: its rows have 1 column(s), too few to hold "
+     "'p_gauge_bar' (column 2 of its header)"),
+    ("p_gauge_bar,t_s\n0\n1\n", "cannot read as CSV with a header row: its rows have 1 column(s), too few to hold "
+     "'t_s' (column 2 of its header)"),
+])
+def test_a_trace_without_the_rows_its_header_names_is_refused_at_the_command_line(tmp_path, cli, text, message):
+    # these once ended in an IndexError's traceback (exit 1)
+    spec = (SCENARIOS / "acra2012_fig4.toml").read_text()
+    start, end = spec.index("[pressure]"), spec.index("[simulation]")
+    (tmp_path / "s.toml").write_text(spec[:start] + '[pressure]\nsource = "prescribed"\n'
+                                     'prescribed = { kind = "trace", file = "tr.csv" }\n\n' + spec[end:])
+    (tmp_path / "tr.csv").write_text(text)
+    proc = cli("run", tmp_path / "s.toml", "-o", tmp_path / "out", "--no-plot", "--no-progress")
+    assert proc.returncode == 2
+    assert proc.stderr == f"pamsim: error: {tmp_path / 's.toml'}: pressure.prescribed.file = 'tr.csv': {message}\n"
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_trace_with_more_columns_in_its_rows_or_header_than_it_uses_is_read(tmp_path):
+    for text in ("t_s,p_gauge_bar\n0,1,9\n1,2,9\n", "t_s,p_gauge_bar,note\n0,1\n1,2\n"):
+        signal = _trace(tmp_path, text).build_model().source.p_gauge_Pa
+        assert signal.t_s.tolist() == [0.0, 1.0] and signal.values.tolist() == [1e5, 2e5]
+
+
 def test_a_trace_takes_its_named_column_in_its_unit(tmp_path):
     sc = _trace(tmp_path, "time,p_gauge_bar,q_gauge_Pa\n0,0,1000\n0.5,1,2000\n", time_column="time",
                 value_column="q_gauge_Pa")
