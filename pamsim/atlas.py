@@ -196,6 +196,21 @@ def measured_points(path: Path | None) -> np.ndarray:
     header = [h.strip() for h in reader.fieldnames or []]
     reader.fieldnames = header
     rows = list(reader)
+    found = _point_columns(path, header)
+    try:
+        return np.array([[float(r[name]) * k for name, k in found] for r in rows], dtype=float).reshape(-1, 3)
+    except (TypeError, ValueError):
+        raise InputError(f"{path}: a measured point is not a number (columns {', '.join(n for n, _ in found)})") from None
+
+
+def _point_columns(path: Path, header: list[str]) -> list[tuple[str, float]]:
+    """``[(column, factor to SI)]`` of the pressure, contraction and force in a measured-point file's header.
+
+    Raises
+    ------
+    InputError
+        Naming every quantity without a column, and the columns there are.
+    """
     found = [unit_column(header, stems, units) for _, stems, units in _POINT_COLUMNS]
     if _PREFERRED_PRESSURE in header:
         found[0] = (_PREFERRED_PRESSURE, PA_PER_BAR)
@@ -203,10 +218,7 @@ def measured_points(path: Path | None) -> np.ndarray:
                for (what, stems, units), col in zip(_POINT_COLUMNS, found) if col is None]
     if missing:
         raise InputError(f"{path}: no measured points: need {', '.join(missing)} (columns: {', '.join(header)})")
-    try:
-        return np.array([[float(r[name]) * k for name, k in found] for r in rows], dtype=float).reshape(-1, 3)
-    except (TypeError, ValueError):
-        raise InputError(f"{path}: a measured point is not a number (columns {', '.join(n for n, _ in found)})") from None
+    return found
 
 
 def default_pressures_Pa(measured: np.ndarray, rating_Pa: float) -> tuple[float, ...]:
@@ -229,21 +241,9 @@ def build_atlas(muscle: str, models: Sequence[str] | None = None, pressures_bar:
     a pressure above a model's domain leaves that curve out.
     """
     m, params = muscle_parameters(muscle, overrides)
-    why = None if models else m.no_model_reason(model_inputs(m, params))
-    if why:
-        raise InputError(f"muscle {m.name!r}: {why}: nothing to draw")
-    names = list(models) if models else [n for n, s in REGISTRY.items() if not s.missing(model_inputs(m, params))]
-    for name in names:  # the same checks and messages as a scenario or `pamsim force`
-        prepare(muscle, name, overrides)
+    names = _models_to_draw(muscle, m, params, models, overrides)
     measured = measured_points(m.data_file)
-    rating = params["rated_pressure_gauge_Pa"]
-    if pressures_bar:
-        for p in pressures_bar:
-            if not 0.0 < p * PA_PER_BAR <= rating:
-                raise InputError(f"pressure {p:g} bar: must lie in (0, {rating / PA_PER_BAR:g}] bar (the muscle's rating)")
-        pressures = tuple(float(p) * PA_PER_BAR for p in pressures_bar)
-    else:
-        pressures = default_pressures_Pa(measured, rating)
+    pressures = _pressures_Pa(pressures_bar, measured, params["rated_pressure_gauge_Pa"])
     x_stop = EndStops.from_parameters(params).x_high_m if {"L0_m", "r0_m", "theta0_deg"} <= set(params) else math.inf
     curves, skipped = [], {}
     for name in names:
@@ -252,18 +252,61 @@ def build_atlas(muscle: str, models: Sequence[str] | None = None, pressures_bar:
         x_lo, x_hi = max(d.x_min_m, 0.0), min(d.x_max_m, x_stop)
         if not math.isfinite(x_hi) or x_hi <= x_lo:
             skipped[name] = f"no finite contraction range (domain {d.x_min_m:g} .. {d.x_max_m:g} m)"
-            continue
-        x = np.linspace(x_lo, x_hi, n_points)
-        for p in pressures:
-            if not d.p_min_Pa <= p <= d.p_max_Pa:
-                continue
-            F = np.asarray(model.force_N(x, p), dtype=float)
-            free = model.free_contraction_m(p, 0.0)
-            note = "" if math.isfinite(free) else (f"the force stays above zero up to the end of its domain "
-                                                    f"({d.x_max_m * 1e3:.3g} mm)")
-            curves.append(Curve(name, p, x, F, float(F[0]) if x_lo == 0.0 else math.nan, float(free), note))
+        else:
+            curves += _model_curves(name, model, pressures, np.linspace(x_lo, x_hi, n_points), x_lo == 0.0)
     if not curves:
         raise InputError(f"muscle {m.name!r}: no curve to draw: the pressures "
                          f"{', '.join(f'{p / PA_PER_BAR:g}' for p in pressures)} bar lie outside the domain of "
                          f"{', '.join(names)}" + "".join(f"; {n}: {w}" for n, w in skipped.items()))
     return Atlas(m, pressures, tuple(curves), measured, skipped)
+
+
+def _models_to_draw(muscle: str, m: Muscle, params: Mapping[str, float], models: Sequence[str] | None,
+                    overrides: Mapping[str, float] | None) -> list[str]:
+    """The models asked for, else every model whose parameters the muscle gives, each checked.
+
+    Raises
+    ------
+    InputError
+        No model applies to the muscle (none asked for), or a model asked for does not apply: the same
+        checks and messages as a scenario or ``pamsim force``.
+    """
+    why = None if models else m.no_model_reason(model_inputs(m, params))
+    if why:
+        raise InputError(f"muscle {m.name!r}: {why}: nothing to draw")
+    names = list(models) if models else [n for n, s in REGISTRY.items() if not s.missing(model_inputs(m, params))]
+    for name in names:
+        prepare(muscle, name, overrides)
+    return names
+
+
+def _pressures_Pa(pressures_bar: Sequence[float] | None, measured: np.ndarray, rating_Pa: float) -> tuple[float, ...]:
+    """The pressures asked for [Pa], each within the rating, else :func:`default_pressures_Pa`.
+
+    Raises
+    ------
+    InputError
+        A pressure at or below zero, or above the muscle's rating.
+    """
+    if not pressures_bar:
+        return default_pressures_Pa(measured, rating_Pa)
+    for p in pressures_bar:
+        if not 0.0 < p * PA_PER_BAR <= rating_Pa:
+            raise InputError(f"pressure {p:g} bar: must lie in (0, {rating_Pa / PA_PER_BAR:g}] bar (the muscle's rating)")
+    return tuple(float(p) * PA_PER_BAR for p in pressures_bar)
+
+
+def _model_curves(name: str, model, pressures: Sequence[float], x: np.ndarray, from_zero: bool) -> list[Curve]:
+    """One model's curves along the contractions ``x`` [m], at the pressures inside its domain; the blocked
+    force (the first point's) when ``from_zero`` (``x`` starts at zero contraction), else NaN."""
+    d = model.domain
+    curves = []
+    for p in pressures:
+        if not d.p_min_Pa <= p <= d.p_max_Pa:
+            continue
+        F = np.asarray(model.force_N(x, p), dtype=float)
+        free = model.free_contraction_m(p, 0.0)
+        note = "" if math.isfinite(free) else (f"the force stays above zero up to the end of its domain "
+                                                f"({d.x_max_m * 1e3:.3g} mm)")
+        curves.append(Curve(name, p, x, F, float(F[0]) if from_zero else math.nan, float(free), note))
+    return curves

@@ -8,6 +8,7 @@ mistake names that file, the key and the value.
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 from typing import Any, Mapping
 
@@ -36,6 +37,16 @@ def signal_from_table(v, where: str, spec: Any, suffix: str, scale: float, base_
     if not isinstance(kind, str) or kind not in SIGNAL_KINDS:
         v.fail(f"{where}.kind", kind, "unknown signal kind", choices=SIGNAL_KINDS)
     suffixes = [(suffix, scale)] + ([alt_suffix] if alt_suffix else [])
+    _check_keys(v, where, spec, kind, suffixes)
+    if kind == "steps":
+        return _steps(v, where, spec, suffixes)
+    if kind == "trace":
+        return _trace(v, where, spec, suffixes, base_dir)
+    return _SHAPES[kind](_Entries(v, where, spec, suffixes))
+
+
+def _check_keys(v, where: str, spec: Mapping, kind: str, suffixes) -> None:
+    """Refuse a key that signal ``kind`` does not take (with the value keys in each of the ``suffixes``)."""
     times, values = SIGNAL_KINDS[kind]
     known = ["kind", *times, *(f"{n}{s}" for n in values for s, _ in suffixes)]
     for key in spec:
@@ -43,37 +54,62 @@ def signal_from_table(v, where: str, spec: Any, suffix: str, scale: float, base_
             raise v.error(f"{v.origin}: unknown key {where}.{key} for kind = {kind!r}"
                           + choices_hint(key, known, "known:"))
 
-    def val(name: str, default: float | None = None) -> float:
-        for s, k in suffixes:
-            if f"{name}{s}" in spec:
-                return v.number(f"{where}.{name}{s}", spec[f"{name}{s}"]) * k
+
+class _Entries:
+    """The entries of one signal table, read as they are asked for (so the first mistake asked is reported)."""
+
+    def __init__(self, v, where: str, spec: Mapping, suffixes):
+        self.v, self.where, self.spec, self.suffixes = v, where, spec, suffixes
+
+    def value(self, name: str, default: float | None = None) -> float:
+        """``name<suffix>`` in SI, in the first of the suffixes it is given with; ``default`` if none (None:
+        required)."""
+        for s, k in self.suffixes:
+            if f"{name}{s}" in self.spec:
+                return self.v.number(f"{self.where}.{name}{s}", self.spec[f"{name}{s}"]) * k
         if default is None:
-            raise v.error(f"{v.origin}: missing key {where}.{name}{suffixes[0][0]}")
+            raise self.v.error(f"{self.v.origin}: missing key {self.where}.{name}{self.suffixes[0][0]}")
         return default
 
-    def t(name: str) -> float:
-        value = v.number(f"{where}.{name}", v.required(spec, name, prefix=f"{where}."))
+    def time(self, name: str) -> float:
+        """Required time ``name`` [s], not negative."""
+        value = self.v.number(f"{self.where}.{name}", self.v.required(self.spec, name, prefix=f"{self.where}."))
         if value < 0:
-            v.fail(f"{where}.{name}", value, "must not be negative")
+            self.v.fail(f"{self.where}.{name}", value, "must not be negative")
         return value
 
-    if kind == "steps":
-        return _steps(v, where, spec, suffixes)
-    if kind == "constant":
-        return Constant(val("value"))
-    if kind == "step":
-        return Step(t("time_s"), val("initial", 0.0), val("final"))
-    if kind == "ramp":
-        start, end = t("start_s"), t("end_s")
+    def after(self, name: str, start_name: str, start: float) -> float:
+        """Required time ``name`` [s], after ``start`` (time ``start_name``)."""
+        end = self.time(name)
         if end <= start:
-            v.fail(f"{where}.end_s", end, f"must be after start_s = {start}")
-        return Ramp(start, end, val("initial", 0.0), val("final"))
-    if kind == "lag":
-        tau = t("tau_s")
+            self.v.fail(f"{self.where}.{name}", end, f"must be after {start_name} = {start}")
+        return end
+
+    def positive_time(self, name: str) -> float:
+        """Required time ``name`` [s], above zero."""
+        tau = self.time(name)
         if tau <= 0:
-            v.fail(f"{where}.tau_s", tau, "must be positive")
-        return FirstOrderLag(t("time_s"), val("initial", 0.0), val("final"), tau)
-    return _trace(v, where, spec, suffixes, base_dir)
+            self.v.fail(f"{self.where}.{name}", tau, "must be positive")
+        return tau
+
+
+def _ramp(e: _Entries) -> Ramp:
+    start = e.time("start_s")
+    return Ramp(start, e.after("end_s", "start_s", start), e.value("initial", 0.0), e.value("final"))
+
+
+def _lag(e: _Entries) -> FirstOrderLag:
+    tau = e.positive_time("tau_s")  # read before time_s: the order the mistakes were always reported in
+    return FirstOrderLag(e.time("time_s"), e.value("initial", 0.0), e.value("final"), tau)
+
+
+# The signals of a few entries each, by kind (steps and trace read lists and files of their own).
+_SHAPES = {
+    "constant": lambda e: Constant(e.value("value")),
+    "step": lambda e: Step(e.time("time_s"), e.value("initial", 0.0), e.value("final")),
+    "ramp": _ramp,
+    "lag": _lag,
+}
 
 
 def _numbers(v, key: str, value: Any) -> list[float]:
@@ -100,29 +136,92 @@ def _steps(v, where: str, spec: Mapping, suffixes) -> PiecewiseConstant:
 
 
 def _trace(v, where: str, spec: Mapping, suffixes, base_dir: Path) -> Trace:
+    """A measured signal from a CSV file: its time column and the first value column in a known unit.
+
+    Parameters
+    ----------
+    v : the validator of the file the table is in.
+    where : the table's key (``pressure.prescribed``).
+    spec : the table: ``file``, optional ``time_column`` (default ``t_s``) and ``value_column``.
+    suffixes : ``[(unit suffix, factor to SI), ...]`` that a value column's name may end in.
+    base_dir : where a relative file name is found.
+    """
+    name, path = _trace_file(v, where, spec, base_dir)
+    time_col = spec.get("time_column", "t_s")
+    header, data = _read_trace(v, where, name, path)
+    if time_col not in header:
+        v.fail(f"{where}.time_column", time_col, f"no such column in {name} (columns: {', '.join(header)})")
+    col, unit = _value_column(v, where, spec, name, header, time_col, suffixes)
+    t = _column(v, where, name, header, data, time_col)
+    y = _column(v, where, name, header, data, col) * unit
+    _check_samples(v, where, name, t, y)
+    return Trace(t, y, str(path))
+
+
+def _trace_file(v, where: str, spec: Mapping, base_dir: Path) -> tuple[str, Path]:
+    """``(name as given, path)`` of a trace's file, relative names under ``base_dir``; it must exist."""
     name = v.required(spec, "file", prefix=f"{where}.")
     if not isinstance(name, str):
         v.fail(f"{where}.file", name, "must be a string (a CSV path)")
     path = (base_dir / name) if not Path(name).is_absolute() else Path(name)
     if not path.is_file():
         v.fail(f"{where}.file", name, f"trace file not found at {path}")
-    time_col = spec.get("time_column", "t_s")
+    return name, path
+
+
+def _read_trace(v, where: str, name: str, path: Path) -> tuple[list[str], np.ndarray]:
+    """The header row's column names and the numbers below it (one row per line; no rows: as many columns
+    as the header)."""
     try:
         with open(path) as fh:
             header = fh.readline().strip().split(",")
-        data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", UserWarning)  # no rows: refused below as too few rows, in one line
+            data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
     except (ValueError, OSError) as exc:
         v.fail(f"{where}.file", name, f"cannot read as CSV with a header row: {exc}")
-    value_cols = [spec["value_column"]] if "value_column" in spec else [c for c in header if c != time_col]
-    if time_col not in header:
-        v.fail(f"{where}.time_column", time_col, f"no such column in {name} (columns: {', '.join(header)})")
-    col = next((c for c in value_cols if c in header), None)
-    unit = next((k for s, k in suffixes if col and col.endswith(s)), None)
+    if data.size == 0:  # numpy gives no rows one column: give them the header's, so the row count is what fails
+        data = np.empty((0, len(header)))
+    return header, data
+
+
+def _column(v, where: str, name: str, header: list[str], data: np.ndarray, column: str) -> np.ndarray:
+    """The values of ``column`` (a name in the header); the rows must reach it.
+
+    Raises
+    ------
+    InputError
+        (through ``v``) Rows with fewer numbers than the header has names, up to ``column``.
+    """
+    i = header.index(column)
+    if i >= data.shape[1]:
+        v.fail(f"{where}.file", name, f"cannot read as CSV with a header row: its rows have {data.shape[1]} "
+               f"column(s), too few to hold {column!r} (column {i + 1} of its header)")
+    return data[:, i]
+
+
+def _value_column(v, where: str, spec: Mapping, name: str, header: list[str], time_col: str,
+                  suffixes) -> tuple[str, float]:
+    """``(column, factor to SI)``: ``value_column`` if given, else the first column other than the time's;
+    its name must end in one of the unit ``suffixes``."""
+    if "value_column" in spec:
+        col = spec["value_column"] if spec["value_column"] in header else None
+    else:
+        col = next((c for c in header if c != time_col), None)
+    unit = _suffix_factor(col, suffixes)
     if col is None or unit is None:
         want = " or ".join(f"a column ending in {s}" for s, _ in suffixes)
         v.fail(f"{where}.value_column", spec.get("value_column", col), f"{name} needs {want}")
-    t = data[:, header.index(time_col)]
-    y = data[:, header.index(col)] * unit
+    return col, unit
+
+
+def _suffix_factor(col: str | None, suffixes) -> float | None:
+    """The factor to SI of the first unit suffix that column ``col`` ends in, or None."""
+    return next((k for s, k in suffixes if col and col.endswith(s)), None)
+
+
+def _check_samples(v, where: str, name: str, t: np.ndarray, y: np.ndarray) -> None:
+    """At least two rows, every value finite and the time increasing strictly (naming the first bad line)."""
     if len(t) < 2:
         v.fail(f"{where}.file", name, "a trace needs at least two rows")
     if not (np.all(np.isfinite(t)) and np.all(np.isfinite(y))):
@@ -132,7 +231,6 @@ def _trace(v, where: str, spec: Mapping, suffixes, base_dir: Path) -> Trace:
     if bad.size:
         v.fail(f"{where}.file", name, f"time must increase strictly; line {int(bad[0]) + 3} has t = {t[bad[0] + 1]:g} "
                f"after {t[bad[0]]:g}")
-    return Trace(t, y, str(path))
 
 
 def signal_range(sig) -> tuple[float, float]:

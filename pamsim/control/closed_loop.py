@@ -98,37 +98,79 @@ class ControllerConfig:
         """
         where = scenario.origin
         refuse_added(scenario, "the closed loop's controller design", InputError)
-        table = scenario.spec.get("controller")
-        if not isinstance(table, dict):
-            raise InputError(f"{where}: missing table [controller] (see docs/control.md)")
-        for key in table:
-            if key not in _CONTROLLER_KEYS:
-                raise InputError(f"{where}: unknown key controller.{key} (known: {', '.join(_CONTROLLER_KEYS)})")
-        if table.get("kind", "lqr_integral") != "lqr_integral":
-            raise InputError(f"{where}: controller.kind = {table['kind']!r}: only 'lqr_integral' is implemented")
-        values = {}
-        for key, (default, factor) in _CONTROLLER_KEYS.items():
-            if key in ("kind", "spec"):
-                continue
-            if key not in table and default is None:
-                raise InputError(f"{where}: missing key controller.{key}")
-            raw = table.get(key, default)
-            if isinstance(raw, bool) or not isinstance(raw, (int, float)) or not math.isfinite(raw):
-                raise InputError(f"{where}: controller.{key} = {raw!r}: must be a finite number")
-            if raw < 0 or (raw == 0 and key != "integrator_deadband_mm"):
-                raise InputError(f"{where}: controller.{key} = {raw!r}: must be positive")
-            name = key.replace("_mm_s", "_m_s").replace("_mm", "_m").replace("_bar", "_Pa")
-            values[name] = float(raw) * factor
-        spec = table.get("spec", {})
-        if not isinstance(spec, dict) or any(k not in _SPEC_KEYS for k in spec):
-            raise InputError(f"{where}: controller.spec must be a table with keys from {', '.join(_SPEC_KEYS)}")
-        for key, raw in spec.items():
-            if isinstance(raw, bool) or not isinstance(raw, (int, float)) or raw <= 0:
-                raise InputError(f"{where}: controller.spec.{key} = {raw!r}: must be a positive number")
+        table = _controller_table(scenario.spec.get("controller"), where)
+        # The numbers in the order of _CONTROLLER_KEYS, then the spec: the first mistake is the one reported.
+        values = {_si_name(key): _controller_number(table, key, where) * factor
+                  for key, (_, factor) in _CONTROLLER_KEYS.items() if key not in ("kind", "spec")}
+        spec = _controller_spec(table.get("spec", {}), where)
         if not 0.0 < values["step_time_s"] < scenario.duration_s:
             raise InputError(f"{where}: controller.step_time_s = {values['step_time_s']:g}: must lie inside the "
                              f"simulation (0, {scenario.duration_s:g}) s")
-        return cls(spec={k: float(v) for k, v in spec.items()}, **values)
+        return cls(spec=spec, **values)
+
+
+def _controller_table(table: Any, where: str) -> dict:
+    """The ``[controller]`` table, its keys known and its kind the one implemented.
+
+    Parameters
+    ----------
+    table : the scenario's ``controller`` entry (None when it has none).
+    where : the scenario's origin, for the messages.
+
+    Raises
+    ------
+    InputError
+        No table, an unknown key (the first, in the file's order), or a kind other than ``lqr_integral``.
+    """
+    if not isinstance(table, dict):
+        raise InputError(f"{where}: missing table [controller] (see docs/control.md)")
+    for key in table:
+        if key not in _CONTROLLER_KEYS:
+            raise InputError(f"{where}: unknown key controller.{key} (known: {', '.join(_CONTROLLER_KEYS)})")
+    if table.get("kind", "lqr_integral") != "lqr_integral":
+        raise InputError(f"{where}: controller.kind = {table['kind']!r}: only 'lqr_integral' is implemented")
+    return table
+
+
+def _controller_number(table: Mapping[str, Any], key: str, where: str) -> float:
+    """``controller.KEY`` in the file's unit (its default when it has one and is not given).
+
+    Raises
+    ------
+    InputError
+        A required key missing, a value that is not a finite number, or one that is not positive
+        (``integrator_deadband_mm`` may be 0: no deadband).
+    """
+    default = _CONTROLLER_KEYS[key][0]
+    if key not in table and default is None:
+        raise InputError(f"{where}: missing key controller.{key}")
+    raw = table.get(key, default)
+    if isinstance(raw, bool) or not isinstance(raw, (int, float)) or not math.isfinite(raw):
+        raise InputError(f"{where}: controller.{key} = {raw!r}: must be a finite number")
+    if raw < 0 or (raw == 0 and key != "integrator_deadband_mm"):
+        raise InputError(f"{where}: controller.{key} = {raw!r}: must be positive")
+    return float(raw)
+
+
+def _si_name(key: str) -> str:
+    """The :class:`ControllerConfig` field of a ``[controller]`` key: its unit suffix in SI."""
+    return key.replace("_mm_s", "_m_s").replace("_mm", "_m").replace("_bar", "_Pa")
+
+
+def _controller_spec(spec: Any, where: str) -> dict[str, float]:
+    """``[controller.spec]``: the step response's requirements, each a positive number.
+
+    Raises
+    ------
+    InputError
+        Not a table, a key outside :data:`_SPEC_KEYS`, or a value that is not a positive number.
+    """
+    if not isinstance(spec, dict) or any(k not in _SPEC_KEYS for k in spec):
+        raise InputError(f"{where}: controller.spec must be a table with keys from {', '.join(_SPEC_KEYS)}")
+    for key, raw in spec.items():
+        if isinstance(raw, bool) or not isinstance(raw, (int, float)) or raw <= 0:
+            raise InputError(f"{where}: controller.spec.{key} = {raw!r}: must be a positive number")
+    return {k: float(v) for k, v in spec.items()}
 
 
 @dataclass(frozen=True)

@@ -64,6 +64,84 @@ def _base_scenario(scenario) -> Scenario:
     raise InputError(f"scenario = {scenario!r}: must be a scenario file's path or a pamsim.Scenario")
 
 
+def _check_choices(render_mode, command: str, backend: str, weight_N, mass_kg) -> None:
+    """Refuse a rendering, an unknown command or backend, and a load given both as weight and mass.
+
+    Raises
+    ------
+    InputError
+        Naming the first argument that is wrong.
+    """
+    if render_mode is not None:
+        raise InputError(f"render_mode = {render_mode!r}: MusclePosition-v0 renders nothing (render_modes: [])")
+    if command not in COMMANDS:
+        raise InputError(f"command = {command!r}: must be one of {', '.join(map(repr, COMMANDS))}")
+    if backend not in PLANTS:
+        raise InputError(f"backend = {backend!r}: must be one of {', '.join(map(repr, PLANTS))}")
+    if weight_N is not None and mass_kg is not None:
+        raise InputError("weight_N and mass_kg: give at most one of the two")
+
+
+def _episode(control_rate_Hz, episode_duration_s, reference_margin) -> tuple[float, int, float]:
+    """``(rate [Hz], steps per episode, reference margin)`` of the arguments, each checked.
+
+    Raises
+    ------
+    InputError
+        A rate or duration that is not a positive finite number, an episode shorter than one step, or a
+        margin outside [0, 0.5).
+    """
+    rate = _positive("control_rate_Hz", control_rate_Hz)
+    duration = _positive("episode_duration_s", episode_duration_s)
+    n_steps = round(duration * rate)
+    if n_steps < 1:
+        raise InputError(f"episode_duration_s = {episode_duration_s!r}: shorter than one control step "
+                         f"(1 / control_rate_Hz = {1 / rate:g} s)")
+    margin = float(reference_margin) if isinstance(reference_margin, (int, float)) else math.nan
+    if not 0.0 <= margin < 0.5:
+        raise InputError(f"reference_margin = {reference_margin!r}: must lie in [0, 0.5)")
+    return rate, n_steps, margin
+
+
+def _plant_scenario(scenario, muscle: str | None, weight_N, mass_kg) -> Scenario:
+    """The scenario of the plant, with the muscle and load given in place of its own.
+
+    Raises
+    ------
+    InputError
+        A bad scenario, muscle or load, or an external force that is not constant (the environment's time
+        restarts every episode).
+    """
+    base = _base_scenario(scenario)
+    changes: dict = {}
+    if muscle is not None:
+        changes["model"] = {"muscle": muscle}
+    if weight_N is not None or mass_kg is not None:
+        changes["load"] = {"weight_N": weight_N} if weight_N is not None else {"mass_kg": mass_kg}
+    if changes:
+        base = base.with_changes(changes)
+    external = base.spec["load"].get("external_force")
+    if external is not None and external.get("kind") != "constant":
+        raise InputError(f"{base.origin}: load.external_force: kind = {external.get('kind')!r}: the environment's "
+                         "time restarts every episode, so it takes only a constant external force")
+    return base
+
+
+def _supply_Pa(base: Scenario, supply_gauge_Pa) -> float:
+    """The valve's supply [Pa gauge]: the argument, else the scenario's supply (or final prescribed) pressure.
+
+    Raises
+    ------
+    InputError
+        An argument that is not a positive finite number, or a scenario whose pressure is not positive.
+    """
+    supply = base.final_pressure_gauge_Pa if supply_gauge_Pa is None else _positive("supply_gauge_Pa",
+                                                                                    supply_gauge_Pa)
+    if not supply > 0:
+        raise InputError(f"{base.origin}: the scenario's pressure is {supply:g} Pa gauge: give supply_gauge_Pa > 0")
+    return float(supply)
+
+
 class MusclePositionEnv(gymnasium.Env):
     """One muscle lifting a hanging load, commanded each control step to track a random contraction.
 
@@ -112,23 +190,8 @@ class MusclePositionEnv(gymnasium.Env):
                  weight_N: float | None = None, mass_kg: float | None = None, supply_gauge_Pa: float | None = None,
                  command: str = "valve", backend: str = "native", control_rate_Hz: float = 100.0,
                  episode_duration_s: float = 2.0, reference_margin: float = 0.1, render_mode: str | None = None):
-        if render_mode is not None:
-            raise InputError(f"render_mode = {render_mode!r}: MusclePosition-v0 renders nothing (render_modes: [])")
-        if command not in COMMANDS:
-            raise InputError(f"command = {command!r}: must be one of {', '.join(map(repr, COMMANDS))}")
-        if backend not in PLANTS:
-            raise InputError(f"backend = {backend!r}: must be one of {', '.join(map(repr, PLANTS))}")
-        if weight_N is not None and mass_kg is not None:
-            raise InputError("weight_N and mass_kg: give at most one of the two")
-        rate = _positive("control_rate_Hz", control_rate_Hz)
-        duration = _positive("episode_duration_s", episode_duration_s)
-        n_steps = round(duration * rate)
-        if n_steps < 1:
-            raise InputError(f"episode_duration_s = {episode_duration_s!r}: shorter than one control step "
-                             f"(1 / control_rate_Hz = {1 / rate:g} s)")
-        margin = float(reference_margin) if isinstance(reference_margin, (int, float)) else math.nan
-        if not 0.0 <= margin < 0.5:
-            raise InputError(f"reference_margin = {reference_margin!r}: must lie in [0, 0.5)")
+        _check_choices(render_mode, command, backend, weight_N, mass_kg)
+        rate, n_steps, margin = _episode(control_rate_Hz, episode_duration_s, reference_margin)
         self.render_mode = None
         self.command = command
         self.backend = backend
@@ -137,23 +200,8 @@ class MusclePositionEnv(gymnasium.Env):
         """Steps of an episode."""
         self._dt = 1.0 / rate
 
-        base = _base_scenario(scenario)
-        changes: dict = {}
-        if muscle is not None:
-            changes["model"] = {"muscle": muscle}
-        if weight_N is not None or mass_kg is not None:
-            changes["load"] = {"weight_N": weight_N} if weight_N is not None else {"mass_kg": mass_kg}
-        if changes:
-            base = base.with_changes(changes)
-        external = base.spec["load"].get("external_force")
-        if external is not None and external.get("kind") != "constant":
-            raise InputError(f"{base.origin}: load.external_force: kind = {external.get('kind')!r}: the environment's "
-                             "time restarts every episode, so it takes only a constant external force")
-        supply = base.final_pressure_gauge_Pa if supply_gauge_Pa is None else _positive("supply_gauge_Pa",
-                                                                                        supply_gauge_Pa)
-        if not supply > 0:
-            raise InputError(f"{base.origin}: the scenario's pressure is {supply:g} Pa gauge: give supply_gauge_Pa > 0")
-        self.supply_gauge_Pa = float(supply)
+        base = _plant_scenario(scenario, muscle, weight_N, mass_kg)
+        self.supply_gauge_Pa = _supply_Pa(base, supply_gauge_Pa)
         """The valve's supply, and the largest pressure command [Pa gauge]."""
         initial = base.spec["pressure"].get("initial_gauge_bar") if base.spec["pressure"]["source"] == "valve" else None
         self._initial_gauge_bar = initial
@@ -163,23 +211,43 @@ class MusclePositionEnv(gymnasium.Env):
         self._plant = PLANTS[backend](self.scenario, COMMANDS[command])
 
         model = self.scenario.build_model()
-        stops, load = model.stops, model.load
+        load = model.load
         self.load_N = load.mass_kg * load.g_m_s2 - load.external_N(0.0)
         """The weight less the external force [N]: what the muscle holds at rest without friction."""
-        x_lo, x_hi = (equilibrium_contraction_m(model.static_force, p, self.load_N, stops.x_high_m)
-                      for p in (0.0, self.supply_gauge_Pa))
-        if not x_hi > x_lo:
-            raise InputError(f"{self.scenario.origin}: the muscle cannot lift {self.load_N:g} N at "
-                             f"{self.supply_gauge_Pa:g} Pa gauge: no contraction to track")
+        x_lo, x_hi = self._reachable_m(model)
         self.reachable_range_m = (float(x_lo), float(x_hi))
         """Contractions [m] at which the muscle holds the load without friction, at no pressure and at the
         supply: the static equilibria (components added to the rig are not counted)."""
         span = x_hi - x_lo
         self.reference_range_m = (float(x_lo + margin * span), float(x_hi - margin * span))
         """Where the reference is drawn from [m]."""
+        self._make_spaces(model, x_lo, x_hi)
+        self._span = float(span)
+        self._k: int | None = None  # steps taken in this episode; None: reset needed
+        self._reference = self.reference_range_m[0]
+        self._time_s = 0.0
 
+    def _reachable_m(self, model) -> tuple[float, float]:
+        """The static equilibria [m] of the load at no pressure and at the supply.
+
+        Raises
+        ------
+        InputError
+            The muscle cannot lift the load at the supply: there would be no contraction to track.
+        """
+        x_lo, x_hi = (equilibrium_contraction_m(model.static_force, p, self.load_N, model.stops.x_high_m)
+                      for p in (0.0, self.supply_gauge_Pa))
+        if not x_hi > x_lo:
+            raise InputError(f"{self.scenario.origin}: the muscle cannot lift {self.load_N:g} N at "
+                             f"{self.supply_gauge_Pa:g} Pa gauge: no contraction to track")
+        return x_lo, x_hi
+
+    def _make_spaces(self, model, x_lo: float, x_hi: float) -> None:
+        """The observation space (stops, a speed bound, pressure and the reachable range) and the action
+        space of the command, with the bounds the step's fast paths read."""
+        stops, load = model.stops, model.load
         p_atm = self.scenario.parameters["p_atm_Pa"]
-        p_bound = self.supply_gauge_Pa if command == "pressure" else 2.0 * max(
+        p_bound = self.supply_gauge_Pa if self.command == "pressure" else 2.0 * max(
             self.supply_gauge_Pa, self.scenario.parameters["rated_pressure_gauge_Pa"])
         drive = model.static_force.force_N(stops.x_low_m, p_bound) + abs(load.mass_kg * load.g_m_s2) \
             + abs(load.external_N(0.0))
@@ -188,16 +256,12 @@ class MusclePositionEnv(gymnasium.Env):
         self._low = np.array([stops.x_low_m, -v_bound, -p_atm, x_lo])
         self._high = np.array([stops.x_high_m, v_bound, p_bound, x_hi])
         self.observation_space = spaces.Box(self._low, self._high, dtype=np.float64)
-        low = -1.0 if command == "valve" else 0.0  # Gymnasium's advice: [-1, 1] or [0, 1]
+        low = -1.0 if self.command == "valve" else 0.0  # Gymnasium's advice: [-1, 1] or [0, 1]
         self.action_space = spaces.Box(low, 1.0, shape=(1,), dtype=np.float64)
         self._a_low, self._a_high = low, 1.0
-        self._scale = 1.0 if command == "valve" else self.supply_gauge_Pa
+        self._scale = 1.0 if self.command == "valve" else self.supply_gauge_Pa
         self._lo = tuple(self._low.tolist())
         self._hi = tuple(self._high.tolist())
-        self._span = float(span)
-        self._k: int | None = None  # steps taken in this episode; None: reset needed
-        self._reference = self.reference_range_m[0]
-        self._time_s = 0.0
 
     # ------------------------------------------------------------------ Gymnasium API
     def reset(self, *, seed: int | None = None, options: Mapping[str, Any] | None = None):

@@ -129,12 +129,20 @@ class Assembly:
     def _signal_sources(self) -> dict[str, tuple[str, str]]:
         """``{"comp.input": ("output", "comp.output") or ("input", model input name)}``, every input bound once."""
         bound: dict[str, tuple[str, str]] = {}
+        for a, b in self._signal_connections():
+            _bind(bound, b, ("output", a.label))
+        for model_input, refs in self.inputs.items():
+            for ep in self._model_input_ends(model_input, refs):
+                _bind(bound, ep, ("input", model_input))
+        for c in self.components:
+            for v in c.inputs:
+                if f"{c.name}.{v.name}" not in bound:
+                    raise AssemblyError(f"input {c.name}.{v.name} [{v.unit}] is not connected")
+        return bound
 
-        def bind(ep: _Endpoint, source: tuple[str, str]):
-            if ep.label in bound:
-                raise AssemblyError(f"input {ep.label} is connected twice ({bound[ep.label][1]} and {source[1]})")
-            bound[ep.label] = source
-
+    def _signal_connections(self):
+        """The connections of an output to an input, as ``(output, input)`` endpoints, checked one by one as
+        they are read (a port connection is skipped: :meth:`_port_connections` has it)."""
         for a_ref, b_ref in self.connections:
             a, b = self._endpoint(a_ref), self._endpoint(b_ref)
             if a.kind == "port":
@@ -147,22 +155,20 @@ class Assembly:
             ua, ub = _var(a.component.outputs, a.name).unit, _var(b.component.inputs, b.name).unit
             if ua != ub:
                 raise AssemblyError(f"cannot connect {a.label} [{ua}] to {b.label} [{ub}]: the units differ")
-            bind(b, ("output", a.label))
-        for model_input, refs in self.inputs.items():
-            units = set()
-            for ref in refs:
-                ep = self._endpoint(ref)
-                if ep.kind != "input":
-                    raise AssemblyError(f"model input {model_input!r}: {ep.label} is a {ep.kind}, not an input")
-                units.add(_var(ep.component.inputs, ep.name).unit)
-                bind(ep, ("input", model_input))
-            if len(units) > 1:
-                raise AssemblyError(f"model input {model_input!r} drives inputs of different units {sorted(units)}")
-        for c in self.components:
-            for v in c.inputs:
-                if f"{c.name}.{v.name}" not in bound:
-                    raise AssemblyError(f"input {c.name}.{v.name} [{v.unit}] is not connected")
-        return bound
+            yield a, b
+
+    def _model_input_ends(self, model_input: str, refs: Sequence[str]):
+        """The component inputs one model input drives, each checked to be an input as it is read, and all of
+        one unit (checked after the last)."""
+        units = set()
+        for ref in refs:
+            ep = self._endpoint(ref)
+            if ep.kind != "input":
+                raise AssemblyError(f"model input {model_input!r}: {ep.label} is a {ep.kind}, not an input")
+            units.add(_var(ep.component.inputs, ep.name).unit)
+            yield ep
+        if len(units) > 1:
+            raise AssemblyError(f"model input {model_input!r} drives inputs of different units {sorted(units)}")
 
     def structure_key(self) -> tuple:
         """Equal for two assemblies that generate the same code (they may differ in parameter values)."""
@@ -359,6 +365,19 @@ def _namespaced(c: Component, v: Var) -> Var:
 
 def _var(vs: Sequence[Var], name: str) -> Var:
     return next(v for v in vs if v.name == name)
+
+
+def _bind(bound: dict[str, tuple[str, str]], ep: _Endpoint, source: tuple[str, str]) -> None:
+    """Bind input ``ep`` to ``source`` (``("output", label)`` or ``("input", model input)``), once only.
+
+    Raises
+    ------
+    AssemblyError
+        The input is bound already, naming both of its sources.
+    """
+    if ep.label in bound:
+        raise AssemblyError(f"input {ep.label} is connected twice ({bound[ep.label][1]} and {source[1]})")
+    bound[ep.label] = source
 
 
 def _root(parent: dict[str, str], k: str) -> str:

@@ -210,48 +210,68 @@ def function_source(fn, py_name: str, arrays: bool = False) -> str:
     result entry (of the arguments' length ``_n``, the last argument): the function at many points at
     once, for results' columns rather than an integrator.
     """
-    import casadi as ca
-
-    ops = _numpy_op_table() if arrays else _op_table()
     args = [fn.name_in(i) for i in range(fn.n_in())]
     lines = [f"def {py_name}({', '.join(args + (['_n'] if arrays else []))}):"]
-    dense_index = []
-    results = []
-    for i in range(fn.n_out()):
-        sp = fn.sparsity_out(i)
-        dense_index.append(sp.find())
-        results.append(["0.0"] * sp.numel())
-    constant: dict[int, float] = {}  # work slots that hold a constant, for a division that needs no guard
-    for k in range(fn.n_instructions()):
-        op = fn.instruction_id(k)
-        ins = fn.instruction_input(k)
-        outs = fn.instruction_output(k)
-        if op == ca.OP_INPUT:
-            lines.append(f"    w{outs[0]} = {args[ins[0]]}[{ins[1]}]")
-        elif op == ca.OP_OUTPUT:
-            name = f"r{outs[0]}_{outs[1]}"
-            lines.append(f"    {name} = w{ins[0]}")
-            results[outs[0]][dense_index[outs[0]][outs[1]]] = name
-            continue
-        elif op == ca.OP_CONST:
-            value = fn.instruction_constant(k)
-            lines.append(f"    w{outs[0]} = {_literal(value)}")
-            constant[outs[0]] = value
-            continue
-        elif (op == ca.OP_DIV and not arrays and math.isfinite(constant.get(ins[1], 0.0))
-              and constant.get(ins[1], 0.0) != 0.0):
-            lines.append(f"    w{outs[0]} = w{ins[0]} / w{ins[1]}")
-        elif op in ops:
-            operands = [f"w{j}" for j in ins]
-            lines.append(f"    w{outs[0]} = {ops[op].format(*operands)}")
-        else:
-            raise NotImplementedError(f"{fn.name()}: CasADi operation {op} has no Python form")
-        constant.pop(outs[0], None)
+    writer = _Instructions(fn, args, arrays)
+    lines += [writer.line(k) for k in range(fn.n_instructions())]
+    results = writer.results
     if arrays:
         results = [[f"_np.broadcast_to(_np.asarray({r}, dtype=float), (_n,))" for r in res] for res in results]
     returned = ", ".join("[" + ", ".join(r) + "]" for r in results)
     lines.append(f"    return {returned}" + ("," if len(results) == 1 else ""))
     return "\n".join(lines) + "\n"
+
+
+class _Instructions:
+    """The lines of a CasADi ``Function``'s instructions, one by one, and the names of its results.
+
+    Parameters
+    ----------
+    fn : casadi.Function
+        The SX function.
+    args : list of str
+        Its arguments' names.
+    arrays : bool
+        Lines for numpy arrays (see :func:`function_source`).
+    """
+
+    def __init__(self, fn, args: list[str], arrays: bool):
+        import casadi as ca
+
+        self.ca, self.fn, self.args, self.arrays = ca, fn, args, arrays
+        self.ops = _numpy_op_table() if arrays else _op_table()
+        self.dense_index = [fn.sparsity_out(i).find() for i in range(fn.n_out())]
+        self.results = [["0.0"] * fn.sparsity_out(i).numel() for i in range(fn.n_out())]
+        """Each result's entries, dense: the name of its output line, "0.0" where it is structurally zero."""
+        self.constant: dict[int, float] = {}  # work slots that hold a constant, for a division that needs no guard
+
+    def line(self, k: int) -> str:
+        """The line of instruction ``k``; a work slot it writes no longer holds a constant (unless it is one)."""
+        ca, fn = self.ca, self.fn
+        op, ins, outs = fn.instruction_id(k), fn.instruction_input(k), fn.instruction_output(k)
+        if op == ca.OP_OUTPUT:
+            name = f"r{outs[0]}_{outs[1]}"
+            self.results[outs[0]][self.dense_index[outs[0]][outs[1]]] = name
+            return f"    {name} = w{ins[0]}"
+        if op == ca.OP_CONST:
+            value = fn.instruction_constant(k)
+            self.constant[outs[0]] = value
+            return f"    w{outs[0]} = {_literal(value)}"
+        if op == ca.OP_INPUT:
+            line = f"    w{outs[0]} = {self.args[ins[0]]}[{ins[1]}]"
+        elif op == ca.OP_DIV and self._by_nonzero_constant(ins[1]):
+            line = f"    w{outs[0]} = w{ins[0]} / w{ins[1]}"
+        elif op in self.ops:
+            line = f"    w{outs[0]} = {self.ops[op].format(*(f'w{j}' for j in ins))}"
+        else:
+            raise NotImplementedError(f"{fn.name()}: CasADi operation {op} has no Python form")
+        self.constant.pop(outs[0], None)
+        return line
+
+    def _by_nonzero_constant(self, slot: int) -> bool:
+        """A division (on floats) by work slot ``slot`` needs no guard: it holds a finite nonzero constant."""
+        divisor = self.constant.get(slot, 0.0)
+        return not self.arrays and math.isfinite(divisor) and divisor != 0.0
 
 
 def module_source(model, names=None) -> str:

@@ -157,6 +157,28 @@ def muscle_from_dict(raw: Mapping[str, Any], origin: str | Path = "<dict>") -> M
     for key in raw:
         if key not in TOP_KEYS:
             raise fail(key, raw[key], "unknown key" + did_you_mean(key, TOP_KEYS))
+    strings = _strings(fail, raw)
+    model = strings["default_static_force"]
+    gaps = raw.get("gaps", [])
+    if not isinstance(gaps, list) or not all(isinstance(g, str) for g in gaps):
+        raise fail("gaps", gaps, "must be a list of strings")
+    entries = _entries(fail, origin, raw)
+    force_map_file = _force_map_file(fail, origin, raw)
+    data_file = _data_file(fail, origin, raw)
+    params = ParameterSet(strings["name"], strings["citation"], entries)
+    return Muscle(strings["name"], strings["description"], strings["citation"], model, params, origin,
+                  tuple(gaps), data_file, force_map_file, *_upper_stop(fail, raw.get("upper_stop")))
+
+
+def _strings(fail, raw: Mapping[str, Any]) -> dict[str, str]:
+    """The file's name, description, citation and default static force, each a non-empty string; the model
+    one of the library's.
+
+    Raises
+    ------
+    MuscleError
+        (made by ``fail``) The first of them missing or blank, or an unknown model.
+    """
     strings = {}
     for key in ("name", "description", "citation", "default_static_force"):
         value = raw.get(key)
@@ -166,9 +188,18 @@ def muscle_from_dict(raw: Mapping[str, Any], origin: str | Path = "<dict>") -> M
     model = strings["default_static_force"]
     if model not in REGISTRY:
         raise fail("default_static_force", model, "unknown static model" + did_you_mean(model, REGISTRY))
-    gaps = raw.get("gaps", [])
-    if not isinstance(gaps, list) or not all(isinstance(g, str) for g in gaps):
-        raise fail("gaps", gaps, "must be a list of strings")
+    return strings
+
+
+def _entries(fail, origin: Path, raw: Mapping[str, Any]) -> dict[str, Parameter]:
+    """The ``[parameters.NAME]`` tables and a top-level rating as :class:`Parameter` s, a radial braid angle
+    converted, the bladder wall completed and the geometry checked.
+
+    Raises
+    ------
+    MuscleError
+        A table or value that is wrong, a rating given twice, or geometry that does not hold together.
+    """
     tables = raw.get("parameters", {})
     if not isinstance(tables, dict):
         raise fail("parameters", tables, "must be a table of [parameters.NAME] tables")
@@ -183,23 +214,42 @@ def muscle_from_dict(raw: Mapping[str, Any], origin: str | Path = "<dict>") -> M
     _convert_radial_angle(fail, entries)
     _complete_wall(fail, entries)
     _check_geometry(fail, entries)
-    force_map_file = None
-    if "force_map" in raw:
-        fm = raw["force_map"]
-        if not isinstance(fm, str) or not (origin.parent / fm).is_file():
-            raise fail("force_map", fm, "must name a CSV file next to the muscle file")
-        force_map_file = (origin.parent / fm).resolve()
-    data_file = None
-    if "data" in raw:
-        data = raw["data"]
-        if not isinstance(data, dict) or set(data) != {"file"} or not isinstance(data["file"], str):
-            raise fail("data", data, 'must be a table with one key, file = "NAME.csv"')
-        data_file = (origin.parent / data["file"]).resolve()
-        if not data_file.is_file():
-            raise fail("data.file", data["file"], f"no such file next to the muscle file ({data_file})")
-    params = ParameterSet(strings["name"], strings["citation"], entries)
-    return Muscle(strings["name"], strings["description"], strings["citation"], model, params, origin,
-                  tuple(gaps), data_file, force_map_file, *_upper_stop(fail, raw.get("upper_stop")))
+    return entries
+
+
+def _force_map_file(fail, origin: Path, raw: Mapping[str, Any]) -> Path | None:
+    """The measured force map named by ``force_map`` (a CSV file next to the muscle file), or None.
+
+    Raises
+    ------
+    MuscleError
+        (made by ``fail``) A name that is not a string or not a file next to the muscle file.
+    """
+    if "force_map" not in raw:
+        return None
+    fm = raw["force_map"]
+    if not isinstance(fm, str) or not (origin.parent / fm).is_file():
+        raise fail("force_map", fm, "must name a CSV file next to the muscle file")
+    return (origin.parent / fm).resolve()
+
+
+def _data_file(fail, origin: Path, raw: Mapping[str, Any]) -> Path | None:
+    """The measured points named by ``[data] file`` (next to the muscle file), or None.
+
+    Raises
+    ------
+    MuscleError
+        (made by ``fail``) A table other than ``{file = "NAME.csv"}``, or no such file.
+    """
+    if "data" not in raw:
+        return None
+    data = raw["data"]
+    if not isinstance(data, dict) or set(data) != {"file"} or not isinstance(data["file"], str):
+        raise fail("data", data, 'must be a table with one key, file = "NAME.csv"')
+    data_file = (origin.parent / data["file"]).resolve()
+    if not data_file.is_file():
+        raise fail("data.file", data["file"], f"no such file next to the muscle file ({data_file})")
+    return data_file
 
 
 def _upper_stop(fail, table: Any) -> tuple[str, str]:
@@ -222,6 +272,32 @@ def _upper_stop(fail, table: Any) -> tuple[str, str]:
 def _entry(fail, origin: Path, name: str, table: Any) -> Parameter:
     """One ``[parameters.NAME]`` table -> :class:`Parameter` with the known unit and bounds."""
     key = f"parameters.{name}"
+    _check_entry_table(fail, origin, name, table)
+    value = _entry_value(fail, key, table)
+    source = table.get("source")
+    if not isinstance(source, str) or not source.strip():
+        raise fail(f"{key}.source", source, 'required: where the value comes from (paper + table/equation, or "assumed: <reason>")')
+    unit = unit_of(name)
+    if "unit" in table and table["unit"] != unit:
+        raise fail(f"{key}.unit", table["unit"], f"does not match the unit of the name's suffix ({unit!r})")
+    known, description = _entry_description(fail, key, name, table)
+    param = Parameter(value, unit, source, description, known.lower, known.upper, known.lower_open, known.upper_open)
+    why = param.violation(value)
+    if why:
+        raise fail(key, value, why)
+    return param
+
+
+def _check_entry_table(fail, origin: Path, name: str, table: Any) -> None:
+    """A known parameter's name (or ``alpha_radial_deg``), its table a table of known keys.
+
+    Raises
+    ------
+    MuscleError
+        An unknown name (its table not quoted: the name is the mistake), a value that is not a table, or an
+        unknown key in it.
+    """
+    key = f"parameters.{name}"
     if name not in KNOWN and name != "alpha_radial_deg":  # the name is the mistake: its table is not quoted
         raise MuscleError(f"{origin}: {key}: unknown parameter"
                           + did_you_mean(name, list(KNOWN) + ["alpha_radial_deg"]))
@@ -230,32 +306,30 @@ def _entry(fail, origin: Path, name: str, table: Any) -> Parameter:
     for k in table:
         if k not in ENTRY_KEYS:
             raise fail(f"{key}.{k}", table[k], "unknown key" + did_you_mean(k, ENTRY_KEYS))
+
+
+def _entry_value(fail, key: str, table: Mapping[str, Any]) -> float:
+    """The entry's ``value``, a finite number (a bool is not one)."""
     value = table.get("value")
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise fail(f"{key}.value", value, "required, a number")
     value = float(value)
     if not math.isfinite(value):
         raise fail(f"{key}.value", value, "must be a finite number")
-    source = table.get("source")
-    if not isinstance(source, str) or not source.strip():
-        raise fail(f"{key}.source", source, 'required: where the value comes from (paper + table/equation, or "assumed: <reason>")')
-    unit = unit_of(name)
-    if "unit" in table and table["unit"] != unit:
-        raise fail(f"{key}.unit", table["unit"], f"does not match the unit of the name's suffix ({unit!r})")
+    return value
+
+
+def _entry_description(fail, key: str, name: str, table: Mapping[str, Any]):
+    """``(known parameter, description)``: the file's description, else the known one's.
+
+    A radial-plane braid angle takes the bounds of ``theta0_deg``, which it becomes (both lie in (0, 90) deg).
+    """
     description = table.get("description", "")
     if not isinstance(description, str):
         raise fail(f"{key}.description", description, "must be a string")
     if name == "alpha_radial_deg":
-        known = KNOWN["theta0_deg"]
-        description = description or "braid angle from the plane normal to the axis (Kothera's convention)"
-    else:
-        known = KNOWN[name]
-        description = description or known.description
-    param = Parameter(value, unit, source, description, known.lower, known.upper, known.lower_open, known.upper_open)
-    why = param.violation(value)
-    if why:
-        raise fail(key, value, why)
-    return param
+        return KNOWN["theta0_deg"], description or "braid angle from the plane normal to the axis (Kothera's convention)"
+    return KNOWN[name], description or KNOWN[name].description
 
 
 def _convert_radial_angle(fail, entries: dict[str, Parameter]) -> None:

@@ -38,40 +38,85 @@ def read_force_map(path: str | Path) -> tuple[np.ndarray, np.ndarray, np.ndarray
         point, or points that do not form a full grid.
     """
     path = Path(path)
-    try:
-        lines = [ln for ln in path.read_text(encoding="utf-8").splitlines() if ln.strip() and not ln.startswith("#")]
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ForceMapError(f"{path}: cannot read the force map: {exc}") from None
-    reader = csv.DictReader(lines)
+    reader = csv.DictReader(_data_lines(path))
     missing = [c for c in COLUMNS if c not in (reader.fieldnames or [])]
     if missing:
         raise ForceMapError(f"{path}: header = {reader.fieldnames!r}: missing column(s) {', '.join(missing)} "
                             f"(need {', '.join(COLUMNS)})")
+    return _grid(path, _points(path, reader))
+
+
+def _data_lines(path: Path) -> list[str]:
+    """The file's lines that are neither blank nor comments.
+
+    Raises
+    ------
+    ForceMapError
+        A file that cannot be read as UTF-8 text.
+    """
+    try:
+        return [ln for ln in path.read_text(encoding="utf-8").splitlines() if ln.strip() and not ln.startswith("#")]
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ForceMapError(f"{path}: cannot read the force map: {exc}") from None
+
+
+def _points(path: Path, reader: csv.DictReader) -> dict[tuple[float, float], float]:
+    """``{(x_m, p_Pa): F_N}`` of the rows, in the file's order.
+
+    Raises
+    ------
+    ForceMapError
+        A value that is not a finite number, or a point given twice (naming its row).
+    """
     points = {}
-    for n, row in enumerate(reader, start=2):
-        values = []
-        for c in COLUMNS:
-            try:
-                v = float(row[c])
-            except (TypeError, ValueError):
-                raise ForceMapError(f"{path}: row {n}: {c} = {row[c]!r}: not a number") from None
-            if not math.isfinite(v):
-                raise ForceMapError(f"{path}: row {n}: {c} = {row[c]!r}: must be finite")
-            values.append(v)
-        key = (values[0], values[1])
-        if key in points:
-            raise ForceMapError(f"{path}: row {n}: (contraction_m, pressure_gauge_Pa) = {key}: duplicate point")
-        points[key] = values[2]
+    for n, row in enumerate(reader, start=2):  # row 1 is the header
+        x, p, F = (_finite(path, n, row, c) for c in COLUMNS)
+        if (x, p) in points:
+            raise ForceMapError(f"{path}: row {n}: (contraction_m, pressure_gauge_Pa) = {(x, p)}: duplicate point")
+        points[(x, p)] = F
+    return points
+
+
+def _finite(path: Path, n: int, row: dict, column: str) -> float:
+    """Column ``column`` of row ``n`` as a finite number.
+
+    Raises
+    ------
+    ForceMapError
+        A value that is missing, not a number or not finite.
+    """
+    try:
+        v = float(row[column])
+    except (TypeError, ValueError):
+        raise ForceMapError(f"{path}: row {n}: {column} = {row[column]!r}: not a number") from None
+    if not math.isfinite(v):
+        raise ForceMapError(f"{path}: row {n}: {column} = {row[column]!r}: must be finite")
+    return v
+
+
+def _grid(path: Path, points: dict[tuple[float, float], float]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(x_m, p_Pa, F_N)`` of points that form a full grid, the axes ascending.
+
+    Raises
+    ------
+    ForceMapError
+        Fewer than two values along an axis, or a grid point without a value (the first one).
+    """
     xs = np.unique([k[0] for k in points])
     ps = np.unique([k[1] for k in points])
     if len(xs) < 2 or len(ps) < 2:
         raise ForceMapError(f"{path}: grid = {len(xs)} x {len(ps)}: needs at least two contractions and two pressures")
     if len(points) != len(xs) * len(ps):
-        absent = next((x, p) for x in xs for p in ps if (x, p) not in points)
-        raise ForceMapError(f"{path}: (contraction_m, pressure_gauge_Pa) = ({absent[0]:g}, {absent[1]:g}): "
+        x, p = _first_absent(points, xs, ps)
+        raise ForceMapError(f"{path}: (contraction_m, pressure_gauge_Pa) = ({x:g}, {p:g}): "
                             f"missing point (the table must be a full {len(xs)} x {len(ps)} grid)")
     F = np.array([[points[(x, p)] for p in ps] for x in xs])
     return xs, ps, F
+
+
+def _first_absent(points: dict, xs: np.ndarray, ps: np.ndarray) -> tuple[float, float]:
+    """The first grid point, contraction by contraction, that has no value."""
+    return next((x, p) for x in xs for p in ps if (x, p) not in points)
 
 
 class ForceMap(StaticForce):
