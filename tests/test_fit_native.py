@@ -198,17 +198,18 @@ def test_trial_cases_are_the_native_backends_own_cases_with_the_coefficients_cha
 def test_fd_step_is_far_above_the_native_simulation_noise(scenario):
     """The Python test's check of the finite-difference step, on the native backend: the Jacobian
     columns at steps 1e-3 and 3e-3 agree.  Unlike the Python backend's, the native trajectories are
-    smooth in the coefficients down to steps of about 1e-10 (docs/identification.md), so the
-    Jacobian at 1e-9 agrees too: the default step suits both."""
+    smooth in the coefficients down to steps of about 1e-7 at the default tolerance (rtol x 0.01;
+    about 1e-10 at native_rtol_factor 1, docs/identification.md), so the Jacobian at 1e-7 agrees
+    too: the default step suits both."""
     noisy, _ = _traces(scenario, [22.74])[0]
     short = TraceData(noisy.t_s[:1801], noisy.x_m[:1801], noisy.p_gauge_Pa[:1801], 22.74)
     prob = make_problem(scenario, [short], free=FREE)
     trials = make_trials(prob, "native")
     theta = np.array([scenario.parameters[n] for n in FREE])
-    J = {h: _Objective(prob, None, h, trials).jacobian(theta) for h in (1e-3, 3e-3, 1e-9)}
+    J = {h: _Objective(prob, None, h, trials).jacobian(theta) for h in (1e-3, 3e-3, 1e-7)}
     rel = lambda a, b: np.linalg.norm(a - b) / np.linalg.norm(b)  # noqa: E731
     assert rel(J[1e-3], J[3e-3]) < 0.05
-    assert rel(J[1e-9], J[1e-3]) < 0.005
+    assert rel(J[1e-7], J[1e-3]) < 0.005
 
 
 class _CountingExecutor(ThreadPoolExecutor):
