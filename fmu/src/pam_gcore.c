@@ -12,11 +12,31 @@
 
 /* ------------------------------------------------------------ the model's vectors in r[] */
 
+#ifdef PAM_NK
+/* The FMU's parameters are not the model's (PAM_NK knobs: a muscle's parameters, its run-time choices, the
+ * load's mass): the generated map pm_kmap derives the model's from them, as Python does. */
+static void gather_knobs(const PamCore *c, double *k) {
+    int j;
+    for (j = 0; j < PAM_NK; j++) k[j] = PAM_K_INT[j] ? (double)c->i[PAM_K_INDEX[j]] : c->r[PAM_K_INDEX[j]];
+}
+#endif
+
+static void gather_parameters(const PamCore *c, double *p) {
+#ifdef PAM_NK
+    double k[PAM_NK];
+    gather_knobs(c, k);
+    pm_kmap(k, p);
+#else
+    int j;
+    for (j = 0; j < PM_NP; j++) p[j] = c->r[PAM_P_R[j]];
+#endif
+}
+
 static void gather_all(const PamCore *c, double *x, double *u, double *p) {
     int k;
     for (k = 0; k < PM_NS; k++) x[k] = c->r[PAM_STATE_R[k]];
     for (k = 0; k < PM_NU; k++) u[k] = c->r[PAM_U_R[k]];
-    for (k = 0; k < PM_NP; k++) p[k] = c->r[PAM_P_R[k]];
+    gather_parameters(c, p);
 }
 
 static int scheduled(const PamCore *c) {
@@ -38,11 +58,45 @@ void pam_reset(PamCore *c) {
     c->inputs_set = 0;
 }
 
-int pam_check_value(PamCore *c, unsigned vr, double value) { return pam_check_own_range(c, vr, value); }
+#ifdef PAM_NCHECKS
+/* The generated checks (pm_checks: per check 1 if it holds, then the values its message shows), over the
+ * knobs and the inputs; `vr` with `value`: an input about to be set, and only its checks (0: every check
+ * that is not an input's).  -1 (each failure logged) if one fails. */
+static int run_checks(PamCore *c, unsigned vr, double value) {
+    double k[PAM_NK], u[PAM_ARRAY(PM_NU)], out[PAM_NCHECKS + PAM_NCHECK_VALUES];
+    int j, bad = 0;
+    gather_knobs(c, k);
+    for (j = 0; j < PM_NU; j++) u[j] = c->r[PAM_U_R[j]];
+    for (j = 0; j < PAM_NK && vr; j++)
+        if (PAM_K_VR[j] == vr) k[j] = value;
+    for (j = 0; j < PM_NU && vr; j++)
+        if (PAM_U_VR[j] == vr) u[j] = value;
+    pm_checks(k, u, out);
+    for (j = 0; j < PAM_NCHECKS; j++) {
+        const PamCheck *check = &PAM_CHECKS[j];
+        const double *v = out + PAM_NCHECKS + check->first_value;
+        if (check->input_vr != vr || out[j] != 0.0) continue;
+        pam_logf(c, PAM_LOG_ERROR, check->message, v[0], v[1], v[2]);
+        bad = -1;
+    }
+    return bad;
+}
+#endif
+
+int pam_check_value(PamCore *c, unsigned vr, double value) {
+    if (pam_check_own_range(c, vr, value)) return -1;
+#ifdef PAM_NCHECKS
+    if (vr >= 1 && vr <= PAM_NVARS && PAM_VARS[vr - 1].causality == PAM_INPUT) return run_checks(c, vr, value);
+#endif
+    return 0;
+}
 
 int pam_check_parameters(PamCore *c) {
     int bad = 0, k;
     if (pam_check_parameter_ranges(c)) return -1;
+#ifdef PAM_NCHECKS
+    if (run_checks(c, 0, 0.0)) bad = -1;
+#endif
     if (c->i[I_input_source] == PAM_INPUT_SOURCE_SCENARIO && pam_check_signals(c)) bad = -1;
     for (k = 0; k < PAM_NVARS; k++)
         if (PAM_VARS[k].causality == PAM_INPUT && pam_check_value(c, (unsigned)k + 1, c->r[PAM_VARS[k].index])) bad = -1;
@@ -209,12 +263,15 @@ int pam_do_step(PamCore *c, double t_end) {
  * its place in its vector (PAM_DD_INDEX); 0 for a variable that is none of these. */
 static int dd_kind(unsigned vr) { return vr >= 1 && vr <= PAM_NVARS ? PAM_DD_KIND[vr - 1] : PAM_DD_NONE; }
 
-/* The column of a known in [x; u; p]. */
+/* The column of a known in [x; u; p], or for knob j (PAM_NK) JCOLS + j: the map's Jacobian chained in. */
 static int known_column(unsigned vr, int initializing) {
     int kind = dd_kind(vr), at = kind == PAM_DD_NONE ? 0 : PAM_DD_INDEX[vr - 1];
     if (kind == PAM_DD_STATE && !initializing) return at;
     if (kind == PAM_DD_INPUT) return PM_NS + at;
     if (kind == PAM_DD_PARAMETER && initializing) return PM_NS + PM_NU + at;
+    /* A knob that is an input (the load's mass) is known at any time; the others only in initialisation. */
+    if (kind == PAM_DD_KNOB && (initializing || PAM_VARS[vr - 1].causality == PAM_INPUT))
+        return PM_NS + PM_NU + PM_NP + at;
     return -1;
 }
 
@@ -230,23 +287,49 @@ static int unknown_row(unsigned vr) {
 
 #define JROWS (PM_NS + PM_NY)
 #define JCOLS (PM_NS + PM_NU + PM_NP)
+#ifndef PAM_NK
+#define PAM_NK 0
+#endif
+
+/* Column `col` of a Jacobian M with `rows` rows over [(skipped) ; u ; p] whose u starts at column `u0`, at
+ * row `row`: a plain column, or for a knob (col >= JCOLS) the sum over the parameters it maps to. */
+static double column_entry(const double *M, int rows, int u0, int col, int row, const double *JK) {
+    int j;
+    double d = 0.0;
+    if (col < JCOLS) return M[(col - PM_NS + u0) * rows + row];
+    for (j = 0; j < PM_NP; j++) d += M[(u0 + PM_NU + j) * rows + row] * JK[(col - JCOLS) * PM_NP + j];
+    return d;
+}
 
 int pam_directional_derivative(PamCore *c, const unsigned *unknowns, int n_unknowns, const unsigned *knowns,
                                int n_knowns, const double *seed, double *sensitivity, int initializing) {
     double x[PAM_ARRAY(PM_NS)], u[PAM_ARRAY(PM_NU)], p[PAM_ARRAY(PM_NP)], dx0[PAM_ARRAY(PM_NS)];
     double *J = (double *)malloc(sizeof(double) * JROWS * JCOLS), *J0 = NULL;
+    double *JK = (double *)malloc(sizeof(double) * PAM_ARRAY(PM_NP * PAM_NK));
     int k, a, s, status = 0;
-    if (!J) return -1;
+    if (!J || !JK) {
+        free(J);
+        free(JK);
+        return -1;
+    }
     if (initializing) {
         J0 = (double *)malloc(sizeof(double) * PAM_ARRAY(PM_NS * (PM_NU + PM_NP)));
         if (!J0) {
             free(J);
+            free(JK);
             return -1;
         }
     }
     gather_all(c, x, u, p);
     pm_jac(c->mode, x, u, p, J); /* column-major: J[col * JROWS + row] */
     if (initializing) pm_jx0(u, p, J0); /* d x0 / d [u; p], column-major */
+#if PAM_NK > 0
+    {
+        double kn[PAM_NK];
+        gather_knobs(c, kn);
+        pm_jkmap(kn, JK); /* d p / d knobs, column-major */
+    }
+#endif
     for (a = 0; a < n_unknowns; a++) sensitivity[a] = 0.0;
     for (k = 0; k < n_knowns && status == 0; k++) {
         int col = known_column(knowns[k], initializing);
@@ -259,13 +342,13 @@ int pam_directional_derivative(PamCore *c, const unsigned *unknowns, int n_unkno
         if (seed[k] == 0.0) continue;
         /* In initialisation the states follow the parameters and inputs: dx0 = d x0 / d known. */
         for (s = 0; s < PM_NS; s++)
-            dx0[s] = initializing ? J0[(col - PM_NS) * PM_NS + s] : (s == col ? 1.0 : 0.0);
+            dx0[s] = initializing ? column_entry(J0, PM_NS, 0, col, s, JK) : (s == col ? 1.0 : 0.0);
         for (a = 0; a < n_unknowns; a++) {
             int row = unknown_row(unknowns[a]);
             double d = 0.0;
             if (row <= -2) d = dx0[-2 - row];
             else {
-                d = J[col * JROWS + row];
+                d = col < PM_NS ? J[col * JROWS + row] : column_entry(J, JROWS, PM_NS, col, row, JK);
                 for (s = 0; s < PM_NS && initializing; s++) d += J[s * JROWS + row] * dx0[s];
             }
             sensitivity[a] += seed[k] * d;
@@ -273,6 +356,7 @@ int pam_directional_derivative(PamCore *c, const unsigned *unknowns, int n_unkno
     }
     free(J);
     free(J0);
+    free(JK);
     return status;
 }
 

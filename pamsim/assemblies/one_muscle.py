@@ -63,11 +63,21 @@ def one_muscle_assembly(model, x0_m: float = 0.0, p0_gauge_Pa: float | None = No
         "x_high_m": model.stops.x_high_m, "restitution": model.stops.restitution,
         "min_rebound_speed_m_s": model.stops.min_rebound_speed_m_s,
         "stick_margin_N": stick_margin_N, "release_margin_N": release_margin_N, "initial_contraction_m": x0_m})
-    source = _source_parts(model.source, p0_gauge_Pa)
+    return rig_assembly(load, _source_parts(model.source, p0_gauge_Pa),
+                        (MuscleStaticForce("muscle", model.static_force), CoulombFriction("friction", model.friction),
+                         ViscousDamping("damping", model.damping)), added, friction_direction)
+
+
+def rig_assembly(load: HangingLoad, source: "SourceParts", forces: tuple, added: tuple = (),
+                 friction_direction: str = "load.slip_direction", name: str = "one_muscle") -> Assembly:
+    """The rig's assembly from its components: the ``load``, the pressure ``source``'s parts, and
+    ``forces``, the components named ``muscle``, ``friction`` and ``damping`` on the load's flange
+    (any with the ports and variables of :class:`MuscleStaticForce`, :class:`CoulombFriction` and
+    :class:`ViscousDamping`); ``added`` and ``friction_direction`` as :func:`one_muscle_assembly`
+    takes them."""
     parts = [load, *source.parts]
     pressure, wiring, inputs = source.pressure, list(source.wiring), dict(source.inputs)
-    parts += [MuscleStaticForce("muscle", model.static_force), CoulombFriction("friction", model.friction),
-              ViscousDamping("damping", model.damping), ExternalForce("external")]
+    parts += [*forces, ExternalForce("external")]
     # The flange adds the forces in this order, as pamsim always has: static, damping, friction.
     wiring += [("load.flange", "muscle.flange"), ("load.flange", "damping.flange"), ("load.flange", "friction.flange"),
                (f"{pressure}.p_gauge_Pa", "muscle.p_gauge_Pa"), (f"{pressure}.p_gauge_Pa", "friction.p_gauge_Pa"),
@@ -78,7 +88,7 @@ def one_muscle_assembly(model, x0_m: float = 0.0, p0_gauge_Pa: float | None = No
     for extra in added:
         parts.append(extra.component)
         wiring += [(target, f"{extra.component.name}.{own}") for own, target in extra.connect.items()]
-    return Assembly(parts, wiring, inputs, name="one_muscle")
+    return Assembly(parts, wiring, inputs, name=name)
 
 
 VALVE_CHAMBER_WIRING = (("chamber.port", "valve.port"), ("load.x_m", "chamber.x_m"), ("load.v_m_s", "chamber.v_m_s"),

@@ -39,8 +39,9 @@ includes the engine, which includes the generated ``pam_model.c``: one translati
 CORE_HEADER = '#include "pam_gcore.h" /* the generic core: a generated model on the engine */\n'
 OWN_PARAMETERS = ("cs_relative_tolerance", "cs_max_step_s", "cs_max_internal_steps", "input_source")
 """The FMU's own parameters, as the one-muscle FMU declares them."""
-DD_KINDS = ("NONE", "STATE", "DERIVATIVE", "OUTPUT", "INPUT", "PARAMETER")
-"""Where a variable sits in the exact Jacobians (``PAM_DD_KIND`` of ``pam_variables.h``)."""
+DD_KINDS = ("NONE", "STATE", "DERIVATIVE", "OUTPUT", "INPUT", "PARAMETER", "KNOB")
+"""Where a variable sits in the exact Jacobians (``PAM_DD_KIND`` of ``pam_variables.h``); ``KNOB``: an FMU
+parameter that the generated parameter map turns into the model's (:mod:`pamsim.fmu.muscle_fmu`)."""
 
 
 def _real(name, causality, variability, description, unit, **kw) -> Variable:
@@ -124,14 +125,18 @@ class AssemblyVariables:
         flat = self.flat
         c = {v.name: v.c_name for v in self.variables}
         idx = lambda names: ", ".join(f"R_{c[n]}" for n in names) or "0"  # noqa: E731
-        out = ["", "/* The generated model's vectors in r[] (pamsim.fmu.assembly_fmu). */",
-               f"static const int PAM_P_R[{max(1, len(flat.parameters))}] = {{{idx([v.name for v in flat.parameters])}}};",
+        out = ["", "/* The generated model's vectors in r[] (pamsim.fmu.assembly_fmu). */", *self._parameter_lines(idx),
                f"static const int PAM_U_R[{max(1, len(flat.inputs))}] = {{{idx([v.name for v in flat.inputs])}}};",
                f"static const int PAM_Y_R[{max(1, len(flat.outputs))}] = {{"
                + (", ".join(f"R_{c[n]}" if n else "-1" for n in self.y_vars) or "0") + "};",
                f"#define PAM_I_MODE {'I_' + c[self.mode] if self.mode else -1}",
                "enum { " + ", ".join(f"PAM_DD_{k} = {i}" for i, k in enumerate(DD_KINDS)) + " };"]
         return out + self._jacobian_places()
+
+    def _parameter_lines(self, idx) -> list[str]:
+        """Where the model's parameters are in r[] (``idx``: names to a list of r[] indices)."""
+        flat = self.flat
+        return [f"static const int PAM_P_R[{max(1, len(flat.parameters))}] = {{{idx([v.name for v in flat.parameters])}}};"]
 
     def _jacobian_places(self) -> list[str]:
         """``PAM_DD_KIND`` and ``PAM_DD_INDEX``, by value reference: each variable's place in the Jacobians."""

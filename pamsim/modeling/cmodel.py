@@ -55,7 +55,9 @@ class CModel:
     hybrid component is supported; a model without one has a single mode, value 0).
     """
 
-    def __init__(self, assembly, component: str | None = None, jacobians: bool = False):
+    def __init__(self, assembly, component: str | None = None, jacobians: bool = False, extra: tuple = ()):
+        """``extra``: further CasADi Functions (named ``pm_<name>_fn``, one result) generated with the model,
+        each called from C as ``pm_<name>(arg0, ..., out)``."""
         import casadi as ca
 
         full = self.full = _runnable(assembly.flatten(), component)
@@ -74,6 +76,8 @@ class CModel:
         self.functions.append(_dense(ca, "pm_x0_fn", [col(full.u), col(full.p)], [full.x0, full.q0]))
         if jacobians:
             self.functions.append(_jacobian(ca, "pm_jx0_fn", [full.u, full.p], full.x0))
+        self.extra = tuple(extra)
+        self.functions += list(self.extra)
 
     def _add_mode(self, ca, m, k: int) -> None:
         """Mode ``k``'s functions (flat model ``m``, the mode fixed), and whether it is held and its
@@ -180,6 +184,13 @@ class CModel:
                       "    const double *arg[PM_SZ_ARG]; double *res[PM_SZ_RES]; long long iw[PM_SZ_IW]; "
                       "double w[PM_SZ_W];", "    arg[0] = u; arg[1] = p; res[0] = out;",
                       "    pm_jx0_fn(arg, res, iw, w, 0);", "}", ""]
+        for fn in self.extra:
+            n = fn.n_in()
+            params = ", ".join(f"const double *a{i}" for i in range(n))
+            lines += [f"static void {fn.name()[:-3]}({params}, double *out) {{",
+                      "    const double *arg[PM_SZ_ARG]; double *res[PM_SZ_RES]; long long iw[PM_SZ_IW]; double w[PM_SZ_W];",
+                      "    " + " ".join(f"arg[{i}] = a{i};" for i in range(n)) + " res[0] = out;",
+                      f"    {fn.name()}(arg, res, iw, w, 0);", "}", ""]
         return "\n".join(lines)
 
 

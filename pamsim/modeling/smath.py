@@ -32,3 +32,25 @@ def if_else(condition, if_true, if_false):
     if isinstance(condition, (bool, int, float)):
         return if_true if condition else if_false
     return _casadi().if_else(condition, if_true, if_false)
+
+
+def _unary(name: str, doc: str):
+    import math
+
+    fn = getattr(math, name)
+
+    def op(a):
+        return fn(a) if isinstance(a, (int, float)) else getattr(_casadi(), name)(a)
+
+    op.__name__, op.__doc__ = name, doc
+    return op
+
+
+cos = _unary("cos", "``cos(a)`` (radians), on floats (:func:`math.cos`) or symbols.")
+sin = _unary("sin", "``sin(a)`` (radians), on floats (:func:`math.sin`) or symbols.")
+sqrt = _unary("sqrt", "``sqrt(a)``, on floats (:func:`math.sqrt`) or symbols.")
+
+
+def radians(degrees):
+    """``degrees`` in radians, on floats bit for bit as :func:`math.radians` (which multiplies by pi / 180)."""
+    return degrees * (3.141592653589793 / 180.0)

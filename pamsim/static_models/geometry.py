@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from typing import Mapping
 
 from ..core_table import BRAID_LOCK_SEC2
+from ..modeling import smath
 from .base import brentq
 from .real_math import sqrt
 
@@ -43,10 +44,11 @@ class Braid:
     def from_parameters(cls, p: Mapping[str, float]) -> "Braid":
         """The braid of a muscle's ``L0_m``, ``r0_m``, ``theta0_deg`` and ``wall_thickness_m`` (0 if not given)."""
         L0, r0 = p["L0_m"], p["r0_m"]
-        theta0 = math.radians(p["theta0_deg"])
+        # smath: the same numbers on floats, and the geometry on symbols for generated code that derives it.
+        theta0 = smath.radians(p["theta0_deg"])
         t0 = p.get("wall_thickness_m", 0.0)
-        b = L0 / math.cos(theta0)
-        N = b * math.sin(theta0) / (2.0 * math.pi * r0)
+        b = L0 / smath.cos(theta0)
+        N = b * smath.sin(theta0) / (2.0 * math.pi * r0)
         Vb = math.pi * L0 * (r0 ** 2 - (r0 - t0) ** 2)
         return cls(L0, r0, theta0, t0, b, N, Vb)
 
@@ -63,7 +65,7 @@ class Braid:
     @property
     def x_lock_m(self) -> float:
         """Contraction at the Gaylord kinematic limit, where ``3 cos^2(theta) = 1``."""
-        return self.L0 - self.b / math.sqrt(BRAID_LOCK_SEC2)
+        return self.L0 - self.b / smath.sqrt(BRAID_LOCK_SEC2)
 
     def x_jam_m(self, fibre_width_m: float, n_fibres: float) -> float:
         """Contraction [m] at the braid's jam angle, where neighbouring fibres of one helix touch.

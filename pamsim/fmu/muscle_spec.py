@@ -1,0 +1,256 @@
+"""The :class:`~pamsim.fmu.spec.FmuSpec` of the one-muscle FMU generated from components.
+
+Its variables are those of :mod:`pamsim.fmu.variables` (the names, value references, ranges and
+choices it has always had), then the generated model's work integrals and outputs that have no
+name there, under their namespaced names.  Its C core is the generic one (``pam_gcore.c``) with the
+parameter map and the checks of :mod:`pamsim.fmu.muscle_fmu` generated beside the model.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from typing import Any
+
+from .assembly_fmu import CORE_HEADER, SOURCES, AssemblyVariables, _per_s, _real, _token
+from .muscle_fmu import MASS_INPUT, MODE_NAME, OUTPUT_NAMES, STATE_NAMES, knob_map, muscle_assembly
+from .spec import FmuSpec
+from .variables import INPUTS, VARIABLES, value_reference, with_preset
+
+OWN = ("cs_relative_tolerance", "cs_max_step_s", "cs_max_internal_steps", "input_source")
+"""The FMU's own parameters: read by its C core, not the model's."""
+
+
+def knob_names() -> tuple[str, ...]:
+    """The FMU variables the model's parameters are derived from: every parameter but the FMU's own, and the
+    load's mass (an input)."""
+    return tuple(v.name for v in VARIABLES if v.causality == "parameter" and v.name not in OWN) + (MASS_INPUT,)
+
+
+@dataclass(frozen=True)
+class Check:
+    """A condition on the FMU's knobs and inputs, refused with ``message`` (printf, at most three ``%g``-like
+    conversions, of ``values``) where ``holds`` is 0; ``input``: the input it concerns, checked whenever that
+    input is set, or None (checked at the end of initialisation)."""
+
+    holds: Any
+    message: str
+    values: tuple = ()
+    input: str | None = None
+
+
+def checks(k: dict, u: dict, has_table: bool) -> list[Check]:
+    """The one-muscle FMU's checks between its parameters, and of its pressure inputs against the rating."""
+    from ..core_table import ORDER_CHECKS
+    from ..modeling.smath import if_else
+    from ..static_models.geometry import Braid
+
+    x_high = if_else(k["x_high_m"] > 0.0, k["x_high_m"], Braid.from_parameters(k).x_lock_m)
+    rated = k["rated_pressure_gauge_Pa"]
+    out = [Check(k[a] < k[b], f"invalid parameters: {a} = %g: must be below {b} = %g", (k[a], k[b]))
+           for a, b in ORDER_CHECKS]
+    out += [
+        Check(k["release_margin_N"] > k["stick_margin_N"],
+              "invalid parameters: release_margin_N = %g: must be above stick_margin_N = %g",
+              (k["release_margin_N"], k["stick_margin_N"])),
+        Check(k["initial_pressure_gauge_Pa"] <= rated,
+              "invalid parameters: initial_pressure_gauge_Pa = %g: must be at most rated_pressure_gauge_Pa = %g",
+              (k["initial_pressure_gauge_Pa"], rated)),
+        Check((k["x_high_m"] <= 0.0) + (k["x_high_m"] < k["L0_m"]) > 0,
+              "invalid parameters: x_high_m = %g: the upper stop must be below the rest length L0_m = %g "
+              "(x_high_m = 0: the braid lock from the geometry)", (k["x_high_m"], k["L0_m"])),
+        Check((k["initial_contraction_m"] >= 0.0) * (k["initial_contraction_m"] <= x_high) > 0,
+              "invalid parameters: initial_contraction_m = %g: must lie between the stops, 0 and %.4f m "
+              "(the upper stop)", (k["initial_contraction_m"], x_high)),
+    ]
+    if not has_table:
+        out.append(Check(k["static_force_model"] != 1.0, "invalid parameters: static_force_model = 1 (table): this "
+                         "FMU was built without a force table (build it with pamsim fmu build --scenario)"))
+    for name in ("supply_pressure_gauge_Pa", "prescribed_pressure_gauge_Pa"):
+        out.append(Check(u[name] <= rated, f"{name} = %g Pa: exceeds the muscle's rating rated_pressure_gauge_Pa = "
+                         "%g Pa", (u[name], rated), name))
+    out.append(Check(u["prescribed_pressure_gauge_Pa"] >= -k["p_atm_Pa"],
+                     "prescribed_pressure_gauge_Pa = %g Pa: below vacuum", (u["prescribed_pressure_gauge_Pa"],),
+                     "prescribed_pressure_gauge_Pa"))
+    return out
+
+
+def _c_string(text: str) -> str:
+    return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
+
+
+class MuscleVariables(AssemblyVariables):
+    """The one-muscle FMU's variables over the generated model (see the module)."""
+
+    def __init__(self, cmodel, legacy: tuple, knobs: tuple[str, ...], mass_rows: list[bool]):
+        self.cmodel, self.flat = cmodel, cmodel.full
+        flat = cmodel.full
+        self._sparsity = flat.sparsity()
+        self.places = {}
+        self.knobs = knobs
+        self.mass_rows = mass_rows
+        self.names = {**{v.name: v.name for v in flat.inputs}, **STATE_NAMES, **OUTPUT_NAMES}
+        by_name = {v.name: v for v in legacy}
+        for k, name in enumerate(knobs):
+            self.places[name] = ("KNOB", k)
+        for k, v in enumerate(flat.inputs):
+            self.places[v.name] = ("INPUT", k)
+        generated = self._states() + self._derivatives() + self._outputs()
+        rows = [self._declared(v, generated) for v in legacy] + [v for v in generated if v.name not in by_name]
+        self.mode = MODE_NAME
+        self.indicators = tuple(f"event_indicator_{k + 1}" for k in range(len(flat.z)))
+        if len(self.indicators) != 2:
+            raise ValueError(f"the one-muscle FMU has 2 event indicators, the generated model {len(self.indicators)}")
+        self.variables = tuple(rows)
+        pinned = {v.name: value_reference(v.name) for v in legacy}
+        nxt = max(pinned.values())
+        self.value_references = dict(pinned)
+        for v in rows:
+            if v.name not in pinned:
+                nxt += 1
+                self.value_references[v.name] = nxt
+
+    def _name(self, flat_name: str) -> str:
+        return self.names.get(flat_name, flat_name)
+
+    def _declared(self, own, generated):
+        """The one-muscle FMU's own row (its description, range, start), with the dependencies the Jacobians'
+        sparsity gives where the generated model has the variable."""
+        for v in generated:
+            if v.name == own.name and v.depends_on is not None:
+                return replace(own, depends_on=v.depends_on)
+        return own
+
+    def _depends(self, row: int, block_x: str, block_u: str) -> tuple[str, ...]:
+        deps = tuple(self._name(n) for n in super()._depends(row, block_x, block_u))
+        offset = len(self.flat.states) if block_x == "C" else 0
+        return deps + ((MASS_INPUT,) if self.mass_rows[offset + row] else ())
+
+    def _states(self):
+        outputs = {v.name for v in self.flat.outputs}
+        rows = []
+        for k, v in enumerate(self.flat.states):
+            name = self._name(v.name)
+            self.places[name] = ("STATE", k)
+            rows.append(_real(name, "output" if v.name in outputs else "local", "continuous",
+                              f"{v.description} [{v.unit}]", v.unit, initial="calculated", nominal=float(v.nominal),
+                              depends_on=(name,)))
+        return rows
+
+    def _derivatives(self):
+        rows = []
+        for k, v in enumerate(self.flat.states):
+            name = f"der({self._name(v.name)})"
+            self.places[name] = ("DERIVATIVE", k)
+            rows.append(_real(name, "local", "continuous", f"d {v.name} / dt", _per_s(v.unit), initial="calculated",
+                              derivative_of=self._name(v.name), depends_on=self._depends(k, "A", "B")))
+        return rows
+
+    def _outputs(self):
+        flat = self.flat
+        taken = {v.name for v in flat.states} | {v.name for v in flat.parameters}
+        self.y_vars = [None if v.name in taken else self._name(v.name) for v in flat.outputs]
+        rows = []
+        for k, v in enumerate(flat.outputs):
+            if self.y_vars[k] is not None:
+                rows.append(_real(self.y_vars[k], "output", "continuous", f"{v.description} [{v.unit}]", v.unit,
+                                  initial="calculated", depends_on=self._depends(k, "C", "D")))
+                self.places[self.y_vars[k]] = ("OUTPUT", k)
+        return rows
+
+    def _parameter_lines(self, idx) -> list[str]:
+        return self._knob_lines()
+
+    def _knob_lines(self) -> list[str]:
+        c = {v.name: v for v in self.variables}
+        kind = ", ".join("1" if c[n].kind == "integer" else "0" for n in self.knobs)
+        index = ", ".join(f"{'I' if c[n].kind == 'integer' else 'R'}_{c[n].c_name}" for n in self.knobs)
+        return ["", "/* The knobs the generated map derives the model's parameters from (pamsim.fmu.muscle_fmu). */",
+                f"#define PAM_NK {len(self.knobs)}", f"static const int PAM_K_INT[PAM_NK] = {{{kind}}};",
+                f"static const int PAM_K_INDEX[PAM_NK] = {{{index}}};",
+                "static const unsigned PAM_K_VR[PAM_NK] = {"
+                + ", ".join(f"{self.value_references[n]}u" for n in self.knobs) + "};",
+                f"static const unsigned PAM_U_VR[{max(1, len(self.flat.inputs))}] = {{"
+                + ", ".join(f"{self.value_references[v.name]}u" for v in self.flat.inputs) + "};"]
+
+
+def check_lines(found: list[Check], value_references: dict) -> tuple[list[str], int]:
+    """The C table of ``found`` (``PAM_CHECKS``) and the number of values their messages show."""
+    rows, first = [], 0
+    for ch in found:
+        vr = value_references[ch.input] if ch.input else 0
+        rows.append(f"    {{{_c_string(ch.message)}, {first}, {vr}u}},")
+        first += len(ch.values)
+    n_values = first + 3  # room for the three values any message is given
+    return (["", "/* The checks of pm_checks: each message, where its values start, the input it concerns (0: none). */",
+             "typedef struct { const char *message; int first_value; unsigned input_vr; } PamCheck;",
+             f"#define PAM_NCHECKS {len(found)}", f"#define PAM_NCHECK_VALUES {n_values}",
+             f"static const PamCheck PAM_CHECKS[PAM_NCHECKS] = {{"] + rows + ["};"], n_values)
+
+
+def muscle_generated_spec(fmi_version: int = 2, preset=None, static_force=None) -> FmuSpec:
+    """The spec of the one-muscle FMU generated from components, for a ``preset`` (its start values and
+    signals) and with ``static_force`` (the scenario's static force element) as its ``table`` option."""
+    import casadi as ca
+
+    from ..modeling.cmodel import CModel
+
+    legacy = with_preset(VARIABLES, None, None) if preset is None else with_preset(VARIABLES, preset.table, preset)
+    knobs = knob_names()
+    rows = {v.name: v for v in legacy}
+    start = {n: float(rows[n].start) for n in knobs}
+    assembly = muscle_assembly(start, static_force)
+    flat = assembly.flatten()
+    kmap, jkmap = knob_map(knobs, tuple(v.name for v in flat.parameters), start, static_force)
+    ksym = ca.SX.sym("k", len(knobs))
+    usym = ca.SX.sym("u", len(flat.inputs))
+    k = {n: ksym[i] for i, n in enumerate(knobs)}
+    u = {v.name: usym[i] for i, v in enumerate(flat.inputs)}
+    found = checks(k, u, static_force is not None)
+    values = [ca.SX(v) for ch in found for v in ch.values] + [ca.SX(0.0)] * 3
+    check_fn = ca.Function("pm_checks_fn", [ksym, usym], [ca.vertcat(*[ca.SX(ch.holds) for ch in found], *values)])
+    cmodel = CModel(assembly, jacobians=True, extra=(kmap, jkmap, check_fn))
+    p_mass = flat.p[[v.name for v in flat.parameters].index("load.mass_kg")]
+    mass_rows = [bool(ca.depends_on(ca.SX(e), p_mass)) for e in list(flat.f) + list(flat.y)]
+    table = MuscleVariables(cmodel, legacy, knobs, mass_rows)
+    lines, _ = check_lines(found, table.value_references)
+    spec = FmuSpec(table.variables, table.value_references, tuple(table._name(v.name) for v in flat.states),
+                   table.indicators, INPUTS, "pamsim_muscle", "pamsim_muscle", "flat", _description(preset),
+                   SOURCES, {"pam_model.c": cmodel.sources()["pam_model.c"], "pam_fmu_core.h": CORE_HEADER},
+                   tuple(table.c_lines()) + tuple(lines), preset.signals if preset is not None else {},
+                   preset.experiment if preset is not None else None, fmi_version=fmi_version,
+                   included=("pam_engine.c",))
+    return replace(spec, token=_token(spec))
+
+
+def _description(preset) -> str:
+    from .generate import DESCRIPTION
+
+    return DESCRIPTION + " (generated from pamsim's components)" + (f"; built for {preset.built_for}" if preset else "")
+
+
+def build_generated(output_path, fmi_version: int = 2, scenario=None):
+    """Generate, compile and zip the one-muscle FMU from components (its variables as
+    :func:`pamsim.fmu.build` gives them), for ``scenario`` if given (as ``pamsim fmu build --scenario``:
+    its start values and signals, and its static force as the ``table`` option); return its path.
+
+    The FMU built by :func:`pamsim.fmu.build` runs the same model written by hand in C; this one is
+    generated from the components, and the tests hold the two to each other.
+
+    Raises :class:`~pamsim.errors.InputError` for an unknown FMI version, a scenario the FMU cannot carry,
+    a static force without C, a missing compiler or a failed compilation.
+    """
+    from pathlib import Path
+
+    from ..errors import InputError
+    from .build import FMI_VERSIONS, build_spec
+    from .preset import for_scenario
+
+    if fmi_version not in FMI_VERSIONS:
+        raise InputError(f"FMI version must be 2 or 3, not {fmi_version!r}")
+    preset = for_scenario(scenario) if scenario is not None else None
+    static_force = scenario.build_model().static_force if preset is not None and preset.table is not None else None
+    try:
+        spec = muscle_generated_spec(fmi_version, preset, static_force)
+    except NotImplementedError as exc:
+        raise InputError(f"the generated one-muscle FMU needs C for its static force: {exc}") from None
+    return build_spec(Path(output_path), spec)
