@@ -263,19 +263,20 @@ int pam_do_step(PamCore *c, double t_end) {
  * its place in its vector (PAM_DD_INDEX); 0 for a variable that is none of these. */
 static int dd_kind(unsigned vr) { return vr >= 1 && vr <= PAM_NVARS ? PAM_DD_KIND[vr - 1] : PAM_DD_NONE; }
 
-/* The column of a known in [x; u; p], or for knob j (PAM_NK) JCOLS + j: the map's Jacobian chained in. */
-static int known_column(unsigned vr, int initializing) {
+/* Adds `seed` to the entry of the seed vectors (dx, du, dp, dk) that variable `vr` is: a state (outside
+ * initialisation), an input, a parameter (in initialisation) or a knob (in initialisation, or at any time
+ * for an input knob, the load's mass); -1 for any other known. */
+static int add_seed(unsigned vr, double seed, int initializing, double *dx, double *du, double *dp, double *dk) {
     int kind = dd_kind(vr), at = kind == PAM_DD_NONE ? 0 : PAM_DD_INDEX[vr - 1];
-    if (kind == PAM_DD_STATE && !initializing) return at;
-    if (kind == PAM_DD_INPUT) return PM_NS + at;
-    if (kind == PAM_DD_PARAMETER && initializing) return PM_NS + PM_NU + at;
-    /* A knob that is an input (the load's mass) is known at any time; the others only in initialisation. */
-    if (kind == PAM_DD_KNOB && (initializing || PAM_VARS[vr - 1].causality == PAM_INPUT))
-        return PM_NS + PM_NU + PM_NP + at;
-    return -1;
+    if (kind == PAM_DD_STATE && !initializing) dx[at] += seed;
+    else if (kind == PAM_DD_INPUT) du[at] += seed;
+    else if (kind == PAM_DD_PARAMETER && initializing) dp[at] += seed;
+    else if (kind == PAM_DD_KNOB && (initializing || PAM_VARS[vr - 1].causality == PAM_INPUT)) dk[at] += seed;
+    else return -1;
+    return 0;
 }
 
-/* The row of an unknown in [der(x); y], or -2 - k for state k (its own derivative is the identity, or in
+/* The place of an unknown in [der(x); y], or -2 - k for state k (its own derivative is the identity, or in
  * initialisation its initial value's). */
 static int unknown_row(unsigned vr) {
     int kind = dd_kind(vr), at = kind == PAM_DD_NONE ? 0 : PAM_DD_INDEX[vr - 1];
@@ -285,79 +286,39 @@ static int unknown_row(unsigned vr) {
     return -1;
 }
 
-#define JROWS (PM_NS + PM_NY)
-#define JCOLS (PM_NS + PM_NU + PM_NP)
 #ifndef PAM_NK
 #define PAM_NK 0
 #endif
 
-/* Column `col` of a Jacobian M with `rows` rows over [(skipped) ; u ; p] whose u starts at column `u0`, at
- * row `row`: a plain column, or for a knob (col >= JCOLS) the sum over the parameters it maps to. */
-static double column_entry(const double *M, int rows, int u0, int col, int row, const double *JK) {
-    int j;
-    double d = 0.0;
-    if (col < JCOLS) return M[(col - PM_NS + u0) * rows + row];
-    for (j = 0; j < PM_NP; j++) d += M[(u0 + PM_NU + j) * rows + row] * JK[(col - JCOLS) * PM_NP + j];
-    return d;
-}
-
+/* One forward-mode pass of the generated derivatives along the seed the knowns make: in initialisation the
+ * states follow the parameters and inputs (dx = d x0 along the seed), and knobs move the parameters their
+ * map derives. */
 int pam_directional_derivative(PamCore *c, const unsigned *unknowns, int n_unknowns, const unsigned *knowns,
                                int n_knowns, const double *seed, double *sensitivity, int initializing) {
-    double x[PAM_ARRAY(PM_NS)], u[PAM_ARRAY(PM_NU)], p[PAM_ARRAY(PM_NP)], dx0[PAM_ARRAY(PM_NS)];
-    double *J = (double *)malloc(sizeof(double) * JROWS * JCOLS), *J0 = NULL;
-    double *JK = (double *)malloc(sizeof(double) * PAM_ARRAY(PM_NP * PAM_NK));
-    int k, a, s, status = 0;
-    if (!J || !JK) {
-        free(J);
-        free(JK);
-        return -1;
-    }
-    if (initializing) {
-        J0 = (double *)malloc(sizeof(double) * PAM_ARRAY(PM_NS * (PM_NU + PM_NP)));
-        if (!J0) {
-            free(J);
-            free(JK);
-            return -1;
-        }
-    }
+    double x[PAM_ARRAY(PM_NS)], u[PAM_ARRAY(PM_NU)], p[PAM_ARRAY(PM_NP)];
+    double dx[PAM_ARRAY(PM_NS)] = {0}, du[PAM_ARRAY(PM_NU)] = {0}, dp[PAM_ARRAY(PM_NP)] = {0};
+    double dk[PAM_ARRAY(PAM_NK)] = {0}, out[PAM_ARRAY(PM_NS + PM_NY)];
+    int k, a;
+    for (k = 0; k < n_knowns; k++)
+        if (add_seed(knowns[k], seed[k], initializing, dx, du, dp, dk)) return -1;
+    for (a = 0; a < n_unknowns; a++)
+        if (unknown_row(unknowns[a]) == -1) return -1;
     gather_all(c, x, u, p);
-    pm_jac(c->mode, x, u, p, J); /* column-major: J[col * JROWS + row] */
-    if (initializing) pm_jx0(u, p, J0); /* d x0 / d [u; p], column-major */
 #if PAM_NK > 0
     {
-        double kn[PAM_NK];
+        double kn[PAM_NK], dpk[PAM_ARRAY(PM_NP)];
         gather_knobs(c, kn);
-        pm_jkmap(kn, JK); /* d p / d knobs, column-major */
+        pm_dkmap(kn, dk, dpk);
+        for (k = 0; k < PM_NP; k++) dp[k] += dpk[k];
     }
 #endif
-    for (a = 0; a < n_unknowns; a++) sensitivity[a] = 0.0;
-    for (k = 0; k < n_knowns && status == 0; k++) {
-        int col = known_column(knowns[k], initializing);
-        if (col < 0) status = -1;
+    if (initializing) pm_dx0(u, p, du, dp, dx);
+    pm_dir(c->mode, x, u, p, dx, du, dp, out);
+    for (a = 0; a < n_unknowns; a++) {
+        int row = unknown_row(unknowns[a]);
+        sensitivity[a] = row <= -2 ? dx[-2 - row] : out[row];
     }
-    for (a = 0; a < n_unknowns && status == 0; a++)
-        if (unknown_row(unknowns[a]) == -1) status = -1;
-    for (k = 0; k < n_knowns && status == 0; k++) {
-        int col = known_column(knowns[k], initializing);
-        if (seed[k] == 0.0) continue;
-        /* In initialisation the states follow the parameters and inputs: dx0 = d x0 / d known. */
-        for (s = 0; s < PM_NS; s++)
-            dx0[s] = initializing ? column_entry(J0, PM_NS, 0, col, s, JK) : (s == col ? 1.0 : 0.0);
-        for (a = 0; a < n_unknowns; a++) {
-            int row = unknown_row(unknowns[a]);
-            double d = 0.0;
-            if (row <= -2) d = dx0[-2 - row];
-            else {
-                d = col < PM_NS ? J[col * JROWS + row] : column_entry(J, JROWS, PM_NS, col, row, JK);
-                for (s = 0; s < PM_NS && initializing; s++) d += J[s * JROWS + row] * dx0[s];
-            }
-            sensitivity[a] += seed[k] * d;
-        }
-    }
-    free(J);
-    free(J0);
-    free(JK);
-    return status;
+    return 0;
 }
 
 /* ------------------------------------------------------------ FMU state */

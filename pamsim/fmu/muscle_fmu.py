@@ -175,7 +175,7 @@ def component_values(components: Mapping[str, Any], laws: RigLaws, like: RigLaws
 
 def knob_map(knobs: tuple[str, ...], flat_parameters: tuple[str, ...], start: Mapping[str, float], static_force=None):
     """The CasADi Function ``pm_kmap(k) -> p``: the generated model's parameters ``flat_parameters``
-    from the FMU's knobs ``knobs`` (in that order), and its Jacobian ``pm_jkmap(k) -> dp/dk`` (dense)."""
+    from the FMU's knobs ``knobs`` (in that order), and its forward derivative ``pm_dkmap(k, dk) -> dp``."""
     import casadi as ca
 
     sym = {name: ca.SX.sym(name) for name in knobs}
@@ -186,8 +186,9 @@ def knob_map(knobs: tuple[str, ...], flat_parameters: tuple[str, ...], start: Ma
         raise ValueError(f"the parameter map leaves out {missing}")
     k = ca.vertcat(*sym.values())
     p = ca.vertcat(*[ca.SX(values[name]) for name in flat_parameters])
+    dk = ca.SX.sym("dk", k.shape[0])
     return (ca.Function("pm_kmap_fn", [k], [ca.cse(ca.densify(p))]),
-            ca.Function("pm_jkmap_fn", [k], [ca.cse(ca.densify(ca.jacobian(p, k)))]))
+            ca.Function("pm_dkmap_fn", [k, dk], [ca.cse(ca.densify(ca.jtimes(p, k, dk)))]))
 
 
 SOURCE_WIRING = (("chamber.port", "valve.port"), ("load.x_m", "chamber.x_m"), ("pressure.v_chamber_m_s", "chamber.v_m_s"),

@@ -200,7 +200,7 @@ def muscle_generated_spec(fmi_version: int = 2, preset=None, static_force=None) 
     start = {n: float(rows[n].start) for n in knobs}
     assembly = muscle_assembly(start, static_force)
     flat = assembly.flatten()
-    kmap, jkmap = knob_map(knobs, tuple(v.name for v in flat.parameters), start, static_force)
+    kmap, dkmap = knob_map(knobs, tuple(v.name for v in flat.parameters), start, static_force)
     ksym = ca.SX.sym("k", len(knobs))
     usym = ca.SX.sym("u", len(flat.inputs))
     k = {n: ksym[i] for i, n in enumerate(knobs)}
@@ -208,7 +208,7 @@ def muscle_generated_spec(fmi_version: int = 2, preset=None, static_force=None) 
     found = checks(k, u, static_force is not None)
     values = [ca.SX(v) for ch in found for v in ch.values] + [ca.SX(0.0)] * 3
     check_fn = ca.Function("pm_checks_fn", [ksym, usym], [ca.vertcat(*[ca.SX(ch.holds) for ch in found], *values)])
-    cmodel = CModel(assembly, jacobians=True, extra=(kmap, jkmap, check_fn))
+    cmodel = CModel(assembly, jacobians=True, extra=(kmap, dkmap, check_fn))
     p_mass = flat.p[[v.name for v in flat.parameters].index("load.mass_kg")]
     mass_rows = [bool(ca.depends_on(ca.SX(e), p_mass)) for e in list(flat.f) + list(flat.y)]
     table = MuscleVariables(cmodel, legacy, knobs, mass_rows)

@@ -17,10 +17,11 @@ function       arguments                   results
 ``y``          x, u, p                     the outputs (x: every state, quadratures included)
 =============  ==========================  =====================================================
 
-and, once, ``x0(u, p) -> (x, q0)``.  With ``jacobians``, also the exact Jacobians an FMU's directional
-derivatives are taken from: per mode ``jac(x, u, p)``, the derivatives of every state then the outputs
-by every state, input and parameter, and once ``jx0(u, p)``, the initial states by the inputs and
-parameters (dense, column-major).  The integrated states are those that are not quadratures
+and, once, ``x0(u, p) -> (x, q0)``.  With ``jacobians``, also the exact directional derivatives an FMU's
+``getDirectionalDerivative`` returns, in CasADi's forward mode (the code is about the size of the model's,
+where dense Jacobians by every parameter were ten times that and took 30 s to compile): per mode
+``dir(x, u, p, dx, du, dp)``, the derivatives of every state then the outputs along the seed
+``(dx, du, dp)``, and once ``dx0(u, p, du, dp)``, the initial states along ``(du, dp)``.  The integrated states are those that are not quadratures
 (:meth:`pamsim.modeling.flat.FlatModel.quadratures`): the engine computes the quadratures from its
 dense output, outside its error control.  A mode is *held* when the hybrid component's own states do
 not move in it (their derivatives are structurally zero); the engine caps its steps only while
@@ -75,7 +76,7 @@ class CModel:
         col = lambda es: ca.vertcat(*es) if es else ca.SX(0, 1)  # noqa: E731
         self.functions.append(_dense(ca, "pm_x0_fn", [col(full.u), col(full.p)], [full.x0, full.q0]))
         if jacobians:
-            self.functions.append(_jacobian(ca, "pm_jx0_fn", [full.u, full.p], full.x0))
+            self.functions.append(_forward(ca, "pm_dx0_fn", [full.u, full.p], full.x0))
         self.extra = tuple(extra)
         self.functions += list(self.extra)
 
@@ -85,7 +86,7 @@ class CModel:
         own = [i for i, v in enumerate(m.states) if self.component and v.name.startswith(self.component + ".")]
         self.functions += self._mode_functions(ca, m, k)
         if self.jacobians:
-            self.functions.append(_jacobian(ca, f"pm_jac{k}", [m.x, m.u, m.p], m.f + m.y))
+            self.functions.append(_forward(ca, f"pm_dir{k}", [m.x, m.u, m.p], m.f + m.y))
         self.held.append(bool(own) and all(ca.SX(m.f[i]).is_zero() for i in own))
         self.quad_zero.append(all(ca.SX(m.f[i]).is_zero() for i in self.quadratures))
 
@@ -175,15 +176,19 @@ class CModel:
                   "    arg[0] = u; arg[1] = p; res[0] = x; res[1] = q0;",
                   "    pm_x0_fn(arg, res, iw, w, 0);", "}", ""]
         if self.jacobians:
-            lines += ["static void pm_jac(int k, const double *x, const double *u, const double *p, double *out) {",
+            lines += ["static void pm_dir(int k, const double *x, const double *u, const double *p, const double *dx, "
+                      "const double *du, const double *dp, double *out) {",
                       "    const double *arg[PM_SZ_ARG]; double *res[PM_SZ_RES]; long long iw[PM_SZ_IW]; "
-                      "double w[PM_SZ_W];", "    arg[0] = x; arg[1] = u; arg[2] = p; res[0] = out;", "    switch (k) {"]
-            lines += [f"    case {k}: pm_jac{k}(arg, res, iw, w, 0); break;" for k in modes]
+                      "double w[PM_SZ_W];",
+                      "    arg[0] = x; arg[1] = u; arg[2] = p; arg[3] = dx; arg[4] = du; arg[5] = dp; res[0] = out;",
+                      "    switch (k) {"]
+            lines += [f"    case {k}: pm_dir{k}(arg, res, iw, w, 0); break;" for k in modes]
             lines += ["    default: break;", "    }", "}", "",
-                      "static void pm_jx0(const double *u, const double *p, double *out) {",
+                      "static void pm_dx0(const double *u, const double *p, const double *du, const double *dp, "
+                      "double *out) {",
                       "    const double *arg[PM_SZ_ARG]; double *res[PM_SZ_RES]; long long iw[PM_SZ_IW]; "
-                      "double w[PM_SZ_W];", "    arg[0] = u; arg[1] = p; res[0] = out;",
-                      "    pm_jx0_fn(arg, res, iw, w, 0);", "}", ""]
+                      "double w[PM_SZ_W];", "    arg[0] = u; arg[1] = p; arg[2] = du; arg[3] = dp; res[0] = out;",
+                      "    pm_dx0_fn(arg, res, iw, w, 0);", "}", ""]
         for fn in self.extra:
             n = fn.n_in()
             params = ", ".join(f"const double *a{i}" for i in range(n))
@@ -207,12 +212,15 @@ def _runnable(full, component: str | None):
     return full
 
 
-def _jacobian(ca, name: str, wrt: list, exprs: list):
-    """A CasADi Function of ``wrt`` (lists of symbols) giving the dense Jacobian of ``exprs`` by all of them."""
+def _forward(ca, name: str, wrt: list, exprs: list):
+    """A CasADi Function of ``wrt`` (lists of symbols) and one seed per list, giving the derivative of
+    ``exprs`` along the seed (forward mode: the Jacobian times the seed)."""
     col = lambda es: ca.vertcat(*es) if es else ca.SX(0, 1)  # noqa: E731
     args = [col(list(w)) for w in wrt]
-    jac = ca.jacobian(col(list(exprs)), ca.vertcat(*args))
-    return ca.Function(name, args, [ca.cse(ca.densify(jac))])
+    seeds = [ca.SX.sym(f"d{k}", a.shape[0]) for k, a in enumerate(args)]
+    wrt_all, seed_all = ca.vertcat(*args), ca.vertcat(*seeds)
+    out = ca.jtimes(col(list(exprs)), wrt_all, seed_all) if wrt_all.shape[0] else ca.SX.zeros(len(exprs), 1)
+    return ca.Function(name, args + seeds, [ca.cse(ca.densify(out))])
 
 
 def _dense(ca, name: str, args: list, outs: list):
