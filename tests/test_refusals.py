@@ -474,3 +474,30 @@ def test_every_input_is_bound_to_its_source():
     components = _gains("g1", "g2") + [FloatForce("push")]
     sources = Assembly(components, [("g2.u_N", "g1.y_N")], {"u": ("g1.u_N", "push.u_N")})._signal_sources()
     assert sources == {"g2.u_N": ("output", "g1.y_N"), "g1.u_N": ("input", "u"), "push.u_N": ("input", "u")}
+
+
+# ----------------------------------------------------------------------------- pamsim fmu build
+@pytest.mark.parametrize("options, message", [
+    (["--fmi", "4"], "--fmi = '4': must be 2 or 3"),
+    (["--fmi", "2.0"], "--fmi = '2.0': must be 2 or 3"),
+    (["--fmi", "4", "--scenario", "s.toml", "--muscle", "m"], "--fmi = '4': must be 2 or 3"),
+    (["--scenario", "s.toml", "--muscle", "kothera2009_5a"],
+     "--scenario = 's.toml': give either --scenario or --muscle"),
+    (["--scenario", "s.toml", "--static-force", "kothera_energy"],
+     "--scenario = 's.toml': give either --scenario or --muscle"),
+    (["--scenario", "s.toml", "--static-force-variant", "v"],
+     "--scenario = 's.toml': give either --scenario or --muscle"),
+    (["--static-force", "kothera_energy"], "--muscle: needed with --static-force"),
+    (["--static-force-variant", "v"], "--muscle: needed with --static-force-variant"),
+    (["--static-force", "kothera_energy", "--static-force-variant", "v"], "--muscle: needed with --static-force"),
+    (["--generated"], "--generated: needs --scenario (the FMU is generated from the scenario's assembly)"),
+    (["--generated", "--muscle", "kothera2009_5a"],
+     "--generated: needs --scenario (the FMU is generated from the scenario's assembly)"),
+    (["--generated", "--static-force", "kothera_energy"], "--muscle: needed with --static-force"),
+    (["--scenario", "s.toml", "--generated"], "s.toml: no such scenario file"),
+])
+def test_fmu_build_options_that_do_not_go_together_are_refused_with_the_first_named(tmp_path, cli, options,
+                                                                                    message):
+    out = cli("fmu", "build", *options, "-o", tmp_path / "m.fmu")
+    assert (out.returncode, out.stdout, out.stderr) == (2, "", f"pamsim: error: {message}\n")
+    assert not list(tmp_path.iterdir())
