@@ -501,3 +501,44 @@ def test_fmu_build_options_that_do_not_go_together_are_refused_with_the_first_na
     out = cli("fmu", "build", *options, "-o", tmp_path / "m.fmu")
     assert (out.returncode, out.stdout, out.stderr) == (2, "", f"pamsim: error: {message}\n")
     assert not list(tmp_path.iterdir())
+
+
+# ----------------------------------------------------------------------------- identification measurement files
+@pytest.mark.parametrize("content, message", [
+    (None, "cannot read it: No such file or directory"),
+    ("folder", "cannot read it: Is a directory"),
+    ("p_bar,x_mm,weight_N\n1,2,\xe9\n".encode("latin-1"), "not a text (UTF-8) CSV file"),
+    ("", "no header row (the file is empty or only comments)"),
+    ("# only\n\n   \n# comments\n", "no header row (the file is empty or only comments)"),
+    ("p_bar,x_mm,weight_N\n# no rows\n\n", "no data rows below the header"),
+    ("p_bar,x_mm,weight_N\n1,2,3\n# c\n4,5\n", "line 4 has 2 fields, the header has 3"),
+    ("p_bar,x_mm,weight_N\n1,2,3,4\n", "line 2 has 4 fields, the header has 3"),
+    ("p_bar,x_mm,weight_N\n1,2,3\n4, five ,6\n", "line 3: value 'five' is not a number"),
+    ("p_bar,x_mm,weight_N\n1,,3\n", "line 2: value '' is not a number"),
+    ("p_bar,x_mm,weight_N\n1,x,3,4\n", "line 2 has 4 fields, the header has 3"),  # the count is checked first
+])
+def test_a_measurement_file_that_is_not_a_numeric_csv_is_refused_naming_file_and_line(tmp_path, content, message):
+    from pamsim.identification.columns import DataError, read_static_data
+
+    path = tmp_path / "static.csv"
+    if content == "folder":
+        path.mkdir()
+    elif isinstance(content, bytes):
+        path.write_bytes(content)
+    elif content is not None:
+        path.write_text(content)
+    with pytest.raises(DataError) as err:
+        read_static_data(path)
+    assert _message(err, tmp_path) == f"TMP/static.csv: {message}"
+
+
+def test_a_measurement_file_skips_blank_and_comment_lines_and_hashes_its_bytes(tmp_path):
+    import hashlib
+
+    from pamsim.identification.columns import read_static_data
+
+    text = "# tests\n\np_bar , x_mm,weight_N\n# first\n1,2,3\n\n  \n2 , 4,5\n"
+    (tmp_path / "static.csv").write_text(text)
+    data = read_static_data(tmp_path / "static.csv")
+    assert data.pressure_gauge_Pa.tolist() == [1e5, 2e5] and data.contraction_m.tolist() == [2e-3, 4e-3]
+    assert data.load_N.tolist() == [3.0, 5.0] and data.sha256 == hashlib.sha256(text.encode()).hexdigest()
