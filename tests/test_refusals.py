@@ -1,11 +1,12 @@
 """Bad input is refused with the one-line message that names the key and the value, and the first of two
 mistakes is the one reported.
 
-The tables hold the exact messages (the scenario's ``[controller]``, the RL environment's arguments, a
-force-map CSV, ``pamsim atlas``'s muscle, models and pressures, a measured-point file, a muscle file and its
-parameter entries, a signal table, a trace CSV and an assembly's signal wiring), so a change in what is checked, in which order, or in how it is said fails here.  The
-messages are those that were given before the checks were split into small functions; the other test files
-check parts of most of them.
+The tables hold the exact messages (the scenario's ``[controller]``, the RL environment's arguments, a force-map
+CSV, ``pamsim atlas``'s muscle, models and pressures, a measured-point file, a muscle file and its parameter
+entries, a signal table, a trace CSV, an assembly's signal wiring, ``pamsim fmu build``'s options, an
+identification measurement file and an uncertainty study's distribution), so a change in what is checked, in which
+order, or in how it is said fails here. The messages are those that were given before the checks were split into
+small functions; the other test files check parts of most of them.
 """
 
 from __future__ import annotations
@@ -542,3 +543,38 @@ def test_a_measurement_file_skips_blank_and_comment_lines_and_hashes_its_bytes(t
     data = read_static_data(tmp_path / "static.csv")
     assert data.pressure_gauge_Pa.tolist() == [1e5, 2e5] and data.contraction_m.tolist() == [2e-3, 4e-3]
     assert data.load_N.tolist() == [3.0, 5.0] and data.sha256 == hashlib.sha256(text.encode()).hexdigest()
+
+
+# ----------------------------------------------------------------------------- [uncertainty.parameters.NAME]
+_LOGNORMAL = {"distribution": "lognormal", "median": 0.3, "sigma": 0.25, "lower": 0.2, "upper": 0.6}
+_UNIFORM = {"distribution": "uniform", "lower": 2.0, "upper": 3.0}
+
+
+@pytest.mark.parametrize("name, entry, message", [
+    ("valve_b", {**_LOGNORMAL, "median": 0.0}, "valve_b.median = 0.0: must be positive"),
+    ("valve_b", {**_LOGNORMAL, "sigma": -0.1}, "valve_b.sigma = -0.1: must be positive"),
+    ("valve_b", {**_LOGNORMAL, "median": -0.3, "sigma": -1.0}, "valve_b.sigma = -1.0: must be positive"),
+    ("valve_b", {**_LOGNORMAL, "std": 1.0},
+     "valve_b.std = 1.0: does not apply to a lognormal distribution (it takes lower, median, relative, sigma, upper)"),
+    ("N0_N_per_bar", {**_UNIFORM, "relative": "yes"},
+     "N0_N_per_bar.relative = 'yes': must be true or false, not a string"),
+    ("N0_N_per_bar", {**_UNIFORM, "relative": "yes", "upper": 1.0},  # relative is read before the bounds
+     "N0_N_per_bar.relative = 'yes': must be true or false, not a string"),
+    ("N0_N_per_bar", {**_UNIFORM, "upper": 2.0}, "N0_N_per_bar.upper = 2.0: must be above lower = 2"),
+    ("stop_restitution", {**_UNIFORM, "relative": True, "lower": 0.9, "upper": 1.1},
+     "stop_restitution.relative = True: the base value is 0, so a factor cannot vary it"),
+    ("N1_N_per_bar_m", {**_LOGNORMAL, "lower": -3.0, "upper": -1.0},
+     "N1_N_per_bar_m.lower = -3.0: the bounds [-3, -1] exclude the lognormal distribution (probability inside 0)"),
+    ("valve_b", {"distribution": "uniform", "relative": True, "lower": 0.5, "upper": 5.0},
+     "valve_b.upper = 5.0: gives valve_b = 1.5, which must lie in [0, 1)"),
+    ("valve_b", {"distribution": "uniform", "lower": -1.0, "upper": 2.0},
+     "valve_b.lower = -1.0: gives valve_b = -1, which must lie in [0, 1)"),
+])
+def test_a_bad_uncertainty_distribution_is_refused_with_its_first_mistake(name, entry, message):
+    from pamsim.sweep import SweepError, sweep_from_dict
+
+    table = {"samples": 5, "seed": 1, "parameters": {name: entry}}
+    with pytest.raises(SweepError) as err:
+        sweep_from_dict({"base_scenario": str(SCENARIOS / "acra2012_fig4.toml"), "uncertainty": table},
+                        origin="study.toml")
+    assert _message(err) == f"study.toml: uncertainty.parameters.{message}"
