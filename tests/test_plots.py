@@ -249,3 +249,41 @@ def test_the_sweeps_time_responses_mark_the_measured_end_of_each_paper_test():
     # fig4 with a spring added names no measured test: nothing measured is drawn for it
     assert not [ln for ln in panels["parallel_spring"].get_lines() if ln.get_label().startswith("measured")]
     assert "the final contraction only" in fig._suptitle.get_text()
+
+
+def _fake_sweep(runs: dict):
+    """A sweep result with the given time responses ``{scenario: {friction: run output}}``, none measured."""
+    scenarios = [SimpleNamespace(name=n, measured_steady_state=lambda: None) for n in runs]
+    return SimpleNamespace(responses=runs, spec=SimpleNamespace(time_responses=scenarios))
+
+
+def _response(scale: float) -> dict:
+    t = np.linspace(0.0, 2.0, 5)
+    return {"error": "", "t_s": t, "x_m": scale * t * 1e-3, "p_gauge_Pa": scale * t * 1e5}
+
+
+def test_time_responses_say_which_runs_failed_and_take_the_pressure_from_the_first_that_did_not():
+    from pamsim.sweep.plots import time_responses_figure
+
+    fig = time_responses_figure(_fake_sweep({
+        "a": {"load_dependent": {"error": "boom"}, "constant": _response(2.0)},
+        "b": {"load_dependent": _response(1.0), "constant": _response(3.0)},
+        "c": {"load_dependent": {"error": "boom"}, "constant": {"error": "lost: worker gone"}}}))
+    grid, twins = fig.axes[:4], fig.axes[4:]
+    assert [ax.get_title() for ax in grid] == ["a", "b", "c", ""] and not grid[3].axison  # 3 panels on 2 x 2
+    assert [ax.get_xlabel() for ax in grid[:3]] == ["", "time [s]", "time [s]"]  # the bottom panel of each column
+    assert [[t.get_text() for t in ax.texts] for ax in grid[:3]] == [
+        ["load_dependent: failed"], [], ["load_dependent: failed", "constant: failed"]]
+    assert [list(_labelled(ax)) for ax in grid[:3]] == [["constant friction"],
+                                                        ["load_dependent friction", "constant friction"], []]
+    pressures = [[line.get_ydata().tolist() for line in ax.get_lines()] for ax in twins]
+    assert pressures == [[(2.0 * np.linspace(0.0, 2.0, 5)).tolist()], [np.linspace(0.0, 2.0, 5).tolist()], []]
+    assert "measured" not in fig._suptitle.get_text()
+
+
+def test_a_sweep_without_time_responses_draws_a_figure_that_says_so():
+    from pamsim.sweep.plots import time_responses_figure
+
+    fig = time_responses_figure(_fake_sweep({}))
+    assert [t.get_text() for t in fig.axes[0].texts] == ["no [time_responses] in the sweep file"]
+    assert not fig.axes[0].axison and fig._suptitle is None
