@@ -80,39 +80,64 @@ def result_figure(result: "Result", title: str | None = None, compare: "list[Res
     """
     fig = Figure(figsize=(9, 9), constrained_layout=True)
     ax_x, ax_p, ax_f = fig.subplots(3, 1, sharex=True)
+    _contraction_panel(ax_x, result, compare or [], measured)
+    _pressure_panel(ax_p, result, measured)
+    _force_panel(ax_f, result)
+    fig.suptitle(_result_title(result, title, backend, measured))
+    return fig
+
+
+def _contraction_panel(ax, result: "Result", compare: "list[Result]", measured) -> None:
+    """The contraction over the held time's shading, the compared results' and the measured end, if any."""
+    shade_held(ax, result.t_s, result.mode)
+    ax.plot(result.t_s, result.x_m * 1e3, **series(0, "k"), label=result.name)
+    for k, other in enumerate(compare, start=1):
+        ax.plot(other.t_s, other.x_m * 1e3, **series(k, f"C{k - 1}"), label=other.name)
+    if measured is not None:
+        draw_measured(ax, measured, measured.contraction_mm, measured_labels(measured)[0])
+    ax.set_ylabel(X_LABEL)
+    ax.legend(loc="lower right", fontsize=8)
+    ax.grid(alpha=0.3)
+
+
+def _pressure_panel(ax, result: "Result", measured) -> None:
+    """The muscle's pressure, the supply's where the run has one, and the measured stable pressure, if any."""
     t = result.t_s
-    shade_held(ax_x, t, result.mode)
-    ax_x.plot(t, result.x_m * 1e3, **series(0, "k"), label=result.name)
-    for k, other in enumerate(compare or [], start=1):
-        ax_x.plot(other.t_s, other.x_m * 1e3, **series(k, f"C{k - 1}"), label=other.name)
-    if measured is not None:
-        draw_measured(ax_x, measured, measured.contraction_mm, measured_labels(measured)[0])
-    ax_x.set_ylabel(X_LABEL)
-    ax_x.legend(loc="lower right", fontsize=8)
-    ax_x.grid(alpha=0.3)
-
-    ax_p.plot(t, result.p_gauge_Pa / PA_PER_BAR, **series(0, "C3"), label="muscle")
+    ax.plot(t, result.p_gauge_Pa / PA_PER_BAR, **series(0, "C3"), label="muscle")
     if "supply_gauge_Pa" in result.signals:
-        ax_p.plot(t, result.signals["supply_gauge_Pa"] / PA_PER_BAR, **series(3, "k"), label="supply")
+        ax.plot(t, result.signals["supply_gauge_Pa"] / PA_PER_BAR, **series(3, "k"), label="supply")
     if measured is not None:
-        draw_measured(ax_p, measured, measured.pressure_stable_bar, measured_labels(measured)[1])
-    ax_p.set_ylabel("gauge pressure [bar]")
-    ax_p.legend(loc="lower right", fontsize=8)
-    ax_p.grid(alpha=0.3)
+        draw_measured(ax, measured, measured.pressure_stable_bar, measured_labels(measured)[1])
+    ax.set_ylabel("gauge pressure [bar]")
+    ax.legend(loc="lower right", fontsize=8)
+    ax.grid(alpha=0.3)
 
+
+def _force_panel(ax, result: "Result") -> None:
+    """The forces on the load: each of the rig's that is ever nonzero in its own style, then those of the
+    components added to the rig."""
+    t = result.t_s
     for key, (label, style) in FORCE_STYLE.items():
         values = result.signals[key]
         if np.any(values != 0.0):
-            ax_f.plot(t, values, label=label, lw=1, **style)
-    # the forces of components added to the rig: their namespaced F_ outputs
-    added = [k for k in result.signals if "." in k and k.split(".", 1)[1].startswith("F_")]
-    for k, key in enumerate(added, start=len(FORCE_STYLE)):
-        ax_f.plot(t, result.signals[key], label=key.split(".", 1)[0], lw=1, **series(k, f"C{k % 10}"))
-    ax_f.axhline(0.0, color="k", lw=0.5)
-    ax_f.set_ylabel(F_LABEL)
-    ax_f.set_xlabel("time [s]")
-    ax_f.legend(loc="upper right", fontsize=8, ncol=3)
-    ax_f.grid(alpha=0.3)
+            ax.plot(t, values, label=label, lw=1, **style)
+    for k, key in enumerate(_added_forces(result.signals), start=len(FORCE_STYLE)):
+        ax.plot(t, result.signals[key], label=key.split(".", 1)[0], lw=1, **series(k, f"C{k % 10}"))
+    ax.axhline(0.0, color="k", lw=0.5)
+    ax.set_ylabel(F_LABEL)
+    ax.set_xlabel("time [s]")
+    ax.legend(loc="upper right", fontsize=8, ncol=3)
+    ax.grid(alpha=0.3)
+
+
+def _added_forces(signals) -> list[str]:
+    """The forces of components added to the rig: their namespaced ``F_`` outputs (``spring.F_spring_N``)."""
+    return [k for k in signals if "." in k and k.split(".", 1)[1].startswith("F_")]
+
+
+def _result_title(result: "Result", title: str | None, backend: str, measured) -> str:
+    """``title``, or the run's name, load and final pressure with the backend if not Python; then the notes on a
+    measured end and on the damping's energy, if any."""
     default = (f"{result.name}: {result.mass_kg * result.g_m_s2:.2f} N hanging weight "
                f"({result.mass_kg:.3f} kg), {result.p_gauge_Pa[-1] / PA_PER_BAR:.2f} bar at the end")
     if backend != "python":
@@ -121,8 +146,7 @@ def result_figure(result: "Result", title: str | None = None, compare: "list[Res
     notes = [measured_note(measured)] if measured is not None else []
     notes += [result.damping_energy_note()]
     note = "\n".join(textwrap.fill(n, 90) for n in notes if n)  # the figure is about 90 title characters wide
-    fig.suptitle((title or default) + (f"\n{note}" if note else ""))
-    return fig
+    return (title or default) + (f"\n{note}" if note else "")
 
 
 def plot_result(result: "Result", path=None, dpi: int | None = None, **kwargs) -> Figure:

@@ -70,6 +70,53 @@ def test_backend_is_named_in_the_title_of_non_python_runs(fig4_and_pulled):
     assert "backend" not in ScenarioRun(res, "python").figure()._suptitle.get_text()
 
 
+@pytest.fixture(scope="module")
+def short_runs():
+    """fig4 (a valve: the run has a supply pressure) cut to 2 s, the same with a prescribed pressure (no supply),
+    and the parallel spring (a component added to the rig)."""
+    fig4 = pamsim.load_scenario(SCENARIOS / "acra2012_fig4.toml").with_changes({"simulation": {"duration_s": 2.0}})
+    spec = dict(fig4.spec)
+    spec["pressure"] = {"source": "prescribed", "prescribed": {"kind": "lag", "time_s": 1.0, "tau_s": 0.05,
+                                                               "final_gauge_bar": 3.0}}
+    prescribed = pamsim.Scenario.from_dict(spec, name="prescribed", origin="test")
+    spring = pamsim.load_scenario(SCENARIOS / "parallel_spring.toml").with_changes({"simulation": {"duration_s": 2.0}})
+    return pamsim.simulate(fig4), pamsim.simulate(prescribed), pamsim.simulate(spring)
+
+
+def _labelled(ax) -> dict:
+    return {line.get_label(): line for line in ax.get_lines() if not line.get_label().startswith("_")}
+
+
+def test_the_supply_pressure_is_drawn_only_for_a_run_that_has_one(short_runs):
+    valve, prescribed, _ = short_runs
+    lines = _labelled(result_figure(valve).axes[1])
+    assert list(lines) == ["muscle", "supply"]
+    assert np.array_equal(lines["supply"].get_ydata(), valve.signals["supply_gauge_Pa"] / 1e5)
+    assert np.array_equal(lines["muscle"].get_ydata(), valve.p_gauge_Pa / 1e5)
+    assert "supply_gauge_Pa" not in prescribed.signals
+    assert list(_labelled(result_figure(prescribed).axes[1])) == ["muscle"]
+
+
+def test_an_added_components_force_is_drawn_under_its_name_after_the_rigs(short_runs):
+    spring = short_runs[2]
+    lines = _labelled(result_figure(spring).axes[2])
+    assert list(lines)[-1] == "spring" and "spring" not in _labelled(result_figure(short_runs[0]).axes[2])
+    assert np.array_equal(lines["spring"].get_ydata(), spring.signals["spring.F_spring_N"])
+    rig = {(ln.get_color(), ln.get_linestyle()) for label, ln in lines.items() if label != "spring"}
+    assert (lines["spring"].get_color(), lines["spring"].get_linestyle()) not in rig
+
+
+def test_compared_runs_are_overlaid_by_name_and_a_title_replaces_only_the_first_line(short_runs):
+    valve, prescribed, spring = short_runs
+    fig = result_figure(valve, title="my title", compare=[prescribed, spring])
+    lines = _labelled(fig.axes[0])
+    assert list(lines) == [valve.name, "prescribed", spring.name]
+    assert np.array_equal(lines["prescribed"].get_ydata(), prescribed.x_m * 1e3)
+    caption = fig._suptitle.get_text()
+    assert caption.startswith("my title\n") and "damping added" in caption  # the damping note is kept
+    assert "hanging weight" not in caption and "hanging weight" in result_figure(valve)._suptitle.get_text()
+
+
 # ---------------------------------------------------------------- the paper's measured points
 def _measured_lines(fig) -> dict[str, list]:
     """{axes y label: the lines labelled "measured ..."} of a run's figure."""
@@ -202,3 +249,41 @@ def test_the_sweeps_time_responses_mark_the_measured_end_of_each_paper_test():
     # fig4 with a spring added names no measured test: nothing measured is drawn for it
     assert not [ln for ln in panels["parallel_spring"].get_lines() if ln.get_label().startswith("measured")]
     assert "the final contraction only" in fig._suptitle.get_text()
+
+
+def _fake_sweep(runs: dict):
+    """A sweep result with the given time responses ``{scenario: {friction: run output}}``, none measured."""
+    scenarios = [SimpleNamespace(name=n, measured_steady_state=lambda: None) for n in runs]
+    return SimpleNamespace(responses=runs, spec=SimpleNamespace(time_responses=scenarios))
+
+
+def _response(scale: float) -> dict:
+    t = np.linspace(0.0, 2.0, 5)
+    return {"error": "", "t_s": t, "x_m": scale * t * 1e-3, "p_gauge_Pa": scale * t * 1e5}
+
+
+def test_time_responses_say_which_runs_failed_and_take_the_pressure_from_the_first_that_did_not():
+    from pamsim.sweep.plots import time_responses_figure
+
+    fig = time_responses_figure(_fake_sweep({
+        "a": {"load_dependent": {"error": "boom"}, "constant": _response(2.0)},
+        "b": {"load_dependent": _response(1.0), "constant": _response(3.0)},
+        "c": {"load_dependent": {"error": "boom"}, "constant": {"error": "lost: worker gone"}}}))
+    grid, twins = fig.axes[:4], fig.axes[4:]
+    assert [ax.get_title() for ax in grid] == ["a", "b", "c", ""] and not grid[3].axison  # 3 panels on 2 x 2
+    assert [ax.get_xlabel() for ax in grid[:3]] == ["", "time [s]", "time [s]"]  # the bottom panel of each column
+    assert [[t.get_text() for t in ax.texts] for ax in grid[:3]] == [
+        ["load_dependent: failed"], [], ["load_dependent: failed", "constant: failed"]]
+    assert [list(_labelled(ax)) for ax in grid[:3]] == [["constant friction"],
+                                                        ["load_dependent friction", "constant friction"], []]
+    pressures = [[line.get_ydata().tolist() for line in ax.get_lines()] for ax in twins]
+    assert pressures == [[(2.0 * np.linspace(0.0, 2.0, 5)).tolist()], [np.linspace(0.0, 2.0, 5).tolist()], []]
+    assert "measured" not in fig._suptitle.get_text()
+
+
+def test_a_sweep_without_time_responses_draws_a_figure_that_says_so():
+    from pamsim.sweep.plots import time_responses_figure
+
+    fig = time_responses_figure(_fake_sweep({}))
+    assert [t.get_text() for t in fig.axes[0].texts] == ["no [time_responses] in the sweep file"]
+    assert not fig.axes[0].axison and fig._suptitle is None

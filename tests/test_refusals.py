@@ -1,11 +1,12 @@
 """Bad input is refused with the one-line message that names the key and the value, and the first of two
 mistakes is the one reported.
 
-The tables hold the exact messages (the scenario's ``[controller]``, the RL environment's arguments, a
-force-map CSV, ``pamsim atlas``'s muscle, models and pressures, a measured-point file, a muscle file and its
-parameter entries, a signal table, a trace CSV and an assembly's signal wiring), so a change in what is checked, in which order, or in how it is said fails here.  The
-messages are those that were given before the checks were split into small functions; the other test files
-check parts of most of them.
+The tables hold the exact messages (the scenario's ``[controller]``, the RL environment's arguments, a force-map
+CSV, ``pamsim atlas``'s muscle, models and pressures, a measured-point file, a muscle file and its parameter
+entries, a signal table, a trace CSV, an assembly's signal wiring, ``pamsim fmu build``'s options, an
+identification measurement file and an uncertainty study's distribution), so a change in what is checked, in which
+order, or in how it is said fails here. The messages are those that were given before the checks were split into
+small functions; the other test files check parts of most of them.
 """
 
 from __future__ import annotations
@@ -474,3 +475,106 @@ def test_every_input_is_bound_to_its_source():
     components = _gains("g1", "g2") + [FloatForce("push")]
     sources = Assembly(components, [("g2.u_N", "g1.y_N")], {"u": ("g1.u_N", "push.u_N")})._signal_sources()
     assert sources == {"g2.u_N": ("output", "g1.y_N"), "g1.u_N": ("input", "u"), "push.u_N": ("input", "u")}
+
+
+# ----------------------------------------------------------------------------- pamsim fmu build
+@pytest.mark.parametrize("options, message", [
+    (["--fmi", "4"], "--fmi = '4': must be 2 or 3"),
+    (["--fmi", "2.0"], "--fmi = '2.0': must be 2 or 3"),
+    (["--fmi", "4", "--scenario", "s.toml", "--muscle", "m"], "--fmi = '4': must be 2 or 3"),
+    (["--scenario", "s.toml", "--muscle", "kothera2009_5a"],
+     "--scenario = 's.toml': give either --scenario or --muscle"),
+    (["--scenario", "s.toml", "--static-force", "kothera_energy"],
+     "--scenario = 's.toml': give either --scenario or --muscle"),
+    (["--scenario", "s.toml", "--static-force-variant", "v"],
+     "--scenario = 's.toml': give either --scenario or --muscle"),
+    (["--static-force", "kothera_energy"], "--muscle: needed with --static-force"),
+    (["--static-force-variant", "v"], "--muscle: needed with --static-force-variant"),
+    (["--static-force", "kothera_energy", "--static-force-variant", "v"], "--muscle: needed with --static-force"),
+    (["--generated"], "--generated: needs --scenario (the FMU is generated from the scenario's assembly)"),
+    (["--generated", "--muscle", "kothera2009_5a"],
+     "--generated: needs --scenario (the FMU is generated from the scenario's assembly)"),
+    (["--generated", "--static-force", "kothera_energy"], "--muscle: needed with --static-force"),
+    (["--scenario", "s.toml", "--generated"], "s.toml: no such scenario file"),
+])
+def test_fmu_build_options_that_do_not_go_together_are_refused_with_the_first_named(tmp_path, cli, options,
+                                                                                    message):
+    out = cli("fmu", "build", *options, "-o", tmp_path / "m.fmu")
+    assert (out.returncode, out.stdout, out.stderr) == (2, "", f"pamsim: error: {message}\n")
+    assert not list(tmp_path.iterdir())
+
+
+# ----------------------------------------------------------------------------- identification measurement files
+@pytest.mark.parametrize("content, message", [
+    (None, "cannot read it: No such file or directory"),
+    ("folder", "cannot read it: Is a directory"),
+    ("p_bar,x_mm,weight_N\n1,2,\xe9\n".encode("latin-1"), "not a text (UTF-8) CSV file"),
+    ("", "no header row (the file is empty or only comments)"),
+    ("# only\n\n   \n# comments\n", "no header row (the file is empty or only comments)"),
+    ("p_bar,x_mm,weight_N\n# no rows\n\n", "no data rows below the header"),
+    ("p_bar,x_mm,weight_N\n1,2,3\n# c\n4,5\n", "line 4 has 2 fields, the header has 3"),
+    ("p_bar,x_mm,weight_N\n1,2,3,4\n", "line 2 has 4 fields, the header has 3"),
+    ("p_bar,x_mm,weight_N\n1,2,3\n4, five ,6\n", "line 3: value 'five' is not a number"),
+    ("p_bar,x_mm,weight_N\n1,,3\n", "line 2: value '' is not a number"),
+    ("p_bar,x_mm,weight_N\n1,x,3,4\n", "line 2 has 4 fields, the header has 3"),  # the count is checked first
+])
+def test_a_measurement_file_that_is_not_a_numeric_csv_is_refused_naming_file_and_line(tmp_path, content, message):
+    from pamsim.identification.columns import DataError, read_static_data
+
+    path = tmp_path / "static.csv"
+    if content == "folder":
+        path.mkdir()
+    elif isinstance(content, bytes):
+        path.write_bytes(content)
+    elif content is not None:
+        path.write_text(content)
+    with pytest.raises(DataError) as err:
+        read_static_data(path)
+    assert _message(err, tmp_path) == f"TMP/static.csv: {message}"
+
+
+def test_a_measurement_file_skips_blank_and_comment_lines_and_hashes_its_bytes(tmp_path):
+    import hashlib
+
+    from pamsim.identification.columns import read_static_data
+
+    text = "# tests\n\np_bar , x_mm,weight_N\n# first\n1,2,3\n\n  \n2 , 4,5\n"
+    (tmp_path / "static.csv").write_text(text)
+    data = read_static_data(tmp_path / "static.csv")
+    assert data.pressure_gauge_Pa.tolist() == [1e5, 2e5] and data.contraction_m.tolist() == [2e-3, 4e-3]
+    assert data.load_N.tolist() == [3.0, 5.0] and data.sha256 == hashlib.sha256(text.encode()).hexdigest()
+
+
+# ----------------------------------------------------------------------------- [uncertainty.parameters.NAME]
+_LOGNORMAL = {"distribution": "lognormal", "median": 0.3, "sigma": 0.25, "lower": 0.2, "upper": 0.6}
+_UNIFORM = {"distribution": "uniform", "lower": 2.0, "upper": 3.0}
+
+
+@pytest.mark.parametrize("name, entry, message", [
+    ("valve_b", {**_LOGNORMAL, "median": 0.0}, "valve_b.median = 0.0: must be positive"),
+    ("valve_b", {**_LOGNORMAL, "sigma": -0.1}, "valve_b.sigma = -0.1: must be positive"),
+    ("valve_b", {**_LOGNORMAL, "median": -0.3, "sigma": -1.0}, "valve_b.sigma = -1.0: must be positive"),
+    ("valve_b", {**_LOGNORMAL, "std": 1.0},
+     "valve_b.std = 1.0: does not apply to a lognormal distribution (it takes lower, median, relative, sigma, upper)"),
+    ("N0_N_per_bar", {**_UNIFORM, "relative": "yes"},
+     "N0_N_per_bar.relative = 'yes': must be true or false, not a string"),
+    ("N0_N_per_bar", {**_UNIFORM, "relative": "yes", "upper": 1.0},  # relative is read before the bounds
+     "N0_N_per_bar.relative = 'yes': must be true or false, not a string"),
+    ("N0_N_per_bar", {**_UNIFORM, "upper": 2.0}, "N0_N_per_bar.upper = 2.0: must be above lower = 2"),
+    ("stop_restitution", {**_UNIFORM, "relative": True, "lower": 0.9, "upper": 1.1},
+     "stop_restitution.relative = True: the base value is 0, so a factor cannot vary it"),
+    ("N1_N_per_bar_m", {**_LOGNORMAL, "lower": -3.0, "upper": -1.0},
+     "N1_N_per_bar_m.lower = -3.0: the bounds [-3, -1] exclude the lognormal distribution (probability inside 0)"),
+    ("valve_b", {"distribution": "uniform", "relative": True, "lower": 0.5, "upper": 5.0},
+     "valve_b.upper = 5.0: gives valve_b = 1.5, which must lie in [0, 1)"),
+    ("valve_b", {"distribution": "uniform", "lower": -1.0, "upper": 2.0},
+     "valve_b.lower = -1.0: gives valve_b = -1, which must lie in [0, 1)"),
+])
+def test_a_bad_uncertainty_distribution_is_refused_with_its_first_mistake(name, entry, message):
+    from pamsim.sweep import SweepError, sweep_from_dict
+
+    table = {"samples": 5, "seed": 1, "parameters": {name: entry}}
+    with pytest.raises(SweepError) as err:
+        sweep_from_dict({"base_scenario": str(SCENARIOS / "acra2012_fig4.toml"), "uncertainty": table},
+                        origin="study.toml")
+    assert _message(err) == f"study.toml: uncertainty.parameters.{message}"

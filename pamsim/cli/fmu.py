@@ -76,35 +76,51 @@ def run_build(args: argparse.Namespace) -> int:
     """
     from ..fmu import build
 
-    if args.fmi not in ("2", "3"):
-        raise InputError(f"--fmi = {args.fmi!r}: must be 2 or 3")
-    by_muscle = args.muscle is not None or args.static_force is not None or args.static_force_variant is not None
-    if args.scenario and by_muscle:
-        raise InputError(f"--scenario = {args.scenario!r}: give either --scenario or --muscle")
-    if by_muscle and args.muscle is None:
-        given = "--static-force" if args.static_force is not None else "--static-force-variant"
-        raise InputError(f"--muscle: needed with {given}")
-    preset = None
-    if args.generated and not args.scenario:
-        raise InputError("--generated: needs --scenario (the FMU is generated from the scenario's assembly)")
+    by_muscle = _check_options(args)
+    scenario = None
     if args.scenario:
         from ..scenario import load_scenario
 
         scenario = load_scenario(args.scenario)
         if scenario.added_components or args.generated or "controller" in scenario.spec:
             return _build_assembly(scenario, args)
-    if args.scenario or by_muscle:
-        from ..fmu import preset as presets
-        from ..scenario import load_scenario
-
-        preset = (presets.for_scenario(load_scenario(args.scenario)) if args.scenario
-                  else presets.for_muscle(_muscle_scenario(args)))
+    preset = _preset(args, scenario, by_muscle)
     path = build(args.output, int(args.fmi), preset=preset)
-    what = ""
-    if preset is not None:
-        table = preset.table
-        force = (f"a {table.shape[0]} x {table.shape[1]} table of {table.model_name}" if table
-                 else "the ACRA 2012 polynomial, exact")
-        what = f", for {preset.built_for}; static force: {force}"
-    print(f"wrote {path} (FMI {args.fmi}.0, Model Exchange and Co-Simulation{what})")
+    print(f"wrote {path} (FMI {args.fmi}.0, Model Exchange and Co-Simulation{_built_for(preset)})")
     return 0
+
+
+def _check_options(args: argparse.Namespace) -> bool:
+    """Refuse an FMI version other than 2 or 3 and options that do not go together, in this order; return
+    whether the FMU is built for a muscle (``--muscle``, ``--static-force`` or ``--static-force-variant``)."""
+    if args.fmi not in ("2", "3"):
+        raise InputError(f"--fmi = {args.fmi!r}: must be 2 or 3")
+    by_muscle = any(a is not None for a in (args.muscle, args.static_force, args.static_force_variant))
+    if args.scenario and by_muscle:
+        raise InputError(f"--scenario = {args.scenario!r}: give either --scenario or --muscle")
+    if by_muscle and args.muscle is None:
+        given = "--static-force" if args.static_force is not None else "--static-force-variant"
+        raise InputError(f"--muscle: needed with {given}")
+    if args.generated and not args.scenario:
+        raise InputError("--generated: needs --scenario (the FMU is generated from the scenario's assembly)")
+    return by_muscle
+
+
+def _preset(args: argparse.Namespace, scenario, by_muscle: bool):
+    """The :class:`pamsim.fmu.preset.Preset` the one-muscle FMU is built for: the scenario's, the muscle's,
+    or None (the FMU of the paper's muscle)."""
+    if scenario is None and not by_muscle:
+        return None
+    from ..fmu import preset as presets
+
+    return presets.for_scenario(scenario) if scenario is not None else presets.for_muscle(_muscle_scenario(args))
+
+
+def _built_for(preset) -> str:
+    """What the report line adds for a preset: what the FMU is built for and its static force."""
+    if preset is None:
+        return ""
+    table = preset.table
+    force = (f"a {table.shape[0]} x {table.shape[1]} table of {table.model_name}" if table
+             else "the ACRA 2012 polynomial, exact")
+    return f", for {preset.built_for}; static force: {force}"

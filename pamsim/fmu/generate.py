@@ -234,93 +234,127 @@ def _attrs(**kw) -> str:
     return "".join(f" {k}={quoteattr(str(v))}" for k, v in kw.items() if v is not None)
 
 
-def _fmi2(spec: FmuSpec) -> str:
-    variables, value_reference, by_name = spec.variables, spec.vr, spec.by_name
-    src_files = "".join(f'\n      <File name="{n}"/>' for n in spec.compiled() + (WRAPPERS[2],))
-    lines = ['<?xml version="1.0" encoding="UTF-8"?>', _header(spec),
-             f'  <ModelExchange modelIdentifier="{spec.identifier}" canGetAndSetFMUstate="true"'
-             ' canSerializeFMUstate="true" providesDirectionalDerivative="true"'
-             ' canNotUseMemoryManagementFunctions="true">',
-             f'    <SourceFiles>{src_files}\n    </SourceFiles>', '  </ModelExchange>',
-             f'  <CoSimulation modelIdentifier="{spec.identifier}" canHandleVariableCommunicationStepSize="true"'
-             ' canGetAndSetFMUstate="true" canSerializeFMUstate="true" providesDirectionalDerivative="true"'
-             ' canNotUseMemoryManagementFunctions="true">',
-             f'    <SourceFiles>{src_files}\n    </SourceFiles>', '  </CoSimulation>']
-    lines += (_unit_definitions(variables) + _type_definitions(2, variables) + _common_elements(spec.experiment)
-              + ['  <ModelVariables>'])
-    index = {v.name: i for i, v in enumerate(variables, start=1)}  # FMI 2.0 refers to variables by position
-    for v in variables:
-        head = _attrs(name=v.name, valueReference=value_reference(v.name), description=v.description,
-                      causality=v.causality, variability=v.variability, initial=v.initial)
-        start = _num(v.start) if v.start is not None else None
-        if v.choices:
-            inner = f"<Enumeration{_attrs(declaredType=enumeration_type(v), **_limits(v), start=start)}/>"
-        elif v.kind == "real":
-            inner = (f'<Real{_attrs(unit=v.unit, **_limits(v), start=start, nominal=v.nominal)}'
-                     f'{_attrs(derivative=index[v.derivative_of] if v.derivative_of else None)}/>')
-        else:
-            inner = f'<Integer{_attrs(**_limits(v), start=start)}/>'
-        lines.append(f'    <ScalarVariable{head}>\n      {inner}\n    </ScalarVariable>')
-    lines.append('  </ModelVariables>')
-    outputs = [v for v in variables if v.causality == "output"]
-    derivs = [v for v in variables if v.derivative_of]
-    states = [by_name[s] for s in spec.states]
-    initial = sorted({v.name: v for v in outputs + derivs + states}.values(), key=lambda v: index[v.name])
-
-    def unknown(v, deps):
-        return f'      <Unknown index="{index[v.name]}"{_attrs(**deps)}/>'
-
-    lines += ['  <ModelStructure>', '    <Outputs>']
-    lines += [unknown(v, _dependencies(v.depends_on, index.get)) for v in outputs]
-    lines += ['    </Outputs>', '    <Derivatives>']
-    lines += [unknown(v, _dependencies(v.depends_on, index.get)) for v in derivs]
-    lines += ['    </Derivatives>', '    <InitialUnknowns>']
-    lines += [unknown(v, _dependencies(v.initial_depends_on, index.get)) for v in initial]
-    lines += ['    </InitialUnknowns>', '  </ModelStructure>', '</fmiModelDescription>', '']
+def _document(spec: FmuSpec, interfaces: list[str], model_variables: list[str], structure: list[str]) -> str:
+    """A ``modelDescription.xml``: the parts FMI 2.0 and 3.0 write alike (header, units, types, log categories,
+    experiment) around the ``interfaces`` (Model Exchange, Co-Simulation), the variables' elements and the
+    model structure's, which each standard writes its own way."""
+    lines = ['<?xml version="1.0" encoding="UTF-8"?>', _header(spec), *interfaces]
+    lines += (_unit_definitions(spec.variables) + _type_definitions(spec.fmi_version, spec.variables)
+              + _common_elements(spec.experiment))
+    lines += ['  <ModelVariables>', *model_variables, '  </ModelVariables>']
+    lines += ['  <ModelStructure>', *structure, '  </ModelStructure>', '</fmiModelDescription>', '']
     return "\n".join(lines)
+
+
+def _variable_attrs(spec: FmuSpec, v) -> str:
+    """The attributes a variable has in both standards: name, value reference, description, causality,
+    variability and initial."""
+    return _attrs(name=v.name, valueReference=spec.vr(v.name), description=v.description,
+                  causality=v.causality, variability=v.variability, initial=v.initial)
+
+
+def _start(v) -> str | None:
+    """The ``start`` attribute's text, or None (left out) for a variable without one."""
+    return _num(v.start) if v.start is not None else None
+
+
+def _unknowns(spec: FmuSpec, key) -> tuple[list, list, list]:
+    """The model structure's unknowns: the outputs and the state derivatives in table order, and the initial
+    unknowns (outputs, derivatives and states, each once) ordered by ``key`` of their name."""
+    outputs = [v for v in spec.variables if v.causality == "output"]
+    derivs = [v for v in spec.variables if v.derivative_of]
+    states = [spec.by_name[s] for s in spec.states]
+    initial = sorted({v.name: v for v in outputs + derivs + states}.values(), key=lambda v: key(v.name))
+    return outputs, derivs, initial
+
+
+def _fmi2(spec: FmuSpec) -> str:
+    index = {v.name: i for i, v in enumerate(spec.variables, start=1)}  # FMI 2.0 refers to variables by position
+    return _document(spec, _fmi2_interfaces(spec), [_fmi2_variable(spec, v, index) for v in spec.variables],
+                     _fmi2_structure(spec, index))
+
+
+def _fmi2_interfaces(spec: FmuSpec) -> list[str]:
+    """``<ModelExchange>`` and ``<CoSimulation>`` of FMI 2.0, each listing the C files to compile."""
+    src_files = "".join(f'\n      <File name="{n}"/>' for n in spec.compiled() + (WRAPPERS[2],))
+    return [f'  <ModelExchange modelIdentifier="{spec.identifier}" canGetAndSetFMUstate="true"'
+            ' canSerializeFMUstate="true" providesDirectionalDerivative="true"'
+            ' canNotUseMemoryManagementFunctions="true">',
+            f'    <SourceFiles>{src_files}\n    </SourceFiles>', '  </ModelExchange>',
+            f'  <CoSimulation modelIdentifier="{spec.identifier}" canHandleVariableCommunicationStepSize="true"'
+            ' canGetAndSetFMUstate="true" canSerializeFMUstate="true" providesDirectionalDerivative="true"'
+            ' canNotUseMemoryManagementFunctions="true">',
+            f'    <SourceFiles>{src_files}\n    </SourceFiles>', '  </CoSimulation>']
+
+
+def _fmi2_variable(spec: FmuSpec, v, index: dict[str, int]) -> str:
+    """A ``<ScalarVariable>`` with its type element inside; a derivative names its state by ``index``."""
+    start = _start(v)
+    if v.choices:
+        inner = f"<Enumeration{_attrs(declaredType=enumeration_type(v), **_limits(v), start=start)}/>"
+    elif v.kind == "real":
+        inner = (f'<Real{_attrs(unit=v.unit, **_limits(v), start=start, nominal=v.nominal)}'
+                 f'{_attrs(derivative=index[v.derivative_of] if v.derivative_of else None)}/>')
+    else:
+        inner = f'<Integer{_attrs(**_limits(v), start=start)}/>'
+    return f'    <ScalarVariable{_variable_attrs(spec, v)}>\n      {inner}\n    </ScalarVariable>'
+
+
+def _fmi2_structure(spec: FmuSpec, index: dict[str, int]) -> list[str]:
+    """``<Outputs>``, ``<Derivatives>`` and ``<InitialUnknowns>``, each unknown and its dependencies by index."""
+    outputs, derivs, initial = _unknowns(spec, index.__getitem__)
+
+    def unknowns(variables, depends) -> list[str]:
+        return [f'      <Unknown index="{index[v.name]}"{_attrs(**_dependencies(depends(v), index.get))}/>'
+                for v in variables]
+
+    return (['    <Outputs>', *unknowns(outputs, lambda v: v.depends_on), '    </Outputs>',
+             '    <Derivatives>', *unknowns(derivs, lambda v: v.depends_on), '    </Derivatives>',
+             '    <InitialUnknowns>', *unknowns(initial, lambda v: v.initial_depends_on), '    </InitialUnknowns>'])
+
+
+_FMI3_TIME = ('    <Float64 name="time" valueReference="0" causality="independent" variability="continuous"'
+              ' description="simulation time [s]" unit="s"/>')
+"""FMI 3.0's independent variable, which FMI 2.0 leaves implicit."""
 
 
 def _fmi3(spec: FmuSpec) -> str:
-    variables, value_reference, by_name = spec.variables, spec.vr, spec.by_name
-    lines = ['<?xml version="1.0" encoding="UTF-8"?>', _header(spec),
-             f'  <ModelExchange modelIdentifier="{spec.identifier}" needsCompletedIntegratorStep="true"'
-             ' canGetAndSetFMUState="true" canSerializeFMUState="true" providesDirectionalDerivatives="true"/>',
-             f'  <CoSimulation modelIdentifier="{spec.identifier}" canHandleVariableCommunicationStepSize="true"'
-             ' canGetAndSetFMUState="true" canSerializeFMUState="true" providesDirectionalDerivatives="true"/>']
-    lines += _unit_definitions(variables) + _type_definitions(3, variables) + _common_elements(spec.experiment)
-    lines += ['  <ModelVariables>',
-              '    <Float64 name="time" valueReference="0" causality="independent" variability="continuous"'
-              ' description="simulation time [s]" unit="s"/>']
-    for v in variables:
-        head = _attrs(name=v.name, valueReference=value_reference(v.name), description=v.description,
-                      causality=v.causality, variability=v.variability, initial=v.initial)
-        start = _num(v.start) if v.start is not None else None
-        if v.choices:
-            tail = _attrs(declaredType=enumeration_type(v), **_limits(v), start=start)
-            lines.append(f"    <Enumeration{head}{tail}/>")
-        elif v.kind == "real":
-            tail = _attrs(unit=v.unit, **_limits(v), start=start,
-                          derivative=value_reference(v.derivative_of) if v.derivative_of else None,
-                          nominal=v.nominal)
-            lines.append(f'    <Float64{head}{tail}/>')
-        else:
-            lines.append(f'    <Int32{head}{_attrs(**_limits(v), start=start)}/>')
-    lines.append('  </ModelVariables>')
-    outputs = [v for v in variables if v.causality == "output"]
-    derivs = [v for v in variables if v.derivative_of]
-    states = [by_name[s] for s in spec.states]
-    initial = sorted({v.name: v for v in outputs + derivs + states}.values(), key=lambda v: value_reference(v.name))
-    lines.append('  <ModelStructure>')
-    lines += [f'    <Output valueReference="{value_reference(v.name)}"'
-              f'{_attrs(**_dependencies(v.depends_on, value_reference))}/>' for v in outputs]
-    lines += [f'    <ContinuousStateDerivative valueReference="{value_reference(v.name)}"'
-              f'{_attrs(**_dependencies(v.depends_on, value_reference))}/>' for v in derivs]
-    lines += [f'    <InitialUnknown valueReference="{value_reference(v.name)}"'
-              f'{_attrs(**_dependencies(v.initial_depends_on, value_reference))}/>' for v in initial]
-    lines += [f'    <EventIndicator valueReference="{value_reference(n)}"'
-              f'{_attrs(**_dependencies(by_name[n].depends_on, value_reference))}/>' for n in spec.event_indicators]
-    lines += ['  </ModelStructure>', '</fmiModelDescription>', '']
-    return "\n".join(lines)
+    return _document(spec, _fmi3_interfaces(spec), [_FMI3_TIME] + [_fmi3_variable(spec, v) for v in spec.variables],
+                     _fmi3_structure(spec))
+
+
+def _fmi3_interfaces(spec: FmuSpec) -> list[str]:
+    """``<ModelExchange>`` and ``<CoSimulation>`` of FMI 3.0."""
+    return [f'  <ModelExchange modelIdentifier="{spec.identifier}" needsCompletedIntegratorStep="true"'
+            ' canGetAndSetFMUState="true" canSerializeFMUState="true" providesDirectionalDerivatives="true"/>',
+            f'  <CoSimulation modelIdentifier="{spec.identifier}" canHandleVariableCommunicationStepSize="true"'
+            ' canGetAndSetFMUState="true" canSerializeFMUState="true" providesDirectionalDerivatives="true"/>']
+
+
+def _fmi3_variable(spec: FmuSpec, v) -> str:
+    """The variable's element, named by its type; a derivative names its state by value reference."""
+    head, start = _variable_attrs(spec, v), _start(v)
+    if v.choices:
+        return f"    <Enumeration{head}{_attrs(declaredType=enumeration_type(v), **_limits(v), start=start)}/>"
+    if v.kind == "real":
+        tail = _attrs(unit=v.unit, **_limits(v), start=start,
+                      derivative=spec.vr(v.derivative_of) if v.derivative_of else None, nominal=v.nominal)
+        return f'    <Float64{head}{tail}/>'
+    return f'    <Int32{head}{_attrs(**_limits(v), start=start)}/>'
+
+
+def _fmi3_structure(spec: FmuSpec) -> list[str]:
+    """The unknowns of FMI 3.0, each its own element naming its value reference and dependencies: outputs, state
+    derivatives, initial unknowns and event indicators."""
+    outputs, derivs, initial = _unknowns(spec, spec.vr)
+
+    def unknown(tag: str, name: str, depends) -> str:
+        return f'    <{tag} valueReference="{spec.vr(name)}"{_attrs(**_dependencies(depends, spec.vr))}/>'
+
+    return ([unknown("Output", v.name, v.depends_on) for v in outputs]
+            + [unknown("ContinuousStateDerivative", v.name, v.depends_on) for v in derivs]
+            + [unknown("InitialUnknown", v.name, v.initial_depends_on) for v in initial]
+            + [unknown("EventIndicator", n, spec.by_name[n].depends_on) for n in spec.event_indicators])
 
 
 def build_description(spec: FmuSpec) -> str:

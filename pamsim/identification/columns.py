@@ -82,31 +82,45 @@ class TraceData:
 
 def _table(path: Path) -> tuple[list[str], np.ndarray, str]:
     """Header names, the numeric rows and the SHA-256 of the file."""
+    raw, text = _file_text(path)
+    lines = _content_lines(path, text)
+    header = [h.strip() for h in lines[0][1].split(",")]
+    rows = [_numbers(path, n, line, len(header)) for n, line in lines[1:]]
+    if not rows:
+        raise DataError(f"{path}: no data rows below the header")
+    return header, np.array(rows, dtype=float), hashlib.sha256(raw).hexdigest()
+
+
+def _file_text(path: Path) -> tuple[bytes, str]:
+    """The file's bytes (hashed as they are) and its text, refused if it cannot be read or is not UTF-8."""
     try:
         raw = path.read_bytes()
     except OSError as exc:
         raise DataError(f"{path}: cannot read it: {exc.strerror or exc}") from None
     try:
-        text = raw.decode()
+        return raw, raw.decode()
     except UnicodeDecodeError:
         raise DataError(f"{path}: not a text (UTF-8) CSV file") from None
+
+
+def _content_lines(path: Path, text: str) -> list[tuple[int, str]]:
+    """The lines that are neither blank nor ``#`` comments, with their line numbers; the first is the header."""
     lines = [(n, line) for n, line in enumerate(text.splitlines(), start=1) if line.strip() and not line.startswith("#")]
     if not lines:
         raise DataError(f"{path}: no header row (the file is empty or only comments)")
-    header = [h.strip() for h in lines[0][1].split(",")]
-    rows = []
-    for n, line in lines[1:]:
-        cells = line.split(",")
-        if len(cells) != len(header):
-            raise DataError(f"{path}: line {n} has {len(cells)} fields, the header has {len(header)}")
-        try:
-            rows.append([float(c) for c in cells])
-        except ValueError:
-            bad = next(c for c in cells if not _is_number(c))
-            raise DataError(f"{path}: line {n}: value {bad.strip()!r} is not a number") from None
-    if not rows:
-        raise DataError(f"{path}: no data rows below the header")
-    return header, np.array(rows, dtype=float), hashlib.sha256(raw).hexdigest()
+    return lines
+
+
+def _numbers(path: Path, n: int, line: str, width: int) -> list[float]:
+    """Data line ``n``'s values: as many fields as the header has (``width``), each a number."""
+    cells = line.split(",")
+    if len(cells) != width:
+        raise DataError(f"{path}: line {n} has {len(cells)} fields, the header has {width}")
+    try:
+        return [float(c) for c in cells]
+    except ValueError:
+        bad = next(c for c in cells if not _is_number(c))
+        raise DataError(f"{path}: line {n}: value {bad.strip()!r} is not a number") from None
 
 
 def _is_number(text: str) -> bool:

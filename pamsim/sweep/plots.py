@@ -154,44 +154,60 @@ def time_responses_figure(result: "SweepResult") -> Figure:
     fig = Figure(figsize=(13, height_in))
     if not names:
         return _empty(fig, "no [time_responses] in the sweep file")
-    ncols = 2 if len(names) > 1 else 1
-    nrows = math.ceil(len(names) / ncols)
     measured = {s.name: s.measured_steady_state() for s in result.spec.time_responses}
-    title_in = 0.75 + (0.2 if any(m is not None for m in measured.values()) else 0.0)  # a second title line
-    margins = dict(left=0.05, right=0.95, top=1 - title_in / height_in, bottom=0.5 / height_in, wspace=0.2, hspace=0.42)
-    axes = np.atleast_1d(fig.subplots(nrows, ncols, squeeze=False, gridspec_kw=margins).ravel())
+    axes, ncols = _response_axes(fig, len(names), height_in, any(m is not None for m in measured.values()))
     for ax, name in zip(axes, names):
-        runs = result.responses[name]
-        for k, (f, out) in enumerate(runs.items()):
-            if out.get("error"):
-                ax.text(0.5, 0.2 + 0.1 * k, f"{f}: failed", transform=ax.transAxes, color="red")
-                continue
-            ax.plot(out["t_s"], out["x_m"] * 1e3, lw=1.6, label=f"{f} friction", **series(k))
-        if measured.get(name) is not None:
-            draw_measured(ax, measured[name], measured[name].contraction_mm, measured_labels(measured[name])[0])
-        pax = ax.twinx()
-        first = next((o for o in runs.values() if not o.get("error")), None)
-        if first is not None:
-            pax.plot(first["t_s"], first["p_gauge_Pa"] / PA_PER_BAR, **REFERENCE)
-        pax.set_ylabel("pressure [bar]", color="0.5", fontsize=8)
-        pax.tick_params(axis="y", colors="0.5", labelsize=8)
-        # An explicit y spares matplotlib the search for tick labels above each axes (a third of the
-        # figure's drawing time with the twin axes); nothing is drawn above these axes.
-        ax.set_title(name, fontsize=10, y=1.0)
-        ax.set_ylabel("contraction [mm]")
-        ax.grid(alpha=0.3)
-        ax.legend(fontsize=8, loc="lower right")
+        _response_panel(ax, name, result.responses[name], measured.get(name))
     for ax in axes[len(names):]:
         ax.set_axis_off()
     for ax in axes[max(0, len(names) - ncols):len(names)]:
         ax.set_xlabel("time [s]")
+    fig.suptitle(_responses_title(measured))
+    return fig
+
+
+def _response_axes(fig: Figure, n: int, height_in: float, two_line_title: bool) -> tuple[np.ndarray, int]:
+    """Axes for ``n`` panels, two to a row (one if alone), with fixed margins for a title of one or two lines;
+    and the number of columns."""
+    ncols = 2 if n > 1 else 1
+    nrows = math.ceil(n / ncols)
+    title_in = 0.75 + (0.2 if two_line_title else 0.0)
+    margins = dict(left=0.05, right=0.95, top=1 - title_in / height_in, bottom=0.5 / height_in, wspace=0.2, hspace=0.42)
+    return np.atleast_1d(fig.subplots(nrows, ncols, squeeze=False, gridspec_kw=margins).ravel()), ncols
+
+
+def _response_panel(ax, name: str, runs: Mapping[str, dict], measured) -> None:
+    """Scenario ``name``'s contraction under each friction model (a failed run said in red), its measured end if
+    any, and the pressure of its first successful run on a grey right axis."""
+    for k, (f, out) in enumerate(runs.items()):
+        if out.get("error"):
+            ax.text(0.5, 0.2 + 0.1 * k, f"{f}: failed", transform=ax.transAxes, color="red")
+            continue
+        ax.plot(out["t_s"], out["x_m"] * 1e3, lw=1.6, label=f"{f} friction", **series(k))
+    if measured is not None:
+        draw_measured(ax, measured, measured.contraction_mm, measured_labels(measured)[0])
+    pax = ax.twinx()
+    first = next((o for o in runs.values() if not o.get("error")), None)
+    if first is not None:
+        pax.plot(first["t_s"], first["p_gauge_Pa"] / PA_PER_BAR, **REFERENCE)
+    pax.set_ylabel("pressure [bar]", color="0.5", fontsize=8)
+    pax.tick_params(axis="y", colors="0.5", labelsize=8)
+    # An explicit y spares matplotlib the search for tick labels above each axes (a third of the
+    # figure's drawing time with the twin axes); nothing is drawn above these axes.
+    ax.set_title(name, fontsize=10, y=1.0)
+    ax.set_ylabel("contraction [mm]")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8, loc="lower right")
+
+
+def _responses_title(measured: Mapping) -> str:
+    """The figure's title, with a line on the measured tests' sources if any panel has one."""
     title = "Time responses: load-dependent against constant friction (grey dots: muscle pressure, right axis)"
     sources = sorted({m.source for m in measured.values() if m is not None})
     if sources:
         title += (f"\nmeasured: the final contraction only ({'; '.join(sources)}); "
                   "the paper draws the traces but does not give them as numbers")
-    fig.suptitle(title)
-    return fig
+    return title
 
 
 def frequency_figure(result: "SweepResult") -> Figure:

@@ -174,6 +174,24 @@ def parse_uncertainty(check: TableChecker, table: Any, base: Scenario) -> Uncert
 
 
 def _distribution(check: TableChecker, where: str, name: str, entry: Any, base: Scenario) -> ParameterDistribution:
+    """Parameter ``name``'s table ``entry`` (at ``where``) read into its distribution, checked in this order:
+    its keys and kind, ``relative``, the bounds, the shape, that a factor can vary the base value, that the
+    bounds hold some of the distribution and that they give values within the parameter's range."""
+    kind = _kind(check, where, entry)
+    relative = check.typed(f"{where}.relative", entry.get("relative", False), bool)
+    lower, upper = _bounds(check, where, entry)
+    shape = _shape(check, where, entry, kind)
+    nominal = float(base.parameters[name])
+    if relative and nominal == 0.0:
+        check.fail(f"{where}.relative", True, "the base value is 0, so a factor cannot vary it")
+    dist = ParameterDistribution(name, kind, lower, upper, shape, relative, nominal)
+    _check_bound_mass(check, where, dist)
+    _check_parameter_range(check, where, dist, base.parameters.entries[name])
+    return dist
+
+
+def _kind(check: TableChecker, where: str, entry: Any) -> str:
+    """The entry's distribution, known, with no key that another distribution takes."""
     check.check_keys(f"[{where}]", where + ".", entry, _PARAM_KEYS)
     kind = check.required(entry, "distribution", str, where + ".")
     if kind not in DISTRIBUTIONS:
@@ -183,31 +201,43 @@ def _distribution(check: TableChecker, where: str, name: str, entry: Any, base: 
         if key not in allowed:
             check.fail(f"{where}.{key}", entry[key], f"does not apply to a {kind} distribution "
                        f"(it takes {', '.join(sorted(allowed - {'distribution'}))})")
-    relative = check.typed(f"{where}.relative", entry.get("relative", False), bool)
+    return kind
+
+
+def _bounds(check: TableChecker, where: str, entry: Any) -> tuple[float, float]:
+    """``lower`` and ``upper``, the one below the other."""
     lower = check.required(entry, "lower", float, where + ".")
     upper = check.required(entry, "upper", float, where + ".")
     if not lower < upper:
         check.fail(f"{where}.upper", upper, f"must be above lower = {lower:g}")
+    return lower, upper
+
+
+def _shape(check: TableChecker, where: str, entry: Any, kind: str) -> tuple[float, ...]:
+    """The shape keys of ``kind`` (:data:`DISTRIBUTIONS`): a positive spread, and a positive lognormal median."""
     shape = tuple(check.required(entry, k, float, where + ".") for k in DISTRIBUTIONS[kind])
     if kind in ("normal", "lognormal") and not shape[1] > 0:
         check.fail(f"{where}.{DISTRIBUTIONS[kind][1]}", shape[1], "must be positive")
     if kind == "lognormal" and not shape[0] > 0:
         check.fail(f"{where}.median", shape[0], "must be positive")
-    nominal = float(base.parameters[name])
-    if relative and nominal == 0.0:
-        check.fail(f"{where}.relative", True, "the base value is 0, so a factor cannot vary it")
-    dist = ParameterDistribution(name, kind, lower, upper, shape, relative, nominal)
+    return shape
+
+
+def _check_bound_mass(check: TableChecker, where: str, dist: ParameterDistribution) -> None:
+    """Refuse bounds that hold (next to) none of the distribution: a truncation to them would be all clamp."""
     mass = dist.bound_mass()
     if not mass >= MIN_BOUND_MASS:
-        check.fail(f"{where}.lower", lower, f"the bounds [{lower:g}, {upper:g}] exclude the {kind} "
-                   f"distribution (probability inside {mass:.3g})")
-    rule = base.parameters.entries[name]
-    for key, bound in (("lower", lower), ("upper", upper)):
-        value = bound * nominal if relative else bound
+        check.fail(f"{where}.lower", dist.lower, f"the bounds [{dist.lower:g}, {dist.upper:g}] exclude the "
+                   f"{dist.distribution} distribution (probability inside {mass:.3g})")
+
+
+def _check_parameter_range(check: TableChecker, where: str, dist: ParameterDistribution, rule) -> None:
+    """Refuse a bound that gives a value outside the parameter's own range (``rule``, its schema entry)."""
+    for key, bound in (("lower", dist.lower), ("upper", dist.upper)):
+        value = bound * dist.nominal if dist.relative else bound
         why = rule.violation(value)
         if why is not None:
-            check.fail(f"{where}.{key}", bound, f"gives {name} = {value:g}, which {why}")
-    return dist
+            check.fail(f"{where}.{key}", bound, f"gives {dist.name} = {value:g}, which {why}")
 
 
 # ---------------------------------------------------------------- results
