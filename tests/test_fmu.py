@@ -41,6 +41,21 @@ def traces(fmus, paper_results):
     return out
 
 
+def vr(name: str) -> int:
+    """The value reference of ``name``: pinned for the FMU's own variables, the generated model's next."""
+    from pamsim.fmu.generate import one_muscle_spec
+
+    return value_reference(name) if name in BY_NAME else one_muscle_spec(2).vr(name)
+
+
+def n_states(path) -> int:
+    """The FMU's continuous states: contraction, velocity, chamber pressure and air mass, then the work
+    integrals of the generated model (``muscle.W_muscle_J``, ...)."""
+    from fmpy import read_model_description
+
+    return len(read_model_description(str(path)).derivatives)
+
+
 def _diff(trace, result):
     assert np.allclose(trace["t_s"], result.t_s, atol=1e-9)
     return np.abs(trace["contraction_m"] - result.x_m)
@@ -58,11 +73,16 @@ def test_validate_fmu_reports_no_problems(fmus, version):
 
 @pytest.mark.parametrize("version,platform", [(2, "binaries/linux64/"), (3, "binaries/x86_64-linux/")])
 def test_archive_layout(fmus, version, platform):
+    from pamsim.fmu.generate import one_muscle_spec
+
     names = zipfile.ZipFile(fmus[version]).namelist()
     assert f"{platform}pamsim_muscle.so" in names
-    for src in ("sources/pam_core.c", "sources/pam_core.h", "sources/pam_variables.h", "sources/buildDescription.xml",
-                f"sources/fmi{version}_wrapper.c", f"sources/fmi{version}Functions.h", "sources/FMI_HEADERS_LICENSE.txt"):
+    spec = one_muscle_spec(version)
+    for src in (*(f"sources/{n}" for n in (*spec.sources, *spec.generated)), "sources/pam_variables.h",
+                "sources/buildDescription.xml", f"sources/fmi{version}_wrapper.c", f"sources/fmi{version}Functions.h",
+                "sources/FMI_HEADERS_LICENSE.txt"):
         assert src in names
+    assert "sources/pam_model.c" in names  # the generated model
 
 
 @pytest.mark.parametrize("version", [2, 3])
@@ -255,11 +275,11 @@ class _Api:
 
     def set(self, name, value):
         f = self.fmu.setReal if self.v == 2 else self.fmu.setFloat64
-        f([value_reference(name)], [value])
+        f([vr(name)], [value])
 
     def get(self, *names):
         f = self.fmu.getReal if self.v == 2 else self.fmu.getFloat64
-        return f([value_reference(n) for n in names])
+        return f([vr(n) for n in names])
 
     def mode(self):
         return (self.fmu.getInteger if self.v == 2 else self.fmu.getInt32)([value_reference("friction_mode")])[0]
@@ -389,7 +409,7 @@ def _header_bounds(version):
     num = lambda t: {"HUGE_VAL": math.inf, "-HUGE_VAL": -math.inf}.get(t) or float(t)  # noqa: E731
     rows = re.findall(r'^    \{"([^"]+)", \'[rie]\', \d+, \w+, [^,]+, ([^,]+), ([^,]+), ([01]), ([01])\},$',
                       c_header(version), flags=re.M)
-    assert len(rows) == len(VARIABLES)
+    assert {n for n, *_ in rows} >= {v.name for v in VARIABLES}
     return {n: (num(lo), num(hi), lo_open == "1", hi_open == "1") for n, lo, hi, lo_open, hi_open in rows}
 
 
@@ -514,14 +534,15 @@ def test_model_exchange_events_protocol(fmus, version):
 
     update()
     fmu.enterContinuousTimeMode()
-    x, dx, z = np.zeros(4), np.zeros(4), np.zeros(2)
+    n = n_states(fmus[version])  # the four of the model, then its work integrals
+    x, dx, z = np.zeros(n), np.zeros(n), np.zeros(2)
 
     def ptr(a):
         return a.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
 
-    get_x = lambda: fmu.getContinuousStates(ptr(x), 4)  # noqa: E731
-    get_dx = (lambda: fmu.getDerivatives(ptr(dx), 4)) if version == 2 else \
-        (lambda: fmu.getContinuousStateDerivatives(ptr(dx), 4))
+    get_x = lambda: fmu.getContinuousStates(ptr(x), n)  # noqa: E731
+    get_dx = (lambda: fmu.getDerivatives(ptr(dx), n)) if version == 2 else \
+        (lambda: fmu.getContinuousStateDerivatives(ptr(dx), n))
     get_z = lambda: fmu.getEventIndicators(ptr(z), 2)  # noqa: E731
     get_x()
     get_z()
@@ -532,7 +553,7 @@ def test_model_exchange_events_protocol(fmus, version):
         x += h * dx
         t += h
         fmu.setTime(t)
-        fmu.setContinuousStates(ptr(x), 4)
+        fmu.setContinuousStates(ptr(x), n)
         get_z()
         if np.any((z_old > 0) & (z <= 0)):
             mode_before = api.mode()

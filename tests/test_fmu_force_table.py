@@ -16,7 +16,7 @@ from pamsim.fmu.force_table import tabulate
 from pamsim.fmu.runner import force_table_for, run_cs, run_me, set_values
 from pamsim.fmu.variables import value_reference
 from pamsim.muscles import load_muscle
-from test_fmu import _Api, _initialise_with, _instance, _start_fig4
+from test_fmu import _Api, _initialise_with, _instance, _start_fig4, n_states
 
 RATED_PA = 4.5e5
 X_HIGH_M = 0.1157  # the braid-lock stop of the Shadow muscle (test_fmu: "between the stops, 0 and 0.1157 m")
@@ -195,9 +195,10 @@ def test_table_choice_without_a_table_reads_nan_during_initialisation(fmus, vers
     if version == 2:
         fmu.setupExperiment(startTime=0.0)
     fmu.enterInitializationMode()
-    dx = np.zeros(4)
+    n = n_states(fmus[version])
+    dx = np.zeros(n)
     get = fmu.getDerivatives if version == 2 else fmu.getContinuousStateDerivatives
-    get(dx.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), 4)  # evaluates the model, outputs included
+    get(dx.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), n)  # evaluates the model, outputs included
     assert np.isnan(_Api(fmu, version).get("F_static_N")[0])
     fmu.freeInstance()
 

@@ -10,6 +10,16 @@
 #ifndef PAM_ENGINE_H
 #define PAM_ENGINE_H
 
+/* Only what a library marks for export leaves it (the FMI functions, PAM_EXPORT), also when it is rebuilt
+ * without -fvisibility=hidden (fmpy compile, cmake): the engine and the generated model stay inside. */
+#include <math.h> /* before the pragma: the C library's own functions keep their visibility */
+#include <stdlib.h>
+#include <string.h>
+
+#if defined(__GNUC__)
+#pragma GCC visibility push(hidden)
+#endif
+
 #include "pam_model.c"
 
 enum { PAM_ENGINE_INFO = 0, PAM_ENGINE_WARNING = 1, PAM_ENGINE_ERROR = 2 };
@@ -58,5 +68,15 @@ typedef struct {
     void *event_env;
     const PamEngineInputs *inputs; /* NULL: the inputs u are held over each call of pam_engine_do_step */
 } PamEngine;
+
+void pam_engine_reset(PamEngine *e);
+/* The initial states and mode from the parameters and inputs (q_start: every state, quadratures included). */
+void pam_engine_initialize(PamEngine *e);
+/* Integrate to t_end; 0 on success, -1 on failure (logged). */
+int pam_engine_do_step(PamEngine *e, double t_end);
+
+#if defined(__GNUC__)
+#pragma GCC visibility pop
+#endif
 
 #endif

@@ -109,6 +109,8 @@ def table_text() -> str:
 
 def token(fmi_version: int, table: ForceTable | None = None, preset=None) -> str:
     """A hash of everything an FMU's binary is built from: sources, generated headers, table, preset."""
+    if table is None and (preset is None or preset.table is None):
+        return one_muscle_spec(fmi_version, table, preset).token
     h = hashlib.sha256()
     src = c_source_dir() / "src"
     for name in CORE_SOURCES + (WRAPPERS[fmi_version],):
@@ -123,8 +125,18 @@ def token(fmi_version: int, table: ForceTable | None = None, preset=None) -> str
 
 
 def one_muscle_spec(fmi_version: int, table: ForceTable | None = None, preset=None) -> FmuSpec:
-    """The :class:`~pamsim.fmu.spec.FmuSpec` of the one-muscle FMU (its core written by hand), built with a
-    force ``table`` and for a ``preset``, if any."""
+    """The :class:`~pamsim.fmu.spec.FmuSpec` of the one-muscle FMU, built with a force ``table`` and for a
+    ``preset``, if any: generated from components (:mod:`pamsim.fmu.muscle_spec`), or with a force table
+    on the core written by hand."""
+    if table is None and (preset is None or preset.table is None):
+        from .muscle_spec import muscle_generated_spec
+
+        return muscle_generated_spec(fmi_version, preset)
+    return hand_written_spec(fmi_version, table, preset)
+
+
+def hand_written_spec(fmi_version: int, table: ForceTable | None = None, preset=None) -> FmuSpec:
+    """The spec of the one-muscle FMU whose core is written by hand (``pam_core.c``), with a force ``table``."""
     variables = with_preset(VARIABLES, table, preset)
     return FmuSpec(
         variables, {v.name: value_reference(v.name) for v in variables}, STATES, EVENT_INDICATORS, INPUTS,

@@ -72,6 +72,18 @@ def _friction_choice(k: Mapping[str, Any]):
 
 
 @dataclass(frozen=True)
+class NoTable:
+    """The ``static_force_model = table`` option of an FMU built without one: refused at the end of
+    initialisation (a generated check), and NaN where the model is evaluated before that (a derivative
+    read in initialisation mode), so that nothing reads a force that is not there."""
+
+    name: str = "no_table"
+
+    def force_N(self, x_m, p_gauge_Pa):
+        return float("nan") * x_m
+
+
+@dataclass(frozen=True)
 class RigLaws:
     """The rig's elements and component values as a function of the FMU's knobs ``k`` (floats, or
     CasADi symbols for the generated map): see :func:`rig_laws`."""
@@ -92,8 +104,7 @@ def rig_laws(k: Mapping[str, Any], static_force=None) -> RigLaws:
     ``static_force_model = table`` option (None: the FMU has the ACRA 2012 polynomial only)."""
     braid = Braid.from_parameters(k)
     muscle = {"acra2012_polynomial": ClippedStaticForce(Acra2012Polynomial.from_parameters(k))}
-    if static_force is not None:
-        muscle["table"] = static_force
+    muscle["table"] = static_force if static_force is not None else NoTable()
     friction = {name: FRICTION_MODELS[law](k, {"friction_negative_level": level})
                 for name, law, level in FRICTION_OPTIONS}
     return RigLaws(

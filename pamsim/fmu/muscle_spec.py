@@ -13,6 +13,7 @@ from typing import Any
 
 from .assembly_fmu import CORE_HEADER, SOURCES, AssemblyVariables, _per_s, _real, _token
 from .muscle_fmu import MASS_INPUT, MODE_NAME, OUTPUT_NAMES, STATE_NAMES, knob_map, muscle_assembly
+from .generate import _usage
 from .spec import FmuSpec
 from .variables import INPUTS, VARIABLES, value_reference, with_preset
 
@@ -187,9 +188,27 @@ def check_lines(found: list[Check], value_references: dict) -> tuple[list[str], 
              f"static const PamCheck PAM_CHECKS[PAM_NCHECKS] = {{"] + rows + ["};"], n_values)
 
 
+_SPECS: dict = {}
+SPECS_KEPT = 16
+"""Specs kept per process: the token, header and model description of one FMU are asked for apart, and
+generating the model takes about 0.5 s."""
+
+
 def muscle_generated_spec(fmi_version: int = 2, preset=None, static_force=None) -> FmuSpec:
     """The spec of the one-muscle FMU generated from components, for a ``preset`` (its start values and
     signals) and with ``static_force`` (the scenario's static force element) as its ``table`` option."""
+    from ..components.element import structure_key
+
+    key = (fmi_version, preset.digest() if preset is not None else None,
+           structure_key(static_force, baked=True) if static_force is not None else None)
+    if key not in _SPECS:
+        if len(_SPECS) >= SPECS_KEPT:
+            _SPECS.pop(next(iter(_SPECS)))
+        _SPECS[key] = _generated_spec(fmi_version, preset, static_force)
+    return _SPECS[key]
+
+
+def _generated_spec(fmi_version: int, preset, static_force) -> FmuSpec:
     import casadi as ca
 
     from ..modeling.cmodel import CModel
@@ -218,14 +237,14 @@ def muscle_generated_spec(fmi_version: int = 2, preset=None, static_force=None) 
                    SOURCES, {"pam_model.c": cmodel.sources()["pam_model.c"], "pam_fmu_core.h": CORE_HEADER},
                    tuple(table.c_lines()) + tuple(lines), preset.signals if preset is not None else {},
                    preset.experiment if preset is not None else None, fmi_version=fmi_version,
-                   included=("pam_engine.c",))
+                   included=("pam_engine.c",), usage=_usage(None, preset))
     return replace(spec, token=_token(spec))
 
 
 def _description(preset) -> str:
-    from .generate import DESCRIPTION
+    from .generate import description
 
-    return DESCRIPTION + " (generated from pamsim's components)" + (f"; built for {preset.built_for}" if preset else "")
+    return description(None, preset)
 
 
 def build_generated(output_path, fmi_version: int = 2, scenario=None):

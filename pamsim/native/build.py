@@ -20,7 +20,7 @@ from pathlib import Path
 from ..errors import InputError
 from ..fmu.build import c_compiler, shared_library_suffix
 from ..fmu.force_table import EMPTY_HEADER
-from ..fmu.generate import CORE_HEADER, c_header, c_source_dir
+from ..fmu.generate import CORE_HEADER, c_source_dir, hand_written_spec, spec_c_header
 
 SOURCES = ("pam_native.c", "pam_native.h", "pam_core.c", "pam_core.h", "pam_dopri.h", "pam_gauss.h", "pam_shared.h",
            "pam_log.h", "pam_fmu_common.c", "pam_fmu_common.h")
@@ -47,7 +47,7 @@ def library_token(cc: str) -> str:
     src = c_source_dir() / "src"
     for name in SOURCES:
         h.update(name.encode() + b"\0" + (src / name).read_bytes())
-    h.update(c_header(2).encode())
+    h.update(_core_header().encode())
     h.update(EMPTY_HEADER.encode())
     h.update("\0".join((cc, *FLAGS)).encode())
     return h.hexdigest()[:24]
@@ -69,7 +69,7 @@ def library_path() -> Path:
     folder.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix="build-", dir=folder) as tmp:
         work = Path(tmp)
-        (work / "pam_variables.h").write_text(c_header(2))
+        (work / "pam_variables.h").write_text(_core_header())
         # No force table: the library runs the polynomial; other static forces are refused before a run.
         (work / "pam_force_table.h").write_text(EMPTY_HEADER)
         (work / "pam_fmu_core.h").write_text(CORE_HEADER)
@@ -87,3 +87,8 @@ def compile_library(cc: str, main: str, work: Path, name: str, what: str) -> Pat
     if proc.returncode != 0:
         raise InputError(f"compiling {what} failed ({cc} ...): {proc.stderr.strip()}")
     return partial
+
+
+def _core_header() -> str:
+    """``pam_variables.h`` of the core written by hand, which the library's force-table path runs."""
+    return spec_c_header(hand_written_spec(2))
