@@ -18,12 +18,17 @@ from .variables import Var
 
 @dataclass(frozen=True, eq=False)
 class External:
-    """``symbol`` stands for ``fn(*args)``, computed by the host on floats (:attr:`Symbols.external`)."""
+    """``symbol`` stands for ``fn(*args)``, computed by the host on floats (:attr:`Symbols.external`).
+
+    ``casadi``, if not None, is the same function as a CasADi ``Function`` of the stacked arguments (built
+    on MX: a table lookup has no SX form), through which the generated C and the exact Jacobians go
+    (:mod:`pamsim.modeling.lifting`)."""
 
     name: str
     fn: Any
     symbol: Any
     args: list[Any]
+    casadi: Any = None
 
 
 @dataclass(eq=False)
