@@ -39,15 +39,24 @@ def lifted(ca, name: str, args: list, outs: list, externals, jacobian: bool = Fa
     NotImplementedError
         If a result reads an external that has no CasADi form, or one whose arguments read another.
     """
-    used = read_externals(ca, outs, externals)
-    if not used:
+    if not read_externals(ca, outs, externals):
         if jacobian:
             return ca.Function(name, args, [ca.cse(ca.densify(ca.jacobian(_column(ca, outs), ca.vertcat(*args))))])
         return ca.Function(name, args, [ca.cse(ca.densify(o)) for o in outs])
+    mx, res = composed(ca, name, args, outs, externals)
+    if jacobian:
+        return ca.Function(name, mx, [ca.densify(ca.jacobian(ca.vertcat(*res), ca.vertcat(*mx)))])
+    return ca.Function(name, mx, [ca.densify(r) for r in res])
+
+
+def composed(ca, name: str, args: list, outs: list, externals) -> tuple[list, list]:
+    """MX symbols shaped as ``args`` and ``outs`` in them, each external placeholder replaced by its CasADi
+    form of its arguments (:func:`lifted`, whose errors it raises)."""
+    used = read_externals(ca, outs, externals)
     lacking = [ext.name for ext in used if ext.casadi is None]
     if lacking:
         raise NotImplementedError(f"no C for the external functions {', '.join(lacking)} (Python-only physics)")
-    w = ca.vertcat(*[ext.symbol for ext in used])
+    w = ca.vertcat(*[ext.symbol for ext in used]) if used else ca.SX(0, 1)
     ext_args = _column(ca, [a for ext in used for a in ext.args])
     if ca.depends_on(ext_args, w):
         raise NotImplementedError(f"{name}: an external function's argument reads another external function")
@@ -59,8 +68,5 @@ def lifted(ca, name: str, args: list, outs: list, externals, jacobian: bool = Fa
     for ext in used:
         values.append(ext.casadi(stacked[at:at + len(ext.args)]))
         at += len(ext.args)
-    res = G(*mx, ca.vertcat(*values))
-    res = list(res) if isinstance(res, (list, tuple)) else [res]
-    if jacobian:
-        return ca.Function(name, mx, [ca.densify(ca.jacobian(ca.vertcat(*res), ca.vertcat(*mx)))])
-    return ca.Function(name, mx, [ca.densify(r) for r in res])
+    res = G(*mx, ca.vertcat(*values) if values else ca.MX(0, 1))
+    return mx, list(res) if isinstance(res, (list, tuple)) else [res]
