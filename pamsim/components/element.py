@@ -123,6 +123,12 @@ def _stable(value, baked: bool):
         return structure_key(value, baked)
     if isinstance(value, Mapping):
         return ("mapping", tuple(sorted((str(k), _stable(v, True)) for k, v in value.items())))
+    return _stable_other(value)
+
+
+def _stable_other(value):
+    """:func:`_stable` of a function, a partial or another object: by what it is made of where that can
+    be told from outside, else as itself."""
     if isinstance(value, types.FunctionType) and not value.__closure__ and not value.__defaults__:
         return ("function", value.__module__, value.__qualname__, value.__code__)
     if isinstance(value, functools.partial):
