@@ -251,23 +251,12 @@ def test_the_generated_fmu_of_a_tabulated_model_runs_its_table_as_python_does(tm
         assert np.max(np.abs(r["load.x_m"] - np.interp(r["time"], ref.t_s, ref.x_m))) * 1e3 < 10 * bound_mm
 
 
-def test_generated_needs_a_scenario_whose_physics_has_c(tmp_path, monkeypatch):
-    """A static model that takes floats alone (Gaylord's name given to one calling :mod:`math`) has no C:
-    the generated FMU is refused naming it, and nothing is written."""
+def test_generated_needs_a_scenario_whose_physics_has_c(tmp_path, floats_only_gaylord):
+    """A static model that takes floats alone has no C: the generated FMU is refused naming it, and
+    nothing is written."""
     from pamsim.errors import InputError
     from pamsim.fmu.assembly_fmu import build_assembly
-    from pamsim.static_models.base import Domain, StaticModelSpec
 
-    class FloatsOnly:
-        name = "gaylord"
-        domain = Domain(0.0, 0.06, 0.0, 1e6)
-
-        def force_N(self, x_m, p_gauge_Pa):
-            return math.fsum([p_gauge_Pa * 2e-4, -500.0 * x_m])
-
-    build = StaticModelSpec.build
-    monkeypatch.setattr(StaticModelSpec, "build", lambda spec, params, variant=None:
-                        FloatsOnly() if spec.name == "gaylord" else build(spec, params, variant))
     scenario = pamsim.load_scenario(SCENARIO).with_changes({"model": {"static_force": "gaylord"}})
     with pytest.raises(InputError, match="needs C for every component.*muscle.force_N"):
         build_assembly(scenario, tmp_path / "c.fmu")

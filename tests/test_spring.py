@@ -143,24 +143,9 @@ def test_native_runs_added_components_with_a_tabulated_static_force_as_python_do
     np.testing.assert_allclose(nat.signals["spring.F_spring_N"], py.signals["spring.F_spring_N"], atol=2e-4)
 
 
-def test_native_refuses_added_components_it_cannot_write_in_c(monkeypatch):
-    """A static model that takes floats alone (here Gaylord's name given to one that calls :mod:`math`)
-    has no C: with a component added, the native backend refuses it by name rather than run
-    it without the component."""
-    import math
-
-    from pamsim.static_models.base import Domain, StaticModelSpec
-
-    class FloatsOnly:
-        name = "gaylord"
-        domain = Domain(0.0, 0.06, 0.0, 1e6)
-
-        def force_N(self, x_m, p_gauge_Pa):
-            return math.fsum([p_gauge_Pa * 2e-4, -500.0 * x_m])
-
-    build = StaticModelSpec.build
-    monkeypatch.setattr(StaticModelSpec, "build", lambda spec, params, variant=None:
-                        FloatsOnly() if spec.name == "gaylord" else build(spec, params, variant))
+def test_native_refuses_added_components_it_cannot_write_in_c(floats_only_gaylord):
+    """A static model that takes floats alone has no C: with a component added, the native backend
+    refuses it by name rather than run it without the component."""
     with pytest.raises(InputError, match="component.*'gaylord'"):
         pamsim.simulate(_scenario({"model": {"static_force": "gaylord"}}), backend="native")
 
