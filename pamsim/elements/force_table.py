@@ -35,10 +35,10 @@ import numpy as np
 from ..static_models.spline import SplineSurface
 
 N_X = 65
-"""Default grid points along the contraction (a pamsim choice: table error below 0.1 % of the
-blocked force at the rated pressure for every implicit model shipped, docs/model.md)."""
+"""Grid points along the contraction that refinement starts from (a pamsim choice: the grid of the
+FMU's force table; the smooth library models need no more, docs/model.md)."""
 N_P = 33
-"""Default grid points along the pressure."""
+"""Grid points along the pressure that refinement starts from."""
 REFINE_TOL = 2.5e-4
 """Largest miss of the spline at a cell centre, relative to the larger of the table's largest pull and
 the force there (a pamsim choice: a quarter of the 0.1 % of the blocked force the tables are held to,
