@@ -7,7 +7,9 @@ Fields that choose a form rather than give a number (``name``, ``negative_level`
 An element that cannot be rebuilt so (not a dataclass, a check of its numbers in ``__post_init__``)
 or whose method does not give on symbols what it gives on floats (a table lookup, a numerical solve,
 a :mod:`math` call, which turns a symbol into NaN without a word) is called on floats instead, as an
-external function (:attr:`pamsim.modeling.component.Symbols.external`): correct, Python only.
+external function (:attr:`pamsim.modeling.component.Symbols.external`): correct, and in generated C
+too where the method has a CasADi form (:meth:`ElementParameters.casadi_form`: a spline table's
+B-spline), else Python only.
 """
 
 from __future__ import annotations
