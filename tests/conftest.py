@@ -132,3 +132,24 @@ def slow_study(folder: Path, samples: int = 2000) -> Path:
                     f'[uncertainty]\nsamples = {samples}\nseed = 3\n[uncertainty.parameters.N0_N_per_bar]\n'
                     'distribution = "uniform"\nrelative = true\nlower = 0.9\nupper = 1.1\n')
     return path
+
+
+@pytest.fixture
+def floats_only_gaylord(monkeypatch):
+    """Gaylord's model name given to a static model that takes floats alone (it calls :mod:`math`), so it
+    has neither a symbolic nor a CasADi form: what needs C must refuse it by name."""
+    import math
+
+    from pamsim.static_models.base import Domain, StaticModelSpec
+
+    class FloatsOnly:
+        name = "gaylord"
+        domain = Domain(0.0, 0.06, 0.0, 1e6)
+
+        def force_N(self, x_m, p_gauge_Pa):
+            return math.fsum([p_gauge_Pa * 2e-4, -500.0 * x_m])
+
+    build = StaticModelSpec.build
+    monkeypatch.setattr(StaticModelSpec, "build", lambda spec, params, variant=None:
+                        FloatsOnly() if spec.name == "gaylord" else build(spec, params, variant))
+    return "gaylord"

@@ -293,17 +293,23 @@ def test_every_static_force_of_every_shipped_muscle_is_a_component():
 
 def test_a_force_table_is_an_external_function():
     """A tabulated static force (an implicit model's) has no symbolic form: the component calls it on
-    floats, the Python model equals it, and what needs symbols (C, exact Jacobians) says so by name."""
-    from pamsim.elements.force_table import tabulate
+    floats, and the Python model equals it.  Its spline has a CasADi form, through which the exact
+    Jacobians go: the table of the polynomial (quadratic in x, affine in p, so the spline reproduces
+    it) has the polynomial model's own Jacobians, a second implementation."""
+    from pamsim.elements.force_table import TabulatedStaticForce
     from pamsim.static_models.acra2012 import Acra2012Polynomial
 
     sc = load_scenario(FIG4)
     poly = Acra2012Polynomial.from_parameters(sc.parameters)
-    table = tabulate(poly, (0.0, 0.08), (0.0, 4.5e5), n_x=33, n_p=9, key=None)
+    # Over every state drawn below (beyond the polynomial's fitted domain, which tabulate would keep to).
+    x, p = np.linspace(0.0, sc.build_model().stops.x_high_m, 33), np.linspace(-2e5, 6e5, 9)
+    table = TabulatedStaticForce(poly.name, poly.domain, x, p, poly.force_N(*np.meshgrid(x, p, indexing="ij")))
     model = dataclasses.replace(sc.build_model(), static_force=table)
     flat = _flat(model)
     assert [e.name for e in flat.externals] == ["muscle.force_N"]
     g = flat.compile_python()
+    flat_poly = _flat(dataclasses.replace(model, static_force=poly))  # its coefficients are parameters
+    jac, jac_poly = flat.function("jacobian"), flat_poly.function("jacobian")
     rng = np.random.default_rng(23)
     for _ in range(200):
         y, ins, F_ext = _random_state(model, rng)
@@ -314,10 +320,13 @@ def test_a_force_table_is_an_external_function():
             want = model.slip_rhs(x, float(mode), ins, F_ext) if mode.is_slip else model.held_rhs(x, ins)
             (got,) = g.f(list(x), [*ins, F_ext], flat.parameter_values, [float(mode)])
             np.testing.assert_array_equal(got, want)
+            u, q = [*ins, F_ext], [float(mode)]
+            for a, b in zip(jac(list(x), u, flat.parameter_values, q),
+                            jac_poly(list(x), u, flat_poly.parameter_values, q)):
+                a, b = np.array(a), np.array(b)
+                np.testing.assert_allclose(a, b, rtol=1e-7, atol=1e-7 * max(1.0, np.abs(b).max()))
     with pytest.raises(NotImplementedError, match="muscle.force_N"):
-        flat.c_sources()
-    with pytest.raises(NotImplementedError, match="muscle.force_N"):
-        flat.function("jacobian")
+        flat.c_sources()  # the flat model's own C (cgen) has no external functions; the engine's C lifts them
 
 
 # ---------------------------------------------------------------- elements of other forms

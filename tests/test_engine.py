@@ -1,8 +1,8 @@
 """The generic C engine running the generated model, against the hand-written C core it replaces in the
 native backend, against hand calculations, and its code generation and caching.
 
-The hand-written core (``fmu/src/pam_core.c``) still runs the FMU and the native force tables, so it
-is a second implementation to compare with: the same integrator and event logic, physics written by
+The hand-written core (``fmu/src/pam_core.c``) still runs the one-muscle FMU (and, natively, a static
+model that takes floats alone), so it is a second implementation to compare with: the same integrator and event logic, physics written by
 hand.  The two compute the same expressions in different orders, so they agree to rounding at first;
 a bound on the later events of a long oscillation would measure only how fast it amplifies rounding
 (``benchmarks/regression.py`` explains), so events are compared over the first ``EVENTS``.

@@ -97,8 +97,7 @@ def test_other_element_choices_and_initial_state_match_the_python_backend():
 
 
 def test_hold_interval_of_the_piecewise_path():
-    """Where inputs are held (a force table on the hand-written core, a signal given as a Python
-    callable), a 10 ms lag is held over pieces of at most tau / 10 and at most one output sample."""
+    """Where inputs are held (a signal given as a Python callable), a 10 ms lag is held over pieces of at most tau / 10 and at most one output sample."""
     sc = pamsim.Scenario.from_dict({"load": {"weight_N": 22.74}, "simulation": {"duration_s": 4.0},
                                     "pressure": {"source": "prescribed", "prescribed": {
                                         "kind": "lag", "time_s": 1.0, "tau_s": 0.01, "final_gauge_bar": 3.6}}})
@@ -247,9 +246,9 @@ def _write_sweep(folder: Path, base: Path) -> Path:
 
 
 def test_a_force_table_case_takes_its_inputs_exactly_too():
-    """The implicit two-phase model runs natively as a force table on the hand-written core: a pressure
+    """The implicit two-phase model runs natively as its spline table's B-spline on the engine: a pressure
     ramp there is exact as well, so 10 Hz and 1 kHz output give the same run (they differed before by
-    the midpoint hold), within the table's error of the python backend's exact model."""
+    the midpoint hold), within the integrators' difference of the python backend's run of the same table."""
     spec = {"model": {"muscle": "mpam_survey_45mm", "static_force": "mpam_two_phase"}, "parameters": {"E_nylon_Pa": 3e9},
             "load": {"weight_N": 0.05}, "simulation": {"duration_s": 2.0},
             "pressure": {"source": "prescribed",

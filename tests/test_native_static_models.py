@@ -1,7 +1,7 @@
 """Library static models on the native backend: one written in symbols runs as generated C on the
-engine, any other as the FMU's bicubic force table on the hand-written core; either way its trajectories
-follow the Python backend's (which evaluates the model itself) to within the integrators' and the
-table's errors."""
+engine, a tabulated one as its spline table's B-spline on the engine; either way its trajectories
+follow the Python backend's (which evaluates the same model or table) to within the integrators'
+errors."""
 
 from pathlib import Path
 
@@ -33,7 +33,7 @@ def test_native_table_run_follows_the_python_model(changes):
 
 def test_kothera_muscle_with_its_energy_model():
     """A muscle whose parameters the C core does not have (wall thickness, bladder modulus) runs: they
-    only shape the force table."""
+    are the static force component's parameters on the engine."""
     sc = pamsim.load_scenario(SCENARIOS / "acra2012_fig4.toml").with_changes(
         {"model": {"muscle": "kothera2009_5a", "static_force": "kothera_energy"},
          "simulation": {"duration_s": 2.0}})

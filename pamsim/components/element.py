@@ -7,7 +7,9 @@ Fields that choose a form rather than give a number (``name``, ``negative_level`
 An element that cannot be rebuilt so (not a dataclass, a check of its numbers in ``__post_init__``)
 or whose method does not give on symbols what it gives on floats (a table lookup, a numerical solve,
 a :mod:`math` call, which turns a symbol into NaN without a word) is called on floats instead, as an
-external function (:attr:`pamsim.modeling.component.Symbols.external`): correct, Python only.
+external function (:attr:`pamsim.modeling.component.Symbols.external`): correct, and in generated C
+too where the method has a CasADi form (:meth:`ElementParameters.casadi_form`: a spline table's
+B-spline), else Python only.
 """
 
 from __future__ import annotations
@@ -113,6 +115,8 @@ def _stable(value, baked: bool):
     """
     if value is None or isinstance(value, (bool, int, float, str)):
         return value
+    if not isinstance(value, type) and callable(getattr(value, "code_key", None)):
+        return value.code_key()  # an object that says what its code depends on (a spline surface)
     if isinstance(value, (tuple, list)):
         return (type(value).__name__, tuple(_stable(v, True) for v in value))
     if isinstance(value, np.ndarray):
@@ -121,6 +125,12 @@ def _stable(value, baked: bool):
         return structure_key(value, baked)
     if isinstance(value, Mapping):
         return ("mapping", tuple(sorted((str(k), _stable(v, True)) for k, v in value.items())))
+    return _stable_other(value)
+
+
+def _stable_other(value):
+    """:func:`_stable` of a function, a partial or another object: by what it is made of where that can
+    be told from outside, else as itself."""
     if isinstance(value, types.FunctionType) and not value.__closure__ and not value.__defaults__:
         return ("function", value.__module__, value.__qualname__, value.__code__)
     if isinstance(value, functools.partial):
@@ -205,6 +215,32 @@ def _probe(element, method, points) -> bool:
     return True
 
 
+def _mx_function(name: str, element, call: Callable, points: Sequence[tuple[float, ...]]):
+    """``call(element, *args)`` as a CasADi ``Function`` of the stacked arguments, built on MX symbols, or
+    None where it does not take them (a numerical solve, a :mod:`math` call) or does not give at
+    ``points`` what it gives on floats there."""
+    import casadi as ca
+
+    a = ca.MX.sym("a", len(points[0]))
+    try:
+        with quiet_numpy_on_symbols(), warnings.catch_warnings(), np.errstate(all="ignore"):
+            warnings.simplefilter("ignore")
+            out = ca.MX(call(element, *ca.vertsplit(a)))
+        fn = ca.Function(name, [a], [out])
+    except Exception:  # whatever a float-only element raises on a symbol: it has no C form
+        return None
+    if fn.has_free():
+        return None
+    for point in points:
+        try:
+            want = float(call(element, *point))
+        except (ValueError, ZeroDivisionError, OverflowError, TypeError):
+            continue  # no value here on floats: nothing to compare
+        if math.isfinite(want) and not abs(float(fn(ca.DM(point))) - want) <= 1e-9 * max(1.0, abs(want)):
+            return None
+    return fn
+
+
 class ElementParameters:
     """Mixin: a component whose parameters are the numbers of its element (``self.element``) when the
     element takes symbols (``self.traces``); otherwise it has none and calls the element on floats."""
@@ -236,19 +272,42 @@ class ElementParameters:
         and return its parameter values.  ``required``: what to call it in the ``TypeError`` raised when
         it must take symbols and does not (an element the python backend cannot call on floats)."""
         self.element = element
-        for kept in ("_element_values", "_parameter_vars"):
+        for kept in [k for k in self.__dict__ if k in ("_element_values", "_parameter_vars")
+                     or (isinstance(k, tuple) and k[0] == "_casadi_form")]:
             self.__dict__.pop(kept, None)
         self._form = structure_key(element)
+        self._probe, self._probe_points = probe, tuple(points)
         self.traces = traces(element, probe, points, self._form)
         if required and not self.traces:
             raise TypeError(f"{required} {type(element).__name__} cannot be written with symbols")
         return self.element_values()
 
     def element_call(self, s, method: str, *args):
-        """``element.method(*args)``: as equations if the element takes symbols, else on floats."""
+        """``element.method(*args)``: as equations if the element takes symbols, else on floats, with its
+        CasADi form (:meth:`casadi_form`) if it has one."""
         if self.traces:
             return getattr(self.symbolic_element(s.p), method)(*args)
-        return s.external(method, getattr(self.element, method), *args)
+        return s.external(method, getattr(self.element, method), *args, casadi=self.casadi_form(method, len(args)))
+
+    def casadi_form(self, method: str, n_args: int):
+        """``element.method`` as a CasADi ``Function`` of its ``n_args`` arguments stacked, built on MX
+        symbols (a spline table's lookup has an MX form but no SX form), or None if the method does not
+        take MX symbols: then the element runs in Python only."""
+        if n_args != len(self._probe_points[0]):
+            return None
+        return self._casadi_of(method, lambda element, *a: getattr(element, method)(*a))
+
+    def _casadi_of(self, name: str, call: Callable):
+        # Checked at the probe points of wrap: the method a component calls takes the probe's arguments.
+        key = ("_casadi_form", name)
+        if key not in self.__dict__:
+            self.__dict__[key] = _mx_function(f"{type(self.element).__name__}_{name}", self.element, call,
+                                              self._probe_points)
+        return self.__dict__[key]
+
+    def has_c_form(self) -> bool:
+        """Whether the element runs in generated C: it takes symbols, or it has a CasADi form (its probe's)."""
+        return self.traces or self._casadi_of("probe", self._probe) is not None
 
     def structure_key(self) -> tuple:
         """The component's key, with the element's form (and its numbers, if they are baked into the code)."""

@@ -19,7 +19,8 @@ class MuscleStaticForce(ElementParameters, Component):
     An element written in operations that act on symbols (the closed-form models) becomes equations
     with its numbers as parameters; one that is not (a force table, a numerical solve) is called on
     floats as an external function (:attr:`pamsim.modeling.component.Symbols.external`), which runs
-    in Python only.  State ``W_muscle_J``: the muscle's work, integral of ``F v``.
+    in generated C too if it has a CasADi form (a spline table's B-spline), else in Python only.
+    State ``W_muscle_J``: the muscle's work, integral of ``F v``.
     """
 
     ports = (Port("flange", TRANSLATIONAL, "branch"),)

@@ -261,9 +261,9 @@ class _Flattening:
 
     def _external(self, component: Component):
         """The component's :attr:`Symbols.external`: a symbol for each call, noted with its function and arguments."""
-        def call(name: str, fn, *args):
+        def call(name: str, fn, *args, casadi=None):
             sym = self.ca.SX.sym(f"{component.name}.{name}#{len(self.externals)}")
-            self.externals.append(External(f"{component.name}.{name}", fn, sym, [self.ca.SX(a) for a in args]))
+            self.externals.append(External(f"{component.name}.{name}", fn, sym, [self.ca.SX(a) for a in args], casadi))
             return sym
         return call
 
@@ -288,7 +288,7 @@ class _Flattening:
         state_exprs = self._state_expressions()
         outputs = [self._flat(self.equations[c.name].outputs[v.name]) for c in self.components for v in c.outputs]
         mode_exprs = self._mode_expressions(hybrid, state_exprs["x0"])
-        externals = [External(e.name, e.fn, e.symbol, [self._flat(a) for a in e.args]) for e in self.externals]
+        externals = [External(e.name, e.fn, e.symbol, [self._flat(a) for a in e.args], e.casadi) for e in self.externals]
         return FlatModel(name=name, inputs=inputs, u=u, y=outputs, tol=self.tol, externals=externals,
                          **self._variables(), **self._symbol_lists(hybrid), **state_exprs, **mode_exprs)
 

@@ -36,6 +36,8 @@ from __future__ import annotations
 import os
 import tempfile
 
+from .lifting import lifted
+
 FUNCTIONS = ("f", "fq", "z", "tr", "rest", "settle", "y")
 """The per-mode functions, in the order they are generated."""
 
@@ -74,9 +76,9 @@ class CModel:
         for k, value in enumerate(self.mode_values):
             self._add_mode(ca, assembly.flatten({self.component: value}) if self.component else full, k)
         col = lambda es: ca.vertcat(*es) if es else ca.SX(0, 1)  # noqa: E731
-        self.functions.append(_dense(ca, "pm_x0_fn", [col(full.u), col(full.p)], [full.x0, full.q0]))
+        self.functions.append(_dense(ca, "pm_x0_fn", [col(full.u), col(full.p)], [full.x0, full.q0], full.externals))
         if jacobians:
-            self.functions.append(_forward(ca, "pm_dx0_fn", [full.u, full.p], full.x0))
+            self.functions.append(_forward(ca, "pm_dx0_fn", [full.u, full.p], full.x0, full.externals))
         self.extra = tuple(extra)
         self.functions += list(self.extra)
 
@@ -86,7 +88,7 @@ class CModel:
         own = [i for i, v in enumerate(m.states) if self.component and v.name.startswith(self.component + ".")]
         self.functions += self._mode_functions(ca, m, k)
         if self.jacobians:
-            self.functions.append(_forward(ca, f"pm_dir{k}", [m.x, m.u, m.p], m.f + m.y))
+            self.functions.append(_forward(ca, f"pm_dir{k}", [m.x, m.u, m.p], m.f + m.y, m.externals))
         self.held.append(bool(own) and all(ca.SX(m.f[i]).is_zero() for i in own))
         self.quad_zero.append(all(ca.SX(m.f[i]).is_zero() for i in self.quadratures))
 
@@ -96,14 +98,15 @@ class CModel:
         x, u, p, e, tol = col(m.x), col(m.u), col(m.p), col(m.e), m._tol()
         pick = lambda es, idx: [es[i] for i in idx]  # noqa: E731
         z = [a + b for a, b in zip(m.z, m.z_margin)]
+        ext = m.externals
         return [
-            _dense(ca, f"pm_f{k}", [xd, u, p], [pick(m.f, self.dynamic)]),
-            _dense(ca, f"pm_fq{k}", [xd, u, p], [pick(m.f, self.quadratures)]),
-            _dense(ca, f"pm_z{k}", [xd, u, p], [z]),
-            _dense(ca, f"pm_tr{k}", [xd, u, p, e], [pick(m.transition_x, self.dynamic), m.transition_q]),
-            _dense(ca, f"pm_rest{k}", [xd, u, p], [m.rest_q]),
-            _dense(ca, f"pm_settle{k}", [xd, u, p, tol], [pick(m.settle_x, self.dynamic)]),
-            _dense(ca, f"pm_y{k}", [x, u, p], [m.y]),
+            _dense(ca, f"pm_f{k}", [xd, u, p], [pick(m.f, self.dynamic)], ext),
+            _dense(ca, f"pm_fq{k}", [xd, u, p], [pick(m.f, self.quadratures)], ext),
+            _dense(ca, f"pm_z{k}", [xd, u, p], [z], ext),
+            _dense(ca, f"pm_tr{k}", [xd, u, p, e], [pick(m.transition_x, self.dynamic), m.transition_q], ext),
+            _dense(ca, f"pm_rest{k}", [xd, u, p], [m.rest_q], ext),
+            _dense(ca, f"pm_settle{k}", [xd, u, p, tol], [pick(m.settle_x, self.dynamic)], ext),
+            _dense(ca, f"pm_y{k}", [x, u, p], [m.y], ext),
         ]
 
     @property
@@ -200,11 +203,13 @@ class CModel:
 
 
 def _runnable(full, component: str | None):
-    """``full``, a flat model the C engine can run: no Python-only functions, at most one hybrid
-    component (``component``, if given).  Else :class:`NotImplementedError`, saying why."""
-    if full.externals:
-        raise NotImplementedError(f"{full.name}: no C for the external functions "
-                                  f"{', '.join(ext.name for ext in full.externals)} (Python-only physics)")
+    """``full``, a flat model the C engine can run: no Python-only functions (an external function must
+    have a CasADi form, :mod:`pamsim.modeling.lifting`), at most one hybrid component (``component``, if
+    given).  Else :class:`NotImplementedError`, saying why."""
+    lacking = [ext.name for ext in full.externals if ext.casadi is None]
+    if lacking:
+        raise NotImplementedError(f"{full.name}: no C for the external functions {', '.join(lacking)} "
+                                  "(Python-only physics)")
     hybrid = [name for name, _ in full.modes]
     if len(hybrid) > 1 or (component is not None and hybrid != [component]):
         raise NotImplementedError(f"{full.name}: the C engine runs models with at most one hybrid component "
@@ -212,19 +217,14 @@ def _runnable(full, component: str | None):
     return full
 
 
-def _forward(ca, name: str, wrt: list, exprs: list):
+def _forward(ca, name: str, wrt: list, exprs: list, externals=()):
     """A CasADi Function of ``wrt`` (lists of symbols) and one seed per list, giving the derivative of
     ``exprs`` along the seed (forward mode: the Jacobian times the seed)."""
     col = lambda es: ca.vertcat(*es) if es else ca.SX(0, 1)  # noqa: E731
-    args = [col(list(w)) for w in wrt]
-    seeds = [ca.SX.sym(f"d{k}", a.shape[0]) for k, a in enumerate(args)]
-    wrt_all, seed_all = ca.vertcat(*args), ca.vertcat(*seeds)
-    out = ca.jtimes(col(list(exprs)), wrt_all, seed_all) if wrt_all.shape[0] else ca.SX.zeros(len(exprs), 1)
-    return ca.Function(name, args + seeds, [ca.cse(ca.densify(out))])
+    return lifted(ca, name, [col(list(w)) for w in wrt], list(exprs), externals, forward=True)
 
 
-def _dense(ca, name: str, args: list, outs: list):
+def _dense(ca, name: str, args: list, outs: list, externals=()):
     """A CasADi Function whose every result entry is written (the C of a sparse result skips its zeros)."""
     col = lambda es: ca.vertcat(*es) if es else ca.SX(0, 1)  # noqa: E731
-    exprs = [ca.cse(ca.densify(col(list(o)) if isinstance(o, list) else o)) for o in outs]
-    return ca.Function(name, args, exprs)
+    return lifted(ca, name, args, [col(list(o)) if isinstance(o, list) else o for o in outs], externals)

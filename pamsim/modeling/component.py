@@ -26,10 +26,11 @@ class Symbols:
     it; for a branch port, the across variables of the node it is connected to.  ``mode`` is the
     component's discrete mode (a symbol that the generated code holds constant between events), or
     None for a component without modes; ``fired`` has one flag per indicator, 1 for those that have
-    crossed at an event (for :attr:`Equations.transition`).  ``external(name, fn, *args)`` stands
-    for ``fn(*args)`` computed by the host on floats: for physics that has no symbolic form (a table
-    lookup, a numerical solve), at the price of a model that runs in Python only, without exact
-    Jacobians.  ``tol`` is the relative tolerance of the integrator that asks for
+    crossed at an event (for :attr:`Equations.transition`).  ``external(name, fn, *args, casadi=None)``
+    stands for ``fn(*args)`` computed by the host on floats: for physics that has no SX form (a table
+    lookup, a numerical solve).  Without ``casadi`` (the same function as a CasADi ``Function`` of the
+    stacked arguments, on MX) the model runs in Python only, without exact Jacobians; with it, the
+    generated C and the Jacobians go through that function.  ``tol`` is the relative tolerance of the integrator that asks for
     :attr:`Equations.settle`.
     """
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
+from .lifting import composed
 from .signatures import FUNCTION_SIGNATURES
 from .variables import Var
 
@@ -18,12 +19,17 @@ from .variables import Var
 
 @dataclass(frozen=True, eq=False)
 class External:
-    """``symbol`` stands for ``fn(*args)``, computed by the host on floats (:attr:`Symbols.external`)."""
+    """``symbol`` stands for ``fn(*args)``, computed by the host on floats (:attr:`Symbols.external`).
+
+    ``casadi``, if not None, is the same function as a CasADi ``Function`` of the stacked arguments (built
+    on MX: a table lookup has no SX form), through which the generated C and the exact Jacobians go
+    (:mod:`pamsim.modeling.lifting`)."""
 
     name: str
     fn: Any
     symbol: Any
     args: list[Any]
+    casadi: Any = None
 
 
 @dataclass(eq=False)
@@ -101,30 +107,46 @@ class FlatModel:
             x, u, p, q, e, tol = self._vectors()
             w = ca.vertcat(*[ext.symbol for ext in self.externals]) if self.externals else ca.SX(0, 1)
             col = lambda es: ca.vertcat(*es) if es else ca.SX(0, 1)  # noqa: E731
+            ins, outs = self.signature(name)
             if name == "jacobian":
-                if self.externals:
-                    raise NotImplementedError(f"{self.name}: no exact Jacobian through the external functions "
-                                              f"{', '.join(ext.name for ext in self.externals)}")
-                f, y = col(self.f), col(self.y)
-                exprs = [ca.jacobian(f, x), ca.jacobian(f, u), ca.jacobian(y, x), ca.jacobian(y, u)]
-            elif name == "externals":
+                self._cache[key] = self._jacobian(x, u, p, q, ins, outs)
+                return self._cache[key]
+            if name == "externals":
                 exprs = [col([a for ext in self.externals for a in ext.args])]
             else:
                 exprs = [col(e) for e in self._expressions(name)]
             # SX keeps a subexpression once only where the components shared it; cse finds the rest.
             exprs = [ca.cse(e) for e in exprs]
-            ins, outs = self.signature(name)
             args = {"x": x, "u": u, "p": p, "q": q, "e": e, "tol": tol, "w": w}
             self._cache[key] = ca.Function(f"{self.name}_{name}", [args[a] for a in ins], exprs, list(ins), list(outs))
         return self._cache[key]
 
+    def _jacobian(self, x, u, p, q, ins, outs):
+        """The exact Jacobians (A, B, C, D): on the SX expressions, or through the CasADi forms of the
+        external functions (:mod:`pamsim.modeling.lifting`; NotImplementedError where one has none)."""
+        import casadi as ca
+
+        col = lambda es: ca.vertcat(*es) if es else ca.SX(0, 1)  # noqa: E731
+        f, y = col(self.f), col(self.y)
+        if not self.externals:
+            exprs = [ca.cse(j) for j in (ca.jacobian(f, x), ca.jacobian(f, u), ca.jacobian(y, x), ca.jacobian(y, u))]
+            return ca.Function(f"{self.name}_jacobian", [x, u, p, q], exprs, list(ins), list(outs))
+        try:
+            (X, U, P, Q), (F, Y) = composed(ca, f"{self.name}_jacobian", [x, u, p, q], [f, y], self.externals)
+        except NotImplementedError as exc:
+            raise NotImplementedError(f"{self.name}: no exact Jacobian through the external functions: {exc}") from None
+        jac = [ca.jacobian(F, X), ca.jacobian(F, U), ca.jacobian(Y, X), ca.jacobian(Y, U)]
+        return ca.Function(f"{self.name}_jacobian", [X, U, P, Q], jac, list(ins), list(outs))
+
     def signature(self, name: str) -> tuple[tuple[str, ...], tuple[str, ...]]:
         """Arguments and results of generated function ``name``.  With external functions, each
-        function also takes ``w``, their values, and ``externals(x, u, p, q)`` gives their arguments."""
+        function but the Jacobians (which go through the externals' CasADi forms) also takes ``w``, their
+        values, and ``externals(x, u, p, q)`` gives their arguments."""
         if name == "externals":
             return ("x", "u", "p", "q"), ("args",)
         ins, outs = FUNCTION_SIGNATURES[name]
-        return (ins + ("w",) if self.externals else ins), outs
+        # The Jacobians go through the externals' CasADi forms rather than take their values.
+        return (ins + ("w",) if self.externals and name != "jacobian" else ins), outs
 
     def depends_on_inputs(self, name: str) -> bool:
         """Whether function ``name`` reads the inputs at all (a sliding load's indicators do not),

@@ -114,11 +114,12 @@ class CaseInputs:
 
 
 def engine_assembly(scenario: Scenario, model: MuscleModel | None = None):
-    """The scenario's assembly if the generic engine can run it (every component written in symbols),
-    else None: a static model called on floats (an implicit or tabulated one) runs as a force table on
-    the hand-written C core.  ``model``: as :func:`case_inputs` takes it."""
+    """The scenario's assembly if the generic engine can run it (every component in generated C: written
+    in symbols, or with a CasADi form, as a spline table has), else None: a static model called on floats
+    alone runs as a force table on the hand-written C core.  ``model``: as :func:`case_inputs` takes it."""
     assembly = scenario_assembly(scenario, model)
-    return assembly if all(getattr(c, "traces", True) for c in assembly.components) else None
+    in_c = (c.has_c_form() if hasattr(c, "has_c_form") else getattr(c, "traces", True) for c in assembly.components)
+    return assembly if all(in_c) else None
 
 
 def refuse_unsupported(scenario: Scenario) -> None:

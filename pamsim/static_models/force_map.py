@@ -4,10 +4,12 @@ File format: comment lines start with ``#``; a header row names three columns
 ``contraction_m`` (x = L0 - L [m]), ``pressure_gauge_Pa`` [Pa] and ``force_N``
 [N]; one row per point of a full rectangular grid (every contraction with every
 pressure, any order, at least two values of each).  The force is interpolated by
-a bicubic interpolating spline (``scipy.interpolate.RectBivariateSpline``,
-``s = 0``; degree lowered to ``n - 1`` along an axis with fewer than four values),
-which is exact for data that are cubic in each variable and smooth (C2) in
-between.  The domain is the table's extent: no extrapolation.
+a bicubic interpolating spline (:class:`pamsim.static_models.spline.SplineSurface`:
+``scipy.interpolate.RectBivariateSpline``, ``s = 0``; degree lowered to ``n - 1``
+along an axis with fewer than four values), which is exact for data that are
+cubic in each variable and smooth (C2) in between; the native engine and the FMU
+evaluate the same spline in generated C.  The domain is the table's extent: no
+extrapolation (outside it the force is held at the nearest edge).
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ import numpy as np
 
 from ..errors import InputError
 from .base import Domain, StaticForce, StaticModelSpec
+from .spline import SplineSurface
 
 COLUMNS = ("contraction_m", "pressure_gauge_Pa", "force_N")
 
@@ -126,9 +129,7 @@ class ForceMap(StaticForce):
 
     def __init__(self, x_m: np.ndarray, p_Pa: np.ndarray, F_N: np.ndarray, origin: str = "<table>"):
         self.origin = origin
-        from scipy.interpolate import RectBivariateSpline  # on use: `pamsim static` starts without it
-
-        self.spline = RectBivariateSpline(x_m, p_Pa, F_N, kx=min(3, len(x_m) - 1), ky=min(3, len(p_Pa) - 1), s=0)
+        self.spline = SplineSurface(x_m, p_Pa, F_N)
         self.domain = Domain(float(x_m[0]), float(x_m[-1]), float(p_Pa[0]), float(p_Pa[-1]))
 
     @classmethod
@@ -137,10 +138,7 @@ class ForceMap(StaticForce):
         return cls(*read_force_map(path), origin=str(path))
 
     def force_N(self, x_m, p_gauge_Pa):
-        if isinstance(x_m, float) and isinstance(p_gauge_Pa, float):
-            return float(self.spline.ev(x_m, p_gauge_Pa))
-        x, p = np.broadcast_arrays(np.asarray(x_m, dtype=float), np.asarray(p_gauge_Pa, dtype=float))
-        return self.spline.ev(x, p)
+        return self.spline(x_m, p_gauge_Pa)
 
 
 SPECS = (
