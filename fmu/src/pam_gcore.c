@@ -76,7 +76,7 @@ static int run_checks(PamCore *c, unsigned vr, double value) {
         const PamCheck *check = &PAM_CHECKS[j];
         const double *v = out + PAM_NCHECKS + check->first_value;
         if (check->input_vr != vr || out[j] != 0.0) continue;
-        pam_logf(c, PAM_LOG_ERROR, check->message, v[0], v[1], v[2]);
+        pam_logf(c, PAM_LOG_ERROR, check->message, v[0], v[1], v[2], v[3]);
         bad = -1;
     }
     return bad;

@@ -9,32 +9,23 @@ any change gives a new token.
 from __future__ import annotations
 
 import datetime
-import hashlib
 import html
 import math
 import os
 import subprocess
-import uuid
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
 from .. import __version__
 from ..references import REFERENCES
 from .units import base_unit
-from .force_table import EMPTY_HEADER, ForceTable
+from .force_table import ForceTable
 from .spec import FmuSpec
-from .variables import (EVENT_INDICATORS, INPUT_SOURCE_CHOICES, INPUTS, STATES, VARIABLES, value_reference,
-                        with_preset)
+from .variables import INPUT_SOURCE_CHOICES, VARIABLES
 
 MODEL_NAME = "pamsim_muscle"
 MODEL_IDENTIFIER = "pamsim_muscle"
 C_DIR = Path(__file__).resolve().parents[2] / "fmu"  # the source tree; an installed wheel has pamsim.fmu.csrc
-CORE_SOURCES = ("pam_core.c", "pam_core.h", "pam_dopri.h", "pam_shared.h", "pam_log.h", "pam_fmu_common.c",
-                "pam_fmu_common.h", "fmi_shell.c", "fmi_shell.h")
-"""The hand-written C sources (pam_shared.h is generated but committed); ``pam_variables.h``,
-``pam_force_table.h`` and ``pam_fmu_core.h`` are generated at build time."""
-CORE_HEADER = '#include "pam_core.h" /* the one-muscle core written by hand */\n'
-"""``pam_fmu_core.h``: the core the FMI shell runs on."""
 WRAPPERS = {2: "fmi2_wrapper.c", 3: "fmi3_wrapper.c"}
 HEADERS = {2: ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h"),
            3: ("fmi3Functions.h", "fmi3FunctionTypes.h", "fmi3PlatformTypes.h")}
@@ -55,7 +46,7 @@ def description(table: ForceTable | None = None, preset=None) -> str:
         what = f"{table.model_name} ({spec.summary}; {spec.source})" if spec else table.model_name
         nx, n_p = table.shape
         text = ("McKibben muscle lifting a hanging load (pamsim): static force " + what + ", tabulated at build "
-                f"time as a {nx} x {n_p} bicubic force table over contraction {table.x_min_m * 1e3:g} to "
+                f"time as a {nx} x {n_p} bicubic spline table over contraction {table.x_min_m * 1e3:g} to "
                 f"{table.x_max_m * 1e3:g} mm and gauge pressure {table.p_min_Pa:g} to {table.p_max_Pa:g} Pa "
                 "(never extrapolated), load-dependent Coulomb friction with stick/slip, damping, ISO 6358 valve "
                 "and chamber, end stops")
@@ -102,49 +93,18 @@ def c_source_dir() -> Path:
     raise InputError(f"the FMU's C sources are neither at {C_DIR / 'src'} nor in the installed package")
 
 
-def table_text() -> str:
-    """A canonical text form of the variable table (hashed into the token)."""
-    return "\n".join(repr(v) for v in VARIABLES)
-
-
 def token(fmi_version: int, table: ForceTable | None = None, preset=None) -> str:
     """A hash of everything an FMU's binary is built from: sources, generated headers, table, preset."""
-    if table is None and (preset is None or preset.table is None):
-        return one_muscle_spec(fmi_version, table, preset).token
-    h = hashlib.sha256()
-    src = c_source_dir() / "src"
-    for name in CORE_SOURCES + (WRAPPERS[fmi_version],):
-        h.update((src / name).read_bytes())
-    h.update(table_text().encode())
-    h.update(str(fmi_version).encode())
-    if table is not None:
-        h.update(table.digest().encode())
-    if preset is not None:
-        h.update(preset.digest().encode())
-    return "{" + str(uuid.UUID(bytes=h.digest()[:16])) + "}"
+    return one_muscle_spec(fmi_version, table, preset).token
 
 
 def one_muscle_spec(fmi_version: int, table: ForceTable | None = None, preset=None) -> FmuSpec:
     """The :class:`~pamsim.fmu.spec.FmuSpec` of the one-muscle FMU, built with a force ``table`` and for a
     ``preset``, if any: generated from components (:mod:`pamsim.fmu.muscle_spec`), or with a force table
     on the core written by hand."""
-    if table is None and (preset is None or preset.table is None):
-        from .muscle_spec import muscle_generated_spec
+    from .muscle_spec import muscle_generated_spec
 
-        return muscle_generated_spec(fmi_version, preset)
-    return hand_written_spec(fmi_version, table, preset)
-
-
-def hand_written_spec(fmi_version: int, table: ForceTable | None = None, preset=None) -> FmuSpec:
-    """The spec of the one-muscle FMU whose core is written by hand (``pam_core.c``), with a force ``table``."""
-    variables = with_preset(VARIABLES, table, preset)
-    return FmuSpec(
-        variables, {v.name: value_reference(v.name) for v in variables}, STATES, EVENT_INDICATORS, INPUTS,
-        MODEL_NAME, MODEL_IDENTIFIER, "flat", description(table, preset), CORE_SOURCES,
-        {"pam_force_table.h": table.c_header() if table is not None else EMPTY_HEADER, "pam_fmu_core.h": CORE_HEADER},
-        signals=preset.signals if preset is not None else {},
-        experiment=preset.experiment if preset is not None else None, token=token(fmi_version, table, preset),
-        fmi_version=fmi_version, usage=_usage(table, preset))
+    return muscle_generated_spec(fmi_version, preset, table)
 
 
 def _num(x) -> str:

@@ -29,7 +29,7 @@ from ..elements.damping import DAMPING_MODELS
 from ..elements.force_clip import ClippedStaticForce
 from ..elements.friction import FRICTION_MODELS
 from ..elements.valve import Iso6358Orifice, ProportionalValve33
-from ..modeling.smath import if_else
+from ..modeling.smath import fmin, if_else
 from ..static_models.acra2012 import Acra2012Polynomial
 from ..static_models.geometry import Braid
 
@@ -97,19 +97,34 @@ class RigLaws:
     damping: tuple
 
 
-def rig_laws(k: Mapping[str, Any], static_force=None) -> RigLaws:
+def own_upper_stop(k: Mapping[str, Any]):
+    """The upper stop ``x_high_m`` gives: its value, or with 0 the braid lock of the geometry."""
+    return if_else(k["x_high_m"] > 0.0, k["x_high_m"], Braid.from_parameters(k).x_lock_m)
+
+
+def on_table(k: Mapping[str, Any], table) -> Any:
+    """1 where the FMU runs on its force ``table`` (``static_force_model = table``), else 0."""
+    return k["static_force_model"] == float(C_CHOICES["static_force_model"].index("table")) if table else 0.0
+
+
+def rig_laws(k: Mapping[str, Any], table=None) -> RigLaws:
     """The elements of the rig for the FMU's knobs ``k`` (its parameters, choices as numbers, and the
     load's mass), built by the elements' own ``from_parameters``: on floats the FMU's start values, on
-    symbols the generated parameter map.  ``static_force``: the scenario's static force, the
-    ``static_force_model = table`` option (None: the FMU has the ACRA 2012 polynomial only)."""
-    braid = Braid.from_parameters(k)
-    muscle = {"acra2012_polynomial": ClippedStaticForce(Acra2012Polynomial.from_parameters(k))}
-    muscle["table"] = static_force if static_force is not None else NoTable()
+    symbols the generated parameter map.  ``table``: the :class:`pamsim.fmu.force_table.ForceTable`
+    the ``static_force_model = table`` option runs on, clipped at zero as the polynomial is (None: the
+    FMU has the ACRA 2012 polynomial only).  On the table the travel stays within its contraction range."""
+    muscle = {"acra2012_polynomial": ClippedStaticForce(Acra2012Polynomial.from_parameters(k)),
+              "table": ClippedStaticForce(table) if table is not None else NoTable()}
+    x_high, inside = own_upper_stop(k), on_table(k, table)
+    if table is not None:
+        x_low = if_else(inside, max(0.0, table.x_min_m), 0.0)
+        x_high = if_else(inside, fmin(x_high, table.x_max_m), x_high)
+    else:
+        x_low = 0.0
     friction = {name: FRICTION_MODELS[law](k, {"friction_negative_level": level})
                 for name, law, level in FRICTION_OPTIONS}
     return RigLaws(
-        load={"mass_kg": k[MASS_INPUT], "g_m_s2": k["g_m_s2"], "x_low_m": 0.0,
-              "x_high_m": if_else(k["x_high_m"] > 0.0, k["x_high_m"], braid.x_lock_m),
+        load={"mass_kg": k[MASS_INPUT], "g_m_s2": k["g_m_s2"], "x_low_m": x_low, "x_high_m": x_high,
               "restitution": k["stop_restitution"], "min_rebound_speed_m_s": MIN_REBOUND_SPEED_M_S,
               "stick_margin_N": k["stick_margin_N"], "release_margin_N": k["release_margin_N"],
               "initial_contraction_m": k["initial_contraction_m"]},
@@ -142,7 +157,7 @@ def _numbers_of(element, like) -> list:
 def _element_values(component, element, like) -> dict:
     """``{parameter: value}`` of a component around ``like`` whose numbers come from ``element``."""
     names = [v.name for v in component.parameter_vars()]
-    return dict(zip(names, _numbers_of(element, like)))
+    return dict(zip(names, _numbers_of(element, like))) if names else {}
 
 
 def _selected_values(component: Selected, choice, elements: Mapping[str, Any], like: Mapping[str, Any]) -> dict:
@@ -184,14 +199,14 @@ def component_values(components: Mapping[str, Any], laws: RigLaws, like: RigLaws
     return out
 
 
-def knob_map(knobs: tuple[str, ...], flat_parameters: tuple[str, ...], start: Mapping[str, float], static_force=None):
+def knob_map(knobs: tuple[str, ...], flat_parameters: tuple[str, ...], start: Mapping[str, float], table=None):
     """The CasADi Function ``pm_kmap(k) -> p``: the generated model's parameters ``flat_parameters``
     from the FMU's knobs ``knobs`` (in that order), and its forward derivative ``pm_dkmap(k, dk) -> dp``."""
     import casadi as ca
 
     sym = {name: ca.SX.sym(name) for name in knobs}
-    like = rig_laws(start, static_force)
-    values = component_values(rig_components(like), rig_laws(sym, static_force), like)
+    like = rig_laws(start, table)
+    values = component_values(rig_components(like), rig_laws(sym, table), like)
     missing = sorted(set(flat_parameters) - set(values))
     if missing:
         raise ValueError(f"the parameter map leaves out {missing}")
@@ -211,10 +226,10 @@ SOURCE_INPUTS = {"valve_command": "pressure.command", "supply_pressure_gauge_Pa"
                  "prescribed_pressure_gauge_Pa": "pressure.prescribed_gauge_Pa"}
 
 
-def muscle_assembly(start: Mapping[str, float], static_force=None):
+def muscle_assembly(start: Mapping[str, float], table=None):
     """The one-muscle FMU's assembly at the knobs' values ``start`` (see :func:`rig_laws`)."""
     from ..assemblies.one_muscle import SourceParts, rig_assembly
 
-    c = rig_components(rig_laws(start, static_force))
+    c = rig_components(rig_laws(start, table))
     source = SourceParts([c["chamber"], c["valve"], c["pressure"]], list(SOURCE_WIRING), dict(SOURCE_INPUTS), "pressure")
     return rig_assembly(c["load"], source, (c["muscle"], c["friction"], c["damping"]), name="one_muscle_fmu")

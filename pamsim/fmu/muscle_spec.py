@@ -39,13 +39,18 @@ class Check:
     input: str | None = None
 
 
-def checks(k: dict, u: dict, has_table: bool) -> list[Check]:
-    """The one-muscle FMU's checks between its parameters, and of its pressure inputs against the rating."""
-    from ..core_table import ORDER_CHECKS
-    from ..modeling.smath import if_else
-    from ..static_models.geometry import Braid
+TABLE_COVER_TOL = 1e-12
+"""The part of the table's range by which a bound computed in Python (the tabulated domain) and in the
+FMU's generated map may differ: a few roundings."""
 
-    x_high = if_else(k["x_high_m"] > 0.0, k["x_high_m"], Braid.from_parameters(k).x_lock_m)
+
+def checks(k: dict, u: dict, table=None) -> list[Check]:
+    """The one-muscle FMU's checks between its parameters, of its force ``table`` against the travel and
+    the rating, and of its pressure inputs against the rating."""
+    from ..core_table import ORDER_CHECKS
+    from .muscle_fmu import on_table, own_upper_stop
+
+    x_high = own_upper_stop(k)
     rated = k["rated_pressure_gauge_Pa"]
     out = [Check(k[a] < k[b], f"invalid parameters: {a} = %g: must be below {b} = %g", (k[a], k[b]))
            for a, b in ORDER_CHECKS]
@@ -63,9 +68,9 @@ def checks(k: dict, u: dict, has_table: bool) -> list[Check]:
               "invalid parameters: initial_contraction_m = %g: must lie between the stops, 0 and %.4f m "
               "(the upper stop)", (k["initial_contraction_m"], x_high)),
     ]
-    if not has_table:
-        out.append(Check(k["static_force_model"] != 1.0, "invalid parameters: static_force_model = 1 (table): this "
-                         "FMU was built without a force table (build it with pamsim fmu build --scenario)"))
+    out += _table_checks(k, table, x_high, on_table(k, table)) if table is not None else [
+        Check(k["static_force_model"] != 1.0, "invalid parameters: static_force_model = 1 (table): this FMU was "
+              "built without a force table (build it with pamsim fmu build --scenario)")]
     for name in ("supply_pressure_gauge_Pa", "prescribed_pressure_gauge_Pa"):
         out.append(Check(u[name] <= rated, f"{name} = %g Pa: exceeds the muscle's rating rated_pressure_gauge_Pa = "
                          "%g Pa", (u[name], rated), name))
@@ -73,6 +78,29 @@ def checks(k: dict, u: dict, has_table: bool) -> list[Check]:
                      "prescribed_pressure_gauge_Pa = %g Pa: below vacuum", (u["prescribed_pressure_gauge_Pa"],),
                      "prescribed_pressure_gauge_Pa"))
     return out
+
+
+def _table_checks(k: dict, table, x_high, inside) -> list[Check]:
+    """The table covers the load's travel (0 to the upper stop) and the gauge pressures the chamber starts and is
+    driven at (0 to the rating): a table is built for one muscle, and another's geometry or rating would leave
+    it.  Checked where the FMU runs on it."""
+    x_tol = TABLE_COVER_TOL * (table.x_max_m - table.x_min_m)
+    p_tol = TABLE_COVER_TOL * (table.p_max_Pa - table.p_min_Pa)
+    name = table.model_name
+    return [
+        Check(1 - inside * ((x_high > table.x_max_m + x_tol) + (table.x_min_m > x_tol) > 0),
+              "invalid parameters: L0_m = %g, theta0_deg = %g, x_high_m = %g: the load's travel, 0 to %.6g m (the "
+              f"upper stop), leaves the force table of {name}, which covers contraction {table.x_min_m:.6g} to "
+              f"{table.x_max_m:.6g} m (a table is built for one muscle: build the FMU for this geometry)",
+              (k["L0_m"], k["theta0_deg"], k["x_high_m"], x_high)),
+        Check(1 - inside * (k["rated_pressure_gauge_Pa"] > table.p_max_Pa + p_tol),
+              f"invalid parameters: rated_pressure_gauge_Pa = %g: above the force table of {name}, which covers gauge "
+              f"pressure {table.p_min_Pa:g} to {table.p_max_Pa:g} Pa (the supply, prescribed and initial pressures "
+              "may reach the rating)", (k["rated_pressure_gauge_Pa"],)),
+        Check(1 - inside * float(table.p_min_Pa > p_tol),
+              f"invalid parameters: static_force_model = 1 (table): the force table of {name} starts at gauge "
+              f"pressure {table.p_min_Pa:g} Pa, above the ambient pressure an exhausted chamber reaches"),
+    ]
 
 
 def _c_string(text: str) -> str:
@@ -174,6 +202,10 @@ class MuscleVariables(AssemblyVariables):
                 + ", ".join(f"{self.value_references[v.name]}u" for v in self.flat.inputs) + "};"]
 
 
+MESSAGE_VALUES = 4
+"""The values every check's message is given (``pam_gcore.c`` passes four; a message shows at most these)."""
+
+
 def check_lines(found: list[Check], value_references: dict) -> tuple[list[str], int]:
     """The C table of ``found`` (``PAM_CHECKS``) and the number of values their messages show."""
     rows, first = [], 0
@@ -181,11 +213,11 @@ def check_lines(found: list[Check], value_references: dict) -> tuple[list[str], 
         vr = value_references[ch.input] if ch.input else 0
         rows.append(f"    {{{_c_string(ch.message)}, {first}, {vr}u}},")
         first += len(ch.values)
-    n_values = first + 3  # room for the three values any message is given
+    n_values = first + MESSAGE_VALUES  # room for the values any message is given
     return (["", "/* The checks of pm_checks: each message, where its values start, the input it concerns (0: none). */",
              "typedef struct { const char *message; int first_value; unsigned input_vr; } PamCheck;",
              f"#define PAM_NCHECKS {len(found)}", f"#define PAM_NCHECK_VALUES {n_values}",
-             f"static const PamCheck PAM_CHECKS[PAM_NCHECKS] = {{"] + rows + ["};"], n_values)
+             "static const PamCheck PAM_CHECKS[PAM_NCHECKS] = {"] + rows + ["};"], n_values)
 
 
 _SPECS: dict = {}
@@ -194,82 +226,65 @@ SPECS_KEPT = 16
 generating the model takes about 0.5 s."""
 
 
-def muscle_generated_spec(fmi_version: int = 2, preset=None, static_force=None) -> FmuSpec:
+def muscle_generated_spec(fmi_version: int = 2, preset=None, table=None) -> FmuSpec:
     """The spec of the one-muscle FMU generated from components, for a ``preset`` (its start values and
-    signals) and with ``static_force`` (the scenario's static force element) as its ``table`` option."""
-    from ..components.element import structure_key
-
-    key = (fmi_version, preset.digest() if preset is not None else None,
-           structure_key(static_force, baked=True) if static_force is not None else None)
+    signals) and with a force ``table`` (:class:`pamsim.fmu.force_table.ForceTable`; the preset's if None)."""
+    table = table if table is not None else (preset.table if preset is not None else None)
+    key = (fmi_version, preset.digest() if preset is not None else None, table.digest() if table else None)
     if key not in _SPECS:
         if len(_SPECS) >= SPECS_KEPT:
             _SPECS.pop(next(iter(_SPECS)))
-        _SPECS[key] = _generated_spec(fmi_version, preset, static_force)
+        _SPECS[key] = _generated_spec(fmi_version, preset, table)
     return _SPECS[key]
 
 
-def _generated_spec(fmi_version: int, preset, static_force) -> FmuSpec:
+def _generated_spec(fmi_version: int, preset, table) -> FmuSpec:
     import casadi as ca
 
     from ..modeling.cmodel import CModel
 
-    legacy = with_preset(VARIABLES, None, None) if preset is None else with_preset(VARIABLES, preset.table, preset)
+    legacy = with_preset(VARIABLES, table, preset)
     knobs = knob_names()
     rows = {v.name: v for v in legacy}
     start = {n: float(rows[n].start) for n in knobs}
-    assembly = muscle_assembly(start, static_force)
+    assembly = muscle_assembly(start, table)
     flat = assembly.flatten()
-    kmap, dkmap = knob_map(knobs, tuple(v.name for v in flat.parameters), start, static_force)
+    kmap, dkmap = knob_map(knobs, tuple(v.name for v in flat.parameters), start, table)
     ksym = ca.SX.sym("k", len(knobs))
     usym = ca.SX.sym("u", len(flat.inputs))
     k = {n: ksym[i] for i, n in enumerate(knobs)}
     u = {v.name: usym[i] for i, v in enumerate(flat.inputs)}
-    found = checks(k, u, static_force is not None)
-    values = [ca.SX(v) for ch in found for v in ch.values] + [ca.SX(0.0)] * 3
+    found = checks(k, u, table)
+    values = [ca.SX(v) for ch in found for v in ch.values] + [ca.SX(0.0)] * MESSAGE_VALUES
     check_fn = ca.Function("pm_checks_fn", [ksym, usym], [ca.vertcat(*[ca.SX(ch.holds) for ch in found], *values)])
     cmodel = CModel(assembly, jacobians=True, extra=(kmap, dkmap, check_fn))
     p_mass = flat.p[[v.name for v in flat.parameters].index("load.mass_kg")]
     mass_rows = [bool(ca.depends_on(ca.SX(e), p_mass)) for e in list(flat.f) + list(flat.y)]
-    table = MuscleVariables(cmodel, legacy, knobs, mass_rows)
-    lines, _ = check_lines(found, table.value_references)
-    spec = FmuSpec(table.variables, table.value_references, tuple(table._name(v.name) for v in flat.states),
-                   table.indicators, INPUTS, "pamsim_muscle", "pamsim_muscle", "flat", _description(preset),
+    mv = MuscleVariables(cmodel, legacy, knobs, mass_rows)
+    lines, _ = check_lines(found, mv.value_references)
+    spec = FmuSpec(mv.variables, mv.value_references, tuple(mv._name(v.name) for v in flat.states),
+                   mv.indicators, INPUTS, "pamsim_muscle", "pamsim_muscle", "flat", _description(table, preset),
                    SOURCES, {"pam_model.c": cmodel.sources()["pam_model.c"], "pam_fmu_core.h": CORE_HEADER},
-                   tuple(table.c_lines()) + tuple(lines), preset.signals if preset is not None else {},
+                   tuple(mv.c_lines()) + tuple(lines), preset.signals if preset is not None else {},
                    preset.experiment if preset is not None else None, fmi_version=fmi_version,
-                   included=("pam_engine.c",), usage=_usage(None, preset))
+                   included=("pam_engine.c",), usage=_usage(table, preset))
     return replace(spec, token=_token(spec))
 
 
-def _description(preset) -> str:
+def _description(table, preset) -> str:
     from .generate import description
 
-    return description(None, preset)
+    return description(table, preset)
 
 
 def build_generated(output_path, fmi_version: int = 2, scenario=None):
-    """Generate, compile and zip the one-muscle FMU from components (its variables as
-    :func:`pamsim.fmu.build` gives them), for ``scenario`` if given (as ``pamsim fmu build --scenario``:
-    its start values and signals, and its static force as the ``table`` option); return its path.
-
-    The FMU built by :func:`pamsim.fmu.build` runs the same model written by hand in C; this one is
-    generated from the components, and the tests hold the two to each other.
+    """Generate, compile and zip the one-muscle FMU for ``scenario`` if given (as ``pamsim fmu build --scenario``)
+    or with its own defaults; return its path.  The same as :func:`pamsim.fmu.build` with a scenario's preset.
 
     Raises :class:`~pamsim.errors.InputError` for an unknown FMI version, a scenario the FMU cannot carry,
-    a static force without C, a missing compiler or a failed compilation.
+    a missing compiler or a failed compilation.
     """
-    from pathlib import Path
-
-    from ..errors import InputError
-    from .build import FMI_VERSIONS, build_spec
+    from .build import build
     from .preset import for_scenario
 
-    if fmi_version not in FMI_VERSIONS:
-        raise InputError(f"FMI version must be 2 or 3, not {fmi_version!r}")
-    preset = for_scenario(scenario) if scenario is not None else None
-    static_force = scenario.build_model().static_force if preset is not None and preset.table is not None else None
-    try:
-        spec = muscle_generated_spec(fmi_version, preset, static_force)
-    except NotImplementedError as exc:
-        raise InputError(f"the generated one-muscle FMU needs C for its static force: {exc}") from None
-    return build_spec(Path(output_path), spec)
+    return build(output_path, fmi_version, preset=for_scenario(scenario) if scenario is not None else None)
