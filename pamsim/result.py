@@ -123,9 +123,7 @@ class Result:
         work.update(zip(outputs.added_states if outputs is not None else (), Y[n:]))
         loss_J = np.array([b for _, b in impact_losses])
         if impacts_J is None:
-            loss_t = np.array([a for a, _ in impact_losses])
-            cum = np.concatenate([[0.0], np.cumsum(loss_J)])
-            impacts_J = cum[np.searchsorted(loss_t, t, side="right")]
+            impacts_J = running_losses(t, [a for a, _ in impact_losses], loss_J)
         work["E_impacts_J"] = impacts_J
         sig = Signals(work, model, t, Y, modes, outputs)
         p = model.pressure_trace_Pa(t, Y)
@@ -274,6 +272,18 @@ class Result:
         from .plotting import plot_result
 
         return plot_result(self, path, dpi=dpi, **kwargs)
+
+
+def running_losses(t_s: np.ndarray, loss_t_s, loss_J: np.ndarray) -> np.ndarray:
+    """At each time of ``t_s`` (ascending), the sum of the losses ``loss_J`` of the events at ``loss_t_s``
+    (ascending) at or before it: ``cumsum(loss_J)[k - 1]`` from the first time at or after event k's
+    (0 before the first event).  Each event fills the samples from its own on, so that a run of
+    thousands of samples and a few events costs a few searches, not one per sample."""
+    out = np.zeros(len(t_s))
+    cum = np.cumsum(loss_J)
+    for k, start in enumerate(np.searchsorted(t_s, loss_t_s, side="left").tolist()):
+        out[start:] = cum[k]
+    return out
 
 
 def pointless_run_warnings(model, t_s: np.ndarray, at_rest_at_end: bool, v_end_m_s: float) -> list[str]:

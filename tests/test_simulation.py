@@ -447,3 +447,23 @@ def test_a_crossing_inside_a_short_step_where_the_load_turns_is_not_missed():
     cut = _with_missed_crossing(sol, named)
     assert cut.status == 1
     np.testing.assert_allclose(cut.t[-1], t_turn - np.sqrt(2 * over / a), rtol=0, atol=1e-12)
+
+
+def test_running_losses_are_the_cumulative_sum_at_the_last_event_at_or_before_each_sample():
+    """Against a second implementation: for every sample, the sum of the losses of the events at or
+    before it, by counting them (ties between events, events on a sample, before the first and after
+    the last sample)."""
+    from pamsim.result import running_losses
+
+    rng = np.random.default_rng(7)
+    t = np.linspace(0.0, 2.0, 201)
+    for n_events in (0, 1, 5, 40):
+        loss_t = np.sort(np.concatenate([rng.uniform(-0.1, 2.1, n_events), t[[3, 3, 50]][:n_events]]))
+        loss_J = rng.uniform(0.0, 1e-3, len(loss_t))
+        expected = np.array([sum(loss_J[:int(np.count_nonzero(loss_t <= ti))], 0.0) if np.any(loss_t <= ti) else 0.0
+                             for ti in t])
+        got = running_losses(t, loss_t.tolist(), loss_J)
+        np.testing.assert_allclose(got, expected, rtol=1e-12, atol=0.0)
+        # and bit for bit against the counting formula on the cumulative sum
+        cum = np.concatenate([[0.0], np.cumsum(loss_J)])
+        assert np.array_equal(got, cum[np.searchsorted(loss_t, t, side="right")])
