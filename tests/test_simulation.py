@@ -9,6 +9,7 @@ import pytest
 import pamsim
 from pamsim.model import Mode
 from pamsim.static import equilibrium_contraction_m, friction_band_m
+from pamsim.signals import Constant, PiecewiseConstant, Step
 
 from conftest import PAPER_SCENARIOS, SCENARIOS
 
@@ -467,3 +468,19 @@ def test_running_losses_are_the_cumulative_sum_at_the_last_event_at_or_before_ea
         # and bit for bit against the counting formula on the cumulative sum
         cum = np.concatenate([[0.0], np.cumsum(loss_J)])
         assert np.array_equal(got, cum[np.searchsorted(loss_t, t, side="right")])
+
+
+@pytest.mark.parametrize("signal", [
+    Constant(2.5), Constant(-0.0), Step(0.3, 0.0, 1.0), Step(-1.0, 4.0, -2.0), Step(0.25, 1.0, 3.0), Step(9.0, 1.0, 3.0),
+    PiecewiseConstant((0.0, 0.105, 0.105, 0.5, 1.7), (1.0, -3.0, 2.0, 7.0, 0.5)),
+    PiecewiseConstant((-0.5, 0.5), (6.0, -6.0)),
+    PiecewiseConstant((0.0, 0.25, 0.255), (1.0, 5.0, 2.0))])  # 5.0 at one sample only, the breakpoint's own
+def test_a_piecewise_constant_signal_at_few_samples_takes_every_value_it_takes_at_all(signal):
+    """The pointless-run checks read a signal's largest value and whether it is ever positive at the
+    samples: from the first sample and the first at or after each breakpoint, the same as from all."""
+    from pamsim.result import at_samples
+
+    t = np.linspace(0.0, 1.0, 201)  # 0.25 is a sample, 0.105 lies between two
+    few, every = np.asarray(at_samples(signal, t)), np.asarray(signal(t))
+    assert set(few.tolist()) == set(every.tolist())
+    assert np.max(few) == np.max(every) and np.any(few > 0.0) == np.any(every > 0.0)

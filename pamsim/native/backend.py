@@ -69,6 +69,8 @@ def native_rtol(opts) -> float:
 
 def event_capacity(max_events):
     """Events kept per case in a batch call (``max_events``: one case's limit, or an array of them)."""
+    if isinstance(max_events, int):  # one case: numpy would cost more than the run's Python around it
+        return min(max_events + 1, BATCH_EVENT_CAPACITY)
     return np.minimum(np.asarray(max_events) + 1, BATCH_EVENT_CAPACITY)
 
 
