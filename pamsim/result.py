@@ -278,12 +278,12 @@ class Result:
 def running_losses(t_s: np.ndarray, loss_t_s, loss_J: np.ndarray) -> np.ndarray:
     """At each time of ``t_s`` (ascending), the sum of the losses ``loss_J`` of the events at ``loss_t_s``
     (ascending) at or before it: ``cumsum(loss_J)[k - 1]`` from the first time at or after event k's
-    (0 before the first event).  Each event fills the samples from its own on, so that a run of
-    thousands of samples and a few events costs a few searches, not one per sample."""
-    out = np.zeros(len(t_s))
-    cum = np.cumsum(loss_J)
-    for k, start in enumerate(np.searchsorted(t_s, loss_t_s, side="left").tolist()):
-        out[start:] = cum[k]
+    (0 before the first event).  Each sum fills the samples from its event's first to the next one's,
+    so that a run of thousands of samples and a few events costs a few searches, not one per sample."""
+    out = np.empty(len(t_s))
+    bounds = [0, *np.searchsorted(t_s, loss_t_s, side="left").tolist(), len(t_s)]
+    for k, value in enumerate([0.0, *np.cumsum(loss_J).tolist()]):
+        out[bounds[k]:bounds[k + 1]] = value
     return out
 
 

@@ -368,6 +368,7 @@ def segment_changes(cases: Sequence[CaseInputs]) -> np.ndarray | None:
 
 
 _MODE_LABELS = {int(m): m.label for m in Mode}
+_MODES = {int(m): m for m in Mode}  # a dict look-up costs less than calling the enum
 _IMPACTS_ROW = lib.SAMPLE_COLUMNS.index("E_impacts_J")
 
 
@@ -423,7 +424,7 @@ def _engine_result(scenario: Scenario, case: CaseInputs, out: dict, i: int, wall
     transitions, losses = [], []
     for e in rows:
         before, after = e[4:4 + n_y], e[4 + n_y:4 + 2 * n_y]
-        name = event_name(Mode(int(e[1])), int(e[3]), Mode(int(e[2])))
+        name = event_name(_MODES[int(e[1])], int(e[3]), _MODES[int(e[2])])
         transitions.append(TransitionEvent(e[0], name, labels[int(e[1])], labels[int(e[2])], after[x_at]))
         losses.append((e[0], before[ke_at] - after[ke_at]))
     stats["events"] = len(transitions)

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import ctypes
 import hashlib
+import itertools
 import math
 import os
 import tempfile
@@ -131,46 +132,51 @@ class EngineLibrary:
 
 
 _F64, _I64, _I32 = np.dtype(np.float64), np.dtype(np.int64), np.dtype(np.int32)
+_SETTINGS = ("rtol", "max_step_s", "duration_s")
+"""The per-case float settings, rows of one block."""
+_COUNTS = ("max_steps", "n_samples", "sample_offset", "n_segments", "segment_offset", "event_capacity", "event_offset")
+"""The per-case integers, rows of one block."""
 
 
 def batch_arrays(cases: Sequence[EngineCase], layout: dict) -> tuple[dict[str, np.ndarray], dict[str, int]]:
     """The arrays of an :class:`EngineBatch` of ``cases`` (for a library of ``layout``), the inputs
     filled and the outputs as the library expects them (counts and statistics zero, extremes NaN),
-    and their addresses.  They share one buffer: its address plus offsets costs far less than an
-    address per array (``ndarray.ctypes``), for the 20 arrays of even a single case."""
+    and their addresses.  They share one buffer, the per-case settings and integers one block each:
+    its address plus offsets costs far less than an address per array (``ndarray.ctypes``), and a block
+    is filled in one assignment, for the 20 arrays of even a single case."""
     n, nu = len(cases), layout["nu"]
     counts = {"n_samples": [k.n_samples for k in cases], "n_segments": [len(k.segment_t_s) for k in cases],
               "event_capacity": [k.event_capacity for k in cases]}
     samples, segments, events = (sum(v) for v in counts.values())
     exact = any(k.segment_du is not None for k in cases)
-    shapes = {"params": (_F64, (n, layout["np"])), "rtol": (_F64, (n,)), "max_step_s": (_F64, (n,)),
-              "max_steps": (_I64, (n,)), "duration_s": (_F64, (n,)), "n_samples": (_I64, (n,)),
-              "sample_offset": (_I64, (n,)), "n_segments": (_I64, (n,)), "segment_offset": (_I64, (n,)),
-              "segment_t_s": (_F64, (segments,)), "segment_u": (_F64, (segments, nu)),
-              **({"segment_du": (_F64, (segments, nu, 3))} if exact else {}),
-              "event_capacity": (_I64, (n,)), "event_offset": (_I64, (n,)),
+    blocks = {"settings": (_F64, (len(_SETTINGS), n)), "counts": (_I64, (len(_COUNTS), n)),
+              "params": (_F64, (n, layout["np"])), "segment_t_s": (_F64, (segments,)),
+              "segment_u": (_F64, (segments, nu)), **({"segment_du": (_F64, (segments, nu, 3))} if exact else {}),
               "samples": (_F64, (samples * layout["ns"],)), "modes": (_I32, (samples,)),
-              "events": (_F64, (max(events, 1), layout["event_columns"])), "n_events": (_I64, (n,)),
-              "stats": (_I64, (n, 3)), "status": (_I32, (n,)), "extremes": (_F64, (n, 2 * layout["ny"]))}
-    arrays, address = _arena(shapes)
+              "events": (_F64, (max(events, 1), layout["event_columns"])), "tallies": (_I64, (4 * n,)),
+              "status": (_I32, (n,)), "extremes": (_F64, (n, 2 * layout["ny"]))}
+    arrays, address = _arena(blocks)
     _fill_inputs(arrays, cases, counts, nu)
-    for name in ("n_events", "stats", "status"):
-        arrays[name].fill(0)
+    arrays["tallies"].fill(0)
+    arrays["status"].fill(0)
     arrays["extremes"].fill(np.nan)
+    # the rows of the blocks, by field: n_events then the n x 3 stats share the tallies
+    for block, rows, size in (("settings", _SETTINGS, 8 * n), ("counts", _COUNTS, 8 * n),
+                              ("tallies", ("n_events", "stats"), 8 * n)):
+        address.update({name: address[block] + k * size for k, name in enumerate(rows)})
+    arrays.update(sample_offset=arrays["counts"][2], event_offset=arrays["counts"][6],
+                  n_events=arrays["tallies"][:n], stats=arrays["tallies"][n:].reshape(n, 3))
     return arrays, address
 
 
 def _fill_inputs(arrays: dict[str, np.ndarray], cases: Sequence[EngineCase], counts: dict[str, list], nu: int) -> None:
     """The cases' settings, counts and offsets, and their segments one after another."""
     arrays["params"][:] = [k.params for k in cases]
-    for name in ("rtol", "max_step_s", "max_steps", "duration_s"):
-        arrays[name][:] = [getattr(k, name) for k in cases]
-    for name, values in counts.items():
-        arrays[name][:] = values
-    for name, offset in (("n_samples", "sample_offset"), ("n_segments", "segment_offset"),
-                         ("event_capacity", "event_offset")):
-        arrays[offset][0] = 0
-        np.cumsum(arrays[name][:-1], out=arrays[offset][1:])
+    arrays["settings"][:] = [[getattr(k, name) for k in cases] for name in _SETTINGS]
+    offsets = {name: [0, *itertools.accumulate(values[:-1])] for name, values in counts.items()}
+    arrays["counts"][:] = [[k.max_steps for k in cases], counts["n_samples"], offsets["n_samples"],
+                           counts["n_segments"], offsets["n_segments"], counts["event_capacity"],
+                           offsets["event_capacity"]]
     start = 0
     for k in cases:
         end = start + len(k.segment_t_s)
