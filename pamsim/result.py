@@ -12,6 +12,7 @@ from .atomic import atomic_path
 from .constants import PA_PER_BAR
 from .elements.pressure_source import PrescribedPressure, ValveChamberSource
 from .model import N_WORK, Mode
+from .signals import Constant, PiecewiseConstant, Step
 
 if TYPE_CHECKING:
     from .model import MuscleModel
@@ -123,9 +124,7 @@ class Result:
         work.update(zip(outputs.added_states if outputs is not None else (), Y[n:]))
         loss_J = np.array([b for _, b in impact_losses])
         if impacts_J is None:
-            loss_t = np.array([a for a, _ in impact_losses])
-            cum = np.concatenate([[0.0], np.cumsum(loss_J)])
-            impacts_J = cum[np.searchsorted(loss_t, t, side="right")]
+            impacts_J = running_losses(t, [a for a, _ in impact_losses], loss_J)
         work["E_impacts_J"] = impacts_J
         sig = Signals(work, model, t, Y, modes, outputs)
         p = model.pressure_trace_Pa(t, Y)
@@ -276,12 +275,24 @@ class Result:
         return plot_result(self, path, dpi=dpi, **kwargs)
 
 
+def running_losses(t_s: np.ndarray, loss_t_s, loss_J: np.ndarray) -> np.ndarray:
+    """At each time of ``t_s`` (ascending), the sum of the losses ``loss_J`` of the events at ``loss_t_s``
+    (ascending) at or before it: ``cumsum(loss_J)[k - 1]`` from the first time at or after event k's
+    (0 before the first event).  Each sum fills the samples from its event's first to the next one's,
+    so that a run of thousands of samples and a few events costs a few searches, not one per sample."""
+    out = np.empty(len(t_s))
+    bounds = [0, *np.searchsorted(t_s, loss_t_s, side="left").tolist(), len(t_s)]
+    for k, value in enumerate([0.0, *np.cumsum(loss_J).tolist()]):
+        out[bounds[k]:bounds[k + 1]] = value
+    return out
+
+
 def pointless_run_warnings(model, t_s: np.ndarray, at_rest_at_end: bool, v_end_m_s: float) -> list[str]:
     """The valve never opens, the load is beyond the blocked force, or the load still moves at the end."""
     t_end = float(t_s[-1])
     out = []
     src = model.source
-    if isinstance(src, ValveChamberSource) and not np.any(np.asarray(src.command(t_s)) > 0.0):
+    if isinstance(src, ValveChamberSource) and not np.any(np.asarray(at_samples(src.command, t_s)) > 0.0):
         opens = getattr(src.command, "time_s", None)  # a step's opening time
         when = f"opens at {opens:g} s, after the run ends at {t_end:g} s" if opens is not None else \
             f"stays closed (command <= 0) until the run ends at {t_end:g} s"
@@ -291,7 +302,8 @@ def pointless_run_warnings(model, t_s: np.ndarray, at_rest_at_end: bool, v_end_m
     if supply is not None:
         blocked = float(model.static_force.force_N(0.0, supply))
         weight = model.load.weight_N
-        if weight > blocked + float(np.max(model.load.external_N(t_s))):
+        external = model.load.external_force_N
+        if weight > blocked + (float(np.max(at_samples(external, t_s))) if external is not None else 0.0):
             out.append(f"the load, {weight:.4g} N, is beyond the muscle's blocked force at the supply pressure, "
                        f"{blocked:.4g} N at {supply / PA_PER_BAR:.4g} bar: it cannot lift it")
     if not at_rest_at_end:
@@ -304,7 +316,20 @@ def _largest_supply_Pa(source, t_s: np.ndarray) -> float | None:
     """Highest gauge pressure [Pa] the source offers during the run: the valve's supply or the prescribed
     pressure; None for a source driven by something else (a controller)."""
     if isinstance(source, ValveChamberSource):
-        return float(np.max(source.supply_gauge_Pa(t_s)))
+        return float(np.max(at_samples(source.supply_gauge_Pa, t_s)))
     if isinstance(source, PrescribedPressure):
-        return float(np.max(source.p_gauge_Pa(t_s)))
+        return float(np.max(at_samples(source.p_gauge_Pa, t_s)))
     return None
+
+
+_PIECEWISE_CONSTANT = (Constant, Step, PiecewiseConstant)
+
+
+def at_samples(signal, t_s: np.ndarray) -> np.ndarray:
+    """The values ``signal`` takes at the samples ``t_s`` (ascending): ``signal(t_s)``, or for a
+    piecewise-constant signal, which changes only at its breakpoints and from them on, its values at
+    the first sample and at the first sample at or after each breakpoint: the same values, without
+    evaluating it at thousands of samples to take their largest."""
+    if type(signal) in _PIECEWISE_CONSTANT and len(t_s):  # a subclass may change between breakpoints
+        t_s = t_s[sorted({0, *np.searchsorted(t_s, signal.breakpoints, side="left").tolist()} - {len(t_s)})]
+    return signal(t_s)

@@ -237,3 +237,36 @@ def test_result_columns_are_the_generated_outputs(backend, name):
     assert checked >= (12 if model.n_source else 7)
     net, level = model.rest_forces(float(res.t_s[-1]), np.array([r[-1] for r in rows]))
     assert res.final_rest_forces_N == pytest.approx((net, level), rel=1e-12, abs=1e-12)
+
+
+def test_a_batch_of_held_and_exact_cases_gives_each_its_run_alone():
+    """One call of cases with different segment counts, some holding their inputs (no ``segment_du``)
+    among ones that follow them exactly: the arrays the library is given are laid out per case, so each
+    case's samples, events and statistics are those of its run alone, to the bit."""
+    from dataclasses import replace
+
+    scenarios = [FIG4, CASES["valve opened, then vented"], CASES["prescribed step"]]
+    cases = []
+    for scenario in scenarios:
+        c = backend.case_inputs(scenario)
+        cases.append((scenario_assembly(scenario), c.engine_case(engine_library(c.assembly), 64)))
+    fig4_assembly, fig4 = cases[0]
+    held = replace(fig4, segment_du=None, segment_t_s=fig4.segment_t_s[:2], segment_u=fig4.segment_u[:2])
+    runs = [(fig4_assembly, held), *cases, (fig4_assembly, held)]
+    by_library = {}
+    for k, (assembly, case) in enumerate(runs):
+        by_library.setdefault(id(engine_library(assembly)), []).append(k)
+    for members in by_library.values():
+        library = engine_library(runs[members[0]][0])
+        together = library.run([runs[k][1] for k in members])
+        for j, k in enumerate(members):
+            alone = library.run([runs[k][1]])
+            ns, n = library.layout["ns"], runs[k][1].n_samples
+            first = together["sample_offset"][j]
+            assert together["status"][j] == alone["status"][0] == 0
+            assert np.array_equal(together["samples"][ns * first:ns * (first + n)], alone["samples"][:ns * n])
+            assert np.array_equal(together["modes"][first:first + n], alone["modes"][:n])
+            e0, m = together["event_offset"][j], int(alone["n_events"][0])
+            assert together["n_events"][j] == m and np.array_equal(together["events"][e0:e0 + m], alone["events"][:m])
+            assert np.array_equal(together["stats"][j], alone["stats"][0])
+            assert np.array_equal(together["extremes"][j], alone["extremes"][0])

@@ -123,6 +123,34 @@ def test_wiring_mistakes_are_refused_naming_component_and_port(build, message):
     assert message in str(err.value)
 
 
+class Clash(Component):
+    """A port and an output of one name."""
+
+    ports = (Port("y_N", TRANSLATIONAL, "branch"),)
+    outputs = (Var("y_N", "N"),)
+
+
+class GainOwnInputs(Gain):
+    """A gain that may declare its inputs per instance."""
+
+    def __init__(self, name, values, inputs=None):
+        if inputs is not None:
+            self.inputs = inputs
+        super().__init__(name, values)
+
+
+def test_a_name_given_to_two_ports_inputs_or_outputs_is_refused_every_time():
+    """The check is kept per class once a class passes it: a class that fails fails at every instance,
+    and an instance that declares its own clashing names fails after instances of its class passed."""
+    for _ in range(2):
+        with pytest.raises(ValueError, match=r"\['y_N'\] name more than one port, input or output"):
+            Clash("clash")
+    GainOwnInputs("fine", {"k": 1.0})
+    GainOwnInputs("fine again", {"k": 1.0})
+    with pytest.raises(ValueError, match=r"component 'own' \(GainOwnInputs\): \['y_N'\] name more than one"):
+        GainOwnInputs("own", {"k": 1.0}, inputs=(Var("y_N", "N"),))
+
+
 def _arguments(flat, name, x, u, P, q, rng):
     """The arguments of generated function ``name``: states, inputs, parameters, modes and (for a jump)
     random flags of the indicators that crossed."""

@@ -9,6 +9,7 @@ import pytest
 import pamsim
 from pamsim.model import Mode
 from pamsim.static import equilibrium_contraction_m, friction_band_m
+from pamsim.signals import Constant, PiecewiseConstant, Step
 
 from conftest import PAPER_SCENARIOS, SCENARIOS
 
@@ -447,3 +448,39 @@ def test_a_crossing_inside_a_short_step_where_the_load_turns_is_not_missed():
     cut = _with_missed_crossing(sol, named)
     assert cut.status == 1
     np.testing.assert_allclose(cut.t[-1], t_turn - np.sqrt(2 * over / a), rtol=0, atol=1e-12)
+
+
+def test_running_losses_are_the_cumulative_sum_at_the_last_event_at_or_before_each_sample():
+    """Against a second implementation: for every sample, the sum of the losses of the events at or
+    before it, by counting them (ties between events, events on a sample, before the first and after
+    the last sample)."""
+    from pamsim.result import running_losses
+
+    rng = np.random.default_rng(7)
+    t = np.linspace(0.0, 2.0, 201)
+    for n_events in (0, 1, 5, 40):
+        loss_t = np.sort(np.concatenate([rng.uniform(-0.1, 2.1, n_events), t[[3, 3, 50]][:n_events]]))
+        loss_J = rng.uniform(0.0, 1e-3, len(loss_t))
+        expected = np.array([sum(loss_J[:int(np.count_nonzero(loss_t <= ti))], 0.0) if np.any(loss_t <= ti) else 0.0
+                             for ti in t])
+        got = running_losses(t, loss_t.tolist(), loss_J)
+        np.testing.assert_allclose(got, expected, rtol=1e-12, atol=0.0)
+        # and bit for bit against the counting formula on the cumulative sum
+        cum = np.concatenate([[0.0], np.cumsum(loss_J)])
+        assert np.array_equal(got, cum[np.searchsorted(loss_t, t, side="right")])
+
+
+@pytest.mark.parametrize("signal", [
+    Constant(2.5), Constant(-0.0), Step(0.3, 0.0, 1.0), Step(-1.0, 4.0, -2.0), Step(0.25, 1.0, 3.0), Step(9.0, 1.0, 3.0),
+    PiecewiseConstant((0.0, 0.105, 0.105, 0.5, 1.7), (1.0, -3.0, 2.0, 7.0, 0.5)),
+    PiecewiseConstant((-0.5, 0.5), (6.0, -6.0)),
+    PiecewiseConstant((0.0, 0.25, 0.255), (1.0, 5.0, 2.0))])  # 5.0 at one sample only, the breakpoint's own
+def test_a_piecewise_constant_signal_at_few_samples_takes_every_value_it_takes_at_all(signal):
+    """The pointless-run checks read a signal's largest value and whether it is ever positive at the
+    samples: from the first sample and the first at or after each breakpoint, the same as from all."""
+    from pamsim.result import at_samples
+
+    t = np.linspace(0.0, 1.0, 201)  # 0.25 is a sample, 0.105 lies between two
+    few, every = np.asarray(at_samples(signal, t)), np.asarray(signal(t))
+    assert set(few.tolist()) == set(every.tolist())
+    assert np.max(few) == np.max(every) and np.any(few > 0.0) == np.any(every > 0.0)

@@ -187,21 +187,60 @@ static void record(Run *run, const double *xd, const double *quad) {
     run->next_sample++;
 }
 
+/* Samples per block of record_step. */
+#define PAM_SAMPLE_BLOCK 64
+
+/* The samples first..end-1, inside one step: its dense output d and quadrature growth w, from the
+ * quadratures run->quad at its start.  A block of samples at a time, state by state, so that each
+ * state's column is written in one contiguous run; each value is state_at's and quad_at's, the same
+ * operations in the same order. */
+static void record_step(Run *run, const DensePoly *d, const QuadPoly *w, int64_t first, int64_t end) {
+    double th[PAM_SAMPLE_BLOCK], phi[PAM_SAMPLE_BLOCK];
+    const int32_t mode = PM_MODE_VALUE[run->engine.mode];
+    int64_t n = run->n_samples, j0;
+    int i, k, m, j;
+    for (j0 = first; j0 < end; j0 += PAM_SAMPLE_BLOCK) {
+        m = end - j0 < PAM_SAMPLE_BLOCK ? (int)(end - j0) : PAM_SAMPLE_BLOCK;
+        for (i = 0; i < m; i++) {
+            double t = sample_time(run, j0 + i);
+            th[i] = d->h > 0.0 ? (t - d->t0) / d->h : 0.0;
+            phi[i] = w->span > 0.0 ? (t - w->t0) / w->span : 0.0;
+        }
+        for (k = 0; k < PM_NX; k++) {
+            double *col = run->samples + (int64_t)PM_DYNAMIC[k] * n + j0;
+            const double y0 = d->y0[k], q0 = d->q[0][k], q1 = d->q[1][k], q2 = d->q[2][k], q3 = d->q[3][k];
+            for (i = 0; i < m; i++) col[i] = y0 + th[i] * (q0 + th[i] * (q1 + th[i] * (q2 + th[i] * q3)));
+        }
+        for (k = 0; k < PM_NQ; k++) {
+            double *col = run->samples + (int64_t)PM_QUADRATURE[k] * n + j0;
+            const double base = run->quad[k];
+            for (i = 0; i < m; i++) {
+                double acc = 0.0;
+                if (!w->moving) { /* + 0.0 as the polynomial's sum gives */
+                    col[i] = base + 0.0;
+                    continue;
+                }
+                for (j = GL_N - 1; j >= 0; j--) acc = (acc + w->c[k][j]) * phi[i];
+                col[i] = base + acc;
+            }
+        }
+        for (i = 0; i < m; i++) run->modes[j0 + i] = mode;
+    }
+    run->next_sample = end;
+}
+
 /* The samples inside an accepted step come from its dense output, as solve_ivp's t_eval. */
 static void on_step(void *env, double t0, double t1, double h, const double *y0, const PamStages *stages) {
     Run *run = (Run *)env;
     DensePoly d;
     QuadPoly w;
-    double y[PM_NX], quad[PM_NQ > 0 ? PM_NQ : 1];
+    double y[PM_NX];
+    int64_t end = run->next_sample;
     int moving = stages != NULL && !PM_MODE_QUAD_ZERO[run->engine.mode];
     dense_poly(&d, stages, y0, t0, h);
     quad_poly(run, &d, moving, t0, t1, &w);
-    while (run->next_sample < run->n_samples && sample_time(run, run->next_sample) <= t1) {
-        double t = sample_time(run, run->next_sample);
-        state_at(&d, t, y);
-        quad_at(&w, t, run->quad, quad);
-        record(run, y, quad);
-    }
+    while (end < run->n_samples && sample_time(run, end) <= t1) end++;
+    record_step(run, &d, &w, run->next_sample, end);
     quad_at(&w, t1, run->quad, run->quad);
     state_at(&d, t1, y);
     inputs_at(&run->engine, t1, 1);

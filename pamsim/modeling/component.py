@@ -78,6 +78,10 @@ class Equations:
     settle: dict[str, Any] = field(default_factory=dict)
 
 
+_NAMES_CHECKED: set[type] = set()
+"""Component classes whose declared ports, inputs and outputs have no name twice."""
+
+
 class Component:
     """Base of every component.  A subclass declares its variables as class attributes and writes
     :meth:`equations`; an instance has a name (unique in its assembly) and parameter values.
@@ -98,17 +102,25 @@ class Component:
         self.name = name
         values = dict(values or {})
         declared = {v.name for v in self.parameter_vars()}
-        unknown = sorted(set(values) - declared)
-        missing = sorted(declared - set(values))
-        if unknown or missing:
+        if values.keys() != declared:
+            unknown, missing = sorted(set(values) - declared), sorted(declared - set(values))
             raise ValueError(f"component {name!r} ({type(self).__name__}): "
                              + "; ".join(filter(None, [unknown and f"unknown parameters {unknown}",
                                                        missing and f"missing parameters {missing}"])))
         self.values = values
+        # A class's own ports, inputs and outputs are checked once: components are made per run.
+        own = self.__dict__.keys() & {"ports", "inputs", "outputs"}
+        if own or type(self) not in _NAMES_CHECKED:
+            self._check_names()
+            if not own:
+                _NAMES_CHECKED.add(type(self))
+
+    def _check_names(self) -> None:
+        """``ValueError`` if a name is given to more than one port, input or output."""
         names = [p.name for p in self.ports] + [v.name for v in self.inputs] + [v.name for v in self.outputs]
         clash = sorted({n for n in names if names.count(n) > 1})
         if clash:
-            raise ValueError(f"component {name!r} ({type(self).__name__}): {clash} name more than one "
+            raise ValueError(f"component {self.name!r} ({type(self).__name__}): {clash} name more than one "
                              "port, input or output")
 
     def parameter_vars(self) -> tuple[Var, ...]:

@@ -27,6 +27,7 @@ Differences from the Python backend, all documented in ``docs/scaling.md``:
 
 from __future__ import annotations
 
+import bisect
 import math
 import time
 from collections import OrderedDict
@@ -68,6 +69,8 @@ def native_rtol(opts) -> float:
 
 def event_capacity(max_events):
     """Events kept per case in a batch call (``max_events``: one case's limit, or an array of them)."""
+    if isinstance(max_events, int):  # one case: numpy would cost more than the run's Python around it
+        return min(max_events + 1, BATCH_EVENT_CAPACITY)
     return np.minimum(np.asarray(max_events) + 1, BATCH_EVENT_CAPACITY)
 
 
@@ -222,7 +225,7 @@ def exact_segments(signals, duration_s: float):
     starts = np.array(sorted(bounds))
     u, du = np.zeros((len(starts), len(pieces))), np.zeros((len(starts), len(pieces), 3))
     for k, piece in enumerate(pieces):
-        for j, t0 in enumerate(starts if piece is not None else ()):
+        for j, t0 in enumerate(starts.tolist() if piece is not None else ()):
             u[j, k] = piece(t0)
             du[j, k] = _change_after(piece, t0)
     return starts, u, du
@@ -234,7 +237,7 @@ def _change_after(piece, t0: float) -> tuple[float, float, float]:
         time_s, initial, final, tau_s = piece.lag
         return (0.0, 0.0, 0.0) if t0 < time_s else (0.0, (initial - final) * math.exp(-(t0 - time_s) / tau_s), tau_s)
     ts, vs = piece.knots_t_s, piece.knots
-    k = int(np.searchsorted(ts, t0, side="right")) - 1
+    k = bisect.bisect_right(ts, t0) - 1  # the last knot at or before t0 (numpy's searchsorted costs more on a tuple)
     if 0 <= k < len(ts) - 1 and ts[k + 1] > ts[k]:
         return ((vs[k + 1] - vs[k]) / (ts[k + 1] - ts[k]), 0.0, 0.0)
     return (0.0, 0.0, 0.0)
@@ -248,10 +251,30 @@ def case_inputs(scenario: Scenario, model: MuscleModel | None = None) -> CaseInp
     """
     refuse_unsupported(scenario)
     model = scenario.build_model() if model is None else model
-    spec = scenario.spec
     opts = scenario.solver
     T = scenario.duration_s
     n_samples = int(round(T * opts.sample_rate_Hz)) + 1
+    # the generic engine runs the generated model; a force table stays with the hand-written core
+    assembly = engine_assembly(scenario, model)
+    names, signals = _signals(model)
+    if assembly is None and names != lib.INPUTS:
+        raise InputError(f"{scenario.origin}: model.static_force = {scenario.spec['model']['static_force']!r}: the "
+                         f"{type(model.source).__name__} runs natively only with a static force written in "
+                         "symbols (this one runs as a force table on the hand-written C core, which has no such "
+                         "source); run it with the python backend")
+    table = force_table(scenario) if assembly is None else None
+    reals, ints = core_values(scenario, model, table)
+    pieces = exact_segments(signals, T)
+    starts, u, du = pieces if pieces is not None else (*held_segments(signals, model, T, n_samples), None)
+    _set_mass(u, names, model)
+    return CaseInputs(reals, ints, T, n_samples, starts, u, opts.max_events, model, table, assembly, du, names)
+
+
+def core_values(scenario: Scenario, model: MuscleModel, table: ForceTable | None) -> tuple[np.ndarray, np.ndarray]:
+    """The C core's variables for ``scenario`` run with ``model`` (and its force ``table``, if it has one):
+    the reals (parameters, start, margins, solver settings) and the ints (element choices).  The generic
+    engine reads only the solver settings from them."""
+    opts = scenario.solver
     reals = lib.REAL_DEFAULTS.copy()
     for name, value in scenario.parameters.items():
         if name in lib.REAL_INDEX:  # the others shape the force table (refuse_unsupported)
@@ -263,42 +286,36 @@ def case_inputs(scenario: Scenario, model: MuscleModel | None = None) -> CaseInp
                "cs_max_step_s": opts.max_step_s if math.isfinite(opts.max_step_s) else _DEFAULT_MAX_STEP_S}
     for name, value in fmu_own.items():
         reals[lib.REAL_INDEX[name]] = value
-    # the generic engine runs the generated model; a force table stays with the hand-written core
-    assembly = engine_assembly(scenario, model)
     ints = lib.INT_DEFAULTS.copy()
-    choices = {"friction_model": ("friction", spec["model"]["friction"]),
-               "damping_model": ("damping", spec["model"]["damping"]),
+    spec = scenario.spec["model"]
+    choices = {"friction_model": ("friction", spec["friction"]), "damping_model": ("damping", spec["damping"]),
                "pressure_source": ("source", "valve" if isinstance(model.source, ValveChamberSource) else "prescribed"),
-               "friction_negative_level": ("friction_negative_level", spec["model"]["friction_negative_level"])}
+               "friction_negative_level": ("friction_negative_level", spec["friction_negative_level"])}
     for name, (key, value) in choices.items():
         if value in C_CHOICES[key]:  # the core's choices (the engine reads none of them)
             ints[lib.INT_INDEX[name]] = C_CHOICES[key].index(value)
-    names, signals = _signals(model)
-    if assembly is None and names != lib.INPUTS:
-        raise InputError(f"{scenario.origin}: model.static_force = {spec['model']['static_force']!r}: the "
-                         f"{type(model.source).__name__} runs natively only with a static force written in "
-                         "symbols (this one runs as a force table on the hand-written C core, which has no such "
-                         "source); run it with the python backend")
-    table = force_table(scenario) if assembly is None else None
     ints[lib.INT_INDEX["static_force_model"]] = C_CHOICES["static_force_model"].index(
         "acra2012_polynomial" if table is None else "table")
-    pieces = exact_segments(signals, T)
-    if pieces is not None:
-        starts, u, du = pieces
-        _set_mass(u, names, model)
-        return CaseInputs(reals, ints, T, n_samples, starts, u, opts.max_events, model, table, assembly, du, names)
+    return reals, ints
+
+
+def held_segments(signals, model: MuscleModel, duration_s: float, n_samples: int) -> tuple[np.ndarray, np.ndarray]:
+    """Segments over which ``signals`` (None where an input has none) are held, for a signal
+    :func:`exact_segments` cannot carry: cut at the model's breakpoints and every
+    :func:`hold_interval_s`, each signal at its segment's midpoint.  Returns the segments' starts and
+    the inputs over them."""
+    T = duration_s
     hold = hold_interval_s(signals, T / max(n_samples - 1, 1))
     bounds = {0.0} | {float(b) for b in model.breakpoints if 0.0 < b < T}
     if math.isfinite(hold):
         bounds |= set(np.linspace(0.0, T, int(math.ceil(T / hold)) + 1)[:-1].tolist())
     starts = np.array(sorted(bounds))
     mid = 0.5 * (starts + np.append(starts[1:], T))  # a step's value is constant inside its segment
-    u = np.zeros((len(starts), len(names)))
+    u = np.zeros((len(starts), len(signals)))
     for k, sig in enumerate(signals):
         if sig is not None:
             u[:, k] = sig(mid)
-    _set_mass(u, names, model)
-    return CaseInputs(reals, ints, T, n_samples, starts, u, opts.max_events, model, table, assembly, None, names)
+    return starts, u
 
 
 def _set_mass(u: np.ndarray, names: Sequence[str], model: MuscleModel) -> None:
@@ -351,6 +368,7 @@ def segment_changes(cases: Sequence[CaseInputs]) -> np.ndarray | None:
 
 
 _MODE_LABELS = {int(m): m.label for m in Mode}
+_MODES = {int(m): m for m in Mode}  # a dict look-up costs less than calling the enum
 _IMPACTS_ROW = lib.SAMPLE_COLUMNS.index("E_impacts_J")
 
 
@@ -399,15 +417,16 @@ def _engine_result(scenario: Scenario, case: CaseInputs, out: dict, i: int, wall
     outputs, n_y, n = names["outputs"], len(names["outputs"]), case.n_samples
     first, ns = int(out["sample_offset"][i]), len(names["states"])
     Y = out["samples"][ns * first:ns * (first + n)].reshape(ns, n)
-    rows = out["events"][out["event_offset"][i]:out["event_offset"][i] + out["n_events"][i]]
+    first_event = int(out["event_offset"][i])
+    rows = out["events"][first_event:first_event + int(out["n_events"][i])].tolist()  # floats: no numpy scalars
     x_at, ke_at = outputs.index("load.x_m"), outputs.index("load.kinetic_energy_J")
     labels = _MODE_LABELS
     transitions, losses = [], []
     for e in rows:
         before, after = e[4:4 + n_y], e[4 + n_y:4 + 2 * n_y]
-        name = event_name(Mode(int(e[1])), int(e[3]), Mode(int(e[2])))
-        transitions.append(TransitionEvent(float(e[0]), name, labels[int(e[1])], labels[int(e[2])], float(after[x_at])))
-        losses.append((float(e[0]), float(before[ke_at] - after[ke_at])))
+        name = event_name(_MODES[int(e[1])], int(e[3]), _MODES[int(e[2])])
+        transitions.append(TransitionEvent(e[0], name, labels[int(e[1])], labels[int(e[2])], after[x_at]))
+        losses.append((e[0], before[ke_at] - after[ke_at]))
     stats["events"] = len(transitions)
     high, low = out["extremes"][i][:n_y], out["extremes"][i][n_y:]
     pressure = next(a for a, b in case.assembly.connections if b == "muscle.p_gauge_Pa")
@@ -418,15 +437,26 @@ def _engine_result(scenario: Scenario, case: CaseInputs, out: dict, i: int, wall
                              peaks=peaks, outputs=RigOutputs(case.assembly, case.model, t, Y, modes))
 
 
+GRID_CACHE_SIZE = 32
+"""Sample grids kept per process: the runs of a sweep share a few."""
+_grids: "OrderedDict[tuple[float, int], np.ndarray]" = OrderedDict()
+
+
 def _sample_grids(cases: Sequence[CaseInputs]) -> list[np.ndarray]:
-    """Each case's sample times [s]; cases with the same grid share one read-only array."""
-    grids: dict[tuple[float, int], np.ndarray] = {}
+    """Each case's sample times [s]: ``linspace(0, duration_s, n_samples)``, one read-only array per grid,
+    kept for the next calls."""
+    out = []
     for c in cases:
         key = (c.duration_s, c.n_samples)
-        if key not in grids:
-            grids[key] = np.linspace(0.0, c.duration_s, c.n_samples)
-            grids[key].flags.writeable = False
-    return [grids[(c.duration_s, c.n_samples)] for c in cases]
+        if key in _grids:
+            _grids.move_to_end(key)  # least recently used goes first
+        else:
+            _grids[key] = np.linspace(0.0, c.duration_s, c.n_samples)
+            _grids[key].flags.writeable = False
+            if len(_grids) > GRID_CACHE_SIZE:
+                _grids.popitem(last=False)
+        out.append(_grids[key])
+    return out
 
 
 def simulate_batch(scenarios: Sequence[Scenario], return_exceptions: bool = False,

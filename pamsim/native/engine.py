@@ -15,6 +15,8 @@ from __future__ import annotations
 
 import ctypes
 import hashlib
+import itertools
+import math
 import os
 import tempfile
 import weakref
@@ -36,21 +38,28 @@ LAYOUT = ("nx", "nq", "nu", "np", "ny", "nz", "nmodes", "ns", "event_columns", "
 STATUS = ("ok", "bad input", "solver failed", "event buffer full")
 MESSAGE_BYTES = 256
 
-_D = ctypes.POINTER(ctypes.c_double)
 _P = ctypes.c_void_p
-_I32 = ctypes.POINTER(ctypes.c_int32)
-_I64 = ctypes.POINTER(ctypes.c_int64)
 
 
 class EngineBatch(ctypes.Structure):
-    """Mirror of ``PamEngineBatch`` in ``pam_engine_batch.c``."""
+    """Mirror of ``PamEngineBatch`` in ``pam_engine_batch.c``.
 
-    _fields_ = [("n_cases", ctypes.c_int64), ("params", _D), ("rtol", _D), ("max_step_s", _D), ("max_steps", _I64),
-                ("duration_s", _D), ("n_samples", _I64), ("sample_offset", _I64), ("n_segments", _I64),
-                ("segment_offset", _I64), ("segment_t_s", _D), ("segment_u", _D), ("segment_du", _D),
-                ("event_capacity", _I64),
-                ("event_offset", _I64), ("samples", _D), ("modes", _I32), ("events", _D), ("n_events", _I64),
-                ("stats", _I64), ("status", _I32), ("extremes", _D), ("messages", ctypes.c_char_p)]
+    Every array is a plain address (``c_void_p``), the same size as the C pointers: an integer costs
+    far less than a typed pointer from ``ndarray.ctypes.data_as``, and even a run of one case passes 21.
+    """
+
+    _fields_ = [("n_cases", ctypes.c_int64), ("params", _P), ("rtol", _P), ("max_step_s", _P), ("max_steps", _P),
+                ("duration_s", _P), ("n_samples", _P), ("sample_offset", _P), ("n_segments", _P),
+                ("segment_offset", _P), ("segment_t_s", _P), ("segment_u", _P), ("segment_du", _P),
+                ("event_capacity", _P),
+                ("event_offset", _P), ("samples", _P), ("modes", _P), ("events", _P), ("n_events", _P),
+                ("stats", _P), ("status", _P), ("extremes", _P), ("messages", _P)]
+
+
+BATCH_OUTPUTS = ("samples", "modes", "events", "n_events", "stats", "status", "extremes")
+"""The fields of :class:`EngineBatch` the library fills."""
+BATCH_FIELDS = tuple(name for name, _ in EngineBatch._fields_[1:-1])
+"""The arrays of :class:`EngineBatch`, in its order (``segment_du`` None if every input is held)."""
 
 
 @dataclass(frozen=True)
@@ -113,47 +122,89 @@ class EngineLibrary:
         before, outputs after), ``n_events``, ``stats`` (RHS evaluations, steps, segments + events),
         ``status``, ``extremes`` (each output's largest then smallest value over every step end and
         event), ``messages``, and the offsets of each case's samples and events."""
-        c = lambda a, t: np.ascontiguousarray(a, dtype=t)  # noqa: E731
-        n, L = len(cases), self.layout
-        offsets = lambda counts: np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)  # noqa: E731
-        n_samples = c([k.n_samples for k in cases], np.int64)
-        capacity = c([k.event_capacity for k in cases], np.int64)
-        n_segments = c([len(k.segment_t_s) for k in cases], np.int64)
-        arrays = {
-            "params": c(np.array([k.params for k in cases]).reshape(n, L["np"]), np.float64),
-            "rtol": c([k.rtol for k in cases], np.float64), "max_step_s": c([k.max_step_s for k in cases], np.float64),
-            "max_steps": c([k.max_steps for k in cases], np.int64),
-            "duration_s": c([k.duration_s for k in cases], np.float64),
-            "segment_t_s": c(np.concatenate([k.segment_t_s for k in cases]), np.float64),
-            "segment_u": c(np.concatenate([np.asarray(k.segment_u, float).reshape(-1, L["nu"]) for k in cases]),
-                           np.float64)}
-        exact = any(k.segment_du is not None for k in cases)
-        if exact:  # a case with held inputs among them: no change over its segments
-            arrays["segment_du"] = c(np.concatenate([
-                np.zeros((len(k.segment_t_s), L["nu"], 3)) if k.segment_du is None
-                else np.asarray(k.segment_du, float).reshape(-1, L["nu"], 3) for k in cases]), np.float64)
-        out = {"sample_offset": offsets(n_samples), "event_offset": offsets(capacity),
-               "samples": np.empty(int(n_samples.sum()) * L["ns"]),
-               "modes": np.empty(int(n_samples.sum()), dtype=np.int32),
-               "events": np.empty((max(int(capacity.sum()), 1), L["event_columns"])),
-               "n_events": np.zeros(n, dtype=np.int64), "stats": np.zeros((n, 3), dtype=np.int64),
-               "status": np.zeros(n, dtype=np.int32), "extremes": np.full((n, 2 * L["ny"]), np.nan)}
-        messages = ctypes.create_string_buffer(MESSAGE_BYTES * n)
-        segment_offset = offsets(n_segments)
-        p = lambda a, kind: a.ctypes.data_as(kind)  # noqa: E731
-        batch = EngineBatch(n, p(arrays["params"], _D), p(arrays["rtol"], _D), p(arrays["max_step_s"], _D),
-                            p(arrays["max_steps"], _I64), p(arrays["duration_s"], _D), p(n_samples, _I64),
-                            p(out["sample_offset"], _I64), p(n_segments, _I64), p(segment_offset, _I64),
-                            p(arrays["segment_t_s"], _D), p(arrays["segment_u"], _D),
-                            p(arrays["segment_du"], _D) if exact else None, p(capacity, _I64),
-                            p(out["event_offset"], _I64), p(out["samples"], _D), p(out["modes"], _I32),
-                            p(out["events"], _D), p(out["n_events"], _I64), p(out["stats"], _I64),
-                            p(out["status"], _I32), p(out["extremes"], _D), ctypes.cast(messages, ctypes.c_char_p))
+        arrays, address = batch_arrays(cases, self.layout)
+        messages = ctypes.create_string_buffer(MESSAGE_BYTES * len(cases))
+        batch = EngineBatch(len(cases), *(address.get(k) for k in BATCH_FIELDS), ctypes.addressof(messages))
         self._lib.pam_engine_run_batch(ctypes.byref(batch))
-        raw = messages.raw
-        out["messages"] = [raw[MESSAGE_BYTES * i:MESSAGE_BYTES * (i + 1)].split(b"\0", 1)[0].decode(errors="replace")
-                           for i in range(n)]
+        out = {k: arrays[k] for k in ("sample_offset", "event_offset", *BATCH_OUTPUTS)}
+        out["messages"] = _messages(messages.raw, len(cases))
         return out
+
+
+_F64, _I64, _I32 = np.dtype(np.float64), np.dtype(np.int64), np.dtype(np.int32)
+_SETTINGS = ("rtol", "max_step_s", "duration_s")
+"""The per-case float settings, rows of one block."""
+_COUNTS = ("max_steps", "n_samples", "sample_offset", "n_segments", "segment_offset", "event_capacity", "event_offset")
+"""The per-case integers, rows of one block."""
+
+
+def batch_arrays(cases: Sequence[EngineCase], layout: dict) -> tuple[dict[str, np.ndarray], dict[str, int]]:
+    """The arrays of an :class:`EngineBatch` of ``cases`` (for a library of ``layout``), the inputs
+    filled and the outputs as the library expects them (counts and statistics zero, extremes NaN),
+    and their addresses.  They share one buffer, the per-case settings and integers one block each:
+    its address plus offsets costs far less than an address per array (``ndarray.ctypes``), and a block
+    is filled in one assignment, for the 20 arrays of even a single case."""
+    n, nu = len(cases), layout["nu"]
+    counts = {"n_samples": [k.n_samples for k in cases], "n_segments": [len(k.segment_t_s) for k in cases],
+              "event_capacity": [k.event_capacity for k in cases]}
+    samples, segments, events = (sum(v) for v in counts.values())
+    exact = any(k.segment_du is not None for k in cases)
+    blocks = {"settings": (_F64, (len(_SETTINGS), n)), "counts": (_I64, (len(_COUNTS), n)),
+              "params": (_F64, (n, layout["np"])), "segment_t_s": (_F64, (segments,)),
+              "segment_u": (_F64, (segments, nu)), **({"segment_du": (_F64, (segments, nu, 3))} if exact else {}),
+              "samples": (_F64, (samples * layout["ns"],)), "modes": (_I32, (samples,)),
+              "events": (_F64, (max(events, 1), layout["event_columns"])), "tallies": (_I64, (4 * n,)),
+              "status": (_I32, (n,)), "extremes": (_F64, (n, 2 * layout["ny"]))}
+    arrays, address = _arena(blocks)
+    _fill_inputs(arrays, cases, counts, nu)
+    arrays["tallies"].fill(0)
+    arrays["status"].fill(0)
+    arrays["extremes"].fill(np.nan)
+    # the rows of the blocks, by field: n_events then the n x 3 stats share the tallies
+    for block, rows, size in (("settings", _SETTINGS, 8 * n), ("counts", _COUNTS, 8 * n),
+                              ("tallies", ("n_events", "stats"), 8 * n)):
+        address.update({name: address[block] + k * size for k, name in enumerate(rows)})
+    arrays.update(sample_offset=arrays["counts"][2], event_offset=arrays["counts"][6],
+                  n_events=arrays["tallies"][:n], stats=arrays["tallies"][n:].reshape(n, 3))
+    return arrays, address
+
+
+def _fill_inputs(arrays: dict[str, np.ndarray], cases: Sequence[EngineCase], counts: dict[str, list], nu: int) -> None:
+    """The cases' settings, counts and offsets, and their segments one after another."""
+    arrays["params"][:] = [k.params for k in cases]
+    arrays["settings"][:] = [[getattr(k, name) for k in cases] for name in _SETTINGS]
+    offsets = {name: [0, *itertools.accumulate(values[:-1])] for name, values in counts.items()}
+    arrays["counts"][:] = [[k.max_steps for k in cases], counts["n_samples"], offsets["n_samples"],
+                           counts["n_segments"], offsets["n_segments"], counts["event_capacity"],
+                           offsets["event_capacity"]]
+    start = 0
+    for k in cases:
+        end = start + len(k.segment_t_s)
+        arrays["segment_t_s"][start:end] = k.segment_t_s
+        arrays["segment_u"][start:end] = np.reshape(k.segment_u, (-1, nu))
+        if "segment_du" in arrays:  # a case with held inputs among exact ones: no change over its segments
+            arrays["segment_du"][start:end] = 0.0 if k.segment_du is None else np.reshape(k.segment_du, (-1, nu, 3))
+        start = end
+
+
+def _arena(shapes: dict[str, tuple[np.dtype, tuple[int, ...]]]) -> tuple[dict[str, np.ndarray], dict[str, int]]:
+    """Uninitialised arrays of the given dtypes and shapes in one buffer, each at a multiple of 8 bytes,
+    and their addresses."""
+    offsets, total = {}, 0
+    for name, (dtype, shape) in shapes.items():
+        offsets[name] = total
+        total += -(-math.prod(shape) * dtype.itemsize // 8) * 8
+    buffer = np.empty(max(total, 8), dtype=np.uint8)
+    base = buffer.ctypes.data
+    arrays = {name: np.frombuffer(buffer, dtype, math.prod(shape), offsets[name]).reshape(shape)
+              for name, (dtype, shape) in shapes.items()}
+    return arrays, {name: base + offset for name, offset in offsets.items()}
+
+
+def _messages(raw: bytes, n: int) -> list[str]:
+    """Each case's message, from the library's ``n`` fixed-size, NUL-terminated slots."""
+    return [raw[MESSAGE_BYTES * i:MESSAGE_BYTES * (i + 1)].split(b"\0", 1)[0].decode(errors="replace")
+            for i in range(n)]
 
 
 class EngineSession:
