@@ -1,89 +1,64 @@
-"""The one-muscle FMU generated from components against the one whose model is written by hand in C.
+"""The one-muscle FMU generated from components: its parameter map, variables, checks and exact
+directional derivatives.  Its runs against the Python simulator are tests/test_fmu.py's.
 
-Both FMUs have the same variables (names, value references, ranges, choices); they share no model
-code: one runs ``pam_core.c``, the other the generic core with the generated model and the generated
-parameter map (``pamsim.fmu.muscle_fmu``).  Co-simulation runs the same integrator on both, so they must
-agree to rounding; Model Exchange runs fmpy's CVode over 8 states instead of 4 (the generated model adds
-the work integrals), so to its tolerance.
+The FMU's parameters are a muscle's and its run-time choices; the generated model's are its
+components'.  The map between them is generated from the elements' own ``from_parameters`` on CasADi
+symbols (``pamsim.fmu.muscle_fmu``); here it is held to the assembly built from the same values on floats.
 """
 
 from __future__ import annotations
-
-import tomllib
 
 import numpy as np
 import pytest
 
 import pamsim
-from conftest import PAPER_SCENARIOS, SCENARIOS
-from pamsim.fmu.runner import run_cs, run_me, set_values
+from conftest import SCENARIOS
+from pamsim.fmu.runner import set_values
 from pamsim.fmu.variables import BY_NAME, VARIABLES, value_reference
-from test_fmu import INITIAL_PRESSURE, OTHER_CHOICES
-
-CS_AGREE_M = 1e-9
-"""Co-simulation, generated against hand-written: the same integrator on the same equations (measured
-8e-17 m on fig4); the bound leaves room for the order of floating-point operations to differ."""
-ME_AGREE_M = 0.05e-3
-"""Model Exchange: fmpy's CVode at its default tolerance over 8 states against 4 (measured 3.1e-7 m on fig4,
-1.9e-5 m on the prescribed lag): the bound test_fmu holds either core's final contraction to against Python."""
 
 
-@pytest.fixture(scope="module")
-def generated(tmp_path_factory):
-    """{FMI version: path} of the generated one-muscle FMU (no preset: the FMU's own defaults)."""
-    from pamsim.fmu.muscle_spec import build_generated
+@pytest.mark.parametrize("name", ["acra2012_fig4", "acra2012_fig4_chou_hannaford", "acra2012_fig6b"])
+def test_the_generated_map_gives_the_assemblys_own_parameters(name):
+    """pm_kmap at the FMU's start values, evaluated by CasADi, equals the parameters of the assembly built
+    from those values on floats, bit for bit (the braid geometry, the upper stop, every law's numbers)."""
+    from pamsim.fmu.muscle_fmu import knob_map, muscle_assembly
+    from pamsim.fmu.muscle_spec import knob_names
+    from pamsim.fmu.preset import for_scenario
+    from pamsim.fmu.variables import with_preset
 
-    root = tmp_path_factory.mktemp("generated")
-    return {v: build_generated(root / f"muscle_generated_fmi{v}.fmu", v) for v in (2, 3)}
+    preset = for_scenario(pamsim.load_scenario(SCENARIOS / f"{name}.toml"))
+    rows = {v.name: v for v in with_preset(VARIABLES, preset.table, preset)}
+    knobs = knob_names()
+    start = {n: float(rows[n].start) for n in knobs}
+    assembly = muscle_assembly(start, preset.table)
+    names = tuple(v.name for v in assembly.flatten().parameters)
+    kmap, _ = knob_map(knobs, names, start, preset.table)
+    got = np.array(kmap(np.array([start[n] for n in knobs]))).ravel()
+    assert np.array_equal(got, np.array(assembly.parameter_values()))
+    # The map moves what depends on a knob: the braid's thread length follows L0_m.
+    moved = dict(start, L0_m=start["L0_m"] * 1.01)
+    p2 = np.array(kmap(np.array([moved[n] for n in knobs]))).ravel()
+    assert p2[names.index("chamber.thread_length_m")] == pytest.approx(
+        got[names.index("chamber.thread_length_m")] * 1.01, rel=1e-12)
 
 
-def _scenarios():
-    out = {name: pamsim.load_scenario(SCENARIOS / f"{name}.toml") for name in PAPER_SCENARIOS}
-    out.update({case: pamsim.Scenario.from_dict(tomllib.loads(text), name=case) for case, text in OTHER_CHOICES.items()})
-    out["initial_pressure"] = pamsim.Scenario.from_dict(tomllib.loads(INITIAL_PRESSURE), name="initial_pressure")
-    out["fig6b_abs"] = out["acra2012_fig6b"].with_changes({"model": {"friction_negative_level": "abs"}})
-    return out
-
-
-SCENARIO_CASES = _scenarios()
-
-
-def test_the_variables_are_the_hand_written_fmus(generated):
-    """Every variable of the hand-written FMU is there, with its value reference, kind, causality and range."""
+def test_every_variable_of_the_table_is_there(fmus):
+    """Every variable of the one-muscle FMU's table is there, with its value reference and causality."""
     from fmpy import read_model_description
 
     for v in (2, 3):
-        md = {x.name: x for x in read_model_description(str(generated[v])).modelVariables}
+        md = {x.name: x for x in read_model_description(str(fmus[v])).modelVariables}
         for row in VARIABLES:
             assert row.name in md, row.name
             assert md[row.name].valueReference == value_reference(row.name), row.name
             assert md[row.name].causality == row.causality, row.name
 
 
-def test_fmpy_validates_it(generated):
+def test_fmpy_validates_it(fmus):
     from fmpy.validation import validate_fmu
 
     for v in (2, 3):
-        assert validate_fmu(str(generated[v])) == [], v
-
-
-@pytest.mark.parametrize("name", sorted(SCENARIO_CASES))
-def test_co_simulation_equals_the_hand_written_core(fmus, generated, name):
-    sc = SCENARIO_CASES[name]
-    for v in (2, 3):
-        mine, theirs = run_cs(sc, v, fmu_path=generated[v]), run_cs(sc, v, fmu_path=fmus[v])
-        assert np.max(np.abs(mine["contraction_m"] - theirs["contraction_m"])) <= CS_AGREE_M
-        assert np.array_equal(mine["friction_mode"], theirs["friction_mode"])
-        assert np.max(np.abs(mine["p_gauge_Pa"] - theirs["p_gauge_Pa"])) <= 1e-3
-
-
-@pytest.mark.parametrize("name", sorted(SCENARIO_CASES))
-def test_model_exchange_agrees_with_the_hand_written_core_and_python(fmus, generated, name):
-    sc = SCENARIO_CASES[name]
-    mine, theirs = run_me(sc, 2, fmu_path=generated[2]), run_me(sc, 2, fmu_path=fmus[2])
-    assert np.max(np.abs(mine["contraction_m"] - theirs["contraction_m"])) <= ME_AGREE_M
-    ref = pamsim.simulate(sc)
-    assert np.max(np.abs(mine["contraction_m"] - ref.x_m)) <= 0.2e-3  # test_fmu.MAX_DIFF_M
+        assert validate_fmu(str(fmus[v])) == [], v
 
 
 def _instance(path, version):
@@ -94,7 +69,7 @@ def _instance(path, version):
     md = read_model_description(str(path))
     cls = FMU2Slave if version == 2 else FMU3Slave
     fmu = cls(guid=md.guid if version == 2 else md.instantiationToken, unzipDirectory=extract(str(path)),
-              modelIdentifier="pamsim_muscle", instanceName="generated")
+              modelIdentifier="pamsim_muscle", instanceName="muscle")
     fmu.instantiate()
     return fmu
 
@@ -129,21 +104,15 @@ def _initialise(path, version, values):
     ({"static_force_model": 1}, "static_force_model = 1 (table): this FMU was built without a force table"),
     ({"fit_x_min_m": 0.2}, "fit_x_min_m = 0.2: must be below fit_x_max_m"),
 ])
-def test_checks_refuse_what_the_hand_written_core_refuses(generated, fmus, values, message, capfd):
-    """The generated checks give the hand-written core's messages (the upper stop of the braid lock,
+def test_checks_refuse_with_their_messages(fmus, values, message, capfd):
+    """The generated checks, with the messages the FMU has always given (the upper stop of the braid lock,
     0.1157 m, computed by the generated map)."""
-    from fmpy import extract
-
-    from test_fmu import _initialise_with
-
     for v in (2, 3):
         capfd.readouterr()
-        assert _initialise_with({v: extract(str(fmus[v]))}, v, values) != 0
-        assert message in capfd.readouterr().out
-        assert _initialise(generated[v], v, values) != 0
+        assert _initialise(fmus[v], v, values) != 0
         log = capfd.readouterr().out
         assert message in log, log
-    assert _initialise(generated[2], 2, {}) == 0
+    assert _initialise(fmus[2], 2, {}) == 0
 
 
 @pytest.mark.parametrize("name, value, message", [
@@ -151,10 +120,10 @@ def test_checks_refuse_what_the_hand_written_core_refuses(generated, fmus, value
     ("prescribed_pressure_gauge_Pa", -2e5, "prescribed_pressure_gauge_Pa = -200000 Pa: below vacuum"),
     ("prescribed_pressure_gauge_Pa", 4.6e5, "prescribed_pressure_gauge_Pa = 460000 Pa: exceeds the muscle's rating"),
 ])
-def test_inputs_beyond_the_rating_are_refused_when_set(generated, fmus, name, value, message, capfd):
+def test_inputs_beyond_the_rating_are_refused_when_set(fmus, name, value, message, capfd):
     from fmpy.fmi1 import FMICallException
 
-    for path in (fmus[2], generated[2]):
+    for path in (fmus[2],):
         fmu = _instance(path, 2)
         capfd.readouterr()
         with pytest.raises(FMICallException):
@@ -164,13 +133,13 @@ def test_inputs_beyond_the_rating_are_refused_when_set(generated, fmus, name, va
         fmu.freeInstance()
 
 
-def test_directional_derivatives_are_exact(generated):
+def test_directional_derivatives_are_exact(fmus):
     """d der(velocity) / d contraction while sliding, against a central difference of the Python model, and
     d der(velocity) / d load_mass_kg (an input that the map turns into a parameter) likewise."""
     from pamsim.fmu.runner import ScenarioInputs
 
     sc = pamsim.load_scenario(SCENARIOS / "acra2012_fig4.toml")
-    fmu = _instance(generated[2], 2)
+    fmu = _instance(fmus[2], 2)
     inputs = ScenarioInputs(sc)
     set_values(fmu, 2, {"supply_pressure_gauge_Pa": 3.6e5, "valve_command": 1.0, "load_mass_kg": sc.mass_kg})
     fmu.setupExperiment(startTime=0.0)

@@ -1,5 +1,5 @@
-/* The FMI logic that FMI 2.0 and 3.0 share, over an FMU core (pam_core.c or pam_gcore.c, chosen by the
- * generated pam_fmu_core.h).
+/* The FMI logic that FMI 2.0 and 3.0 share, over the FMU core (pam_gcore.c, named by the generated
+ * pam_fmu_core.h).
  *
  * Both wrappers keep their instance as a struct whose first member is an FmuInstance, so a
  * component / instance pointer can be passed here as it is.  Every function takes the name of

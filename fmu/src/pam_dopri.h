@@ -1,5 +1,5 @@
 /* The Dormand-Prince 5(4) tableau, its error weights and Shampine's continuous extension: shared by
- * the hand-written core (pam_core.c) and the generic engine (pam_engine.c). */
+ * the generic engine (pam_engine.c). */
 #ifndef PAM_DOPRI_H
 #define PAM_DOPRI_H
 

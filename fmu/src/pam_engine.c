@@ -1,5 +1,6 @@
 /* pamsim generic engine; see pam_engine.h.  The integrator, event location and mode switching of
- * the hand-written core (pam_core.c), with every physical quantity taken from the generated model. */
+ * pamsim's first C core (written by hand, since removed), with every physical quantity taken from the
+ * generated model. */
 #include "pam_engine.h"
 #include "pam_dopri.h"
 

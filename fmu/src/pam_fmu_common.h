@@ -1,7 +1,7 @@
-/* What both FMU cores (pam_core.c, the one-muscle model written by hand, and pam_gcore.c, any generated
- * assembly on the generic engine) share: logging, a variable's range check and the input signals of the
- * scenario the FMU was built from.  Each core's header defines PamCore with the fields used here (r[],
- * i[], time_s, inputs_set, log, log_env) and includes this file after it. */
+/* What an FMU core needs beside its model (pam_gcore.c, any generated assembly on the generic engine):
+ * logging, a variable's range check and the input signals of the scenario the FMU was built from.  The
+ * core's header defines PamCore with the fields used here (r[], i[], time_s, inputs_set, log, log_env)
+ * and includes this file after it. */
 #ifndef PAM_FMU_COMMON_H
 #define PAM_FMU_COMMON_H
 

@@ -1,6 +1,6 @@
-/* 5-point Gauss-Legendre quadrature on [0, 1] as polynomials of the step fraction: shared by the
- * native drivers of the hand-written core (pam_native.c) and of the generic engine
- * (pam_engine_batch.c), which integrate the work states over each step's dense output. */
+/* 5-point Gauss-Legendre quadrature on [0, 1] as polynomials of the step fraction: used by the drivers
+ * of the generic engine (pam_engine_batch.c, pam_gcore.c), which integrate the work states over each
+ * step's dense output. */
 #ifndef PAM_GAUSS_H
 #define PAM_GAUSS_H
 

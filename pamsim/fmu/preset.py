@@ -36,7 +36,7 @@ _PARAMETERS = {v.name for v in VARIABLES if v.causality == "parameter" and v.kin
 
 @dataclass(frozen=True)
 class InputSignal:
-    """One input's signal as the FMU's C core evaluates it (``pam_signal_value`` in ``pam_core.c``).
+    """One input's signal as the FMU's C core evaluates it (``fmu/src/pam_fmu_common.c``).
 
     Either knots ``(knots_t_s[k], knots[k])``, interpolated linearly (as ``numpy.interp``), held
     outside them and right-continuous at a repeated time (a step: the later value from that time

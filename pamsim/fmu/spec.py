@@ -2,9 +2,9 @@
 
 :mod:`pamsim.fmu.generate` writes ``modelDescription.xml`` (FMI 2.0 and 3.0), ``pam_variables.h``
 and the documentation from an :class:`FmuSpec`, whichever model it describes: the one-muscle model
-of :mod:`pamsim.fmu.variables` with its core written by hand (``pam_core.c``), or an assembly of
-components whose core (``pam_gcore.c``) runs the model generated from it
-(:mod:`pamsim.fmu.assembly_fmu`).
+under the names of :mod:`pamsim.fmu.variables` (:mod:`pamsim.fmu.muscle_spec`), or any assembly of
+components (:mod:`pamsim.fmu.assembly_fmu`); both run the model generated from their components on
+the generic core (``pam_gcore.c``).
 """
 
 from __future__ import annotations

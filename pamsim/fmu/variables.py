@@ -41,8 +41,7 @@ NEGATIVE_LEVEL = C_CHOICES["friction_negative_level"]
 """``friction_negative_level`` values 0, 1 (the scenario's ``model.friction_negative_level`` names)."""
 INPUT_SOURCE_CHOICES = ("importer", "scenario")
 """``input_source`` values 0, 1: the inputs are the importer's, or follow the signals of the scenario the
-FMU was built from (:mod:`pamsim.fmu.preset`).  The FMU's own choice, so its C enumeration is generated
-into ``pam_variables.h`` rather than ``pam_shared.h``."""
+FMU was built from (:mod:`pamsim.fmu.preset`).  Its C enumeration is generated into ``pam_variables.h``."""
 
 
 VALUE_REFERENCES = {
@@ -293,6 +292,5 @@ def value_reference(name: str) -> int:
 
 STATES = tuple(v.derivative_of for v in VARIABLES if v.derivative_of)
 INPUTS = tuple(v.name for v in VARIABLES if v.causality == "input")
-"""The inputs, in table order: the FMU's, and the native library's ``segment_u`` columns (whose C
-side, ``INPUT_R`` in ``fmu/src/pam_native.c``, lists them in this order; a test compares the two)."""
+"""The inputs, in table order: the FMU's, and the columns of a native case's ``segment_u``."""
 EVENT_INDICATORS = ("event_indicator_1", "event_indicator_2")

@@ -6,8 +6,7 @@ Each trace's case is built once, at the start of the fit, exactly as the native 
 scenario's (:func:`pamsim.native.backend.case_inputs`), with the trace's load, duration and the
 fit's tolerance, and with the recorded pressure as the source when there is one.  Like the backend,
 the fit runs such a case on the generic engine compiled with the case's generated model
-(:mod:`pamsim.native.engine`), and a case with a force table on the hand-written C core
-(:mod:`pamsim.native.library`).
+(:mod:`pamsim.native.engine`).
 
 **A trial point on the engine.**  The engine takes the flat model's parameter vector
 (``assembly.parameter_values()``: ``friction.N0_N_per_bar``, ``load.mass_kg``, ...), whose entries are
@@ -32,12 +31,8 @@ A trial whose coefficients the parameter set refuses (a value outside its range,
 is refused without a run, NaN as on the Python backend, and so is one whose rebuilt scenario fails its
 own checks.
 
-**A trial point on the core** (force tables): the free coefficients are entries of the core's vector
-of every variable, so a trial is that vector with them replaced, and the load mass, an input of the
-core, is recomputed from the trial's ``g_m_s2``.
-
 **The recorded pressure** is a trace of its knots (:class:`.pressure_input.PiecewiseLinearInput`), which
-the backend takes as it takes a scenario's trace, on the engine and on the core alike: the run is cut at
+the backend takes as it takes a scenario's trace: the run is cut at
 every knot and the integrator evaluates the line between two knots exactly
 (:func:`pamsim.native.backend.exact_segments`), so a trial's contraction is ``pamsim.simulate`` of the
 trace's scenario with that trace on the native backend, and the output sample rate changes nothing but
@@ -54,19 +49,12 @@ from typing import Sequence
 
 import numpy as np
 
-from ..assemblies import scenario_assembly
 from ..elements.pressure_source import PrescribedPressure
 from ..errors import InputError
-from ..native import library as lib
-from ..native.backend import CaseInputs, case_inputs, event_capacity, outgrew_batch, segment_changes
+from ..native.backend import CaseInputs, case_inputs, engine_assembly, event_capacity, needs_table, outgrew_batch
 from ..native.engine import EngineCase, EngineLibrary, engine_library
 from ..static_models import get as get_static_model
 from .trials import trace_scenario
-
-_X_ROW = lib.SAMPLE_COLUMNS.index("x_m")
-_MASS = lib.INPUTS.index("load_mass_kg")
-_G = lib.REAL_INDEX["g_m_s2"]
-
 
 def _contractions(n_cases: int, max_events, sample_t_s, first_pass, alone, trace) -> list[np.ndarray]:
     """Each case's contraction [m] at its sample times, NaN for a case that failed.
@@ -89,81 +77,6 @@ def _contractions(n_cases: int, max_events, sample_t_s, first_pass, alone, trace
         grid, x = trace(found, k, i)
         xs.append(np.interp(sample_t_s[i], grid, x))
     return xs
-
-
-# ------------------------------------------------------------------------------------- the C core
-@dataclass(frozen=True)
-class Chunk:
-    """Trial cases with a force table, sent to the C core in one call (pickles to a worker process)."""
-
-    reals: np.ndarray
-    ints: np.ndarray
-    duration_s: np.ndarray
-    n_samples: np.ndarray
-    segment_counts: np.ndarray
-    segment_t_s: np.ndarray
-    segment_u: np.ndarray
-    segment_du: np.ndarray | None
-    max_events: np.ndarray
-    sample_t_s: tuple[np.ndarray, ...]
-    tables: tuple = ()
-
-    def __len__(self) -> int:
-        return len(self.duration_s)
-
-    def sub(self, a: int, b: int) -> "Chunk":
-        """Cases ``a`` to ``b - 1``."""
-        seg = np.concatenate([[0], np.cumsum(self.segment_counts)])
-        du = None if self.segment_du is None else self.segment_du[seg[a]:seg[b]]
-        return Chunk(self.reals[a:b], self.ints[a:b], self.duration_s[a:b], self.n_samples[a:b],
-                     self.segment_counts[a:b], self.segment_t_s[seg[a]:seg[b]], self.segment_u[seg[a]:seg[b]], du,
-                     self.max_events[a:b], self.sample_t_s[a:b], self.tables)
-
-    def run(self) -> list[np.ndarray]:
-        """Contraction [m] of every case at its sample times; NaN for a case that failed."""
-        out = _run(self, event_capacity(self.max_events))
-
-        def trace(found, k, i):
-            first, m = int(found["sample_offset"][k]), int(self.n_samples[i])
-            block = found["samples"][len(lib.SAMPLE_COLUMNS) * first:len(lib.SAMPLE_COLUMNS) * (first + m)]
-            return np.linspace(0.0, self.duration_s[i], m), block.reshape(-1, m)[_X_ROW]
-
-        return _contractions(len(self), self.max_events, self.sample_t_s, lambda i: (out, i),
-                             lambda i: _run(self.sub(i, i + 1), self.max_events[i:i + 1] + 1), trace)
-
-
-def _run(chunk: Chunk, capacity: np.ndarray) -> dict:
-    """One call of the C core; the cases share the fit's one force table."""
-    return lib.run_batch(chunk.reals, chunk.ints, chunk.duration_s, chunk.n_samples, chunk.segment_counts,
-                         chunk.segment_t_s, chunk.segment_u, capacity, chunk.tables,
-                         np.zeros(len(chunk), dtype=np.int64) if chunk.tables else None, chunk.segment_du)
-
-
-class _CoreTrials:
-    """Trial chunks of traces whose cases have a force table: the free coefficients replaced in each
-    case's vector of every variable, the load mass recomputed from the trial's ``g_m_s2``."""
-
-    def __init__(self, problem, cases: Sequence[CaseInputs], samples: Sequence[np.ndarray]):
-        self.cases, self.samples = list(cases), list(samples)
-        self.weights_N = np.array(problem.loads_N)
-        self.free_index = np.array([lib.REAL_INDEX[n] for n in problem.free], dtype=int)
-        # One scenario, one static model: the traces share its table.
-        self.tables = () if cases[0].table is None else (cases[0].table,)
-
-    def chunk(self, thetas: np.ndarray) -> Chunk:
-        n_tr, cases = len(self.cases), self.cases * len(thetas)
-        reals = np.repeat(np.array([c.reals for c in self.cases])[None], len(thetas), axis=0)
-        reals[:, :, self.free_index] = thetas[:, None, :]
-        reals = reals.reshape(len(thetas) * n_tr, -1)
-        counts = np.array([len(c.segment_t_s) for c in cases], dtype=np.int64)
-        u = np.concatenate([c.segment_u for c in cases])
-        # The load mass is the only input a coefficient feeds (through g): the trial's own.
-        u[:, _MASS] = np.repeat(np.tile(self.weights_N, len(thetas)) / reals[:, _G], counts)
-        return Chunk(reals, np.array([c.ints for c in cases]), np.array([c.duration_s for c in cases]),
-                     np.array([c.n_samples for c in cases], dtype=np.int64), counts,
-                     np.concatenate([c.segment_t_s for c in cases]), u, segment_changes(cases),
-                     np.array([c.max_events for c in cases], dtype=np.int64), tuple(self.samples * len(thetas)),
-                     self.tables)
 
 
 # ------------------------------------------------------------------------------- the generic engine
@@ -268,7 +181,7 @@ class _EngineTrials:
     def _assembly(self, i: int, overrides: dict):
         """Trace ``i``'s assembly with ``overrides``, as :func:`case_inputs` builds it (with the
         components the scenario adds)."""
-        return scenario_assembly(*_trace_model(self.problem, i, overrides, self.rtol))
+        return engine_assembly(*_trace_model(self.problem, i, overrides, self.rtol))
 
     def _set_up(self, i: int, case: CaseInputs) -> _EngineTrace:
         library = engine_library(case.assembly)
@@ -353,7 +266,7 @@ class _EngineTrials:
                            tuple(self.samples * len(thetas)))
 
 
-def run_chunk(chunk: Chunk | EngineChunk) -> list[np.ndarray]:
+def run_chunk(chunk: EngineChunk) -> list[np.ndarray]:
     """Contraction [m] of every case of ``chunk`` at its sample times; NaN for a case that failed.
 
     One library call for the chunk (one per engine library: traces with and without a recorded
@@ -369,10 +282,10 @@ TABLE_SHAPERS = ("rated_pressure_gauge_Pa", "L0_m", "r0_m", "theta0_deg")
 
 
 def _refuse_free_table_parameters(problem) -> None:
-    """A static force other than the polynomial runs as a force table built once per fit: a free
-    coefficient that shapes it (a parameter of the model, or of the table's domain) is refused."""
+    """A static force without generated C runs as a force table built once per fit: a free coefficient
+    that shapes it (a parameter of the model, or of the table's domain) is refused."""
     m = problem.scenario.spec["model"]
-    if m["static_force"] == "acra2012_polynomial":
+    if not needs_table(problem.scenario):
         return
     spec = get_static_model(m["static_force"])
     shapers = set(spec.parameters) | set(spec.optional) | set(TABLE_SHAPERS)
@@ -405,13 +318,9 @@ class NativeTrials:
         _refuse_free_table_parameters(problem)
         cases = [case_inputs(*_trace_model(problem, i, {}, rtol)) for i in range(len(problem.traces))]
         samples = [tr.t_s - tr.t_s[0] for tr in problem.traces]
-        # One scenario, one static model: every trace's case has a force table or none does.
-        if cases[0].assembly is None:
-            self.trials = _CoreTrials(problem, cases, samples)
-        else:
-            self.trials = _EngineTrials(problem, rtol, cases, samples)
+        self.trials = _EngineTrials(problem, rtol, cases, samples)
 
-    def chunk(self, thetas: np.ndarray) -> Chunk | EngineChunk:
+    def chunk(self, thetas: np.ndarray) -> EngineChunk:
         """Every trace at every row of ``thetas`` as one batch."""
         return self.trials.chunk(np.atleast_2d(np.asarray(thetas, dtype=float)))
 

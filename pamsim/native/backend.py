@@ -1,12 +1,10 @@
 """The native backend: scenarios run in C (``pamsim.simulate(scenario, backend="native")``).
 
 Every case's inputs are built here (parameters, element choices, and the
-input signals as segments over which they are held); a library then runs a
+input signals as segments over which they are held); the generic engine compiled
+with the case's assembly's generated C (:mod:`pamsim.native.engine`) then runs a
 whole batch in one call, and the traces become the same :class:`Result` as the
-Python backend's: columns, modes, events, work integrals and summary.  A case
-without a force table runs on the generic engine compiled with its assembly's
-generated C (:mod:`pamsim.native.engine`); a case with one on the hand-written C
-core (:mod:`pamsim.native.library`).
+Python backend's: columns, modes, events, work integrals and summary.
 
 Differences from the Python backend, all documented in ``docs/scaling.md``:
 
@@ -14,12 +12,13 @@ Differences from the Python backend, all documented in ``docs/scaling.md``:
   ``solver.native_rtol_factor`` (:func:`native_rtol`; 0.01 unless the scenario says otherwise, so that
   it meets LSODA's accuracy at ``rtol``) (``solver.method`` may be ``LSODA``, the automatic choice, or ``RK45``, the
   same method; the implicit ones are refused);
-- a static force other than the ACRA 2012 polynomial is the FMU's bicubic force
-  table of the model (:func:`force_table`), not the model itself;
+- a static force that has no form in symbols or in CasADi (a model a user writes for
+  floats alone) runs as the FMU's spline table of it (:func:`force_table`), not the
+  model itself; every other static force runs as the python backend runs it;
 - the work integrals are Gauss-Legendre quadratures of each step's dense output
   (the Python backend integrates them as states);
-- every input signal the FMU can carry (constant, step, steps, ramp, lag, trace) is exact, on
-  the generic engine and on the hand-written core alike: the run is cut at its knots and lag
+- every input signal the FMU can carry (constant, step, steps, ramp, lag, trace) is exact: the
+  run is cut at its knots and lag
   starts, and inside each piece the integrator evaluates it in closed form
   (:func:`exact_segments`); a signal of another kind (a Python function) is held at its midpoint
   value over intervals of at most :func:`hold_interval_s`, a second-order approximation.
@@ -31,7 +30,7 @@ import bisect
 import math
 import time
 from collections import OrderedDict
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Sequence
 
 import numpy as np
@@ -39,7 +38,8 @@ import numpy as np
 from ..assemblies import scenario_assembly
 from ..assemblies.one_muscle import RigOutputs, input_signals
 from ..components.hanging_load import event_name
-from ..core_table import C_CHOICES, SCENARIO_KEYS, unimplemented_choice
+from ..core_table import C_CHOICES
+from ..elements.force_clip import with_negative_force
 from ..elements.pressure_source import PrescribedPressure, ValveChamberSource
 from ..errors import InputError, SolverFailure
 from ..fmu.force_table import ForceTable
@@ -83,7 +83,6 @@ HOLD_STEPS_PER_TAU = 10
 """A first-order lag is held over at most tau / 10 (and never longer than one output sample)."""
 METHOD_LABEL = "native DOPRI5(4)"
 _EXACT = (Constant, Step, PiecewiseConstant)  # constant between breakpoints: held exactly
-_STATE_ROWS = {2: slice(0, 8), 0: [0, 1, 4, 5, 6, 7]}  # Result's state rows by source state count (a view if it can)
 _DEFAULT_MAX_STEP_S = float(lib.REAL_DEFAULTS[lib.REAL_INDEX["cs_max_step_s"]])
 
 
@@ -99,8 +98,7 @@ class CaseInputs:
     segment_u: np.ndarray
     max_events: int
     model: MuscleModel
-    table: ForceTable | None = None
-    assembly: object | None = None
+    assembly: object
     segment_du: np.ndarray | None = None  # exact inputs (EngineCase.segment_du), in segment_u's columns
     input_names: tuple[str, ...] = lib.INPUTS  # segment_u's columns
 
@@ -116,13 +114,41 @@ class CaseInputs:
                           self.segment_t_s, u, int(capacity), du)
 
 
+def engine_model(scenario: Scenario, model: MuscleModel | None = None) -> MuscleModel:
+    """``model`` (``scenario.build_model()`` if None) as the engine runs it: as it is where every element has
+    generated C, else with a static force that has none (a model written for floats alone) replaced by its
+    spline table (:func:`force_table`), clipped at zero as the dynamics apply it."""
+    model = scenario.build_model() if model is None else model
+    if in_c(scenario_assembly(scenario, model), "muscle"):
+        return model
+    return replace(model, static_force=with_negative_force(force_table(scenario), "clip"))
+
+
 def engine_assembly(scenario: Scenario, model: MuscleModel | None = None):
-    """The scenario's assembly if the generic engine can run it (every component in generated C: written
-    in symbols, or with a CasADi form, as a spline table has), else None: a static model called on floats
-    alone runs as a force table on the hand-written C core.  ``model``: as :func:`case_inputs` takes it."""
-    assembly = scenario_assembly(scenario, model)
-    in_c = (c.has_c_form() if hasattr(c, "has_c_form") else getattr(c, "traces", True) for c in assembly.components)
-    return assembly if all(in_c) else None
+    """The assembly the engine runs for ``scenario`` (:func:`engine_model`'s).
+
+    Raises
+    ------
+    InputError
+        For an element other than the static force that has no generated C (a law written for floats alone).
+    """
+    assembly = scenario_assembly(scenario, engine_model(scenario, model))
+    lacking = [c.name for c in assembly.components if not in_c(assembly, c.name)]
+    if lacking:
+        raise InputError(f"{scenario.origin}: component {lacking[0]!r} is written for floats alone and has no C; "
+                         "run it with the python backend")
+    return assembly
+
+
+def needs_table(scenario: Scenario) -> bool:
+    """Whether ``scenario``'s static force runs natively as its spline table (it has no generated C)."""
+    return not in_c(scenario_assembly(scenario, scenario.build_model()), "muscle")
+
+
+def in_c(assembly, name: str) -> bool:
+    """Whether component ``name`` of ``assembly`` has generated C (written in symbols, or with a CasADi form)."""
+    c = next(c for c in assembly.components if c.name == name)
+    return c.has_c_form() if hasattr(c, "has_c_form") else getattr(c, "traces", True)
 
 
 def refuse_unsupported(scenario: Scenario) -> None:
@@ -133,30 +159,17 @@ def refuse_unsupported(scenario: Scenario) -> None:
         table = spec if not section else spec.get(section, {})
         for key in sorted(set(table) - keys):
             if not section and key == "component":
-                if engine_assembly(scenario) is not None:
-                    continue  # the generated model holds them
-                raise InputError(f"{where}: component: components added to the rig run natively only with a "
-                                 f"static force written in symbols, not {spec['model']['static_force']!r} (it runs "
-                                 "as a force table on the hand-written C core); run it with the python backend")
+                continue  # the generated model holds them
             name = f"{section}.{key}" if section else key
             raise InputError(f"{where}: {name}: the native backend cannot honour this key; "
                              "run it with the python backend")
     if spec["model"]["static_force_negative"] != "clip":
         raise InputError(f"{where}: model.static_force_negative = {spec['model']['static_force_negative']!r}: "
-                         "the C core clips a negative static force at zero; run it with the python backend")
-    # Any static force runs (on the engine, or as a force table); another choice the core lacks runs on the
-    # engine when it is written in symbols (a friction or damping law added in Python alone).
-    lacking = unimplemented_choice(spec, skip=("static_force",))
-    if lacking and engine_assembly(scenario) is None:
-        key = next(k for k, w in SCENARIO_KEYS.items() if w == lacking[0])
-        raise InputError(f"{where}: {lacking[0]} = {lacking[1]!r}: the C core implements only "
-                         f"{', '.join(C_CHOICES[key])}; run it with the python backend")
+                         "the native backend clips a negative static force at zero; run it with the python backend")
     method = spec.get("solver", {}).get("method", "LSODA")
     if method not in METHODS:
         raise InputError(f"{where}: solver.method = {method!r}: the native backend integrates with Dormand-Prince "
                          f"5(4) and honours only {', '.join(METHODS)}; run it with the python backend")
-    # A parameter the core lacks (wall_thickness_m, E_bladder_Pa, ...) is a component's on the engine, and
-    # only shapes the force table on the core.
 
 
 TABLE_CACHE_SIZE = 32
@@ -166,7 +179,7 @@ _tables: "OrderedDict[tuple, ForceTable]" = OrderedDict()
 
 def force_table(scenario: Scenario) -> ForceTable:
     """The static force table of ``scenario`` as the FMU would bake it (:func:`pamsim.fmu.runner.tabulate_model`),
-    for a static model the engine cannot run (:func:`engine_assembly`).  Tables are cached by the model,
+    for a static model without generated C (:func:`engine_model`).  Tables are cached by the model,
     its variant, the parameters and the force-map file, so the cases of a sweep tabulate once."""
     m = scenario.spec["model"]
     key = (m["static_force"], m.get("static_force_variant"), tuple(sorted(scenario.parameters.items())),
@@ -254,26 +267,20 @@ def case_inputs(scenario: Scenario, model: MuscleModel | None = None) -> CaseInp
     opts = scenario.solver
     T = scenario.duration_s
     n_samples = int(round(T * opts.sample_rate_Hz)) + 1
-    # the generic engine runs the generated model; a force table stays with the hand-written core
     assembly = engine_assembly(scenario, model)
+    model = engine_model(scenario, model)
     names, signals = _signals(model)
-    if assembly is None and names != lib.INPUTS:
-        raise InputError(f"{scenario.origin}: model.static_force = {scenario.spec['model']['static_force']!r}: the "
-                         f"{type(model.source).__name__} runs natively only with a static force written in "
-                         "symbols (this one runs as a force table on the hand-written C core, which has no such "
-                         "source); run it with the python backend")
-    table = force_table(scenario) if assembly is None else None
-    reals, ints = core_values(scenario, model, table)
+    reals, ints = core_values(scenario, model)
     pieces = exact_segments(signals, T)
     starts, u, du = pieces if pieces is not None else (*held_segments(signals, model, T, n_samples), None)
     _set_mass(u, names, model)
-    return CaseInputs(reals, ints, T, n_samples, starts, u, opts.max_events, model, table, assembly, du, names)
+    return CaseInputs(reals, ints, T, n_samples, starts, u, opts.max_events, model, assembly, du, names)
 
 
-def core_values(scenario: Scenario, model: MuscleModel, table: ForceTable | None) -> tuple[np.ndarray, np.ndarray]:
-    """The C core's variables for ``scenario`` run with ``model`` (and its force ``table``, if it has one):
-    the reals (parameters, start, margins, solver settings) and the ints (element choices).  The generic
-    engine reads only the solver settings from them."""
+def core_values(scenario: Scenario, model: MuscleModel) -> tuple[np.ndarray, np.ndarray]:
+    """The one-muscle FMU's variables for ``scenario`` run with ``model``: the reals (parameters, start,
+    margins, solver settings) and the ints (element choices).  The engine reads the solver settings from
+    them, and a fit the parameters it moves."""
     opts = scenario.solver
     reals = lib.REAL_DEFAULTS.copy()
     for name, value in scenario.parameters.items():
@@ -294,8 +301,6 @@ def core_values(scenario: Scenario, model: MuscleModel, table: ForceTable | None
     for name, (key, value) in choices.items():
         if value in C_CHOICES[key]:  # the core's choices (the engine reads none of them)
             ints[lib.INT_INDEX[name]] = C_CHOICES[key].index(value)
-    ints[lib.INT_INDEX["static_force_model"]] = C_CHOICES["static_force_model"].index(
-        "acra2012_polynomial" if table is None else "table")
     return reals, ints
 
 
@@ -325,51 +330,22 @@ def _set_mass(u: np.ndarray, names: Sequence[str], model: MuscleModel) -> None:
 
 
 def _run(cases: Sequence[CaseInputs], capacity: Sequence[int]) -> list[tuple[dict, int]]:
-    """Each case's batch output and its index in it: cases of one assembly structure in one engine call,
-    the cases with a force table in one call of the C core."""
+    """Each case's batch output and its index in it: the cases of one assembly structure in one engine call."""
     where: list = [None] * len(cases)
     groups: dict = {}
     for i, c in enumerate(cases):
-        key = c.assembly.structure_key() if c.assembly is not None else None
-        groups.setdefault(key, []).append(i)
-    for key, members in groups.items():
-        if key is None:
-            out = _run_core([cases[i] for i in members], [capacity[i] for i in members])
-        else:
-            library = engine_library(cases[members[0]].assembly)
-            out = library.run([cases[i].engine_case(library, capacity[i]) for i in members])
-            out["library"] = library
+        groups.setdefault(c.assembly.structure_key(), []).append(i)
+    for members in groups.values():
+        library = engine_library(cases[members[0]].assembly)
+        out = library.run([cases[i].engine_case(library, capacity[i]) for i in members])
+        out["library"] = library
         for j, i in enumerate(members):
             where[i] = (out, j)
     return where
 
 
-def _run_core(cases: Sequence[CaseInputs], capacity: Sequence[int]) -> dict:
-    tables: list[ForceTable] = []
-    index: dict[int, int] = {}  # id(table) -> its place in tables: the cases of one muscle share one table
-    for c in cases:
-        if c.table is not None and id(c.table) not in index:
-            index[id(c.table)] = len(tables)
-            tables.append(c.table)
-    return lib.run_batch(np.array([c.reals for c in cases]), np.array([c.ints for c in cases]),
-                         np.array([c.duration_s for c in cases]), np.array([c.n_samples for c in cases]),
-                         np.array([len(c.segment_t_s) for c in cases]),
-                         np.concatenate([c.segment_t_s for c in cases]), np.concatenate([c.segment_u for c in cases]),
-                         np.asarray(capacity), tables,
-                         np.array([-1 if c.table is None else index[id(c.table)] for c in cases]), segment_changes(cases))
-
-
-def segment_changes(cases: Sequence[CaseInputs]) -> np.ndarray | None:
-    """The cases' inputs' change over each segment (zeros for held ones), or None if every one is held."""
-    if all(c.segment_du is None for c in cases):
-        return None
-    return np.concatenate([np.zeros((len(c.segment_t_s), len(lib.INPUTS), 3)) if c.segment_du is None
-                           else c.segment_du for c in cases])
-
-
 _MODE_LABELS = {int(m): m.label for m in Mode}
 _MODES = {int(m): m for m in Mode}  # a dict look-up costs less than calling the enum
-_IMPACTS_ROW = lib.SAMPLE_COLUMNS.index("E_impacts_J")
 
 
 def _result(scenario: Scenario, case: CaseInputs, out: dict, i: int, wall_time_s: float,
@@ -390,22 +366,7 @@ def _result(scenario: Scenario, case: CaseInputs, out: dict, i: int, wall_time_s
         t = np.linspace(0.0, case.duration_s, case.n_samples)
     stats = {"rhs_evaluations": int(out["stats"][i][0]), "segments": int(out["stats"][i][2]),
              "method": METHOD_LABEL, "rtol": native_rtol(scenario.solver)}
-    if "library" in out:
-        return _engine_result(scenario, case, out, i, wall_time_s, t, stats)
-    model = case.model
-    first, n = int(out["sample_offset"][i]), case.n_samples
-    S = out["samples"][len(lib.SAMPLE_COLUMNS) * first:len(lib.SAMPLE_COLUMNS) * (first + n)].reshape(-1, n)
-    Y = S[_STATE_ROWS[model.n_source]]
-    events = out["events"][out["event_offset"][i]:out["event_offset"][i] + out["n_events"][i]].tolist()
-    kinds, labels = lib.EVENT_KINDS, _MODE_LABELS
-    transitions = [TransitionEvent(e[0], kinds[int(e[1])], labels[int(e[2])], labels[int(e[3])], e[4])
-                   for e in events]
-    losses = [(e[0], e[5]) for e in events]
-    stats["events"] = len(transitions)
-    x_max, x_min, p_max = (float(v) for v in out["peaks"][i])
-    return Result.from_trace(model, scenario.name, t, Y, out["modes"][first:first + n].astype(int), transitions,
-                             losses, stats, wall_time_s, peaks={"x_m": x_max, "x_min_m": x_min, "p_gauge_Pa": p_max},
-                             impacts_J=S[_IMPACTS_ROW])
+    return _engine_result(scenario, case, out, i, wall_time_s, t, stats)
 
 
 def _engine_result(scenario: Scenario, case: CaseInputs, out: dict, i: int, wall_time_s: float, t: np.ndarray,
