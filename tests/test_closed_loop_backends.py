@@ -54,14 +54,12 @@ def test_native_runs_the_closed_loop_as_python_does(native_run, python_run):
     assert [e.kind for e in native_run.result.transitions] == [e.kind for e in python_run.result.transitions]
 
 
-def test_native_refuses_a_controller_on_the_hand_written_core(monkeypatch):
-    """A static force the engine cannot run (one called on floats) runs as a force table on the
-    hand-written core, which has no controller: refused by name, not run open loop."""
+def test_native_refuses_a_law_written_for_floats_alone_by_name(monkeypatch):
+    """A friction law with no generated C (one called on floats) is refused by name, not run without it."""
     from pamsim.native import backend
 
-    monkeypatch.setattr(backend, "engine_assembly", lambda scenario, model=None: None)
-    with pytest.raises(InputError, match="ClosedLoopValveSource runs natively only with a static force written in "
-                                         "symbols") as err:
+    monkeypatch.setattr(backend, "in_c", lambda assembly, name: name != "friction")
+    with pytest.raises(InputError, match="component 'friction' is written for floats alone") as err:
         pamsim.run(CLOSED_LOOP, backend="native")
     assert "\n" not in str(err.value)
 

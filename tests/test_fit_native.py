@@ -321,15 +321,23 @@ def test_engine_trials_keep_the_components_a_scenario_adds():
     check_trials_are_native_runs(spring, ("N0_N_per_bar", "g_m_s2"))
 
 
-def test_a_library_static_force_fits_on_its_force_table(scenario):
-    """A static model other than the polynomial runs on the C core as its force table, which every
-    trial case carries; the load mass follows a free g."""
+def test_a_library_static_force_fits_on_the_engine(scenario):
+    """A static model other than the polynomial runs on the engine as its own generated C; the load
+    mass follows a free g."""
     gaylord = scenario.with_changes({"model": {"static_force": "gaylord"}})
     check_trials_are_native_runs(gaylord, ("N0_N_per_bar", "g_m_s2"))
     noisy, _ = synthetic_trace(gaylord, {"N0_N_per_bar": 6.0}, 22.74, NOISE_M, seed=3, duration_s=2.0)
     fit = fit_dynamic(gaylord, [noisy], free=["N0_N_per_bar"], backend="native")
     assert fit.parameters["N0_N_per_bar"] == pytest.approx(6.0, rel=0.02)
     assert fit.rms_pooled_mm == pytest.approx(NOISE_M * 1e3, rel=0.2)
+
+
+def test_a_floats_only_static_force_refuses_free_coefficients_that_shape_its_table(scenario, short_pair,
+                                                                                  floats_only_gaylord):
+    noisy, _ = short_pair[0]
+    gaylord = scenario.with_changes({"model": {"static_force": "gaylord"}})
+    with pytest.raises(InputError, match="'r0_m' shapes the force table of static model 'gaylord'"):
+        fit_dynamic(gaylord, [noisy], free=["r0_m"], backend="native")
 
 
 @pytest.mark.parametrize("changes, key", [
@@ -340,11 +348,12 @@ def test_settings_the_native_backend_cannot_honour_are_refused_before_the_fit(sc
     noisy, _ = short_pair[0]
     with pytest.raises(InputError, match=key.replace(".", r"\.")):
         fit_dynamic(scenario.with_changes(changes), [noisy], free=["N0_N_per_bar"], backend="native")
-    # A library static force runs as a force table built once per fit: a free coefficient that
-    # shapes the table is refused by name.
+    # A static force written for floats alone runs as a force table built once per fit: a free
+    # coefficient that shapes the table is refused by name (a closed-form one runs itself: no table).
+    from pamsim.native.backend import needs_table
+
     gaylord = scenario.with_changes({"model": {"static_force": "gaylord"}})
-    with pytest.raises(InputError, match="'r0_m' shapes the force table of static model 'gaylord'"):
-        fit_dynamic(gaylord, [noisy], free=["r0_m"], backend="native")
+    assert not needs_table(gaylord)
     with pytest.raises(InputError, match="--backend = 'c'"):
         fit_dynamic(scenario, [noisy], free=["N0_N_per_bar"], backend="c")
 

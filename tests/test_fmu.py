@@ -21,7 +21,7 @@ import pytest
 import pamsim
 from conftest import PAPER_SCENARIOS, SCENARIOS
 from pamsim.fmu import build
-from pamsim.fmu.generate import c_header, token
+from pamsim.fmu.muscle_spec import c_header, token
 from pamsim.fmu.runner import ScenarioInputs, run_cs, run_me, set_values, start_values
 from pamsim.fmu.variables import BY_NAME, VARIABLES, value_reference
 from pamsim.parameters import get_parameter_set
@@ -43,7 +43,7 @@ def traces(fmus, paper_results):
 
 def vr(name: str) -> int:
     """The value reference of ``name``: pinned for the FMU's own variables, the generated model's next."""
-    from pamsim.fmu.generate import one_muscle_spec
+    from pamsim.fmu.muscle_spec import one_muscle_spec
 
     return value_reference(name) if name in BY_NAME else one_muscle_spec(2).vr(name)
 
@@ -73,7 +73,7 @@ def test_validate_fmu_reports_no_problems(fmus, version):
 
 @pytest.mark.parametrize("version,platform", [(2, "binaries/linux64/"), (3, "binaries/x86_64-linux/")])
 def test_archive_layout(fmus, version, platform):
-    from pamsim.fmu.generate import one_muscle_spec
+    from pamsim.fmu.muscle_spec import one_muscle_spec
 
     names = zipfile.ZipFile(fmus[version]).namelist()
     assert f"{platform}pamsim_muscle.so" in names

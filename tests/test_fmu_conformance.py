@@ -561,7 +561,7 @@ def test_base_units_against_hand_conversions():
 def test_every_unit_definition_has_its_base_unit(fmus, version):
     from pamsim.fmu.units import base_unit
 
-    from pamsim.fmu.generate import one_muscle_spec
+    from pamsim.fmu.muscle_spec import one_muscle_spec
 
     units = _model_description(fmus, version).find("UnitDefinitions")
     declared = {v.unit for v in one_muscle_spec(version).variables if v.unit}

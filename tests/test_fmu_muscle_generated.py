@@ -14,7 +14,8 @@ import pytest
 import pamsim
 from conftest import SCENARIOS
 from pamsim.fmu.runner import set_values
-from pamsim.fmu.variables import BY_NAME, VARIABLES, value_reference
+from pamsim.fmu.variables import VARIABLES, value_reference
+from test_fmu import _initialise_with
 
 
 @pytest.mark.parametrize("name", ["acra2012_fig4", "acra2012_fig4_chou_hannaford", "acra2012_fig6b"])
@@ -74,25 +75,6 @@ def _instance(path, version):
     return fmu
 
 
-def _initialise(path, version, values):
-    """Set ``values``, initialise; the status of exitInitializationMode (0 OK, 3 error)."""
-    from fmpy.fmi1 import FMICallException
-
-    fmu = _instance(path, version)
-    try:
-        set_values(fmu, version, {n: int(x) if BY_NAME[n].kind == "integer" else float(x) for n, x in values.items()})
-        if version == 2:
-            fmu.setupExperiment(startTime=0.0)
-        fmu.enterInitializationMode()
-        try:
-            fmu.exitInitializationMode()
-            return 0
-        except FMICallException as exc:
-            return exc.status
-    finally:
-        fmu.freeInstance()
-
-
 @pytest.mark.parametrize("values, message", [
     ({"release_margin_N": 1e-8}, "release_margin_N = 1e-08: must be above stick_margin_N = 1e-07"),
     ({"initial_pressure_gauge_Pa": 5e5},
@@ -104,15 +86,15 @@ def _initialise(path, version, values):
     ({"static_force_model": 1}, "static_force_model = 1 (table): this FMU was built without a force table"),
     ({"fit_x_min_m": 0.2}, "fit_x_min_m = 0.2: must be below fit_x_max_m"),
 ])
-def test_checks_refuse_with_their_messages(fmus, values, message, capfd):
+def test_checks_refuse_with_their_messages(unzipped, values, message, capfd):
     """The generated checks, with the messages the FMU has always given (the upper stop of the braid lock,
     0.1157 m, computed by the generated map)."""
     for v in (2, 3):
         capfd.readouterr()
-        assert _initialise(fmus[v], v, values) != 0
+        assert _initialise_with(unzipped, v, values) != 0
         log = capfd.readouterr().out
         assert message in log, log
-    assert _initialise(fmus[2], 2, {}) == 0
+    assert _initialise_with(unzipped, 2, {}) == 0
 
 
 @pytest.mark.parametrize("name, value, message", [

@@ -14,7 +14,7 @@ def test_pyproject_lists_every_subpackage():
     found = {".".join(p.parent.relative_to(ROOT).parts) for p in (ROOT / "pamsim").rglob("__init__.py")}
     assert found <= listed, f"add to [tool.setuptools] packages: {sorted(found - listed)}"
     assert conf["package-dir"]["pamsim.fmu.csrc"] == "fmu"
-    assert (ROOT / "fmu" / "src" / "pam_core.c").is_file()
+    assert (ROOT / "fmu" / "src" / "pam_gcore.c").is_file()
 
 
 def test_license_file_matches_pyproject_and_ships():

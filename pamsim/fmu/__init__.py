@@ -7,7 +7,7 @@ generated from a scenario's assembly of components;
 """
 
 from .assembly_fmu import build_assembly
-from .build import build
+from .muscle_spec import build
 from .runner import simulate_fmu
 
 __all__ = ["build", "build_assembly", "simulate_fmu"]

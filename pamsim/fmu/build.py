@@ -21,8 +21,7 @@ from pathlib import Path
 from typing import Callable
 
 from ..errors import InputError
-from .force_table import ForceTable
-from .generate import (MODEL_IDENTIFIER, WRAPPERS, generation_date, one_muscle_spec, spec_model_description,
+from .generate import (MODEL_IDENTIFIER, WRAPPERS, generation_date, spec_model_description,
                        write_spec_documentation, write_spec_sources)
 from .spec import FmuSpec
 
@@ -79,29 +78,6 @@ def c_compiler(purpose: str) -> str:
     if not found:
         raise InputError(f"{purpose} needs a C compiler (install gcc, or set CC)")
     return found
-
-def build(output_path: str | os.PathLike | None = None, fmi_version: int = 2,
-          force_table: ForceTable | None = None, preset=None) -> Path:
-    """Generate, compile and zip the FMU; return the path of the ``.fmu`` file.
-
-    ``force_table`` (:func:`pamsim.fmu.force_table.tabulate`) bakes a static force table into the
-    FMU, which then starts with ``static_force_model`` = table; without one the FMU has only the
-    exact ACRA 2012 polynomial.  ``preset`` (:func:`pamsim.fmu.preset.for_muscle`,
-    :func:`~pamsim.fmu.preset.for_scenario`) builds the FMU for a muscle or a scenario: its values
-    become the FMU's start values, and its table the FMU's (``force_table`` must then be None).
-
-    Raises :class:`~pamsim.errors.InputError` for an unknown FMI version, a
-    missing C compiler or a failed compilation (with the compiler's message).
-    """
-    if fmi_version not in FMI_VERSIONS:
-        raise InputError(f"FMI version must be 2 or 3, not {fmi_version!r}")
-    if preset is not None:
-        if force_table is not None:
-            raise ValueError("give the force table in the preset, not beside it")
-        force_table = preset.table
-    out = Path(output_path) if output_path else default_output(fmi_version)
-    return build_spec(out, one_muscle_spec(fmi_version, force_table, preset))
-
 
 def build_spec(out: Path, spec: FmuSpec) -> Path:
     """Generate, compile and zip the FMU ``spec`` describes into ``out`` (a ``.fmu`` path); return ``out``.

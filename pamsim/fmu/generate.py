@@ -19,7 +19,6 @@ from xml.sax.saxutils import quoteattr
 from .. import __version__
 from ..references import REFERENCES
 from .units import base_unit
-from .force_table import ForceTable
 from .spec import FmuSpec
 from .variables import INPUT_SOURCE_CHOICES, VARIABLES
 
@@ -34,7 +33,7 @@ DESCRIPTION = ("McKibben muscle lifting a hanging load (ACRA 2012 model, pamsim)
 """The model description's ``description`` of an FMU without a force table (:func:`description`)."""
 
 
-def description(table: ForceTable | None = None, preset=None) -> str:
+def description(table=None, preset=None) -> str:
     """What the FMU is: the exact polynomial (:data:`DESCRIPTION`) or, for a table FMU, which static model
     it tabulates, from what and over which domain; and what it was built for."""
     if table is None:
@@ -91,20 +90,6 @@ def c_source_dir() -> Path:
     from ..errors import InputError
 
     raise InputError(f"the FMU's C sources are neither at {C_DIR / 'src'} nor in the installed package")
-
-
-def token(fmi_version: int, table: ForceTable | None = None, preset=None) -> str:
-    """A hash of everything an FMU's binary is built from: sources, generated headers, table, preset."""
-    return one_muscle_spec(fmi_version, table, preset).token
-
-
-def one_muscle_spec(fmi_version: int, table: ForceTable | None = None, preset=None) -> FmuSpec:
-    """The :class:`~pamsim.fmu.spec.FmuSpec` of the one-muscle FMU, built with a force ``table`` and for a
-    ``preset``, if any: generated from components (:mod:`pamsim.fmu.muscle_spec`), or with a force table
-    on the core written by hand."""
-    from .muscle_spec import muscle_generated_spec
-
-    return muscle_generated_spec(fmi_version, preset, table)
 
 
 def _num(x) -> str:
@@ -187,14 +172,6 @@ def _header(spec: FmuSpec) -> str:
                    generationDateAndTime=generation_date(), variableNamingConvention=spec.naming)
     extra = f' numberOfEventIndicators="{len(spec.event_indicators)}"' if fmi_version == 2 else ""
     return f'<fmiModelDescription fmiVersion="{fmi_version}.0"{attrs}{extra}>'
-
-
-def model_description(fmi_version: int, table: ForceTable | None = None, preset=None) -> str:
-    """``modelDescription.xml``; ``table``: the force table the FMU is built with, if any; ``preset``: the
-    :class:`pamsim.fmu.preset.Preset` of the muscle or scenario it is built for, if any."""
-    if fmi_version not in (2, 3):
-        raise ValueError(f"FMI version must be 2 or 3, not {fmi_version!r}")
-    return spec_model_description(one_muscle_spec(fmi_version, table, preset))
 
 
 def spec_model_description(spec: FmuSpec) -> str:
@@ -346,11 +323,6 @@ def _c_bound(x: float) -> str:
     return repr(float(x))
 
 
-def c_header(fmi_version: int, table: ForceTable | None = None, preset=None) -> str:
-    """``pam_variables.h`` of the one-muscle FMU (:func:`spec_c_header`)."""
-    return spec_c_header(one_muscle_spec(fmi_version, table, preset))
-
-
 def spec_c_header(spec: FmuSpec) -> str:
     """``pam_variables.h``: indices into the value arrays, value references, start values, the token, and
     the input signals of the scenario the FMU is built for, if any."""
@@ -440,11 +412,6 @@ def _c_signals(spec: FmuSpec) -> list[str]:
     return out + [f"static const PamSignal PAM_SIGNALS[{size}] = {{"] + rows + ["};"]
 
 
-def write_sources(dest: Path, fmi_version: int, table: ForceTable | None = None, preset=None) -> list[str]:
-    """Write the sources the one-muscle FMU ships into ``dest`` (:func:`write_spec_sources`)."""
-    return write_spec_sources(dest, one_muscle_spec(fmi_version, table, preset))
-
-
 def write_spec_sources(dest: Path, spec: FmuSpec) -> list[str]:
     """Write the sources an FMU ships (C files, generated headers, FMI headers, licence) into ``dest``."""
     dest.mkdir(parents=True, exist_ok=True)
@@ -508,7 +475,7 @@ USAGE = (
 """The usage page in the FMU's documentation/index.html."""
 
 
-def _usage(table: ForceTable | None, preset) -> tuple[tuple[str, str], ...]:
+def _usage(table, preset) -> tuple[tuple[str, str], ...]:
     """The usage page of the one-muscle FMU: :data:`USAGE` for what it was built with and for."""
     usage = (("What it is", description(table, preset) + USAGE[0][1][len(DESCRIPTION):]),) + USAGE[1:]
     if preset is not None:  # its start values are not the Shadow muscle's
@@ -519,11 +486,6 @@ def _usage(table: ForceTable | None, preset) -> tuple[tuple[str, str], ...]:
                                  "exactly within each step; set input_source = importer to drive them."
                                  if preset.signals else "")),) + usage[2:]
     return usage
-
-
-def documentation_html(fmi_version: int, table: ForceTable | None = None, preset=None) -> str:
-    """``documentation/index.html`` of the one-muscle FMU (:func:`spec_documentation_html`)."""
-    return spec_documentation_html(one_muscle_spec(fmi_version, table, preset))
 
 
 def spec_documentation_html(spec: FmuSpec) -> str:
@@ -542,11 +504,6 @@ def spec_documentation_html(spec: FmuSpec) -> str:
             f'{fmi_version}.0)</title></head>\n<body>\n<h1>{spec.model_name}: pamsim {__version__}, FMI '
             f'{fmi_version}.0</h1>\n{sections}<h2>Variables</h2>\n<table>\n<tr>{head}</tr>\n' + "\n".join(rows)
             + "\n</table>\n</body>\n</html>\n")
-
-
-def write_documentation(dest: Path, fmi_version: int, table: ForceTable | None = None, preset=None) -> None:
-    """Write the one-muscle FMU's ``documentation/`` folder into ``dest``."""
-    write_spec_documentation(dest, one_muscle_spec(fmi_version, table, preset))
 
 
 def write_spec_documentation(dest: Path, spec: FmuSpec) -> None:

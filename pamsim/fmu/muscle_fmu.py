@@ -80,6 +80,7 @@ class NoTable:
     name: str = "no_table"
 
     def force_N(self, x_m, p_gauge_Pa):
+        """NaN, of the shape of ``x_m``."""
         return float("nan") * x_m
 
 

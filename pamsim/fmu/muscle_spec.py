@@ -1,4 +1,4 @@
-"""The :class:`~pamsim.fmu.spec.FmuSpec` of the one-muscle FMU generated from components.
+"""The one-muscle FMU generated from components: its :class:`~pamsim.fmu.spec.FmuSpec`, and building it.
 
 Its variables are those of :mod:`pamsim.fmu.variables` (the names, value references, ranges and
 choices it has always had), then the generated model's work integrals and outputs that have no
@@ -8,12 +8,19 @@ parameter map and the checks of :mod:`pamsim.fmu.muscle_fmu` generated beside th
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass, replace
+from pathlib import Path
 from typing import Any
 
-from .assembly_fmu import CORE_HEADER, SOURCES, AssemblyVariables, _per_s, _real, _token
+from ..errors import InputError
+from .build import FMI_VERSIONS, build_spec, default_output
+from .force_table import ForceTable
+from .generate import (_usage, description, spec_c_header, spec_documentation_html, spec_model_description,
+                       write_spec_documentation, write_spec_sources)
+from .generated import CORE_HEADER, SOURCES, AssemblyVariables, per_s, real_variable
+from .generated import token as spec_token
 from .muscle_fmu import MASS_INPUT, MODE_NAME, OUTPUT_NAMES, STATE_NAMES, knob_map, muscle_assembly
-from .generate import _usage
 from .spec import FmuSpec
 from .variables import INPUTS, VARIABLES, value_reference, with_preset
 
@@ -160,7 +167,7 @@ class MuscleVariables(AssemblyVariables):
         for k, v in enumerate(self.flat.states):
             name = self._name(v.name)
             self.places[name] = ("STATE", k)
-            rows.append(_real(name, "output" if v.name in outputs else "local", "continuous",
+            rows.append(real_variable(name, "output" if v.name in outputs else "local", "continuous",
                               f"{v.description} [{v.unit}]", v.unit, initial="calculated", nominal=float(v.nominal),
                               depends_on=(name,)))
         return rows
@@ -170,7 +177,7 @@ class MuscleVariables(AssemblyVariables):
         for k, v in enumerate(self.flat.states):
             name = f"der({self._name(v.name)})"
             self.places[name] = ("DERIVATIVE", k)
-            rows.append(_real(name, "local", "continuous", f"d {v.name} / dt", _per_s(v.unit), initial="calculated",
+            rows.append(real_variable(name, "local", "continuous", f"d {v.name} / dt", per_s(v.unit), initial="calculated",
                               derivative_of=self._name(v.name), depends_on=self._depends(k, "A", "B")))
         return rows
 
@@ -181,7 +188,7 @@ class MuscleVariables(AssemblyVariables):
         rows = []
         for k, v in enumerate(flat.outputs):
             if self.y_vars[k] is not None:
-                rows.append(_real(self.y_vars[k], "output", "continuous", f"{v.description} [{v.unit}]", v.unit,
+                rows.append(real_variable(self.y_vars[k], "output", "continuous", f"{v.description} [{v.unit}]", v.unit,
                                   initial="calculated", depends_on=self._depends(k, "C", "D")))
                 self.places[self.y_vars[k]] = ("OUTPUT", k)
         return rows
@@ -268,23 +275,70 @@ def _generated_spec(fmi_version: int, preset, table) -> FmuSpec:
                    tuple(mv.c_lines()) + tuple(lines), preset.signals if preset is not None else {},
                    preset.experiment if preset is not None else None, fmi_version=fmi_version,
                    included=("pam_engine.c",), usage=_usage(table, preset))
-    return replace(spec, token=_token(spec))
+    return replace(spec, token=spec_token(spec))
 
 
 def _description(table, preset) -> str:
-    from .generate import description
-
     return description(table, preset)
 
 
-def build_generated(output_path, fmi_version: int = 2, scenario=None):
-    """Generate, compile and zip the one-muscle FMU for ``scenario`` if given (as ``pamsim fmu build --scenario``)
-    or with its own defaults; return its path.  The same as :func:`pamsim.fmu.build` with a scenario's preset.
+def token(fmi_version: int, table: ForceTable | None = None, preset=None) -> str:
+    """A hash of everything an FMU's binary is built from: sources, generated headers, table, preset."""
+    return one_muscle_spec(fmi_version, table, preset).token
 
-    Raises :class:`~pamsim.errors.InputError` for an unknown FMI version, a scenario the FMU cannot carry,
-    a missing compiler or a failed compilation.
+
+def one_muscle_spec(fmi_version: int, table: ForceTable | None = None, preset=None) -> FmuSpec:
+    """The :class:`~pamsim.fmu.spec.FmuSpec` of the one-muscle FMU, built with a force ``table`` and for a
+    ``preset``, if any (:func:`muscle_generated_spec`)."""
+    return muscle_generated_spec(fmi_version, preset, table)
+
+
+def model_description(fmi_version: int, table: ForceTable | None = None, preset=None) -> str:
+    """``modelDescription.xml``; ``table``: the force table the FMU is built with, if any; ``preset``: the
+    :class:`pamsim.fmu.preset.Preset` of the muscle or scenario it is built for, if any."""
+    if fmi_version not in (2, 3):
+        raise ValueError(f"FMI version must be 2 or 3, not {fmi_version!r}")
+    return spec_model_description(one_muscle_spec(fmi_version, table, preset))
+
+
+def c_header(fmi_version: int, table: ForceTable | None = None, preset=None) -> str:
+    """``pam_variables.h`` of the one-muscle FMU (:func:`spec_c_header`)."""
+    return spec_c_header(one_muscle_spec(fmi_version, table, preset))
+
+
+def write_sources(dest: Path, fmi_version: int, table: ForceTable | None = None, preset=None) -> list[str]:
+    """Write the sources the one-muscle FMU ships into ``dest`` (:func:`write_spec_sources`)."""
+    return write_spec_sources(dest, one_muscle_spec(fmi_version, table, preset))
+
+
+def documentation_html(fmi_version: int, table: ForceTable | None = None, preset=None) -> str:
+    """``documentation/index.html`` of the one-muscle FMU (:func:`spec_documentation_html`)."""
+    return spec_documentation_html(one_muscle_spec(fmi_version, table, preset))
+
+
+def build(output_path: str | os.PathLike | None = None, fmi_version: int = 2,
+          force_table: ForceTable | None = None, preset=None) -> Path:
+    """Generate, compile and zip the FMU; return the path of the ``.fmu`` file.
+
+    ``force_table`` (:func:`pamsim.fmu.force_table.tabulate`) bakes a static force table into the
+    FMU, which then starts with ``static_force_model`` = table; without one the FMU has only the
+    exact ACRA 2012 polynomial.  ``preset`` (:func:`pamsim.fmu.preset.for_muscle`,
+    :func:`~pamsim.fmu.preset.for_scenario`) builds the FMU for a muscle or a scenario: its values
+    become the FMU's start values, and its table the FMU's (``force_table`` must then be None).
+
+    Raises :class:`~pamsim.errors.InputError` for an unknown FMI version, a
+    missing C compiler or a failed compilation (with the compiler's message).
     """
-    from .build import build
-    from .preset import for_scenario
+    if fmi_version not in FMI_VERSIONS:
+        raise InputError(f"FMI version must be 2 or 3, not {fmi_version!r}")
+    if preset is not None:
+        if force_table is not None:
+            raise ValueError("give the force table in the preset, not beside it")
+        force_table = preset.table
+    out = Path(output_path) if output_path else default_output(fmi_version)
+    return build_spec(out, one_muscle_spec(fmi_version, force_table, preset))
 
-    return build(output_path, fmi_version, preset=for_scenario(scenario) if scenario is not None else None)
+
+def write_documentation(dest: Path, fmi_version: int, table: ForceTable | None = None, preset=None) -> None:
+    """Write the one-muscle FMU's ``documentation/`` folder into ``dest``."""
+    write_spec_documentation(dest, one_muscle_spec(fmi_version, table, preset))

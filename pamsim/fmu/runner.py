@@ -29,9 +29,9 @@ from ..elements.pressure_source import ValveChamberSource
 from ..errors import InputError, SolverFailure
 from ..result import Result
 from ..scenario import Scenario
-from .build import build, temp_fmu
+from .build import temp_fmu
 from .force_table import DEFAULT_POINTS, ForceTable, tabulate
-from .generate import token
+from .muscle_spec import build, token
 from .variables import (BY_NAME, DAMPING_CHOICES, FRICTION_CHOICES, INPUT_SOURCE_CHOICES, INPUTS, NEGATIVE_LEVEL,
                         SOURCE_CHOICES, STATIC_FORCE_CHOICES, VARIABLES, value_reference)
 
@@ -44,17 +44,18 @@ def cached_fmu(fmi_version: int = 2, force_table: ForceTable | None = None) -> P
                     lambda path: build(path, fmi_version, force_table))
 
 
-def tabulate_model(scenario: Scenario, points: tuple[int, int] = DEFAULT_POINTS) -> ForceTable:
+def tabulate_model(scenario: Scenario, points: tuple[int, int] = DEFAULT_POINTS, narrow: bool = True) -> ForceTable:
     """The scenario's static force tabulated for the FMU, over its valid domain: the contraction
     between the end stops and the gauge pressure from 0 to ``rated_pressure_gauge_Pa``, narrowed to
-    the model's own ``domain`` where it declares one."""
+    the model's own ``domain`` where it declares one (``narrow``; else over the stops and the rating
+    whatever the domain, as the python backend evaluates the model)."""
     model = scenario.build_model()
     # The raw library model: the C core clips a negative force itself, and a table of the clipped
     # force would smear its kink over a cell.
     force = scenario.static_model()
     x_lo, x_hi = model.stops.x_low_m, model.stops.x_high_m
     p_lo, p_hi = 0.0, float(scenario.parameters["rated_pressure_gauge_Pa"])
-    domain = getattr(force, "domain", None)
+    domain = getattr(force, "domain", None) if narrow else None
     if domain is not None:
         x_lo, x_hi = max(x_lo, domain.x_min_m), min(x_hi, domain.x_max_m)
         p_lo, p_hi = max(p_lo, domain.p_min_Pa), min(p_hi, domain.p_max_Pa)

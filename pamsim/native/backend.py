@@ -178,8 +178,9 @@ _tables: "OrderedDict[tuple, ForceTable]" = OrderedDict()
 
 
 def force_table(scenario: Scenario) -> ForceTable:
-    """The static force table of ``scenario`` as the FMU would bake it (:func:`pamsim.fmu.runner.tabulate_model`),
-    for a static model without generated C (:func:`engine_model`).  Tables are cached by the model,
+    """The static force table of ``scenario`` (:func:`pamsim.fmu.runner.tabulate_model`) over its stops and
+    rating, where the python backend evaluates the model, for a static model without generated C
+    (:func:`engine_model`).  Tables are cached by the model,
     its variant, the parameters and the force-map file, so the cases of a sweep tabulate once."""
     m = scenario.spec["model"]
     key = (m["static_force"], m.get("static_force_variant"), tuple(sorted(scenario.parameters.items())),
@@ -187,7 +188,7 @@ def force_table(scenario: Scenario) -> ForceTable:
     if key in _tables:
         _tables.move_to_end(key)  # least recently used goes first
     else:
-        _tables[key] = tabulate_model(scenario)
+        _tables[key] = tabulate_model(scenario, narrow=False)
         if len(_tables) > TABLE_CACHE_SIZE:
             _tables.popitem(last=False)
     return _tables[key]
