@@ -114,30 +114,31 @@ class CaseInputs:
                           self.segment_t_s, u, int(capacity), du)
 
 
-def engine_model(scenario: Scenario, model: MuscleModel | None = None) -> MuscleModel:
-    """``model`` (``scenario.build_model()`` if None) as the engine runs it: as it is where every element has
-    generated C, else with a static force that has none (a model written for floats alone) replaced by its
-    spline table (:func:`force_table`), clipped at zero as the dynamics apply it."""
-    model = scenario.build_model() if model is None else model
-    if in_c(scenario_assembly(scenario, model), "muscle"):
-        return model
-    return replace(model, static_force=with_negative_force(force_table(scenario), "clip"))
-
-
-def engine_assembly(scenario: Scenario, model: MuscleModel | None = None):
-    """The assembly the engine runs for ``scenario`` (:func:`engine_model`'s).
+def engine_parts(scenario: Scenario, model: MuscleModel | None = None) -> tuple[MuscleModel, object]:
+    """``model`` (``scenario.build_model()`` if None) as the engine runs it, and its assembly: the model as it
+    is where every element has generated C, else with a static force that has none (a model written for
+    floats alone) replaced by its spline table (:func:`force_table`), clipped at zero as the dynamics apply it.
 
     Raises
     ------
     InputError
         For an element other than the static force that has no generated C (a law written for floats alone).
     """
-    assembly = scenario_assembly(scenario, engine_model(scenario, model))
+    model = scenario.build_model() if model is None else model
+    assembly = scenario_assembly(scenario, model)
+    if not in_c(assembly, "muscle"):
+        model = replace(model, static_force=with_negative_force(force_table(scenario), "clip"))
+        assembly = scenario_assembly(scenario, model)
     lacking = [c.name for c in assembly.components if not in_c(assembly, c.name)]
     if lacking:
         raise InputError(f"{scenario.origin}: component {lacking[0]!r} is written for floats alone and has no C; "
                          "run it with the python backend")
-    return assembly
+    return model, assembly
+
+
+def engine_assembly(scenario: Scenario, model: MuscleModel | None = None):
+    """The assembly the engine runs for ``scenario`` (:func:`engine_parts`)."""
+    return engine_parts(scenario, model)[1]
 
 
 def needs_table(scenario: Scenario) -> bool:
@@ -180,7 +181,7 @@ _tables: "OrderedDict[tuple, ForceTable]" = OrderedDict()
 def force_table(scenario: Scenario) -> ForceTable:
     """The static force table of ``scenario`` (:func:`pamsim.fmu.runner.tabulate_model`) over its stops and
     rating, where the python backend evaluates the model, for a static model without generated C
-    (:func:`engine_model`).  Tables are cached by the model,
+    (:func:`engine_parts`).  Tables are cached by the model,
     its variant, the parameters and the force-map file, so the cases of a sweep tabulate once."""
     m = scenario.spec["model"]
     key = (m["static_force"], m.get("static_force_variant"), tuple(sorted(scenario.parameters.items())),
@@ -268,8 +269,7 @@ def case_inputs(scenario: Scenario, model: MuscleModel | None = None) -> CaseInp
     opts = scenario.solver
     T = scenario.duration_s
     n_samples = int(round(T * opts.sample_rate_Hz)) + 1
-    assembly = engine_assembly(scenario, model)
-    model = engine_model(scenario, model)
+    model, assembly = engine_parts(scenario, model)
     names, signals = _signals(model)
     reals, ints = core_values(scenario, model)
     pieces = exact_segments(signals, T)
