@@ -62,10 +62,15 @@ class AssemblyVariables:
             self.places[v.name] = (kind, k)
         return rows
 
+    def _name(self, flat_name: str) -> str:
+        """The FMU's name of the flat model's variable ``flat_name`` (its own; an FMU may give older ones)."""
+        return flat_name
+
     def _depends(self, row: int, block_x: str, block_u: str) -> tuple[str, ...]:
         """The states and inputs row ``row`` of the Jacobian blocks ``block_x``, ``block_u`` depends on."""
         flat, sp = self.flat, self._sparsity
-        return tuple([flat.states[i].name for i in sp[block_x][row]] + [flat.inputs[i].name for i in sp[block_u][row]])
+        return tuple([self._name(flat.states[i].name) for i in sp[block_x][row]]
+                     + [self._name(flat.inputs[i].name) for i in sp[block_u][row]])
 
     def _parameters(self, values) -> list[Variable]:
         return self._placed("PARAMETER", [
@@ -83,26 +88,28 @@ class AssemblyVariables:
     def _states(self) -> list[Variable]:
         outputs = {v.name for v in self.flat.outputs}
         return self._placed("STATE", [
-            real_variable(v.name, "output" if v.name in outputs else "local", "continuous", f"{v.description} [{v.unit}]",
-                  v.unit, initial="calculated", nominal=float(v.nominal), depends_on=(v.name,))
+            real_variable(self._name(v.name), "output" if v.name in outputs else "local", "continuous",
+                          f"{v.description} [{v.unit}]", v.unit, initial="calculated", nominal=float(v.nominal),
+                          depends_on=(self._name(v.name),))
             for v in self.flat.states])
 
     def _derivatives(self) -> list[Variable]:
         return self._placed("DERIVATIVE", [
-            real_variable(f"der({v.name})", "local", "continuous", f"d {v.name} / dt", per_s(v.unit), initial="calculated",
-                  derivative_of=v.name, depends_on=self._depends(k, "A", "B")) for k, v in enumerate(self.flat.states)])
+            real_variable(f"der({self._name(v.name)})", "local", "continuous", f"d {v.name} / dt", per_s(v.unit),
+                          initial="calculated", derivative_of=self._name(v.name), depends_on=self._depends(k, "A", "B"))
+            for k, v in enumerate(self.flat.states)])
 
     def _outputs(self) -> list[Variable]:
         """Every output but one named as a state or a parameter, which is that variable (``y_vars`` None)."""
         flat = self.flat
         taken = {v.name for v in flat.states} | {v.name for v in flat.parameters}
-        self.y_vars: list[str | None] = [None if v.name in taken else v.name for v in flat.outputs]
+        self.y_vars: list[str | None] = [None if v.name in taken else self._name(v.name) for v in flat.outputs]
         rows = []
         for k, v in enumerate(flat.outputs):
             if self.y_vars[k] is not None:
-                rows.append(real_variable(v.name, "output", "continuous", f"{v.description} [{v.unit}]", v.unit,
-                                  initial="calculated", depends_on=self._depends(k, "C", "D")))
-                self.places[v.name] = ("OUTPUT", k)
+                rows.append(real_variable(self.y_vars[k], "output", "continuous", f"{v.description} [{v.unit}]", v.unit,
+                                          initial="calculated", depends_on=self._depends(k, "C", "D")))
+                self.places[self.y_vars[k]] = ("OUTPUT", k)
         return rows
 
     def c_lines(self) -> list[str]:

@@ -18,7 +18,7 @@ from .build import FMI_VERSIONS, build_spec, default_output
 from .force_table import ForceTable
 from .generate import (_usage, description, spec_c_header, spec_documentation_html, spec_model_description,
                        write_spec_documentation, write_spec_sources)
-from .generated import CORE_HEADER, SOURCES, AssemblyVariables, per_s, real_variable
+from .generated import CORE_HEADER, SOURCES, AssemblyVariables
 from .generated import token as spec_token
 from .muscle_fmu import MASS_INPUT, MODE_NAME, OUTPUT_NAMES, STATE_NAMES, knob_map, muscle_assembly
 from .spec import FmuSpec
@@ -157,41 +157,8 @@ class MuscleVariables(AssemblyVariables):
         return own
 
     def _depends(self, row: int, block_x: str, block_u: str) -> tuple[str, ...]:
-        deps = tuple(self._name(n) for n in super()._depends(row, block_x, block_u))
         offset = len(self.flat.states) if block_x == "C" else 0
-        return deps + ((MASS_INPUT,) if self.mass_rows[offset + row] else ())
-
-    def _states(self):
-        outputs = {v.name for v in self.flat.outputs}
-        rows = []
-        for k, v in enumerate(self.flat.states):
-            name = self._name(v.name)
-            self.places[name] = ("STATE", k)
-            rows.append(real_variable(name, "output" if v.name in outputs else "local", "continuous",
-                              f"{v.description} [{v.unit}]", v.unit, initial="calculated", nominal=float(v.nominal),
-                              depends_on=(name,)))
-        return rows
-
-    def _derivatives(self):
-        rows = []
-        for k, v in enumerate(self.flat.states):
-            name = f"der({self._name(v.name)})"
-            self.places[name] = ("DERIVATIVE", k)
-            rows.append(real_variable(name, "local", "continuous", f"d {v.name} / dt", per_s(v.unit), initial="calculated",
-                              derivative_of=self._name(v.name), depends_on=self._depends(k, "A", "B")))
-        return rows
-
-    def _outputs(self):
-        flat = self.flat
-        taken = {v.name for v in flat.states} | {v.name for v in flat.parameters}
-        self.y_vars = [None if v.name in taken else self._name(v.name) for v in flat.outputs]
-        rows = []
-        for k, v in enumerate(flat.outputs):
-            if self.y_vars[k] is not None:
-                rows.append(real_variable(self.y_vars[k], "output", "continuous", f"{v.description} [{v.unit}]", v.unit,
-                                  initial="calculated", depends_on=self._depends(k, "C", "D")))
-                self.places[self.y_vars[k]] = ("OUTPUT", k)
-        return rows
+        return super()._depends(row, block_x, block_u) + ((MASS_INPUT,) if self.mass_rows[offset + row] else ())
 
     def _parameter_lines(self, idx) -> list[str]:
         return self._knob_lines()
