@@ -87,7 +87,7 @@ pamsim.simulate(like(sc), backend="native")
 native_first = time.perf_counter() - t
 native, batch = native_times(like(sc), [like(c) for c in cases])
 default = native_times(sc, cases) if scaled else (None, None)
-print(json.dumps({"fig4_s": statistics.median(runs), "grid_s": min(grid), "first_s": first,
+print(json.dumps({"pamsim_file": pamsim.__file__, "fig4_s": statistics.median(runs), "grid_s": min(grid), "first_s": first,
                   "import_s": t1 - t0, "native_fig4_s": native, "native_grid_s": batch,
                   "native_first_s": native_first, "native_default_fig4_s": default[0],
                   "native_default_grid_s": default[1]}))
@@ -100,16 +100,20 @@ def measure(checkout: Path, repeat: int) -> dict:
         # library, the second finds both.
         env = {**os.environ, "PYTHONPATH": str(checkout), "PAMSIM_CODE_CACHE": cache,
                "PAMSIM_NATIVE_CACHE": native_cache}
-        runs = [json.loads(subprocess.run([sys.executable, "-c", MEASURE, str(checkout), str(repeat)], env=env,
+        # cwd is the checkout: ``python -c`` and ``-m`` put the working directory ahead of PYTHONPATH, so
+        # run from another checkout they would import that one's pamsim.
+        runs = [json.loads(subprocess.run([sys.executable, "-c", MEASURE, str(checkout), str(repeat)], env=env, cwd=checkout,
                                           check=True, capture_output=True, text=True).stdout.strip().splitlines()[-1])
                 for _ in range(2)]
     data = runs[0]
+    if Path(data["pamsim_file"]).resolve().parents[1] != checkout.resolve():
+        raise SystemExit(f"measuring {checkout} imported {data['pamsim_file']}")
     data["first_cached_s"] = runs[1]["first_s"]
     data["native_first_cached_s"] = runs[1]["native_first_s"]
     helps = []
     for _ in range(repeat):
         t = time.perf_counter()
-        subprocess.run([sys.executable, "-m", "pamsim", "--help"], env=env, check=True, capture_output=True)
+        subprocess.run([sys.executable, "-m", "pamsim", "--help"], env=env, cwd=checkout, check=True, capture_output=True)
         helps.append(time.perf_counter() - t)
     data["help_s"] = min(helps)
     return data
