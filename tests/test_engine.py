@@ -248,3 +248,25 @@ def test_a_batch_of_held_and_exact_cases_gives_each_its_run_alone():
             assert together["n_events"][j] == m and np.array_equal(together["events"][e0:e0 + m], alone["events"][:m])
             assert np.array_equal(together["stats"][j], alone["stats"][0])
             assert np.array_equal(together["extremes"][j], alone["extremes"][0])
+
+
+def test_a_run_reuses_its_buffer_only_when_nothing_holds_the_last_one():
+    """A run's arrays live in one buffer, which the next run reuses only if no array or view of the last
+    run's is alive: a kept result is never overwritten, and a dropped one leaves its pages to the next."""
+    c = backend.case_inputs(FIG4)
+    library = engine_library(c.assembly)
+    case = c.engine_case(library, 64)
+    first = library.run([case])
+    x_view, kept = first["samples"][:100], first["samples"].copy()
+    address = first["samples"].ctypes.data
+    del first
+    heavier = backend.case_inputs(FIG4.with_changes({"load": {"weight_N": 42.74}})).engine_case(library, 64)
+    second = library.run([heavier])
+    assert second["samples"].ctypes.data != address  # a view of the first run is alive
+    assert np.array_equal(x_view, kept[:100])
+    assert not np.array_equal(second["samples"], kept)
+    address = second["samples"].ctypes.data
+    del second, x_view
+    third = library.run([case])
+    assert third["samples"].ctypes.data == address  # nothing held the second run's arrays
+    assert np.array_equal(third["samples"], kept)  # and the run is the first one's, to the bit

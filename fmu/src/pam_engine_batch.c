@@ -323,7 +323,8 @@ static int enter_segment(Run *run, double seg_t, const double *seg_u, const doub
             snprintf(run->message, PAM_ENGINE_MSG, "%s: a segment's change is not finite", PM_INPUTS_NAMES[k / 3]);
             return -1;
         }
-    e->inputs = seg_du ? &run->inputs : NULL;
+    /* A segment whose inputs do not change is held: nothing to evaluate at every stage. */
+    e->inputs = seg_du && !segment_constant(run, seg_t) ? &run->inputs : NULL;
     return 0;
 }
 
