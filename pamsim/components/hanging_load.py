@@ -1,59 +1,22 @@
 """The hanging load: a mass on the muscle's flange, with its own stick/slip and end-stop modes.
 
-The mode machine is written here: the equations of each mode, the event indicators that end it, the
-jump at an event and the decision of a load at rest (docs/model.md sec. 4), which the python backend
-and the native backend's C engine integrate.  Until the FMU moves onto the code generated from it,
-the hand-written C core keeps its own copy, and the results' force columns come from
-:meth:`pamsim.model.MuscleModel.breakdown`; the conformance suite and the tests hold them to this one.  The Coulomb level comes in as a signal; this component decides
-its direction (against the motion when sliding, whatever holds the load when it is held).
+Its modes are those of any body with one degree of freedom (:mod:`pamsim.components.stick_slip`,
+docs/model.md sec. 4), which the python backend, the native backend's C engine and the FMU integrate
+from the code generated here.  The Coulomb level comes in as a signal; the modes decide its direction
+(against the motion when sliding, whatever holds the load when it is held).
 """
 
 from __future__ import annotations
 
-from enum import IntEnum
-
 from ..core_table import EVENT_V_TOL_M_S, EVENT_X_TOL_M
 from ..modeling import TRANSLATIONAL, Component, Equations, Port, Symbols, Var, non_negative, positive
-from ..modeling.smath import if_else
+from .stick_slip import EVENT_NAMES, BodyMode, Contact, event_name, stick_slip
+
+__all__ = ["EVENT_NAMES", "HangingLoad", "LoadMode", "event_name"]
 
 
-class LoadMode(IntEnum):
-    """Friction / contact mode of the load."""
-
-    SLIP_DOWN = -1
-    STICK = 0
-    SLIP_UP = 1
-    STOP_LOW = 2
-    STOP_HIGH = 3
-
-    @property
-    def is_slip(self) -> bool:
-        """Whether the load slides in this mode (up or down)."""
-        return self in (LoadMode.SLIP_UP, LoadMode.SLIP_DOWN)
-
-    @property
-    def label(self) -> str:
-        """The mode's name in results and events (``slip_up``, ``stick``...)."""
-        return self.name.lower()
-
-
-EVENT_NAMES = {
-    LoadMode.SLIP_UP: ("velocity_zero", "stop_high"),
-    LoadMode.SLIP_DOWN: ("velocity_zero", "stop_low"),
-    LoadMode.STICK: ("release_up", "release_down"),
-    LoadMode.STOP_LOW: ("release_up", None),
-    LoadMode.STOP_HIGH: (None, "release_down"),
-}
-"""What a crossing of each indicator means in each mode (None: that indicator never crosses there)."""
-
-
-def event_name(mode: LoadMode, fired: int, to: LoadMode) -> str:
-    """The name of an event that left ``mode`` for ``to`` with the indicators in the bit mask ``fired``:
-    a stop reached takes precedence over a velocity reaching zero (as in the transition), and a
-    release is named by the direction the load takes."""
-    if mode.is_slip:
-        return EVENT_NAMES[mode][1] if fired & 2 else EVENT_NAMES[mode][0]
-    return "release_up" if to == LoadMode.SLIP_UP else "release_down"
+LoadMode = BodyMode
+"""Friction / contact mode of the load (:class:`pamsim.components.stick_slip.BodyMode`)."""
 
 
 class HangingLoad(Component):
@@ -100,51 +63,23 @@ class HangingLoad(Component):
 
     def equations(self, s: Symbols) -> Equations:
         P = s.p
-        q, x, v = s.mode, s.x["x_m"], s.x["v_m_s"]
-        M = LoadMode
-        slip = q * q == 1
-        up = q == M.SLIP_UP
-        low, high = q == M.STOP_LOW, q == M.STOP_HIGH
-        v_flange = if_else(slip, v, 0.0)
+        x, v = s.x["x_m"], s.x["v_m_s"]
         weight = P["mass_kg"] * P["g_m_s2"]
         # The flange's forces include friction's -q F_c while sliding; at rest they hold neither
         # friction nor damping (its velocity is zero), so they add up to the static force.
         F, level = s.port["flange"]["F_N"], s.u["friction_level_N"]
         net = F - weight + s.u["F_external_N"]
-        accel = if_else(slip, net / P["mass_kg"], 0.0)
-
-        eps = P["release_margin_N"]
-        z_slip = (if_else(up, v, -v), if_else(up, P["x_high_m"] - x, x - P["x_low_m"]))
-        z_held = (if_else(high, 1.0, level + eps - net), if_else(low, 1.0, level + eps + net))
-        indicators = tuple(if_else(slip, a, b) for a, b in zip(z_slip, z_held))
-        margins = (if_else(slip, EVENT_V_TOL_M_S, 0.0), if_else(slip, EVENT_X_TOL_M, 0.0))
-
-        margin = P["stick_margin_N"]
-        rest = if_else(slip, q, if_else((1 - high) * (net - level > margin), float(M.SLIP_UP),
-                                        if_else((1 - low) * (-net - level > margin), float(M.SLIP_DOWN), q)))
-        at_stop = slip * s.fired[1]
-        stopped = slip * (1 - at_stop) * s.fired[0]
-        rebound = P["restitution"] * abs(v)
-        bounces = rebound > P["min_rebound_speed_m_s"]
-        transition = {
-            "x_m": if_else(at_stop, if_else(up, P["x_high_m"], P["x_low_m"]), x),
-            "v_m_s": if_else(at_stop, if_else(bounces, if_else(up, -rebound, rebound), 0.0),
-                             if_else(stopped, 0.0, v)),
-            "mode": if_else(at_stop, if_else(bounces, -q, if_else(up, float(M.STOP_HIGH), float(M.STOP_LOW))),
-                            if_else(stopped, float(M.STICK), q)),
-        }
-        held_by_friction = (q == M.STICK) + low * (net > 0.0) + high * (net < 0.0)
-        on_stop = low * (net <= 0.0) + high * (net >= 0.0)
+        contact = Contact(P["x_low_m"], P["x_high_m"], P["restitution"], P["min_rebound_speed_m_s"],
+                          P["stick_margin_N"], P["release_margin_N"], EVENT_V_TOL_M_S, EVENT_X_TOL_M)
         x0 = P["initial_contraction_m"]
+        b = stick_slip(s.mode, x, v, net, level, P["mass_kg"], contact, s.fired, x0)
         return Equations(
-            der={"x_m": v_flange, "v_m_s": accel},
-            outputs={"x_m": x, "v_m_s": v_flange, "mass_kg": P["mass_kg"], "F_gravity_N": -weight,
-                     "F_friction_N": if_else(slip, -q * level, if_else(held_by_friction, -net, 0.0)),
-                     "F_stop_N": if_else(on_stop, -net, 0.0), "F_coulomb_level_N": level,
+            der={"x_m": b.v_reported, "v_m_s": b.accel},
+            outputs={"x_m": x, "v_m_s": b.v_reported, "mass_kg": P["mass_kg"], "F_gravity_N": -weight,
+                     "F_friction_N": b.friction, "F_stop_N": b.stop_reaction, "F_coulomb_level_N": level,
                      "kinetic_energy_J": 0.5 * P["mass_kg"] * v * v, "F_net_N": net,
-                     "slip_direction": if_else(slip, q, 0.0)},
-            port={"flange": {"x_m": x, "v_m_s": v_flange}},
-            indicators=indicators, indicator_margins=margins, transition=transition, rest_mode=rest,
-            initial={"x_m": x0, "v_m_s": 0.0,
-                     "mode": if_else(x0 <= P["x_low_m"], float(M.STOP_LOW),
-                                     if_else(x0 >= P["x_high_m"], float(M.STOP_HIGH), float(M.STICK)))})
+                     "slip_direction": b.slip_direction},
+            port={"flange": {"x_m": x, "v_m_s": b.v_reported}},
+            indicators=b.indicators, indicator_margins=b.margins,
+            transition={"x_m": b.jump_pos, "v_m_s": b.jump_vel, "mode": b.jump_mode}, rest_mode=b.rest_mode,
+            initial={"x_m": x0, "v_m_s": 0.0, "mode": b.initial_mode})
