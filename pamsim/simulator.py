@@ -223,32 +223,39 @@ def _distinct_breaks(breakpoints, duration_s: float) -> list[float]:
     return out + [duration_s]
 
 
-class _Generated:
-    """The one-muscle model's generated code for one run, one set of functions per mode of the load
+class GeneratedCode:
+    """An assembly's generated code for one run, one set of functions per mode of its hybrid component
     (:func:`pamsim.modeling.pygen.compiled_by_mode`, shared by runs of the same structure), with the
-    run's parameter values and its input signals in the flat model's input order."""
+    run's parameter values, its inputs in the flat model's input order (``inputs(t)``) and the
+    absolute tolerance scale of each state (``nominal``)."""
 
-    def __init__(self, model: MuscleModel, opts: SolverOptions, x0_m: float, p0_gauge_Pa: float | None,
-                 added: tuple = ()):
-        assembly = self.assembly = one_muscle_assembly(model, x0_m, p0_gauge_Pa, opts.stick_margin_N,
-                                                       opts.release_margin_N, added)
-        self.code = compiled_by_mode(assembly, "load", RUN_FUNCTIONS)
-        local = [name.split(".", 1)[1] for name in self.code[Mode.STICK].names["states"]]
-        if local[:len(model.state_names)] != list(model.state_names):  # peaks and Result read them by position
-            raise ValueError(f"the components' states {local} do not begin with the model's {list(model.state_names)}")
+    def __init__(self, assembly, hybrid: str, inputs: Callable, nominal):
+        self.assembly = assembly
+        self.code = compiled_by_mode(assembly, hybrid, RUN_FUNCTIONS)
+        self.nominal = np.asarray(nominal, dtype=float)
+        self.p = assembly.parameter_values()
+        self.kinetic = self.code[Mode.STICK].names["outputs"].index(f"{hybrid}.kinetic_energy_J")
+        self.t_left = math.inf  # inputs are read at min(t, t_left): the left limit at a segment's end
+        self.inputs = inputs
+
+    @classmethod
+    def of_model(cls, model: MuscleModel, opts: SolverOptions, x0_m: float, p0_gauge_Pa: float | None,
+                 added: tuple = ()) -> "GeneratedCode":
+        """The one-muscle rig's code for ``model`` with the components ``added`` to it."""
+        assembly = one_muscle_assembly(model, x0_m, p0_gauge_Pa, opts.stick_margin_N, opts.release_margin_N, added)
         # Absolute tolerances: the rig's states' typical scales (10 mm, 0.1 m/s, 1 bar, 10 mg of air, 0.1 J of
         # work and of a controller's states, as always), then each added component's declared nominals.
         added_nominal = [v.nominal for c in assembly.components[-len(added):] for v in c.states] if added else []
-        self.nominal = np.array([STATE_SCALES.get(n, 0.1) for n in model.state_names] + added_nominal)
-        self.p = assembly.parameter_values()
-        self.kinetic = self.code[Mode.STICK].names["outputs"].index("load.kinetic_energy_J")
         source, external_N = model.source.inputs, model.load.external_N
-        self.t_left = math.inf  # inputs are read at min(t, t_left): the left limit at a segment's end
 
         def inputs(t):
             return [*source(t), external_N(t)]
 
-        self.inputs = inputs
+        gen = cls(assembly, "load", inputs, [STATE_SCALES.get(n, 0.1) for n in model.state_names] + added_nominal)
+        local = [name.split(".", 1)[1] for name in gen.code[Mode.STICK].names["states"]]
+        if local[:len(model.state_names)] != list(model.state_names):  # peaks and Result read them by position
+            raise ValueError(f"the components' states {local} do not begin with the model's {list(model.state_names)}")
+        return gen
 
     def start(self) -> tuple[np.ndarray, Mode]:
         """The state at rest at the start, and its mode decided from the forces."""
@@ -311,15 +318,7 @@ def simulate_model(model: MuscleModel, duration_s: float, options: SolverOptions
     """
     wall0 = time.perf_counter()
     run = _Run(model, duration_s, options or SolverOptions(), x0_m, p0_gauge_Pa, progress, added)
-    while run.t < duration_s:
-        run.report(run.t)
-        t_break = min(next(b for b in run.breaks if b > run.t), run.hold_until)
-        sol, named = run.segment(t_break)
-        run.record(sol, t_break)
-        if sol.status == 1:
-            run.at_event(sol, named)
-        else:
-            run.at_breakpoint(sol, t_break)
+    run.integrate(duration_s)
     if progress is not None:
         progress(duration_s)
     return run.result(name, time.perf_counter() - wall0)
@@ -416,17 +415,21 @@ class SteppedRun:
                 run.t, run.hold_until, run.y = t_break, math.inf, sol.y[:, -1].copy()
 
 
-class _Run:
-    """One run of :func:`simulate_model`: where it is, what it has sampled and seen so far."""
+class HybridRun:
+    """One run of an assembly's generated code (:class:`GeneratedCode`) with ``solve_ivp``, mode by mode of
+    its hybrid component: where it is, what it has sampled and seen so far.  Its first state is the
+    hybrid component's position (the extremes taken over every step are of it).  ``breakpoints``: times
+    [s] where an input jumps; ``max_input_step_s``: the longest step over which every input is monotonic.
+    A subclass turns the run into its result."""
 
-    def __init__(self, model: MuscleModel, duration_s: float, opts: SolverOptions, x0_m: float,
-                 p0_gauge_Pa: float | None, progress: Callable[[float], None] | None, added: tuple = ()):
-        self.model, self.opts, self.progress = model, opts, progress
+    def __init__(self, gen: GeneratedCode, duration_s: float, opts: SolverOptions, breakpoints,
+                 max_input_step_s: float, progress: Callable[[float], None] | None):
+        self.opts, self.progress = opts, progress
         self.grid = np.linspace(0.0, duration_s, n_samples(duration_s, opts.sample_rate_Hz))
-        self.breaks = _distinct_breaks(model.breakpoints, duration_s)
-        self.gen = _Generated(model, opts, x0_m, p0_gauge_Pa, added)
+        self.breaks = _distinct_breaks(breakpoints, duration_s)
+        self.gen = gen
         self.atol = opts.rtol * self.gen.nominal
-        self.held_max_step = min(opts.held_max_step_s, model.max_input_step_s)
+        self.held_max_step = min(opts.held_max_step_s, max_input_step_s)
         self.t = 0.0
         self.y, self.mode = self.gen.start()
         self.ts, self.ys, self.modes = [], [], []
@@ -435,7 +438,7 @@ class _Run:
         self.nfev = self.n_segments = self.n_zero = self.next_sample = 0
         self.hold_until = math.inf  # end of a short hold after a slip too small to resolve (see _HOLD_S)
         # Over every integrator step and event, not the samples.
-        self.low_x, self.peak_x, self.peak_p = math.inf, -math.inf, -math.inf
+        self.low_x, self.peak_x = math.inf, -math.inf
         self.calls = 0
         self.reached = 0.0  # reported time: the RHS is also evaluated at trial points, which need not increase
 
@@ -493,10 +496,6 @@ class _Run:
         # x is monotonic within a segment (the velocity keeps its sign between events), so its peak
         # is at a step; the pressure's peak is taken over the steps as well.
         self.low_x, self.peak_x = min(self.low_x, float(sol.y[0].min())), max(self.peak_x, float(sol.y[0].max()))
-        source = self.model.source
-        p_steps = source.pressure_gauge_Pa(sol.y[2:2 + self.model.n_source],
-                                           source.inputs(np.minimum(sol.t, self.t_left)))
-        self.peak_p = max(self.peak_p, float(np.max(p_steps)))
 
     def at_event(self, sol, named) -> None:
         """The jump at the segment's event, and the short hold of a slip too small to resolve."""
@@ -529,11 +528,49 @@ class _Run:
         if self.mode in _REST:
             self.mode = self.gen.rest_mode(self.mode, self.t, self.y)
 
+    def integrate(self, duration_s: float) -> None:
+        """Integrate from where the run is to ``duration_s``, segment by segment, sampling each."""
+        while self.t < duration_s:
+            self.report(self.t)
+            t_break = min(next(b for b in self.breaks if b > self.t), self.hold_until)
+            sol, named = self.segment(t_break)
+            self.record(sol, t_break)
+            if sol.status == 1:
+                self.at_event(sol, named)
+            else:
+                self.at_breakpoint(sol, t_break)
+
+    def trace(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The samples' times [s], states (one row per state) and modes."""
+        return np.concatenate(self.ts), np.concatenate(self.ys, axis=1), np.concatenate(self.modes)
+
+    def stats(self) -> dict:
+        """Right-hand-side evaluations, events, segments, the method and its tolerance."""
+        return {"rhs_evaluations": int(self.nfev), "events": len(self.transitions), "segments": self.n_segments,
+                "method": self.opts.method, "rtol": self.opts.rtol}
+
+
+class _Run(HybridRun):
+    """One run of :func:`simulate_model`: the one-muscle rig's, with the pressure's peak over every step."""
+
+    def __init__(self, model: MuscleModel, duration_s: float, opts: SolverOptions, x0_m: float,
+                 p0_gauge_Pa: float | None, progress: Callable[[float], None] | None, added: tuple = ()):
+        self.model = model
+        super().__init__(GeneratedCode.of_model(model, opts, x0_m, p0_gauge_Pa, added), duration_s, opts,
+                         model.breakpoints, model.max_input_step_s, progress)
+        self.peak_p = -math.inf
+
+    def record(self, sol, t_break: float) -> None:
+        """The segment's samples and extremes, the pressure's over its steps among them."""
+        super().record(sol, t_break)
+        source = self.model.source
+        p_steps = source.pressure_gauge_Pa(sol.y[2:2 + self.model.n_source],
+                                           source.inputs(np.minimum(sol.t, self.t_left)))
+        self.peak_p = max(self.peak_p, float(np.max(p_steps)))
+
     def result(self, name: str, wall_time_s: float) -> Result:
-        t, Y, modes = np.concatenate(self.ts), np.concatenate(self.ys, axis=1), np.concatenate(self.modes)
-        return Result.from_trace(self.model, name, t, Y, modes, self.transitions, self.impact_loss_J,
-                                 {"rhs_evaluations": int(self.nfev), "events": len(self.transitions),
-                                  "segments": self.n_segments, "method": self.opts.method, "rtol": self.opts.rtol},
+        t, Y, modes = self.trace()
+        return Result.from_trace(self.model, name, t, Y, modes, self.transitions, self.impact_loss_J, self.stats(),
                                  wall_time_s, peaks={"x_m": self.peak_x, "p_gauge_Pa": self.peak_p,
                                                      "x_min_m": self.low_x},
                                  outputs=RigOutputs(self.gen.assembly, self.model, t, Y, modes))

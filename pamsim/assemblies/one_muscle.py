@@ -63,7 +63,7 @@ def one_muscle_assembly(model, x0_m: float = 0.0, p0_gauge_Pa: float | None = No
         "x_high_m": model.stops.x_high_m, "restitution": model.stops.restitution,
         "min_rebound_speed_m_s": model.stops.min_rebound_speed_m_s,
         "stick_margin_N": stick_margin_N, "release_margin_N": release_margin_N, "initial_contraction_m": x0_m})
-    return rig_assembly(load, _source_parts(model.source, p0_gauge_Pa),
+    return rig_assembly(load, source_parts(model.source, p0_gauge_Pa),
                         (MuscleStaticForce("muscle", model.static_force), CoulombFriction("friction", model.friction),
                          ViscousDamping("damping", model.damping)), added, friction_direction)
 
@@ -120,7 +120,7 @@ def register_source(cls: type, parts: Callable[[Any, float | None], SourceParts]
     SOURCE_PARTS[cls] = parts
 
 
-def _source_parts(src, p0_gauge_Pa: float | None) -> SourceParts:
+def source_parts(src, p0_gauge_Pa: float | None) -> SourceParts:
     for cls in type(src).__mro__:
         if cls in SOURCE_PARTS:
             return SOURCE_PARTS[cls](src, p0_gauge_Pa)
@@ -131,7 +131,7 @@ def _source_parts(src, p0_gauge_Pa: float | None) -> SourceParts:
 def input_signals(model) -> dict:
     """The signals of the model inputs of ``model``'s assembly, by the flat model's names and in its order:
     the pressure source's (its ``signals``, named by its :class:`SourceParts`), then the external force."""
-    names = _source_parts(model.source, None).inputs
+    names = source_parts(model.source, None).inputs
     external = model.load.external_force_N
     return {**dict(zip(names, model.source.signals)),
             "external_force_N": external if external is not None else Constant(0.0)}

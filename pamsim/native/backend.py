@@ -373,7 +373,7 @@ def _result(scenario: Scenario, case: CaseInputs, out: dict, i: int, wall_time_s
 def _engine_result(scenario: Scenario, case: CaseInputs, out: dict, i: int, wall_time_s: float, t: np.ndarray,
                    stats: dict) -> Result:
     """Case ``i`` of a generic engine's batch as a :class:`Result`: its states in the flat model's order
-    (the model's, which :class:`pamsim.simulator._Generated` checks), events named from the indicators
+    (the model's, which :class:`pamsim.simulator.GeneratedCode` checks), events named from the indicators
     that fired, the kinetic energy an event removed from the load's output."""
     names = out["library"].names
     outputs, n_y, n = names["outputs"], len(names["outputs"]), case.n_samples
