@@ -269,6 +269,7 @@ class GeneratedCode:
         return Mode(int(q[0]))
 
     def rhs(self, mode: Mode):
+        """The right-hand side ``f(t, y)`` of ``mode``, as ``solve_ivp`` calls it."""
         f, inputs, p = self.code[mode].f, self.inputs, self.p
 
         def rhs(t, y):
@@ -443,6 +444,7 @@ class HybridRun:
         self.reached = 0.0  # reported time: the RHS is also evaluated at trial points, which need not increase
 
     def report(self, t: float) -> None:
+        """Tell the progress callback, if any, the simulated time reached (never less than before)."""
         if self.progress is not None:
             self.reached = max(self.reached, t)
             self.progress(self.reached)

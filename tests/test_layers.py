@@ -22,7 +22,7 @@ EXPECTED_LAYERS = [
     "cli",
     "api",
     "sweep | identification | control | atlas | export | envs",
-    "backends",
+    "backends | joints",
     "native",
     "fmu",
     "scenario",

@@ -121,6 +121,8 @@ def register_source(cls: type, parts: Callable[[Any, float | None], SourceParts]
 
 
 def source_parts(src, p0_gauge_Pa: float | None) -> SourceParts:
+    """The components of pressure source ``src`` (:data:`SOURCE_PARTS`, by its class or a base class), its
+    chamber at ``p0_gauge_Pa`` at the start (None: the source's own)."""
     for cls in type(src).__mro__:
         if cls in SOURCE_PARTS:
             return SOURCE_PARTS[cls](src, p0_gauge_Pa)

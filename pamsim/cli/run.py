@@ -71,25 +71,82 @@ def run(args: argparse.Namespace) -> int:
     """``pamsim run``: check every scenario, then simulate each and write its CSV, JSON and figure into
     ``--output``; exit code 1 if a closed-loop run misses its ``[controller.spec]``, else 0.
     """
-    from ..scenario import load_scenario
-
     args.figures = figure_args.options(args)
     if not args.max_csv_MB > 0:
         raise InputError(f"--max-csv-MB = {args.max_csv_MB:g}: must be positive")
-    scenarios = [load_scenario(p) for p in scenario_paths(args.scenario)]  # every file checked before any run
+    scenarios = [_load(p) for p in scenario_paths(args.scenario)]  # every file checked before any run
     seen = {}
     for sc in scenarios:
         if sc.name in seen:
             raise InputError(f"{sc.origin}: name = {sc.name!r}: {seen[sc.name]} has the same name; "
                              "their outputs would overwrite each other")
         seen[sc.name] = sc.origin
+        if _is_joint(sc):
+            _check_joint(sc, args)
+            continue
         _check_csv_size(sc, args.max_csv_MB)
         check_backend(args.backend, sc)  # a setting the backend cannot honour, before any run
     missed = 0
     with output_folder(args.output) as out:  # checked before the runs; removed again if nothing gets written
         for scenario in scenarios:
-            missed += bool(_run_one(scenario, args, out))
+            missed += bool(_run_joint(scenario, args, out) if _is_joint(scenario) else _run_one(scenario, args, out))
     return 1 if missed else 0
+
+
+def _load(path: Path):
+    """A one-muscle scenario, or muscles on a joint (a file with ``[joint]`` or ``[[muscle]]`` tables)."""
+    from ..joints import is_joint_spec, load_joint_scenario
+    from ..scenario import load_scenario
+
+    try:
+        spec = tomllib.loads(path.read_text(encoding="utf-8"))
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError, OSError):
+        spec = {}  # load_scenario reports it
+    return load_joint_scenario(path) if is_joint_spec(spec) else load_scenario(path)
+
+
+def _is_joint(scenario) -> bool:
+    return type(scenario).__name__ == "JointScenario"
+
+
+def _check_joint(scenario, args: argparse.Namespace) -> None:
+    if args.backend != "python":
+        raise InputError(f"{scenario.origin}: --backend {args.backend}: muscles on a joint run on the python "
+                         "backend only, so far; run it with --backend python")
+    n = int(round(scenario.duration_s * scenario.solver.sample_rate_Hz)) + 1
+    size_MB = n * (4 + 4 * len(scenario.muscles) + 3) * 18 / 1e6  # at most 18 characters a value
+    if size_MB > args.max_csv_MB:
+        raise InputError(f"{scenario.origin}: simulation.sample_rate_Hz = {scenario.solver.sample_rate_Hz:g}: {n} "
+                         f"samples make a CSV of up to {size_MB:.0f} MB, above the limit of {args.max_csv_MB:g} MB")
+
+
+def _run_joint(scenario, args: argparse.Namespace, out: Path) -> list[str]:
+    """Run muscles on a joint and write NAME.csv, NAME.json and the figure."""
+    from ..figure_style import save
+    from ..joints import simulate_joint
+    from ..joints.plots import joint_figure
+    from ..joints.static import JointStatics
+
+    result = simulate_joint(scenario)
+    fmt, dpi = args.figures
+    names = [f"{scenario.name}.csv", f"{scenario.name}.json"] + ([] if args.no_plot else [f"{scenario.name}.{fmt}"])
+    summary = result.summary()
+    eq = JointStatics(scenario).equilibrium([v["p_gauge_Pa"] for v in summary["muscles"].values()])
+    summary["equilibrium_at_final_pressures"] = {"theta_rad": eq.theta_rad, "k_Nm_per_rad": eq.k_Nm_per_rad,
+                                                 "on_limit": eq.on_limit}
+    with atomic_outputs(out, names) as tmp:
+        result.to_csv(tmp[names[0]])
+        tmp[names[1]].write_text(json.dumps(summary, indent=2) + "\n")
+        if not args.no_plot:
+            save(joint_figure(result), tmp[names[2]], fmt=fmt, dpi=dpi)
+    muscles = ", ".join(f"{m} {v['p_gauge_Pa'] / 1e5:.3f} bar, {v['F_tendon_N']:.2f} N" for m, v in summary["muscles"].items())
+    print(f"{scenario.name}: final angle {summary['final_theta_rad']:.4f} rad ({summary['final_mode']}), {muscles}; "
+          f"{len(summary['events'])} events, {result.stats['rhs_evaluations']} RHS evaluations, "
+          f"{result.wall_time_s * 1e3:.0f} ms")
+    print(f"  at rest at these pressures the joint balances at {eq.theta_rad:.4f} rad"
+          + (f" (on its {eq.on_limit} limit)" if eq.on_limit else "") + f", stiffness {eq.k_Nm_per_rad:.4g} N m/rad")
+    print(f"wrote {', '.join(str(out / n) for n in names)}")
+    return []
 
 
 def _check_csv_size(scenario, limit_MB: float) -> None:

@@ -13,10 +13,13 @@ from .external_force import ExternalForce
 from .friction import CoulombFriction
 from .hanging_load import HangingLoad, LoadMode
 from .pressure import PressureSignal
+from .pulley import Pulley
+from .rotary_joint import RotaryJoint
 from .spring import LinearSpring
 from .static_force import MuscleStaticForce
 from .valve import ProportionalValve
 
 __all__ = ["COMPONENT_TYPES", "CoulombFriction", "ExternalForce", "HangingLoad", "LinearSpring", "LoadMode",
-           "MuscleStaticForce", "PolytropicChamber", "PressureSignal", "ProportionalValve", "ViscousDamping",
+           "MuscleStaticForce", "PolytropicChamber", "PressureSignal", "ProportionalValve", "Pulley", "RotaryJoint",
+           "ViscousDamping",
            "register_component"]

@@ -74,6 +74,14 @@ TRANSLATIONAL = PortKind(
     through=(Var("F_N", "N", "force on the node along the line of action"),))
 """A mechanical flange along one line: position and velocity, force."""
 
+ROTATIONAL = PortKind(
+    "rotational",
+    across=(Var("theta_rad", "rad", "angle of the shaft"), Var("omega_rad_s", "rad/s", "angular velocity of the shaft")),
+    through=(Var("tau_Nm", "N m", "torque on the shaft"),
+             Var("tau_level_Nm", "N m", "Coulomb friction level the branch adds to the shaft's stick/slip decision")))
+"""A mechanical shaft: angle and angular velocity; torque, and the friction level a branch brings (a
+muscle's Coulomb friction acts on the joint it turns, and decides with the joint's own whether it sticks)."""
+
 PNEUMATIC = PortKind(
     "pneumatic",
     across=(Var("p_abs_Pa", "Pa", "absolute pressure of the volume"),

@@ -1,0 +1,103 @@
+"""Muscles on a rotary joint: an antagonistic pair, or any number, each on its own pulley.
+
+::
+
+    flexor_valve -- flexor_chamber --p--> flexor_muscle, flexor_friction
+                                              | flange
+    flexor_muscle, flexor_damping, flexor_friction -- flexor_pulley --shaft-- joint -- extensor_pulley ...
+
+Each muscle brings its own static force, friction, damping and pressure source (any of the one-muscle
+rig's: a valve and chamber, a prescribed pressure), its components named after it
+(``flexor_chamber.p_gauge_Pa``).  Model inputs: each muscle's source inputs, prefixed with its name
+(``flexor.valve_command``), and the joint's ``tau_external_Nm``.
+"""
+
+from __future__ import annotations
+
+import copy
+from dataclasses import dataclass
+from typing import Any
+
+from ..components import CoulombFriction, MuscleStaticForce, ViscousDamping
+from ..components.pulley import Pulley
+from ..components.rotary_joint import RotaryJoint
+from ..modeling import Assembly
+from .one_muscle import SourceParts, source_parts
+
+@dataclass(frozen=True)
+class JointMuscle:
+    """One muscle on the joint: its ``name`` (an identifier, the prefix of its components), its
+    elements (``static_force``, ``friction``, ``damping``, pressure ``source``, as a
+    :class:`pamsim.model.MuscleModel` holds them), its pulley (``radius_m``, ``side`` +1 or -1,
+    contraction ``x_at_zero_m`` at angle zero) and its chamber's initial gauge pressure
+    (``p0_gauge_Pa``, None: ambient)."""
+
+    name: str
+    static_force: Any
+    friction: Any
+    damping: Any
+    source: Any
+    radius_m: float
+    side: float
+    x_at_zero_m: float
+    p0_gauge_Pa: float | None = None
+
+
+def joint_assembly(joint_values: dict, muscles: tuple[JointMuscle, ...], g_m_s2: float,
+                   name: str = "joint") -> Assembly:
+    """The assembly of a :class:`RotaryJoint` with parameters ``joint_values`` and ``muscles`` on it.
+
+    Model inputs: each muscle's pressure source inputs as ``<muscle>.<input>``, then
+    ``tau_external_Nm``.
+    """
+    parts: list = [RotaryJoint("joint", joint_values)]
+    wiring: list = []
+    inputs: dict = {}
+    for m in muscles:
+        own, own_wiring, own_inputs = _muscle_parts(m, g_m_s2)
+        parts += own
+        wiring += own_wiring
+        inputs.update(own_inputs)
+    inputs["tau_external_Nm"] = "joint.tau_external_Nm"
+    return Assembly(parts, wiring, inputs, name=name)
+
+
+def _muscle_parts(m: JointMuscle, g_m_s2: float) -> tuple[list, list, dict]:
+    """A muscle's components, wiring and model inputs, its components prefixed with its name."""
+    pulley = f"{m.name}_pulley"
+    source = _prefixed(source_parts(m.source, m.p0_gauge_Pa), m.name, pulley)
+    parts = [*source.parts, MuscleStaticForce(f"{m.name}_muscle", m.static_force),
+             CoulombFriction(f"{m.name}_friction", m.friction), ViscousDamping(f"{m.name}_damping", m.damping),
+             Pulley(pulley, {"radius_m": m.radius_m, "side": m.side, "x_at_zero_m": m.x_at_zero_m, "g_m_s2": g_m_s2})]
+    p = f"{source.pressure}.p_gauge_Pa"
+    # The flange adds the forces in the one-muscle rig's order: static, damping, friction.
+    wiring = [*source.wiring, (f"{pulley}.shaft", "joint.shaft"), (f"{pulley}.flange", f"{m.name}_muscle.flange"),
+              (f"{pulley}.flange", f"{m.name}_damping.flange"), (f"{pulley}.flange", f"{m.name}_friction.flange"),
+              (p, f"{m.name}_muscle.p_gauge_Pa"), (p, f"{m.name}_friction.p_gauge_Pa"),
+              (f"{pulley}.load_mass_kg", f"{m.name}_friction.mass_kg"),
+              (f"{pulley}.direction", f"{m.name}_friction.direction"),
+              (f"{m.name}_friction.level_N", f"{pulley}.friction_level_N"),
+              (f"{m.name}_muscle.F_static_N", f"{pulley}.F_static_N"), ("joint.slip_direction", f"{pulley}.joint_direction")]
+    inputs = {f"{m.name}.{k}": v for k, v in source.inputs.items()}
+    return parts, wiring, inputs
+
+
+def _prefixed(source: SourceParts, prefix: str, node: str) -> SourceParts:
+    """``source``'s parts renamed ``<prefix>_<name>``, its wiring and inputs with them, and what it
+    read from the rig's load read from ``node`` instead."""
+    names = {c.name: f"{prefix}_{c.name}" for c in source.parts}
+    parts = []
+    for c in source.parts:
+        renamed = copy.copy(c)
+        renamed.name = names[c.name]
+        parts.append(renamed)
+
+    def ref(r: str) -> str:
+        owner, _, rest = r.partition(".")
+        if owner == "load":
+            return f"{node}.{rest}"
+        return f"{names.get(owner, owner)}.{rest}"
+
+    wiring = [(ref(a), ref(b)) for a, b in source.wiring]
+    inputs = {k: tuple(ref(v) for v in ((vs,) if isinstance(vs, str) else vs)) for k, vs in source.inputs.items()}
+    return SourceParts(parts, wiring, {k: v[0] if len(v) == 1 else v for k, v in inputs.items()}, names[source.pressure])

@@ -1,0 +1,203 @@
+"""A joint scenario: muscles on a rotary joint, read from a TOML file or a dict.
+
+::
+
+    name = "antagonistic_pair"
+    [joint]                      # the link and its bearing (RotaryJoint's parameters, SI)
+    inertia_kg_m2 = 2.0e-4
+    ...
+    [[muscle]]                   # one table per muscle
+    name = "flexor"
+    side = 1                     # +1: it turns the joint toward larger angles
+    radius_m = 0.01
+    x_at_zero_m = 0.012          # its contraction at angle zero
+    [muscle.model]               # as a one-muscle scenario's [model], [parameters] and [pressure]
+    parameter_set = "shadow_6x300_acra2012"
+    [muscle.pressure]
+    source = "prescribed"
+    ...
+
+Each muscle's ``model``, ``parameters`` and ``pressure`` tables are read as a one-muscle scenario's
+(:class:`pamsim.scenario.Scenario`), so every static force model, friction and damping law and
+pressure source a one-muscle scenario offers works per muscle, with the same checks and messages.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Mapping
+
+from ..assemblies.joint import JointMuscle, joint_assembly
+from ..scenario import Scenario, ScenarioError
+from ..simulator import SolverOptions
+
+JOINT_KEYS: dict[str, tuple[float | None, str]] = {
+    "inertia_kg_m2": (None, "positive"), "link_mass_kg": (0.0, "non_negative"),
+    "com_distance_m": (0.0, "non_negative"), "g_m_s2": (9.81, "positive"), "theta_down_rad": (0.0, "any"),
+    "b_Nm_s_per_rad": (0.0, "non_negative"), "tau_coulomb_Nm": (0.0, "non_negative"),
+    "theta_min_rad": (None, "any"), "theta_max_rad": (None, "any"), "restitution": (0.0, "unit"),
+    "min_rebound_speed_rad_s": (1e-3, "non_negative"), "initial_angle_rad": (0.0, "any")}
+"""``[joint]`` keys: default (None: required) and the range a value must lie in.  g is standard gravity
+(9.81 m/s^2, as the one-muscle scenarios); min_rebound_speed_rad_s is assumed (a slower rebound than 1 mrad/s
+moves the link by less than any angle a figure resolves)."""
+MUSCLE_KEYS = {"name", "side", "radius_m", "x_at_zero_m", "model", "parameters", "pressure"}
+TOP_KEYS = {"name", "description", "joint", "muscle", "simulation", "solver"}
+SOLVER_KEYS = {"method", "rtol", "max_events", "max_step_s"}
+PLACEHOLDER_LOAD = {"weight_N": 1.0}
+"""A muscle's one-muscle scenario needs a load; on a joint its tendon carries the load instead, and this
+one is never used (the friction law reads the load from the tendon, :class:`pamsim.components.pulley.Pulley`)."""
+
+
+def _fail(origin: str, key: str, value, why: str):
+    raise ScenarioError(f"{origin}: {key} = {value!r}: {why}")
+
+
+def _number(origin: str, key: str, value, kind: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        _fail(origin, key, value, "must be a finite number")
+    value = float(value)
+    rules = {"positive": (value > 0, "must be > 0"), "non_negative": (value >= 0, "must be >= 0"),
+             "unit": (0 <= value <= 1, "must lie in [0, 1]"), "any": (True, "")}
+    ok, why = rules[kind]
+    if not ok:
+        _fail(origin, key, value, why)
+    return value
+
+
+@dataclass(frozen=True)
+class JointScenario:
+    """A validated joint scenario: the joint's parameters, its muscles (each with the one-muscle
+    scenario its tables make), the run's length, sampling and solver settings."""
+
+    name: str
+    spec: Mapping[str, Any] = field(repr=False)
+    joint: Mapping[str, float] = field(repr=False)
+    muscles: tuple[tuple[Mapping[str, Any], Scenario], ...] = field(repr=False)
+    duration_s: float
+    solver: SolverOptions
+    origin: str = "<dict>"
+
+    @classmethod
+    def from_dict(cls, spec: Mapping[str, Any], origin: str = "<dict>", base_dir: str | Path = ".") -> "JointScenario":
+        """Validate ``spec`` (a TOML file's content) and return the scenario; :class:`ScenarioError`
+        names the key and value of the first mistake."""
+        spec = copy.deepcopy(dict(spec))
+        for key in sorted(set(spec) - TOP_KEYS):
+            _fail(origin, key, spec[key], f"unknown key; a joint scenario has {sorted(TOP_KEYS)}")
+        sim = spec.get("simulation", {})
+        duration = _number(origin, "simulation.duration_s", sim.get("duration_s", 5.0), "positive")
+        rate = _number(origin, "simulation.sample_rate_Hz", sim.get("sample_rate_Hz", 1000.0), "positive")
+        joint = _joint(origin, spec.get("joint"))
+        solver = spec.get("solver", {})
+        for key in sorted(set(solver) - SOLVER_KEYS):
+            _fail(origin, f"solver.{key}", solver[key], f"unknown key; [solver] has {sorted(SOLVER_KEYS)}")
+        shared = {"solver": solver, "simulation": {"duration_s": duration, "sample_rate_Hz": rate}}
+        muscles = _muscles(origin, spec.get("muscle"), shared, Path(base_dir))
+        # Each muscle's one-muscle scenario has read the [solver] table, with its checks and messages.
+        scenario = cls(str(spec.get("name", "joint")), spec, joint, muscles, duration, muscles[0][1].solver, origin)
+        scenario._check_limits()
+        return scenario
+
+    def _check_limits(self) -> None:
+        """Each muscle's contraction stays inside its own stops (the static model's range) over the
+        joint's limits: beyond them its force is not defined."""
+        lo, hi = self.joint["theta_min_rad"], self.joint["theta_max_rad"]
+        for table, sc in self.muscles:
+            stops = sc.build_model().stops
+            for key, theta in (("theta_min_rad", lo), ("theta_max_rad", hi), ("initial_angle_rad", self.joint["initial_angle_rad"])):
+                x = table["x_at_zero_m"] + table["side"] * table["radius_m"] * theta
+                if not stops.x_low_m - 1e-12 <= x <= stops.x_high_m + 1e-12:
+                    _fail(self.origin, f"joint.{key}", theta,
+                          f"muscle {table['name']!r} would contract to {x * 1e3:.2f} mm there, outside its range "
+                          f"[{stops.x_low_m * 1e3:.2f}, {stops.x_high_m * 1e3:.2f}] mm (x_at_zero_m + side radius_m theta)")
+
+    def joint_muscles(self) -> tuple[JointMuscle, ...]:
+        """The muscles as the joint's assembly takes them."""
+        out = []
+        for table, sc in self.muscles:
+            m = sc.build_model()
+            out.append(JointMuscle(table["name"], m.static_force, m.friction, m.damping, m.source,
+                                   table["radius_m"], table["side"], table["x_at_zero_m"], sc.initial_pressure_gauge_Pa))
+        return tuple(out)
+
+    def joint_values(self) -> dict[str, float]:
+        """The :class:`pamsim.components.rotary_joint.RotaryJoint` parameters, the solver's margins in
+        torque (its force margins times the largest pulley radius)."""
+        r = max(t["radius_m"] for t, _ in self.muscles)
+        return {**self.joint, "stick_margin_Nm": self.solver.stick_margin_N * r,
+                "release_margin_Nm": self.solver.release_margin_N * r}
+
+    def assembly(self):
+        """The joint's assembly (:func:`pamsim.assemblies.joint.joint_assembly`)."""
+        return joint_assembly(self.joint_values(), self.joint_muscles(), self.joint["g_m_s2"], name=self.name)
+
+
+def load_joint_scenario(path: str | Path) -> JointScenario:
+    """Read and validate a joint scenario file."""
+    path = Path(path)
+    try:
+        spec = tomllib.loads(path.read_text(encoding="utf-8"))
+    except (OSError, tomllib.TOMLDecodeError) as exc:
+        raise ScenarioError(f"{path}: {exc}") from exc
+    return JointScenario.from_dict(spec, origin=str(path), base_dir=path.parent)
+
+
+def is_joint_spec(spec: Mapping[str, Any]) -> bool:
+    """Whether a scenario file's content describes muscles on a joint (it has ``[joint]`` or ``[[muscle]]``)."""
+    return "joint" in spec or isinstance(spec.get("muscle"), list)
+
+
+def _joint(origin: str, table) -> dict[str, float]:
+    if not isinstance(table, dict):
+        raise ScenarioError(f"{origin}: [joint] is missing (the link's inertia and limits)")
+    for key in sorted(set(table) - set(JOINT_KEYS)):
+        _fail(origin, f"joint.{key}", table[key], f"unknown key; [joint] has {sorted(JOINT_KEYS)}")
+    out = {}
+    for key, (default, kind) in JOINT_KEYS.items():
+        if key not in table and default is None:
+            raise ScenarioError(f"{origin}: joint.{key} is required")
+        out[key] = _number(origin, f"joint.{key}", table.get(key, default), kind)
+    if out["theta_min_rad"] >= out["theta_max_rad"]:
+        _fail(origin, "joint.theta_min_rad", out["theta_min_rad"],
+              f"must be below joint.theta_max_rad = {out['theta_max_rad']!r}")
+    if not out["theta_min_rad"] <= out["initial_angle_rad"] <= out["theta_max_rad"]:
+        _fail(origin, "joint.initial_angle_rad", out["initial_angle_rad"], "must lie between the joint's limits")
+    return out
+
+
+def _muscles(origin: str, tables, shared: dict, base_dir: Path) -> tuple:
+    if not isinstance(tables, list) or not tables:
+        raise ScenarioError(f"{origin}: no [[muscle]] tables (a joint needs at least one muscle)")
+    seen, out = set(), []
+    for k, table in enumerate(tables):
+        where = f"muscle[{k}]"
+        if not isinstance(table, dict):
+            _fail(origin, where, table, "must be a table")
+        name = table.get("name")
+        if not isinstance(name, str) or not name.isidentifier():
+            _fail(origin, f"{where}.name", name, "must be a name made of letters, digits and _")
+        if name in seen:
+            _fail(origin, f"{where}.name", name, "is given to two muscles")
+        seen.add(name)
+        out.append(_muscle(origin, f"muscle {name!r}", table, shared, base_dir))
+    return tuple(out)
+
+
+def _muscle(origin: str, where: str, table: dict, shared: dict, base_dir: Path):
+    for key in sorted(set(table) - MUSCLE_KEYS):
+        _fail(origin, f"{where}.{key}", table[key], f"unknown key; a [[muscle]] has {sorted(MUSCLE_KEYS)}")
+    if "pressure" not in table:
+        raise ScenarioError(f"{origin}: {where} has no [muscle.pressure] table: every muscle needs a pressure input")
+    side = table.get("side")
+    if side not in (1, -1) or isinstance(side, bool):
+        _fail(origin, f"{where}.side", side, "must be 1 (it turns the joint toward larger angles) or -1")
+    values = {"name": table["name"], "side": float(side),
+              "radius_m": _number(origin, f"{where}.radius_m", table.get("radius_m"), "positive"),
+              "x_at_zero_m": _number(origin, f"{where}.x_at_zero_m", table.get("x_at_zero_m", 0.0), "any")}
+    one = {"model": table.get("model", {}), "parameters": table.get("parameters", {}), "pressure": table["pressure"],
+           "load": PLACEHOLDER_LOAD, **shared}
+    return values, Scenario.from_dict(one, name=table["name"], base_dir=base_dir, origin=f"{origin}: {where}")

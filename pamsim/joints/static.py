@@ -1,0 +1,92 @@
+"""The joint at rest: its net torque, equilibrium angle and stiffness for given muscle pressures.
+
+Everything comes from the joint's own generated code, with each muscle's pressure prescribed: the net
+torque is the joint's output ``tau_net_Nm`` in its held mode (no velocity, so no damping and no
+friction), and the stiffness ``k = -d tau_net / d theta`` is its exact derivative (CasADi's Jacobian
+of the same output).  At an equilibrium ``k`` is the joint's stiffness against a small rotation: the
+slope of the muscles' torques and of gravity; co-contraction raises it without moving the angle.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from ..assemblies.joint import joint_assembly
+from ..components.stick_slip import BodyMode
+from ..elements.pressure_source import PrescribedPressure
+from ..modeling.pygen import compiled_by_mode
+from ..signals import Constant
+from .scenario import JointScenario
+
+
+@dataclass(frozen=True)
+class Equilibrium:
+    """Where the joint rests at given pressures: ``theta_rad``, the stiffness there ``k_Nm_per_rad``, and
+    ``on_limit`` (``"lower"``/``"upper"`` if the torques push it onto a limit, where ``k`` is the muscles'
+    and gravity's slope at the limit, else None)."""
+
+    theta_rad: float
+    k_Nm_per_rad: float
+    on_limit: str | None
+
+
+class JointStatics:
+    """The joint of ``scenario`` with each muscle's pressure prescribed, at rest.
+
+    Parameters
+    ----------
+    scenario : JointScenario
+        The joint and its muscles (their pressure sources are replaced by prescribed pressures).
+    """
+
+    def __init__(self, scenario: JointScenario):
+        self.scenario = scenario
+        muscles = tuple(replace(m, source=PrescribedPressure(Constant(0.0))) for m in scenario.joint_muscles())
+        assembly = joint_assembly(scenario.joint_values(), muscles, scenario.joint["g_m_s2"], name=scenario.name)
+        self.names = [m.name for m in muscles]
+        self.code = compiled_by_mode(assembly, "joint", ("y", "jacobian"))[int(BodyMode.STICK)]
+        self.p = assembly.parameter_values()
+        states = self.code.names["states"]
+        self._theta = states.index("joint.theta_rad")
+        self._net = self.code.names["outputs"].index("joint.tau_net_Nm")
+        self._n_states = len(states)
+        self._limits = (scenario.joint["theta_min_rad"], scenario.joint["theta_max_rad"])
+
+    def _point(self, theta_rad: float, p_gauge_Pa) -> tuple[list, list]:
+        if len(p_gauge_Pa) != len(self.names):
+            raise ValueError(f"{len(p_gauge_Pa)} pressures for the muscles {self.names}")
+        x = [0.0] * self._n_states
+        x[self._theta] = float(theta_rad)
+        return x, [float(p) for p in p_gauge_Pa] + [0.0]  # then the external torque
+
+    def net_torque_Nm(self, theta_rad: float, p_gauge_Pa) -> float:
+        """Net torque on the link at rest at ``theta_rad`` with the muscles at ``p_gauge_Pa`` (in the
+        scenario's muscle order): the muscles' and gravity's."""
+        x, u = self._point(theta_rad, p_gauge_Pa)
+        return float(self.code.y(x, u, self.p, (float(BodyMode.STICK),))[0][self._net])
+
+    def stiffness_Nm_per_rad(self, theta_rad: float, p_gauge_Pa) -> float:
+        """``-d tau_net / d theta`` at rest [N m/rad], exactly."""
+        x, u = self._point(theta_rad, p_gauge_Pa)
+        C = self.code.jacobian(x, u, self.p, (float(BodyMode.STICK),))[2]
+        return float(-C[self._net, self._theta])
+
+    def equilibrium(self, p_gauge_Pa) -> Equilibrium:
+        """The angle where the net torque vanishes between the limits (the stable one: torque falling
+        through zero), or the limit the torques push the link onto."""
+        from scipy.optimize import brentq
+
+        lo, hi = self._limits
+        grid = np.linspace(lo, hi, 65)
+        tau = np.array([self.net_torque_Nm(t, p_gauge_Pa) for t in grid])
+        falls = np.nonzero((tau[:-1] >= 0.0) & (tau[1:] <= 0.0))[0]
+        if falls.size:
+            k = falls[0]
+            theta = grid[k] if tau[k] == 0.0 else brentq(lambda t: self.net_torque_Nm(t, p_gauge_Pa), grid[k],
+                                                          grid[k + 1], xtol=1e-14, rtol=4 * np.finfo(float).eps)
+            return Equilibrium(float(theta), self.stiffness_Nm_per_rad(theta, p_gauge_Pa), None)
+        on = "upper" if tau[-1] > 0.0 else "lower"
+        theta = hi if on == "upper" else lo
+        return Equilibrium(float(theta), self.stiffness_Nm_per_rad(theta, p_gauge_Pa), on)

@@ -1,0 +1,236 @@
+"""Muscles on a rotary joint: statics against a hand-written torque balance, the exact stiffness against
+finite differences, symmetry, the energy balance, slack tendons, and bad scenarios."""
+
+from __future__ import annotations
+
+import copy
+import math
+import subprocess
+import sys
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+import pamsim
+from pamsim.joints import JointScenario, load_joint_scenario, simulate_joint
+from pamsim.joints.static import JointStatics
+from pamsim.scenario import ScenarioError
+
+ROOT = Path(__file__).resolve().parents[1]
+PAIR_FILE = ROOT / "scenarios" / "antagonistic_pair.toml"
+PAIR = tomllib.loads(PAIR_FILE.read_text())
+BAR = 1e5
+
+
+def prescribed(spec: dict, pressures_bar, time_s: float = 0.1) -> dict:
+    """``spec`` with each muscle's pressure a step to ``pressures_bar`` at ``time_s``."""
+    spec = copy.deepcopy(spec)
+    for table, p in zip(spec["muscle"], pressures_bar):
+        table["pressure"] = {"source": "prescribed",
+                             "prescribed": {"kind": "step", "time_s": time_s, "final_gauge_bar": p}}
+    return spec
+
+
+def static_forces(spec: dict) -> list:
+    """Each muscle's static force element, as a one-muscle scenario of its [muscle.model] builds it."""
+    return [pamsim.Scenario.from_dict({"model": t["model"], "load": {"weight_N": 1.0}, "simulation": {"duration_s": 1.0},
+                                       "pressure": {"source": "prescribed", "prescribed": {"kind": "constant",
+                                                                                          "value_gauge_bar": 0.0}}}
+                                      ).build_model().static_force for t in spec["muscle"]]
+
+
+def hand_torque_Nm(spec: dict, forces: list, theta: float, pressures_Pa) -> float:
+    """The torque balance written out by hand: each muscle's static force (its element, called on
+    floats) at its contraction x0 + side r theta, a tendon that only pulls, and the link's weight."""
+    j = spec["joint"]
+    total = -j["link_mass_kg"] * 9.81 * j["com_distance_m"] * math.sin(theta - j.get("theta_down_rad", 0.0))
+    for table, force, p in zip(spec["muscle"], forces, pressures_Pa):
+        x = table["x_at_zero_m"] + table["side"] * table["radius_m"] * theta
+        total += table["side"] * table["radius_m"] * max(float(force.force_N(x, p)), 0.0)
+    return total
+
+
+PAIRS_BAR = [(a, b) for a in (1.5, 2.5, 3.5) for b in (1.5, 2.5, 3.5)]
+
+
+@pytest.mark.parametrize("p_bar", PAIRS_BAR)
+def test_equilibrium_is_the_hand_torque_balance(p_bar):
+    """At 9 pressure pairs the equilibrium from the generated code is the root of the hand-written
+    torque balance (to 1e-10 rad), or the limit it pushes the link onto."""
+    statics = JointStatics(JointScenario.from_dict(PAIR))
+    p = [v * BAR for v in p_bar]
+    eq = statics.equilibrium(p)
+    lo, hi = PAIR["joint"]["theta_min_rad"], PAIR["joint"]["theta_max_rad"]
+    forces = static_forces(PAIR)
+    tau = lambda t: hand_torque_Nm(PAIR, forces, t, p)  # noqa: E731
+    if eq.on_limit is None:
+        want = brentq(tau, lo, hi, xtol=1e-15)
+        assert eq.theta_rad == pytest.approx(want, abs=1e-10)
+        assert abs(statics.net_torque_Nm(eq.theta_rad, p) - tau(eq.theta_rad)) <= 1e-14
+    else:
+        assert np.sign(tau(lo)) == np.sign(tau(hi)) and eq.theta_rad == {"lower": lo, "upper": hi}[eq.on_limit]
+        assert (tau(hi) > 0) == (eq.on_limit == "upper")
+    if p_bar[0] == p_bar[1]:
+        assert eq.on_limit is None and abs(eq.theta_rad) < 0.01  # only the link's weight moves it off zero
+
+
+@pytest.mark.parametrize("theta", [-0.6, -0.1, 0.0, 0.25, 0.7])
+@pytest.mark.parametrize("p_bar", [(1.0, 1.0), (3.0, 2.0), (2.0, 4.0)])
+def test_stiffness_is_the_derivative_of_the_net_torque(theta, p_bar):
+    """The exact ``-d tau / d theta`` agrees with a central finite difference of the net torque to 1e-6."""
+    statics = JointStatics(JointScenario.from_dict(PAIR))
+    p = [v * BAR for v in p_bar]
+    h = 1e-5
+    fd = -(statics.net_torque_Nm(theta + h, p) - statics.net_torque_Nm(theta - h, p)) / (2 * h)
+    assert statics.stiffness_Nm_per_rad(theta, p) == pytest.approx(fd, rel=1e-6)
+
+
+def test_co_contraction_raises_the_stiffness_at_the_same_angle():
+    """Equal pressures on the pair hold the link near zero; raising both raises the stiffness."""
+    statics = JointStatics(JointScenario.from_dict(PAIR))
+    ks = [statics.equilibrium([p * BAR, p * BAR]) for p in (1.5, 2.5, 3.5)]
+    assert all(abs(e.theta_rad) < 0.01 for e in ks)
+    assert ks[0].k_Nm_per_rad < ks[1].k_Nm_per_rad < ks[2].k_Nm_per_rad
+
+
+def symmetric(spec: dict) -> dict:
+    spec = copy.deepcopy(spec)
+    spec["joint"].update(link_mass_kg=0.0)
+    return spec
+
+
+def test_equal_pressures_without_gravity_hold_the_angle_at_zero_exactly():
+    spec = prescribed(symmetric(PAIR), (2.5, 2.5))
+    res = simulate_joint(JointScenario.from_dict(spec))
+    assert np.all(res.theta_rad == 0.0) and np.all(res.omega_rad_s == 0.0)
+    assert res.muscle("flexor", "F_tendon_N")[-1] > 10.0  # both pull, and cancel
+
+
+def test_swapping_the_muscles_mirrors_the_run():
+    """The pair with its muscles' sides and pressures swapped turns the other way, by the same angle."""
+    spec = prescribed(symmetric(PAIR), (3.0, 2.0))
+    mirror = copy.deepcopy(spec)
+    mirror["muscle"] = [dict(t, side=-t["side"]) for t in reversed(copy.deepcopy(spec["muscle"]))]
+    mirror["muscle"][0]["pressure"], mirror["muscle"][1]["pressure"] = spec["muscle"][1]["pressure"], spec["muscle"][0]["pressure"]
+    mirror["muscle"] = list(reversed(mirror["muscle"]))
+    a, b = (simulate_joint(JointScenario.from_dict(s)) for s in (spec, mirror))
+    assert np.max(np.abs(a.theta_rad)) > 0.1
+    np.testing.assert_allclose(b.theta_rad, -a.theta_rad, rtol=0, atol=1e-12)
+    mirrored = {"release_up": "release_down", "release_down": "release_up", "stop_high": "stop_low",
+                "stop_low": "stop_high", "velocity_zero": "velocity_zero"}
+    assert [e.kind for e in a.transitions] == [mirrored[e.kind] for e in b.transitions]
+    assert [e.t_s for e in a.transitions] == [e.t_s for e in b.transitions]
+
+
+def test_the_shipped_pair_settles_within_the_friction_band_and_balances_its_energy():
+    scenario = load_joint_scenario(PAIR_FILE)
+    res = simulate_joint(scenario)
+    balance = res.energy_balance()
+    assert balance["relative"] < 2e-5
+    assert balance["flexor.W_tendon_J"] > 0 > balance["extensor.W_tendon_J"]
+    statics = JointStatics(scenario)
+    p_end = [res.muscle(m, "p_gauge_Pa")[-1] for m in res.muscles]
+    eq = statics.equilibrium(p_end)
+    assert res.final_mode.name == "STICK" and eq.on_limit is None
+    # held where the net torque is within the bearing's Coulomb level (the muscles' is zero at this load)
+    assert abs(statics.net_torque_Nm(res.theta_rad[-1], p_end)) <= PAIR["joint"]["tau_coulomb_Nm"] + 1e-9
+    assert abs(res.theta_rad[-1] - eq.theta_rad) <= PAIR["joint"]["tau_coulomb_Nm"] / eq.k_Nm_per_rad + 1e-9
+
+
+def test_a_tendon_never_pushes_and_no_nan_appears():
+    """A muscle whose forces add up to a push (its static force kept negative past its free contraction,
+    its pressure zero) leaves its tendon slack: zero force and torque, and no NaN anywhere."""
+    spec = prescribed(PAIR, (4.0, 0.0))
+    for table in spec["muscle"]:
+        table["model"] = dict(table["model"], static_force_negative="keep")
+    res = simulate_joint(JointScenario.from_dict(spec))
+    ext_static = res.signals["extensor_muscle.F_static_N"]
+    assert np.min(ext_static) < -1.0  # it would push
+    assert np.all(res.muscle("extensor", "F_tendon_N") >= 0.0)
+    slack = res.signals["extensor_pulley.taut"] == 0.0
+    assert slack.sum() > 100 and np.all(res.muscle("extensor", "tau_Nm")[slack] == 0.0)
+    assert all(np.all(np.isfinite(v)) for v in res.signals.values())
+
+
+BAD = [
+    (lambda s: s["muscle"][0].update(radius_m=0.0), "muscle 'flexor'.radius_m = 0.0: must be > 0"),
+    (lambda s: s["joint"].update(inertia_kg_m2=-1.0), "joint.inertia_kg_m2 = -1.0: must be > 0"),
+    (lambda s: s["joint"].update(theta_min_rad=0.9), "joint.theta_min_rad = 0.9: must be below joint.theta_max_rad"),
+    (lambda s: s["muscle"][1].update(name="flexor"), "muscle[1].name = 'flexor': is given to two muscles"),
+    (lambda s: s["muscle"][1].pop("pressure"), "muscle 'extensor' has no [muscle.pressure] table"),
+    (lambda s: s["muscle"][0].update(side=2), "muscle 'flexor'.side = 2: must be 1"),
+    (lambda s: s["joint"].update(theta_max_rad=3.0), "muscle 'extensor' would contract to -10.00 mm there, outside its range"),
+    (lambda s: s["muscle"][0]["pressure"].update(supply_gauge_bar=-1.0), "muscle 'flexor': pressure.supply_gauge_bar"),
+]
+
+
+@pytest.mark.parametrize("change, message", BAD, ids=[m.split(":")[0][:40] for _, m in BAD])
+def test_bad_joint_scenarios_are_refused_by_key(change, message):
+    spec = copy.deepcopy(PAIR)
+    change(spec)
+    with pytest.raises(ScenarioError) as info:
+        JointScenario.from_dict(spec, origin="pair.toml")
+    assert message in str(info.value) and str(info.value).startswith("pair.toml")
+
+
+def test_pamsim_run_writes_a_joint_run_and_refuses_what_it_cannot_run(tmp_path):
+    """``pamsim run`` on a joint scenario writes its CSV, JSON and figure; a bad one and another backend
+    exit 2 with a message naming the key, and write nothing."""
+    out = tmp_path / "out"
+    done = subprocess.run([sys.executable, "-m", "pamsim", "run", str(PAIR_FILE), "-o", str(out)],
+                          capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    summary = __import__("json").loads((out / "antagonistic_pair.json").read_text())
+    eq = summary["equilibrium_at_final_pressures"]
+    assert abs(summary["final_theta_rad"] - eq["theta_rad"]) <= PAIR["joint"]["tau_coulomb_Nm"] / eq["k_Nm_per_rad"]
+    assert (out / "antagonistic_pair.png").stat().st_size > 10_000
+    header = (out / "antagonistic_pair.csv").read_text().splitlines()[0].split(",")
+    assert header[:4] == ["t_s", "theta_rad", "omega_rad_s", "mode"] and "extensor.F_tendon_N" in header
+    bad = tmp_path / "bad.toml"
+    bad.write_text(PAIR_FILE.read_text().replace("inertia_kg_m2 = 2.0e-5", "inertia_kg_m2 = 0.0"))
+    for args, message in [([str(bad)], "joint.inertia_kg_m2 = 0.0: must be > 0"),
+                          ([str(PAIR_FILE), "--backend", "native"], "python backend only")]:
+        again = subprocess.run([sys.executable, "-m", "pamsim", "run", *args, "-o", str(tmp_path / "none")],
+                               capture_output=True, text=True)
+        assert again.returncode == 2 and message in again.stderr and "Traceback" not in again.stderr
+        assert not (tmp_path / "none").exists()
+
+
+def test_exact_jacobians_of_the_joint_agree_with_central_differences():
+    """df/dx, df/du, dy/dx, dy/du of the pair (the joint, the pulleys, every muscle's components) at 1,000
+    random states, inputs and modes, to 1e-7 relative; an entry whose step straddles a kink (a slack
+    tendon, |omega|, the valve's switches) is counted, not tested: at most 1 % of them."""
+    from test_components import _fd_jacobian
+
+    flat = JointScenario.from_dict(PAIR).assembly().flatten()
+    g = flat.compile_python()
+    P = flat.parameter_values
+    x_nom = np.array([v.nominal for v in flat.states])
+    u_nom = np.array([{"1": 1.0, "Pa": 1e5, "N m": 0.1}[v.unit] for v in flat.inputs])
+    names = [v.name for v in flat.states]
+    rng = np.random.default_rng(23)
+    compared = skipped = 0
+    for _ in range(1000):
+        x = x_nom * rng.uniform(-1.0, 1.0, len(x_nom))
+        x[names.index("joint.theta_rad")] = rng.uniform(-0.8, 0.8)
+        for m in ("flexor", "extensor"):
+            p_abs = rng.uniform(1.0e5, 4.5e5)
+            x[names.index(f"{m}_chamber.p_abs_Pa")] = p_abs
+            x[names.index(f"{m}_chamber.air_mass_kg")] = p_abs * rng.uniform(2e-6, 8e-6) / (287.0 * 293.15)
+        u = np.array([rng.uniform(-1, 1), rng.uniform(0, 4e5), rng.uniform(-1, 1), rng.uniform(0, 4e5),
+                      rng.uniform(-0.1, 0.1)])
+        q = [float(rng.choice([-1, 0, 1, 2, 3]))]
+        A, B, C, D = g.jacobian(list(x), list(u), P, q)
+        for exact, fun in ((np.hstack([A, B]), lambda z: g.f(list(z[:len(x)]), list(z[len(x):]), P, q)[0]),
+                           (np.hstack([C, D]), lambda z: g.y(list(z[:len(x)]), list(z[len(x):]), P, q)[0])):
+            nom = np.concatenate([x_nom, u_nom])
+            fd, kink = _fd_jacobian(fun, np.concatenate([x, u]), nom)
+            row_scale = np.max(np.abs(exact) * nom, axis=1, keepdims=True) / nom
+            bad = ~(np.abs(exact - fd) <= 1e-7 * (np.abs(exact) + np.abs(fd)) + 1e-9 * row_scale) & ~kink
+            compared += int(np.sum(~kink))
+            skipped += int(np.sum(kink))
+            assert not bad.any(), (np.argwhere(bad), exact[bad], fd[bad], q)
+    assert skipped <= 0.01 * compared, (skipped, compared)
