@@ -449,6 +449,9 @@ def _checked_name(v: "_Validator", name: str) -> str:
 # ---------------------------------------------------------------- validation
 def _check_sections(v: "_Validator", spec: dict) -> None:
     """Every table's keys and types, and the sections a scenario cannot do without."""
+    if "joint" in spec or isinstance(spec.get("muscle"), list):
+        raise ScenarioError(f"{v.origin}: [joint] and [[muscle]] tables make muscles on a joint: run it with "
+                            "`pamsim run`, or read it with pamsim.joints.load_joint_scenario")
     v.check_table("", spec)
     for section in ("model", "load", "pressure", "simulation", "solver", "measured"):
         if section in spec:

@@ -25,7 +25,9 @@ from pamsim.sweep import sweep_from_dict
 
 from conftest import SCENARIOS
 
-EXAMPLES = {"scenario_mutations": 1000, "scenario_random": 350, "scenario_text": 300, "sweep_mutations": 400}
+from pamsim.joints import JointScenario, is_joint_spec
+
+EXAMPLES = {"joint_mutations": 400, "scenario_mutations": 1000, "scenario_random": 350, "scenario_text": 300, "sweep_mutations": 400}
 FUZZ = settings(derandomize=True, deadline=None, database=None,
                 suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
 
@@ -80,7 +82,16 @@ def _mutate(doc: dict, data) -> dict:
 
 
 def _outcome_scenario(doc: dict) -> None:
-    """A valid setup, or a one-line InputError; any other exception propagates and fails the test."""
+    """A valid setup, or a one-line InputError; any other exception propagates and fails the test.  A
+    document with joint tables is read as muscles on a joint."""
+    if is_joint_spec(doc):
+        try:
+            joint = JointScenario.from_dict(doc, base_dir=SCENARIOS, origin="fuzz.toml")
+        except InputError as exc:
+            _one_line(exc)
+            return
+        assert joint.assembly().flatten().states and joint.duration_s > 0
+        return
     try:
         sc = pamsim.Scenario.from_dict(doc, base_dir=SCENARIOS, origin="fuzz.toml")
     except InputError as exc:
@@ -101,6 +112,12 @@ def _one_line(exc: InputError) -> None:
 @given(name=st.sampled_from(sorted(VALID)), data=st.data())
 def test_mutated_scenarios_are_valid_or_one_line_errors(name, data):
     _outcome_scenario(_mutate(VALID[name], data))
+
+
+@settings(FUZZ, max_examples=EXAMPLES["joint_mutations"])
+@given(data=st.data())
+def test_mutated_joint_scenarios_are_valid_or_one_line_errors(data):
+    _outcome_scenario(_mutate(VALID["antagonistic_pair"], data))
 
 
 @settings(FUZZ, max_examples=EXAMPLES["scenario_random"])

@@ -56,6 +56,12 @@ def _fail(origin: str, key: str, value, why: str):
     raise ScenarioError(f"{origin}: {key} = {value!r}: {why}")
 
 
+def _table(origin: str, key: str, value) -> dict:
+    if not isinstance(value, dict):
+        _fail(origin, key, value, "must be a table")
+    return value
+
+
 def _number(origin: str, key: str, value, kind: str) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
         _fail(origin, key, value, "must be a finite number")
@@ -88,17 +94,20 @@ class JointScenario:
         spec = copy.deepcopy(dict(spec))
         for key in sorted(set(spec) - TOP_KEYS):
             _fail(origin, key, spec[key], f"unknown key; a joint scenario has {sorted(TOP_KEYS)}")
-        sim = spec.get("simulation", {})
+        sim = _table(origin, "simulation", spec.get("simulation", {}))
+        name = spec.get("name", "joint")
+        if not isinstance(name, str) or not name.isidentifier():
+            _fail(origin, "name", name, "must be a name made of letters, digits and _")
         duration = _number(origin, "simulation.duration_s", sim.get("duration_s", 5.0), "positive")
         rate = _number(origin, "simulation.sample_rate_Hz", sim.get("sample_rate_Hz", 1000.0), "positive")
         joint = _joint(origin, spec.get("joint"))
-        solver = spec.get("solver", {})
+        solver = _table(origin, "solver", spec.get("solver", {}))
         for key in sorted(set(solver) - SOLVER_KEYS):
             _fail(origin, f"solver.{key}", solver[key], f"unknown key; [solver] has {sorted(SOLVER_KEYS)}")
         shared = {"solver": solver, "simulation": {"duration_s": duration, "sample_rate_Hz": rate}}
         muscles = _muscles(origin, spec.get("muscle"), shared, Path(base_dir))
         # Each muscle's one-muscle scenario has read the [solver] table, with its checks and messages.
-        scenario = cls(str(spec.get("name", "joint")), spec, joint, muscles, duration, muscles[0][1].solver, origin)
+        scenario = cls(name, spec, joint, muscles, duration, muscles[0][1].solver, origin)
         scenario._check_limits()
         return scenario
 
@@ -188,6 +197,9 @@ def _muscles(origin: str, tables, shared: dict, base_dir: Path) -> tuple:
 
 
 def _muscle(origin: str, where: str, table: dict, shared: dict, base_dir: Path):
+    for key in ("model", "parameters", "pressure"):
+        if key in table:
+            _table(origin, f"{where}.{key}", table[key])
     for key in sorted(set(table) - MUSCLE_KEYS):
         _fail(origin, f"{where}.{key}", table[key], f"unknown key; a [[muscle]] has {sorted(MUSCLE_KEYS)}")
     if "pressure" not in table:
