@@ -165,7 +165,10 @@ def test_the_fuzzing_covers_at_least_2000_documents():
 @pytest.mark.parametrize("name", sorted(VALID))
 def test_the_unmutated_files_are_valid(name):
     """The seeds of the mutations are themselves valid (else every mutation would be an error)."""
-    pamsim.Scenario.from_dict(VALID[name], base_dir=SCENARIOS, origin=name).build_model()
+    if is_joint_spec(VALID[name]):
+        JointScenario.from_dict(VALID[name], base_dir=SCENARIOS, origin=name).assembly()
+    else:
+        pamsim.Scenario.from_dict(VALID[name], base_dir=SCENARIOS, origin=name).build_model()
 
 
 def test_the_unmutated_sweep_is_valid():
