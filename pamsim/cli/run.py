@@ -110,9 +110,11 @@ def _is_joint(scenario) -> bool:
 
 
 def _check_joint(scenario, args: argparse.Namespace) -> None:
-    if args.backend != "python":
-        raise InputError(f"{scenario.origin}: --backend {args.backend}: muscles on a joint run on the python "
-                         "backend only, so far; run it with --backend python")
+    from ..joints import BACKENDS as JOINT_BACKENDS
+
+    if args.backend not in JOINT_BACKENDS:
+        raise InputError(f"{scenario.origin}: --backend {args.backend}: muscles on a joint run on the "
+                         f"{' and '.join(JOINT_BACKENDS)} backends so far")
     n = int(round(scenario.duration_s * scenario.solver.sample_rate_Hz)) + 1
     size_MB = n * (4 + 4 * len(scenario.muscles) + 3) * 18 / 1e6  # at most 18 characters a value
     if size_MB > args.max_csv_MB:
@@ -127,7 +129,7 @@ def _run_joint(scenario, args: argparse.Namespace, out: Path) -> list[str]:
     from ..joints.plots import joint_figure
     from ..joints.static import JointStatics
 
-    result = simulate_joint(scenario)
+    result = simulate_joint(scenario, args.backend)
     fmt, dpi = args.figures
     names = [f"{scenario.name}.csv", f"{scenario.name}.json"] + ([] if args.no_plot else [f"{scenario.name}.{fmt}"])
     summary = result.summary()

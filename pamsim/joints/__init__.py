@@ -6,6 +6,6 @@
 
 from .result import JointEvent, JointResult
 from .scenario import JointScenario, is_joint_spec, load_joint_scenario
-from .simulate import simulate_joint
+from .run import BACKENDS, simulate_joint
 
-__all__ = ["JointEvent", "JointResult", "JointScenario", "is_joint_spec", "load_joint_scenario", "simulate_joint"]
+__all__ = ["BACKENDS", "JointEvent", "JointResult", "JointScenario", "is_joint_spec", "load_joint_scenario", "simulate_joint"]

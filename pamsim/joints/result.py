@@ -3,6 +3,7 @@ name, the mode changes, and the energy balance; plotting is in :mod:`pamsim.join
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -37,7 +38,7 @@ class JointResult:
 
     name: str
     t_s: np.ndarray
-    signals: dict[str, np.ndarray] = field(repr=False)
+    signals: Mapping[str, np.ndarray] = field(repr=False)
     mode: np.ndarray = field(repr=False)
     transitions: list[JointEvent] = field(repr=False)
     impact_losses_J: list[float] = field(repr=False)

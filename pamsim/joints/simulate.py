@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Mapping
 
 import numpy as np
 
@@ -14,7 +15,7 @@ from .result import JointEvent, JointResult
 from .scenario import JointScenario
 
 
-class _JointInputs:
+class JointInputs:
     """The joint model's inputs at a time: each muscle's pressure source's, in the assembly's order, then
     the external torque (none yet: zero)."""
 
@@ -26,19 +27,51 @@ class _JointInputs:
         return [*out, 0.0 * np.asarray(t, dtype=float) if np.ndim(t) else 0.0]
 
 
+class SampledSignals(Mapping):
+    """Every state and output at the samples, by the flat model's names: the states as sampled, the
+    outputs computed from them by the per-mode generated code when one is first asked for (a run whose
+    caller reads only the angle does not pay for them)."""
+
+    def __init__(self, code: dict, p, Y, inputs, modes):
+        names = next(iter(code.values())).names
+        self._states = dict(zip(names["states"], Y))
+        self._output_names = [n for n in names["outputs"] if n not in self._states]
+        self._args, self._outputs = (code, p, Y, inputs, modes), None
+
+    def __getitem__(self, key: str):
+        if key in self._states:
+            return self._states[key]
+        if self._outputs is None:
+            code, p, Y, inputs, modes = self._args
+            self._outputs = outputs_by_mode(code, p, list(Y), inputs, modes)
+        return self._outputs[key]
+
+    def __iter__(self):
+        return iter([*self._states, *self._output_names])
+
+    def __len__(self) -> int:
+        return len(self._states) + len(self._output_names)
+
+
+def sampled_signals(code: dict, p, Y, inputs, modes) -> SampledSignals:
+    """Every state (rows of ``Y``) and every output at the samples (:class:`SampledSignals`), from the
+    per-mode generated code ``code``; ``inputs`` are the model's inputs at the samples."""
+    return SampledSignals(code, p, Y, inputs, modes)
+
+
 def joint_run(scenario: JointScenario) -> tuple[HybridRun, list[str]]:
     """A run of ``scenario`` ready to integrate, and its muscles' names."""
     muscles = scenario.joint_muscles()
     assembly = scenario.assembly()
     flat = assembly.flatten()
-    inputs = _JointInputs([m.source for m in muscles])
+    inputs = JointInputs([m.source for m in muscles])
     gen = GeneratedCode(assembly, "joint", inputs, [v.nominal for v in flat.states])
     breaks = tuple(b for m in muscles for b in m.source.breakpoints)
     longest = min([getattr(m.source, "max_input_step_s", math.inf) for m in muscles])
     return HybridRun(gen, scenario.duration_s, scenario.solver, breaks, longest, None), [m.name for m in muscles]
 
 
-def simulate_joint(scenario: JointScenario) -> JointResult:
+def simulate_joint_python(scenario: JointScenario) -> JointResult:
     """Integrate ``scenario`` with ``scipy.integrate.solve_ivp`` and return its :class:`JointResult`.
 
     Raises
@@ -50,10 +83,7 @@ def simulate_joint(scenario: JointScenario) -> JointResult:
     run, names = joint_run(scenario)
     run.integrate(scenario.duration_s)
     t, Y, modes = run.trace()
-    code = run.gen.code
-    states = next(iter(code.values())).names["states"]
-    signals = dict(zip(states, Y))
-    signals.update(outputs_by_mode(code, run.gen.p, list(Y), run.gen.inputs(t), modes))
+    signals = sampled_signals(run.gen.code, run.gen.p, Y, run.gen.inputs(t), modes)
     events = [JointEvent(e.t_s, e.kind, e.from_mode, e.to_mode, e.x_m) for e in run.transitions]
     return JointResult(scenario.name, t, signals, modes, events, [loss for _, loss in run.impact_loss_J],
                        run.stats(), time.perf_counter() - wall0, tuple(names),

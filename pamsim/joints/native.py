@@ -1,0 +1,89 @@
+"""A joint scenario on the native backend: the joint's assembly compiled into the generic C engine
+(:mod:`pamsim.native.engine`), its inputs cut into exact segments as the one-muscle rig's are, and the
+engine's samples and events turned into the same :class:`JointResult` as the python backend's."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from ..components.stick_slip import BodyMode, event_name
+from ..errors import InputError, SolverFailure
+from ..assemblies.one_muscle import RUN_FUNCTIONS
+from ..modeling.pygen import compiled_by_mode
+from ..native.backend import METHOD_LABEL, event_capacity, exact_segments, native_rtol
+from ..native.engine import EngineCase, engine_library
+from ..signals import Constant
+from ..simulator import too_many_events
+from .result import JointEvent, JointResult
+from .scenario import JointScenario
+from .simulate import JointInputs, sampled_signals
+
+MAX_STEP_S = 0.1
+"""The engine's longest step when the scenario sets none [s] (the one-muscle FMU's default step)."""
+MAX_INTERNAL_STEPS = 1_000_000
+"""Integrator steps the engine may take per input segment before it gives up."""
+
+
+def simulate_joint_native(scenario: JointScenario) -> JointResult:
+    """Integrate ``scenario`` on the native engine and return its :class:`JointResult`.
+
+    Raises
+    ------
+    InputError
+        A muscle's input signal the engine cannot carry (a Python callable), or a bad value the engine
+        finds (a parameter out of range).
+    SolverFailure
+        The integrator failed, or the run had more than ``solver.max_events`` events.
+    """
+    assembly = scenario.assembly()
+    library = engine_library(assembly)
+    signals = [s for m in scenario.joint_muscles() for s in m.source.signals] + [Constant(0.0)]
+    pieces = exact_segments(signals, scenario.duration_s)
+    if pieces is None:
+        raise InputError(f"{scenario.origin}: a muscle's pressure input is a Python function, which the native "
+                         "backend cannot carry; run it with the python backend")
+    starts, u, du = pieces
+    opts = scenario.solver
+    n = int(round(scenario.duration_s * opts.sample_rate_Hz)) + 1
+    case = EngineCase(np.array(assembly.parameter_values()), native_rtol(opts),
+                      opts.max_step_s if np.isfinite(opts.max_step_s) else MAX_STEP_S, MAX_INTERNAL_STEPS,
+                      scenario.duration_s, n, starts, u, event_capacity(opts.max_events), du)
+    wall0 = time.perf_counter()
+    out = library.run([case])
+    wall = time.perf_counter() - wall0
+    status, message = int(out["status"][0]), out["messages"][0]
+    if status == 1:
+        raise InputError(f"{scenario.origin}: {message}")
+    if status == 2:
+        raise SolverFailure(f"native backend: {message}")
+    if status == 3 or int(out["n_events"][0]) > opts.max_events:
+        raise too_many_events(opts.max_events)
+    return _result(scenario, assembly, library.names, out, np.linspace(0.0, scenario.duration_s, n), wall)
+
+
+def _result(scenario: JointScenario, assembly, names: dict, out: dict, t: np.ndarray, wall_s: float) -> JointResult:
+    """The engine's output as a :class:`JointResult`: every state sampled, the outputs computed from them
+    by the python backend's generated code, the events named from the indicators that fired."""
+    ns, n = len(names["states"]), len(t)
+    Y = np.array(out["samples"][:ns * n].reshape(ns, n))
+    modes = out["modes"][:n].astype(int)
+    code = compiled_by_mode(assembly, "joint", RUN_FUNCTIONS)
+    muscles = scenario.joint_muscles()
+    signals = sampled_signals(code, assembly.parameter_values(), Y, JointInputs([m.source for m in muscles])(t), modes)
+    outputs = names["outputs"]
+    theta, ke = outputs.index("joint.theta_rad"), outputs.index("joint.kinetic_energy_J")
+    ny = len(outputs)
+    events, losses = [], []
+    for e in out["events"][:int(out["n_events"][0])].tolist():
+        before, after = e[4:4 + ny], e[4 + ny:4 + 2 * ny]
+        mode, to = BodyMode(int(e[1])), BodyMode(int(e[2]))
+        events.append(JointEvent(e[0], event_name(mode, int(e[3]), to), mode.label, to.label, after[theta]))
+        if before[ke] != after[ke]:
+            losses.append(before[ke] - after[ke])
+    high, low = out["extremes"][0][:ny], out["extremes"][0][ny:]
+    stats = {"rhs_evaluations": int(out["stats"][0][0]), "events": len(events), "segments": int(out["stats"][0][2]),
+             "method": METHOD_LABEL, "rtol": native_rtol(scenario.solver)}
+    return JointResult(scenario.name, t, signals, modes, events, losses, stats, wall_s, tuple(m.name for m in muscles),
+                       {"theta_rad": float(high[theta]), "theta_min_rad": float(low[theta])})
