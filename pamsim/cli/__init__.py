@@ -20,6 +20,7 @@ from ..errors import InputError, RunFailure, SolverFailure
 COMMANDS = (
     "pamsim.cli.run",
     "pamsim.cli.static",
+    "pamsim.cli.joint_map",
     "pamsim.cli.sweep",
     "pamsim.cli.fmu",
     "pamsim.cli.linearize",

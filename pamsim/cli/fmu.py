@@ -4,6 +4,7 @@ compile the muscle model as an FMU, for a scenario or a muscle if one is given."
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 from ..errors import InputError
 
@@ -79,14 +80,27 @@ def run_build(args: argparse.Namespace) -> int:
     by_muscle = _check_options(args)
     scenario = None
     if args.scenario:
-        from ..scenario import load_scenario
+        from .run import is_joint, load_any_scenario
 
-        scenario = load_scenario(args.scenario)
+        scenario = load_any_scenario(Path(args.scenario))
+        if is_joint(scenario):
+            return _build_joint(scenario, args)
         if scenario.added_components or args.generated or "controller" in scenario.spec:
             return _build_assembly(scenario, args)
     preset = _preset(args, scenario, by_muscle)
     path = build(args.output, int(args.fmi), preset=preset)
     print(f"wrote {path} (FMI {args.fmi}.0, Model Exchange and Co-Simulation{_built_for(preset)})")
+    return 0
+
+
+def _build_joint(scenario, args: argparse.Namespace) -> int:
+    """The FMU of muscles on a joint (:func:`pamsim.joints.fmu.build_joint_fmu`)."""
+    from ..joints.fmu import build_joint_fmu
+
+    path = build_joint_fmu(scenario, args.output, int(args.fmi))
+    print(f"wrote {path} (FMI {args.fmi}.0, Model Exchange and Co-Simulation, the joint and its "
+          f"{len(scenario.muscles)} muscles of scenario {scenario.name}: structured variable names such as "
+          "joint.theta_rad)")
     return 0
 
 

@@ -15,7 +15,6 @@ import math
 from pathlib import Path
 
 from ..atomic import atomic_outputs, output_folder
-from ..errors import InputError
 from ..control.choices import FRICTION_KINDS, VALVE_SLOPES
 from . import figure_args, finite_float
 

@@ -74,14 +74,14 @@ def run(args: argparse.Namespace) -> int:
     args.figures = figure_args.options(args)
     if not args.max_csv_MB > 0:
         raise InputError(f"--max-csv-MB = {args.max_csv_MB:g}: must be positive")
-    scenarios = [_load(p) for p in scenario_paths(args.scenario)]  # every file checked before any run
+    scenarios = [load_any_scenario(p) for p in scenario_paths(args.scenario)]  # every file checked before any run
     seen = {}
     for sc in scenarios:
         if sc.name in seen:
             raise InputError(f"{sc.origin}: name = {sc.name!r}: {seen[sc.name]} has the same name; "
                              "their outputs would overwrite each other")
         seen[sc.name] = sc.origin
-        if _is_joint(sc):
+        if is_joint(sc):
             _check_joint(sc, args)
             continue
         _check_csv_size(sc, args.max_csv_MB)
@@ -89,11 +89,11 @@ def run(args: argparse.Namespace) -> int:
     missed = 0
     with output_folder(args.output) as out:  # checked before the runs; removed again if nothing gets written
         for scenario in scenarios:
-            missed += bool(_run_joint(scenario, args, out) if _is_joint(scenario) else _run_one(scenario, args, out))
+            missed += bool(_run_joint(scenario, args, out) if is_joint(scenario) else _run_one(scenario, args, out))
     return 1 if missed else 0
 
 
-def _load(path: Path):
+def load_any_scenario(path: Path):
     """A one-muscle scenario, or muscles on a joint (a file with ``[joint]`` or ``[[muscle]]`` tables)."""
     from ..joints import is_joint_spec, load_joint_scenario
     from ..scenario import load_scenario
@@ -105,8 +105,9 @@ def _load(path: Path):
     return load_joint_scenario(path) if is_joint_spec(spec) else load_scenario(path)
 
 
-def _is_joint(scenario) -> bool:
-    return type(scenario).__name__ == "JointScenario"
+def is_joint(scenario) -> bool:
+    """Whether ``scenario`` is muscles on a joint (:class:`pamsim.joints.JointScenario`)."""
+    return type(scenario).__name__ == "JointScenario"  # without importing pamsim.joints for --help
 
 
 def _check_joint(scenario, args: argparse.Namespace) -> None:

@@ -144,7 +144,15 @@ class AssemblyVariables:
 
 def per_s(unit: str) -> str:
     """The unit of a rate of a quantity in ``unit``."""
-    return {"m": "m/s", "m/s": "m/s^2", "1": "1/s"}.get(unit, f"{unit}/s")
+    if unit == "1":
+        return "1/s"
+    numerator, slash, denominator = unit.partition("/")
+    if not slash:
+        return f"{unit}/s"
+    symbol, _, power = denominator.partition("^")
+    if symbol == "s":
+        return f"{numerator}/s^{int(power or 1) + 1}"
+    return f"{numerator}/({denominator.strip('()')} s)"
 
 
 def token(spec: FmuSpec) -> str:

@@ -45,3 +45,30 @@ def plot_joint(result, path=None, dpi: int | None = None) -> Figure:
         with atomic_path(path) as tmp:
             save(fig, tmp, fmt, dpi)
     return fig
+
+
+def equilibrium_map_figure(emap) -> Figure:
+    """The equilibrium angle and the stiffness over the two muscles' pressures
+    (:class:`pamsim.joints.static.EquilibriumMap`), with lines of equal angle drawn on the stiffness:
+    along one, co-contraction changes the stiffness and not the angle."""
+    fig = Figure(figsize=(10.0, 4.4), layout="constrained")
+    ax_theta, ax_k = fig.subplots(1, 2, sharey=True)
+    a, b = emap.p_first_Pa / PA_PER_BAR, emap.p_second_Pa / PA_PER_BAR
+    theta_deg = np.degrees(emap.theta_rad)
+    for ax, values, label in ((ax_theta, theta_deg, "equilibrium angle [deg]"),
+                              (ax_k, emap.k_Nm_per_rad, "stiffness -dtau/dtheta [N m/rad]")):
+        mesh = ax.pcolormesh(b, a, values, shading="nearest", cmap="viridis")
+        fig.colorbar(mesh, ax=ax, label=label)
+        ax.set_xlabel(f"{emap.names[1]} gauge pressure [bar]")
+    lines = ax_k.contour(b, a, theta_deg, colors="w", linewidths=0.8)
+    ax_k.clabel(lines, fmt="%.0f deg", fontsize="x-small")
+    ax_theta.contour(b, a, theta_deg, colors="w", linewidths=0.8)
+    limited = emap.on_limit != ""
+    if limited.any():
+        i, j = np.nonzero(limited)
+        ax_theta.plot(b[j], a[i], "x", color="C3", ms=4, label="on a joint limit")
+        ax_theta.legend(loc="lower right", fontsize="x-small")
+    ax_theta.set_ylabel(f"{emap.names[0]} gauge pressure [bar]")
+    fig.suptitle("Joint at rest: angle and stiffness over the two pressures (white: lines of equal angle)",
+                 fontsize="medium")
+    return fig

@@ -3,19 +3,22 @@
 from __future__ import annotations
 
 from ..errors import InputError
+from .fmu import simulate_joint_cs, simulate_joint_me
 from .native import simulate_joint_native
 from .result import JointResult
 from .scenario import JointScenario
 from .simulate import simulate_joint_python
 
-BACKENDS = {"python": simulate_joint_python, "native": simulate_joint_native}
+BACKENDS = {"python": simulate_joint_python, "native": simulate_joint_native, "fmu-cs": simulate_joint_cs,
+            "fmu-me": simulate_joint_me}
 """The backends that run muscles on a joint, by name."""
 
 
 def simulate_joint(scenario: JointScenario, backend: str = "python") -> JointResult:
     """Integrate ``scenario`` and return its :class:`JointResult`: with ``scipy.integrate.solve_ivp``
-    (``backend="python"``), or on the generic C engine (``"native"``,
-    :func:`pamsim.joints.native.simulate_joint_native`).
+    (``backend="python"``), on the generic C engine (``"native"``,
+    :func:`pamsim.joints.native.simulate_joint_native`), or through its FMU with fmpy (``"fmu-cs"``,
+    ``"fmu-me"``, :func:`pamsim.joints.fmu.simulate_joint_fmu`).
 
     Raises
     ------

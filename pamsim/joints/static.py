@@ -90,3 +90,44 @@ class JointStatics:
         on = "upper" if tau[-1] > 0.0 else "lower"
         theta = hi if on == "upper" else lo
         return Equilibrium(float(theta), self.stiffness_Nm_per_rad(theta, p_gauge_Pa), on)
+
+
+@dataclass(frozen=True)
+class EquilibriumMap:
+    """Equilibria over a grid of two muscles' pressures: ``theta_rad[i, j]`` and ``k_Nm_per_rad[i, j]`` at
+    ``p_first_Pa[i]`` and ``p_second_Pa[j]``, ``on_limit[i, j]`` ("" between the limits), the muscles'
+    names in that order."""
+
+    names: tuple[str, str]
+    p_first_Pa: np.ndarray
+    p_second_Pa: np.ndarray
+    theta_rad: np.ndarray
+    k_Nm_per_rad: np.ndarray
+    on_limit: np.ndarray
+
+    def rows(self) -> list[dict]:
+        """One dict per grid point: both pressures [Pa], the angle [rad], the stiffness [N m/rad], the limit."""
+        return [{f"{self.names[0]}.p_gauge_Pa": float(a), f"{self.names[1]}.p_gauge_Pa": float(b),
+                 "theta_rad": float(self.theta_rad[i, j]), "k_Nm_per_rad": float(self.k_Nm_per_rad[i, j]),
+                 "on_limit": str(self.on_limit[i, j])}
+                for i, a in enumerate(self.p_first_Pa) for j, b in enumerate(self.p_second_Pa)]
+
+
+def equilibrium_map(statics: JointStatics, p_first_Pa, p_second_Pa) -> EquilibriumMap:
+    """The equilibrium angle and stiffness of a two-muscle joint at every pair of the pressures given.
+
+    Raises
+    ------
+    ValueError
+        For a joint without exactly two muscles.
+    """
+    if len(statics.names) != 2:
+        raise ValueError(f"an equilibrium map needs two muscles, not {len(statics.names)} ({statics.names})")
+    a, b = np.asarray(p_first_Pa, dtype=float), np.asarray(p_second_Pa, dtype=float)
+    theta, k = np.empty((a.size, b.size)), np.empty((a.size, b.size))
+    limit = np.full((a.size, b.size), "", dtype=object)
+    for i, pa in enumerate(a):
+        for j, pb in enumerate(b):
+            eq = statics.equilibrium([pa, pb])
+            theta[i, j], k[i, j], limit[i, j] = eq.theta_rad, eq.k_Nm_per_rad, eq.on_limit or ""
+    return EquilibriumMap(tuple(statics.names), a, b, theta, k, limit)
