@@ -309,3 +309,26 @@ def test_pamsim_joint_map_writes_the_equilibria_over_both_pressures(tmp_path):
         again = subprocess.run([sys.executable, "-m", "pamsim", "joint-map", str(PAIR_FILE), "-o",
                                 str(tmp_path / "none"), *bad], capture_output=True, text=True)
         assert again.returncode == 2 and message in again.stderr and not (tmp_path / "none").exists()
+
+
+def test_co_contraction_shrinks_the_deflection_under_the_same_torque():
+    """pair_cocontraction.toml: equal pressures 1-4 bar, a 0.02 N m pulse at each level.  The link turns
+    less at each higher level; where it comes to rest under the pulse, its angle is the static
+    deflection tau / k of the exact stiffness at that level, within the friction band (level / k); and
+    the run's external work balances."""
+    scenario = load_joint_scenario(ROOT / "scenarios" / "pair_cocontraction.toml")
+    res = simulate_joint(scenario)
+    statics = JointStatics(scenario)
+    peaks = []
+    for level, (start, end) in zip((1, 2, 3, 4), ((1.0, 1.5), (3.0, 3.5), (5.0, 5.5), (7.0, 7.5))):
+        during = (res.t_s >= start) & (res.t_s < end)
+        peaks.append(np.max(res.theta_rad[during]))
+        held = during & (res.mode == 0) & (res.t_s > start + 0.1)
+        if level > 1:
+            k = statics.equilibrium([level * BAR] * 2).k_Nm_per_rad
+            theta = res.theta_rad[held][-1]
+            band = (statics.net_torque_Nm(theta, [level * BAR] * 2) + 0.02)  # what friction holds, at rest
+            assert abs(theta - 0.02 / k) < 0.1 * 0.02 / k and abs(band) < 0.06
+    assert peaks[0] == 0.0 and peaks[1] > peaks[2] > peaks[3] > 0.05
+    # 38 events and four pressure steps at rtol 1e-6: within the one-muscle rig's bound (1e-3), by far
+    assert res.energy_balance()["relative"] < 1e-4 and res.energy_balance()["W_external_J"] > 0.007

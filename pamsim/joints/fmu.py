@@ -25,7 +25,6 @@ from ..fmu.preset import SIGNAL_UNITS, Experiment, input_signal
 from ..fmu.runner import grid_rows, trace_stats
 from ..fmu.spec import FmuSpec
 from ..modeling.pygen import compiled_by_mode
-from ..signals import Constant
 from .result import JointResult
 from .scenario import JointScenario
 from .simulate import JointInputs, sampled_signals
@@ -46,7 +45,7 @@ def joint_fmu_spec(scenario: JointScenario, fmi_version: int = 2) -> FmuSpec:
     for m in scenario.joint_muscles():
         names = list(source_parts(m.source, None).inputs)
         signals.update({f"{m.name}.{n}": s for n, s in zip(names, m.source.signals)})
-    signals["tau_external_Nm"] = Constant(0.0)
+    signals["tau_external_Nm"] = scenario.external_torque
 
     def signals_of(names):
         out = {}
@@ -114,7 +113,7 @@ def simulate_joint_fmu(scenario: JointScenario, interface: str = "cs", fmi_versi
     assembly = scenario.assembly()
     muscles = scenario.joint_muscles()
     signals = sampled_signals(compiled_by_mode(assembly, "joint", RUN_FUNCTIONS), assembly.parameter_values(), Y,
-                              JointInputs([m.source for m in muscles])(t), modes)
+                              JointInputs.of(scenario, muscles)(t), modes)
     return JointResult(scenario.name, t, signals, modes, [], [], trace_stats(modes, f"fmu-{interface}", opts.rtol),
                        wall, tuple(m.name for m in muscles))
 

@@ -14,7 +14,6 @@ from ..assemblies.one_muscle import RUN_FUNCTIONS
 from ..modeling.pygen import compiled_by_mode
 from ..native.backend import METHOD_LABEL, event_capacity, exact_segments, native_rtol
 from ..native.engine import EngineCase, engine_library
-from ..signals import Constant
 from ..simulator import too_many_events
 from .result import JointEvent, JointResult
 from .scenario import JointScenario
@@ -39,7 +38,7 @@ def simulate_joint_native(scenario: JointScenario) -> JointResult:
     """
     assembly = scenario.assembly()
     library = engine_library(assembly)
-    signals = [s for m in scenario.joint_muscles() for s in m.source.signals] + [Constant(0.0)]
+    signals = [s for m in scenario.joint_muscles() for s in m.source.signals] + [scenario.external_torque]
     pieces = exact_segments(signals, scenario.duration_s)
     if pieces is None:
         raise InputError(f"{scenario.origin}: a muscle's pressure input is a Python function, which the native "
@@ -71,7 +70,7 @@ def _result(scenario: JointScenario, assembly, names: dict, out: dict, t: np.nda
     modes = out["modes"][:n].astype(int)
     code = compiled_by_mode(assembly, "joint", RUN_FUNCTIONS)
     muscles = scenario.joint_muscles()
-    signals = sampled_signals(code, assembly.parameter_values(), Y, JointInputs([m.source for m in muscles])(t), modes)
+    signals = sampled_signals(code, assembly.parameter_values(), Y, JointInputs.of(scenario, muscles)(t), modes)
     outputs = names["outputs"]
     theta, ke = outputs.index("joint.theta_rad"), outputs.index("joint.kinetic_energy_J")
     ny = len(outputs)

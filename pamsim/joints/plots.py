@@ -26,6 +26,9 @@ def joint_figure(result) -> Figure:
         ax_tau.plot(t, result.muscle(m, "tau_Nm"), label=f"{m} (tendon {np.max(result.muscle(m, 'F_tendon_N')):.3g} N max)",
                     **series(k))
     ax_tau.plot(t, result.signals["joint.tau_gravity_Nm"], label="gravity", **series(len(result.muscles), "C7"))
+    external = result.signals["joint.tau_applied_Nm"]
+    if np.any(external != 0.0):
+        ax_tau.plot(t, external, label="external", **series(len(result.muscles) + 1, "C4"))
     ax_p.set_ylabel("gauge pressure [bar]")
     ax_p.legend(loc="best", fontsize="small")
     ax_tau.set_ylabel("torque on the link [N m]\n(positive turns it to larger angles)")

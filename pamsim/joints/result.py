@@ -96,11 +96,12 @@ class JointResult:
 
     def columns(self) -> dict[str, np.ndarray]:
         """``t_s``, ``theta_rad``, ``omega_rad_s``, ``mode``, then per muscle :data:`MUSCLE_COLUMNS`, then the
-        joint's gravity, muscle and net torques."""
+        joint's gravity, muscle, external and net torques."""
         cols = {"t_s": self.t_s, "theta_rad": self.theta_rad, "omega_rad_s": self.omega_rad_s, "mode": self.mode}
         for m in self.muscles:
             cols.update({f"{m}.{q}": self.muscle(m, q) for q in MUSCLE_COLUMNS})
-        cols.update({k: self.signals[f"joint.{k}"] for k in ("tau_gravity_Nm", "tau_muscles_Nm", "tau_net_Nm")})
+        cols.update({k: self.signals[f"joint.{k}"] for k in ("tau_gravity_Nm", "tau_muscles_Nm", "tau_applied_Nm",
+                                                                  "tau_net_Nm")})
         return cols
 
     def to_csv(self, path) -> None:

@@ -33,7 +33,10 @@ from typing import Any, Mapping
 
 from ..assemblies.joint import JointMuscle, joint_assembly
 from ..scenario import Scenario, ScenarioError
+from ..signal_tables import signal_from_table
+from ..signals import Constant
 from ..simulator import SolverOptions
+from ..table_checks import TableChecker
 
 JOINT_KEYS: dict[str, tuple[float | None, str]] = {
     "inertia_kg_m2": (None, "positive"), "link_mass_kg": (0.0, "non_negative"),
@@ -86,6 +89,8 @@ class JointScenario:
     duration_s: float
     solver: SolverOptions
     origin: str = "<dict>"
+    external_torque: Any = field(default=Constant(0.0), repr=False)
+    """The external torque on the link [N m], a signal of time (``[joint.external_torque]``; default none)."""
 
     @classmethod
     def from_dict(cls, spec: Mapping[str, Any], origin: str = "<dict>", base_dir: str | Path = ".") -> "JointScenario":
@@ -100,14 +105,18 @@ class JointScenario:
             _fail(origin, "name", name, "must be a name made of letters, digits and _")
         duration = _number(origin, "simulation.duration_s", sim.get("duration_s", 5.0), "positive")
         rate = _number(origin, "simulation.sample_rate_Hz", sim.get("sample_rate_Hz", 1000.0), "positive")
-        joint = _joint(origin, spec.get("joint"))
+        joint_table = dict(_table(origin, "joint", spec.get("joint", {})))
+        torque = joint_table.pop("external_torque", None)
+        joint = _joint(origin, joint_table if "joint" in spec else None)
+        external = (signal_from_table(TableChecker(origin, ScenarioError), "joint.external_torque", torque, "_Nm", 1.0,
+                                      Path(base_dir)) if torque is not None else Constant(0.0))
         solver = _table(origin, "solver", spec.get("solver", {}))
         for key in sorted(set(solver) - SOLVER_KEYS):
             _fail(origin, f"solver.{key}", solver[key], f"unknown key; [solver] has {sorted(SOLVER_KEYS)}")
         shared = {"solver": solver, "simulation": {"duration_s": duration, "sample_rate_Hz": rate}}
         muscles = _muscles(origin, spec.get("muscle"), shared, Path(base_dir))
         # Each muscle's one-muscle scenario has read the [solver] table, with its checks and messages.
-        scenario = cls(name, spec, joint, muscles, duration, muscles[0][1].solver, origin)
+        scenario = cls(name, spec, joint, muscles, duration, muscles[0][1].solver, origin, external)
         scenario._check_limits()
         return scenario
 

@@ -7,9 +7,9 @@ import math
 import time
 from collections.abc import Mapping
 
-import numpy as np
 
 from ..modeling.pygen import outputs_by_mode
+from ..signals import max_step_hint_s
 from ..simulator import GeneratedCode, HybridRun
 from .result import JointEvent, JointResult
 from .scenario import JointScenario
@@ -17,14 +17,25 @@ from .scenario import JointScenario
 
 class JointInputs:
     """The joint model's inputs at a time: each muscle's pressure source's, in the assembly's order, then
-    the external torque (none yet: zero)."""
+    the external torque (a signal of time)."""
 
-    def __init__(self, sources):
-        self.sources = sources
+    def __init__(self, sources, external_torque):
+        self.sources, self.external_torque = sources, external_torque
 
     def __call__(self, t):
-        out = [v for s in self.sources for v in s.inputs(t)]
-        return [*out, 0.0 * np.asarray(t, dtype=float) if np.ndim(t) else 0.0]
+        return [*(v for s in self.sources for v in s.inputs(t)), self.external_torque(t)]
+
+    @classmethod
+    def of(cls, scenario: JointScenario, muscles=None) -> "JointInputs":
+        """The inputs of ``scenario`` (its muscles from :meth:`JointScenario.joint_muscles` if not given)."""
+        return cls([m.source for m in muscles or scenario.joint_muscles()], scenario.external_torque)
+
+
+ENERGY_SCALE_J = 1e-3
+"""Absolute tolerance scale of a joint run's energy states [J] (the integrator's atol is rtol times it).
+Assumed: a finger-sized joint turns through its range with millijoules (the shipped pair's largest term
+is 11 mJ); the components' own scale, 0.1 J, is the hanging load's, and would leave these energies
+balanced only to a few 1e-4 of themselves at rtol 1e-6."""
 
 
 class SampledSignals(Mapping):
@@ -64,10 +75,11 @@ def joint_run(scenario: JointScenario) -> tuple[HybridRun, list[str]]:
     muscles = scenario.joint_muscles()
     assembly = scenario.assembly()
     flat = assembly.flatten()
-    inputs = JointInputs([m.source for m in muscles])
-    gen = GeneratedCode(assembly, "joint", inputs, [v.nominal for v in flat.states])
-    breaks = tuple(b for m in muscles for b in m.source.breakpoints)
-    longest = min([getattr(m.source, "max_input_step_s", math.inf) for m in muscles])
+    inputs = JointInputs.of(scenario, muscles)
+    gen = GeneratedCode(assembly, "joint", inputs, [ENERGY_SCALE_J if v.unit == "J" else v.nominal for v in flat.states])
+    breaks = tuple(b for m in muscles for b in m.source.breakpoints) + tuple(scenario.external_torque.breakpoints)
+    longest = min([getattr(m.source, "max_input_step_s", math.inf) for m in muscles]
+                  + [max_step_hint_s(scenario.external_torque)])
     return HybridRun(gen, scenario.duration_s, scenario.solver, breaks, longest, None), [m.name for m in muscles]
 
 
