@@ -332,3 +332,73 @@ def test_co_contraction_shrinks_the_deflection_under_the_same_torque():
     assert peaks[0] == 0.0 and peaks[1] > peaks[2] > peaks[3] > 0.05
     # 38 events and four pressure steps at rtol 1e-6: within the one-muscle rig's bound (1e-3), by far
     assert res.energy_balance()["relative"] < 1e-4 and res.energy_balance()["W_external_J"] > 0.007
+
+
+def prescribed_pair(p_bar=(2.0, 2.0)) -> JointScenario:
+    spec = copy.deepcopy(PAIR)
+    for table, p in zip(spec["muscle"], p_bar):
+        table["pressure"] = {"source": "prescribed", "prescribed": {"kind": "constant", "value_gauge_bar": p}}
+    return JointScenario.from_dict(spec)
+
+
+@pytest.mark.parametrize("p_bar", [(2.0, 2.0), (2.5, 2.0), (3.0, 3.4)])
+def test_the_mimo_linearisation_agrees_with_finite_differences(p_bar):
+    """A, B against central differences of the generated right-hand side (Coulomb terms dropped), C, D
+    against those of the angle and of JointStatics' exact stiffness, to 1e-6 relative; and the angle row
+    of A is -k / J, the statics' stiffness over the inertia."""
+    from pamsim.joints.linear import linearize_joint
+
+    scenario = prescribed_pair()
+    p = [v * BAR for v in p_bar]
+    lm = linearize_joint(scenario, p)
+    assert lm.states == ("joint.theta_rad", "joint.omega_rad_s") and lm.outputs[1] == "joint.k_Nm_per_rad"
+    statics = JointStatics(scenario)
+    J = PAIR["joint"]["inertia_kg_m2"]
+    assert lm.A[1, 0] == pytest.approx(-statics.stiffness_Nm_per_rad(lm.theta0_rad, p) / J, rel=1e-12)
+    assert lm.k0_Nm_per_rad == pytest.approx(statics.equilibrium(p).k_Nm_per_rad, rel=1e-12)
+    flat = scenario.assembly().flatten()
+    g = flat.compile_python()
+    params = [0.0 if v.name == "joint.tau_coulomb_Nm" or v.name.split(".")[0].endswith("_friction") else value
+              for v, value in zip(flat.parameters, flat.parameter_values)]
+    names = [v.name for v in flat.states]
+    rows = [names.index(s) for s in lm.states]
+
+    def f(theta, omega, u):
+        x = [0.0] * len(names)
+        x[rows[0]], x[rows[1]] = theta, omega
+        return np.array(g.f(x, list(u), params, [1.0])[0])[rows]
+
+    u0 = np.array([*p, 0.0])
+    for j, h in enumerate((1e-6, 1e-4)):
+        z = [lm.theta0_rad, 0.0]
+        zp, zm = list(z), list(z)
+        zp[j] += h
+        zm[j] -= h
+        fd = (f(*zp, u0) - f(*zm, u0)) / (2 * h)
+        np.testing.assert_allclose(lm.A[:, j], fd, rtol=1e-6, atol=1e-9 * np.max(np.abs(lm.A)))
+    for j, h in enumerate((10.0, 10.0, 1e-6)):
+        du = np.zeros(3)
+        du[j] = h
+        fd = (f(lm.theta0_rad, 0.0, u0 + du) - f(lm.theta0_rad, 0.0, u0 - du)) / (2 * h)
+        np.testing.assert_allclose(lm.B[:, j], fd, rtol=1e-6, atol=1e-12)
+    h = 1e-5
+    k_fd = (statics.stiffness_Nm_per_rad(lm.theta0_rad + h, p) - statics.stiffness_Nm_per_rad(lm.theta0_rad - h, p)) / (2 * h)
+    assert lm.C[1, 0] == pytest.approx(k_fd, rel=1e-6) and lm.C[0, 0] == 1.0 and lm.C[1, 1] == 0.0
+    for j in range(2):
+        dp = [0.0, 0.0]
+        dp[j] = 10.0
+        up = [a + b for a, b in zip(p, dp)]
+        down = [a - b for a, b in zip(p, dp)]
+        k_fd = (statics.stiffness_Nm_per_rad(lm.theta0_rad, up) - statics.stiffness_Nm_per_rad(lm.theta0_rad, down)) / 20.0
+        assert lm.D[1, j] == pytest.approx(k_fd, rel=1e-6)
+    assert lm.to_control().output_labels == ["joint_theta_rad", "joint_k_Nm_per_rad"]
+
+
+def test_a_joint_on_valves_or_on_a_limit_is_not_linearised():
+    from pamsim.errors import InputError
+    from pamsim.joints.linear import linearize_joint
+
+    with pytest.raises(InputError, match="muscle 'flexor': pressure.source = 'valve'"):
+        linearize_joint(load_joint_scenario(PAIR_FILE), [2e5, 2e5])
+    with pytest.raises(InputError, match="rests on its upper limit"):
+        linearize_joint(prescribed_pair(), [4e5, 1e5])

@@ -14,7 +14,6 @@ rig's: a valve and chamber, a prescribed pressure), its components named after i
 
 from __future__ import annotations
 
-import copy
 from dataclasses import dataclass
 from typing import Any
 
@@ -22,7 +21,7 @@ from ..components import CoulombFriction, MuscleStaticForce, ViscousDamping
 from ..components.pulley import Pulley
 from ..components.rotary_joint import RotaryJoint
 from ..modeling import Assembly
-from .one_muscle import SourceParts, source_parts
+from .one_muscle import rewired, source_parts
 
 @dataclass(frozen=True)
 class JointMuscle:
@@ -65,7 +64,7 @@ def joint_assembly(joint_values: dict, muscles: tuple[JointMuscle, ...], g_m_s2:
 def _muscle_parts(m: JointMuscle, g_m_s2: float) -> tuple[list, list, dict]:
     """A muscle's components, wiring and model inputs, its components prefixed with its name."""
     pulley = f"{m.name}_pulley"
-    source = _prefixed(source_parts(m.source, m.p0_gauge_Pa), m.name, pulley)
+    source = rewired(source_parts(m.source, m.p0_gauge_Pa), pulley, m.name)
     parts = [*source.parts, MuscleStaticForce(f"{m.name}_muscle", m.static_force),
              CoulombFriction(f"{m.name}_friction", m.friction), ViscousDamping(f"{m.name}_damping", m.damping),
              Pulley(pulley, {"radius_m": m.radius_m, "side": m.side, "x_at_zero_m": m.x_at_zero_m, "g_m_s2": g_m_s2})]
@@ -80,24 +79,3 @@ def _muscle_parts(m: JointMuscle, g_m_s2: float) -> tuple[list, list, dict]:
               (f"{m.name}_muscle.F_static_N", f"{pulley}.F_static_N"), ("joint.slip_direction", f"{pulley}.joint_direction")]
     inputs = {f"{m.name}.{k}": v for k, v in source.inputs.items()}
     return parts, wiring, inputs
-
-
-def _prefixed(source: SourceParts, prefix: str, node: str) -> SourceParts:
-    """``source``'s parts renamed ``<prefix>_<name>``, its wiring and inputs with them, and what it
-    read from the rig's load read from ``node`` instead."""
-    names = {c.name: f"{prefix}_{c.name}" for c in source.parts}
-    parts = []
-    for c in source.parts:
-        renamed = copy.copy(c)
-        renamed.name = names[c.name]
-        parts.append(renamed)
-
-    def ref(r: str) -> str:
-        owner, _, rest = r.partition(".")
-        if owner == "load":
-            return f"{node}.{rest}"
-        return f"{names.get(owner, owner)}.{rest}"
-
-    wiring = [(ref(a), ref(b)) for a, b in source.wiring]
-    inputs = {k: tuple(ref(v) for v in ((vs,) if isinstance(vs, str) else vs)) for k, vs in source.inputs.items()}
-    return SourceParts(parts, wiring, {k: v[0] if len(v) == 1 else v for k, v in inputs.items()}, names[source.pressure])

@@ -12,6 +12,7 @@ Model inputs: ``valve_command`` and ``supply_pressure_gauge_Pa`` (valve source) 
 
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass
 from typing import Any, Callable
 
@@ -128,6 +129,28 @@ def source_parts(src, p0_gauge_Pa: float | None) -> SourceParts:
             return SOURCE_PARTS[cls](src, p0_gauge_Pa)
     raise TypeError(f"no components for the pressure source {type(src).__name__} "
                     f"(pamsim.assemblies.one_muscle.register_source names them)")
+
+
+def rewired(source: SourceParts, node: str, prefix: str = "") -> SourceParts:
+    """``source``'s parts reading from component ``node`` what they read from the rig's load (its
+    ``x_m`` and ``v_m_s``), renamed ``<prefix>_<name>`` if ``prefix`` is given, with their wiring and
+    inputs."""
+    names = {c.name: f"{prefix}_{c.name}" if prefix else c.name for c in source.parts}
+    parts = []
+    for c in source.parts:
+        renamed = copy.copy(c)
+        renamed.name = names[c.name]
+        parts.append(renamed)
+
+    def ref(r: str) -> str:
+        owner, _, rest = r.partition(".")
+        if owner == "load":
+            return f"{node}.{rest}"
+        return f"{names.get(owner, owner)}.{rest}"
+
+    wiring = [(ref(a), ref(b)) for a, b in source.wiring]
+    inputs = {k: tuple(ref(v) for v in ((vs,) if isinstance(vs, str) else vs)) for k, vs in source.inputs.items()}
+    return SourceParts(parts, wiring, {k: v[0] if len(v) == 1 else v for k, v in inputs.items()}, names[source.pressure])
 
 
 def input_signals(model) -> dict:

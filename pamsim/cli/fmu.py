@@ -37,6 +37,10 @@ def register(sub) -> None:
                    help="with --scenario: the FMU generated from the scenario's assembly of components (structured "
                         "names such as load.x_m, exact directional derivatives), as a scenario that adds components "
                         "always gets, rather than the one-muscle FMU with its own variable names")
+    b.add_argument("--muscle-only", action="store_true",
+                   help="with --scenario: the muscle alone, its length and lengthening velocity inputs (length_m, "
+                        "lengthening_velocity_m_s) and its force an output (motion.F_N), for an importer that owns "
+                        "the mechanics; the scenario gives the muscle, its model and its pressure source")
     b.set_defaults(func=run_build)
 
 
@@ -85,6 +89,8 @@ def run_build(args: argparse.Namespace) -> int:
         scenario = load_any_scenario(Path(args.scenario))
         if is_joint(scenario):
             return _build_joint(scenario, args)
+        if args.muscle_only:
+            return _build_muscle_only(scenario, args)
         if scenario.added_components or args.generated or "controller" in scenario.spec:
             return _build_assembly(scenario, args)
     preset = _preset(args, scenario, by_muscle)
@@ -104,6 +110,16 @@ def _build_joint(scenario, args: argparse.Namespace) -> int:
     return 0
 
 
+def _build_muscle_only(scenario, args: argparse.Namespace) -> int:
+    """The muscle-only FMU of a one-muscle scenario (:mod:`pamsim.fmu.muscle_only`)."""
+    from ..fmu.muscle_only import build_muscle_only
+
+    path = build_muscle_only(scenario, args.output, int(args.fmi))
+    print(f"wrote {path} (FMI {args.fmi}.0, Model Exchange and Co-Simulation, the muscle of scenario {scenario.name} "
+          "alone: inputs length_m and lengthening_velocity_m_s, its force the output motion.F_N)")
+    return 0
+
+
 def _check_options(args: argparse.Namespace) -> bool:
     """Refuse an FMI version other than 2 or 3 and options that do not go together, in this order; return
     whether the FMU is built for a muscle (``--muscle``, ``--static-force`` or ``--static-force-variant``)."""
@@ -115,6 +131,8 @@ def _check_options(args: argparse.Namespace) -> bool:
     if by_muscle and args.muscle is None:
         given = "--static-force" if args.static_force is not None else "--static-force-variant"
         raise InputError(f"--muscle: needed with {given}")
+    if args.muscle_only and not args.scenario:
+        raise InputError("--muscle-only: needs --scenario (its muscle, model and pressure source)")
     if args.generated and not args.scenario:
         raise InputError("--generated: needs --scenario (the FMU is generated from the scenario's assembly)")
     return by_muscle

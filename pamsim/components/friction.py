@@ -5,10 +5,17 @@ friction holds whatever it must)."""
 from __future__ import annotations
 
 from ..modeling import TRANSLATIONAL, Component, Equations, Port, Symbols, Var
+from ..modeling.smath import fmax
 from .element import ElementParameters
 
 PROBE_POINTS = tuple((x, p, m) for x in (0.0, 0.01, 0.04) for p in (0.0, 1e5, 4e5) for m in (0.5, 2.0, 8.0))
 """Contractions [m], gauge pressures [Pa] and load masses [kg] at which a law's symbolic form is checked."""
+
+
+def equivalent_mass_kg(F_static_N, g_m_s2):
+    """The load a muscle holds, as the load-dependent friction law reads it: the mass whose weight is its
+    static force, ``max(F_static, 0) / g`` (pamsim's choice where the load is not a hanging mass)."""
+    return fmax(F_static_N, 0.0) / g_m_s2
 
 
 def _level_N(element, x_m, p_gauge_Pa, mass_kg):

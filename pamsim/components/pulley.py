@@ -11,7 +11,8 @@ step control resolves, not events.
 from __future__ import annotations
 
 from ..modeling import ROTATIONAL, TRANSLATIONAL, Component, Equations, Port, Symbols, Var, positive
-from ..modeling.smath import fmax, if_else
+from ..modeling.smath import if_else
+from .friction import equivalent_mass_kg
 
 
 class Pulley(Component):
@@ -55,7 +56,7 @@ class Pulley(Component):
             der={"W_tendon_J": T * v},
             outputs={"x_m": x, "v_m_s": v, "F_tendon_N": T, "tau_Nm": arm * T, "taut": if_else(taut, 1.0, 0.0),
                      "direction": P["side"] * s.u["joint_direction"],
-                     "load_mass_kg": fmax(s.u["F_static_N"], 0.0) / P["g_m_s2"]},
+                     "load_mass_kg": equivalent_mass_kg(s.u["F_static_N"], P["g_m_s2"])},
             port={"flange": {"x_m": x, "v_m_s": v},
                   "shaft": {"tau_Nm": arm * T, "tau_level_Nm": if_else(taut, P["radius_m"] * s.u["friction_level_N"], 0.0)}},
             initial={"W_tendon_J": 0.0})

@@ -1,0 +1,122 @@
+"""A joint's linear model about its equilibrium at given muscle pressures: the MIMO system from the
+muscles' pressure inputs to the joint angle and the joint's stiffness.
+
+The model is the joint's own flat model with its Coulomb terms dropped (the bearing's and the muscles':
+they have no derivative at rest, as the one-muscle ``linearize`` drops them by default), written for a
+link that moves (its angular velocity is a state) and differentiated exactly by CasADi.  The states are
+the integrated ones (the work integrals, which nothing reads, are left out); the inputs each muscle's
+prescribed gauge pressure and the external torque; the outputs the angle and the stiffness
+``k = -d tau_net / d theta`` at rest, whose own derivatives are CasADi's second derivatives of the net
+torque.  A muscle fed by a valve is refused: its chamber at rest sits where the valve's flow has no
+derivative (a pressure ratio of 1).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from ..assemblies.joint import joint_assembly
+from ..components.stick_slip import BodyMode
+from ..elements.pressure_source import PrescribedPressure
+from ..errors import InputError
+from ..signals import Constant
+from .scenario import JointScenario
+from .static import JointStatics
+
+
+@dataclass(frozen=True)
+class JointLinearModel:
+    """``dx/dt = A dx + B du``, ``dy = C dx + D du`` about ``theta0_rad`` at pressures ``p0_gauge_Pa``.
+
+    ``states``, ``inputs`` and ``outputs`` name the rows and columns (outputs: ``joint.theta_rad`` and
+    ``joint.k_Nm_per_rad``); ``k0_Nm_per_rad`` is the stiffness at the operating point.
+    """
+
+    A: np.ndarray
+    B: np.ndarray
+    C: np.ndarray
+    D: np.ndarray
+    states: tuple[str, ...]
+    inputs: tuple[str, ...]
+    outputs: tuple[str, ...]
+    theta0_rad: float
+    p0_gauge_Pa: tuple[float, ...]
+    k0_Nm_per_rad: float
+
+    def poles(self) -> np.ndarray:
+        """The eigenvalues of ``A`` [1/s]."""
+        return np.linalg.eigvals(self.A)
+
+    def to_control(self):
+        """The model as a python-control ``StateSpace`` with named states, inputs and outputs (python-control
+        allows no ``.`` in a name: ``joint.theta_rad`` is ``joint_theta_rad`` there)."""
+        import control
+
+        plain = lambda names: [n.replace(".", "_") for n in names]  # noqa: E731
+        return control.ss(self.A, self.B, self.C, self.D, states=plain(self.states), inputs=plain(self.inputs),
+                          outputs=plain(self.outputs))
+
+
+def _prescribed(scenario: JointScenario):
+    """The joint's muscles with constant prescribed pressures, refusing a muscle fed by a valve."""
+    muscles = scenario.joint_muscles()
+    for m in muscles:
+        if not isinstance(m.source, PrescribedPressure):
+            raise InputError(f"{scenario.origin}: muscle {m.name!r}: pressure.source = {m.source.name!r}: a joint is "
+                             "linearised with each muscle's pressure prescribed (a valve's flow has no derivative "
+                             "at rest); give it a prescribed pressure")
+    return tuple(replace(m, source=PrescribedPressure(Constant(0.0))) for m in muscles)
+
+
+def linearize_joint(scenario: JointScenario, p_gauge_Pa) -> JointLinearModel:
+    """The linear model of ``scenario``'s joint about its equilibrium at the muscles' gauge pressures
+    ``p_gauge_Pa`` (in the scenario's muscle order).
+
+    Raises
+    ------
+    InputError
+        A muscle fed by a valve, pressures that push the link onto a limit (no equilibrium inside), or a
+        static force without a symbolic form.
+    """
+    import casadi as ca
+
+    muscles = _prescribed(scenario)
+    eq = JointStatics(scenario).equilibrium(p_gauge_Pa)
+    if eq.on_limit:
+        raise InputError(f"{scenario.origin}: at {[p / 1e5 for p in p_gauge_Pa]} bar the link rests on its "
+                         f"{eq.on_limit} limit: there is no equilibrium to linearise about")
+    assembly = joint_assembly(scenario.joint_values(), muscles, scenario.joint["g_m_s2"], name=scenario.name)
+    moving, held = (assembly.flatten({"joint": int(m)}) for m in (BodyMode.SLIP_UP, BodyMode.STICK))
+    if moving.externals:
+        raise InputError(f"{scenario.origin}: a static force without a symbolic form cannot be linearised exactly")
+    p = np.array(moving.parameter_values, dtype=float)
+    for k, v in enumerate(moving.parameters):  # the Coulomb terms: the bearing's and every muscle's friction
+        if v.name == "joint.tau_coulomb_Nm" or v.name.split(".")[0].endswith("_friction"):
+            p[k] = 0.0
+    keep = [i for i in range(len(moving.states)) if i not in moving.quadratures()]
+    x, u = ca.vertcat(*moving.x), ca.vertcat(*moving.u)
+    xs = ca.vertcat(*[moving.x[i] for i in keep])
+    f = ca.vertcat(*[moving.f[i] for i in keep])
+    out = [v.name for v in held.outputs]
+    theta = moving.x[[v.name for v in moving.states].index("joint.theta_rad")]
+    tau = held.y[out.index("joint.tau_net_Nm")]
+    tau = ca.substitute(tau, ca.vertcat(*held.x, *held.u, *held.p), ca.vertcat(x, u, *moving.p))
+    k = -ca.jacobian(tau, theta)
+    y = ca.vertcat(theta, k)
+    fn = ca.Function("lin", [x, u, ca.vertcat(*moving.p)],
+                     [ca.jacobian(f, xs), ca.jacobian(f, u), ca.jacobian(y, xs), ca.jacobian(y, u), k])
+    x0 = _operating_state(moving, eq.theta_rad)
+    u0 = [float(v) for v in p_gauge_Pa] + [0.0]
+    A, B, C, D, k0 = (np.array(m, dtype=float) for m in fn(x0, u0, p))
+    return JointLinearModel(A, B, C, D, tuple(moving.states[i].name for i in keep), tuple(v.name for v in moving.inputs),
+                            ("joint.theta_rad", "joint.k_Nm_per_rad"), eq.theta_rad,
+                            tuple(float(v) for v in p_gauge_Pa), float(k0.item()))
+
+
+def _operating_state(flat, theta_rad: float) -> list[float]:
+    """Every state at the operating point: the link at ``theta_rad`` at rest, the work integrals zero."""
+    x0 = [0.0] * len(flat.states)
+    x0[[v.name for v in flat.states].index("joint.theta_rad")] = theta_rad
+    return x0
