@@ -402,3 +402,21 @@ def test_a_joint_on_valves_or_on_a_limit_is_not_linearised():
         linearize_joint(load_joint_scenario(PAIR_FILE), [2e5, 2e5])
     with pytest.raises(InputError, match="rests on its upper limit"):
         linearize_joint(prescribed_pair(), [4e5, 1e5])
+
+
+def test_pamsim_linearize_a_joint_prints_the_mimo_model():
+    """``pamsim linearize`` on a joint scenario with prescribed pressures: the model about the equilibrium at
+    the final pressures (pair_cocontraction: 4 bar on both, the link at zero), as JSON; the stiffness is the
+    statics'; on valves it exits 2 naming the muscle."""
+    import json
+
+    done = subprocess.run([sys.executable, "-m", "pamsim", "linearize", str(ROOT / "scenarios" / "pair_cocontraction.toml"),
+                           "--json"], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    rep = json.loads(done.stdout)
+    scenario = load_joint_scenario(ROOT / "scenarios" / "pair_cocontraction.toml")
+    assert rep["p0_gauge_Pa"] == [4e5, 4e5] and rep["theta0_rad"] == 0.0
+    assert rep["k0_Nm_per_rad"] == pytest.approx(JointStatics(scenario).equilibrium([4e5, 4e5]).k_Nm_per_rad, rel=1e-12)
+    assert rep["inputs"][:2] == ["flexor.prescribed_pressure_gauge_Pa", "extensor.prescribed_pressure_gauge_Pa"]
+    again = subprocess.run([sys.executable, "-m", "pamsim", "linearize", str(PAIR_FILE)], capture_output=True, text=True)
+    assert again.returncode == 2 and "muscle 'flexor': pressure.source = 'valve'" in again.stderr

@@ -96,10 +96,12 @@ def run(args: argparse.Namespace) -> int:
     figures (as JSON with ``--json``) and write the Bode and pole-zero plots (not with ``--json`` alone,
     without ``-o``); exit code 0.
     """
-    from ..scenario import load_scenario
+    from .run import is_joint, load_any_scenario
 
     args.figures = figure_args.options(args)
-    scenario = load_scenario(args.scenario)
+    scenario = load_any_scenario(Path(args.scenario))
+    if is_joint(scenario):
+        return _linearize_joint(scenario, args)
     if args.json and args.output is None:  # the numbers only: no file written, nothing on stderr
         print(json.dumps(_linearize(scenario, args)[1], indent=2))
         return 0
@@ -112,6 +114,40 @@ def run(args: argparse.Namespace) -> int:
         return 0
     _print_text(lin, rep)
     print(wrote)
+    return 0
+
+
+def _linearize_joint(scenario, args: argparse.Namespace) -> int:
+    """Muscles on a joint: the MIMO model about the equilibrium at the muscles' prescribed pressures at the
+    end of the run (:func:`pamsim.joints.linear.linearize_joint`); printed, or as JSON with ``--json``."""
+    import numpy as np
+
+    from ..errors import InputError
+    from ..joints.linear import linearize_joint
+
+    for flag, value in (("--at-time", args.at_time), ("--contraction-mm", args.contraction_mm), ("-o", args.output)):
+        if value is not None:
+            raise InputError(f"{flag}: a joint is linearised about its equilibrium at the muscles' final "
+                             "pressures; this option is for one muscle")
+    pressures = [float(np.asarray(m.source.inputs(scenario.duration_s)[0])) if hasattr(m.source, "p_gauge_Pa") else 0.0
+                 for m in scenario.joint_muscles()]
+    lm = linearize_joint(scenario, pressures)
+    rep = {"A": _matrix(lm.A), "B": _matrix(lm.B), "C": _matrix(lm.C), "D": _matrix(lm.D), "states": list(lm.states),
+           "inputs": list(lm.inputs), "outputs": list(lm.outputs), "poles": [_complex(z) for z in lm.poles()],
+           "theta0_rad": lm.theta0_rad, "p0_gauge_Pa": list(lm.p0_gauge_Pa), "k0_Nm_per_rad": lm.k0_Nm_per_rad,
+           "friction": "Coulomb friction dropped (the bearing's and the muscles': no linearisation at rest)"}
+    if args.json:
+        print(json.dumps(rep, indent=2))
+        return 0
+    np.set_printoptions(precision=6, linewidth=140)
+    print(f"operating point: the joint at rest at {lm.theta0_rad:.6g} rad, muscles at "
+          + ", ".join(f"{p / 1e5:g} bar" for p in lm.p0_gauge_Pa) + f"; stiffness {lm.k0_Nm_per_rad:.6g} N m/rad")
+    print(f"friction: {rep['friction']}")
+    for key in ("states", "inputs", "outputs"):
+        print(f"{key + ':':8} {', '.join(rep[key])}")
+    for key in ("A", "B", "C", "D"):
+        print(f"{key} =\n{np.array(rep[key])}")
+    print("poles [1/s]: " + ", ".join(f"{re:.6g}{im:+.6g}j" for re, im in rep["poles"]))
     return 0
 
 

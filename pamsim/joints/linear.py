@@ -80,8 +80,6 @@ def linearize_joint(scenario: JointScenario, p_gauge_Pa) -> JointLinearModel:
         A muscle fed by a valve, pressures that push the link onto a limit (no equilibrium inside), or a
         static force without a symbolic form.
     """
-    import casadi as ca
-
     muscles = _prescribed(scenario)
     eq = JointStatics(scenario).equilibrium(p_gauge_Pa)
     if eq.on_limit:
@@ -91,28 +89,38 @@ def linearize_joint(scenario: JointScenario, p_gauge_Pa) -> JointLinearModel:
     moving, held = (assembly.flatten({"joint": int(m)}) for m in (BodyMode.SLIP_UP, BodyMode.STICK))
     if moving.externals:
         raise InputError(f"{scenario.origin}: a static force without a symbolic form cannot be linearised exactly")
-    p = np.array(moving.parameter_values, dtype=float)
-    for k, v in enumerate(moving.parameters):  # the Coulomb terms: the bearing's and every muscle's friction
-        if v.name == "joint.tau_coulomb_Nm" or v.name.split(".")[0].endswith("_friction"):
-            p[k] = 0.0
     keep = [i for i in range(len(moving.states)) if i not in moving.quadratures()]
-    x, u = ca.vertcat(*moving.x), ca.vertcat(*moving.u)
-    xs = ca.vertcat(*[moving.x[i] for i in keep])
-    f = ca.vertcat(*[moving.f[i] for i in keep])
-    out = [v.name for v in held.outputs]
-    theta = moving.x[[v.name for v in moving.states].index("joint.theta_rad")]
-    tau = held.y[out.index("joint.tau_net_Nm")]
-    tau = ca.substitute(tau, ca.vertcat(*held.x, *held.u, *held.p), ca.vertcat(x, u, *moving.p))
-    k = -ca.jacobian(tau, theta)
-    y = ca.vertcat(theta, k)
-    fn = ca.Function("lin", [x, u, ca.vertcat(*moving.p)],
-                     [ca.jacobian(f, xs), ca.jacobian(f, u), ca.jacobian(y, xs), ca.jacobian(y, u), k])
     x0 = _operating_state(moving, eq.theta_rad)
     u0 = [float(v) for v in p_gauge_Pa] + [0.0]
-    A, B, C, D, k0 = (np.array(m, dtype=float) for m in fn(x0, u0, p))
+    A, B, C, D, k0 = (np.array(m, dtype=float) for m in _jacobians(moving, held, keep)(x0, u0, _without_coulomb(moving)))
     return JointLinearModel(A, B, C, D, tuple(moving.states[i].name for i in keep), tuple(v.name for v in moving.inputs),
                             ("joint.theta_rad", "joint.k_Nm_per_rad"), eq.theta_rad,
                             tuple(float(v) for v in p_gauge_Pa), float(k0.item()))
+
+
+def _without_coulomb(flat) -> np.ndarray:
+    """``flat``'s parameter values with the Coulomb terms zero: the bearing's and every muscle's friction."""
+    p = np.array(flat.parameter_values, dtype=float)
+    for k, v in enumerate(flat.parameters):
+        if v.name == "joint.tau_coulomb_Nm" or v.name.split(".")[0].endswith("_friction"):
+            p[k] = 0.0
+    return p
+
+
+def _jacobians(moving, held, keep: list[int]):
+    """CasADi function of (x, u, p): df/dx and df/du of the moving link's states ``keep``, d/dx and d/du of
+    the outputs (angle, stiffness at rest), and the stiffness itself."""
+    import casadi as ca
+
+    x, u, p = ca.vertcat(*moving.x), ca.vertcat(*moving.u), ca.vertcat(*moving.p)
+    xs, f = ca.vertcat(*[moving.x[i] for i in keep]), ca.vertcat(*[moving.f[i] for i in keep])
+    theta = moving.x[[v.name for v in moving.states].index("joint.theta_rad")]
+    tau = held.y[[v.name for v in held.outputs].index("joint.tau_net_Nm")]
+    tau = ca.substitute(tau, ca.vertcat(*held.x, *held.u, *held.p), ca.vertcat(x, u, p))  # one set of symbols
+    k = -ca.jacobian(tau, theta)
+    y = ca.vertcat(theta, k)
+    return ca.Function("joint_linear", [x, u, p],
+                       [ca.jacobian(f, xs), ca.jacobian(f, u), ca.jacobian(y, xs), ca.jacobian(y, u), k])
 
 
 def _operating_state(flat, theta_rad: float) -> list[float]:
