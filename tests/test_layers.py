@@ -21,7 +21,7 @@ EXPECTED_LAYERS = [
     "__main__",
     "cli",
     "api",
-    "sweep | identification | control | atlas | export | envs",
+    "sweep | identification | control | atlas | export | envs | coupling",
     "backends | joints",
     "native",
     "fmu",

@@ -1,0 +1,84 @@
+"""pamsim muscles driving a MuJoCo hinge, against pamsim's own joint model.
+
+The coupling is explicit (each muscle's force over a MuJoCo step is the one its pneumatics reach at the
+step's end, from the length at its start) and MuJoCo's Euler integration is first order: both errors
+shrink in proportion to the time step dt.  The tolerance follows from that: for a first-order method
+e(dt) = C dt + O(dt^2), so e(dt) - e(dt/2) = C dt / 2 and e(dt) ~ 2 |theta(dt) - theta(dt/2)|, the
+Richardson estimate from the two runs.  The test holds the error against pamsim's own run (native, rtol
+1e-9) to 1.5 times that estimate, and checks the order itself: halving dt must at least cut the error by
+a third.  The shipped pair's bearing has no Coulomb friction here and its muscles none either: MuJoCo's
+friction is a soft constraint, pamsim's an exact stick/slip, and they differ by design.
+"""
+
+from __future__ import annotations
+
+import copy
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from pamsim.errors import InputError
+from pamsim.joints import JointScenario, simulate_joint
+
+mujoco = pytest.importorskip("mujoco", reason="the optional extra pamsim[mujoco] (installed by the test extra)")
+from pamsim.coupling.mujoco import CoupledMuscle, MujocoMuscles, joint_mjcf, joint_muscles  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[1]
+PAIR = tomllib.loads((ROOT / "scenarios" / "antagonistic_pair.toml").read_text())
+
+
+def frictionless_pair() -> JointScenario:
+    spec = copy.deepcopy(PAIR)
+    spec["joint"]["tau_coulomb_Nm"] = 0.0
+    for table in spec["muscle"]:
+        table["model"] = dict(table["model"], friction="none")
+    return JointScenario.from_dict(spec)
+
+
+def mujoco_run(scenario, dt: float):
+    model = mujoco.MjModel.from_xml_string(joint_mjcf(scenario, dt))
+    data = mujoco.MjData(model)
+    coupled = MujocoMuscles(model, data, joint_muscles(scenario))
+    n = int(round(scenario.duration_s / dt))
+    t, theta = np.empty(n + 1), np.empty(n + 1)
+    t[0], theta[0] = 0.0, data.qpos[0]
+    for k in range(n):
+        coupled.mj_step()
+        t[k + 1], theta[k + 1] = data.time, data.qpos[0]
+    return t, theta, coupled
+
+
+def test_the_coupling_converges_to_pamsims_joint_at_first_order():
+    scenario = frictionless_pair()
+    reference = simulate_joint(JointScenario.from_dict({**copy.deepcopy(scenario.spec), "solver": {"rtol": 1e-9}}),
+                               "native")
+    dt = 2.5e-4
+    t1, th1, coupled = mujoco_run(scenario, dt)
+    t2, th2, _ = mujoco_run(scenario, dt / 2)
+    err1 = np.max(np.abs(th1 - np.interp(t1, reference.t_s, reference.theta_rad)))
+    err2 = np.max(np.abs(th2 - np.interp(t2, reference.t_s, reference.theta_rad)))
+    richardson = 2.0 * np.max(np.abs(th1 - th2[::2]))
+    assert err1 <= 1.5 * richardson, (err1, richardson)
+    assert err2 <= err1 / 1.5, (err1, err2)
+    assert err1 < 0.01  # rad, at dt = 0.25 ms: the transient's 12 Hz ringing at 0.3 rad
+    # at rest both balance the same torques: the static equilibrium
+    assert th1[-1] == pytest.approx(reference.theta_rad[-1], abs=1e-7)
+    for m in reference.muscles:
+        assert coupled.tension_N(m) == pytest.approx(reference.muscle(m, "F_tendon_N")[-1], rel=1e-6)
+        assert coupled.outputs(m)["chamber.p_gauge_Pa"] == pytest.approx(reference.muscle(m, "p_gauge_Pa")[-1], rel=1e-6)
+
+
+def test_a_missing_actuator_or_one_not_on_a_tendon_is_refused_by_name():
+    scenario = frictionless_pair()
+    model = mujoco.MjModel.from_xml_string(joint_mjcf(scenario))
+    data = mujoco.MjData(model)
+    table, sc = scenario.muscles[0]
+    with pytest.raises(InputError, match="muscle 'flexor': actuator = 'elbow': the MuJoCo model has no such actuator"):
+        MujocoMuscles(model, data, [CoupledMuscle("flexor", sc, "elbow", 0.28)])
+    joint_actuated = mujoco.MjModel.from_xml_string(
+        '<mujoco><worldbody><body><joint name="j" type="hinge"/><geom size=".1"/></body></worldbody>'
+        '<actuator><motor name="m" joint="j"/></actuator></mujoco>')
+    with pytest.raises(InputError, match="actuator = 'm': it does not act on a tendon"):
+        MujocoMuscles(joint_actuated, mujoco.MjData(joint_actuated), [CoupledMuscle("flexor", sc, "m", 0.28)])
