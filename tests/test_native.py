@@ -96,6 +96,32 @@ def test_other_element_choices_and_initial_state_match_the_python_backend():
         assert nat.energy_balance()["relative"] < 1e-3
 
 
+def test_exact_segments_against_a_hand_calculation():
+    """Every knot and lag start inside the run cuts it; each input's value at a piece's start and its change
+    over the piece (slope, lag amplitude, lag time constant) by hand; an input without a signal is zero."""
+    import math
+
+    from pamsim.native.backend import exact_segments
+    from pamsim.signals import FirstOrderLag, PiecewiseConstant, Ramp, Step
+
+    signals = (Step(1.0, 0.0, 1.0), None, Ramp(0.5, 1.5, 2.0, 4.0), FirstOrderLag(0.25, 1.0, 3.0, 0.1),
+               PiecewiseConstant((0.0, 0.75, 9.0), (5.0, -1.0, 7.0)))
+    starts, u, du = exact_segments(signals, 2.0)
+    assert starts.tolist() == [0.0, 0.25, 0.5, 0.75, 1.0, 1.5]  # 9 s is after the end
+    lag = [1.0, 1.0] + [3.0 - 2.0 * math.exp(-(t - 0.25) / 0.1) for t in (0.5, 0.75, 1.0, 1.5)]
+    ramp = [2.0, 2.0, 2.0, 2.5, 3.0, 4.0]
+    want_u = [[0.0, 0.0, 0.0, 0.0, 1.0, 1.0], [0.0] * 6, ramp, lag, [5.0, 5.0, 5.0, -1.0, -1.0, -1.0]]
+    assert u.dtype == float and u.shape == (6, 5)
+    for k, column in enumerate(want_u):
+        np.testing.assert_allclose(u[:, k], column, rtol=1e-15, atol=0.0)
+    amplitude = [0.0, -2.0] + [-2.0 * math.exp(-(t - 0.25) / 0.1) for t in (0.5, 0.75, 1.0, 1.5)]
+    np.testing.assert_allclose(du[:, 3, 1], amplitude, rtol=1e-15, atol=0.0)
+    assert du[:, 3, 2].tolist() == [0.0] + [0.1] * 5
+    assert du[:, 2, 0].tolist() == [0.0, 0.0, 2.0, 2.0, 2.0, 0.0]  # the ramp's slope over its pieces
+    assert not du[:, [0, 1, 4]].any() and not du[:, 2, 1:].any() and not du[:, 3, 0].any()
+    assert exact_segments((lambda t: t,), 1.0) is None  # a callable is held piecewise instead
+
+
 def test_hold_interval_of_the_piecewise_path():
     """Where inputs are held (a signal given as a Python callable), a 10 ms lag is held over pieces of at most tau / 10 and at most one output sample."""
     sc = pamsim.Scenario.from_dict({"load": {"weight_N": 22.74}, "simulation": {"duration_s": 4.0},

@@ -237,13 +237,13 @@ def exact_segments(signals, duration_s: float):
         if piece is not None:
             times = (piece.lag[0],) if piece.lag is not None else piece.knots_t_s
             bounds |= {float(t) for t in times if 0.0 < t < duration_s}
-    starts = np.array(sorted(bounds))
-    u, du = np.zeros((len(starts), len(pieces))), np.zeros((len(starts), len(pieces), 3))
-    for k, piece in enumerate(pieces):
-        for j, t0 in enumerate(starts.tolist() if piece is not None else ()):
-            u[j, k] = piece(t0)
-            du[j, k] = _change_after(piece, t0)
-    return starts, u, du
+    starts = sorted(bounds)
+    none = (0.0, (0.0, 0.0, 0.0))  # an input without a signal: nothing, and no change
+    # Rows built as lists and made arrays once: numpy costs more per element set than per array made.
+    rows = [[none if piece is None else (piece(t0), _change_after(piece, t0)) for piece in pieces] for t0 in starts]
+    u = np.array([[value for value, _ in row] for row in rows], dtype=float)
+    du = np.array([[change for _, change in row] for row in rows], dtype=float)
+    return np.array(starts), u, du
 
 
 def _change_after(piece, t0: float) -> tuple[float, float, float]:
