@@ -148,7 +148,7 @@ def needs_table(scenario: Scenario) -> bool:
 
 def in_c(assembly, name: str) -> bool:
     """Whether component ``name`` of ``assembly`` has generated C (written in symbols, or with a CasADi form)."""
-    c = next(c for c in assembly.components if c.name == name)
+    c = assembly.by_name[name]
     return c.has_c_form() if hasattr(c, "has_c_form") else getattr(c, "traces", True)
 
 
