@@ -122,6 +122,33 @@ def test_exact_segments_against_a_hand_calculation():
     assert exact_segments((lambda t: t,), 1.0) is None  # a callable is held piecewise instead
 
 
+def test_a_scenario_run_again_reuses_its_case_by_the_object_not_by_equality(monkeypatch):
+    """The case of a scenario's own model is kept for the scenario object: the same object finds it (its
+    arrays read-only), an equal scenario (another object) or a run with a model given builds its own, a
+    kept case whose scenario is gone is never handed to another that took its id, and the kept cases
+    are bounded."""
+    import weakref
+
+    from pamsim.native import backend
+
+    fig4 = pamsim.load_scenario(SCENARIOS / "acra2012_fig4.toml")
+    case = backend.case_inputs(fig4)
+    assert backend.case_inputs(fig4) is case
+    assert not case.segment_u.flags.writeable and not case.reals.flags.writeable
+    twin = fig4.with_changes({})
+    assert twin == fig4 and backend.case_inputs(twin) is not case
+    assert backend.case_inputs(fig4, fig4.build_model()) is not case
+    other = fig4.with_changes({"load": {"weight_N": 30.0}})
+    backend._cases[id(other)] = (weakref.ref(twin), case)  # as if `other` took a dead scenario's id
+    assert backend.case_inputs(other) is not case
+    assert backend.case_inputs(other).model.load.mass_kg == pytest.approx(30.0 / 9.81, rel=1e-12)
+    monkeypatch.setattr(backend, "SCENARIO_CACHE_SIZE", 2)
+    for weight in (10.0, 11.0, 12.0):
+        backend.case_inputs(fig4.with_changes({"load": {"weight_N": weight}}))
+    assert len(backend._cases) == 2
+    assert backend.simulate(fig4).x_m[-1] == simulate_batch([fig4.with_changes({})])[0].x_m[-1]
+
+
 def test_hold_interval_of_the_piecewise_path():
     """Where inputs are held (a signal given as a Python callable), a 10 ms lag is held over pieces of at most tau / 10 and at most one output sample."""
     sc = pamsim.Scenario.from_dict({"load": {"weight_N": 22.74}, "simulation": {"duration_s": 4.0},

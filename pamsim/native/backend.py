@@ -28,7 +28,9 @@ from __future__ import annotations
 
 import bisect
 import math
+import threading
 import time
+import weakref
 from collections import OrderedDict
 from dataclasses import dataclass, replace
 from typing import Sequence
@@ -258,12 +260,39 @@ def _change_after(piece, t0: float) -> tuple[float, float, float]:
     return (0.0, 0.0, 0.0)
 
 
+SCENARIO_CACHE_SIZE = 256
+"""Cases kept per process, by scenario object (:func:`case_inputs`)."""
+_cases: dict[int, tuple[weakref.ref, CaseInputs]] = {}
+_cases_lock = threading.Lock()
+
+
 def case_inputs(scenario: Scenario, model: MuscleModel | None = None) -> CaseInputs:
     """The library's inputs for ``scenario``; refuses (``InputError``) what the backend cannot honour.
 
     ``model`` is ``scenario.build_model()`` (built here if not given), or that model with its pressure
     source replaced (a fit drives it with a recorded pressure): the source choice follows the model.
+    A scenario is immutable, so the case of its own model is kept (its arrays read-only) for its next
+    run, by the scenario object (not by equality, which would take ``1`` for ``1.0``), for the last
+    :data:`SCENARIO_CACHE_SIZE` scenarios.
     """
+    if model is None:
+        kept = _cases.get(id(scenario))
+        if kept is not None and kept[0]() is scenario:  # a scenario's id is reused only after it is gone
+            return kept[1]
+    case = _new_case(scenario, model)
+    if model is None:
+        for array in (case.reals, case.ints, case.segment_t_s, case.segment_u, case.segment_du):
+            if array is not None:
+                array.flags.writeable = False
+        with _cases_lock:  # the pool's runs may share this process's cases
+            _cases[id(scenario)] = (weakref.ref(scenario), case)
+            while len(_cases) > SCENARIO_CACHE_SIZE:
+                del _cases[next(iter(_cases))]  # the oldest first
+    return case
+
+
+def _new_case(scenario: Scenario, model: MuscleModel | None) -> CaseInputs:
+    """:func:`case_inputs`, built."""
     refuse_unsupported(scenario)
     model = scenario.build_model() if model is None else model
     opts = scenario.solver
