@@ -130,6 +130,7 @@ def test_a_scenario_run_again_reuses_its_case_by_the_object_not_by_equality(monk
     import weakref
 
     from pamsim.native import backend
+    from pamsim.native.engine import engine_library
 
     fig4 = pamsim.load_scenario(SCENARIOS / "acra2012_fig4.toml")
     case = backend.case_inputs(fig4)
@@ -147,6 +148,10 @@ def test_a_scenario_run_again_reuses_its_case_by_the_object_not_by_equality(monk
         backend.case_inputs(fig4.with_changes({"load": {"weight_N": weight}}))
     assert len(backend._cases) == 2
     assert backend.simulate(fig4).x_m[-1] == simulate_batch([fig4.with_changes({})])[0].x_m[-1]
+    library = engine_library(case.assembly)
+    engine_case = case.engine_case(library, 64)  # kept with the case too, read-only
+    assert case.engine_case(library, 64) is engine_case and case.engine_case(library, 65) is not engine_case
+    assert not engine_case.params.flags.writeable and not engine_case.segment_u.flags.writeable
 
 
 def test_hold_interval_of_the_piecewise_path():

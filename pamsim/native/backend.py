@@ -105,7 +105,19 @@ class CaseInputs:
     input_names: tuple[str, ...] = lib.INPUTS  # segment_u's columns
 
     def engine_case(self, library, capacity: int) -> EngineCase:
-        """This case as the generic engine takes it: the flat model's parameters and inputs."""
+        """This case as the generic engine takes it: the flat model's parameters and inputs (kept for the
+        case's next run on ``library``: a case is kept for its scenario, :func:`case_inputs`)."""
+        kept = self.__dict__.setdefault("_engine_cases", {})  # frozen: the cache is no field
+        key = (id(library), int(capacity))
+        if key not in kept or kept[key][0] is not library:
+            case = self._engine_case(library, capacity)
+            for array in (case.params, case.segment_u, case.segment_du):
+                if array is not None:
+                    array.flags.writeable = False  # shared by the runs of the case: a caller copies to change
+            kept[key] = (library, case)
+        return kept[key][1]
+
+    def _engine_case(self, library, capacity: int) -> EngineCase:
         names = library.names["inputs"]
         columns = [self.input_names.index(n) for n in names]
         u = self.segment_u[:, columns]
