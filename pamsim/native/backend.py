@@ -252,12 +252,17 @@ def exact_segments(signals, duration_s: float):
             times = (piece.lag[0],) if piece.lag is not None else piece.knots_t_s
             bounds |= {float(t) for t in times if 0.0 < t < duration_s}
     starts = sorted(bounds)
-    none = (0.0, (0.0, 0.0, 0.0))  # an input without a signal: nothing, and no change
+    return (np.array(starts), *_piece_starts(pieces, starts))
+
+
+def _piece_starts(pieces, starts: list[float]) -> tuple[np.ndarray, np.ndarray]:
+    """Each piece's value at each of ``starts`` and its change from there (:func:`exact_segments`' ``u`` and
+    ``du``), zero for an input without a signal (None)."""
+    none = (0.0, (0.0, 0.0, 0.0))
     # Rows built as lists and made arrays once: numpy costs more per element set than per array made.
     rows = [[none if piece is None else (piece(t0), _change_after(piece, t0)) for piece in pieces] for t0 in starts]
-    u = np.array([[value for value, _ in row] for row in rows], dtype=float)
-    du = np.array([[change for _, change in row] for row in rows], dtype=float)
-    return np.array(starts), u, du
+    return (np.array([[value for value, _ in row] for row in rows], dtype=float),
+            np.array([[change for _, change in row] for row in rows], dtype=float))
 
 
 def _change_after(piece, t0: float) -> tuple[float, float, float]:
