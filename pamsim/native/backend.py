@@ -330,25 +330,30 @@ def core_values(scenario: Scenario, model: MuscleModel) -> tuple[np.ndarray, np.
     them, and a fit the parameters it moves."""
     opts = scenario.solver
     reals = lib.REAL_DEFAULTS.copy()
-    for name, value in scenario.parameters.items():
-        if name in lib.REAL_INDEX:  # the others shape the force table (refuse_unsupported)
-            reals[lib.REAL_INDEX[name]] = value
-    fmu_own = {"initial_contraction_m": scenario.initial_contraction_m, "x_high_m": upper_stop_start(model),
-               "initial_pressure_gauge_Pa": scenario.initial_pressure_gauge_Pa or 0.0,
-               "stick_margin_N": opts.stick_margin_N, "release_margin_N": opts.release_margin_N,
-               "cs_relative_tolerance": native_rtol(opts),
-               "cs_max_step_s": opts.max_step_s if math.isfinite(opts.max_step_s) else _DEFAULT_MAX_STEP_S}
-    for name, value in fmu_own.items():
-        reals[lib.REAL_INDEX[name]] = value
+    # the parameters the FMU has (the others shape the force table: refuse_unsupported)
+    _put(reals, lib.REAL_INDEX, {name: p.value for name, p in scenario.parameters.entries.items()})
+    _put(reals, lib.REAL_INDEX, {
+        "initial_contraction_m": scenario.initial_contraction_m, "x_high_m": upper_stop_start(model),
+        "initial_pressure_gauge_Pa": scenario.initial_pressure_gauge_Pa or 0.0,
+        "stick_margin_N": opts.stick_margin_N, "release_margin_N": opts.release_margin_N,
+        "cs_relative_tolerance": native_rtol(opts),
+        "cs_max_step_s": opts.max_step_s if math.isfinite(opts.max_step_s) else _DEFAULT_MAX_STEP_S})
     ints = lib.INT_DEFAULTS.copy()
     spec = scenario.spec["model"]
     choices = {"friction_model": ("friction", spec["friction"]), "damping_model": ("damping", spec["damping"]),
                "pressure_source": ("source", "valve" if isinstance(model.source, ValveChamberSource) else "prescribed"),
                "friction_negative_level": ("friction_negative_level", spec["friction_negative_level"])}
-    for name, (key, value) in choices.items():
-        if value in C_CHOICES[key]:  # the core's choices (the engine reads none of them)
-            ints[lib.INT_INDEX[name]] = C_CHOICES[key].index(value)
+    # the core's choices (the engine reads none of them)
+    _put(ints, lib.INT_INDEX, {name: C_CHOICES[key].index(value) for name, (key, value) in choices.items()
+                               if value in C_CHOICES[key]})
     return reals, ints
+
+
+def _put(array: np.ndarray, index: dict[str, int], values: dict) -> None:
+    """``array[index[name]] = value`` for each of ``values`` that ``index`` names."""
+    for name, value in values.items():
+        if name in index:
+            array[index[name]] = value
 
 
 def held_segments(signals, model: MuscleModel, duration_s: float, n_samples: int) -> tuple[np.ndarray, np.ndarray]:
