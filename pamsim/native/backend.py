@@ -400,6 +400,15 @@ _MODE_LABELS = {int(m): m.label for m in Mode}
 _MODES = {int(m): m for m in Mode}  # a dict look-up costs less than calling the enum
 
 
+_event_names: dict[tuple[int, int, int], str] = {}  # a few modes and indicators: a few names
+
+
+def _event_name(mode: int, fired: int, to: int) -> str:
+    """:func:`event_name` of an event by the modes' and mask's numbers, kept for the next event."""
+    _event_names[(mode, fired, to)] = name = event_name(_MODES[mode], fired, _MODES[to])
+    return name
+
+
 def _result(scenario: Scenario, case: CaseInputs, out: dict, i: int, wall_time_s: float,
             t: np.ndarray | None = None) -> Result:
     """Case ``i`` of a batch's output as a :class:`Result`, or the error it ended with.
@@ -433,13 +442,13 @@ def _engine_result(scenario: Scenario, case: CaseInputs, out: dict, i: int, wall
     first_event = int(out["event_offset"][i])
     rows = out["events"][first_event:first_event + int(out["n_events"][i])].tolist()  # floats: no numpy scalars
     x_at, ke_at = outputs.index("load.x_m"), outputs.index("load.kinetic_energy_J")
-    labels = _MODE_LABELS
+    labels, after = _MODE_LABELS, 4 + n_y  # a row: t, modes before and after, fired mask, outputs before, after
     transitions, losses = [], []
     for e in rows:
-        before, after = e[4:4 + n_y], e[4 + n_y:4 + 2 * n_y]
-        name = event_name(_MODES[int(e[1])], int(e[3]), _MODES[int(e[2])])
-        transitions.append(TransitionEvent(e[0], name, labels[int(e[1])], labels[int(e[2])], after[x_at]))
-        losses.append((e[0], before[ke_at] - after[ke_at]))
+        mode, to, fired = int(e[1]), int(e[2]), int(e[3])
+        name = _event_names.get((mode, fired, to)) or _event_name(mode, fired, to)
+        transitions.append(TransitionEvent(e[0], name, labels[mode], labels[to], e[after + x_at]))
+        losses.append((e[0], e[4 + ke_at] - e[after + ke_at]))
     stats["events"] = len(transitions)
     high, low = out["extremes"][i][:n_y], out["extremes"][i][n_y:]
     pressure = next(a for a, b in case.assembly.connections if b == "muscle.p_gauge_Pa")
