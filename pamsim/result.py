@@ -32,11 +32,14 @@ class Signals(Mapping):
     :meth:`MuscleModel.breakdown`; the source's own columns (its command, supply, air mass) come from
     the source."""
 
-    def __init__(self, work: dict[str, np.ndarray], model: "MuscleModel", t, Y, modes, outputs=None):
+    def __init__(self, work: dict[str, np.ndarray], model: "MuscleModel", t, Y, modes, outputs=None, impacts=None):
         self._work = work
         self._trace = (model, t, Y, modes)
         self._outputs = outputs
         self._all: dict[str, np.ndarray] | None = None
+        # (t_s, event times, losses): E_impacts_J, the last work integral, is summed when first read, since
+        # filling a column per run costs as much as a native run's other columns together.
+        self._impacts = impacts
 
     def _everything(self) -> dict[str, np.ndarray]:
         if self._all is None:
@@ -49,11 +52,19 @@ class Signals(Mapping):
                 own = model.source.outputs(t, Y[2:2 + model.n_source], Y[0])
                 forces = {k: v for k, v in generated.items() if k.startswith("F_")}
                 sig = {**forces, **{k: generated.get(k, v) for k, v in own.items()}, **generated}
-            self._all = {**sig, **self._work}
+            self._all = {**sig, **self._integrals()}
         return self._all
 
+    def _integrals(self) -> dict[str, np.ndarray]:
+        """The work integrals, ``E_impacts_J`` last (summed here if it was left to the first read)."""
+        if self._impacts is not None:
+            self._work["E_impacts_J"] = running_losses(*self._impacts)
+            self._impacts = None
+        return self._work
+
     def __getitem__(self, key: str) -> np.ndarray:
-        return self._work[key] if key in self._work else self._everything()[key]
+        work = self._integrals() if key == "E_impacts_J" else self._work
+        return work[key] if key in work else self._everything()[key]
 
     def __iter__(self):
         return iter(self._everything())
@@ -123,10 +134,10 @@ class Result:
         work = {key: Y[n - N_WORK + i] for i, key in enumerate(model.state_names[-N_WORK:])}
         work.update(zip(outputs.added_states if outputs is not None else (), Y[n:]))
         loss_J = np.array([b for _, b in impact_losses])
-        if impacts_J is None:
-            impacts_J = running_losses(t, [a for a, _ in impact_losses], loss_J)
-        work["E_impacts_J"] = impacts_J
-        sig = Signals(work, model, t, Y, modes, outputs)
+        if impacts_J is not None:
+            work["E_impacts_J"] = impacts_J
+        sig = Signals(work, model, t, Y, modes, outputs,
+                      None if impacts_J is not None else (t, [a for a, _ in impact_losses], loss_J))
         p = model.pressure_trace_Pa(t, Y)
         fr = model.fit_range
         peaks = dict(peaks or {})

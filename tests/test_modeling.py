@@ -316,3 +316,17 @@ def test_generated_code_is_kept_on_disk_for_the_next_process(tmp_path):
     assert third == first and loaded_third
     assert code_cache.entry_name(("model", object())) is None
     assert code_cache.entry_name(("model", (1.0, "a", None))) is not None
+
+
+def test_an_assemblys_parameter_values_are_the_flat_models_and_a_fresh_list_each_time():
+    """The vector is kept after the first call: equal to the flattened model's, and a caller that changes the
+    list it was given does not change the next caller's."""
+    from pamsim.assemblies import scenario_assembly
+    from pamsim.scenario import load_scenario
+
+    assembly = scenario_assembly(load_scenario(Path(__file__).resolve().parents[1] / "scenarios" / "acra2012_fig4.toml"))
+    first = assembly.parameter_values()
+    assert first == list(assembly.flatten().parameter_values)
+    first[0] = -1.0
+    again = assembly.parameter_values()
+    assert again == list(assembly.flatten().parameter_values) and again is not first

@@ -96,6 +96,64 @@ def test_other_element_choices_and_initial_state_match_the_python_backend():
         assert nat.energy_balance()["relative"] < 1e-3
 
 
+def test_exact_segments_against_a_hand_calculation():
+    """Every knot and lag start inside the run cuts it; each input's value at a piece's start and its change
+    over the piece (slope, lag amplitude, lag time constant) by hand; an input without a signal is zero."""
+    import math
+
+    from pamsim.native.backend import exact_segments
+    from pamsim.signals import FirstOrderLag, PiecewiseConstant, Ramp, Step
+
+    signals = (Step(1.0, 0.0, 1.0), None, Ramp(0.5, 1.5, 2.0, 4.0), FirstOrderLag(0.25, 1.0, 3.0, 0.1),
+               PiecewiseConstant((0.0, 0.75, 9.0), (5.0, -1.0, 7.0)))
+    starts, u, du = exact_segments(signals, 2.0)
+    assert starts.tolist() == [0.0, 0.25, 0.5, 0.75, 1.0, 1.5]  # 9 s is after the end
+    lag = [1.0, 1.0] + [3.0 - 2.0 * math.exp(-(t - 0.25) / 0.1) for t in (0.5, 0.75, 1.0, 1.5)]
+    ramp = [2.0, 2.0, 2.0, 2.5, 3.0, 4.0]
+    want_u = [[0.0, 0.0, 0.0, 0.0, 1.0, 1.0], [0.0] * 6, ramp, lag, [5.0, 5.0, 5.0, -1.0, -1.0, -1.0]]
+    assert u.dtype == float and u.shape == (6, 5)
+    for k, column in enumerate(want_u):
+        np.testing.assert_allclose(u[:, k], column, rtol=1e-15, atol=0.0)
+    amplitude = [0.0, -2.0] + [-2.0 * math.exp(-(t - 0.25) / 0.1) for t in (0.5, 0.75, 1.0, 1.5)]
+    np.testing.assert_allclose(du[:, 3, 1], amplitude, rtol=1e-15, atol=0.0)
+    assert du[:, 3, 2].tolist() == [0.0] + [0.1] * 5
+    assert du[:, 2, 0].tolist() == [0.0, 0.0, 2.0, 2.0, 2.0, 0.0]  # the ramp's slope over its pieces
+    assert not du[:, [0, 1, 4]].any() and not du[:, 2, 1:].any() and not du[:, 3, 0].any()
+    assert exact_segments((lambda t: t,), 1.0) is None  # a callable is held piecewise instead
+
+
+def test_a_scenario_run_again_reuses_its_case_by_the_object_not_by_equality(monkeypatch):
+    """The case of a scenario's own model is kept for the scenario object: the same object finds it (its
+    arrays read-only), an equal scenario (another object) or a run with a model given builds its own, a
+    kept case whose scenario is gone is never handed to another that took its id, and the kept cases
+    are bounded."""
+    import weakref
+
+    from pamsim.native import backend
+    from pamsim.native.engine import engine_library
+
+    fig4 = pamsim.load_scenario(SCENARIOS / "acra2012_fig4.toml")
+    case = backend.case_inputs(fig4)
+    assert backend.case_inputs(fig4) is case
+    assert not case.segment_u.flags.writeable and not case.reals.flags.writeable
+    twin = fig4.with_changes({})
+    assert twin == fig4 and backend.case_inputs(twin) is not case
+    assert backend.case_inputs(fig4, fig4.build_model()) is not case
+    other = fig4.with_changes({"load": {"weight_N": 30.0}})
+    backend._cases[id(other)] = (weakref.ref(twin), case)  # as if `other` took a dead scenario's id
+    assert backend.case_inputs(other) is not case
+    assert backend.case_inputs(other).model.load.mass_kg == pytest.approx(30.0 / 9.81, rel=1e-12)
+    monkeypatch.setattr(backend, "SCENARIO_CACHE_SIZE", 2)
+    for weight in (10.0, 11.0, 12.0):
+        backend.case_inputs(fig4.with_changes({"load": {"weight_N": weight}}))
+    assert len(backend._cases) == 2
+    assert backend.simulate(fig4).x_m[-1] == simulate_batch([fig4.with_changes({})])[0].x_m[-1]
+    library = engine_library(case.assembly)
+    engine_case = case.engine_case(library, 64)  # kept with the case too, read-only
+    assert case.engine_case(library, 64) is engine_case and case.engine_case(library, 65) is not engine_case
+    assert not engine_case.params.flags.writeable and not engine_case.segment_u.flags.writeable
+
+
 def test_hold_interval_of_the_piecewise_path():
     """Where inputs are held (a signal given as a Python callable), a 10 ms lag is held over pieces of at most tau / 10 and at most one output sample."""
     sc = pamsim.Scenario.from_dict({"load": {"weight_N": 22.74}, "simulation": {"duration_s": 4.0},

@@ -470,6 +470,33 @@ def test_running_losses_are_the_cumulative_sum_at_the_last_event_at_or_before_ea
         assert np.array_equal(got, cum[np.searchsorted(loss_t, t, side="right")])
 
 
+def test_the_impact_losses_column_is_the_running_sum_however_it_is_first_read():
+    """E_impacts_J, summed when first read, is the running sum of the events' losses (a second
+    implementation: the count of events at or before each sample), the last work integral in the
+    columns, whether it is read alone, with every column, or after the result went through pickle."""
+    import pickle
+
+    from pamsim.result import Result
+
+    model = pamsim.load_scenario(SCENARIOS / "acra2012_fig4.toml").build_model()
+    t = np.linspace(0.0, 1.0, 11)
+    Y = np.repeat(np.asarray(model.initial_state(0.01), dtype=float)[:, None], len(t), axis=1)
+    losses = [(0.15, 1e-3), (0.3, 2e-3), (0.3, 5e-4), (0.95, 1e-4)]
+    want = np.array([sum(b for a, b in losses if a <= ti) for ti in t])
+    stats = {"events": 0, "rhs_evaluations": 0, "segments": 0}
+
+    def run():
+        return Result.from_trace(model, "r", t, Y, np.zeros(len(t), dtype=int), [], losses, stats, 0.0)
+
+    alone, every, pickled = run(), run(), pickle.loads(pickle.dumps(run()))
+    np.testing.assert_allclose(alone.signals["E_impacts_J"], want, rtol=1e-15, atol=0.0)
+    columns = list(every.signals)
+    assert columns[-5:] == ["W_muscle_J", "E_friction_J", "E_damping_J", "W_external_J", "E_impacts_J"]
+    assert np.array_equal(dict(every.signals)["E_impacts_J"], alone.signals["E_impacts_J"])
+    assert np.array_equal(pickled.signals["E_impacts_J"], alone.signals["E_impacts_J"])
+    assert alone.impact_loss_J == pytest.approx(sum(b for _, b in losses), rel=1e-15)
+
+
 @pytest.mark.parametrize("signal", [
     Constant(2.5), Constant(-0.0), Step(0.3, 0.0, 1.0), Step(-1.0, 4.0, -2.0), Step(0.25, 1.0, 3.0), Step(9.0, 1.0, 3.0),
     PiecewiseConstant((0.0, 0.105, 0.105, 0.5, 1.7), (1.0, -3.0, 2.0, 7.0, 0.5)),

@@ -38,29 +38,51 @@ def _field_names(cls: type) -> tuple[str, ...]:
     return tuple(f.name for f in dataclasses.fields(cls))
 
 
+@functools.lru_cache(maxsize=None)
+def _fields(cls: type) -> tuple[tuple[str, bool], ...]:
+    """Each field's name and whether it is :data:`STRUCTURAL`, once per class."""
+    return tuple((name, name in STRUCTURAL) for name in _field_names(cls))
+
+
 def _is_instance_of_dataclass(value) -> bool:
     return not isinstance(value, type) and hasattr(type(value), "__dataclass_fields__")
 
 
-def _numbers(element, out: dict[str, float], path: str) -> None:
-    for name in _field_names(type(element)):
+def form_and_numbers(element) -> tuple[tuple, dict[str, float]]:
+    """:func:`structure_key` of ``element`` and its numbers (:func:`element_parameters`), in one walk:
+    a component takes both from each element, once per run."""
+    numbers: dict[str, float] = {}
+    if not _is_instance_of_dataclass(element):
+        return _stable(element, True), numbers
+    return _walk(element, numbers, ""), numbers
+
+
+def _walk(element, numbers: dict[str, float], path: str, keyed: bool = True) -> tuple | None:
+    """The key of a dataclass ``element`` whose numbers are parameters, put into ``numbers`` (a nested
+    element's under its plain name unless another number has it already, else under its path).
+    ``keyed``: build the key (not for an element that says itself what its code depends on)."""
+    items = []
+    for name, structural in _fields(type(element)):
         value = getattr(element, name)
-        if name in STRUCTURAL:
-            continue
-        if _is_instance_of_dataclass(value):
-            _numbers(value, out, f"{path}{name}.")
-        elif _is_number(value):
-            # A nested element's number keeps its plain name unless another number has it already.
-            out[name if name not in out else f"{path}{name}"] = float(value)
+        if structural:
+            if keyed:
+                items.append((name, _stable(value, True)))
+        elif type(value) is float or _is_number(value):  # float first: most fields are
+            numbers[name if name not in numbers else f"{path}{name}"] = float(value)
+        elif _is_instance_of_dataclass(value):
+            own = callable(getattr(value, "code_key", None))  # a spline surface: keyed as _stable keys it
+            key = _walk(value, numbers, f"{path}{name}.", keyed and not own)
+            if keyed:
+                items.append((name, value.code_key() if own else key))
+        elif keyed:
+            items.append((name, _stable(value, False)))
+    return (type(element).__module__, type(element).__qualname__, tuple(items)) if keyed else None
 
 
 def element_parameters(element) -> dict[str, float]:
     """``{name: value}`` of every number of a dataclass ``element`` (nested elements included), named
     by field; a field name met twice is qualified by its path (``orifice.C_m3_per_s_Pa``)."""
-    out: dict[str, float] = {}
-    if _is_instance_of_dataclass(element):
-        _numbers(element, out, "")
-    return out
+    return form_and_numbers(element)[1]
 
 
 def symbolic(element, symbols: Mapping[str, Any]):
@@ -91,14 +113,10 @@ def structure_key(element, baked: bool = False) -> tuple:
     values, so they share one generated model.  ``baked``: the numbers are constants of the generated
     code (an element called on floats, or numbers :func:`symbolic` does not replace), so they count.
     """
-    if _is_instance_of_dataclass(element):
-        items = []
-        for name in _field_names(type(element)):
-            value = getattr(element, name)
-            if name in STRUCTURAL or baked or not _is_number(value):
-                items.append((name, _stable(value, baked or name in STRUCTURAL)))
-        return (type(element).__module__, type(element).__qualname__, tuple(items))
-    return _stable(element, True)
+    if baked and _is_instance_of_dataclass(element):
+        items = tuple((name, _stable(getattr(element, name), True)) for name, _ in _fields(type(element)))
+        return (type(element).__module__, type(element).__qualname__, items)
+    return form_and_numbers(element)[0]
 
 
 def _is_number(value) -> bool:
@@ -275,11 +293,12 @@ class ElementParameters:
         for kept in [k for k in self.__dict__ if k in ("_element_values", "_parameter_vars")
                      or (isinstance(k, tuple) and k[0] == "_casadi_form")]:
             self.__dict__.pop(kept, None)
-        self._form = structure_key(element)
+        self._form, numbers = form_and_numbers(element)
         self._probe, self._probe_points = probe, tuple(points)
         self.traces = traces(element, probe, points, self._form)
         if required and not self.traces:
             raise TypeError(f"{required} {type(element).__name__} cannot be written with symbols")
+        self._element_values = numbers if self.traces else {}
         return self.element_values()
 
     def element_call(self, s, method: str, *args):

@@ -89,7 +89,7 @@ class NativePlant:
         first = case.engine_case(library, 1)
         self._params = np.array(first.params, dtype=float)
         self._settings = (first.rtol, first.max_step_s, first.max_steps)
-        self._u = np.ascontiguousarray(first.segment_u[0], dtype=float)
+        self._u = np.array(first.segment_u[0], dtype=float)  # a copy: the case's own is read-only, shared by its runs
         self._k = library.names["inputs"].index(input_name)
         states, outputs = library.names["states"], library.names["outputs"]
         self._ix, self._iv = states.index("load.x_m"), states.index("load.v_m_s")

@@ -16,6 +16,7 @@ core follows).
 
 from __future__ import annotations
 
+import bisect
 import hashlib
 import math
 from dataclasses import dataclass, field
@@ -58,7 +59,7 @@ class InputSignal:
             time_s, initial, final, tau_s = self.lag
             return initial if t_s < time_s else final + (initial - final) * math.exp(-(t_s - time_s) / tau_s)
         ts, vs = self.knots_t_s, self.knots
-        k = int(np.searchsorted(ts, t_s, side="right")) - 1  # the last knot at or before t_s
+        k = bisect.bisect_right(ts, t_s) - 1  # the last knot at or before t_s (numpy's costs more on a tuple)
         if k < 0:
             return vs[0]
         if k == len(ts) - 1:

@@ -53,6 +53,7 @@ class Assembly:
         self.components = tuple(components)
         self.connections = tuple(tuple(c) for c in connections)
         self._key = None
+        self._values: tuple[float, ...] | None = None
         self.inputs = {k: (v,) if isinstance(v, str) else tuple(v) for k, v in (inputs or {}).items()}
         by_name: dict[str, Component] = {}
         for c in self.components:
@@ -179,7 +180,9 @@ class Assembly:
 
     def parameter_values(self) -> list[float]:
         """The parameter vector of the flat model, in its order, without flattening."""
-        return [float(c.values[v.name]) for c in self.components for v in c.parameter_vars()]
+        if self._values is None:  # kept, as the key is: a run asks for it twice (its inputs, its outputs)
+            self._values = tuple(float(c.values[v.name]) for c in self.components for v in c.parameter_vars())
+        return list(self._values)
 
     # ------------------------------------------------------------------ flattening
     def flatten(self, modes: Mapping[str, int] | None = None) -> FlatModel:

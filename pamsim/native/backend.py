@@ -28,7 +28,9 @@ from __future__ import annotations
 
 import bisect
 import math
+import threading
 import time
+import weakref
 from collections import OrderedDict
 from dataclasses import dataclass, replace
 from typing import Sequence
@@ -103,7 +105,19 @@ class CaseInputs:
     input_names: tuple[str, ...] = lib.INPUTS  # segment_u's columns
 
     def engine_case(self, library, capacity: int) -> EngineCase:
-        """This case as the generic engine takes it: the flat model's parameters and inputs."""
+        """This case as the generic engine takes it: the flat model's parameters and inputs (kept for the
+        case's next run on ``library``: a case is kept for its scenario, :func:`case_inputs`)."""
+        kept = self.__dict__.setdefault("_engine_cases", {})  # frozen: the cache is no field
+        key = (id(library), int(capacity))
+        if key not in kept or kept[key][0] is not library:
+            case = self._engine_case(library, capacity)
+            for array in (case.params, case.segment_u, case.segment_du):
+                if array is not None:
+                    array.flags.writeable = False  # shared by the runs of the case: a caller copies to change
+            kept[key] = (library, case)
+        return kept[key][1]
+
+    def _engine_case(self, library, capacity: int) -> EngineCase:
         names = library.names["inputs"]
         columns = [self.input_names.index(n) for n in names]
         u = self.segment_u[:, columns]
@@ -148,7 +162,7 @@ def needs_table(scenario: Scenario) -> bool:
 
 def in_c(assembly, name: str) -> bool:
     """Whether component ``name`` of ``assembly`` has generated C (written in symbols, or with a CasADi form)."""
-    c = next(c for c in assembly.components if c.name == name)
+    c = assembly.by_name[name]
     return c.has_c_form() if hasattr(c, "has_c_form") else getattr(c, "traces", True)
 
 
@@ -237,13 +251,18 @@ def exact_segments(signals, duration_s: float):
         if piece is not None:
             times = (piece.lag[0],) if piece.lag is not None else piece.knots_t_s
             bounds |= {float(t) for t in times if 0.0 < t < duration_s}
-    starts = np.array(sorted(bounds))
-    u, du = np.zeros((len(starts), len(pieces))), np.zeros((len(starts), len(pieces), 3))
-    for k, piece in enumerate(pieces):
-        for j, t0 in enumerate(starts.tolist() if piece is not None else ()):
-            u[j, k] = piece(t0)
-            du[j, k] = _change_after(piece, t0)
-    return starts, u, du
+    starts = sorted(bounds)
+    return (np.array(starts), *_piece_starts(pieces, starts))
+
+
+def _piece_starts(pieces, starts: list[float]) -> tuple[np.ndarray, np.ndarray]:
+    """Each piece's value at each of ``starts`` and its change from there (:func:`exact_segments`' ``u`` and
+    ``du``), zero for an input without a signal (None)."""
+    none = (0.0, (0.0, 0.0, 0.0))
+    # Rows built as lists and made arrays once: numpy costs more per element set than per array made.
+    rows = [[none if piece is None else (piece(t0), _change_after(piece, t0)) for piece in pieces] for t0 in starts]
+    return (np.array([[value for value, _ in row] for row in rows], dtype=float),
+            np.array([[change for _, change in row] for row in rows], dtype=float))
 
 
 def _change_after(piece, t0: float) -> tuple[float, float, float]:
@@ -258,12 +277,39 @@ def _change_after(piece, t0: float) -> tuple[float, float, float]:
     return (0.0, 0.0, 0.0)
 
 
+SCENARIO_CACHE_SIZE = 256
+"""Cases kept per process, by scenario object (:func:`case_inputs`)."""
+_cases: dict[int, tuple[weakref.ref, CaseInputs]] = {}
+_cases_lock = threading.Lock()
+
+
 def case_inputs(scenario: Scenario, model: MuscleModel | None = None) -> CaseInputs:
     """The library's inputs for ``scenario``; refuses (``InputError``) what the backend cannot honour.
 
     ``model`` is ``scenario.build_model()`` (built here if not given), or that model with its pressure
     source replaced (a fit drives it with a recorded pressure): the source choice follows the model.
+    A scenario is immutable, so the case of its own model is kept (its arrays read-only) for its next
+    run, by the scenario object (not by equality, which would take ``1`` for ``1.0``), for the last
+    :data:`SCENARIO_CACHE_SIZE` scenarios.
     """
+    if model is None:
+        kept = _cases.get(id(scenario))
+        if kept is not None and kept[0]() is scenario:  # a scenario's id is reused only after it is gone
+            return kept[1]
+    case = _new_case(scenario, model)
+    if model is None:
+        for array in (case.reals, case.ints, case.segment_t_s, case.segment_u, case.segment_du):
+            if array is not None:
+                array.flags.writeable = False
+        with _cases_lock:  # the pool's runs may share this process's cases
+            _cases[id(scenario)] = (weakref.ref(scenario), case)
+            while len(_cases) > SCENARIO_CACHE_SIZE:
+                del _cases[next(iter(_cases))]  # the oldest first
+    return case
+
+
+def _new_case(scenario: Scenario, model: MuscleModel | None) -> CaseInputs:
+    """:func:`case_inputs`, built."""
     refuse_unsupported(scenario)
     model = scenario.build_model() if model is None else model
     opts = scenario.solver
@@ -284,25 +330,30 @@ def core_values(scenario: Scenario, model: MuscleModel) -> tuple[np.ndarray, np.
     them, and a fit the parameters it moves."""
     opts = scenario.solver
     reals = lib.REAL_DEFAULTS.copy()
-    for name, value in scenario.parameters.items():
-        if name in lib.REAL_INDEX:  # the others shape the force table (refuse_unsupported)
-            reals[lib.REAL_INDEX[name]] = value
-    fmu_own = {"initial_contraction_m": scenario.initial_contraction_m, "x_high_m": upper_stop_start(model),
-               "initial_pressure_gauge_Pa": scenario.initial_pressure_gauge_Pa or 0.0,
-               "stick_margin_N": opts.stick_margin_N, "release_margin_N": opts.release_margin_N,
-               "cs_relative_tolerance": native_rtol(opts),
-               "cs_max_step_s": opts.max_step_s if math.isfinite(opts.max_step_s) else _DEFAULT_MAX_STEP_S}
-    for name, value in fmu_own.items():
-        reals[lib.REAL_INDEX[name]] = value
+    # the parameters the FMU has (the others shape the force table: refuse_unsupported)
+    _put(reals, lib.REAL_INDEX, {name: p.value for name, p in scenario.parameters.entries.items()})
+    _put(reals, lib.REAL_INDEX, {
+        "initial_contraction_m": scenario.initial_contraction_m, "x_high_m": upper_stop_start(model),
+        "initial_pressure_gauge_Pa": scenario.initial_pressure_gauge_Pa or 0.0,
+        "stick_margin_N": opts.stick_margin_N, "release_margin_N": opts.release_margin_N,
+        "cs_relative_tolerance": native_rtol(opts),
+        "cs_max_step_s": opts.max_step_s if math.isfinite(opts.max_step_s) else _DEFAULT_MAX_STEP_S})
     ints = lib.INT_DEFAULTS.copy()
     spec = scenario.spec["model"]
     choices = {"friction_model": ("friction", spec["friction"]), "damping_model": ("damping", spec["damping"]),
                "pressure_source": ("source", "valve" if isinstance(model.source, ValveChamberSource) else "prescribed"),
                "friction_negative_level": ("friction_negative_level", spec["friction_negative_level"])}
-    for name, (key, value) in choices.items():
-        if value in C_CHOICES[key]:  # the core's choices (the engine reads none of them)
-            ints[lib.INT_INDEX[name]] = C_CHOICES[key].index(value)
+    # the core's choices (the engine reads none of them)
+    _put(ints, lib.INT_INDEX, {name: C_CHOICES[key].index(value) for name, (key, value) in choices.items()
+                               if value in C_CHOICES[key]})
     return reals, ints
+
+
+def _put(array: np.ndarray, index: dict[str, int], values: dict) -> None:
+    """``array[index[name]] = value`` for each of ``values`` that ``index`` names."""
+    for name, value in values.items():
+        if name in index:
+            array[index[name]] = value
 
 
 def held_segments(signals, model: MuscleModel, duration_s: float, n_samples: int) -> tuple[np.ndarray, np.ndarray]:
@@ -349,6 +400,15 @@ _MODE_LABELS = {int(m): m.label for m in Mode}
 _MODES = {int(m): m for m in Mode}  # a dict look-up costs less than calling the enum
 
 
+_event_names: dict[tuple[int, int, int], str] = {}  # a few modes and indicators: a few names
+
+
+def _event_name(mode: int, fired: int, to: int) -> str:
+    """:func:`event_name` of an event by the modes' and mask's numbers, kept for the next event."""
+    _event_names[(mode, fired, to)] = name = event_name(_MODES[mode], fired, _MODES[to])
+    return name
+
+
 def _result(scenario: Scenario, case: CaseInputs, out: dict, i: int, wall_time_s: float,
             t: np.ndarray | None = None) -> Result:
     """Case ``i`` of a batch's output as a :class:`Result`, or the error it ended with.
@@ -382,13 +442,13 @@ def _engine_result(scenario: Scenario, case: CaseInputs, out: dict, i: int, wall
     first_event = int(out["event_offset"][i])
     rows = out["events"][first_event:first_event + int(out["n_events"][i])].tolist()  # floats: no numpy scalars
     x_at, ke_at = outputs.index("load.x_m"), outputs.index("load.kinetic_energy_J")
-    labels = _MODE_LABELS
+    labels, after = _MODE_LABELS, 4 + n_y  # a row: t, modes before and after, fired mask, outputs before, after
     transitions, losses = [], []
     for e in rows:
-        before, after = e[4:4 + n_y], e[4 + n_y:4 + 2 * n_y]
-        name = event_name(_MODES[int(e[1])], int(e[3]), _MODES[int(e[2])])
-        transitions.append(TransitionEvent(e[0], name, labels[int(e[1])], labels[int(e[2])], after[x_at]))
-        losses.append((e[0], before[ke_at] - after[ke_at]))
+        mode, to, fired = int(e[1]), int(e[2]), int(e[3])
+        name = _event_names.get((mode, fired, to)) or _event_name(mode, fired, to)
+        transitions.append(TransitionEvent(e[0], name, labels[mode], labels[to], e[after + x_at]))
+        losses.append((e[0], e[4 + ke_at] - e[after + ke_at]))
     stats["events"] = len(transitions)
     high, low = out["extremes"][i][:n_y], out["extremes"][i][n_y:]
     pressure = next(a for a, b in case.assembly.connections if b == "muscle.p_gauge_Pa")
