@@ -273,10 +273,7 @@ class Result:
 
     def to_csv(self, path) -> None:
         """Write the trace; the first columns are ``t_s,x_m,v_m_s,p_gauge_Pa``. Atomic."""
-        cols = self.columns()
-        data = np.column_stack([np.asarray(v, dtype=float) for v in cols.values()])
-        with atomic_path(path) as tmp:
-            np.savetxt(tmp, data, delimiter=",", header=",".join(cols), comments="", fmt="%.10g")
+        write_columns(path, self.columns())
 
     def plot(self, path=None, dpi: int | None = None, **kwargs):
         """Plot contraction, pressure and forces; write them to ``path`` if given, as PNG, PDF or SVG by its
@@ -284,6 +281,13 @@ class Result:
         from .plotting import plot_result
 
         return plot_result(self, path, dpi=dpi, **kwargs)
+
+
+def write_columns(path, cols: dict) -> None:
+    """Write ``cols`` (name: values at the samples) as a CSV, one column each, 10 significant digits. Atomic."""
+    data = np.column_stack([np.asarray(v, dtype=float) for v in cols.values()])
+    with atomic_path(path) as tmp:
+        np.savetxt(tmp, data, delimiter=",", header=",".join(cols), comments="", fmt="%.10g")
 
 
 def running_losses(t_s: np.ndarray, loss_t_s, loss_J: np.ndarray) -> np.ndarray:

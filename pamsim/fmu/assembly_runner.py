@@ -58,12 +58,28 @@ def simulate_assembly(scenario, model, interface: str = "cs", fmi_version: int =
     SolverFailure
         When fmpy or the FMU fails.
     """
-    from fmpy import simulate_fmu
-
     if interface not in KINDS:
         raise InputError(f"FMU interface must be 'cs' or 'me', not {interface!r}")
     path, states = cached_assembly_fmu(scenario, model, fmi_version)
-    opts = scenario.solver
+    t, Y, modes, wall = run_trace(path, interface, scenario.duration_s, scenario.solver, states, "load.mode")
+    assembly = scenario_assembly(scenario, model)
+    return Result.from_trace(model, scenario.name, t, Y, modes, [], [],
+                             trace_stats(modes, f"fmu-{interface}", scenario.solver.rtol), wall,
+                             outputs=RigOutputs(assembly, model, t, Y, modes))
+
+
+def run_trace(path: Path, interface: str, duration_s: float, opts, states, mode: str):
+    """Run the FMU at ``path`` with fmpy (``interface`` ``"cs"`` or ``"me"``) over ``duration_s`` at the
+    solver settings ``opts`` (its ``rtol``, ``max_step_s`` and output rate) and return the output grid's
+    times [s], the ``states`` (one row each), the hybrid component's ``mode`` variable and the wall time [s].
+
+    Raises
+    ------
+    SolverFailure
+        When fmpy or the FMU fails.
+    """
+    from fmpy import simulate_fmu
+
     dt = 1.0 / opts.sample_rate_Hz
     start = {"cs_relative_tolerance": opts.rtol}
     if math.isfinite(opts.max_step_s):
@@ -71,19 +87,14 @@ def simulate_assembly(scenario, model, interface: str = "cs", fmi_version: int =
     wall0 = time.perf_counter()
     try:
         res = simulate_fmu(str(path), fmi_type=KINDS[interface], solver="CVode", start_time=0.0,
-                           stop_time=scenario.duration_s, output_interval=dt, relative_tolerance=opts.rtol,
-                           start_values=start, output=[*states, "load.mode"], validate=False)
+                           stop_time=duration_s, output_interval=dt, relative_tolerance=opts.rtol,
+                           start_values=start, output=[*states, mode], validate=False)
     except Exception as exc:  # fmpy raises a bare Exception carrying the FMI status
-        raise SolverFailure(f"FMU {KINDS[interface]} of the assembly failed: {exc}") from None
+        raise SolverFailure(f"FMU {KINDS[interface]} of {Path(path).name} failed: {exc}") from None
     wall = time.perf_counter() - wall0
     rows = grid_rows(res["time"], dt)
-    t = np.asarray(res["time"][rows], dtype=float)
-    Y = np.array([np.asarray(res[name][rows], dtype=float) for name in states])
-    modes = np.asarray(res["load.mode"][rows], dtype=int)
-    assembly = scenario_assembly(scenario, model)
-    return Result.from_trace(model, scenario.name, t, Y, modes, [], [],
-                             trace_stats(modes, f"fmu-{interface}", opts.rtol), wall,
-                             outputs=RigOutputs(assembly, model, t, Y, modes))
+    return (np.asarray(res["time"][rows], dtype=float), np.array([np.asarray(res[n][rows], dtype=float) for n in states]),
+            np.asarray(res[mode][rows], dtype=int), wall)
 
 
 def simulate_cs(scenario, model) -> Result:

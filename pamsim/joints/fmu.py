@@ -10,28 +10,22 @@ are counted from the mode's changes between samples (an FMU does not report its 
 
 from __future__ import annotations
 
-import math
 import os
-import time
 from pathlib import Path
 
-import numpy as np
 
 from ..assemblies.one_muscle import RUN_FUNCTIONS, source_parts
-from ..errors import InputError, SolverFailure
+from ..errors import InputError
 from ..fmu.assembly_fmu import spec_of_assembly
 from ..fmu.build import FMI_VERSIONS, build_spec, temp_fmu
 from ..fmu.preset import SIGNAL_UNITS, Experiment, input_signal
-from ..fmu.runner import grid_rows, trace_stats
+from ..fmu.assembly_runner import KINDS, run_trace
+from ..fmu.runner import trace_stats
 from ..fmu.spec import FmuSpec
 from ..modeling.pygen import compiled_by_mode
 from .result import JointResult
 from .scenario import JointScenario
 from .simulate import JointInputs, sampled_signals
-
-KINDS = {"cs": "CoSimulation", "me": "ModelExchange"}
-"""fmpy's name of each interface."""
-
 
 def joint_fmu_spec(scenario: JointScenario, fmi_version: int = 2) -> FmuSpec:
     """The :class:`~pamsim.fmu.spec.FmuSpec` of the FMU of ``scenario``'s joint and muscles.
@@ -87,29 +81,12 @@ def simulate_joint_fmu(scenario: JointScenario, interface: str = "cs", fmi_versi
     SolverFailure
         When fmpy or the FMU fails.
     """
-    from fmpy import simulate_fmu
-
     if interface not in KINDS:
         raise InputError(f"FMU interface must be 'cs' or 'me', not {interface!r}")
     spec = joint_fmu_spec(scenario, fmi_version)
     path = temp_fmu(spec.token, f"{spec.identifier}_fmi{fmi_version}.fmu", lambda out: build_spec(out, spec))
+    t, Y, modes, wall = run_trace(path, interface, scenario.duration_s, scenario.solver, spec.states, "joint.mode")
     opts = scenario.solver
-    dt = 1.0 / opts.sample_rate_Hz
-    start = {"cs_relative_tolerance": opts.rtol}
-    if math.isfinite(opts.max_step_s):
-        start["cs_max_step_s"] = opts.max_step_s
-    wall0 = time.perf_counter()
-    try:
-        res = simulate_fmu(str(path), fmi_type=KINDS[interface], solver="CVode", start_time=0.0,
-                           stop_time=scenario.duration_s, output_interval=dt, relative_tolerance=opts.rtol,
-                           start_values=start, output=[*spec.states, "joint.mode"], validate=False)
-    except Exception as exc:  # fmpy raises a bare Exception carrying the FMI status
-        raise SolverFailure(f"FMU {KINDS[interface]} of the joint failed: {exc}") from None
-    wall = time.perf_counter() - wall0
-    rows = grid_rows(res["time"], dt)
-    t = np.asarray(res["time"][rows], dtype=float)
-    Y = np.array([np.asarray(res[name][rows], dtype=float) for name in spec.states])
-    modes = np.asarray(res["joint.mode"][rows], dtype=int)
     assembly = scenario.assembly()
     muscles = scenario.joint_muscles()
     signals = sampled_signals(compiled_by_mode(assembly, "joint", RUN_FUNCTIONS), assembly.parameter_values(), Y,

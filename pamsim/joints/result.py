@@ -8,8 +8,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..atomic import atomic_path
 from ..components.stick_slip import BodyMode
+from ..result import write_columns
 
 MUSCLE_COLUMNS = ("p_gauge_Pa", "x_m", "F_tendon_N", "tau_Nm")
 """Per muscle, the columns of a joint run's CSV (``<muscle>.<quantity>``)."""
@@ -106,10 +106,7 @@ class JointResult:
 
     def to_csv(self, path) -> None:
         """Write :meth:`columns`, one row per sample. Atomic."""
-        cols = self.columns()
-        data = np.column_stack([np.asarray(v, dtype=float) for v in cols.values()])
-        with atomic_path(path) as tmp:
-            np.savetxt(tmp, data, delimiter=",", header=",".join(cols), comments="", fmt="%.10g")
+        write_columns(path, self.columns())
 
     def summary(self) -> dict:
         """The run in numbers: final and extreme angles, final mode, each muscle's final pressure, tendon
