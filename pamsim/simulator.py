@@ -352,13 +352,24 @@ class SteppedRun:
 
     def __init__(self, model: MuscleModel, options: SolverOptions | None = None, x0_m: float = 0.0,
                  p0_gauge_Pa: float | None = None, added: tuple = ()):
-        self._run = _Run(model, 0.0, options or SolverOptions(), x0_m, p0_gauge_Pa, None, added)
+        self._attach(_Run(model, 0.0, options or SolverOptions(), x0_m, p0_gauge_Pa, None, added))
+
+    @classmethod
+    def of(cls, run: HybridRun) -> "SteppedRun":
+        """A stepped run of any assembly's :class:`HybridRun` (muscles on a joint, say), its inputs those
+        its :class:`GeneratedCode` reads."""
+        self = cls.__new__(cls)
+        self._attach(run)
+        return self
+
+    def _attach(self, run: HybridRun) -> None:
+        self._run = run
         self._started = False
-        self.assembly = self._run.gen.assembly
+        self.assembly = run.gen.assembly
         """The assembly the run integrates (the rig and the components added to it)."""
-        self.state_names = tuple(self._run.gen.code[Mode.STICK].names["states"])
+        self.state_names = tuple(run.gen.code[Mode.STICK].names["states"])
         """The states' names, in the order of :attr:`y` (the flat model's)."""
-        self.output_names = tuple(self._run.gen.code[Mode.STICK].names["outputs"])
+        self.output_names = tuple(run.gen.code[Mode.STICK].names["outputs"])
         """The outputs' names, in the order :meth:`outputs` returns them."""
 
     @property

@@ -27,7 +27,7 @@ from conftest import SCENARIOS
 
 from pamsim.joints import JointScenario, is_joint_spec
 
-EXAMPLES = {"joint_mutations": 400, "scenario_mutations": 1000, "scenario_random": 350, "scenario_text": 300, "sweep_mutations": 400}
+EXAMPLES = {"joint_mutations": 900, "scenario_mutations": 1000, "scenario_random": 350, "scenario_text": 300, "sweep_mutations": 400}
 FUZZ = settings(derandomize=True, deadline=None, database=None,
                 suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
 
@@ -114,10 +114,13 @@ def test_mutated_scenarios_are_valid_or_one_line_errors(name, data):
     _outcome_scenario(_mutate(VALID[name], data))
 
 
+JOINTS = sorted(name for name, doc in VALID.items() if is_joint_spec(doc))
+
+
 @settings(FUZZ, max_examples=EXAMPLES["joint_mutations"])
-@given(data=st.data())
-def test_mutated_joint_scenarios_are_valid_or_one_line_errors(data):
-    _outcome_scenario(_mutate(VALID["antagonistic_pair"], data))
+@given(name=st.sampled_from(JOINTS), data=st.data())
+def test_mutated_joint_scenarios_are_valid_or_one_line_errors(name, data):
+    _outcome_scenario(_mutate(VALID[name], data))
 
 
 @settings(FUZZ, max_examples=EXAMPLES["scenario_random"])

@@ -4,6 +4,7 @@ finite differences, symmetry, the energy balance, slack tendons, and bad scenari
 from __future__ import annotations
 
 import copy
+import re
 import math
 import subprocess
 import sys
@@ -420,3 +421,86 @@ def test_pamsim_linearize_a_joint_prints_the_mimo_model():
     assert rep["inputs"][:2] == ["flexor.prescribed_pressure_gauge_Pa", "extensor.prescribed_pressure_gauge_Pa"]
     again = subprocess.run([sys.executable, "-m", "pamsim", "linearize", str(PAIR_FILE)], capture_output=True, text=True)
     assert again.returncode == 2 and "muscle 'flexor': pressure.source = 'valve'" in again.stderr
+
+
+CONTROLLED = ROOT / "scenarios" / "pair_angle_stiffness.toml"
+
+
+def test_the_feedforward_rests_the_link_at_the_angle_with_the_commanded_stiffness():
+    """At each angle of its table the feedforward's pressures hold the link there at rest (net torque 0)
+    with the commanded stiffness, to the statics' precision."""
+    from pamsim.joints.control import controller_of
+
+    scenario = load_joint_scenario(CONTROLLED)
+    controller = controller_of(scenario)
+    statics = JointStatics(scenario)
+    ff = controller.feedforward
+    for theta, p in zip(ff.grid_rad, ff.p_Pa):
+        assert abs(statics.net_torque_Nm(theta, p)) < 1e-11
+        assert statics.stiffness_Nm_per_rad(theta, p) == pytest.approx(0.15, rel=1e-9)
+
+
+def test_the_pid_puts_the_linear_loops_poles_where_it_was_designed():
+    """The linear model about the reference's start, closed with the PID (its torque through the model's
+    own torque input), has the characteristic polynomial J (s + w)^3 / J, w the scenario's bandwidth."""
+    from pamsim.joints.control import controller_of
+    from pamsim.joints.linear import linearize_joint
+
+    scenario = load_joint_scenario(CONTROLLED)
+    controller = controller_of(scenario)
+    g, w = controller.gains, scenario.controller["bandwidth_rad_s"]
+    lm = linearize_joint(scenario, list(controller.feedforward(0.0)))
+    b = lm.B[:, 2]  # the external torque's column: 1 / J on the angular acceleration
+    # states theta, omega, integral of (reference - theta); torque = -Kp theta + Ki z - Kd omega
+    closed = np.array([[lm.A[0, 0], lm.A[0, 1], 0.0],
+                       [lm.A[1, 0] - b[1] * g.Kp, lm.A[1, 1] - b[1] * g.Kd, b[1] * g.Ki],
+                       [-1.0, 0.0, 0.0]])
+    np.testing.assert_allclose(np.poly(closed), [1.0, 3 * w, 3 * w * w, w ** 3], rtol=1e-9)
+
+
+@pytest.mark.parametrize("backend", ["python", "native"])
+def test_the_controlled_pair_meets_its_spec(backend):
+    """pair_angle_stiffness.toml on both backends: the angle settles on each step and follows the
+    sinusoid, the stiffness stays at its command, within the scenario's [controller.spec]."""
+    from pamsim.joints.control import controller_of, metrics, spec_failures
+
+    scenario = load_joint_scenario(CONTROLLED)
+    controller = controller_of(scenario)
+    run = controller.run(backend)
+    measured = metrics(run, controller.reference, scenario.controller["settle_s"], scenario.duration_s)
+    assert set(measured) == {"step_angle_rms_rad", "sine_angle_rms_rad", "stiffness_rms_Nm_per_rad"}
+    assert spec_failures(measured, scenario.controller["spec"]) == []
+    assert np.max(run.theta_rad) > 0.29 and np.min(run.theta_rad) < -0.39  # it did move through the references
+
+
+CONTROLLER_BAD = [
+    (lambda c: c.update(kind="lqr"), "controller.kind = 'lqr': must be 'angle_stiffness'"),
+    (lambda c: c.update(gain=1.0), "controller.gain = 1.0: unknown key"),
+    (lambda c: c.update(steps_angle_rad=[0.9, -0.2]), "controller.steps_angle_rad[0] = 0.9: must lie between"),
+    (lambda c: c.update(steps_time_s=[2.0, 0.5]), "controller.steps_time_s[1] = 0.5: must be after"),
+    (lambda c: c.pop("stiffness_Nm_per_rad"), "controller.stiffness_Nm_per_rad is required"),
+    (lambda c: c["spec"].update(overshoot_max=1.0), "controller.spec.overshoot_max = 1.0: unknown key"),
+]
+
+
+@pytest.mark.parametrize("change, message", CONTROLLER_BAD, ids=[m.split(":")[0] for _, m in CONTROLLER_BAD])
+def test_a_bad_controller_table_is_refused_by_key(change, message):
+    spec = tomllib.loads(CONTROLLED.read_text())
+    change(spec["controller"])
+    with pytest.raises(ScenarioError, match=re.escape(message)):
+        JointScenario.from_dict(spec, origin="c.toml")
+    valve = tomllib.loads(CONTROLLED.read_text())
+    valve["muscle"][0]["pressure"] = {"source": "valve", "supply_gauge_bar": 3.0, "valve_open_time_s": 0.1}
+    with pytest.raises(ScenarioError, match="muscle 'flexor'.pressure.source = 'valve'"):
+        JointScenario.from_dict(valve, origin="c.toml")
+
+
+def test_pamsim_run_exits_1_when_the_controlled_joint_misses_its_spec(tmp_path):
+    strict = tmp_path / "strict.toml"
+    strict.write_text(CONTROLLED.read_text().replace("sine_angle_rms_max_rad = 5.0e-3", "sine_angle_rms_max_rad = 1.0e-4"))
+    done = subprocess.run([sys.executable, "-m", "pamsim", "run", str(strict), "-o", str(tmp_path / "out"), "--no-plot",
+                           "--backend", "native"], capture_output=True, text=True)
+    assert done.returncode == 1, done.stderr
+    assert "misses its specification: sine_angle_rms_rad" in done.stdout
+    summary = __import__("json").loads((tmp_path / "out" / "pair_angle_stiffness.json").read_text())
+    assert summary["meets_spec"] is False and summary["metrics"]["step_angle_rms_rad"] < 1e-3

@@ -110,9 +110,45 @@ def is_joint(scenario) -> bool:
     return type(scenario).__name__ == "JointScenario"  # without importing pamsim.joints for --help
 
 
+def _run_joint_controller(scenario, args: argparse.Namespace, out: Path) -> list[str]:
+    """A joint under its ``[controller]``: write NAME.csv, NAME.json and the figure; return the spec's misses."""
+    from ..figure_style import save
+    from ..joints.control import controller_of, metrics, spec_failures
+    from ..joints.plots import closed_loop_figure
+    from ..result import write_columns
+
+    controller = controller_of(scenario)
+    run = controller.run(args.backend)
+    measured = metrics(run, controller.reference, scenario.controller["settle_s"], scenario.duration_s)
+    failures = spec_failures(measured, scenario.controller["spec"])
+    names = tuple(t["name"] for t, _ in scenario.muscles)
+    summary = {"name": scenario.name, "backend": args.backend,
+               "gains": {k: float(v) for k, v in vars(controller.gains).items()}, "metrics": measured,
+               "spec": scenario.controller["spec"], "meets_spec": not failures, "failures": failures,
+               "final_theta_rad": float(run.theta_rad[-1])}
+    fmt, dpi = args.figures
+    files = [f"{scenario.name}.csv", f"{scenario.name}.json"] + ([] if args.no_plot else [f"{scenario.name}.{fmt}"])
+    with atomic_outputs(out, files) as tmp:
+        write_columns(tmp[files[0]], run.columns(names))
+        tmp[files[1]].write_text(json.dumps(summary, indent=2) + "\n")
+        if not args.no_plot:
+            save(closed_loop_figure(run, names, f"{scenario.name}: angle at "
+                                    f"{controller.k_Nm_per_rad:g} N m/rad ({args.backend})"), tmp[files[2]],
+                 fmt=fmt, dpi=dpi)
+    print(f"{scenario.name}: " + ", ".join(f"{k} {v:.4g}" for k, v in measured.items())
+          + f"; gains Kp {controller.gains.Kp:.4g} N m/rad, Ki {controller.gains.Ki:.4g} N m/(rad s), "
+          f"Kd {controller.gains.Kd:.4g} N m s/rad")
+    print("  meets its specification" if not failures else "  misses its specification: " + "; ".join(failures))
+    print(f"wrote {', '.join(str(out / n) for n in files)}")
+    return failures
+
+
 def _check_joint(scenario, args: argparse.Namespace) -> None:
     from ..joints import BACKENDS as JOINT_BACKENDS
 
+    if scenario.controller is not None and args.backend not in ("python", "native"):
+        raise InputError(f"{scenario.origin}: --backend {args.backend}: a joint under a [controller] runs on the "
+                         "python and native backends")
     if args.backend not in JOINT_BACKENDS:
         raise InputError(f"{scenario.origin}: --backend {args.backend}: muscles on a joint run on the "
                          f"{' and '.join(JOINT_BACKENDS)} backends so far")
@@ -130,6 +166,8 @@ def _run_joint(scenario, args: argparse.Namespace, out: Path) -> list[str]:
     from ..joints.plots import joint_figure
     from ..joints.static import JointStatics
 
+    if scenario.controller is not None:
+        return _run_joint_controller(scenario, args, out)
     result = simulate_joint(scenario, args.backend)
     fmt, dpi = args.figures
     names = [f"{scenario.name}.csv", f"{scenario.name}.json"] + ([] if args.no_plot else [f"{scenario.name}.{fmt}"])

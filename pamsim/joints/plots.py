@@ -75,3 +75,27 @@ def equilibrium_map_figure(emap) -> Figure:
     fig.suptitle("Joint at rest: angle and stiffness over the two pressures (white: lines of equal angle)",
                  fontsize="medium")
     return fig
+
+
+def closed_loop_figure(run, names, title: str) -> Figure:
+    """A closed-loop joint run (:class:`pamsim.joints.control.ClosedLoopJoint`): the angle against its
+    reference, the two muscles' pressures (``names``, in the scenario's order), and the stiffness against
+    its target."""
+    fig = Figure(figsize=(7.5, 8.0), layout="constrained")
+    ax_theta, ax_p, ax_k = fig.subplots(3, 1, sharex=True)
+    t = run.t_s
+    ax_theta.plot(t, np.degrees(run.reference_rad), label="reference", **series(1, "C7"))
+    ax_theta.plot(t, np.degrees(run.theta_rad), color="k", label="angle")
+    ax_theta.set_ylabel("joint angle [deg]")
+    ax_theta.legend(loc="best", fontsize="small")
+    for k, name in enumerate(names):
+        ax_p.plot(t, run.p_Pa[:, k] / PA_PER_BAR, label=name, **series(k))
+    ax_p.set_ylabel("gauge pressure [bar]\n(the controller's outputs)")
+    ax_p.legend(loc="best", fontsize="small")
+    ax_k.plot(t, run.k_Nm_per_rad, color="k", label="stiffness at rest at the angle and pressures")
+    ax_k.axhline(run.k_target_Nm_per_rad, **series(1, "C3"), label="commanded")
+    ax_k.set_ylabel("stiffness [N m/rad]")
+    ax_k.set_xlabel("time [s]")
+    ax_k.legend(loc="best", fontsize="small")
+    fig.suptitle(title, fontsize="medium")
+    return fig

@@ -48,7 +48,16 @@ JOINT_KEYS: dict[str, tuple[float | None, str]] = {
 (9.81 m/s^2, as the one-muscle scenarios); min_rebound_speed_rad_s is assumed (a slower rebound than 1 mrad/s
 moves the link by less than any angle a figure resolves)."""
 MUSCLE_KEYS = {"name", "side", "radius_m", "x_at_zero_m", "model", "parameters", "pressure"}
-TOP_KEYS = {"name", "description", "joint", "muscle", "simulation", "solver"}
+TOP_KEYS = {"name", "description", "joint", "muscle", "simulation", "solver", "controller"}
+CONTROLLER_KEYS: dict[str, tuple[object, str]] = {
+    "kind": (None, "text"), "sample_rate_Hz": (1000.0, "positive"), "stiffness_Nm_per_rad": (None, "positive"),
+    "bandwidth_rad_s": (80.0, "positive"), "steps_time_s": ((), "list"), "steps_angle_rad": ((), "list"),
+    "sine_start_s": (math.inf, "non_negative"), "sine_amplitude_rad": (0.0, "non_negative"),
+    "sine_frequency_Hz": (0.0, "non_negative"), "settle_s": (0.3, "non_negative"), "spec": ({}, "table")}
+"""``[controller]`` keys of a joint: default (None: required) and kind.  The defaults: a 1 kHz controller;
+its PID's poles at -80 rad/s (about the shipped pair's open-loop frequency, sqrt(k/J)); 0.3 s after a
+step before its error counts as settled (the pair's transients ring out within it)."""
+SPEC_KEYS = ("step_angle_rms_max_rad", "sine_angle_rms_max_rad", "stiffness_rms_max_Nm_per_rad")
 SOLVER_KEYS = {"method", "rtol", "max_events", "max_step_s"}
 PLACEHOLDER_LOAD = {"weight_N": 1.0}
 """A muscle's one-muscle scenario needs a load; on a joint its tendon carries the load instead, and this
@@ -91,6 +100,8 @@ class JointScenario:
     origin: str = "<dict>"
     external_torque: Any = field(default=Constant(0.0), repr=False)
     """The external torque on the link [N m], a signal of time (``[joint.external_torque]``; default none)."""
+    controller: Mapping[str, Any] | None = field(default=None, repr=False)
+    """The ``[controller]`` table, checked (:data:`CONTROLLER_KEYS`), or None for an open-loop run."""
 
     @classmethod
     def from_dict(cls, spec: Mapping[str, Any], origin: str = "<dict>", base_dir: str | Path = ".") -> "JointScenario":
@@ -116,7 +127,8 @@ class JointScenario:
         shared = {"solver": solver, "simulation": {"duration_s": duration, "sample_rate_Hz": rate}}
         muscles = _muscles(origin, spec.get("muscle"), shared, Path(base_dir))
         # Each muscle's one-muscle scenario has read the [solver] table, with its checks and messages.
-        scenario = cls(name, spec, joint, muscles, duration, muscles[0][1].solver, origin, external)
+        controller = _controller(origin, spec["controller"], joint, muscles) if "controller" in spec else None
+        scenario = cls(name, spec, joint, muscles, duration, muscles[0][1].solver, origin, external, controller)
         scenario._check_limits()
         return scenario
 
@@ -222,3 +234,50 @@ def _muscle(origin: str, where: str, table: dict, shared: dict, base_dir: Path):
     one = {"model": table.get("model", {}), "parameters": table.get("parameters", {}), "pressure": table["pressure"],
            "load": PLACEHOLDER_LOAD, **shared}
     return values, Scenario.from_dict(one, name=table["name"], base_dir=base_dir, origin=f"{origin}: {where}")
+
+
+def _controller(origin: str, table, joint: dict, muscles) -> dict:
+    """The ``[controller]`` table checked: its keys, kinds and ranges, steps inside the joint's limits, two
+    muscles on prescribed pressures (the controller's outputs take their place)."""
+    table = _table(origin, "controller", table)
+    for key in sorted(set(table) - set(CONTROLLER_KEYS)):
+        _fail(origin, f"controller.{key}", table[key], f"unknown key; [controller] has {sorted(CONTROLLER_KEYS)}")
+    if table.get("kind") != "angle_stiffness":
+        _fail(origin, "controller.kind", table.get("kind"), "must be 'angle_stiffness' (angle tracking at a commanded stiffness)")
+    out = {"kind": "angle_stiffness"}
+    for key, (default, kind) in CONTROLLER_KEYS.items():
+        if key in ("kind", "spec", "steps_time_s", "steps_angle_rad"):
+            continue
+        if key not in table and default is None:
+            raise ScenarioError(f"{origin}: controller.{key} is required")
+        out[key] = _number(origin, f"controller.{key}", table.get(key, default), kind) if key in table else default
+    out["steps_time_s"], out["steps_angle_rad"] = _steps(origin, table, joint)
+    spec = _table(origin, "controller.spec", table.get("spec", {}))
+    for key in sorted(set(spec) - set(SPEC_KEYS)):
+        _fail(origin, f"controller.spec.{key}", spec[key], f"unknown key; [controller.spec] has {list(SPEC_KEYS)}")
+    out["spec"] = {key: _number(origin, f"controller.spec.{key}", v, "positive") for key, v in spec.items()}
+    for t, sc in muscles:
+        if sc.spec["pressure"]["source"] != "prescribed":
+            _fail(origin, f"muscle {t['name']!r}.pressure.source", sc.spec["pressure"]["source"],
+                  "under a [controller] a muscle's pressure is the controller's output: give source = 'prescribed'")
+    if len(muscles) != 2:
+        _fail(origin, "controller.kind", "angle_stiffness", f"drives two muscles, not {len(muscles)}")
+    return out
+
+
+def _steps(origin: str, table: dict, joint: dict) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    times, angles = table.get("steps_time_s", []), table.get("steps_angle_rad", [])
+    for key, values in (("steps_time_s", times), ("steps_angle_rad", angles)):
+        if not isinstance(values, list):
+            _fail(origin, f"controller.{key}", values, "must be a list of numbers")
+    times = [_number(origin, f"controller.steps_time_s[{k}]", v, "non_negative") for k, v in enumerate(times)]
+    angles = [_number(origin, f"controller.steps_angle_rad[{k}]", v, "any") for k, v in enumerate(angles)]
+    if len(times) != len(angles):
+        _fail(origin, "controller.steps_angle_rad", f"{len(angles)} values", f"must be as many as steps_time_s ({len(times)})")
+    for k in range(1, len(times)):
+        if times[k] <= times[k - 1]:
+            _fail(origin, f"controller.steps_time_s[{k}]", times[k], f"must be after steps_time_s[{k - 1}] = {times[k - 1]:g}")
+    for k, a in enumerate(angles):
+        if not joint["theta_min_rad"] < a < joint["theta_max_rad"]:
+            _fail(origin, f"controller.steps_angle_rad[{k}]", a, "must lie between the joint's limits")
+    return tuple(times), tuple(angles)
