@@ -458,9 +458,9 @@ def test_the_pid_puts_the_linear_loops_poles_where_it_was_designed():
     np.testing.assert_allclose(np.poly(closed), [1.0, 3 * w, 3 * w * w, w ** 3], rtol=1e-9)
 
 
-@pytest.mark.parametrize("backend", ["python", "native"])
+@pytest.mark.parametrize("backend", ["python", "native", "fmu-cs"])
 def test_the_controlled_pair_meets_its_spec(backend):
-    """pair_angle_stiffness.toml on both backends: the angle settles on each step and follows the
+    """pair_angle_stiffness.toml on the python and native backends and through its FMU in co-simulation: the angle settles on each step and follows the
     sinusoid, the stiffness stays at its command, within the scenario's [controller.spec]."""
     from pamsim.joints.control import controller_of, metrics, spec_failures
 

@@ -146,9 +146,9 @@ def _run_joint_controller(scenario, args: argparse.Namespace, out: Path) -> list
 def _check_joint(scenario, args: argparse.Namespace) -> None:
     from ..joints import BACKENDS as JOINT_BACKENDS
 
-    if scenario.controller is not None and args.backend not in ("python", "native"):
+    if scenario.controller is not None and args.backend not in ("python", "native", "fmu-cs"):
         raise InputError(f"{scenario.origin}: --backend {args.backend}: a joint under a [controller] runs on the "
-                         "python and native backends")
+                         "python, native and fmu-cs backends (the controller steps the plant sample by sample)")
     if args.backend not in JOINT_BACKENDS:
         raise InputError(f"{scenario.origin}: --backend {args.backend}: muscles on a joint run on the "
                          f"{' and '.join(JOINT_BACKENDS)} backends so far")

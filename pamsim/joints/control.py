@@ -236,12 +236,13 @@ class AngleStiffnessController:
 
     def run(self, backend: str = "python") -> ClosedLoopJoint:
         """The closed loop over the scenario's duration: the plant on the python backend (``solve_ivp``,
-        exact stick/slip) or the native one (the generic engine, advanced a sample at a time).
+        exact stick/slip), the native one (the generic engine, advanced a sample at a time) or its FMU in
+        co-simulation (``fmu-cs``).
 
         Raises
         ------
         InputError
-            A backend other than python and native.
+            A backend other than those three.
         """
         if backend not in STEPPERS:
             raise InputError(f"{self.scenario.origin}: backend {backend!r}: the joint's controller runs on "
@@ -311,6 +312,59 @@ class _EngineStepper:
         self.session.advance(self._inputs(self.session.time_s), t_end_s)
 
 
+class _FmuStepper:
+    """The joint's FMU in co-simulation (fmpy, FMI 2.0), stepped by its caller with the pressures ``held``
+    holds set as its inputs (``input_source = importer``) before each step; its own Dormand-Prince 5(4)
+    at the scenario's ``rtol``."""
+
+    def __init__(self, scenario: JointScenario, held: np.ndarray):
+        import shutil
+        import weakref
+
+        from fmpy import extract, read_model_description
+        from fmpy.fmi2 import FMU2Slave
+
+        from ..fmu.build import build_spec, temp_fmu
+        from .fmu import joint_fmu_spec
+
+        spec = joint_fmu_spec(scenario)
+        path = temp_fmu(spec.token, f"{spec.identifier}_fmi2.fmu", lambda out: build_spec(out, spec))
+        md = read_model_description(str(path))
+        vr = {v.name: v.valueReference for v in md.modelVariables}
+        unzipped = extract(str(path))
+        self.fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzipped, modelIdentifier=md.coSimulation.modelIdentifier,
+                             instanceName="joint")
+        self._cleanup = weakref.finalize(self, shutil.rmtree, unzipped, True)
+        self.state_names = tuple(spec.states)
+        self._states = [vr[n] for n in spec.states]
+        self._inputs_vr = [vr[n] for n in spec.inputs]
+        self._mode = [vr["joint.mode"]]
+        self.held, self.external, self.t = held, scenario.external_torque, 0.0
+        self.fmu.instantiate()
+        self.fmu.setupExperiment(startTime=0.0, stopTime=scenario.duration_s)
+        self.fmu.setInteger([vr["input_source"]], [0])
+        self.fmu.setReal([vr["cs_relative_tolerance"]], [scenario.solver.rtol])
+        self.fmu.setReal(self._inputs_vr, self._inputs(0.0))
+        self.fmu.enterInitializationMode()
+        self.fmu.exitInitializationMode()
+
+    def _inputs(self, t: float) -> list[float]:
+        return [*map(float, self.held), float(self.external(t))]
+
+    @property
+    def y(self) -> np.ndarray:
+        return np.array(self.fmu.getReal(self._states))
+
+    @property
+    def mode(self) -> int:
+        return int(self.fmu.getInteger(self._mode)[0])
+
+    def advance(self, t_end_s: float) -> None:
+        self.fmu.setReal(self._inputs_vr, self._inputs(self.t))
+        self.fmu.doStep(currentCommunicationPoint=self.t, communicationStepSize=t_end_s - self.t)
+        self.t = t_end_s
+
+
 def _stepper(scenario: JointScenario, held: np.ndarray) -> SteppedRun:
     """A stepped python run of the joint with each muscle's pressure the value ``held`` holds."""
     assembly = _pressure_assembly(scenario)
@@ -324,5 +378,5 @@ def _stepper(scenario: JointScenario, held: np.ndarray) -> SteppedRun:
     return SteppedRun.of(HybridRun(gen, scenario.duration_s, scenario.solver, (), math.inf, None))
 
 
-STEPPERS = {"python": _stepper, "native": _EngineStepper}
+STEPPERS = {"python": _stepper, "native": _EngineStepper, "fmu-cs": _FmuStepper}
 """How the controller's plant runs, by backend."""
