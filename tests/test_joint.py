@@ -504,3 +504,63 @@ def test_pamsim_run_exits_1_when_the_controlled_joint_misses_its_spec(tmp_path):
     assert "misses its specification: sine_angle_rms_rad" in done.stdout
     summary = __import__("json").loads((tmp_path / "out" / "pair_angle_stiffness.json").read_text())
     assert summary["meets_spec"] is False and summary["metrics"]["step_angle_rms_rad"] < 1e-3
+
+
+def lever_pair() -> dict:
+    """The pair on levers: each muscle from an anchor 0.35 m from the joint on the base to a point 0.03 m
+    from it on the link, the arms at right angles at angle zero, a tendon that makes it 20 mm contracted
+    there (0.3 m muscle, path sqrt(0.03^2 + 0.35^2))."""
+    spec = prescribed(PAIR, (2.5, 2.0))
+    tendon = math.hypot(0.03, 0.35) - (0.3 - 0.02)
+    for table in spec["muscle"]:
+        for key in ("radius_m", "x_at_zero_m"):
+            table.pop(key)
+        table.update(attachment="lever", link_attach_m=0.03, base_attach_m=0.35, angle_at_zero_rad=math.pi / 2,
+                     tendon_length_m=tendon)
+    spec["joint"].update(theta_min_rad=-0.5, theta_max_rad=0.5)
+    return spec
+
+
+def test_a_lever_attachment_follows_its_geometry():
+    """Muscles on levers: the contraction, the lever arm a d sin(phi) / L and the equilibrium of the hand
+    torque balance written with the geometry, and the stiffness against finite differences."""
+    spec = lever_pair()
+    scenario = JointScenario.from_dict(spec)
+    forces = static_forces(spec)
+    g, j = 9.81, spec["joint"]
+
+    def geometry(side, theta):
+        phi = math.pi / 2 - side * theta
+        L = math.sqrt(0.03 ** 2 + 0.35 ** 2 - 2 * 0.03 * 0.35 * math.cos(phi))
+        return 0.3 - (L - spec["muscle"][0]["tendon_length_m"]), side * 0.03 * 0.35 * math.sin(phi) / L
+
+    def tau(theta, p):
+        total = -j["link_mass_kg"] * g * j["com_distance_m"] * math.sin(theta)
+        for table, force, pk in zip(spec["muscle"], forces, p):
+            x, arm = geometry(table["side"], theta)
+            total += arm * max(float(force.force_N(x, pk)), 0.0)
+        return total
+
+    statics = JointStatics(scenario)
+    p = [2.5 * BAR, 2.0 * BAR]
+    eq = statics.equilibrium(p)
+    assert eq.on_limit is None and eq.theta_rad == pytest.approx(brentq(lambda t: tau(t, p), -0.5, 0.5, xtol=1e-15), abs=1e-10)
+    h = 1e-5
+    assert eq.k_Nm_per_rad == pytest.approx(-(tau(eq.theta_rad + h, p) - tau(eq.theta_rad - h, p)) / (2 * h), rel=1e-6)
+    res = simulate_joint(scenario)
+    x, arm = geometry(1.0, res.theta_rad[-1])
+    assert res.muscle("flexor", "x_m")[-1] == pytest.approx(x, abs=1e-12)
+    assert res.muscle("flexor", "moment_arm_m")[-1] == pytest.approx(arm, rel=1e-12)
+    nat = simulate_joint(scenario, "native")
+    assert abs(nat.theta_rad[-1] - res.theta_rad[-1]) < 1e-5 and res.energy_balance()["relative"] < 2e-5
+
+
+def test_a_lever_whose_arms_line_up_is_refused():
+    spec = lever_pair()
+    spec["muscle"][0]["angle_at_zero_rad"] = 0.3
+    with pytest.raises(ScenarioError, match="muscle 'flexor'.angle_at_zero_rad = 0.3: its lever's arms would line up"):
+        JointScenario.from_dict(spec, origin="lever.toml")
+    spec = lever_pair()
+    spec["muscle"][0]["radius_m"] = 0.01
+    with pytest.raises(ScenarioError, match="radius_m = 0.01: not a key of attachment = 'lever'"):
+        JointScenario.from_dict(spec, origin="lever.toml")

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from ..components import CoulombFriction, MuscleStaticForce, ViscousDamping
-from ..components.pulley import Pulley
+from ..components.pulley import LeverAttachment, Pulley
 from ..components.rotary_joint import RotaryJoint
 from ..modeling import Assembly
 from .one_muscle import rewired, source_parts
@@ -28,7 +28,7 @@ class JointMuscle:
     """One muscle on the joint: its ``name`` (an identifier, the prefix of its components), its
     elements (``static_force``, ``friction``, ``damping``, pressure ``source``, as a
     :class:`pamsim.model.MuscleModel` holds them), its pulley (``radius_m``, ``side`` +1 or -1,
-    contraction ``x_at_zero_m`` at angle zero) and its chamber's initial gauge pressure
+    contraction ``x_at_zero_m`` at angle zero) or lever (``lever``), and its chamber's initial gauge pressure
     (``p0_gauge_Pa``, None: ambient)."""
 
     name: str
@@ -40,6 +40,14 @@ class JointMuscle:
     side: float
     x_at_zero_m: float
     p0_gauge_Pa: float | None = None
+    lever: dict | None = None
+    """A lever attachment's parameters (:class:`pamsim.components.pulley.LeverAttachment`, ``side`` and
+    ``g_m_s2`` aside) in place of the pulley (``radius_m`` and ``x_at_zero_m`` then unused)."""
+
+
+def attachment_name(m: JointMuscle) -> str:
+    """The name of the component that attaches muscle ``m`` to the joint: ``<muscle>_pulley`` or ``<muscle>_lever``."""
+    return f"{m.name}_lever" if m.lever is not None else f"{m.name}_pulley"
 
 
 def joint_assembly(joint_values: dict, muscles: tuple[JointMuscle, ...], g_m_s2: float,
@@ -63,11 +71,14 @@ def joint_assembly(joint_values: dict, muscles: tuple[JointMuscle, ...], g_m_s2:
 
 def _muscle_parts(m: JointMuscle, g_m_s2: float) -> tuple[list, list, dict]:
     """A muscle's components, wiring and model inputs, its components prefixed with its name."""
-    pulley = f"{m.name}_pulley"
+    pulley = attachment_name(m)
     source = rewired(source_parts(m.source, m.p0_gauge_Pa), pulley, m.name)
+    if m.lever is not None:
+        attach = LeverAttachment(pulley, {**m.lever, "side": m.side, "g_m_s2": g_m_s2})
+    else:
+        attach = Pulley(pulley, {"radius_m": m.radius_m, "side": m.side, "x_at_zero_m": m.x_at_zero_m, "g_m_s2": g_m_s2})
     parts = [*source.parts, MuscleStaticForce(f"{m.name}_muscle", m.static_force),
-             CoulombFriction(f"{m.name}_friction", m.friction), ViscousDamping(f"{m.name}_damping", m.damping),
-             Pulley(pulley, {"radius_m": m.radius_m, "side": m.side, "x_at_zero_m": m.x_at_zero_m, "g_m_s2": g_m_s2})]
+             CoulombFriction(f"{m.name}_friction", m.friction), ViscousDamping(f"{m.name}_damping", m.damping), attach]
     p = f"{source.pressure}.p_gauge_Pa"
     # The flange adds the forces in the one-muscle rig's order: static, damping, friction.
     wiring = [*source.wiring, (f"{pulley}.shaft", "joint.shaft"), (f"{pulley}.flange", f"{m.name}_muscle.flange"),

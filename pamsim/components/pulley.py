@@ -1,7 +1,8 @@
-"""A muscle's tendon on a pulley of the joint it turns: the muscle's contraction follows the joint angle,
-and its pull becomes a torque; a tendon only pulls.
+"""How a muscle's tendon turns a joint: on a pulley (a constant lever arm), or from an anchor on the base
+to a point on the link (a lever arm that changes with the angle).  The muscle's contraction follows
+the joint angle, and its pull becomes a torque; a tendon only pulls.
 
-The pulley is the node of its muscle's flange (the static force, damping and friction are branches on
+An attachment is the node of its muscle's flange (the static force, damping and friction are branches on
 it, as on the hanging load) and a branch on the joint's shaft.  A muscle whose forces add up to a push
 (pushed past the contraction at which it pulls nothing) leaves its tendon slack: no force, no torque,
 no friction on the joint.  The slack's start and end are kinks in the torque, which the integrators'
@@ -11,28 +12,25 @@ step control resolves, not events.
 from __future__ import annotations
 
 from ..modeling import ROTATIONAL, TRANSLATIONAL, Component, Equations, Port, Symbols, Var, positive
-from ..modeling.smath import if_else
+from ..modeling.smath import cos, if_else, sin, sqrt
 from .friction import equivalent_mass_kg
 
+SIDE = Var("side", "1", "+1: the muscle turns the joint toward larger angles; -1: toward smaller", lower=-1.0, upper=1.0)
+G = positive("g_m_s2", "m/s^2", "gravitational acceleration (the load-dependent friction's mass)")
 
-class Pulley(Component):
-    """``x = x_at_zero + side r theta`` and ``v = side r omega`` for the muscle; a tendon force
-    ``T = max(F, 0)`` from the sum ``F`` of the muscle's forces; ``tau = side r T`` on the shaft.
 
-    ``side`` is +1 for a muscle that contracts as the angle grows (it turns the joint toward larger
-    angles), -1 for one that contracts as it falls.  The muscle's Coulomb level reaches the joint as
-    ``r F_c`` while the tendon is taut, and the joint's slip direction reaches the muscle's friction as
-    ``side`` times it.  The load-dependent friction law reads the load a muscle holds as a mass: here
-    the mass whose weight equals its static force, ``max(F_static, 0) / g``.
+class TendonAttachment(Component):
+    """A muscle's tendon on a joint, its kinematics given by a subclass: the muscle's contraction
+    ``x(theta)`` and its derivative ``dx/dtheta`` (:meth:`kinematics`).  Then ``v = dx/dtheta omega``, a
+    tendon force ``T = max(F, 0)`` from the sum ``F`` of the muscle's forces, ``tau = dx/dtheta T`` on
+    the shaft (a pull turns the joint the way that contracts the muscle).  The muscle's Coulomb level
+    reaches the joint as ``|dx/dtheta| F_c`` while the tendon is taut, and the joint's slip direction
+    reaches the muscle's friction times the sign of ``dx/dtheta``.  The load-dependent friction law reads
+    the load a muscle holds as the mass whose weight equals its static force, ``max(F_static, 0) / g``.
 
     State ``W_tendon_J``: the work the tendon does on the joint, integral of ``T v``.
     """
 
-    parameters = (positive("radius_m", "m", "pulley radius (the tendon's lever arm)"),
-                  Var("side", "1", "+1: the muscle turns the joint toward larger angles; -1: toward smaller",
-                      lower=-1.0, upper=1.0),
-                  Var("x_at_zero_m", "m", "the muscle's contraction at joint angle zero"),
-                  positive("g_m_s2", "m/s^2", "gravitational acceleration (the load-dependent friction's mass)"))
     ports = (Port("shaft", ROTATIONAL, "branch"), Port("flange", TRANSLATIONAL, "node"))
     inputs = (Var("friction_level_N", "N", "Coulomb friction level of the muscle"),
               Var("joint_direction", "1", "+1 or -1 while the joint angle grows or falls, 0 while held"),
@@ -42,21 +40,61 @@ class Pulley(Component):
                Var("F_tendon_N", "N", "tendon force (zero when slack)"), Var("tau_Nm", "N m", "torque on the joint"),
                Var("taut", "1", "1 while the tendon pulls, 0 while slack"),
                Var("direction", "1", "+1 or -1 while the muscle contracts or extends under the joint's slip, 0 held"),
-               Var("load_mass_kg", "kg", "mass whose weight is the muscle's static force"))
+               Var("load_mass_kg", "kg", "mass whose weight is the muscle's static force"),
+               Var("moment_arm_m", "m", "the tendon's lever arm about the joint, |dx/dtheta|"))
+
+    def kinematics(self, P, theta):
+        """The muscle's contraction at joint angle ``theta`` and its derivative ``dx/dtheta`` [m/rad]."""
+        raise NotImplementedError
 
     def equations(self, s: Symbols) -> Equations:
         P, shaft = s.p, s.port["shaft"]
-        arm = P["side"] * P["radius_m"]
-        x = P["x_at_zero_m"] + arm * shaft["theta_rad"]
+        x, arm = self.kinematics(P, shaft["theta_rad"])
         v = arm * shaft["omega_rad_s"]
         F = s.port["flange"]["F_N"]
         taut = F > 0.0
         T = if_else(taut, F, 0.0)
+        reach = abs(arm)
         return Equations(
             der={"W_tendon_J": T * v},
             outputs={"x_m": x, "v_m_s": v, "F_tendon_N": T, "tau_Nm": arm * T, "taut": if_else(taut, 1.0, 0.0),
-                     "direction": P["side"] * s.u["joint_direction"],
-                     "load_mass_kg": equivalent_mass_kg(s.u["F_static_N"], P["g_m_s2"])},
+                     "direction": if_else(arm >= 0.0, 1.0, -1.0) * s.u["joint_direction"],
+                     "load_mass_kg": equivalent_mass_kg(s.u["F_static_N"], P["g_m_s2"]), "moment_arm_m": reach},
             port={"flange": {"x_m": x, "v_m_s": v},
-                  "shaft": {"tau_Nm": arm * T, "tau_level_Nm": if_else(taut, P["radius_m"] * s.u["friction_level_N"], 0.0)}},
+                  "shaft": {"tau_Nm": arm * T, "tau_level_Nm": if_else(taut, reach * s.u["friction_level_N"], 0.0)}},
             initial={"W_tendon_J": 0.0})
+
+
+class Pulley(TendonAttachment):
+    """A tendon on a pulley of radius ``r``: ``x = x_at_zero + side r theta``, a constant lever arm ``r``."""
+
+    parameters = (positive("radius_m", "m", "pulley radius (the tendon's lever arm)"), SIDE,
+                  Var("x_at_zero_m", "m", "the muscle's contraction at joint angle zero"), G)
+
+    def kinematics(self, P, theta):
+        arm = P["side"] * P["radius_m"]
+        return P["x_at_zero_m"] + arm * theta, arm
+
+
+class LeverAttachment(TendonAttachment):
+    """A muscle from an anchor on the base, ``base_attach_m`` from the joint, to a point on the link,
+    ``link_attach_m`` from it, the two arms at ``angle_at_zero_rad`` apart at joint angle zero, and at
+    ``angle_at_zero_rad - side theta`` at ``theta`` (a muscle of ``side`` +1 pulls the arms together as
+    the angle grows).  The path is ``L = sqrt(a^2 + d^2 - 2 a d cos(phi))``, the muscle the path less its
+    tendon, ``x = muscle_L0_m - (L - tendon_length_m)``, and the lever arm
+    ``|dx/dtheta| = a d sin(phi) / L``: largest with the arms at right angles, zero when they line up.
+    """
+
+    parameters = (positive("link_attach_m", "m", "distance from the joint to the muscle's point on the link"),
+                  positive("base_attach_m", "m", "distance from the joint to the muscle's anchor on the base"),
+                  Var("angle_at_zero_rad", "rad", "angle between the two arms at joint angle zero", lower=0.0,
+                      upper=3.141592653589793), SIDE,
+                  positive("muscle_L0_m", "m", "the muscle's rest length"),
+                  Var("tendon_length_m", "m", "the tendon between the muscle and the link", lower=0.0), G)
+
+    def kinematics(self, P, theta):
+        a, d = P["link_attach_m"], P["base_attach_m"]
+        phi = P["angle_at_zero_rad"] - P["side"] * theta
+        L = sqrt(a * a + d * d - 2.0 * a * d * cos(phi))
+        # dx/dtheta = -dL/dtheta = -(a d sin(phi) / L) dphi/dtheta, dphi/dtheta = -side
+        return P["muscle_L0_m"] - (L - P["tendon_length_m"]), P["side"] * a * d * sin(phi) / L

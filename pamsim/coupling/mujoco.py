@@ -147,10 +147,14 @@ def joint_mjcf(scenario, timestep_s: float = 1e-3) -> str:
     Raises
     ------
     InputError
-        A joint whose link does not hang down at angle zero, or whose inertia is not above its mass's
-        ``m l^2`` about the hinge.
+        A joint whose link does not hang down at angle zero, whose inertia is not above its mass's
+        ``m l^2`` about the hinge, or with a muscle on a lever.
     """
     j = scenario.joint
+    for t, _ in scenario.muscles:
+        if t["lever"] is not None:
+            raise InputError(f"{scenario.origin}: muscle {t['name']!r}: attachment = 'lever': joint_mjcf writes "
+                             "pulleys (fixed tendons); write a spatial tendon for a lever into your own MuJoCo model")
     m, l, J = j["link_mass_kg"], j["com_distance_m"], j["inertia_kg_m2"]
     for key, ok in (("theta_down_rad", j["theta_down_rad"] == 0.0), ("inertia_kg_m2", J > m * l * l)):
         if not ok:

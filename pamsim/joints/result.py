@@ -64,14 +64,20 @@ class JointResult:
 
     def muscle(self, name: str, quantity: str) -> np.ndarray:
         """A muscle's signal: ``p_gauge_Pa`` (its pressure), ``x_m`` (contraction), ``F_tendon_N``,
-        ``tau_Nm`` (its torque on the joint), ``F_static_N``; ``KeyError`` for an unknown one."""
-        where = {"p_gauge_Pa": "pressure", "x_m": "pulley", "F_tendon_N": "pulley", "tau_Nm": "pulley",
-                 "taut": "pulley", "F_static_N": "muscle"}
+        ``tau_Nm`` (its torque on the joint), ``taut``, ``moment_arm_m``, ``F_static_N``; ``KeyError`` for an
+        unknown one."""
+        attach = "pulley" if f"{name}_pulley.x_m" in self.signals else "lever"
+        where = {"p_gauge_Pa": "pressure", "x_m": attach, "F_tendon_N": attach, "tau_Nm": attach,
+                 "taut": attach, "moment_arm_m": attach, "F_static_N": "muscle"}
         if quantity == "p_gauge_Pa":
             found = [k for k in self.signals if k.startswith(f"{name}_") and k.endswith(".p_gauge_Pa")
                      and k.split(".")[0] in (f"{name}_chamber", f"{name}_pressure")]
             return self.signals[found[0]]
         return self.signals[f"{name}_{where[quantity]}.{quantity}"]
+
+    def signals_key(self, muscle: str, name: str) -> str:
+        """The name in :attr:`signals` of the variable ``name`` of ``muscle``'s pulley or lever."""
+        return f"{muscle}_pulley.{name}" if f"{muscle}_pulley.{name}" in self.signals else f"{muscle}_lever.{name}"
 
     def energy_balance(self) -> dict[str, float]:
         """The tendons' and the external torque's work against what the link gained and lost [J].
@@ -82,14 +88,15 @@ class JointResult:
         """
         s = self.signals
         d = lambda key: float(s[key][-1] - s[key][0])  # noqa: E731
-        terms = {f"{m}.W_tendon_J": float(s[f"{m}_pulley.W_tendon_J"][-1]) for m in self.muscles}
+        tendon = {m: self.signals_key(m, "W_tendon_J") for m in self.muscles}
+        terms = {f"{m}.W_tendon_J": float(s[tendon[m]][-1]) for m in self.muscles}
         terms.update({"W_external_J": float(s["joint.W_external_J"][-1]), "dKE_J": d("joint.kinetic_energy_J"),
                       "dPE_J": d("joint.potential_energy_J"), "E_viscous_J": float(s["joint.E_viscous_J"][-1]),
                       "E_coulomb_J": float(s["joint.E_coulomb_J"][-1]), "E_impacts_J": float(sum(self.impact_losses_J))})
         residual = (sum(terms[f"{m}.W_tendon_J"] for m in self.muscles) + terms["W_external_J"] - terms["dKE_J"]
                     - terms["dPE_J"] - terms["E_viscous_J"] - terms["E_coulomb_J"] - terms["E_impacts_J"])
         slack = {f"{m}.slack_J": float(s[f"{m}_muscle.W_muscle_J"][-1] - s[f"{m}_damping.E_damping_J"][-1]
-                                       - s[f"{m}_friction.E_friction_J"][-1] - s[f"{m}_pulley.W_tendon_J"][-1])
+                                       - s[f"{m}_friction.E_friction_J"][-1] - s[tendon[m]][-1])
                  for m in self.muscles}
         scale = max(abs(v) for v in terms.values()) or 1.0
         return {**terms, **slack, "residual_J": float(residual), "relative": float(abs(residual) / scale)}

@@ -32,6 +32,7 @@ from pathlib import Path
 from typing import Any, Mapping
 
 from ..assemblies.joint import JointMuscle, joint_assembly
+from ..components.pulley import LeverAttachment, Pulley
 from ..scenario import Scenario, ScenarioError
 from ..signal_tables import signal_from_table
 from ..signals import Constant
@@ -47,7 +48,11 @@ JOINT_KEYS: dict[str, tuple[float | None, str]] = {
 """``[joint]`` keys: default (None: required) and the range a value must lie in.  g is standard gravity
 (9.81 m/s^2, as the one-muscle scenarios); min_rebound_speed_rad_s is assumed (a slower rebound than 1 mrad/s
 moves the link by less than any angle a figure resolves)."""
-MUSCLE_KEYS = {"name", "side", "radius_m", "x_at_zero_m", "model", "parameters", "pressure"}
+MUSCLE_KEYS = {"name", "side", "radius_m", "x_at_zero_m", "model", "parameters", "pressure", "attachment",
+               "link_attach_m", "base_attach_m", "angle_at_zero_rad", "tendon_length_m"}
+LEVER_KEYS = {"link_attach_m": "positive", "base_attach_m": "positive", "angle_at_zero_rad": "positive",
+              "tendon_length_m": "non_negative"}
+"""A lever attachment's keys in a ``[[muscle]]`` table (``attachment = "lever"``) and their ranges."""
 TOP_KEYS = {"name", "description", "joint", "muscle", "simulation", "solver", "controller"}
 CONTROLLER_KEYS: dict[str, tuple[object, str]] = {
     "kind": (None, "text"), "sample_rate_Hz": (1000.0, "positive"), "stiffness_Nm_per_rad": (None, "positive"),
@@ -136,34 +141,51 @@ class JointScenario:
         """Each muscle's contraction stays inside its own stops (the static model's range) over the
         joint's limits: beyond them its force is not defined."""
         lo, hi = self.joint["theta_min_rad"], self.joint["theta_max_rad"]
-        for table, sc in self.muscles:
+        for m, (table, sc) in zip(self.joint_muscles(), self.muscles):
             stops = sc.build_model().stops
+            if m.lever is not None:
+                phi = [m.lever["angle_at_zero_rad"] - m.side * t for t in (lo, hi)]
+                if not 0.0 < min(phi) and max(phi) < math.pi:
+                    _fail(self.origin, f"muscle {m.name!r}.angle_at_zero_rad", m.lever["angle_at_zero_rad"],
+                          f"its lever's arms would line up within the joint's limits (arm angle from {phi[0]:.4g} to "
+                          f"{phi[1]:.4g} rad, must stay inside (0, pi)): the muscle would have no lever arm there")
             for key, theta in (("theta_min_rad", lo), ("theta_max_rad", hi), ("initial_angle_rad", self.joint["initial_angle_rad"])):
-                x = table["x_at_zero_m"] + table["side"] * table["radius_m"] * theta
+                x = contraction_m(m, theta)
                 if not stops.x_low_m - 1e-12 <= x <= stops.x_high_m + 1e-12:
                     _fail(self.origin, f"joint.{key}", theta,
                           f"muscle {table['name']!r} would contract to {x * 1e3:.2f} mm there, outside its range "
-                          f"[{stops.x_low_m * 1e3:.2f}, {stops.x_high_m * 1e3:.2f}] mm (x_at_zero_m + side radius_m theta)")
+                          f"[{stops.x_low_m * 1e3:.2f}, {stops.x_high_m * 1e3:.2f}] mm (its attachment's geometry)")
 
     def joint_muscles(self) -> tuple[JointMuscle, ...]:
         """The muscles as the joint's assembly takes them."""
         out = []
         for table, sc in self.muscles:
             m = sc.build_model()
+            lever = ({**table["lever"], "muscle_L0_m": sc.parameters["L0_m"]} if table["lever"] is not None else None)
             out.append(JointMuscle(table["name"], m.static_force, m.friction, m.damping, m.source,
-                                   table["radius_m"], table["side"], table["x_at_zero_m"], sc.initial_pressure_gauge_Pa))
+                                   table["radius_m"], table["side"], table["x_at_zero_m"], sc.initial_pressure_gauge_Pa,
+                                   lever))
         return tuple(out)
 
     def joint_values(self) -> dict[str, float]:
         """The :class:`pamsim.components.rotary_joint.RotaryJoint` parameters, the solver's margins in
-        torque (its force margins times the largest pulley radius)."""
-        r = max(t["radius_m"] for t, _ in self.muscles)
+        torque (its force margins times the largest lever arm: a pulley's radius, or a bound on a lever's,
+        its shorter arm)."""
+        r = max(t["radius_m"] if t["lever"] is None else min(t["lever"]["link_attach_m"], t["lever"]["base_attach_m"])
+                for t, _ in self.muscles)
         return {**self.joint, "stick_margin_Nm": self.solver.stick_margin_N * r,
                 "release_margin_Nm": self.solver.release_margin_N * r}
 
     def assembly(self):
         """The joint's assembly (:func:`pamsim.assemblies.joint.joint_assembly`)."""
         return joint_assembly(self.joint_values(), self.joint_muscles(), self.joint["g_m_s2"], name=self.name)
+
+
+def contraction_m(m: JointMuscle, theta_rad: float) -> float:
+    """Muscle ``m``'s contraction at joint angle ``theta_rad``, by its attachment's own kinematics."""
+    if m.lever is None:
+        return Pulley.kinematics(None, {"x_at_zero_m": m.x_at_zero_m, "side": m.side, "radius_m": m.radius_m}, theta_rad)[0]
+    return LeverAttachment.kinematics(None, {**m.lever, "side": m.side}, theta_rad)[0]
 
 
 def load_joint_scenario(path: str | Path) -> JointScenario:
@@ -228,9 +250,20 @@ def _muscle(origin: str, where: str, table: dict, shared: dict, base_dir: Path):
     side = table.get("side")
     if side not in (1, -1) or isinstance(side, bool):
         _fail(origin, f"{where}.side", side, "must be 1 (it turns the joint toward larger angles) or -1")
-    values = {"name": table["name"], "side": float(side),
-              "radius_m": _number(origin, f"{where}.radius_m", table.get("radius_m"), "positive"),
-              "x_at_zero_m": _number(origin, f"{where}.x_at_zero_m", table.get("x_at_zero_m", 0.0), "any")}
+    attachment = table.get("attachment", "pulley")
+    if attachment not in ("pulley", "lever"):
+        _fail(origin, f"{where}.attachment", attachment, "must be 'pulley' (radius_m, x_at_zero_m) or 'lever' "
+              f"({', '.join(LEVER_KEYS)})")
+    own = set(LEVER_KEYS) if attachment == "lever" else {"radius_m", "x_at_zero_m"}
+    for key in sorted((set(LEVER_KEYS) | {"radius_m", "x_at_zero_m"}) - own):
+        if key in table:
+            _fail(origin, f"{where}.{key}", table[key], f"not a key of attachment = {attachment!r}")
+    values = {"name": table["name"], "side": float(side), "radius_m": 0.0, "x_at_zero_m": 0.0, "lever": None}
+    if attachment == "pulley":
+        values["radius_m"] = _number(origin, f"{where}.radius_m", table.get("radius_m"), "positive")
+        values["x_at_zero_m"] = _number(origin, f"{where}.x_at_zero_m", table.get("x_at_zero_m", 0.0), "any")
+    else:
+        values["lever"] = {k: _number(origin, f"{where}.{k}", table.get(k), kind) for k, kind in LEVER_KEYS.items()}
     one = {"model": table.get("model", {}), "parameters": table.get("parameters", {}), "pressure": table["pressure"],
            "load": PLACEHOLDER_LOAD, **shared}
     return values, Scenario.from_dict(one, name=table["name"], base_dir=base_dir, origin=f"{origin}: {where}")
