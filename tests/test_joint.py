@@ -98,8 +98,12 @@ def test_co_contraction_raises_the_stiffness_at_the_same_angle():
 
 
 def symmetric(spec: dict) -> dict:
+    """``spec`` without gravity and without Coulomb friction (the bearing's and the muscles'), so that only
+    the symmetry of the pair, not friction holding the link, keeps it at zero."""
     spec = copy.deepcopy(spec)
-    spec["joint"].update(link_mass_kg=0.0)
+    spec["joint"].update(link_mass_kg=0.0, tau_coulomb_Nm=0.0)
+    for table in spec["muscle"]:
+        table["model"] = dict(table["model"], friction="none", damping="none")
     return spec
 
 
@@ -480,6 +484,7 @@ CONTROLLER_BAD = [
     (lambda c: c.update(steps_time_s=[2.0, 0.5]), "controller.steps_time_s[1] = 0.5: must be after"),
     (lambda c: c.pop("stiffness_Nm_per_rad"), "controller.stiffness_Nm_per_rad is required"),
     (lambda c: c["spec"].update(overshoot_max=1.0), "controller.spec.overshoot_max = 1.0: unknown key"),
+    (lambda c: c.update(sine_amplitude_rad=1.5), "controller.sine_amplitude_rad = 1.5: the sinusoid about -0.2 rad"),
 ]
 
 
@@ -556,11 +561,54 @@ def test_a_lever_attachment_follows_its_geometry():
 
 
 def test_a_lever_whose_arms_line_up_is_refused():
-    spec = lever_pair()
-    spec["muscle"][0]["angle_at_zero_rad"] = 0.3
-    with pytest.raises(ScenarioError, match="muscle 'flexor'.angle_at_zero_rad = 0.3: its lever's arms would line up"):
-        JointScenario.from_dict(spec, origin="lever.toml")
+    for angle in (0.3, 3.0):  # the arms line up at 0 (below the range) or at pi (above it)
+        spec = lever_pair()
+        spec["muscle"][0]["angle_at_zero_rad"] = angle
+        with pytest.raises(ScenarioError, match=f"muscle 'flexor'.angle_at_zero_rad = {angle}: its lever's arms would line up"):
+            JointScenario.from_dict(spec, origin="lever.toml")
     spec = lever_pair()
     spec["muscle"][0]["radius_m"] = 0.01
     with pytest.raises(ScenarioError, match="radius_m = 0.01: not a key of attachment = 'lever'"):
         JointScenario.from_dict(spec, origin="lever.toml")
+
+
+def test_the_papers_damping_alone_does_not_hold_a_frictionless_joint():
+    """The ACRA 2012 damping's slope at rest is negative: without any Coulomb friction a slightly asymmetric
+    pair at 2.5 bar rings up to its limits with it, and settles at its equilibrium with a dissipative law."""
+    spec = prescribed(PAIR, (2.5, 2.5), time_s=0.0)
+    spec["joint"]["tau_coulomb_Nm"] = 0.0
+    spec["muscle"][0]["x_at_zero_m"] = 0.0201
+    ends = {}
+    for damping in ("paper", "linear", "none"):
+        case = copy.deepcopy(spec)
+        for table in case["muscle"]:
+            table["model"] = dict(table["model"], damping=damping)
+        res = simulate_joint(JointScenario.from_dict(case))
+        ends[damping] = (np.max(np.abs(res.theta_rad[res.t_s > 2.5])), res.theta_rad[-1])
+    eq = JointStatics(JointScenario.from_dict(spec)).equilibrium([2.5 * BAR] * 2).theta_rad
+    assert ends["paper"][0] > 0.7
+    for damping in ("linear", "none"):
+        assert abs(ends[damping][1] - eq) < 2e-4
+
+
+@pytest.mark.parametrize("args, message", [
+    (["fmu", "build", "--scenario", str(PAIR_FILE), "--muscle-only", "-o", "{tmp}/m.fmu"], "is a joint scenario"),
+    (["linearize", str(CONTROLLED)], "[controller]: its muscles' prescribed pressures are placeholders"),
+    (["linearize", str(ROOT / "scenarios" / "pair_cocontraction.toml"), "--friction", "regularised"], "--friction:"),
+    (["joint-map", str(ROOT / "scenarios" / "acra2012_fig4.toml"), "-o", "{tmp}/map"], "not a joint scenario"),
+])
+def test_commands_refuse_what_does_not_apply_to_a_joint(tmp_path, args, message):
+    args = [a.replace("{tmp}", str(tmp_path)) for a in args]
+    done = subprocess.run([sys.executable, "-m", "pamsim", *args], capture_output=True, text=True)
+    assert done.returncode == 2 and message in done.stderr and "Traceback" not in done.stderr
+    assert not any(tmp_path.iterdir())
+
+
+def test_a_bandwidth_below_the_joints_own_stiffness_is_refused():
+    spec = tomllib.loads(CONTROLLED.read_text())
+    spec["controller"]["bandwidth_rad_s"] = 20.0
+    from pamsim.errors import InputError
+    from pamsim.joints.control import controller_of
+
+    with pytest.raises(InputError, match="controller.bandwidth_rad_s = 20: the joint's own stiffness"):
+        controller_of(JointScenario.from_dict(spec, origin="c.toml"))

@@ -88,6 +88,9 @@ def run_build(args: argparse.Namespace) -> int:
 
         scenario = load_any_scenario(Path(args.scenario))
         if is_joint(scenario):
+            if args.muscle_only:
+                raise InputError(f"--muscle-only: {args.scenario} is a joint scenario; give a one-muscle scenario "
+                                 "(its muscle, model and pressure source) for the muscle-only FMU")
             return _build_joint(scenario, args)
         if args.muscle_only:
             return _build_muscle_only(scenario, args)
@@ -107,6 +110,9 @@ def _build_joint(scenario, args: argparse.Namespace) -> int:
     print(f"wrote {path} (FMI {args.fmi}.0, Model Exchange and Co-Simulation, the joint and its "
           f"{len(scenario.muscles)} muscles of scenario {scenario.name}: structured variable names such as "
           "joint.theta_rad)")
+    if scenario.controller is not None:
+        print("  the scenario's [controller] is not in the FMU: it is the plant, its pressure inputs "
+              "(input_source = importer) the importer's controller's to set")
     return 0
 
 

@@ -125,7 +125,14 @@ def _linearize_joint(scenario, args: argparse.Namespace) -> int:
     from ..errors import InputError
     from ..joints.linear import linearize_joint
 
-    for flag, value in (("--at-time", args.at_time), ("--contraction-mm", args.contraction_mm), ("-o", args.output)):
+    given = {"--at-time": args.at_time, "--contraction-mm": args.contraction_mm, "-o": args.output,
+             "--friction": None if args.friction == "dropped" else args.friction,
+             "--valve-slope": None if args.valve_slope == "mean" else args.valve_slope}
+    if scenario.controller is not None:
+        raise InputError(f"{scenario.origin}: [controller]: its muscles' prescribed pressures are placeholders for "
+                         "the controller's; linearise the joint without it (pamsim.joints.linear.linearize_joint at "
+                         "the pressures you choose)")
+    for flag, value in given.items():
         if value is not None:
             raise InputError(f"{flag}: a joint is linearised about its equilibrium at the muscles' final "
                              "pressures; this option is for one muscle")

@@ -5,8 +5,9 @@ stiffness through their sum.  The controller inverts the static map for both at 
 for the reference angle ``theta_r`` and the commanded stiffness ``k_r`` it takes the pressures at which
 the link rests at ``theta_r`` with stiffness ``k_r`` (:class:`FeedforwardMap`, solved by Newton's method
 on :class:`pamsim.joints.static.JointStatics` at a grid of angles, interpolated between them).  A PID
-on the angle error adds a differential pressure (the flexor's up, the extensor's down, in the ratio
-that leaves the stiffness unchanged to first order), with gains placed on the linear model at the
+on the angle error adds a differential pressure (the flexor's up and the extensor's down by the same
+amount, which for a symmetric pair moves the stiffness little: 5.7e-9 N m/rad per Pa on the shipped
+pair at 0.3 rad), with gains placed on the linear model at the
 reference's start (:func:`pamsim.joints.linear.linearize_joint`): three closed-loop poles at
 ``-bandwidth``.  The muscles' pressures are the controller's outputs, held over each sample (pressure-
 regulated muscles: pamsim's choice, the valves' dynamics left out).  The run is the python backend's
@@ -98,7 +99,7 @@ def _solve(statics: JointStatics, theta: float, k: float, p0, p_max_Pa: float) -
         J = np.column_stack([(_residual(statics, theta, k, p + d) - r) / 10.0 for d in np.eye(2) * 10.0])
         p = np.clip(p - np.linalg.solve(J, r), 0.0, p_max_Pa)
     raise InputError(f"no pressures within [0, {p_max_Pa / BAR:g}] bar hold the link at {theta:.4g} rad with "
-                     f"stiffness {k:g} N m/rad (controller.stiffness_Nm_per_rad)")
+                     f"that stiffness")
 
 
 @dataclass(frozen=True)
@@ -119,7 +120,10 @@ def design_gains(scenario: JointScenario, p_Pa, bandwidth_rad_s: float) -> Gains
     lm = linearize_joint(scenario, list(p_Pa))
     J, w = scenario.joint["inertia_kg_m2"], bandwidth_rad_s
     k, c = -lm.A[1, 0] * J, lm.A[1, 1] * J
-    return Gains(Kp=max(3 * J * w * w - k, 0.0), Ki=J * w ** 3, Kd=3 * J * w + c)
+    if 3 * J * w * w < k:  # the poles would need a negative Kp: the muscles alone are stiffer than that
+        raise InputError(f"{scenario.origin}: controller.bandwidth_rad_s = {w:g}: the joint's own stiffness, "
+                         f"{k:.4g} N m/rad, puts its poles beyond it; give at least {np.sqrt(k / (3 * J)):.4g} rad/s")
+    return Gains(Kp=3 * J * w * w - k, Ki=J * w ** 3, Kd=3 * J * w + c)
 
 
 @dataclass
@@ -217,8 +221,12 @@ class AngleStiffnessController:
         self.statics = JointStatics(scenario)
         lo, hi = reference.span_rad()
         margin = 0.05 * (hi - lo) + 1e-3
-        self.feedforward = FeedforwardMap(self.statics, k_Nm_per_rad, np.linspace(lo - margin, hi + margin, 25),
-                                          self.p_max_Pa)
+        try:
+            self.feedforward = FeedforwardMap(self.statics, k_Nm_per_rad, np.linspace(lo - margin, hi + margin, 25),
+                                              self.p_max_Pa)
+        except InputError as exc:
+            raise InputError(f"{scenario.origin}: controller.stiffness_Nm_per_rad = {k_Nm_per_rad:g}: {exc} (the "
+                             f"reference spans {lo:.4g} to {hi:.4g} rad)") from None
         self.gains = design_gains(scenario, self.feedforward(reference(0.0)), bandwidth_rad_s)
         self._flexor = sides.index(1.0)
 
@@ -259,7 +267,8 @@ class AngleStiffnessController:
             held[:] = self.pressures(t, theta, omega, integral)
             rows.append((t, theta, omega, self.reference(t), *held, self.statics.stiffness_Nm_per_rad(theta, held),
                          int(stepper.mode)))
-            integral += (self.reference(t) - theta) * self.dt_s
+            if np.all((held > 0.0) & (held < self.p_max_Pa)):  # no wind-up while a pressure is at its bound
+                integral += (self.reference(t) - theta) * self.dt_s
             if k < n:
                 stepper.advance((k + 1) * self.dt_s)
         a = np.array(rows)

@@ -145,7 +145,7 @@ class JointScenario:
             stops = sc.build_model().stops
             if m.lever is not None:
                 phi = [m.lever["angle_at_zero_rad"] - m.side * t for t in (lo, hi)]
-                if not 0.0 < min(phi) and max(phi) < math.pi:
+                if not (0.0 < min(phi) and max(phi) < math.pi):
                     _fail(self.origin, f"muscle {m.name!r}.angle_at_zero_rad", m.lever["angle_at_zero_rad"],
                           f"its lever's arms would line up within the joint's limits (arm angle from {phi[0]:.4g} to "
                           f"{phi[1]:.4g} rad, must stay inside (0, pi)): the muscle would have no lever arm there")
@@ -195,6 +195,8 @@ def load_joint_scenario(path: str | Path) -> JointScenario:
         spec = tomllib.loads(path.read_text(encoding="utf-8"))
     except (OSError, tomllib.TOMLDecodeError) as exc:
         raise ScenarioError(f"{path}: {exc}") from exc
+    if not is_joint_spec(spec):
+        raise ScenarioError(f"{path}: not a joint scenario (it has no [joint] or [[muscle]] tables)")
     return JointScenario.from_dict(spec, origin=str(path), base_dir=path.parent)
 
 
@@ -285,17 +287,32 @@ def _controller(origin: str, table, joint: dict, muscles) -> dict:
             raise ScenarioError(f"{origin}: controller.{key} is required")
         out[key] = _number(origin, f"controller.{key}", table.get(key, default), kind) if key in table else default
     out["steps_time_s"], out["steps_angle_rad"] = _steps(origin, table, joint)
+    _check_sine(origin, out, joint)
     spec = _table(origin, "controller.spec", table.get("spec", {}))
     for key in sorted(set(spec) - set(SPEC_KEYS)):
         _fail(origin, f"controller.spec.{key}", spec[key], f"unknown key; [controller.spec] has {list(SPEC_KEYS)}")
     out["spec"] = {key: _number(origin, f"controller.spec.{key}", v, "positive") for key, v in spec.items()}
+    _check_controlled(origin, muscles)
+    return out
+
+
+def _check_sine(origin: str, controller: dict, joint: dict) -> None:
+    """The sinusoid about the last step's angle stays between the joint's limits."""
+    centre = controller["steps_angle_rad"][-1] if controller["steps_angle_rad"] else 0.0
+    a = controller["sine_amplitude_rad"]
+    if a > 0 and not (joint["theta_min_rad"] < centre - a and centre + a < joint["theta_max_rad"]):
+        _fail(origin, "controller.sine_amplitude_rad", a,
+              f"the sinusoid about {centre:g} rad (the last step's angle) must stay between the joint's limits")
+
+
+def _check_controlled(origin: str, muscles) -> None:
+    """Two muscles, each on a prescribed pressure (the controller's output takes its place)."""
     for t, sc in muscles:
         if sc.spec["pressure"]["source"] != "prescribed":
             _fail(origin, f"muscle {t['name']!r}.pressure.source", sc.spec["pressure"]["source"],
                   "under a [controller] a muscle's pressure is the controller's output: give source = 'prescribed'")
     if len(muscles) != 2:
         _fail(origin, "controller.kind", "angle_stiffness", f"drives two muscles, not {len(muscles)}")
-    return out
 
 
 def _steps(origin: str, table: dict, joint: dict) -> tuple[tuple[float, ...], tuple[float, ...]]:
