@@ -122,13 +122,15 @@ class Result:
 
     @classmethod
     def from_trace(cls, model: "MuscleModel", name, t, Y, modes, transitions, impact_losses, stats, wall_time_s,
-                   peaks: dict[str, float] | None = None, impacts_J: np.ndarray | None = None, outputs=None):
+                   peaks: dict[str, float] | None = None, impacts_J: np.ndarray | None = None, outputs=None,
+                   p_gauge_Pa: np.ndarray | None = None):
         """A Result from a sampled trace ``Y`` (one row per model state, one column per time ``t`` [s]).
 
         ``impact_losses`` lists ``(t_s, loss_J)`` of every event; ``impacts_J`` is their running sum
         at the samples [J] where the backend has it, else it is summed here.  ``outputs``: the run's
         generated outputs (:class:`pamsim.assemblies.one_muscle.RigOutputs`), which give the force
         columns and the forces at rest at the end; without them the composed model computes both.
+        ``p_gauge_Pa``: ``model.pressure_trace_Pa(t, Y)`` where the backend has it (in memory of its own).
         """
         n = len(model.state_names)  # rows past them: the states of components added to the rig, by name
         work = {key: Y[n - N_WORK + i] for i, key in enumerate(model.state_names[-N_WORK:])}
@@ -138,7 +140,7 @@ class Result:
             work["E_impacts_J"] = impacts_J
         sig = Signals(work, model, t, Y, modes, outputs,
                       None if impacts_J is not None else (t, [a for a, _ in impact_losses], loss_J))
-        p = model.pressure_trace_Pa(t, Y)
+        p = model.pressure_trace_Pa(t, Y) if p_gauge_Pa is None else p_gauge_Pa
         fr = model.fit_range
         peaks = dict(peaks or {})
         x_lo = min(peaks.get("x_min_m", np.inf), Y[0].min())

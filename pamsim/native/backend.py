@@ -454,9 +454,12 @@ def _engine_result(scenario: Scenario, case: CaseInputs, out: dict, i: int, wall
     pressure = next(a for a, b in case.assembly.connections if b == "muscle.p_gauge_Pa")
     peaks = {"x_m": float(high[x_at]), "x_min_m": float(low[x_at]),
              "p_gauge_Pa": float(high[outputs.index(pressure)])}
-    modes = out["modes"][first:first + n].astype(int)
+    # In the run's buffer (SAMPLE_ROOM), not in new arrays: the same values, without a page fault per 4 KiB.
+    modes, p = out["modes_int64"][first:first + n], out["column_f64"][first:first + n]
+    np.copyto(modes, out["modes"][first:first + n])  # int32 to int64: exact
+    p[:] = case.model.pressure_trace_Pa(t, Y)
     return Result.from_trace(case.model, scenario.name, t, Y, modes, transitions, losses, stats, wall_time_s,
-                             peaks=peaks, outputs=RigOutputs(case.assembly, case.model, t, Y, modes))
+                             peaks=peaks, outputs=RigOutputs(case.assembly, case.model, t, Y, modes), p_gauge_Pa=p)
 
 
 GRID_CACHE_SIZE = 32
