@@ -348,5 +348,8 @@ def at_samples(signal, t_s: np.ndarray) -> np.ndarray:
     the first sample and at the first sample at or after each breakpoint: the same values, without
     evaluating it at thousands of samples to take their largest."""
     if type(signal) in _PIECEWISE_CONSTANT and len(t_s):  # a subclass may change between breakpoints
-        t_s = t_s[sorted({0, *np.searchsorted(t_s, signal.breakpoints, side="left").tolist()} - {len(t_s)})]
+        breakpoints = signal.breakpoints
+        # no breakpoints (a constant): the first sample alone, without a search
+        t_s = t_s[sorted({0, *t_s.searchsorted(breakpoints, side="left").tolist()} - {len(t_s)})] if breakpoints \
+            else t_s[:1]
     return signal(t_s)

@@ -18,6 +18,7 @@ import dataclasses
 import functools
 import hashlib
 import math
+import operator
 import struct
 import types
 import warnings
@@ -196,9 +197,13 @@ def exact_key(value):
     elif kind is dict and all(type(k) is str for k in value):
         items = (*value, *value.values())
     elif _is_instance_of_dataclass(value):
-        items = [getattr(value, name) for name in _field_names(kind)]
+        return _dataclass_key(value)
     else:
         return _NO_KEY  # an array, a function, another object: no key that could not mislead
+    return _composite_key(kind, items)
+
+
+def _composite_key(kind: type, items) -> tuple:
     parts = [kind]  # a composite's key starts with its type, a leaf's is not a tuple or starts with int or bool
     for v in items:  # the leaves here, not by a call each: most are floats
         t = type(v)
@@ -212,6 +217,30 @@ def exact_key(value):
                 return _NO_KEY
             parts.append(k)
     return tuple(parts)
+
+
+@functools.lru_cache(maxsize=None)
+def _fields_of(cls: type) -> Callable[[Any], tuple]:
+    """A function giving the fields of an instance of dataclass ``cls``, as a tuple, in one call."""
+    names = _field_names(cls)
+    if len(names) == 1:  # attrgetter gives one field as itself
+        getter = operator.attrgetter(names[0])
+        return lambda obj: (getter(obj),)
+    return operator.attrgetter(*names) if names else lambda obj: ()
+
+
+@functools.lru_cache(maxsize=None)
+def _packer(n: int) -> Callable[..., bytes]:
+    return struct.Struct(f"<{n}d").pack
+
+
+def _dataclass_key(value):
+    """:func:`exact_key` of a dataclass."""
+    kind = type(value)
+    items = _fields_of(kind)(value)
+    if all(type(v) is float for v in items):  # most elements: their numbers' bits in one call
+        return (kind, _packer(len(items))(*items))
+    return _composite_key(kind, items)
 
 
 KEPT_COMPONENTS = 256

@@ -27,6 +27,7 @@ Differences from the Python backend, all documented in ``docs/scaling.md``:
 from __future__ import annotations
 
 import bisect
+import functools
 import math
 import threading
 import time
@@ -118,14 +119,21 @@ class CaseInputs:
         return kept[key][1]
 
     def _engine_case(self, library, capacity: int) -> EngineCase:
-        names = library.names["inputs"]
-        columns = [self.input_names.index(n) for n in names]
-        u = self.segment_u[:, columns]
-        du = None if self.segment_du is None else self.segment_du[:, columns, :]
+        columns = _columns(self.input_names, tuple(library.names["inputs"]))
+        # take: the same copy as indexing with a list, at a third of its cost on arrays this small
+        u = self.segment_u.take(columns, axis=1)
+        du = None if self.segment_du is None else self.segment_du.take(columns, axis=1)
         return EngineCase(np.array(self.assembly.parameter_values()), float(self.reals[lib.REAL_INDEX["cs_relative_tolerance"]]),
                           float(self.reals[lib.REAL_INDEX["cs_max_step_s"]]),
                           int(self.ints[lib.INT_INDEX["cs_max_internal_steps"]]), self.duration_s, self.n_samples,
                           self.segment_t_s, u, int(capacity), du)
+
+
+@functools.lru_cache(maxsize=64)
+def _columns(names: tuple[str, ...], wanted: tuple[str, ...]) -> tuple[int, ...]:
+    """The column of each of ``wanted`` in ``names`` (a case's inputs as the library takes them), kept: a
+    library's inputs and a case's columns are a few orders."""
+    return tuple(names.index(n) for n in wanted)
 
 
 def engine_parts(scenario: Scenario, model: MuscleModel | None = None) -> tuple[MuscleModel, object]:
