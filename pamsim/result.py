@@ -309,7 +309,8 @@ def pointless_run_warnings(model, t_s: np.ndarray, at_rest_at_end: bool, v_end_m
     t_end = float(t_s[-1])
     out = []
     src = model.source
-    if isinstance(src, ValveChamberSource) and not np.any(np.asarray(at_samples(src.command, t_s)) > 0.0):
+    # ndarray methods, not np.any and np.max: the same reductions without numpy's dispatch, run after run
+    if isinstance(src, ValveChamberSource) and not (np.asarray(at_samples(src.command, t_s)) > 0.0).any():
         opens = getattr(src.command, "time_s", None)  # a step's opening time
         when = f"opens at {opens:g} s, after the run ends at {t_end:g} s" if opens is not None else \
             f"stays closed (command <= 0) until the run ends at {t_end:g} s"
@@ -320,7 +321,7 @@ def pointless_run_warnings(model, t_s: np.ndarray, at_rest_at_end: bool, v_end_m
         blocked = float(model.static_force.force_N(0.0, supply))
         weight = model.load.weight_N
         external = model.load.external_force_N
-        if weight > blocked + (float(np.max(at_samples(external, t_s))) if external is not None else 0.0):
+        if weight > blocked + (float(np.asarray(at_samples(external, t_s)).max()) if external is not None else 0.0):
             out.append(f"the load, {weight:.4g} N, is beyond the muscle's blocked force at the supply pressure, "
                        f"{blocked:.4g} N at {supply / PA_PER_BAR:.4g} bar: it cannot lift it")
     if not at_rest_at_end:
@@ -333,9 +334,9 @@ def _largest_supply_Pa(source, t_s: np.ndarray) -> float | None:
     """Highest gauge pressure [Pa] the source offers during the run: the valve's supply or the prescribed
     pressure; None for a source driven by something else (a controller)."""
     if isinstance(source, ValveChamberSource):
-        return float(np.max(at_samples(source.supply_gauge_Pa, t_s)))
+        return float(np.asarray(at_samples(source.supply_gauge_Pa, t_s)).max())
     if isinstance(source, PrescribedPressure):
-        return float(np.max(at_samples(source.p_gauge_Pa, t_s)))
+        return float(np.asarray(at_samples(source.p_gauge_Pa, t_s)).max())
     return None
 
 

@@ -19,6 +19,7 @@ from typing import Any, Callable
 import numpy as np
 
 from ..components.element import kept_component
+from ..components.hanging_load import LoadMode
 from ..components import (CoulombFriction, ExternalForce, HangingLoad, MuscleStaticForce, PolytropicChamber,
                           PressureSignal, ProportionalValve, ViscousDamping)
 from ..elements.pressure_source import PrescribedPressure, ValveChamberSource
@@ -165,6 +166,8 @@ def input_signals(model) -> dict:
             "external_force_N": external if external is not None else Constant(0.0)}
 
 
+_STICK = int(LoadMode.STICK)
+
 RIG_COMPONENTS = frozenset({"load", "muscle", "friction", "damping", "external", "chamber", "valve", "pressure",
                             "controller"})
 """The rig's own components (every pressure source's included); any other was added to it."""
@@ -207,9 +210,7 @@ class RigOutputs:
 
     def rest_forces(self) -> tuple[float, float]:
         """Net force on the load at rest at the last sample, and the Coulomb level [N] there."""
-        from ..components.hanging_load import LoadMode
-
-        code = self.code[int(LoadMode.STICK)]
+        code = self.code[_STICK]
         y = [float(v) for v in self.Y[:, -1]]
         y[1] = 0.0
         (out,) = code.y(y, [float(np.asarray(v)) for v in self.inputs(float(self.t[-1]))], self.p, ())
