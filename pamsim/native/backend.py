@@ -48,6 +48,7 @@ from ..errors import InputError, SolverFailure
 from ..fmu.force_table import ForceTable
 from ..fmu.preset import input_signal
 from ..fmu.runner import REPRESENTED, tabulate_model, upper_stop_start
+from ..gc_control import paused_gc
 from ..model import Mode, MuscleModel
 from ..result import Result, TransitionEvent
 from ..scenario import Scenario
@@ -506,6 +507,15 @@ def simulate_batch(scenarios: Sequence[Scenario], return_exceptions: bool = Fals
     models : sequence of MuscleModel or None, optional
         Each scenario's model, as :func:`case_inputs` takes it (None: the scenario's own).
     """
+    # The collector paused: a batch makes objects by the thousand (components, events, results), few of them
+    # in cycles, and its passes over them cost a fortieth of a 66-case batch.
+    with paused_gc():
+        return _simulate_batch(scenarios, return_exceptions, models)
+
+
+def _simulate_batch(scenarios: Sequence[Scenario], return_exceptions: bool,
+                    models: Sequence[MuscleModel | None] | None) -> list:
+    """:func:`simulate_batch`, with the collector paused."""
     cases = [case_inputs(s, m) for s, m in zip(scenarios, models or [None] * len(scenarios))]
     wall0 = time.perf_counter()
     found = _run(cases, [event_capacity(c.max_events) for c in cases])
