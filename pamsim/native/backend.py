@@ -181,7 +181,8 @@ def refuse_unsupported(scenario: Scenario) -> None:
     where = scenario.origin
     for section, keys in REPRESENTED.items():
         table = spec if not section else spec.get(section, {})
-        for key in sorted(set(table) - keys):
+        extra = table.keys() - keys  # most tables have none: sorted only when there are
+        for key in sorted(extra) if extra else ():
             if not section and key == "component":
                 continue  # the generated model holds them
             name = f"{section}.{key}" if section else key
@@ -267,11 +268,18 @@ def exact_segments(signals, duration_s: float):
 def _piece_starts(pieces, starts: list[float]) -> tuple[np.ndarray, np.ndarray]:
     """Each piece's value at each of ``starts`` and its change from there (:func:`exact_segments`' ``u`` and
     ``du``), zero for an input without a signal (None)."""
-    none = (0.0, (0.0, 0.0, 0.0))
-    # Rows built as lists and made arrays once: numpy costs more per element set than per array made.
-    rows = [[none if piece is None else (piece(t0), _change_after(piece, t0)) for piece in pieces] for t0 in starts]
-    return (np.array([[value for value, _ in row] for row in rows], dtype=float),
-            np.array([[change for _, change in row] for row in rows], dtype=float))
+    values, changes = [], []
+    for t0 in starts:
+        for piece in pieces:
+            values.append(0.0 if piece is None else piece(t0))
+            changes += _NO_CHANGE if piece is None else _change_after(piece, t0)
+    # Flat lists made arrays once, then shaped: numpy costs more per element set, or per nested list it
+    # parses, than per array made.
+    shape = (len(starts), len(pieces))
+    return np.array(values, dtype=float).reshape(shape), np.array(changes, dtype=float).reshape(*shape, 3)
+
+
+_NO_CHANGE = (0.0, 0.0, 0.0)
 
 
 def _change_after(piece, t0: float) -> tuple[float, float, float]:
