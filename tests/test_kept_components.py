@@ -21,16 +21,11 @@ ROOT = Path(__file__).resolve().parents[1]
 FIG4 = ROOT / "scenarios" / "acra2012_fig4.toml"
 
 
-@dataclasses.dataclass(frozen=True)
-class _Inner:
-    a: object
-    name: str = "inner"
-
-
-@dataclasses.dataclass(frozen=True)
-class _Outer:
-    inner: _Inner
-    b: object = 1.0
+# An element of another element and numbers of any type (frozen dataclasses, as the elements are).
+_Inner = dataclasses.make_dataclass("_Inner", [("a", object), ("name", str, dataclasses.field(default="inner"))],
+                                    frozen=True)
+_Outer = dataclasses.make_dataclass("_Outer", [("inner", object), ("b", object, dataclasses.field(default=1.0))],
+                                    frozen=True)
 
 
 @pytest.mark.parametrize("x, y", [(0.0, -0.0), (1, 1.0), (1, True), (1.0, True), (float("nan"), -float("nan")),
