@@ -20,6 +20,7 @@ import hashlib
 import math
 import operator
 import struct
+import threading
 import types
 import warnings
 from typing import Any, Callable, Mapping, Sequence
@@ -246,6 +247,7 @@ def _dataclass_key(value):
 KEPT_COMPONENTS = 256
 """Components kept per process by :func:`kept_component`: a sweep's cases share most of theirs."""
 _kept: dict = {}
+_kept_lock = threading.Lock()
 
 
 def kept_component(cls: type, *args):
@@ -259,9 +261,11 @@ def kept_component(cls: type, *args):
     key = (cls, key)
     component = _kept.get(key)
     if component is None:
-        component = _kept[key] = cls(*args)
-        while len(_kept) > KEPT_COMPONENTS:
-            _kept.pop(next(iter(_kept)), None)  # the oldest first (another thread may have taken it)
+        component = cls(*args)
+        with _kept_lock:  # a sweep's threads may share this process's components
+            _kept[key] = component
+            while len(_kept) > KEPT_COMPONENTS:
+                del _kept[next(iter(_kept))]  # the oldest first
     return component
 
 
