@@ -122,13 +122,15 @@ class Result:
 
     @classmethod
     def from_trace(cls, model: "MuscleModel", name, t, Y, modes, transitions, impact_losses, stats, wall_time_s,
-                   peaks: dict[str, float] | None = None, impacts_J: np.ndarray | None = None, outputs=None):
+                   peaks: dict[str, float] | None = None, impacts_J: np.ndarray | None = None, outputs=None,
+                   p_gauge_Pa: np.ndarray | None = None):
         """A Result from a sampled trace ``Y`` (one row per model state, one column per time ``t`` [s]).
 
         ``impact_losses`` lists ``(t_s, loss_J)`` of every event; ``impacts_J`` is their running sum
         at the samples [J] where the backend has it, else it is summed here.  ``outputs``: the run's
         generated outputs (:class:`pamsim.assemblies.one_muscle.RigOutputs`), which give the force
         columns and the forces at rest at the end; without them the composed model computes both.
+        ``p_gauge_Pa``: ``model.pressure_trace_Pa(t, Y)`` where the backend has it (in memory of its own).
         """
         n = len(model.state_names)  # rows past them: the states of components added to the rig, by name
         work = {key: Y[n - N_WORK + i] for i, key in enumerate(model.state_names[-N_WORK:])}
@@ -138,7 +140,7 @@ class Result:
             work["E_impacts_J"] = impacts_J
         sig = Signals(work, model, t, Y, modes, outputs,
                       None if impacts_J is not None else (t, [a for a, _ in impact_losses], loss_J))
-        p = model.pressure_trace_Pa(t, Y)
+        p = model.pressure_trace_Pa(t, Y) if p_gauge_Pa is None else p_gauge_Pa
         fr = model.fit_range
         peaks = dict(peaks or {})
         x_lo = min(peaks.get("x_min_m", np.inf), Y[0].min())
@@ -307,7 +309,8 @@ def pointless_run_warnings(model, t_s: np.ndarray, at_rest_at_end: bool, v_end_m
     t_end = float(t_s[-1])
     out = []
     src = model.source
-    if isinstance(src, ValveChamberSource) and not np.any(np.asarray(at_samples(src.command, t_s)) > 0.0):
+    # ndarray methods, not np.any and np.max: the same reductions without numpy's dispatch, run after run
+    if isinstance(src, ValveChamberSource) and not (np.asarray(at_samples(src.command, t_s)) > 0.0).any():
         opens = getattr(src.command, "time_s", None)  # a step's opening time
         when = f"opens at {opens:g} s, after the run ends at {t_end:g} s" if opens is not None else \
             f"stays closed (command <= 0) until the run ends at {t_end:g} s"
@@ -318,7 +321,7 @@ def pointless_run_warnings(model, t_s: np.ndarray, at_rest_at_end: bool, v_end_m
         blocked = float(model.static_force.force_N(0.0, supply))
         weight = model.load.weight_N
         external = model.load.external_force_N
-        if weight > blocked + (float(np.max(at_samples(external, t_s))) if external is not None else 0.0):
+        if weight > blocked + (float(np.asarray(at_samples(external, t_s)).max()) if external is not None else 0.0):
             out.append(f"the load, {weight:.4g} N, is beyond the muscle's blocked force at the supply pressure, "
                        f"{blocked:.4g} N at {supply / PA_PER_BAR:.4g} bar: it cannot lift it")
     if not at_rest_at_end:
@@ -331,9 +334,9 @@ def _largest_supply_Pa(source, t_s: np.ndarray) -> float | None:
     """Highest gauge pressure [Pa] the source offers during the run: the valve's supply or the prescribed
     pressure; None for a source driven by something else (a controller)."""
     if isinstance(source, ValveChamberSource):
-        return float(np.max(at_samples(source.supply_gauge_Pa, t_s)))
+        return float(np.asarray(at_samples(source.supply_gauge_Pa, t_s)).max())
     if isinstance(source, PrescribedPressure):
-        return float(np.max(at_samples(source.p_gauge_Pa, t_s)))
+        return float(np.asarray(at_samples(source.p_gauge_Pa, t_s)).max())
     return None
 
 
@@ -346,5 +349,8 @@ def at_samples(signal, t_s: np.ndarray) -> np.ndarray:
     the first sample and at the first sample at or after each breakpoint: the same values, without
     evaluating it at thousands of samples to take their largest."""
     if type(signal) in _PIECEWISE_CONSTANT and len(t_s):  # a subclass may change between breakpoints
-        t_s = t_s[sorted({0, *np.searchsorted(t_s, signal.breakpoints, side="left").tolist()} - {len(t_s)})]
+        breakpoints = signal.breakpoints
+        # no breakpoints (a constant): the first sample alone, without a search
+        t_s = t_s[sorted({0, *t_s.searchsorted(breakpoints, side="left").tolist()} - {len(t_s)})] if breakpoints \
+            else t_s[:1]
     return signal(t_s)

@@ -1,4 +1,4 @@
-"""The garbage-collector scopes of a sweep's process (pamsim.sweep.gc_control): what they change
+"""The garbage-collector scopes of a sweep's process (pamsim.gc_control): what they change
 while they are open, and that they give the collector back as it was."""
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ import pytest
 
 import pamsim
 from pamsim.sweep import sweep_from_dict
-from pamsim.sweep.gc_control import frozen_gc, paused_gc
+from pamsim.gc_control import frozen_gc, paused_gc
 
 FIG4 = str(Path(__file__).resolve().parents[1] / "scenarios" / "acra2012_fig4.toml")
 SWEEP = {"base_scenario": FIG4, "axes": {"pressure_bar": [2.8, 3.6], "weight_N": [12.74, 32.74]}}

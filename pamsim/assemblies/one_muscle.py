@@ -18,6 +18,8 @@ from typing import Any, Callable
 
 import numpy as np
 
+from ..components.element import kept_component
+from ..components.hanging_load import LoadMode
 from ..components import (CoulombFriction, ExternalForce, HangingLoad, MuscleStaticForce, PolytropicChamber,
                           PressureSignal, ProportionalValve, ViscousDamping)
 from ..elements.pressure_source import PrescribedPressure, ValveChamberSource
@@ -59,14 +61,16 @@ def one_muscle_assembly(model, x0_m: float = 0.0, p0_gauge_Pa: float | None = No
     rig's states and outputs keep their places.  ``friction_direction`` is the output that gives the
     friction its direction: the load's (+1 or -1 sliding, 0 held), or an added component's (a
     linearisation's smooth treatment of the Coulomb term)."""
-    load = HangingLoad("load", {
+    load = kept_component(HangingLoad, "load", {
         "mass_kg": model.load.mass_kg, "g_m_s2": model.load.g_m_s2, "x_low_m": model.stops.x_low_m,
         "x_high_m": model.stops.x_high_m, "restitution": model.stops.restitution,
         "min_rebound_speed_m_s": model.stops.min_rebound_speed_m_s,
         "stick_margin_N": stick_margin_N, "release_margin_N": release_margin_N, "initial_contraction_m": x0_m})
-    return rig_assembly(load, source_parts(model.source, p0_gauge_Pa),
-                        (MuscleStaticForce("muscle", model.static_force), CoulombFriction("friction", model.friction),
-                         ViscousDamping("damping", model.damping)), added, friction_direction)
+    # Kept components: a sweep's cases differ in a few numbers, and making a component costs more than its key.
+    forces = (kept_component(MuscleStaticForce, "muscle", model.static_force),
+              kept_component(CoulombFriction, "friction", model.friction),
+              kept_component(ViscousDamping, "damping", model.damping))
+    return rig_assembly(load, source_parts(model.source, p0_gauge_Pa), forces, added, friction_direction)
 
 
 def rig_assembly(load: HangingLoad, source: "SourceParts", forces: tuple, added: tuple = (),
@@ -78,7 +82,7 @@ def rig_assembly(load: HangingLoad, source: "SourceParts", forces: tuple, added:
     takes them."""
     parts = [load, *source.parts]
     pressure, wiring, inputs = source.pressure, list(source.wiring), dict(source.inputs)
-    parts += [*forces, ExternalForce("external")]
+    parts += [*forces, kept_component(ExternalForce, "external")]
     # The flange adds the forces in this order, as pamsim always has: static, damping, friction.
     wiring += [("load.flange", "muscle.flange"), ("load.flange", "damping.flange"), ("load.flange", "friction.flange"),
                (f"{pressure}.p_gauge_Pa", "muscle.p_gauge_Pa"), (f"{pressure}.p_gauge_Pa", "friction.p_gauge_Pa"),
@@ -99,14 +103,14 @@ VALVE_CHAMBER_WIRING = (("chamber.port", "valve.port"), ("load.x_m", "chamber.x_
 
 def _valve_parts(src: ValveChamberSource, p0_gauge_Pa: float | None) -> SourceParts:
     return SourceParts(
-        [PolytropicChamber("chamber", src.chamber, src.p_atm_Pa, p0_gauge_Pa or 0.0, src.T_supply_K),
-         ProportionalValve("valve", src.valve, src.T_supply_K, src.p_atm_Pa, src.chamber.R_J_per_kg_K)],
+        [kept_component(PolytropicChamber, "chamber", src.chamber, src.p_atm_Pa, p0_gauge_Pa or 0.0, src.T_supply_K),
+         kept_component(ProportionalValve, "valve", src.valve, src.T_supply_K, src.p_atm_Pa, src.chamber.R_J_per_kg_K)],
         list(VALVE_CHAMBER_WIRING),
         {"valve_command": "valve.command", "supply_pressure_gauge_Pa": "valve.supply_gauge_Pa"}, "chamber")
 
 
 def _prescribed_parts(src: PrescribedPressure, p0_gauge_Pa: float | None) -> SourceParts:
-    return SourceParts([PressureSignal("pressure")], [], {"prescribed_pressure_gauge_Pa": "pressure.p_in_gauge_Pa"},
+    return SourceParts([kept_component(PressureSignal, "pressure")], [], {"prescribed_pressure_gauge_Pa": "pressure.p_in_gauge_Pa"},
                        "pressure")
 
 
@@ -162,6 +166,8 @@ def input_signals(model) -> dict:
             "external_force_N": external if external is not None else Constant(0.0)}
 
 
+_STICK = int(LoadMode.STICK)
+
 RIG_COMPONENTS = frozenset({"load", "muscle", "friction", "damping", "external", "chamber", "valve", "pressure",
                             "controller"})
 """The rig's own components (every pressure source's included); any other was added to it."""
@@ -204,9 +210,7 @@ class RigOutputs:
 
     def rest_forces(self) -> tuple[float, float]:
         """Net force on the load at rest at the last sample, and the Coulomb level [N] there."""
-        from ..components.hanging_load import LoadMode
-
-        code = self.code[int(LoadMode.STICK)]
+        code = self.code[_STICK]
         y = [float(v) for v in self.Y[:, -1]]
         y[1] = 0.0
         (out,) = code.y(y, [float(np.asarray(v)) for v in self.inputs(float(self.t[-1]))], self.p, ())

@@ -18,6 +18,9 @@ import dataclasses
 import functools
 import hashlib
 import math
+import operator
+import struct
+import threading
 import types
 import warnings
 from typing import Any, Callable, Mapping, Sequence
@@ -172,6 +175,98 @@ class _Identity:
 
     def __hash__(self):
         return id(self.obj)
+
+
+_NO_KEY = object()
+_PACK = struct.Struct("<d").pack
+
+
+def exact_key(value):
+    """A key equal for two values only if they are of the same types and equal to the last bit, or
+    :data:`_NO_KEY` if ``value`` holds anything but numbers, strings, None, tuples, lists, string-keyed dicts
+    and dataclasses of them.  Unlike ``==``, which takes ``0.0`` for ``-0.0`` and ``1`` for ``1.0`` or
+    ``True``: two values with one key behave alike in every computation."""
+    kind = type(value)
+    if kind is float:
+        return _PACK(value)  # the bits (bytes, equal to no other key): -0.0 is not 0.0
+    if kind is str or value is None:
+        return value
+    if kind is int or kind is bool:
+        return (kind, value)
+    if kind is tuple or kind is list:
+        items = value
+    elif kind is dict and all(type(k) is str for k in value):
+        items = (*value, *value.values())
+    elif _is_instance_of_dataclass(value):
+        return _dataclass_key(value)
+    else:
+        return _NO_KEY  # an array, a function, another object: no key that could not mislead
+    return _composite_key(kind, items)
+
+
+def _composite_key(kind: type, items) -> tuple:
+    parts = [kind]  # a composite's key starts with its type, a leaf's is not a tuple or starts with int or bool
+    for v in items:  # the leaves here, not by a call each: most are floats
+        t = type(v)
+        if t is float:
+            parts.append(_PACK(v))
+        elif t is str or v is None:
+            parts.append(v)
+        else:
+            k = exact_key(v)
+            if k is _NO_KEY:
+                return _NO_KEY
+            parts.append(k)
+    return tuple(parts)
+
+
+@functools.lru_cache(maxsize=None)
+def _fields_of(cls: type) -> Callable[[Any], tuple]:
+    """A function giving the fields of an instance of dataclass ``cls``, as a tuple, in one call."""
+    names = _field_names(cls)
+    if len(names) == 1:  # attrgetter gives one field as itself
+        getter = operator.attrgetter(names[0])
+        return lambda obj: (getter(obj),)
+    return operator.attrgetter(*names) if names else lambda obj: ()
+
+
+@functools.lru_cache(maxsize=None)
+def _packer(n: int) -> Callable[..., bytes]:
+    return struct.Struct(f"<{n}d").pack
+
+
+def _dataclass_key(value):
+    """:func:`exact_key` of a dataclass."""
+    kind = type(value)
+    items = _fields_of(kind)(value)
+    if all(type(v) is float for v in items):  # most elements: their numbers' bits in one call
+        return (kind, _packer(len(items))(*items))
+    return _composite_key(kind, items)
+
+
+KEPT_COMPONENTS = 256
+"""Components kept per process by :func:`kept_component`: a sweep's cases share most of theirs."""
+_kept: dict = {}
+_kept_lock = threading.Lock()
+
+
+def kept_component(cls: type, *args):
+    """``cls(*args)``, the component made before from arguments of the same :func:`exact_key` if there is
+    one (the last :data:`KEPT_COMPONENTS`), since a component does not change after it is made and making
+    one (walking its element, checking its declarations) costs more than keying its arguments; made anew
+    where an argument has no exact key."""
+    key = exact_key(args)
+    if key is _NO_KEY:
+        return cls(*args)
+    key = (cls, key)
+    component = _kept.get(key)
+    if component is None:
+        component = cls(*args)
+        with _kept_lock:  # a sweep's threads may share this process's components
+            _kept[key] = component
+            while len(_kept) > KEPT_COMPONENTS:
+                del _kept[next(iter(_kept))]  # the oldest first
+    return component
 
 
 def parameter_vars(values: Mapping[str, float], descriptions: Mapping[str, str] | None = None) -> tuple[Var, ...]:

@@ -139,12 +139,13 @@ class EngineLibrary:
         x its samples), ``modes``, ``events`` (rows of t, mode before, mode after, fired mask, outputs
         before, outputs after), ``n_events``, ``stats`` (RHS evaluations, steps, segments + events),
         ``status``, ``extremes`` (each output's largest then smallest value over every step end and
-        event), ``messages``, and the offsets of each case's samples and events."""
+        event), ``messages``, the offsets of each case's samples and events, and the uninitialised
+        :data:`SAMPLE_ROOM`."""
         arrays, address = batch_arrays(cases, self.layout, self._buffer)
         messages = ctypes.create_string_buffer(MESSAGE_BYTES * len(cases))
         batch = EngineBatch(len(cases), *(address.get(k) for k in BATCH_FIELDS), ctypes.addressof(messages))
         self._lib.pam_engine_run_batch(ctypes.byref(batch))
-        out = {k: arrays[k] for k in ("sample_offset", "event_offset", *BATCH_OUTPUTS)}
+        out = {k: arrays[k] for k in ("sample_offset", "event_offset", *BATCH_OUTPUTS, *SAMPLE_ROOM)}
         out["messages"] = _messages(messages.raw, len(cases))
         return out
 
@@ -152,6 +153,11 @@ class EngineLibrary:
 SPARE_BYTES = 256 * 2**20
 """Largest run buffer an engine library keeps for the next run, per thread."""
 _F64, _I64, _I32 = np.dtype(np.float64), np.dtype(np.int64), np.dtype(np.int32)
+SAMPLE_ROOM = {"modes_int64": _I64, "column_f64": _F64}
+"""Room the library leaves alone, one value per sample like ``modes``, for what its caller makes of each case's
+samples (the modes as numpy's default integers, a column computed from the states): written there, in the run's
+buffer, which is reused while it is free, they are not new arrays whose first touch costs the kernel a page
+fault per 4 KiB, as a batch's results would be (they are kept, so the heap grows)."""
 _SETTINGS = ("rtol", "max_step_s", "duration_s")
 """The per-case float settings, rows of one block."""
 _COUNTS = ("max_steps", "n_samples", "sample_offset", "n_segments", "segment_offset", "event_capacity", "event_offset")
@@ -175,7 +181,8 @@ def batch_arrays(cases: Sequence[EngineCase], layout: dict, allocate=None) -> tu
               "segment_u": (_F64, (segments, nu)), **({"segment_du": (_F64, (segments, nu, 3))} if exact else {}),
               "samples": (_F64, (samples * layout["ns"],)), "modes": (_I32, (samples,)),
               "events": (_F64, (max(events, 1), layout["event_columns"])), "tallies": (_I64, (4 * n,)),
-              "status": (_I32, (n,)), "extremes": (_F64, (n, 2 * layout["ny"]))}
+              "status": (_I32, (n,)), "extremes": (_F64, (n, 2 * layout["ny"])),
+              **{name: (dtype, (samples,)) for name, dtype in SAMPLE_ROOM.items()}}
     arrays, address = _arena(blocks, allocate)
     _fill_inputs(arrays, cases, counts, nu)
     arrays["tallies"].fill(0)

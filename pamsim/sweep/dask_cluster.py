@@ -26,7 +26,7 @@ from concurrent.futures import Executor
 from typing import Callable, Iterator
 
 from ..errors import InputError
-from .gc_control import paused_gc
+from ..gc_control import paused_gc
 
 EXTRA = "pamsim[dask]"
 CONNECT_TIMEOUT_S = 10.0

@@ -30,7 +30,7 @@ from ..scenario import Scenario
 from ..static import friction_band_m, static_report
 from .dask_cluster import executor_watch, executor_workers
 from .figures import SWEEP_FIGURES, UNCERTAINTY_FIGURES
-from .gc_control import frozen_gc
+from ..gc_control import frozen_gc
 from .spec import SweepCase, SweepSpec, load_sweep
 from .sample_table import ChunkOrder, SampleTable, row_bytes
 from .uncertainty import LOST, QUANTITIES, RunColumns, Samples, UncertaintyResult

@@ -14,7 +14,7 @@ import contextlib
 import gc
 import importlib
 
-from .gc_control import paused_gc
+from ..gc_control import paused_gc
 
 MODULES = ("distributed", "numpy", "pamsim.sweep.run", "pamsim.native")
 """The modules a worker needs, each imported on its own: one that fails does not stop the others

@@ -1,4 +1,4 @@
-"""Python's cyclic garbage collector in the process that runs a sweep on an executor.
+"""Python's cyclic garbage collector in the process that runs a sweep on an executor, or a native batch.
 
 That process holds the imported modules, the sweep's tasks and, with ``--dask-local``, the Dask
 scheduler, nannies and client: over a hundred thousand objects the collector tracks.  Each full
