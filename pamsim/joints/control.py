@@ -6,8 +6,8 @@ for the reference angle ``theta_r`` and the commanded stiffness ``k_r`` it takes
 the link rests at ``theta_r`` with stiffness ``k_r`` (:class:`FeedforwardMap`, solved by Newton's method
 on :class:`pamsim.joints.static.JointStatics` at a grid of angles, interpolated between them).  A PID
 on the angle error adds a differential pressure (the flexor's up and the extensor's down by the same
-amount, which for a symmetric pair moves the stiffness little: 5.7e-9 N m/rad per Pa on the shipped
-pair at 0.3 rad), with gains placed on the linear model at the
+amount, which for a symmetric pair moves the stiffness little: the two muscles' stiffness slopes nearly
+cancel), with gains placed on the linear model at the
 reference's start (:func:`pamsim.joints.linear.linearize_joint`): three closed-loop poles at
 ``-bandwidth``.  The muscles' pressures are the controller's outputs, held over each sample (pressure-
 regulated muscles: pamsim's choice, the valves' dynamics left out).  The run is the python backend's

@@ -70,7 +70,7 @@ one is never used (the friction law reads the load from the tendon, :class:`pams
 
 
 def _fail(origin: str, key: str, value, why: str):
-    raise ScenarioError(f"{origin}: {key} = {value!r}: {why}")
+    TableChecker(origin, ScenarioError).fail(key, value, why)
 
 
 def _table(origin: str, key: str, value) -> dict:
@@ -80,9 +80,8 @@ def _table(origin: str, key: str, value) -> dict:
 
 
 def _number(origin: str, key: str, value, kind: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        _fail(origin, key, value, "must be a finite number")
-    value = float(value)
+    """``value`` as a float (the scenario files' one check of a number), then within the range ``kind`` names."""
+    value = TableChecker(origin, ScenarioError).number(key, value)
     rules = {"positive": (value > 0, "must be > 0"), "non_negative": (value >= 0, "must be >= 0"),
              "unit": (0 <= value <= 1, "must lie in [0, 1]"), "any": (True, "")}
     ok, why = rules[kind]

@@ -57,6 +57,9 @@ class SampledSignals(Mapping):
             self._outputs = outputs_by_mode(code, p, list(Y), inputs, modes)
         return self._outputs[key]
 
+    def __contains__(self, key) -> bool:  # by name: asking must not compute the outputs
+        return key in self._states or key in self._output_names
+
     def __iter__(self):
         return iter([*self._states, *self._output_names])
 
