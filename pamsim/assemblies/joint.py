@@ -18,7 +18,8 @@ from dataclasses import dataclass
 from typing import Any
 
 from ..components import CoulombFriction, MuscleStaticForce, ViscousDamping
-from ..components.pulley import LeverAttachment, Pulley
+from ..components.linear_slider import LinearSlider
+from ..components.pulley import LeverAttachment, Pulley, SliderTendon
 from ..components.rotary_joint import RotaryJoint
 from ..modeling import Assembly
 from .one_muscle import rewired, source_parts
@@ -45,8 +46,11 @@ class JointMuscle:
     ``g_m_s2`` aside) in place of the pulley (``radius_m`` and ``x_at_zero_m`` then unused)."""
 
 
-def attachment_name(m: JointMuscle) -> str:
-    """The name of the component that attaches muscle ``m`` to the joint: ``<muscle>_pulley`` or ``<muscle>_lever``."""
+def attachment_name(m: JointMuscle, body: str = "joint") -> str:
+    """The name of the component that attaches muscle ``m`` to the ``body``: on a joint ``<muscle>_pulley``
+    or ``<muscle>_lever``, on a slider ``<muscle>_tendon``."""
+    if body == "slider":
+        return f"{m.name}_tendon"
     return f"{m.name}_lever" if m.lever is not None else f"{m.name}_pulley"
 
 
@@ -57,36 +61,70 @@ def joint_assembly(joint_values: dict, muscles: tuple[JointMuscle, ...], g_m_s2:
     Model inputs: each muscle's pressure source inputs as ``<muscle>.<input>``, then
     ``tau_external_Nm``.
     """
-    parts: list = [RotaryJoint("joint", joint_values)]
+    def attach(m: JointMuscle):
+        if m.lever is not None:
+            return LeverAttachment(attachment_name(m), {**m.lever, "side": m.side, "g_m_s2": g_m_s2})
+        return Pulley(attachment_name(m), {"radius_m": m.radius_m, "side": m.side, "x_at_zero_m": m.x_at_zero_m,
+                                           "g_m_s2": g_m_s2})
+
+    return _body_assembly(RotaryJoint("joint", joint_values), muscles, attach, "tau_external_Nm", name)
+
+
+SLIDER_FRICTION_LOADS = ("static_force", "slider_mass")
+"""What a slider's muscles' load-dependent friction reads as their load: the mass whose weight is each
+muscle's static force (as on a joint), or the slider's own mass (the paper's rig, where the load the
+friction law was measured with is the hanging mass)."""
+
+
+def slider_assembly(slider_values: dict, muscles: tuple[JointMuscle, ...], g_m_s2: float,
+                    friction_load: str = "static_force", name: str = "slider") -> Assembly:
+    """The assembly of a :class:`LinearSlider` with parameters ``slider_values`` and ``muscles`` on it,
+    each on a :class:`SliderTendon` (its ``side`` and ``x_at_zero_m``; ``radius_m`` and ``lever`` unused);
+    ``friction_load`` one of :data:`SLIDER_FRICTION_LOADS`.
+
+    Model inputs: each muscle's pressure source inputs as ``<muscle>.<input>``, then ``F_external_N``.
+    """
+    if friction_load not in SLIDER_FRICTION_LOADS:
+        raise ValueError(f"friction_load must be one of {SLIDER_FRICTION_LOADS}, not {friction_load!r}")
+
+    def attach(m: JointMuscle):
+        return SliderTendon(attachment_name(m, "slider"), {"side": m.side, "x_at_zero_m": m.x_at_zero_m, "g_m_s2": g_m_s2})
+
+    load = "slider.mass_kg" if friction_load == "slider_mass" else None
+    return _body_assembly(LinearSlider("slider", slider_values), muscles, attach, "F_external_N", name, load)
+
+
+def _body_assembly(body, muscles, attach, external: str, name: str, friction_load: str | None = None) -> Assembly:
+    """``body`` with each of ``muscles`` on the attachment ``attach(muscle)`` makes, its external input
+    ``external``; the muscles' friction reads its load from ``friction_load`` (None: the attachment's)."""
+    parts: list = [body]
     wiring: list = []
     inputs: dict = {}
     for m in muscles:
-        own, own_wiring, own_inputs = _muscle_parts(m, g_m_s2)
+        own, own_wiring, own_inputs = _muscle_parts(m, attach(m), body, friction_load)
         parts += own
         wiring += own_wiring
         inputs.update(own_inputs)
-    inputs["tau_external_Nm"] = "joint.tau_external_Nm"
+    inputs[external] = f"{body.name}.{external}"
     return Assembly(parts, wiring, inputs, name=name)
 
 
-def _muscle_parts(m: JointMuscle, g_m_s2: float) -> tuple[list, list, dict]:
+def _muscle_parts(m: JointMuscle, attach, body, friction_load: str | None) -> tuple[list, list, dict]:
     """A muscle's components, wiring and model inputs, its components prefixed with its name."""
-    pulley = attachment_name(m)
+    pulley = attach.name
     source = rewired(source_parts(m.source, m.p0_gauge_Pa), pulley, m.name)
-    if m.lever is not None:
-        attach = LeverAttachment(pulley, {**m.lever, "side": m.side, "g_m_s2": g_m_s2})
-    else:
-        attach = Pulley(pulley, {"radius_m": m.radius_m, "side": m.side, "x_at_zero_m": m.x_at_zero_m, "g_m_s2": g_m_s2})
     parts = [*source.parts, MuscleStaticForce(f"{m.name}_muscle", m.static_force),
              CoulombFriction(f"{m.name}_friction", m.friction), ViscousDamping(f"{m.name}_damping", m.damping), attach]
     p = f"{source.pressure}.p_gauge_Pa"
+    port = attach.body.name
     # The flange adds the forces in the one-muscle rig's order: static, damping, friction.
-    wiring = [*source.wiring, (f"{pulley}.shaft", "joint.shaft"), (f"{pulley}.flange", f"{m.name}_muscle.flange"),
+    wiring = [*source.wiring, (f"{pulley}.{port}", f"{body.name}.{port}"), (f"{pulley}.flange", f"{m.name}_muscle.flange"),
               (f"{pulley}.flange", f"{m.name}_damping.flange"), (f"{pulley}.flange", f"{m.name}_friction.flange"),
               (p, f"{m.name}_muscle.p_gauge_Pa"), (p, f"{m.name}_friction.p_gauge_Pa"),
-              (f"{pulley}.load_mass_kg", f"{m.name}_friction.mass_kg"),
+              (friction_load or f"{pulley}.load_mass_kg", f"{m.name}_friction.mass_kg"),
               (f"{pulley}.direction", f"{m.name}_friction.direction"),
               (f"{m.name}_friction.level_N", f"{pulley}.friction_level_N"),
-              (f"{m.name}_muscle.F_static_N", f"{pulley}.F_static_N"), ("joint.slip_direction", f"{pulley}.joint_direction")]
+              (f"{m.name}_muscle.F_static_N", f"{pulley}.F_static_N"),
+              (f"{body.name}.slip_direction", f"{pulley}.joint_direction")]
     inputs = {f"{m.name}.{k}": v for k, v in source.inputs.items()}
     return parts, wiring, inputs

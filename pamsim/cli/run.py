@@ -172,20 +172,25 @@ def _run_joint(scenario, args: argparse.Namespace, out: Path) -> list[str]:
     fmt, dpi = args.figures
     names = [f"{scenario.name}.csv", f"{scenario.name}.json"] + ([] if args.no_plot else [f"{scenario.name}.{fmt}"])
     summary = result.summary()
-    eq = JointStatics(scenario).equilibrium([v["p_gauge_Pa"] for v in summary["muscles"].values()])
-    summary["equilibrium_at_final_pressures"] = {"theta_rad": eq.theta_rad, "k_Nm_per_rad": eq.k_Nm_per_rad,
-                                                 "on_limit": eq.on_limit}
+    joint = scenario.body.name == "joint"
+    if joint:  # a slider's statics are its muscles' force balance, which pamsim static gives per muscle
+        eq = JointStatics(scenario).equilibrium([v["p_gauge_Pa"] for v in summary["muscles"].values()])
+        summary["equilibrium_at_final_pressures"] = {"theta_rad": eq.theta_rad, "k_Nm_per_rad": eq.k_Nm_per_rad,
+                                                     "on_limit": eq.on_limit}
     with atomic_outputs(out, names) as tmp:
         result.to_csv(tmp[names[0]])
         tmp[names[1]].write_text(json.dumps(summary, indent=2) + "\n")
         if not args.no_plot:
             save(joint_figure(result), tmp[names[2]], fmt=fmt, dpi=dpi)
     muscles = ", ".join(f"{m} {v['p_gauge_Pa'] / 1e5:.3f} bar, {v['F_tendon_N']:.2f} N" for m, v in summary["muscles"].items())
-    print(f"{scenario.name}: final angle {summary['final_theta_rad']:.4f} rad ({summary['final_mode']}), {muscles}; "
+    pos = scenario.body.position
+    final = f"final angle {summary[f'final_{pos}']:.4f} rad" if joint else f"final position {summary[f'final_{pos}'] * 1e3:.3f} mm"
+    print(f"{scenario.name}: {final} ({summary['final_mode']}), {muscles}; "
           f"{len(summary['events'])} events, {result.stats['rhs_evaluations']} RHS evaluations, "
           f"{result.wall_time_s * 1e3:.0f} ms")
-    print(f"  at rest at these pressures the joint balances at {eq.theta_rad:.4f} rad"
-          + (f" (on its {eq.on_limit} limit)" if eq.on_limit else "") + f", stiffness {eq.k_Nm_per_rad:.4g} N m/rad")
+    if joint:
+        print(f"  at rest at these pressures the joint balances at {eq.theta_rad:.4f} rad"
+              + (f" (on its {eq.on_limit} limit)" if eq.on_limit else "") + f", stiffness {eq.k_Nm_per_rad:.4g} N m/rad")
     print(f"wrote {', '.join(str(out / n) for n in names)}")
     return []
 

@@ -12,14 +12,15 @@ from .damping import ViscousDamping
 from .external_force import ExternalForce
 from .friction import CoulombFriction
 from .hanging_load import HangingLoad, LoadMode
+from .linear_slider import LinearSlider
 from .pressure import PressureSignal
-from .pulley import Pulley
+from .pulley import Pulley, SliderTendon
 from .rotary_joint import RotaryJoint
 from .spring import LinearSpring
 from .static_force import MuscleStaticForce
 from .valve import ProportionalValve
 
-__all__ = ["COMPONENT_TYPES", "CoulombFriction", "ExternalForce", "HangingLoad", "LinearSpring", "LoadMode",
+__all__ = ["COMPONENT_TYPES", "CoulombFriction", "ExternalForce", "HangingLoad", "LinearSlider", "LinearSpring", "LoadMode",
            "MuscleStaticForce", "PolytropicChamber", "PressureSignal", "ProportionalValve", "Pulley", "RotaryJoint",
-           "ViscousDamping",
+           "SliderTendon", "ViscousDamping",
            "register_component"]

@@ -8,9 +8,10 @@ bearing friction (viscous and Coulomb), the link's gravity torque and an externa
 
 from __future__ import annotations
 
-from ..modeling import ROTATIONAL, Component, Equations, Port, Symbols, Var, non_negative, positive
-from ..modeling.smath import if_else, sin, cos
-from .stick_slip import BodyMode, Contact, stick_slip
+from ..modeling import ROTATIONAL, Port, Var, non_negative, positive
+from ..modeling.smath import cos, sin
+from .guided_body import BodyNames, GuidedBody
+from .stick_slip import BodyMode
 
 EVENT_OMEGA_TOL_RAD_S = 1e-9
 """Event indicators on the angular velocity are shifted by this in the engine, so omega = 0 right after a
@@ -23,7 +24,7 @@ JointMode = BodyMode
 the lower or upper limit)."""
 
 
-class RotaryJoint(Component):
+class RotaryJoint(GuidedBody):
     """A link of moment of inertia ``J`` about the joint, between two angle limits.
 
     Sliding: ``J domega/dt = tau - m g l sin(theta - theta_down) - b omega - q tau_c + tau_ext``, with
@@ -38,7 +39,6 @@ class RotaryJoint(Component):
     """
 
     modes = JointMode
-    n_indicators = 2
     parameters = (positive("inertia_kg_m2", "kg m^2", "moment of inertia of the link about the joint"),
                   non_negative("link_mass_kg", "kg", "mass of the link (its gravity torque)"),
                   non_negative("com_distance_m", "m", "distance from the joint to the link's centre of mass"),
@@ -73,37 +73,11 @@ class RotaryJoint(Component):
                Var("tau_net_Nm", "N m", "sum of the torques on the link; held, of those other than friction and the limits"),
                Var("slip_direction", "1", "+1 or -1 while the angle grows or falls, 0 while held"))
 
-    def equations(self, s: Symbols) -> Equations:
-        P = s.p
-        q, theta, omega = s.mode, s.x["theta_rad"], s.x["omega_rad_s"]
-        shaft = s.port["shaft"]
-        direction = if_else(q * q == 1, q, 0.0)
-        omega_reported = if_else(q * q == 1, omega, 0.0)
+    names = BodyNames("shaft", "theta_rad", "omega_rad_s", "inertia_kg_m2", "b_Nm_s_per_rad", "tau_coulomb_Nm",
+                      "theta_min_rad", "theta_max_rad", "min_rebound_speed_rad_s", "stick_margin_Nm",
+                      "release_margin_Nm", "initial_angle_rad", "tau", "Nm")
+    event_tolerances = (EVENT_OMEGA_TOL_RAD_S, EVENT_THETA_TOL_RAD)
+
+    def gravity(self, P, theta):
         mgl = P["link_mass_kg"] * P["g_m_s2"] * P["com_distance_m"]
-        gravity = -mgl * sin(theta - P["theta_down_rad"])
-        viscous = -P["b_Nm_s_per_rad"] * omega_reported
-        # The branches' torques hold their muscles' friction while sliding; the bearing's is added here.
-        net = shaft["tau_Nm"] + gravity + viscous - direction * P["tau_coulomb_Nm"] + s.u["tau_external_Nm"]
-        level = shaft["tau_level_Nm"] + P["tau_coulomb_Nm"]
-        contact = Contact(P["theta_min_rad"], P["theta_max_rad"], P["restitution"], P["min_rebound_speed_rad_s"],
-                          P["stick_margin_Nm"], P["release_margin_Nm"], EVENT_OMEGA_TOL_RAD_S, EVENT_THETA_TOL_RAD)
-        theta0 = P["initial_angle_rad"]
-        b = stick_slip(q, theta, omega, net, level, P["inertia_kg_m2"], contact, s.fired, theta0)
-        bearing = if_else(q * q == 1, -direction * P["tau_coulomb_Nm"], 0.0)
-        return Equations(
-            der={"theta_rad": b.v_reported, "omega_rad_s": b.accel,
-                 "E_viscous_J": P["b_Nm_s_per_rad"] * omega_reported * omega_reported,
-                 "E_coulomb_J": P["tau_coulomb_Nm"] * abs(omega_reported),
-                 "W_external_J": s.u["tau_external_Nm"] * omega_reported},
-            outputs={"theta_rad": theta, "omega_rad_s": b.v_reported, "tau_gravity_Nm": gravity,
-                     "tau_muscles_Nm": shaft["tau_Nm"], "tau_applied_Nm": s.u["tau_external_Nm"], "tau_friction_Nm": if_else(q * q == 1, bearing, b.friction),
-                     "tau_stop_Nm": b.stop_reaction, "tau_coulomb_level_Nm": level,
-                     "kinetic_energy_J": 0.5 * P["inertia_kg_m2"] * omega * omega,
-                     "potential_energy_J": mgl * (1.0 - cos(theta - P["theta_down_rad"])),
-                     "tau_net_Nm": net, "slip_direction": b.slip_direction},
-            port={"shaft": {"theta_rad": theta, "omega_rad_s": b.v_reported}},
-            indicators=b.indicators, indicator_margins=b.margins,
-            transition={"theta_rad": b.jump_pos, "omega_rad_s": b.jump_vel, "mode": b.jump_mode},
-            rest_mode=b.rest_mode,
-            initial={"theta_rad": theta0, "omega_rad_s": 0.0, "E_viscous_J": 0.0, "E_coulomb_J": 0.0,
-                     "W_external_J": 0.0, "mode": b.initial_mode})
+        return -mgl * sin(theta - P["theta_down_rad"]), mgl * (1.0 - cos(theta - P["theta_down_rad"]))

@@ -148,8 +148,11 @@ def joint_mjcf(scenario, timestep_s: float = 1e-3) -> str:
     ------
     InputError
         A joint whose link does not hang down at angle zero, whose inertia is not above its mass's
-        ``m l^2`` about the hinge, or with a muscle on a lever.
+        ``m l^2`` about the hinge, with a muscle on a lever, or a slider scenario.
     """
+    if scenario.body.name != "joint":
+        raise InputError(f"{scenario.origin}: joint_mjcf writes a hinge; this scenario's muscles move a "
+                         f"{scenario.body.name}")
     j = scenario.joint
     for t, _ in scenario.muscles:
         if t["lever"] is not None:

@@ -39,12 +39,13 @@ def joint_fmu_spec(scenario: JointScenario, fmi_version: int = 2) -> FmuSpec:
     for m in scenario.joint_muscles():
         names = list(source_parts(m.source, None).inputs)
         signals.update({f"{m.name}.{n}": s for n, s in zip(names, m.source.signals)})
-    signals["tau_external_Nm"] = scenario.external_torque
+    external = scenario.body.external
+    signals[external] = scenario.external_torque
 
     def signals_of(names):
         out = {}
         for name in names:
-            unit = "N m" if name == "tau_external_Nm" else SIGNAL_UNITS[name.split(".", 1)[1]]
+            unit = {"Nm": "N m", "N": "N"}[scenario.body.unit] if name == external else SIGNAL_UNITS[name.split(".", 1)[1]]
             try:
                 out[name] = input_signal(signals[name], unit)
             except InputError as exc:
@@ -85,14 +86,15 @@ def simulate_joint_fmu(scenario: JointScenario, interface: str = "cs", fmi_versi
         raise InputError(f"FMU interface must be 'cs' or 'me', not {interface!r}")
     spec = joint_fmu_spec(scenario, fmi_version)
     path = temp_fmu(spec.token, f"{spec.identifier}_fmi{fmi_version}.fmu", lambda out: build_spec(out, spec))
-    t, Y, modes, wall = run_trace(path, interface, scenario.duration_s, scenario.solver, spec.states, "joint.mode")
+    body = scenario.body
+    t, Y, modes, wall = run_trace(path, interface, scenario.duration_s, scenario.solver, spec.states, f"{body.name}.mode")
     opts = scenario.solver
     assembly = scenario.assembly()
     muscles = scenario.joint_muscles()
-    signals = sampled_signals(compiled_by_mode(assembly, "joint", RUN_FUNCTIONS), assembly.parameter_values(), Y,
+    signals = sampled_signals(compiled_by_mode(assembly, body.name, RUN_FUNCTIONS), assembly.parameter_values(), Y,
                               JointInputs.of(scenario, muscles)(t), modes)
     return JointResult(scenario.name, t, signals, modes, [], [], trace_stats(modes, f"fmu-{interface}", opts.rtol),
-                       wall, tuple(m.name for m in muscles))
+                       wall, tuple(m.name for m in muscles), body=body)
 
 
 def simulate_joint_cs(scenario: JointScenario) -> JointResult:

@@ -68,11 +68,12 @@ def _result(scenario: JointScenario, assembly, names: dict, out: dict, t: np.nda
     ns, n = len(names["states"]), len(t)
     Y = np.array(out["samples"][:ns * n].reshape(ns, n))
     modes = out["modes"][:n].astype(int)
-    code = compiled_by_mode(assembly, "joint", RUN_FUNCTIONS)
+    code = compiled_by_mode(assembly, scenario.body.name, RUN_FUNCTIONS)
     muscles = scenario.joint_muscles()
     signals = sampled_signals(code, assembly.parameter_values(), Y, JointInputs.of(scenario, muscles)(t), modes)
     outputs = names["outputs"]
-    theta, ke = outputs.index("joint.theta_rad"), outputs.index("joint.kinetic_energy_J")
+    body = scenario.body
+    theta, ke = outputs.index(f"{body.name}.{body.position}"), outputs.index(f"{body.name}.kinetic_energy_J")
     ny = len(outputs)
     events, losses = [], []
     for e in out["events"][:int(out["n_events"][0])].tolist():
@@ -85,4 +86,4 @@ def _result(scenario: JointScenario, assembly, names: dict, out: dict, t: np.nda
     stats = {"rhs_evaluations": int(out["stats"][0][0]), "events": len(events), "segments": int(out["stats"][0][2]),
              "method": METHOD_LABEL, "rtol": native_rtol(scenario.solver)}
     return JointResult(scenario.name, t, signals, modes, events, losses, stats, wall_s, tuple(m.name for m in muscles),
-                       {"theta_rad": float(high[theta]), "theta_min_rad": float(low[theta])})
+                       {body.position: float(high[theta]), body.min_key: float(low[theta])}, body)

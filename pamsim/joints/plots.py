@@ -1,4 +1,5 @@
-"""Figures of a joint run: the angle, each muscle's pressure, and the torques on the link, over time."""
+"""Figures of a joint (or slider) run: the angle (position), each muscle's pressure, and the torques on the link
+(forces on the carriage), over time."""
 
 from __future__ import annotations
 
@@ -11,31 +12,41 @@ from ..figure_style import format_of, save, series
 from ..plotting import shade_held
 
 
+DISPLAY = {"joint": ("joint angle [deg]", np.degrees, "deg", "torque on the link [N m]\n(positive turns it to larger angles)"),
+           "slider": ("position [mm]", lambda x: 1e3 * np.asarray(x), "mm",
+                      "force on the carriage [N]\n(positive moves it to larger x)")}
+"""How a figure shows each body's coordinate and efforts: label, conversion from SI, unit, effort label."""
+
+
 def joint_figure(result) -> Figure:
     """Three panels over time: the joint angle (shaded where the link is held), each muscle's gauge
-    pressure, and each muscle's torque with gravity's and the net torque at rest."""
+    pressure, and each muscle's torque with gravity's and the external torque (a slider's: its position
+    and the forces on the carriage)."""
+    body = result.body
+    label, convert, unit, effort_label = DISPLAY[body.name]
     fig = Figure(figsize=(7.5, 8.0), layout="constrained")
     ax_theta, ax_p, ax_tau = fig.subplots(3, 1, sharex=True)
     t = result.t_s
     shade_held(ax_theta, t, result.mode)
-    ax_theta.plot(t, np.degrees(result.theta_rad), color="k", label="angle")
-    ax_theta.set_ylabel("joint angle [deg]")
+    ax_theta.plot(t, convert(result.position), color="k", label=body.noun)
+    ax_theta.set_ylabel(label)
     ax_theta.legend(loc="best", fontsize="small")
     for k, m in enumerate(result.muscles):
         ax_p.plot(t, result.muscle(m, "p_gauge_Pa") / PA_PER_BAR, label=m, **series(k))
-        ax_tau.plot(t, result.muscle(m, "tau_Nm"), label=f"{m} (tendon {np.max(result.muscle(m, 'F_tendon_N')):.3g} N max)",
-                    **series(k))
-    ax_tau.plot(t, result.signals["joint.tau_gravity_Nm"], label="gravity", **series(len(result.muscles), "C7"))
-    external = result.signals["joint.tau_applied_Nm"]
+        ax_tau.plot(t, result.muscle(m, body.attach_effort),
+                    label=f"{m} (tendon {np.max(result.muscle(m, 'F_tendon_N')):.3g} N max)", **series(k))
+    ax_tau.plot(t, result.body_signal(body.effort_name("gravity")), label="gravity", **series(len(result.muscles), "C7"))
+    external = result.body_signal(body.effort_name("applied"))
     if np.any(external != 0.0):
         ax_tau.plot(t, external, label="external", **series(len(result.muscles) + 1, "C4"))
     ax_p.set_ylabel("gauge pressure [bar]")
     ax_p.legend(loc="best", fontsize="small")
-    ax_tau.set_ylabel("torque on the link [N m]\n(positive turns it to larger angles)")
+    ax_tau.set_ylabel(effort_label)
     ax_tau.set_xlabel("time [s]")
     ax_tau.legend(loc="best", fontsize="small")
-    final = np.degrees(result.theta_rad[-1])
-    fig.suptitle(f"{result.name}: {len(result.muscles)} muscles on a joint, final angle {final:.2f} deg "
+    final = convert(result.position[-1])
+    n = len(result.muscles)
+    fig.suptitle(f"{result.name}: {n} muscle{'s' if n > 1 else ''} on a {body.name}, final {body.noun} {final:.2f} {unit} "
                  f"({result.final_mode.label})", fontsize="medium")
     return fig
 

@@ -10,20 +10,30 @@ import numpy as np
 
 from ..components.stick_slip import BodyMode
 from ..result import write_columns
+from .body import JOINT, Body
 
 MUSCLE_COLUMNS = ("p_gauge_Pa", "x_m", "F_tendon_N", "tau_Nm")
-"""Per muscle, the columns of a joint run's CSV (``<muscle>.<quantity>``)."""
+"""Per muscle, the columns of a joint run's CSV (``<muscle>.<quantity>``); on a slider ``F_N`` in place of
+``tau_Nm`` (the force of its tendon on the carriage)."""
+ATTACHMENTS = ("pulley", "lever", "tendon")
+"""The suffixes of a muscle's attachment's name: a joint's pulley or lever, a slider's tendon."""
 
 
 @dataclass(frozen=True)
 class JointEvent:
-    """A mode change of the joint: when, why, from and to which mode, at which angle."""
+    """A mode change of the joint (slider): when, why, from and to which mode, at which angle (position)."""
 
     t_s: float
     kind: str
     from_mode: str
     to_mode: str
-    theta_rad: float
+    coordinate: float
+    """The body's coordinate after the event: a joint's angle [rad], a slider's position [m]."""
+
+    @property
+    def theta_rad(self) -> float:
+        """A joint's angle after the event [rad]."""
+        return self.coordinate
 
 
 @dataclass
@@ -46,6 +56,23 @@ class JointResult:
     wall_time_s: float
     muscles: tuple[str, ...]
     peaks: dict[str, float] = field(default_factory=dict)
+    body: Body = JOINT
+    """The body the muscles moved (:data:`pamsim.joints.body.JOINT` or ``SLIDER``): the names of its
+    variables in :attr:`signals`."""
+
+    def body_signal(self, name: str) -> np.ndarray:
+        """A variable of the body (``theta_rad``, ``tau_gravity_Nm``; a slider's ``x_m``, ``F_gravity_N``)."""
+        return self.signals[f"{self.body.name}.{name}"]
+
+    @property
+    def position(self) -> np.ndarray:
+        """The body's coordinate at the samples: a joint's angle [rad], a slider's position [m]."""
+        return self.body_signal(self.body.position)
+
+    @property
+    def velocity(self) -> np.ndarray:
+        """The body's velocity at the samples (zero while held): [rad/s] or [m/s]."""
+        return self.body_signal(self.body.velocity)
 
     @property
     def theta_rad(self) -> np.ndarray:
@@ -64,10 +91,10 @@ class JointResult:
 
     def muscle(self, name: str, quantity: str) -> np.ndarray:
         """A muscle's signal: ``p_gauge_Pa`` (its pressure), ``x_m`` (contraction), ``F_tendon_N``,
-        ``tau_Nm`` (its torque on the joint), ``taut``, ``moment_arm_m``, ``F_static_N``; ``KeyError`` for an
-        unknown one."""
-        attach = "pulley" if f"{name}_pulley.x_m" in self.signals else "lever"
-        where = {"p_gauge_Pa": "pressure", "x_m": attach, "F_tendon_N": attach, "tau_Nm": attach,
+        ``tau_Nm`` (its torque on the joint; on a slider ``F_N``, its force on the carriage), ``taut``,
+        ``moment_arm_m``, ``F_static_N``; ``KeyError`` for an unknown one."""
+        attach = next(a for a in ATTACHMENTS if f"{name}_{a}.x_m" in self.signals)
+        where = {"p_gauge_Pa": "pressure", "x_m": attach, "F_tendon_N": attach, "tau_Nm": attach, "F_N": attach,
                  "taut": attach, "moment_arm_m": attach, "F_static_N": "muscle"}
         if quantity == "p_gauge_Pa":
             found = [k for k in self.signals if k.startswith(f"{name}_") and k.endswith(".p_gauge_Pa")
@@ -76,11 +103,11 @@ class JointResult:
         return self.signals[f"{name}_{where[quantity]}.{quantity}"]
 
     def signals_key(self, muscle: str, name: str) -> str:
-        """The name in :attr:`signals` of the variable ``name`` of ``muscle``'s pulley or lever."""
-        return f"{muscle}_pulley.{name}" if f"{muscle}_pulley.{name}" in self.signals else f"{muscle}_lever.{name}"
+        """The name in :attr:`signals` of the variable ``name`` of ``muscle``'s pulley, lever or tendon."""
+        return next(key for a in ATTACHMENTS if (key := f"{muscle}_{a}.{name}") in self.signals)
 
     def energy_balance(self) -> dict[str, float]:
-        """The tendons' and the external torque's work against what the link gained and lost [J].
+        """The tendons' and the external torque's (force's) work against what the body gained and lost [J].
 
         ``residual_J`` = work in - (kinetic + potential gain + bearing friction + impacts); ``relative``
         divides it by the largest term.  Per muscle, ``<name>.slack_J`` is the work of its forces that
@@ -90,9 +117,10 @@ class JointResult:
         d = lambda key: float(s[key][-1] - s[key][0])  # noqa: E731
         tendon = {m: self.signals_key(m, "W_tendon_J") for m in self.muscles}
         terms = {f"{m}.W_tendon_J": float(s[tendon[m]][-1]) for m in self.muscles}
-        terms.update({"W_external_J": float(s["joint.W_external_J"][-1]), "dKE_J": d("joint.kinetic_energy_J"),
-                      "dPE_J": d("joint.potential_energy_J"), "E_viscous_J": float(s["joint.E_viscous_J"][-1]),
-                      "E_coulomb_J": float(s["joint.E_coulomb_J"][-1]), "E_impacts_J": float(sum(self.impact_losses_J))})
+        b = self.body.name
+        terms.update({"W_external_J": float(s[f"{b}.W_external_J"][-1]), "dKE_J": d(f"{b}.kinetic_energy_J"),
+                      "dPE_J": d(f"{b}.potential_energy_J"), "E_viscous_J": float(s[f"{b}.E_viscous_J"][-1]),
+                      "E_coulomb_J": float(s[f"{b}.E_coulomb_J"][-1]), "E_impacts_J": float(sum(self.impact_losses_J))})
         residual = (sum(terms[f"{m}.W_tendon_J"] for m in self.muscles) + terms["W_external_J"] - terms["dKE_J"]
                     - terms["dPE_J"] - terms["E_viscous_J"] - terms["E_coulomb_J"] - terms["E_impacts_J"])
         slack = {f"{m}.slack_J": float(s[f"{m}_muscle.W_muscle_J"][-1] - s[f"{m}_damping.E_damping_J"][-1]
@@ -103,12 +131,13 @@ class JointResult:
 
     def columns(self) -> dict[str, np.ndarray]:
         """``t_s``, ``theta_rad``, ``omega_rad_s``, ``mode``, then per muscle :data:`MUSCLE_COLUMNS`, then the
-        joint's gravity, muscle, external and net torques."""
-        cols = {"t_s": self.t_s, "theta_rad": self.theta_rad, "omega_rad_s": self.omega_rad_s, "mode": self.mode}
+        joint's gravity, muscle, external and net torques (a slider's: ``x_m``, ``v_m_s``, forces)."""
+        body = self.body
+        cols = {"t_s": self.t_s, body.position: self.position, body.velocity: self.velocity, "mode": self.mode}
+        quantities = (*MUSCLE_COLUMNS[:-1], body.attach_effort)
         for m in self.muscles:
-            cols.update({f"{m}.{q}": self.muscle(m, q) for q in MUSCLE_COLUMNS})
-        cols.update({k: self.signals[f"joint.{k}"] for k in ("tau_gravity_Nm", "tau_muscles_Nm", "tau_applied_Nm",
-                                                                  "tau_net_Nm")})
+            cols.update({f"{m}.{q}": self.muscle(m, q) for q in quantities})
+        cols.update({k: self.body_signal(k) for k in map(body.effort_name, ("gravity", "muscles", "applied", "net"))})
         return cols
 
     def to_csv(self, path) -> None:
@@ -118,12 +147,14 @@ class JointResult:
     def summary(self) -> dict:
         """The run in numbers: final and extreme angles, final mode, each muscle's final pressure, tendon
         force and torque, the events, the solver's statistics and the energy balance."""
-        return {"name": self.name, "final_theta_rad": float(self.theta_rad[-1]),
-                "peak_theta_rad": float(self.peaks.get("theta_rad", np.max(self.theta_rad))),
-                "min_theta_rad": float(self.peaks.get("theta_min_rad", np.min(self.theta_rad))),
+        pos, q = self.body.position, self.position
+        quantities = (*MUSCLE_COLUMNS[:-1], self.body.attach_effort)
+        return {"name": self.name, f"final_{pos}": float(q[-1]),
+                f"peak_{pos}": float(self.peaks.get(pos, np.max(q))),
+                f"min_{pos}": float(self.peaks.get(self.body.min_key, np.min(q))),
                 "final_mode": self.final_mode.label,
-                "muscles": {m: {q: float(self.muscle(m, q)[-1]) for q in MUSCLE_COLUMNS} for m in self.muscles},
-                "events": [{"t_s": e.t_s, "kind": e.kind, "from": e.from_mode, "to": e.to_mode, "theta_rad": e.theta_rad}
+                "muscles": {m: {k: float(self.muscle(m, k)[-1]) for k in quantities} for m in self.muscles},
+                "events": [{"t_s": e.t_s, "kind": e.kind, "from": e.from_mode, "to": e.to_mode, pos: e.coordinate}
                            for e in self.transitions],
                 "stats": {**self.stats, "wall_time_s": self.wall_time_s}, "energy_balance": self.energy_balance()}
 

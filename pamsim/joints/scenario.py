@@ -26,18 +26,20 @@ from __future__ import annotations
 
 import copy
 import math
+import re
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping
 
-from ..assemblies.joint import JointMuscle, joint_assembly
-from ..components.pulley import LeverAttachment, Pulley
+from ..assemblies.joint import SLIDER_FRICTION_LOADS, JointMuscle, joint_assembly, slider_assembly
+from ..components.pulley import LeverAttachment, Pulley, SliderTendon
 from ..scenario import Scenario, ScenarioError
 from ..signal_tables import signal_from_table
 from ..signals import Constant
 from ..simulator import SolverOptions
 from ..table_checks import TableChecker
+from .body import JOINT, SLIDER, Body
 
 JOINT_KEYS: dict[str, tuple[float | None, str]] = {
     "inertia_kg_m2": (None, "positive"), "link_mass_kg": (0.0, "non_negative"),
@@ -53,7 +55,18 @@ MUSCLE_KEYS = {"name", "side", "radius_m", "x_at_zero_m", "model", "parameters",
 LEVER_KEYS = {"link_attach_m": "positive", "base_attach_m": "positive", "angle_at_zero_rad": "positive",
               "tendon_length_m": "non_negative"}
 """A lever attachment's keys in a ``[[muscle]]`` table (``attachment = "lever"``) and their ranges."""
-TOP_KEYS = {"name", "description", "joint", "muscle", "simulation", "solver", "controller"}
+SLIDER_KEYS: dict[str, tuple[float | None, str]] = {
+    "mass_kg": (None, "positive"), "g_m_s2": (9.81, "positive"), "incline_rad": (math.pi / 2, "any"),
+    "b_N_s_per_m": (0.0, "non_negative"), "F_coulomb_N": (0.0, "non_negative"),
+    "x_min_m": (None, "any"), "x_max_m": (None, "any"), "restitution": (0.0, "unit"),
+    "min_rebound_speed_m_s": (1e-3, "non_negative"), "initial_position_m": (0.0, "any")}
+"""``[slider]`` keys: default (None: required) and range.  The guide is vertical unless ``incline_rad`` says
+otherwise (the paper's rig); min_rebound_speed_m_s is assumed (a rebound slower than 1 mm/s moves the
+carriage by less than a figure resolves).  Besides these, ``weight_N`` in place of ``mass_kg`` (the mass is
+then ``weight_N / g_m_s2``, as a one-muscle scenario's ``[load]``), ``friction_load`` (:data:`SLIDER_FRICTION_LOADS`,
+default ``"static_force"``) and an ``external_force`` signal table."""
+SLIDER_MUSCLE_KEYS = {"name", "side", "x_at_zero_m", "model", "parameters", "pressure"}
+TOP_KEYS = {"name", "description", "joint", "slider", "muscle", "simulation", "solver", "controller"}
 CONTROLLER_KEYS: dict[str, tuple[object, str]] = {
     "kind": (None, "text"), "sample_rate_Hz": (1000.0, "positive"), "stiffness_Nm_per_rad": (None, "positive"),
     "bandwidth_rad_s": (80.0, "positive"), "steps_time_s": ((), "list"), "steps_angle_rad": ((), "list"),
@@ -92,8 +105,8 @@ def _number(origin: str, key: str, value, kind: str) -> float:
 
 @dataclass(frozen=True)
 class JointScenario:
-    """A validated joint scenario: the joint's parameters, its muscles (each with the one-muscle
-    scenario its tables make), the run's length, sampling and solver settings."""
+    """A validated joint scenario: the joint's parameters (or the slider's: :attr:`body`), its muscles
+    (each with the one-muscle scenario its tables make), the run's length, sampling and solver settings."""
 
     name: str
     spec: Mapping[str, Any] = field(repr=False)
@@ -106,6 +119,9 @@ class JointScenario:
     """The external torque on the link [N m], a signal of time (``[joint.external_torque]``; default none)."""
     controller: Mapping[str, Any] | None = field(default=None, repr=False)
     """The ``[controller]`` table, checked (:data:`CONTROLLER_KEYS`), or None for an open-loop run."""
+    body: Body = JOINT
+    """The body the muscles move: a rotary joint (``[joint]``) or a linear slider (``[slider]``, whose
+    parameters :attr:`joint` then holds, with ``friction_load``)."""
 
     @classmethod
     def from_dict(cls, spec: Mapping[str, Any], origin: str = "<dict>", base_dir: str | Path = ".") -> "JointScenario":
@@ -120,26 +136,32 @@ class JointScenario:
             _fail(origin, "name", name, "must be a name made of letters, digits and _")
         duration = _number(origin, "simulation.duration_s", sim.get("duration_s", 5.0), "positive")
         rate = _number(origin, "simulation.sample_rate_Hz", sim.get("sample_rate_Hz", 1000.0), "positive")
-        joint_table = dict(_table(origin, "joint", spec.get("joint", {})))
-        torque = joint_table.pop("external_torque", None)
-        joint = _joint(origin, joint_table if "joint" in spec else None)
-        external = (signal_from_table(TableChecker(origin, ScenarioError), "joint.external_torque", torque, "_Nm", 1.0,
-                                      Path(base_dir)) if torque is not None else Constant(0.0))
+        body = _body(origin, spec)
+        joint_table = dict(_table(origin, body.name, spec.get(body.name, {})))
+        effort_key = "external_torque" if body is JOINT else "external_force"
+        torque = joint_table.pop(effort_key, None)
+        joint = (_joint if body is JOINT else _slider)(origin, joint_table if body.name in spec else None)
+        external = (signal_from_table(TableChecker(origin, ScenarioError), f"{body.name}.{effort_key}", torque,
+                                      f"_{body.unit}", 1.0, Path(base_dir)) if torque is not None else Constant(0.0))
         solver = _table(origin, "solver", spec.get("solver", {}))
         for key in sorted(set(solver) - SOLVER_KEYS):
             _fail(origin, f"solver.{key}", solver[key], f"unknown key; [solver] has {sorted(SOLVER_KEYS)}")
         shared = {"solver": solver, "simulation": {"duration_s": duration, "sample_rate_Hz": rate}}
-        muscles = _muscles(origin, spec.get("muscle"), shared, Path(base_dir))
+        muscles = _muscles(origin, spec.get("muscle"), shared, Path(base_dir), body)
         # Each muscle's one-muscle scenario has read the [solver] table, with its checks and messages.
+        if "controller" in spec and body is SLIDER:
+            _fail(origin, "controller", spec["controller"], "a slider has no controller yet (the angle-stiffness "
+                  "controller drives a joint)")
         controller = _controller(origin, spec["controller"], joint, muscles) if "controller" in spec else None
-        scenario = cls(name, spec, joint, muscles, duration, muscles[0][1].solver, origin, external, controller)
+        scenario = cls(name, spec, joint, muscles, duration, muscles[0][1].solver, origin, external, controller, body)
         scenario._check_limits()
         return scenario
 
     def _check_limits(self) -> None:
         """Each muscle's contraction stays inside its own stops (the static model's range) over the
         joint's limits: beyond them its force is not defined."""
-        lo, hi = self.joint["theta_min_rad"], self.joint["theta_max_rad"]
+        low_key, high_key, initial_key = self.body.limit_keys
+        lo, hi = self.joint[low_key], self.joint[high_key]
         for m, (table, sc) in zip(self.joint_muscles(), self.muscles):
             stops = sc.build_model().stops
             if m.lever is not None:
@@ -148,10 +170,10 @@ class JointScenario:
                     _fail(self.origin, f"muscle {m.name!r}.angle_at_zero_rad", m.lever["angle_at_zero_rad"],
                           f"its lever's arms would line up within the joint's limits (arm angle from {phi[0]:.4g} to "
                           f"{phi[1]:.4g} rad, must stay inside (0, pi)): the muscle would have no lever arm there")
-            for key, theta in (("theta_min_rad", lo), ("theta_max_rad", hi), ("initial_angle_rad", self.joint["initial_angle_rad"])):
-                x = contraction_m(m, theta)
+            for key, theta in ((low_key, lo), (high_key, hi), (initial_key, self.joint[initial_key])):
+                x = contraction_m(m, theta, self.body)
                 if not stops.x_low_m - 1e-12 <= x <= stops.x_high_m + 1e-12:
-                    _fail(self.origin, f"joint.{key}", theta,
+                    _fail(self.origin, f"{self.body.name}.{key}", theta,
                           f"muscle {table['name']!r} would contract to {x * 1e3:.2f} mm there, outside its range "
                           f"[{stops.x_low_m * 1e3:.2f}, {stops.x_high_m * 1e3:.2f}] mm (its attachment's geometry)")
 
@@ -169,19 +191,30 @@ class JointScenario:
     def joint_values(self) -> dict[str, float]:
         """The :class:`pamsim.components.rotary_joint.RotaryJoint` parameters, the solver's margins in
         torque (its force margins times the largest lever arm: a pulley's radius, or a bound on a lever's,
-        its shorter arm)."""
+        its shorter arm); for a slider, the :class:`pamsim.components.linear_slider.LinearSlider`'s, the
+        margins the solver's own."""
+        if self.body is SLIDER:
+            values = {k: v for k, v in self.joint.items() if k != "friction_load"}
+            return {**values, "stick_margin_N": self.solver.stick_margin_N, "release_margin_N": self.solver.release_margin_N}
         r = max(t["radius_m"] if t["lever"] is None else min(t["lever"]["link_attach_m"], t["lever"]["base_attach_m"])
                 for t, _ in self.muscles)
         return {**self.joint, "stick_margin_Nm": self.solver.stick_margin_N * r,
                 "release_margin_Nm": self.solver.release_margin_N * r}
 
     def assembly(self):
-        """The joint's assembly (:func:`pamsim.assemblies.joint.joint_assembly`)."""
+        """The joint's assembly (:func:`pamsim.assemblies.joint.joint_assembly`), or the slider's
+        (:func:`pamsim.assemblies.joint.slider_assembly`)."""
+        if self.body is SLIDER:
+            return slider_assembly(self.joint_values(), self.joint_muscles(), self.joint["g_m_s2"],
+                                   self.joint["friction_load"], name=self.name)
         return joint_assembly(self.joint_values(), self.joint_muscles(), self.joint["g_m_s2"], name=self.name)
 
 
-def contraction_m(m: JointMuscle, theta_rad: float) -> float:
-    """Muscle ``m``'s contraction at joint angle ``theta_rad``, by its attachment's own kinematics."""
+def contraction_m(m: JointMuscle, theta_rad: float, body: Body = JOINT) -> float:
+    """Muscle ``m``'s contraction at joint angle ``theta_rad`` (on a slider, ``body``: at that position), by
+    its attachment's own kinematics."""
+    if body is SLIDER:
+        return SliderTendon.kinematics(None, {"x_at_zero_m": m.x_at_zero_m, "side": m.side}, theta_rad)[0]
     if m.lever is None:
         return Pulley.kinematics(None, {"x_at_zero_m": m.x_at_zero_m, "side": m.side, "radius_m": m.radius_m}, theta_rad)[0]
     return LeverAttachment.kinematics(None, {**m.lever, "side": m.side}, theta_rad)[0]
@@ -195,36 +228,67 @@ def load_joint_scenario(path: str | Path) -> JointScenario:
     except (OSError, tomllib.TOMLDecodeError) as exc:
         raise ScenarioError(f"{path}: {exc}") from exc
     if not is_joint_spec(spec):
-        raise ScenarioError(f"{path}: not a joint scenario (it has no [joint] or [[muscle]] tables)")
+        raise ScenarioError(f"{path}: not a joint scenario (it has no [joint], [slider] or [[muscle]] tables)")
     return JointScenario.from_dict(spec, origin=str(path), base_dir=path.parent)
 
 
 def is_joint_spec(spec: Mapping[str, Any]) -> bool:
-    """Whether a scenario file's content describes muscles on a joint (it has ``[joint]`` or ``[[muscle]]``)."""
-    return "joint" in spec or isinstance(spec.get("muscle"), list)
+    """Whether a scenario file's content describes muscles on a joint or a slider (it has ``[joint]``,
+    ``[slider]`` or ``[[muscle]]``)."""
+    return "joint" in spec or "slider" in spec or isinstance(spec.get("muscle"), list)
+
+
+def _body(origin: str, spec: Mapping[str, Any]) -> Body:
+    """The body a scenario's muscles move: a joint unless it has a ``[slider]`` table (and no ``[joint]``)."""
+    if "slider" in spec and "joint" in spec:
+        _fail(origin, "slider", spec["slider"], "a scenario has a [joint] or a [slider], not both")
+    return SLIDER if "slider" in spec else JOINT
+
+
+def _slider(origin: str, table) -> dict:
+    if not isinstance(table, dict):
+        raise ScenarioError(f"{origin}: [slider] is missing (the carriage's mass and stops)")
+    load = table.get("friction_load", "static_force")
+    if load not in SLIDER_FRICTION_LOADS:
+        _fail(origin, "slider.friction_load", load, f"must be one of {list(SLIDER_FRICTION_LOADS)}")
+    table = {k: v for k, v in table.items() if k != "friction_load"}
+    if "weight_N" in table:
+        if "mass_kg" in table:
+            _fail(origin, "slider.weight_N", table["weight_N"], "give mass_kg or weight_N, not both")
+        weight = _number(origin, "slider.weight_N", table.pop("weight_N"), "positive")
+        g = _number(origin, "slider.g_m_s2", table.get("g_m_s2", SLIDER_KEYS["g_m_s2"][0]), "positive")
+        table["mass_kg"] = weight / g  # as a one-muscle scenario's [load] reads a weight
+    out = _checked(origin, "slider", table, SLIDER_KEYS)
+    return {**out, "friction_load": load}
 
 
 def _joint(origin: str, table) -> dict[str, float]:
     if not isinstance(table, dict):
         raise ScenarioError(f"{origin}: [joint] is missing (the link's inertia and limits)")
-    for key in sorted(set(table) - set(JOINT_KEYS)):
-        _fail(origin, f"joint.{key}", table[key], f"unknown key; [joint] has {sorted(JOINT_KEYS)}")
+    return _checked(origin, "joint", table, JOINT_KEYS)
+
+
+def _checked(origin: str, where: str, table: dict, keys: dict) -> dict[str, float]:
+    """A body's table checked against ``keys`` (:data:`JOINT_KEYS`, :data:`SLIDER_KEYS`): known keys, the
+    required ones, their ranges, and limits in order with the start between them."""
+    for key in sorted(set(table) - set(keys)):
+        _fail(origin, f"{where}.{key}", table[key], f"unknown key; [{where}] has {sorted(keys)}")
     out = {}
-    for key, (default, kind) in JOINT_KEYS.items():
+    for key, (default, kind) in keys.items():
         if key not in table and default is None:
-            raise ScenarioError(f"{origin}: joint.{key} is required")
-        out[key] = _number(origin, f"joint.{key}", table.get(key, default), kind)
-    if out["theta_min_rad"] >= out["theta_max_rad"]:
-        _fail(origin, "joint.theta_min_rad", out["theta_min_rad"],
-              f"must be below joint.theta_max_rad = {out['theta_max_rad']!r}")
-    if not out["theta_min_rad"] <= out["initial_angle_rad"] <= out["theta_max_rad"]:
-        _fail(origin, "joint.initial_angle_rad", out["initial_angle_rad"], "must lie between the joint's limits")
+            raise ScenarioError(f"{origin}: {where}.{key} is required")
+        out[key] = _number(origin, f"{where}.{key}", table.get(key, default), kind)
+    low, high, initial = (JOINT if where == "joint" else SLIDER).limit_keys
+    if out[low] >= out[high]:
+        _fail(origin, f"{where}.{low}", out[low], f"must be below {where}.{high} = {out[high]!r}")
+    if not out[low] <= out[initial] <= out[high]:
+        _fail(origin, f"{where}.{initial}", out[initial], f"must lie between the {where}'s limits")
     return out
 
 
-def _muscles(origin: str, tables, shared: dict, base_dir: Path) -> tuple:
+def _muscles(origin: str, tables, shared: dict, base_dir: Path, body: Body = JOINT) -> tuple:
     if not isinstance(tables, list) or not tables:
-        raise ScenarioError(f"{origin}: no [[muscle]] tables (a joint needs at least one muscle)")
+        raise ScenarioError(f"{origin}: no [[muscle]] tables (a {body.name} needs at least one muscle)")
     seen, out = set(), []
     for k, table in enumerate(tables):
         where = f"muscle[{k}]"
@@ -236,21 +300,22 @@ def _muscles(origin: str, tables, shared: dict, base_dir: Path) -> tuple:
         if name in seen:
             _fail(origin, f"{where}.name", name, "is given to two muscles")
         seen.add(name)
-        out.append(_muscle(origin, f"muscle {name!r}", table, shared, base_dir))
+        out.append(_muscle(origin, f"muscle {name!r}", table, shared, base_dir, body))
     return tuple(out)
 
 
-def _muscle(origin: str, where: str, table: dict, shared: dict, base_dir: Path):
+def _muscle(origin: str, where: str, table: dict, shared: dict, base_dir: Path, body: Body = JOINT):
     for key in ("model", "parameters", "pressure"):
         if key in table:
             _table(origin, f"{where}.{key}", table[key])
-    for key in sorted(set(table) - MUSCLE_KEYS):
-        _fail(origin, f"{where}.{key}", table[key], f"unknown key; a [[muscle]] has {sorted(MUSCLE_KEYS)}")
+    allowed = MUSCLE_KEYS if body is JOINT else SLIDER_MUSCLE_KEYS
+    for key in sorted(set(table) - allowed):
+        _fail(origin, f"{where}.{key}", table[key], f"unknown key; a [[muscle]] on a {body.name} has {sorted(allowed)}")
     if "pressure" not in table:
         raise ScenarioError(f"{origin}: {where} has no [muscle.pressure] table: every muscle needs a pressure input")
     side = table.get("side")
     if side not in (1, -1) or isinstance(side, bool):
-        _fail(origin, f"{where}.side", side, "must be 1 (it turns the joint toward larger angles) or -1")
+        _fail(origin, f"{where}.side", side, f"must be 1 (it moves the {body.name} toward larger {body.noun}s) or -1")
     attachment = table.get("attachment", "pulley")
     if attachment not in ("pulley", "lever"):
         _fail(origin, f"{where}.attachment", attachment, "must be 'pulley' (radius_m, x_at_zero_m) or 'lever' "
@@ -260,7 +325,9 @@ def _muscle(origin: str, where: str, table: dict, shared: dict, base_dir: Path):
         if key in table:
             _fail(origin, f"{where}.{key}", table[key], f"not a key of attachment = {attachment!r}")
     values = {"name": table["name"], "side": float(side), "radius_m": 0.0, "x_at_zero_m": 0.0, "lever": None}
-    if attachment == "pulley":
+    if body is SLIDER:
+        values["x_at_zero_m"] = _number(origin, f"{where}.x_at_zero_m", table.get("x_at_zero_m", 0.0), "any")
+    elif attachment == "pulley":
         values["radius_m"] = _number(origin, f"{where}.radius_m", table.get("radius_m"), "positive")
         values["x_at_zero_m"] = _number(origin, f"{where}.x_at_zero_m", table.get("x_at_zero_m", 0.0), "any")
     else:
@@ -330,3 +397,36 @@ def _steps(origin: str, table: dict, joint: dict) -> tuple[tuple[float, ...], tu
         if not joint["theta_min_rad"] < a < joint["theta_max_rad"]:
             _fail(origin, f"controller.steps_angle_rad[{k}]", a, "must lie between the joint's limits")
     return tuple(times), tuple(angles)
+
+
+def slider_of_rig(scenario: Scenario) -> JointScenario:
+    """The one-muscle rig of ``scenario`` (a hanging load) as a slider: a vertical guide whose carriage is
+    the load, between the rig's stops, pulled up by the muscle's tendon, the muscle's friction reading the
+    carriage's mass (``friction_load = "slider_mass"``), with the same pressure source, external force,
+    sampling and solver.  While the muscle pulls, both are the same equations; they differ where it
+    would push (a tendon goes slack) and in the slider's energy states, which the integrator's error
+    control also weighs.
+
+    Raises
+    ------
+    ScenarioError
+        For a rig with added components or a controller, which a slider scenario does not carry.
+    """
+    for key in ("component", "controller"):
+        if key in scenario.spec:
+            _fail(scenario.origin, key, "...", "a rig with it has no slider form")
+    stops, spec = scenario.build_model().stops, scenario.spec
+    sim = dict(spec.get("simulation", {}))
+    x0 = float(sim.pop("initial_contraction_m", 0.0))
+    slider = {"mass_kg": scenario.mass_kg, "g_m_s2": scenario.parameters["g_m_s2"], "incline_rad": math.pi / 2,
+              "x_min_m": stops.x_low_m, "x_max_m": stops.x_high_m, "restitution": stops.restitution,
+              "min_rebound_speed_m_s": stops.min_rebound_speed_m_s, "initial_position_m": x0,
+              "friction_load": "slider_mass"}
+    if "external_force" in spec["load"]:
+        slider["external_force"] = spec["load"]["external_force"]
+    muscle = {"name": "muscle", "side": 1, "x_at_zero_m": 0.0, "model": spec.get("model", {}),
+              "parameters": spec.get("parameters", {}), "pressure": spec["pressure"]}
+    name = re.sub(r"\W", "_", f"{scenario.name}_slider")
+    out = {"name": name if name.isidentifier() else f"rig_{name}", "slider": slider, "muscle": [muscle], "simulation": sim,
+           "solver": {k: v for k, v in spec.get("solver", {}).items() if k in SOLVER_KEYS}}
+    return JointScenario.from_dict(out, origin=f"{scenario.origin} (as a slider)", base_dir=scenario.base_dir)

@@ -17,7 +17,7 @@ from .scenario import JointScenario
 
 class JointInputs:
     """The joint model's inputs at a time: each muscle's pressure source's, in the assembly's order, then
-    the external torque (a signal of time)."""
+    the external torque (a slider's: force), a signal of time."""
 
     def __init__(self, sources, external_torque):
         self.sources, self.external_torque = sources, external_torque
@@ -79,7 +79,7 @@ def joint_run(scenario: JointScenario) -> tuple[HybridRun, list[str]]:
     assembly = scenario.assembly()
     flat = assembly.flatten()
     inputs = JointInputs.of(scenario, muscles)
-    gen = GeneratedCode(assembly, "joint", inputs, [ENERGY_SCALE_J if v.unit == "J" else v.nominal for v in flat.states])
+    gen = GeneratedCode(assembly, scenario.body.name, inputs, [ENERGY_SCALE_J if v.unit == "J" else v.nominal for v in flat.states])
     breaks = tuple(b for m in muscles for b in m.source.breakpoints) + tuple(scenario.external_torque.breakpoints)
     longest = min([getattr(m.source, "max_input_step_s", math.inf) for m in muscles]
                   + [max_step_hint_s(scenario.external_torque)])
@@ -100,6 +100,7 @@ def simulate_joint_python(scenario: JointScenario) -> JointResult:
     t, Y, modes = run.trace()
     signals = sampled_signals(run.gen.code, run.gen.p, Y, run.gen.inputs(t), modes)
     events = [JointEvent(e.t_s, e.kind, e.from_mode, e.to_mode, e.x_m) for e in run.transitions]
+    body = scenario.body
     return JointResult(scenario.name, t, signals, modes, events, [loss for _, loss in run.impact_loss_J],
                        run.stats(), time.perf_counter() - wall0, tuple(names),
-                       {"theta_rad": run.peak_x, "theta_min_rad": run.low_x})
+                       {body.position: run.peak_x, body.min_key: run.low_x}, body)

@@ -16,6 +16,7 @@ import numpy as np
 from ..assemblies.joint import joint_assembly
 from ..components.stick_slip import BodyMode
 from ..elements.pressure_source import PrescribedPressure
+from ..errors import InputError
 from ..modeling.pygen import compiled_by_mode
 from ..signals import Constant
 from .scenario import JointScenario
@@ -42,6 +43,9 @@ class JointStatics:
     """
 
     def __init__(self, scenario: JointScenario):
+        if scenario.body.name != "joint":
+            raise InputError(f"{scenario.origin}: the statics, stiffness and linearisation of muscles are for a joint; "
+                             f"this scenario's muscles move a {scenario.body.name}")
         self.scenario = scenario
         muscles = tuple(replace(m, source=PrescribedPressure(Constant(0.0))) for m in scenario.joint_muscles())
         assembly = joint_assembly(scenario.joint_values(), muscles, scenario.joint["g_m_s2"], name=scenario.name)

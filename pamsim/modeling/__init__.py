@@ -12,7 +12,7 @@ from . import code_cache, smath
 from .assembly import Assembly, AssemblyError
 from .component import Component, Equations, Symbols
 from .flat import FlatModel
-from .variables import PNEUMATIC, ROTATIONAL, SIGNAL, TRANSLATIONAL, Port, PortKind, Var, non_negative, positive
+from .variables import LINEAR, PNEUMATIC, ROTATIONAL, SIGNAL, TRANSLATIONAL, Port, PortKind, Var, non_negative, positive
 
 __all__ = ["Assembly", "AssemblyError", "Component", "Equations", "FlatModel", "PNEUMATIC", "Port", "PortKind",
-           "ROTATIONAL", "SIGNAL", "Symbols", "TRANSLATIONAL", "Var", "code_cache", "non_negative", "positive", "smath"]
+           "LINEAR", "ROTATIONAL", "SIGNAL", "Symbols", "TRANSLATIONAL", "Var", "code_cache", "non_negative", "positive", "smath"]

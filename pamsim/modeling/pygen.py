@@ -415,10 +415,13 @@ def compiled_by_mode(assembly, component: str, names=("f", "z", "transition", "r
     """``{mode: GeneratedModel}``: the assembly flattened and generated once for each mode of its hybrid
     component ``component``, with no mode logic left in the code an integrator runs in that mode.
 
-    Cached by the assembly's structure, so runs that differ only in parameter values share the code,
+    Cached by the assembly's structure, so runs that differ only in parameter values (or the assembly's
+    name, which the code does not use) share the code,
     in this process and, through :mod:`pamsim.modeling.code_cache`, in the next ones.
     """
-    key = (assembly.structure_key(), component, tuple(names))
+    # Without the assembly's name, which the generated functions do not use: scenarios that differ in
+    # name alone (a sweep's cases) share the code.
+    key = (assembly.structure_key()[1:], component, tuple(names))
     if key not in _BY_MODE_CACHE:
         if len(_BY_MODE_CACHE) >= BY_MODE_CACHE_SIZE:
             _BY_MODE_CACHE.pop(next(iter(_BY_MODE_CACHE), None), None)

@@ -82,6 +82,15 @@ ROTATIONAL = PortKind(
 """A mechanical shaft: angle and angular velocity; torque, and the friction level a branch brings (a
 muscle's Coulomb friction acts on the joint it turns, and decides with the joint's own whether it sticks)."""
 
+LINEAR = PortKind(
+    "linear",
+    across=(Var("x_m", "m", "position of the carriage along its guide"),
+            Var("v_m_s", "m/s", "velocity of the carriage along its guide")),
+    through=(Var("F_N", "N", "force on the carriage along its guide"),
+             Var("F_level_N", "N", "Coulomb friction level the branch adds to the carriage's stick/slip decision")))
+"""A guided carriage (a slider): position and velocity; force, and the friction level a branch brings, as
+:data:`ROTATIONAL` for a shaft."""
+
 PNEUMATIC = PortKind(
     "pneumatic",
     across=(Var("p_abs_Pa", "Pa", "absolute pressure of the volume"),

@@ -394,7 +394,9 @@ def engine_library(assembly) -> EngineLibrary:
     NotImplementedError
         For an assembly the C engine cannot run (external functions, more than one hybrid component).
     """
-    key = assembly.structure_key()
+    # The assembly's name is only a comment in the C: scenarios that differ in name alone (a sweep's
+    # cases) share one engine.
+    key = assembly.structure_key()[1:]
     if key in _LOADED:
         return _LOADED[key]
     cc = compiler()
