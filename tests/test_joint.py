@@ -23,6 +23,9 @@ from pamsim.scenario import ScenarioError
 ROOT = Path(__file__).resolve().parents[1]
 PAIR_FILE = ROOT / "scenarios" / "antagonistic_pair.toml"
 PAIR = tomllib.loads(PAIR_FILE.read_text())
+FESTO = tomllib.loads((ROOT / "scenarios" / "antagonistic_festo.toml").read_text())
+SHIPPED_PAIRS = {"shadow_acra": PAIR, "festo_ogden": FESTO}
+"""The shipped pairs: Shadow muscles with the ACRA 2012 model, Festo DMSP-10 muscles with the Ogden model."""
 BAR = 1e5
 
 
@@ -57,16 +60,18 @@ def hand_torque_Nm(spec: dict, forces: list, theta: float, pressures_Pa) -> floa
 PAIRS_BAR = [(a, b) for a in (1.5, 2.5, 3.5) for b in (1.5, 2.5, 3.5)]
 
 
+@pytest.mark.parametrize("pair", SHIPPED_PAIRS)
 @pytest.mark.parametrize("p_bar", PAIRS_BAR)
-def test_equilibrium_is_the_hand_torque_balance(p_bar):
+def test_equilibrium_is_the_hand_torque_balance(p_bar, pair):
     """At 9 pressure pairs the equilibrium from the generated code is the root of the hand-written
     torque balance (to 1e-10 rad), or the limit it pushes the link onto."""
-    statics = JointStatics(JointScenario.from_dict(PAIR))
+    spec = SHIPPED_PAIRS[pair]
+    statics = JointStatics(JointScenario.from_dict(spec))
     p = [v * BAR for v in p_bar]
     eq = statics.equilibrium(p)
-    lo, hi = PAIR["joint"]["theta_min_rad"], PAIR["joint"]["theta_max_rad"]
-    forces = static_forces(PAIR)
-    tau = lambda t: hand_torque_Nm(PAIR, forces, t, p)  # noqa: E731
+    lo, hi = spec["joint"]["theta_min_rad"], spec["joint"]["theta_max_rad"]
+    forces = static_forces(spec)
+    tau = lambda t: hand_torque_Nm(spec, forces, t, p)  # noqa: E731
     if eq.on_limit is None:
         want = brentq(tau, lo, hi, xtol=1e-15)
         assert eq.theta_rad == pytest.approx(want, abs=1e-10)
@@ -78,11 +83,12 @@ def test_equilibrium_is_the_hand_torque_balance(p_bar):
         assert eq.on_limit is None and abs(eq.theta_rad) < 0.01  # only the link's weight moves it off zero
 
 
+@pytest.mark.parametrize("pair", SHIPPED_PAIRS)
 @pytest.mark.parametrize("theta", [-0.6, -0.1, 0.0, 0.25, 0.7])
 @pytest.mark.parametrize("p_bar", [(1.0, 1.0), (3.0, 2.0), (2.0, 4.0)])
-def test_stiffness_is_the_derivative_of_the_net_torque(theta, p_bar):
+def test_stiffness_is_the_derivative_of_the_net_torque(theta, p_bar, pair):
     """The exact ``-d tau / d theta`` agrees with a central finite difference of the net torque to 1e-6."""
-    statics = JointStatics(JointScenario.from_dict(PAIR))
+    statics = JointStatics(JointScenario.from_dict(SHIPPED_PAIRS[pair]))
     p = [v * BAR for v in p_bar]
     h = 1e-5
     fd = -(statics.net_torque_Nm(theta + h, p) - statics.net_torque_Nm(theta - h, p)) / (2 * h)
@@ -612,3 +618,19 @@ def test_a_bandwidth_below_the_joints_own_stiffness_is_refused():
 
     with pytest.raises(InputError, match="controller.bandwidth_rad_s = 20: the joint's own stiffness"):
         controller_of(JointScenario.from_dict(spec, origin="c.toml"))
+
+
+@pytest.mark.parametrize("backend", ["python", "native", "fmu-cs"])
+def test_the_festo_pair_settles_in_its_friction_band_on_every_backend(backend):
+    """The Festo DMSP-10 pair with the Ogden model: at rest within the bearing's friction band of the
+    static equilibrium at its final pressures (|theta - theta_eq| <= tau_c / k), its energy balanced
+    within the shipped pair's bound, and every backend at python's final angle within 10 rtol."""
+    scenario = load_joint_scenario(ROOT / "scenarios" / "antagonistic_festo.toml")
+    res = simulate_joint(scenario, backend)
+    eq = JointStatics(scenario).equilibrium([res.muscle(m, "p_gauge_Pa")[-1] for m in res.muscles])
+    assert res.final_mode.label == "stick" and eq.on_limit is None
+    assert abs(res.theta_rad[-1] - eq.theta_rad) <= FESTO["joint"]["tau_coulomb_Nm"] / eq.k_Nm_per_rad
+    if backend != "fmu-cs":  # the FMU reports no energy of its impacts (none here) nor its events
+        assert res.energy_balance()["relative"] < 2e-5
+    python = res if backend == "python" else simulate_joint(scenario)
+    assert abs(res.theta_rad[-1] - python.theta_rad[-1]) < 1e-5
