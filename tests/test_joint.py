@@ -20,6 +20,8 @@ from pamsim.joints import JointScenario, load_joint_scenario, simulate_joint
 from pamsim.joints.static import JointStatics
 from pamsim.scenario import ScenarioError
 
+from joint_specs import on_levers
+
 ROOT = Path(__file__).resolve().parents[1]
 PAIR_FILE = ROOT / "scenarios" / "antagonistic_pair.toml"
 PAIR = tomllib.loads(PAIR_FILE.read_text())
@@ -518,18 +520,8 @@ def test_pamsim_run_exits_1_when_the_controlled_joint_misses_its_spec(tmp_path):
 
 
 def lever_pair() -> dict:
-    """The pair on levers: each muscle from an anchor 0.35 m from the joint on the base to a point 0.03 m
-    from it on the link, the arms at right angles at angle zero, a tendon that makes it 20 mm contracted
-    there (0.3 m muscle, path sqrt(0.03^2 + 0.35^2))."""
-    spec = prescribed(PAIR, (2.5, 2.0))
-    tendon = math.hypot(0.03, 0.35) - (0.3 - 0.02)
-    for table in spec["muscle"]:
-        for key in ("radius_m", "x_at_zero_m"):
-            table.pop(key)
-        table.update(attachment="lever", link_attach_m=0.03, base_attach_m=0.35, angle_at_zero_rad=math.pi / 2,
-                     tendon_length_m=tendon)
-    spec["joint"].update(theta_min_rad=-0.5, theta_max_rad=0.5)
-    return spec
+    """The pair on levers (:func:`joint_specs.on_levers`) at 2.5 and 2 bar."""
+    return on_levers(prescribed(PAIR, (2.5, 2.0)))
 
 
 def test_a_lever_attachment_follows_its_geometry():
