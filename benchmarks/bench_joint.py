@@ -1,7 +1,7 @@
 """Muscles on a joint against one muscle on its hanging load, on both backends, in the same run.
 
 The antagonistic pair (``scenarios/antagonistic_pair.toml``, run for 5 s) and the ACRA 2012 Figure 4
-scenario (one muscle, 8 s): the median wall time of N runs after warm-up, with the engine's own time for
+scenario (one muscle, 8 s), then the Festo pair and Figure 4 as a slider against Figure 4: the median wall time of N runs after warm-up, with the engine's own time for
 the native runs, and the ratio pair / one muscle per backend.  Targets for the pair: native <= 2 ms,
 python <= 80 ms.  A joint run's outputs (torques, flows) are computed when first read, as a one-muscle
 run's force columns are; the timed runs read the angle only.
@@ -18,7 +18,7 @@ import tomllib
 from pathlib import Path
 
 import pamsim
-from pamsim.joints import JointScenario, simulate_joint
+from pamsim.joints import JointScenario, load_joint_scenario, simulate_joint
 
 ROOT = Path(__file__).resolve().parents[1]
 TARGETS_MS = {"native": 2.0, "python": 80.0}
@@ -35,7 +35,7 @@ def median_ms(run, repeats: int) -> tuple[float, float]:
         res = run()
         walls.append(time.perf_counter() - t0)
         own.append(res.wall_time_s)
-        res.theta_rad if hasattr(res, "theta_rad") else res.x_m  # noqa: B018 (what a caller reads)
+        res.position if hasattr(res, "position") else res.x_m  # noqa: B018 (what a caller reads)
     return statistics.median(walls) * 1e3, statistics.median(own) * 1e3
 
 
@@ -56,6 +56,15 @@ def main() -> None:
     res = simulate_joint(pair, "native")
     print(f"pair on native: {res.stats['rhs_evaluations']} RHS evaluations, {len(res.transitions)} events, "
           f"final angle {res.theta_rad[-1]:.4f} rad")
+    # The other shipped bodies, against Figure 4 on the same backend in the same run.
+    others = {"Festo pair (Ogden), 3 s": load_joint_scenario(ROOT / "scenarios" / "antagonistic_festo.toml"),
+              "Figure 4 as a slider, 8 s": load_joint_scenario(ROOT / "scenarios" / "acra2012_fig4_slider.toml")}
+    print(f"{'scenario':28} {'backend':8} {'[ms]':>9} {'/ fig4':>7}")
+    for backend in ("native", "python"):
+        f_ms, _ = median_ms(lambda: pamsim.simulate(fig4, backend=backend), args.repeats)
+        for label, scenario in others.items():
+            ms, _ = median_ms(lambda: simulate_joint(scenario, backend), args.repeats)
+            print(f"{label:28} {backend:8} {ms:9.3f} {ms / f_ms:7.2f}")
 
 
 if __name__ == "__main__":

@@ -626,3 +626,18 @@ def test_the_festo_pair_settles_in_its_friction_band_on_every_backend(backend):
         assert res.energy_balance()["relative"] < 2e-5
     python = res if backend == "python" else simulate_joint(scenario)
     assert abs(res.theta_rad[-1] - python.theta_rad[-1]) < 1e-5
+
+
+def test_a_joint_scenario_run_again_on_native_reuses_its_case_by_the_object():
+    """The native backend keeps a joint scenario's assembly, engine and case for the scenario object: a
+    second run finds them and gives the same trace; an equal scenario (another object) builds its own."""
+    from pamsim.joints import native
+
+    scenario = load_joint_scenario(PAIR_FILE)
+    first = simulate_joint(scenario, "native")
+    kept = native._PREPARED.get(scenario)
+    assert kept is not None and native._prepared(scenario) is kept
+    again = simulate_joint(scenario, "native")
+    assert all(np.array_equal(first.signals[k], again.signals[k]) for k in ("joint.theta_rad", "flexor_chamber.p_abs_Pa"))
+    twin = load_joint_scenario(PAIR_FILE)
+    assert native._PREPARED.get(twin) is None and native._prepared(twin) is not kept

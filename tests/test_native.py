@@ -140,13 +140,13 @@ def test_a_scenario_run_again_reuses_its_case_by_the_object_not_by_equality(monk
     assert twin == fig4 and backend.case_inputs(twin) is not case
     assert backend.case_inputs(fig4, fig4.build_model()) is not case
     other = fig4.with_changes({"load": {"weight_N": 30.0}})
-    backend._cases[id(other)] = (weakref.ref(twin), case)  # as if `other` took a dead scenario's id
+    backend._cases._kept[id(other)] = (weakref.ref(twin), case)  # as if `other` took a dead scenario's id
     assert backend.case_inputs(other) is not case
     assert backend.case_inputs(other).model.load.mass_kg == pytest.approx(30.0 / 9.81, rel=1e-12)
-    monkeypatch.setattr(backend, "SCENARIO_CACHE_SIZE", 2)
+    monkeypatch.setattr(backend._cases, "size", 2)
     for weight in (10.0, 11.0, 12.0):
         backend.case_inputs(fig4.with_changes({"load": {"weight_N": weight}}))
-    assert len(backend._cases) == 2
+    assert len(backend._cases._kept) == 2
     assert backend.simulate(fig4).x_m[-1] == simulate_batch([fig4.with_changes({})])[0].x_m[-1]
     library = engine_library(case.assembly)
     engine_case = case.engine_case(library, 64)  # kept with the case too, read-only

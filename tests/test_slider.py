@@ -162,3 +162,18 @@ def test_every_number_of_the_shipped_slider_says_where_it_comes_from():
     keys = set(spec["slider"]) | {"side", "x_at_zero_m"}
     lines = [ln for ln in text.splitlines() if ln.split("=")[0].strip() in keys]
     assert len(lines) == len(keys) and all("#" in ln for ln in lines), lines
+
+
+def test_the_slider_fmu_validates_with_the_sliders_names(tmp_path):
+    """``pamsim fmu build --scenario`` on the slider file: fmpy validates it; its variables are the
+    slider's (``slider.x_m``, ``F_external_N``, the muscle's tendon)."""
+    from fmpy import read_model_description
+    from fmpy.validation import validate_fmu
+
+    path = tmp_path / "slider.fmu"
+    done = subprocess.run([sys.executable, "-m", "pamsim", "fmu", "build", "--scenario", str(FIG4_SLIDER), "-o",
+                           str(path)], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert "the slider and its 1 muscle" in done.stdout and validate_fmu(str(path)) == []
+    names = {v.name for v in read_model_description(str(path)).modelVariables}
+    assert {"slider.x_m", "slider.mass_kg", "F_external_N", "muscle_tendon.F_N", "muscle_chamber.p_gauge_Pa"} <= names

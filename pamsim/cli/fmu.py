@@ -107,9 +107,10 @@ def _build_joint(scenario, args: argparse.Namespace) -> int:
     from ..joints.fmu import build_joint_fmu
 
     path = build_joint_fmu(scenario, args.output, int(args.fmi))
-    print(f"wrote {path} (FMI {args.fmi}.0, Model Exchange and Co-Simulation, the joint and its "
-          f"{len(scenario.muscles)} muscles of scenario {scenario.name}: structured variable names such as "
-          "joint.theta_rad)")
+    body, n = scenario.body, len(scenario.muscles)
+    print(f"wrote {path} (FMI {args.fmi}.0, Model Exchange and Co-Simulation, the {body.name} and its "
+          f"{n} muscle{'s' if n > 1 else ''} of scenario {scenario.name}: structured variable names such as "
+          f"{body.name}.{body.position})")
     if scenario.controller is not None:
         print("  the scenario's [controller] is not in the FMU: it is the plant, its pressure inputs "
               "(input_source = importer) the importer's controller's to set")

@@ -12,7 +12,8 @@ from ..components.stick_slip import BodyMode, event_name
 from ..errors import InputError, SolverFailure
 from ..assemblies.one_muscle import RUN_FUNCTIONS
 from ..modeling.pygen import compiled_by_mode
-from ..native.backend import METHOD_LABEL, event_capacity, exact_segments, native_rtol
+from ..native.backend import (METHOD_LABEL, SCENARIO_CACHE_SIZE, KeptByObject, event_capacity, exact_segments,
+                              native_rtol)
 from ..native.engine import EngineCase, engine_library
 from ..simulator import too_many_events
 from .result import JointEvent, JointResult
@@ -23,6 +24,7 @@ MAX_STEP_S = 0.1
 """The engine's longest step when the scenario sets none [s] (the one-muscle FMU's default step)."""
 MAX_INTERNAL_STEPS = 1_000_000
 """Integrator steps the engine may take per input segment before it gives up."""
+_PREPARED = KeptByObject(SCENARIO_CACHE_SIZE)
 
 
 def simulate_joint_native(scenario: JointScenario) -> JointResult:
@@ -36,19 +38,8 @@ def simulate_joint_native(scenario: JointScenario) -> JointResult:
     SolverFailure
         The integrator failed, or the run had more than ``solver.max_events`` events.
     """
-    assembly = scenario.assembly()
-    library = engine_library(assembly)
-    signals = [s for m in scenario.joint_muscles() for s in m.source.signals] + [scenario.external_torque]
-    pieces = exact_segments(signals, scenario.duration_s)
-    if pieces is None:
-        raise InputError(f"{scenario.origin}: a muscle's pressure input is a Python function, which the native "
-                         "backend cannot carry; run it with the python backend")
-    starts, u, du = pieces
+    assembly, library, case, muscles = _prepared(scenario)
     opts = scenario.solver
-    n = int(round(scenario.duration_s * opts.sample_rate_Hz)) + 1
-    case = EngineCase(np.array(assembly.parameter_values()), native_rtol(opts),
-                      opts.max_step_s if np.isfinite(opts.max_step_s) else MAX_STEP_S, MAX_INTERNAL_STEPS,
-                      scenario.duration_s, n, starts, u, event_capacity(opts.max_events), du)
     wall0 = time.perf_counter()
     out = library.run([case])
     wall = time.perf_counter() - wall0
@@ -59,17 +50,43 @@ def simulate_joint_native(scenario: JointScenario) -> JointResult:
         raise SolverFailure(f"native backend: {message}")
     if status == 3 or int(out["n_events"][0]) > opts.max_events:
         raise too_many_events(opts.max_events)
-    return _result(scenario, assembly, library.names, out, np.linspace(0.0, scenario.duration_s, n), wall)
+    return _result(scenario, assembly, muscles, library.names, out, np.linspace(0.0, scenario.duration_s, case.n_samples),
+                   wall)
 
 
-def _result(scenario: JointScenario, assembly, names: dict, out: dict, t: np.ndarray, wall_s: float) -> JointResult:
+def _prepared(scenario: JointScenario) -> tuple:
+    """The assembly, engine, :class:`EngineCase` and muscles of ``scenario``, built at its first native run
+    and kept for the next, by the scenario object (a scenario does not change once made; a sweep's new
+    scenarios build their own)."""
+    kept = _PREPARED.get(scenario)
+    if kept is not None:
+        return kept
+    assembly = scenario.assembly()
+    library = engine_library(assembly)
+    muscles = scenario.joint_muscles()
+    signals = [s for m in muscles for s in m.source.signals] + [scenario.external_torque]
+    pieces = exact_segments(signals, scenario.duration_s)
+    if pieces is None:
+        raise InputError(f"{scenario.origin}: a muscle's pressure input is a Python function, which the native "
+                         "backend cannot carry; run it with the python backend")
+    starts, u, du = pieces
+    opts = scenario.solver
+    n = int(round(scenario.duration_s * opts.sample_rate_Hz)) + 1
+    case = EngineCase(np.array(assembly.parameter_values()), native_rtol(opts),
+                      opts.max_step_s if np.isfinite(opts.max_step_s) else MAX_STEP_S, MAX_INTERNAL_STEPS,
+                      scenario.duration_s, n, starts, u, event_capacity(opts.max_events), du)
+    kept = (assembly, library, case, muscles)
+    _PREPARED.put(scenario, kept)
+    return kept
+
+
+def _result(scenario: JointScenario, assembly, muscles, names: dict, out: dict, t: np.ndarray, wall_s: float) -> JointResult:
     """The engine's output as a :class:`JointResult`: every state sampled, the outputs computed from them
     by the python backend's generated code, the events named from the indicators that fired."""
     ns, n = len(names["states"]), len(t)
     Y = np.array(out["samples"][:ns * n].reshape(ns, n))
     modes = out["modes"][:n].astype(int)
     code = compiled_by_mode(assembly, scenario.body.name, RUN_FUNCTIONS)
-    muscles = scenario.joint_muscles()
     signals = sampled_signals(code, assembly.parameter_values(), Y, JointInputs.of(scenario, muscles)(t), modes)
     outputs = names["outputs"]
     body = scenario.body

@@ -76,13 +76,19 @@ class JointResult:
 
     @property
     def theta_rad(self) -> np.ndarray:
-        """Joint angle [rad] at the samples."""
-        return self.signals["joint.theta_rad"]
+        """Joint angle [rad] at the samples (a slider's result has none: :attr:`position`)."""
+        return self._joint_signal("theta_rad")
 
     @property
     def omega_rad_s(self) -> np.ndarray:
         """Joint angular velocity [rad/s] at the samples (zero while held)."""
-        return self.signals["joint.omega_rad_s"]
+        return self._joint_signal("omega_rad_s")
+
+    def _joint_signal(self, name: str) -> np.ndarray:
+        if self.body.name != "joint":
+            raise AttributeError(f"{name}: a {self.body.name}'s result has no joint angle; it has position "
+                                 f"({self.body.position}) and velocity ({self.body.velocity})")
+        return self.signals[f"joint.{name}"]
 
     @property
     def final_mode(self) -> BodyMode:

@@ -296,8 +296,32 @@ def _change_after(piece, t0: float) -> tuple[float, float, float]:
 
 SCENARIO_CACHE_SIZE = 256
 """Cases kept per process, by scenario object (:func:`case_inputs`)."""
-_cases: dict[int, tuple[weakref.ref, CaseInputs]] = {}
-_cases_lock = threading.Lock()
+
+
+class KeptByObject:
+    """Values kept for the last ``size`` objects, by the object itself (not by equality, which would take
+    ``1`` for ``1.0``), for immutable objects whose value costs more to build than to keep; threads may
+    share it."""
+
+    def __init__(self, size: int):
+        self.size, self._kept, self._lock = size, {}, threading.Lock()
+
+    def get(self, obj):
+        """The value kept for ``obj``, or None."""
+        kept = self._kept.get(id(obj))
+        if kept is not None and kept[0]() is obj:  # an object's id is reused only after it is gone
+            return kept[1]
+        return None
+
+    def put(self, obj, value) -> None:
+        """Keep ``value`` for ``obj``, dropping the oldest beyond :attr:`size`."""
+        with self._lock:
+            self._kept[id(obj)] = (weakref.ref(obj), value)
+            while len(self._kept) > self.size:
+                del self._kept[next(iter(self._kept))]
+
+
+_cases = KeptByObject(SCENARIO_CACHE_SIZE)
 
 
 def case_inputs(scenario: Scenario, model: MuscleModel | None = None) -> CaseInputs:
@@ -310,18 +334,15 @@ def case_inputs(scenario: Scenario, model: MuscleModel | None = None) -> CaseInp
     :data:`SCENARIO_CACHE_SIZE` scenarios.
     """
     if model is None:
-        kept = _cases.get(id(scenario))
-        if kept is not None and kept[0]() is scenario:  # a scenario's id is reused only after it is gone
-            return kept[1]
+        kept = _cases.get(scenario)
+        if kept is not None:
+            return kept
     case = _new_case(scenario, model)
     if model is None:
         for array in (case.reals, case.ints, case.segment_t_s, case.segment_u, case.segment_du):
             if array is not None:
                 array.flags.writeable = False
-        with _cases_lock:  # the pool's runs may share this process's cases
-            _cases[id(scenario)] = (weakref.ref(scenario), case)
-            while len(_cases) > SCENARIO_CACHE_SIZE:
-                del _cases[next(iter(_cases))]  # the oldest first
+        _cases.put(scenario, case)  # the pool's runs may share this process's cases
     return case
 
 
