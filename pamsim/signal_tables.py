@@ -14,7 +14,8 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from .signals import Constant, FirstOrderLag, PiecewiseConstant, Ramp, Step, Trace
+from .signals import (MAX_PWM_FREQUENCY_HZ, MAX_PWM_SWITCHES, Constant, FirstOrderLag, PiecewiseConstant, Pwm, Ramp,
+                      Step, Trace)
 from .table_checks import choices_hint
 
 # Signal kind -> (keys without a unit, value keys that take the unit suffix of where the signal is used).
@@ -25,6 +26,8 @@ SIGNAL_KINDS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
     "lag": (("time_s", "tau_s"), ("initial", "final")),
     "trace": (("file", "time_column", "value_column"), ()),
     "steps": (("times_s",), ("values",)),
+    "pwm": (("start_s", "end_s", "frequency_Hz", "duty", "delay_on_s", "delay_off_s", "rise_s", "fall_s"),
+            ("low", "high")),
 }
 
 
@@ -103,12 +106,32 @@ def _lag(e: _Entries) -> FirstOrderLag:
     return FirstOrderLag(e.time("time_s"), e.value("initial", 0.0), e.value("final"), tau)
 
 
+def _pwm(e: _Entries) -> Pwm:
+    """A PWM command: its period's frequency in (0, MAX_PWM_FREQUENCY_HZ], its duty in [0, 1], the valve's
+    delays and opening and closing times not negative, and no more than MAX_PWM_SWITCHES switches."""
+    start = e.time("start_s")
+    end = e.after("end_s", "start_s", start)
+    f = e.v.number(f"{e.where}.frequency_Hz", e.v.required(e.spec, "frequency_Hz", prefix=f"{e.where}."))
+    if not 0.0 < f <= MAX_PWM_FREQUENCY_HZ:
+        e.v.fail(f"{e.where}.frequency_Hz", f, f"must lie in (0, {MAX_PWM_FREQUENCY_HZ:g}] Hz (above it, use "
+                 "the valve's averaged command: the duty)")
+    if (end - start) * f * 2 > MAX_PWM_SWITCHES:
+        e.v.fail(f"{e.where}.frequency_Hz", f, f"{(end - start) * f * 2:.0f} switches from start_s to end_s, "
+                 f"more than {MAX_PWM_SWITCHES}")
+    duty = e.v.number(f"{e.where}.duty", e.v.required(e.spec, "duty", prefix=f"{e.where}."))
+    if not 0.0 <= duty <= 1.0:
+        e.v.fail(f"{e.where}.duty", duty, "must lie in [0, 1]")
+    timing = {k: e.time(k) if k in e.spec else 0.0 for k in ("delay_on_s", "delay_off_s", "rise_s", "fall_s")}
+    return Pwm(start, end, f, duty, e.value("low", 0.0), e.value("high"), **timing)
+
+
 # The signals of a few entries each, by kind (steps and trace read lists and files of their own).
 _SHAPES = {
     "constant": lambda e: Constant(e.value("value")),
     "step": lambda e: Step(e.time("time_s"), e.value("initial", 0.0), e.value("final")),
     "ramp": _ramp,
     "lag": _lag,
+    "pwm": _pwm,
 }
 
 
@@ -239,5 +262,7 @@ def signal_range(sig) -> tuple[float, float]:
         return float(sig.values.min()), float(sig.values.max())
     if isinstance(sig, PiecewiseConstant):
         return min(sig.values), max(sig.values)
+    if isinstance(sig, Pwm):
+        return min(sig.knots), max(sig.knots)
     vals = [getattr(sig, a) for a in ("value", "initial", "final") if hasattr(sig, a)]
     return min(vals), max(vals)

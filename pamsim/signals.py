@@ -159,6 +159,119 @@ class PiecewiseConstant(_Signal):
         return float(self.values[-1])
 
 
+MAX_PWM_FREQUENCY_HZ = 1000.0
+"""The highest PWM frequency a signal takes [Hz].  Assumed: fast solenoid valves switch in 1-3 ms, so a
+few hundred Hz is their limit; above 1 kHz an on/off valve is better modelled by its averaged flow."""
+MAX_PWM_SWITCHES = 1_000_000
+"""The most switching instants a PWM signal may have (a run's memory for its knots)."""
+
+
+@dataclass(frozen=True)
+class Pwm(_Signal):
+    """A pulse-width-modulated on/off command as the valve it drives follows it: ``high`` for ``duty`` of
+    each period ``1 / frequency_Hz`` from ``start_s`` until ``end_s``, ``low`` otherwise; each switch takes
+    effect ``delay_on_s`` or ``delay_off_s`` after it is commanded and moves linearly over ``rise_s`` or
+    ``fall_s`` (a valve's opening and closing times).  A pulse shorter than the opening time does not
+    open the valve fully; the closing starts from where the opening got.
+
+    Every knot of the piecewise-linear trace is a breakpoint, so each switching instant starts a new
+    integration segment: the switches are exact, not sampled.
+    """
+
+    start_s: float
+    end_s: float
+    frequency_Hz: float
+    duty: float
+    low: float = 0.0
+    high: float = 1.0
+    delay_on_s: float = 0.0
+    delay_off_s: float = 0.0
+    rise_s: float = 0.0
+    fall_s: float = 0.0
+    knots_t_s: tuple = field(default=(), repr=False, compare=False)
+    knots: tuple = field(default=(), repr=False, compare=False)
+
+    def __post_init__(self):
+        t, level = pwm_levels(self)
+        object.__setattr__(self, "knots_t_s", tuple(t))
+        object.__setattr__(self, "knots", tuple(self.low + (self.high - self.low) * x for x in level))
+
+    def __call__(self, t):
+        ts, vs = self.knots_t_s, self.knots
+        if isinstance(t, float):
+            k = bisect.bisect_right(ts, t)  # after every knot at t: the value just after a jump
+            if k == 0 or k == len(ts):
+                return vs[0] if k == 0 else vs[-1]
+            t0, t1 = ts[k - 1], ts[k]
+            return vs[k - 1] + (vs[k] - vs[k - 1]) * (t - t0) / (t1 - t0)
+        return np.array([self(float(x)) for x in np.ravel(np.asarray(t, dtype=float))]).reshape(np.shape(t))
+
+    @property
+    def breakpoints(self) -> tuple[float, ...]:
+        """Every knot time, once."""
+        return tuple(sorted(set(self.knots_t_s)))
+
+    @property
+    def final_value(self) -> float:
+        """The value after the last knot."""
+        return self.knots[-1]
+
+    @property
+    def switch_times_s(self) -> tuple[float, ...]:
+        """The commanded switching instants: on at each period's start, off ``duty`` of a period later."""
+        return tuple(t for t, _ in _pwm_commands(self))
+
+
+def _pwm_commands(p: Pwm) -> list[tuple[float, int]]:
+    """The commanded instants and states (1 on, 0 off) of ``p``, in time order."""
+    if p.duty <= 0.0:
+        return []
+    if p.duty >= 1.0:
+        return [(p.start_s, 1), (p.end_s, 0)]
+    period = 1.0 / p.frequency_Hz
+    n = int(math.ceil((p.end_s - p.start_s) * p.frequency_Hz - 1e-12))
+    out = []
+    for k in range(n):
+        on = p.start_s + k * period
+        out += [(on, 1), (min(on + p.duty * period, p.end_s), 0)]
+    return out
+
+
+def pwm_levels(p: Pwm) -> tuple[list[float], list[float]]:
+    """The valve's opening (0 closed, 1 open) under ``p``'s commands as knots ``(times, levels)``: each
+    command takes effect after its delay and ramps at ``1 / rise_s`` or ``1 / fall_s`` toward its level
+    until it gets there or the next command comes (a zero ramp: a jump, two knots at one time)."""
+    events = sorted((t + (p.delay_on_s if on else p.delay_off_s), on) for t, on in _pwm_commands(p))
+    times, levels = [0.0], [0.0]
+    level, target, now = 0.0, 0.0, 0.0
+    for t_event, on in events:
+        level, now = _ramp_until(times, levels, level, target, now, t_event, p)
+        if (times[-1], levels[-1]) != (t_event, level):  # where the level stood when the command came
+            times.append(t_event)
+            levels.append(level)
+        target = float(on)
+        if (p.rise_s if on else p.fall_s) == 0.0 and level != target:
+            times.append(t_event)
+            levels.append(target)
+            level = target
+    _ramp_until(times, levels, level, target, now, math.inf, p)
+    return times, levels
+
+
+def _ramp_until(times, levels, level, target, now, t_end, p: Pwm) -> tuple[float, float]:
+    """Move ``level`` toward ``target`` from ``now`` until ``t_end`` at the ramp's rate, adding the knots."""
+    if level == target:
+        return level, t_end if math.isfinite(t_end) else now
+    ramp = p.rise_s if target > level else p.fall_s
+    reach = now + abs(target - level) * ramp
+    if reach <= t_end:
+        times.append(reach)
+        levels.append(target)
+        return target, t_end if math.isfinite(t_end) else reach
+    level += (t_end - now) / ramp * (1.0 if target > level else -1.0)
+    return level, t_end
+
+
 def max_step_hint_s(*signals) -> float:
     """The smallest ``max_step_s`` of some signals (callables without one count as smooth)."""
     return min((getattr(sig, "max_step_s", math.inf) for sig in signals if sig is not None), default=math.inf)

@@ -22,12 +22,11 @@ import math
 from dataclasses import dataclass, field
 from typing import Mapping
 
-import numpy as np
 
 from ..assemblies.one_muscle import input_signals
 from ..errors import InputError
 from ..scenario import Scenario
-from ..signals import Constant, FirstOrderLag, PiecewiseConstant, Ramp, Step, Trace
+from ..signals import Constant, FirstOrderLag, PiecewiseConstant, Pwm, Ramp, Step, Trace
 from .force_table import ForceTable
 from .runner import ScenarioInputs, force_table_for, start_values, upper_stop_start
 from .variables import INPUT_SOURCE_CHOICES, INPUTS, VARIABLES
@@ -105,7 +104,11 @@ def input_signal(signal, unit: str) -> InputSignal:
         return InputSignal((signal.times_s[0], *(t for t in times for _ in (0, 1))),
                            tuple(float(v) for v in signal.values[:-1] for _ in (0, 1)) + (float(signal.values[-1]),),
                            text=f"{len(signal.times_s)} steps")
-    raise InputError(f"the FMU can carry only constant, step, ramp, lag, trace and steps signals, not {signal!r}")
+    if isinstance(signal, Pwm):  # its knots, a jump as two knots at one time
+        return InputSignal(signal.knots_t_s, signal.knots,
+                           text=f"pwm {q(signal.low)} / {q(signal.high)} at {signal.frequency_Hz:g} Hz, duty "
+                                f"{signal.duty:g}, {signal.start_s:g} to {signal.end_s:g} s")
+    raise InputError(f"the FMU can carry only constant, step, ramp, lag, trace, steps and pwm signals, not {signal!r}")
 
 
 @dataclass(frozen=True)
