@@ -204,7 +204,14 @@ class Pwm(_Signal):
                 return vs[0] if k == 0 else vs[-1]
             t0, t1 = ts[k - 1], ts[k]
             return vs[k - 1] + (vs[k] - vs[k - 1]) * (t - t0) / (t1 - t0)
-        return np.array([self(float(x)) for x in np.ravel(np.asarray(t, dtype=float))]).reshape(np.shape(t))
+        t = np.asarray(t, dtype=float)
+        t_k, v_k = np.asarray(ts), np.asarray(vs)
+        k = np.clip(np.searchsorted(t_k, t, side="right"), 1, len(ts) - 1)
+        # ts[k - 1] <= t < ts[k] inside the knots (no zero width); outside them, held at the end values
+        inside = (t >= t_k[0]) & (t < t_k[-1])
+        t0, t1, v0, v1 = t_k[k - 1], t_k[k], v_k[k - 1], v_k[k]
+        between = v0 + (v1 - v0) * (t - t0) / np.where(inside, t1 - t0, 1.0)
+        return np.where(inside, between, np.where(t < t_k[0], v_k[0], v_k[-1]))
 
     @property
     def breakpoints(self) -> tuple[float, ...]:
