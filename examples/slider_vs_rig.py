@@ -53,4 +53,4 @@ ax_gap.semilogy(np.arange(1, len(gaps) + 1), np.maximum(gaps, 1e-16), "o", ms=3,
 ax_gap.set_xlabel("paper test (grid order)")
 ax_gap.set_ylabel("largest gap over the run [m]\n(zero drawn at 1e-16)")
 ax_gap.set_title("The 66 tests, native backend")
-plt.show()
+fig.savefig("slider_vs_rig.png", dpi=110)

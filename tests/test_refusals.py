@@ -333,7 +333,7 @@ def _prescribed(table):
 @pytest.mark.parametrize("table, message", [
     ({"kind": "stp"}, "pressure.prescribed.kind = 'stp': unknown signal kind (did you mean 'step'?)"),
     ({"kind": 3}, "pressure.prescribed.kind = 3: unknown signal kind (choose from constant, step, ramp, lag, trace, "
-     "steps)"),
+     "steps, pwm)"),
     ({"kind": "constant", "value": 1.0}, "unknown key pressure.prescribed.value for kind = 'constant' (known: kind, "
      "value_gauge_bar, value_gauge_Pa)"),
     ({"kind": "step", "time_s": 1, "final_gauge_bar": 2, "tau_s": 1}, "unknown key pressure.prescribed.tau_s for "
