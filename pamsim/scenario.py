@@ -118,7 +118,8 @@ class Scenario:
 
         Keys are merged into each section, except that a change of
         ``pressure.source`` replaces the whole ``[pressure]`` table (the keys of
-        one source mean nothing to the other), and naming one of a pair of
+        one source mean nothing to the other), a change of ``chamber.law`` the whole
+        ``[chamber]`` table (likewise), and naming one of a pair of
         alternatives (``weight_N``/``mass_kg``, ``supply_gauge_bar``/``supply_gauge_Pa``,
         ``muscle``/``parameter_set``) drops the other.  A new muscle without a
         new ``static_force`` takes its own default model if the old muscle ran its default.
@@ -132,6 +133,8 @@ class Scenario:
         """The table ``old`` of ``section`` with ``values`` merged in, less the keys they replace."""
         if section == "pressure" and "source" in values and values["source"] != old.get("source"):
             old = {}
+        if section == "chamber" and "law" in values and values["law"] != old.get("law", CHAMBER_DEFAULTS["law"][0]):
+            old = {}  # the keys of one law mean nothing to another
         if section == "model" and ({"muscle", "parameter_set"} & set(values)):
             old = self._model_without_muscle(old, values)
         return _without_alternatives({**old, **copy.deepcopy(dict(values))}, values)
