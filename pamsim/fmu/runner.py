@@ -100,6 +100,13 @@ def check_scenario(scenario: Scenario) -> None:
         start_values(scenario)
 
 
+def _refuse_chamber_law(scenario: Scenario) -> None:
+    """The one-muscle FMU has the polytropic chamber: another law is refused, naming the key."""
+    if scenario.chamber_law != "polytropic":
+        raise InputError(f"{scenario.origin}: chamber.law = {scenario.chamber_law!r}: the one-muscle FMU has the "
+                         "polytropic chamber; pamsim.simulate runs this scenario through the FMU of its assembly")
+
+
 def _refuse_unrepresented(scenario: Scenario) -> None:
     spec = scenario.spec
     for section, keys in REPRESENTED.items():
@@ -109,9 +116,7 @@ def _refuse_unrepresented(scenario: Scenario) -> None:
                 full = f"{section}.{key}" if section else key
                 raise InputError(f"{scenario.origin}: the FMU cannot represent scenario key {full!r}; "
                                  "run it with the python backend")
-    if scenario.chamber_law != "polytropic":
-        raise InputError(f"{scenario.origin}: chamber.law = {scenario.chamber_law!r}: the one-muscle FMU has the "
-                         "polytropic chamber; pamsim.simulate runs this scenario through the FMU of its assembly")
+    _refuse_chamber_law(scenario)
     model = spec["model"]
     if model["static_force_negative"] != "clip":
         raise InputError(f"{scenario.origin}: the FMU clips a negative static force at zero, "
