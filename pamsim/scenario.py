@@ -43,7 +43,8 @@ from .table_checks import TableChecker, choices_hint, did_you_mean
 # Schema: section -> {key: (type, required)}; a nested dict is a sub-table.
 _SCHEMA: dict[str, dict[str, Any]] = {
     "": {"name": str, "description": str, "model": dict, "parameters": dict, "load": dict, "pressure": dict,
-         "simulation": dict, "solver": dict, "controller": dict, "component": list, "measured": dict, "chamber": dict},
+         "simulation": dict, "solver": dict, "controller": dict, "component": list, "measured": dict,
+         "chamber": dict},
     "model": {"muscle": str, "parameter_set": str, "static_force": str, "static_force_variant": str,
               "static_force_negative": str, "friction": str, "damping": str, "friction_negative_level": str,
               "upper_stop": str},
@@ -53,7 +54,7 @@ _SCHEMA: dict[str, dict[str, Any]] = {
     "simulation": {"duration_s": float, "sample_rate_Hz": float, "initial_contraction_m": float},
     "solver": {"method": str, "rtol": float, "max_events": int, "max_step_s": float, "native_rtol_factor": float},
     "measured": {"steady_state": str},
-    "chamber": {"law": str, "T_wall_K": float, "h_W_per_m2_K": float, "heat_capacity_ratio": float},
+    "chamber": {"law": str, **{key: float for key in CHAMBER_DEFAULTS if key != "law"}},
 }
 _MAX_SAMPLES = 1e7  # 8 s at 1 kHz is 8,001; beyond this the output would not fit in memory comfortably
 MAX_STEPS = 1e7

@@ -327,3 +327,12 @@ def test_the_one_muscle_fmu_refuses_another_law_by_name():
         start_values(sc)
     check_scenario(sc)  # the FMU backends take it: through the FMU of its assembly
     assert start_values(sc.with_changes({"chamber": {"law": "polytropic"}}))["polytropic_index"] == 1.0
+
+
+def test_the_slider_form_of_a_rig_refuses_another_law_rather_than_drop_it():
+    from pamsim.joints.scenario import slider_of_rig
+
+    sc = pamsim.load_scenario(SCENARIOS / "thermal_drift.toml")
+    with pytest.raises(InputError, match=r"chamber.law = 'thermal': a slider's muscles have the polytropic chamber"):
+        slider_of_rig(sc)
+    assert slider_of_rig(sc.with_changes({"chamber": {"law": "polytropic"}})).muscles

@@ -19,8 +19,8 @@ def register(sub) -> None:
                         description="Generate the sources and model description, compile them and write the .fmu.")
     b.add_argument("-o", "--output", default=None,
                    help="FMU file to write (default: pamsim_muscle_fmi<version>.fmu in the current folder, or "
-                        "pamsim_assembly_fmi<version>.fmu for a scenario that adds components, has a controller or a chamber "
-                        "law other than the polytropic)")
+                        "pamsim_assembly_fmi<version>.fmu for a scenario that adds components, has a controller or "
+                        "a chamber law other than the polytropic)")
     b.add_argument("--fmi", default="2", help="FMI version: 2 (FMI 2.0) or 3 (FMI 3.0); default 2")
     b.add_argument("--scenario", default=None,
                    help="build the FMU for this scenario: its muscle's and its own values (parameters, choices, "

@@ -358,7 +358,8 @@ def _closed_loop_parts(source: "ClosedLoopValveSource", p0_gauge_Pa: float | Non
     the feedforward pressure of the first reference), the controller, and the valve it drives."""
     plant = source.plant
     p0 = source.feedforward_gauge_Pa(0.0) if p0_gauge_Pa is None else p0_gauge_Pa
-    parts = [Chamber("chamber", plant.chamber, plant.p_atm_Pa, p0, plant.chamber.start_temperature_K(plant.T_supply_K)),
+    T0 = plant.chamber.start_temperature_K(plant.T_supply_K)
+    parts = [Chamber("chamber", plant.chamber, plant.p_atm_Pa, p0, T0),
              PositionController("controller", source),
              ProportionalValve("valve", plant.valve, plant.T_supply_K, plant.p_atm_Pa, plant.chamber.R_J_per_kg_K)]
     wiring = [*VALVE_CHAMBER_WIRING, ("load.x_m", "controller.x_m"), ("chamber.p_abs_Pa", "controller.p_abs_Pa"),

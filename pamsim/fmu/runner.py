@@ -27,6 +27,7 @@ from ..constants import PA_PER_BAR
 from ..core_table import unimplemented_choice
 from ..elements.pressure_source import ValveChamberSource
 from ..errors import InputError, SolverFailure
+from ..parameters import CHAMBER_DEFAULTS
 from ..result import Result
 from ..scenario import Scenario
 from .build import temp_fmu
@@ -88,7 +89,7 @@ REPRESENTED = {
                  "initial_gauge_bar"},
     "simulation": {"duration_s", "sample_rate_Hz", "initial_contraction_m"},
     "solver": {"method", "rtol", "max_events", "max_step_s", "native_rtol_factor"},
-    "chamber": {"law", "T_wall_K", "h_W_per_m2_K", "heat_capacity_ratio"},
+    "chamber": set(CHAMBER_DEFAULTS),
 }
 
 
