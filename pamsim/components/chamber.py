@@ -81,7 +81,3 @@ class Chamber(ElementParameters, Component):
             initial={"p_abs_Pa": p0, "air_mass_kg": ch.air_mass_kg(p0, V, s.p["T_initial_K"])},
             settle={"p_abs_Pa": if_else(near, target, p),
                     "air_mass_kg": if_else(near, m + dp_settle * flow["mdot_kg_s"] / rate_held, m)})
-
-
-PolytropicChamber = Chamber
-"""The name the chamber had while it had one law."""
