@@ -46,7 +46,8 @@ from ..static_models.geometry import Braid
 
 class BraidCylinder:
     """The chamber's geometry and its gas as an ideal gas: what every law shares.  A mixin of a dataclass
-    with the fields ``L0_m``, ``thread_length_m``, ``turns``, ``dead_volume_m3`` and ``R_J_per_kg_K``."""
+    with the fields ``L0_m``, ``thread_length_m``, ``turns``, ``dead_volume_m3`` and ``R_J_per_kg_K``, and
+    the law's own ``pressure_rate_of_flows_Pa_s`` and ``start_temperature_K``."""
 
     def volume_m3(self, x_m):
         """Chamber volume [m^3] at contraction ``x_m``: the braid's cylinder plus the dead volume."""
