@@ -49,8 +49,8 @@ DESCRIPTIONS: dict[str, str] = {
 # name -> "module:function" that raises InputError for a scenario the backend cannot run, before any work
 CHECKS: dict[str, str] = {
     "native": "pamsim.native:refuse_unsupported",
-    "fmu-cs": "pamsim.fmu.runner:start_values",
-    "fmu-me": "pamsim.fmu.runner:start_values",
+    "fmu-cs": "pamsim.fmu.runner:check_scenario",
+    "fmu-me": "pamsim.fmu.runner:check_scenario",
 }
 
 
@@ -115,8 +115,10 @@ def simulate(scenario: "Scenario | str | os.PathLike", backend: str = "python",
         from .simulator import simulate_python
 
         return simulate_python(scenario, progress, model)
-    if model is None and scenario.added_components and backend in ("fmu-cs", "fmu-me"):
-        model = scenario.build_model()  # the one-muscle FMU has the rig alone: the assembly's FMU carries them
+    if (model is None and backend in ("fmu-cs", "fmu-me")
+            and (scenario.added_components or scenario.chamber_law != "polytropic")):
+        # The one-muscle FMU has the rig alone, with the polytropic chamber: the assembly's FMU carries the rest.
+        model = scenario.build_model()
     if model is None:
         return get_backend(backend)(scenario)
     get_backend(backend)  # an unknown name refused as such

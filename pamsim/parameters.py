@@ -59,6 +59,23 @@ DYNAMICS_DEFAULTS: Mapping[str, tuple[float, str]] = MappingProxyType({
 })
 """name -> (value, source) of every dynamics value a muscle file may leave out."""
 
+CHAMBER_DEFAULTS: Mapping[str, tuple[float | str, str]] = MappingProxyType({
+    "law": ("polytropic", "pamsim's law before the choice existed: every earlier result stands"),
+    "T_wall_K": (293.15, "assumed: room temperature, the default supply temperature (T_supply_K)"),
+    "h_W_per_m2_K": (15.7, "assumed: no measured value for a McKibben muscle found; laminar heat transfer in a "
+                           "6 mm tube, Nu_D = h D / k = 3.66 (fully developed laminar flow, uniform wall "
+                           "temperature: Incropera and DeWitt, Fundamentals of Heat and Mass Transfer, eq. 8.55) "
+                           "with k_air = 0.0257 W/(m K) at 20 C and D = 6 mm; within the 2..25 W/(m^2 K) of free "
+                           "convection in gases (ibid., Table 1.1)"),
+    "heat_capacity_ratio": (1.4, "dry air near 20 C: c_p / c_v = 1005 / 718 (ideal diatomic gas, 7/5)"),
+})
+"""``[chamber]`` key -> (default, source): the chamber's law and the parameters of the laws that need them
+(isothermal: ``T_wall_K``; thermal: all three; polytropic: none, its index is ``polytropic_index``)."""
+
+CHAMBER_LAW_KEYS: Mapping[str, tuple[str, ...]] = MappingProxyType({
+    "isothermal": ("T_wall_K",), "polytropic": (), "thermal": ("T_wall_K", "h_W_per_m2_K", "heat_capacity_ratio")})
+"""The ``[chamber]`` keys each law takes besides ``law``."""
+
 
 def dynamics_parameters(muscle: ParameterSet) -> ParameterSet:
     """A muscle's parameters completed with :data:`DYNAMICS_DEFAULTS` for what it does not give.

@@ -69,7 +69,7 @@ def draw_measured(ax, measured, value: float, label: str) -> None:
 
 def result_figure(result: "Result", title: str | None = None, compare: "list[Result] | None" = None,
                   backend: str = "python", measured=None) -> Figure:
-    """Contraction, pressure and force components against time.
+    """Contraction, pressure, the gas temperature (a thermal chamber's) and force components against time.
 
     ``compare`` overlays the contraction of other results (for example the
     constant-friction model).  A ``backend`` other than ``"python"`` is named
@@ -78,11 +78,14 @@ def result_figure(result: "Result", title: str | None = None, compare: "list[Res
     contraction and stable pressure of the test, and the title says that these are
     all the paper gives of it as numbers.
     """
-    fig = Figure(figsize=(9, 9), constrained_layout=True)
-    ax_x, ax_p, ax_f = fig.subplots(3, 1, sharex=True)
-    _contraction_panel(ax_x, result, compare or [], measured)
-    _pressure_panel(ax_p, result, measured)
-    _force_panel(ax_f, result)
+    thermal = "wall_heat_W" in result.signals  # the thermal chamber's: its temperature gets a panel
+    fig = Figure(figsize=(9, 11 if thermal else 9), constrained_layout=True)
+    axes = fig.subplots(4 if thermal else 3, 1, sharex=True)
+    _contraction_panel(axes[0], result, compare or [], measured)
+    _pressure_panel(axes[1], result, measured)
+    if thermal:
+        _temperature_panel(axes[2], result)
+    _force_panel(axes[-1], result)
     fig.suptitle(_result_title(result, title, backend, measured))
     return fig
 
@@ -110,6 +113,18 @@ def _pressure_panel(ax, result: "Result", measured) -> None:
         draw_measured(ax, measured, measured.pressure_stable_bar, measured_labels(measured)[1])
     ax.set_ylabel("gauge pressure [bar]")
     ax.legend(loc="lower right", fontsize=8)
+    ax.grid(alpha=0.3)
+
+
+def _temperature_panel(ax, result: "Result") -> None:
+    """The chamber's gas temperature, and its wall's where the run's model has one."""
+    t = result.t_s
+    ax.plot(t, result.signals["gas_temperature_K"], **series(0, "C1"), label="gas")
+    T_wall = getattr(getattr(getattr(result.model, "source", None), "chamber", None), "T_wall_K", None)
+    if T_wall is not None:
+        ax.axhline(T_wall, **series(3, "k"), label="wall")
+    ax.set_ylabel("chamber temperature [K]")
+    ax.legend(loc="upper right", fontsize=8)
     ax.grid(alpha=0.3)
 
 

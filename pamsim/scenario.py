@@ -18,7 +18,7 @@ from typing import Any, Mapping
 
 from .constants import PA_PER_BAR
 from .errors import InputError
-from .elements.chamber import MuscleChamber
+from .elements.chamber import CHAMBER_LAWS, IsothermalChamber, MuscleChamber, ThermalChamber
 from .elements.damping import DAMPING_MODELS
 from .elements.friction import FRICTION_MODELS, NEGATIVE_LEVEL_CHOICES
 from .elements.load import HangingLoad
@@ -31,7 +31,7 @@ from .model import FitRange, MuscleModel
 from .muscle_setup import applicable_model, model_inputs, with_overrides
 from .muscles import Muscle, load_muscle, shipped_names
 from .paperdata import STEADY_STATE_SETS, SteadyState, steady_state
-from .parameters import LOAD_MASS, ParameterSet, dynamics_parameters
+from .parameters import CHAMBER_DEFAULTS, CHAMBER_LAW_KEYS, LOAD_MASS, ParameterSet, dynamics_parameters
 from .scenario_components import added_components, check_wiring
 from .static_models import REGISTRY
 from .signal_tables import signal_from_table, signal_range
@@ -43,7 +43,8 @@ from .table_checks import TableChecker, choices_hint, did_you_mean
 # Schema: section -> {key: (type, required)}; a nested dict is a sub-table.
 _SCHEMA: dict[str, dict[str, Any]] = {
     "": {"name": str, "description": str, "model": dict, "parameters": dict, "load": dict, "pressure": dict,
-         "simulation": dict, "solver": dict, "controller": dict, "component": list, "measured": dict},
+         "simulation": dict, "solver": dict, "controller": dict, "component": list, "measured": dict,
+         "chamber": dict},
     "model": {"muscle": str, "parameter_set": str, "static_force": str, "static_force_variant": str,
               "static_force_negative": str, "friction": str, "damping": str, "friction_negative_level": str,
               "upper_stop": str},
@@ -53,6 +54,7 @@ _SCHEMA: dict[str, dict[str, Any]] = {
     "simulation": {"duration_s": float, "sample_rate_Hz": float, "initial_contraction_m": float},
     "solver": {"method": str, "rtol": float, "max_events": int, "max_step_s": float, "native_rtol_factor": float},
     "measured": {"steady_state": str},
+    "chamber": {"law": str, **{key: float for key in CHAMBER_DEFAULTS if key != "law"}},
 }
 _MAX_SAMPLES = 1e7  # 8 s at 1 kHz is 8,001; beyond this the output would not fit in memory comfortably
 MAX_STEPS = 1e7
@@ -117,7 +119,8 @@ class Scenario:
 
         Keys are merged into each section, except that a change of
         ``pressure.source`` replaces the whole ``[pressure]`` table (the keys of
-        one source mean nothing to the other), and naming one of a pair of
+        one source mean nothing to the other), a change of ``chamber.law`` the whole
+        ``[chamber]`` table (likewise), and naming one of a pair of
         alternatives (``weight_N``/``mass_kg``, ``supply_gauge_bar``/``supply_gauge_Pa``,
         ``muscle``/``parameter_set``) drops the other.  A new muscle without a
         new ``static_force`` takes its own default model if the old muscle ran its default.
@@ -131,6 +134,8 @@ class Scenario:
         """The table ``old`` of ``section`` with ``values`` merged in, less the keys they replace."""
         if section == "pressure" and "source" in values and values["source"] != old.get("source"):
             old = {}
+        if section == "chamber" and "law" in values and values["law"] != old.get("law", CHAMBER_DEFAULTS["law"][0]):
+            old = {}  # the keys of one law mean nothing to another
         if section == "model" and ({"muscle", "parameter_set"} & set(values)):
             old = self._model_without_muscle(old, values)
         return _without_alternatives({**old, **copy.deepcopy(dict(values))}, values)
@@ -228,7 +233,7 @@ class Scenario:
                        f"must lie between 0 and the rating, {rating / PA_PER_BAR:g} bar")
         command = self._valve_command(v, pr)
         return ValveChamberSource(ProportionalValve33(Iso6358Orifice.from_parameters(p)),
-                                  MuscleChamber.from_parameters(p), Constant(supply), command,
+                                  _chamber(v, self.spec.get("chamber", {}), p), Constant(supply), command,
                                   p["T_supply_K"], p["p_atm_Pa"])
 
     def _supply_gauge_Pa(self, v: "_Validator", pr: Mapping[str, Any]) -> float:
@@ -263,6 +268,9 @@ class Scenario:
 
     def _prescribed_source(self, v: "_Validator", pr: Mapping[str, Any]) -> PrescribedPressure:
         v.allowed("pressure", pr, {"source", "prescribed"})
+        if "chamber" in self.spec:
+            v.fail("chamber", self.spec["chamber"], "a prescribed pressure has no chamber: [chamber] takes "
+                   'pressure.source = "valve"')
         sig = signal_from_table(v, "pressure.prescribed", v.required(pr, "prescribed", prefix="pressure."),
                                 "_gauge_bar", PA_PER_BAR, self.base_dir, alt_suffix=("_gauge_Pa", 1.0))
         lo, hi = signal_range(sig)
@@ -304,6 +312,12 @@ class Scenario:
         """The components the scenario adds to the rig (``[[component]]`` tables), as
         :class:`pamsim.assemblies.one_muscle.AddedComponent` s."""
         return self._added
+
+    @property
+    def chamber_law(self) -> str:
+        """The chamber's law (``[chamber] law``, :data:`pamsim.elements.chamber.CHAMBER_LAWS`); ``"polytropic"``
+        without the table."""
+        return self.spec.get("chamber", {}).get("law", CHAMBER_DEFAULTS["law"][0])
 
     @property
     def initial_contraction_m(self) -> float:
@@ -401,6 +415,34 @@ def _key(kind: str, name: str) -> str:
             "variant": "model.static_force_variant"}[kind]
 
 
+# ---------------------------------------------------------------- chamber section
+def _chamber(v: "_Validator", table: Mapping[str, Any], p: ParameterSet):
+    """The chamber element of ``[chamber]`` (:data:`pamsim.parameters.CHAMBER_DEFAULTS` for what it
+    leaves out) and the muscle's parameters ``p``; a key of another law, or a value out of range, fails
+    naming the key."""
+    law = table.get("law", CHAMBER_DEFAULTS["law"][0])
+    if law not in CHAMBER_LAWS:
+        v.fail("chamber.law", law, "unknown law", choices=CHAMBER_LAWS)
+    keys = CHAMBER_LAW_KEYS[law]
+    for key in table:
+        if key != "law" and key not in keys:
+            v.fail(f"chamber.{key}", table[key], f"does not apply to law = {law!r}"
+                   + (f" (it takes {', '.join(keys)})" if keys else ""))
+    values = {key: v.number(f"chamber.{key}", table.get(key, CHAMBER_DEFAULTS[key][0])) for key in keys}
+    for key, ok, why in (("T_wall_K", lambda T: T > 0.0, "must be positive"),
+                         ("h_W_per_m2_K", lambda h: h >= 0.0, "must not be negative"),
+                         ("heat_capacity_ratio", lambda g: 1.0 < g <= 5.0 / 3.0,
+                          "must lie in (1, 5/3], the ratio c_p / c_v of a gas")):
+        if key in values and not ok(values[key]):
+            v.fail(f"chamber.{key}", values[key], why)
+    if law == "isothermal":
+        return IsothermalChamber.from_parameters(p, values["T_wall_K"])
+    if law == "thermal":
+        return ThermalChamber.from_parameters(p, values["heat_capacity_ratio"], values["h_W_per_m2_K"],
+                                              values["T_wall_K"])
+    return MuscleChamber.from_parameters(p)
+
+
 # ---------------------------------------------------------------- simulation and solver sections
 def _simulation(v: "_Validator", sim: dict) -> tuple[float, float, float]:
     """``[simulation]``'s duration [s], output rate [Hz] and initial contraction [m] (checked against the
@@ -453,7 +495,7 @@ def _check_sections(v: "_Validator", spec: dict) -> None:
         raise ScenarioError(f"{v.origin}: [joint] and [[muscle]] tables make muscles on a joint: run it with "
                             "`pamsim run`, or read it with pamsim.joints.load_joint_scenario")
     v.check_table("", spec)
-    for section in ("model", "load", "pressure", "simulation", "solver", "measured"):
+    for section in ("model", "load", "pressure", "simulation", "solver", "measured", "chamber"):
         if section in spec:
             v.check_table(section, spec[section])
     if "measured" in spec:

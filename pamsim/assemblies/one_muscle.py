@@ -20,7 +20,7 @@ import numpy as np
 
 from ..components.element import kept_component
 from ..components.hanging_load import LoadMode
-from ..components import (CoulombFriction, ExternalForce, HangingLoad, MuscleStaticForce, PolytropicChamber,
+from ..components import (Chamber, CoulombFriction, ExternalForce, HangingLoad, MuscleStaticForce,
                           PressureSignal, ProportionalValve, ViscousDamping)
 from ..elements.pressure_source import PrescribedPressure, ValveChamberSource
 from ..modeling import Assembly
@@ -103,7 +103,8 @@ VALVE_CHAMBER_WIRING = (("chamber.port", "valve.port"), ("load.x_m", "chamber.x_
 
 def _valve_parts(src: ValveChamberSource, p0_gauge_Pa: float | None) -> SourceParts:
     return SourceParts(
-        [kept_component(PolytropicChamber, "chamber", src.chamber, src.p_atm_Pa, p0_gauge_Pa or 0.0, src.T_supply_K),
+        [kept_component(Chamber, "chamber", src.chamber, src.p_atm_Pa, p0_gauge_Pa or 0.0,
+                        src.chamber.start_temperature_K(src.T_supply_K)),
          kept_component(ProportionalValve, "valve", src.valve, src.T_supply_K, src.p_atm_Pa, src.chamber.R_J_per_kg_K)],
         list(VALVE_CHAMBER_WIRING),
         {"valve_command": "valve.command", "supply_pressure_gauge_Pa": "valve.supply_gauge_Pa"}, "chamber")
@@ -180,9 +181,11 @@ OUTPUT_COLUMNS = {"muscle.F_static_N": "F_static_N", "load.F_friction_N": "F_fri
                   "damping.F_damping_N": "F_damping_N", "load.F_gravity_N": "F_gravity_N",
                   "external.F_external_N": "F_external_N", "load.F_stop_N": "F_stop_N",
                   "load.F_coulomb_level_N": "F_coulomb_level_N", "valve.mass_flow_kg_s": "valve_mass_flow_kg_s",
-                  "chamber.gas_temperature_K": "gas_temperature_K"}
+                  "chamber.gas_temperature_K": "gas_temperature_K", "chamber.wall_heat_W": "wall_heat_W",
+                  "chamber.wall_area_m2": "wall_area_m2"}
 """The rig's outputs under the names results have always given them, in the order of their columns
-(an output of a component added to the rig keeps its namespaced name)."""
+(an output of a component added to the rig keeps its namespaced name); the last two are the thermal
+chamber's alone."""
 
 
 class RigOutputs:

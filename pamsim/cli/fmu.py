@@ -19,13 +19,15 @@ def register(sub) -> None:
                         description="Generate the sources and model description, compile them and write the .fmu.")
     b.add_argument("-o", "--output", default=None,
                    help="FMU file to write (default: pamsim_muscle_fmi<version>.fmu in the current folder, or "
-                        "pamsim_assembly_fmi<version>.fmu for a scenario that adds components or has a controller)")
+                        "pamsim_assembly_fmi<version>.fmu for a scenario that adds components, has a controller or "
+                        "a chamber law other than the polytropic)")
     b.add_argument("--fmi", default="2", help="FMI version: 2 (FMI 2.0) or 3 (FMI 3.0); default 2")
     b.add_argument("--scenario", default=None,
                    help="build the FMU for this scenario: its muscle's and its own values (parameters, choices, "
                         "initial state, input signals, run) are the FMU's start values, and a static force other "
                         "than the ACRA 2012 polynomial is baked in as a force table; a scenario that adds components "
-                        "([[component]]) or has a [controller] gives the FMU generated from its assembly, with "
+                        "([[component]]), has a [controller] or a [chamber] law other than the polytropic gives "
+                        "the FMU generated from its assembly, with "
                         "structured names (the controller, designed as pamsim run designs it, inside)")
     b.add_argument("--muscle", default=None,
                    help="build the FMU for this muscle (shipped name or TOML path): its parameters are the FMU's "
@@ -94,7 +96,9 @@ def run_build(args: argparse.Namespace) -> int:
             return _build_joint(scenario, args)
         if args.muscle_only:
             return _build_muscle_only(scenario, args)
-        if scenario.added_components or args.generated or "controller" in scenario.spec:
+        # The one-muscle FMU has the rig's own components with the polytropic chamber: anything else is generated.
+        if (scenario.added_components or args.generated or "controller" in scenario.spec
+                or scenario.chamber_law != "polytropic"):
             return _build_assembly(scenario, args)
     preset = _preset(args, scenario, by_muscle)
     path = build(args.output, int(args.fmi), preset=preset)

@@ -7,7 +7,7 @@ place and every generated form comes from them.
 """
 
 from .catalogue import COMPONENT_TYPES, register_component
-from .chamber import PolytropicChamber
+from .chamber import Chamber
 from .damping import ViscousDamping
 from .external_force import ExternalForce
 from .friction import CoulombFriction
@@ -20,7 +20,8 @@ from .spring import LinearSpring
 from .static_force import MuscleStaticForce
 from .valve import ProportionalValve
 
-__all__ = ["COMPONENT_TYPES", "CoulombFriction", "ExternalForce", "HangingLoad", "LinearSlider", "LinearSpring", "LoadMode",
-           "MuscleStaticForce", "PolytropicChamber", "PressureSignal", "ProportionalValve", "Pulley", "RotaryJoint",
+__all__ = ["COMPONENT_TYPES", "Chamber", "CoulombFriction", "ExternalForce", "HangingLoad", "LinearSlider",
+           "LinearSpring", "LoadMode",
+           "MuscleStaticForce", "PressureSignal", "ProportionalValve", "Pulley", "RotaryJoint",
            "SliderTendon", "ViscousDamping",
            "register_component"]

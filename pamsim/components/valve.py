@@ -22,7 +22,7 @@ class ProportionalValve(ElementParameters, Component):
     pressure.  Inflow carries the supply temperature, outflow the volume's gas temperature.  Output
     ``p_settle_abs_Pa``: the port pressure at which the flow stops, the supply's or the exhaust's
     (the port's own while the valve is closed), for a chamber that settles
-    (:class:`pamsim.components.PolytropicChamber`).
+    (:class:`pamsim.components.Chamber`).
     """
 
     ports = (Port("port", PNEUMATIC, "branch"),)

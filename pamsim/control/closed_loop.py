@@ -35,7 +35,7 @@ import control as ct
 import numpy as np
 
 from ..assemblies.one_muscle import VALVE_CHAMBER_WIRING, SourceParts, register_source
-from ..components import PolytropicChamber, ProportionalValve
+from ..components import Chamber, ProportionalValve
 from ..constants import PA_PER_BAR
 from ..elements.pressure_source import ValveChamberSource
 from ..errors import InputError
@@ -358,7 +358,8 @@ def _closed_loop_parts(source: "ClosedLoopValveSource", p0_gauge_Pa: float | Non
     the feedforward pressure of the first reference), the controller, and the valve it drives."""
     plant = source.plant
     p0 = source.feedforward_gauge_Pa(0.0) if p0_gauge_Pa is None else p0_gauge_Pa
-    parts = [PolytropicChamber("chamber", plant.chamber, plant.p_atm_Pa, p0, plant.T_supply_K),
+    T0 = plant.chamber.start_temperature_K(plant.T_supply_K)
+    parts = [Chamber("chamber", plant.chamber, plant.p_atm_Pa, p0, T0),
              PositionController("controller", source),
              ProportionalValve("valve", plant.valve, plant.T_supply_K, plant.p_atm_Pa, plant.chamber.R_J_per_kg_K)]
     wiring = [*VALVE_CHAMBER_WIRING, ("load.x_m", "controller.x_m"), ("chamber.p_abs_Pa", "controller.p_abs_Pa"),

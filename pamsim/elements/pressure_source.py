@@ -14,7 +14,7 @@ from typing import Callable
 import numpy as np
 
 from ..signals import max_step_hint_s
-from .chamber import MuscleChamber
+from .chamber import BraidCylinder
 from .valve import ProportionalValve33
 
 
@@ -27,7 +27,7 @@ class ValveChamberSource:
     """
 
     valve: ProportionalValve33
-    chamber: MuscleChamber
+    chamber: BraidCylinder
     supply_gauge_Pa: Callable
     command: Callable
     T_supply_K: float
@@ -37,10 +37,11 @@ class ValveChamberSource:
 
     def initial_state(self, x_m: float, p_gauge_Pa: float = 0.0) -> list[float]:
         """``[absolute pressure, air mass]`` of the chamber at rest at ``x_m`` and gauge pressure ``p_gauge_Pa``,
-        filled at the supply temperature.
+        at the chamber's starting temperature (the supply's, or the wall's for a law with a wall temperature).
         """
         p = self.p_atm_Pa + p_gauge_Pa
-        return [p, self.chamber.air_mass_kg(p, self.chamber.volume_m3(x_m), self.T_supply_K)]
+        T = self.chamber.start_temperature_K(self.T_supply_K)
+        return [p, self.chamber.air_mass_kg(p, self.chamber.volume_m3(x_m), T)]
 
     def inputs(self, t_s) -> tuple:
         """The source's inputs at time t: (valve command [-], supply gauge pressure [Pa])."""
@@ -75,7 +76,7 @@ class ValveChamberSource:
         mdot = float(mdot)
         T_in = self.T_supply_K if mdot >= 0.0 else T_gas
         dV = self.chamber.dvolume_dx_m2(x_m) * v_m_s
-        return self.chamber.pressure_rate_Pa_s(p, V, dV, mdot, T_in), mdot
+        return self.chamber.pressure_rate_Pa_s(p, V, dV, mdot, T_in, s[1], x_m), mdot
 
     @property
     def breakpoints(self) -> tuple[float, ...]:

@@ -19,7 +19,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any, Mapping
 
-from ..components import CoulombFriction, HangingLoad, MuscleStaticForce, PolytropicChamber, ProportionalValve
+from ..components import Chamber, CoulombFriction, HangingLoad, MuscleStaticForce, ProportionalValve
 from ..components import ViscousDamping
 from ..components.choice import SEPARATOR, PressureChoice, Selected
 from ..components.element import STRUCTURAL, _field_names, _is_instance_of_dataclass, _is_number
@@ -174,7 +174,7 @@ def rig_components(laws: RigLaws) -> dict:
     muscle, friction, damping = laws.muscle[0], laws.friction[0], laws.damping[0]
     return {
         "load": HangingLoad("load", laws.load),
-        "chamber": PolytropicChamber("chamber", laws.chamber[0], **laws.chamber[1]),
+        "chamber": Chamber("chamber", laws.chamber[0], **laws.chamber[1]),
         "valve": ProportionalValve("valve", laws.valve[0], **laws.valve[1]),
         "pressure": PressureChoice("pressure", laws.pressure),
         "muscle": Selected("muscle", {n: MuscleStaticForce(n, e) for n, e in muscle.items()}, laws.muscle[1]),

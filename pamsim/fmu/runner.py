@@ -27,6 +27,7 @@ from ..constants import PA_PER_BAR
 from ..core_table import unimplemented_choice
 from ..elements.pressure_source import ValveChamberSource
 from ..errors import InputError, SolverFailure
+from ..parameters import CHAMBER_DEFAULTS
 from ..result import Result
 from ..scenario import Scenario
 from .build import temp_fmu
@@ -76,9 +77,11 @@ def force_table_for(scenario: Scenario) -> ForceTable | None:
 # [solver] sets the Python integrator: the FMU's integrators are CVode at solver.rtol (ME) and its
 # own Dormand-Prince 5(4) (CS), at solver.rtol (native_rtol_factor is the native backend's alone).  [controller] is read by pamsim.control, which designs the controller
 # and runs its model through the FMU of its assembly (pamsim.fmu.assembly_runner), not this FMU.
+# [chamber]: the polytropic law is this FMU's chamber; another law runs through the FMU of the scenario's
+# assembly (pamsim.backends.simulate), which the check below lets through.
 REPRESENTED = {
     "": {"name", "description", "model", "parameters", "load", "pressure", "simulation", "solver", "controller",
-         "measured"},  # [measured] names what the figure draws beside the run, not the model
+         "measured", "chamber"},  # [measured] names what the figure draws beside the run, not the model
     "model": {"muscle", "parameter_set", "static_force", "static_force_negative", "friction", "damping",
               "friction_negative_level", "upper_stop"},
     "load": {"weight_N", "mass_kg", "external_force"},
@@ -86,7 +89,23 @@ REPRESENTED = {
                  "initial_gauge_bar"},
     "simulation": {"duration_s", "sample_rate_Hz", "initial_contraction_m"},
     "solver": {"method", "rtol", "max_events", "max_step_s", "native_rtol_factor"},
+    "chamber": set(CHAMBER_DEFAULTS),
 }
+
+
+def check_scenario(scenario: Scenario) -> None:
+    """Raise :class:`~pamsim.errors.InputError` for a scenario the FMU backends cannot run: through this FMU
+    (:func:`start_values`), or, for a chamber law other than the polytropic, through the FMU of its assembly,
+    which carries any law."""
+    if scenario.chamber_law == "polytropic":
+        start_values(scenario)
+
+
+def _refuse_chamber_law(scenario: Scenario) -> None:
+    """The one-muscle FMU has the polytropic chamber: another law is refused, naming the key."""
+    if scenario.chamber_law != "polytropic":
+        raise InputError(f"{scenario.origin}: chamber.law = {scenario.chamber_law!r}: the one-muscle FMU has the "
+                         "polytropic chamber; pamsim.simulate runs this scenario through the FMU of its assembly")
 
 
 def _refuse_unrepresented(scenario: Scenario) -> None:
@@ -98,6 +117,7 @@ def _refuse_unrepresented(scenario: Scenario) -> None:
                 full = f"{section}.{key}" if section else key
                 raise InputError(f"{scenario.origin}: the FMU cannot represent scenario key {full!r}; "
                                  "run it with the python backend")
+    _refuse_chamber_law(scenario)
     model = spec["model"]
     if model["static_force_negative"] != "clip":
         raise InputError(f"{scenario.origin}: the FMU clips a negative static force at zero, "

@@ -24,6 +24,7 @@ SYMBOLS: dict[str, tuple[float, dict[str, int]]] = {
     "Pa": (1.0, {"kg": 1, "m": -1, "s": -2}),
     "bar": (1.0e5, {"kg": 1, "m": -1, "s": -2}),
     "J": (1.0, {"kg": 1, "m": 2, "s": -2}),
+    "W": (1.0, {"kg": 1, "m": 2, "s": -3}),
     "deg": (math.pi / 180.0, {"rad": 1}),
     "rad": (1.0, {"rad": 1}),
 }

@@ -410,11 +410,14 @@ def slider_of_rig(scenario: Scenario) -> JointScenario:
     Raises
     ------
     ScenarioError
-        For a rig with added components or a controller, which a slider scenario does not carry.
+        For a rig with added components, a controller or a chamber law other than the polytropic, which a
+        slider scenario does not carry.
     """
     for key in ("component", "controller"):
         if key in scenario.spec:
             _fail(scenario.origin, key, "...", "a rig with it has no slider form")
+    if scenario.chamber_law != "polytropic":  # a joint's muscle has the polytropic chamber: refused, not dropped
+        _fail(scenario.origin, "chamber.law", scenario.chamber_law, "a slider's muscles have the polytropic chamber")
     stops, spec = scenario.build_model().stops, scenario.spec
     sim = dict(spec.get("simulation", {}))
     x0 = float(sim.pop("initial_contraction_m", 0.0))
