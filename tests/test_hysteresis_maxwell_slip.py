@@ -10,6 +10,8 @@ import pytest
 from pamsim.errors import InputError
 from pamsim.hysteresis.maxwell_slip import MaxwellSlip
 
+from hysteresis_paths import resample
+
 # (stiffness [N/m], slip force [N]) per element: one element, three spread ones, five equal deflections.
 MODELS = {
     "one": ([1.0e4], [5.0]),
@@ -28,17 +30,6 @@ def sequential(k, f, x):
         d = np.clip(d + (b - a), -f / k, f / k)
         out.append(float(k @ d))
     return np.array([0.0] + out)
-
-
-def resample(vertices, per_segment, rng=None):
-    """The piecewise-linear path through ``vertices`` with ``per_segment`` points on each piece (random
-    positions with ``rng``), the vertices kept; returns the samples and the vertices' indices."""
-    xs, idx = [np.array([vertices[0]])], [0]
-    for a, b in zip(vertices[:-1], vertices[1:]):
-        s = np.sort(rng.uniform(0, 1, per_segment)) if rng is not None else np.linspace(0, 1, per_segment + 2)[1:-1]
-        xs.append(np.concatenate([a + (b - a) * s, [b]]))
-        idx.append(idx[-1] + per_segment + 1)
-    return np.concatenate(xs), np.array(idx)
 
 
 @pytest.mark.parametrize("name", MODELS)

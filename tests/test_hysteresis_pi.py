@@ -14,6 +14,8 @@ from pamsim.errors import InputError
 from pamsim.hysteresis.play import play, stop
 from pamsim.hysteresis.prandtl_ishlinskii import PrandtlIshlinskii
 
+from hysteresis_paths import resample
+
 # thresholds, weights, offset, envelope scale (inf: the classical operator)
 OPERATORS = {
     "classical": ([0.0, 0.1, 0.25, 0.5], [1.0, 0.4, 0.3, 0.2], 0.0, math.inf),
@@ -35,15 +37,6 @@ def sequential_play(u, r):
         z = np.minimum(np.maximum(z, x - np.asarray(r)), x + np.asarray(r))
         out.append(z.copy())
     return np.array(out)
-
-
-def resample(vertices, per_segment, rng=None):
-    xs, idx = [np.array([vertices[0]])], [0]
-    for a, b in zip(vertices[:-1], vertices[1:]):
-        s = np.sort(rng.uniform(0, 1, per_segment)) if rng is not None else np.linspace(0, 1, per_segment + 2)[1:-1]
-        xs.append(np.concatenate([a + (b - a) * s, [b]]))
-        idx.append(idx[-1] + per_segment + 1)
-    return np.concatenate(xs), np.array(idx)
 
 
 def test_play_and_stop_against_the_sample_by_sample_update():
@@ -165,3 +158,18 @@ def test_the_inverse_refuses_an_output_beyond_the_envelope():
     pi = PrandtlIshlinskii([0.0], [1.0], 0.0, 1.0)  # y = tanh(u): |y| < 1
     with pytest.raises(InputError, match="envelope_scale = 1.0: the inverse asks for g"):
         pi.inverse().run(np.array([0.0, 0.5, 1.2]))
+
+
+@pytest.mark.parametrize("k, f, k0", [([2e4, 5e3, 2e3], [10.0, 20.0, 25.0], -3000.0), ([8e3], [6.0], 500.0)])
+def test_maxwell_slip_is_the_operator_with_the_slip_deflections_as_thresholds(k, f, k0):
+    # k0 x - sum k_i d_i with d_i = x - P_{F_i/k_i}[x]: a Prandtl-Ishlinskii operator with thresholds 0 and F_i/k_i,
+    # weights k0 - sum k_i and k_i, both relaxed at the first sample.
+    from pamsim.hysteresis.maxwell_slip import MaxwellSlip
+
+    x, _ = resample(np.array([0.01, 0.03, 0.005, 0.025, 0.012, 0.03, -0.01]), 17)
+    delta = np.asarray(f) / np.asarray(k)
+    order = np.argsort(delta)
+    pi = PrandtlIshlinskii(np.concatenate([[0.0], delta[order]]),
+                           np.concatenate([[k0 - sum(k)], np.asarray(k)[order]]))
+    pull = k0 * x - MaxwellSlip(k, f).run(x).force_N
+    assert np.max(np.abs(pi.run(x, np.full(len(k) + 1, x[0])).output - pull)) < 1e-9
