@@ -88,6 +88,7 @@ def test_fit_hysteresis_writes_its_outputs(synthetic_csv, tmp_path):
     body = json.loads(proc.stdout)
     assert body["fit"]["label"] == "maxwell_slip N=2" and body["elements"] == "chosen by BIC"
     assert body["input"] == "contraction x_m" and body["output"] == "force_N"
+    assert set(body["models"]) == {"maxwell_slip", "pi", "bouc_wen"} and body["models"]["maxwell_slip"] == body["fit"]
     assert sorted(p.name for p in out.iterdir()) == ["compare.csv", "fit.json", "fit.png", "report.md",
                                                     "residuals.png"]
     assert json.loads((out / "fit.json").read_text()) == body
@@ -196,3 +197,32 @@ def test_the_loop_csv_round_trips(tmp_path):
     back = read_loop(tmp_path / "l.csv")
     for key in ("t_s", "p_gauge_Pa", "x_m", "force_N"):
         assert np.allclose(getattr(back, key), getattr(data, key), rtol=1e-9, atol=1e-12)
+
+
+def test_loop_arrays_are_checked():
+    from pamsim.hysteresis import LoopData
+    from pamsim.identification.columns import DataError
+
+    data = loop("maxwell_slip_2")
+    with pytest.raises(DataError, match="<arrays>: force_N: need 1361 finite values"):
+        LoopData(data.t_s, data.p_gauge_Pa, data.x_m, data.force_N[:-1])
+    bad = data.force_N.copy()
+    bad[7] = np.nan
+    with pytest.raises(DataError, match="<arrays>: force_N: need 1361 finite values"):
+        LoopData(data.t_s, data.p_gauge_Pa, data.x_m, bad)
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    (dict(model="preisach"), "model = 'preisach': choose from maxwell_slip, pi, bouc_wen"),
+    (dict(elements=0), "elements = 0: must be an integer from 1 to 100"),
+    (dict(max_elements=101), "max_elements = 101: must be an integer from 1 to 100"),
+    (dict(plays=0), "plays = 0: must be an integer from 1 to 100"),
+    (dict(thresholds_m=[0.0, 0.002, 0.001]), "thresholds[2] = 0.001: thresholds must increase strictly"),
+    (dict(exponent=0.0), "exponent = 0.0: must be above 0"),
+])
+def test_the_api_refuses_bad_options_before_fitting(kwargs, message):
+    from pamsim.errors import InputError
+
+    with pytest.raises(InputError) as info:
+        fit_hysteresis(loop("maxwell_slip_2"), **kwargs)
+    assert message in str(info.value)

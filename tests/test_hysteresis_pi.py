@@ -75,7 +75,8 @@ def test_return_point_memory_and_wiping_out(name):
 @pytest.mark.parametrize("amplitude", [0.3, 0.8, 1.2])
 def test_loop_area_is_the_sum_of_the_plays_parallelograms(amplitude):
     # A play of half-width r on a cycle of span A > 2 r encloses a parallelogram of area 2 r (A - 2 r) in the
-    # (u, z) plane, traversed clockwise; the operator's loop is the weighted sum.  The output is linear
+    # (u, z) plane, traversed counterclockwise (rising below, falling above), so the integral of z du is minus
+    # that area; the operator's is the weighted sum (a negative weight, a loop the other way round).  The output is linear
     # between samples that include every corner (steps of 1e-3 divide r and A), so the trapezoid is exact.
     r, w, offset, _ = OPERATORS["negative_weights"]
     pi = PrandtlIshlinskii(r, w, offset)
@@ -84,7 +85,7 @@ def test_loop_area_is_the_sum_of_the_plays_parallelograms(amplitude):
                         np.linspace(-amplitude, amplitude, 2 * n + 1)[1:]])
     y = pi.run(u).output[n:]
     cycle = u[n:]
-    area = -float(np.sum(0.5 * (y[1:] + y[:-1]) * np.diff(cycle)))  # clockwise: the integral of y du is -area
+    area = -float(np.sum(0.5 * (y[1:] + y[:-1]) * np.diff(cycle)))
     span = 2 * amplitude
     rr, ww = np.asarray(r), np.asarray(w)
     analytic = float(np.sum(np.where(span > 2 * rr, ww * 2 * rr * (span - 2 * rr), 0.0)))

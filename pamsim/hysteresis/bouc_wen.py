@@ -2,10 +2,11 @@
 
 ``dz = A dx - beta |dx| |z|^(n-1) z - gamma dx |z|^n`` and the force ``F = F0 + k_e x + alpha z``.  The law
 holds for ``dx``, not ``dt``: it is rate independent, and on a stretch where the input moves one way
-(``s = sign(dx)``) it is the ordinary differential equation in the input
+(``s = sign(dx)``) it is the ordinary differential equation in the input::
 
-    dz/dx = A - (beta s + gamma) |z|^n       (z s >= 0, the ordinary case of a loading branch)
-    dz/dx = A - beta s |z|^(n-1) z - gamma |z|^n   (in general),
+    dz/dx = A - beta s |z|^(n-1) z - gamma |z|^n
+          = A - (beta + gamma) |z|^n      where z has the sign of s (a loading branch)
+          = A + (beta - gamma) |z|^n      where it has the other sign (just after a reversal),
 
 integrated here sample interval by sample interval with classical Runge-Kutta (4th order) in ``x`` on steps of
 at most :data:`STEP_FRACTION` of the saturation value ``z_u = (A / (beta + gamma))^(1/n)``.  ``z`` carries the

@@ -120,11 +120,12 @@ class HysteresisFit:
                 for f in rows]
 
     def to_json(self) -> dict:
-        """The chosen fit, the comparison and the data's provenance."""
+        """The chosen fit, each model's best fit, the comparison and the data's provenance."""
         return {"data": {"file": self.data.origin, "sha256": self.data.sha256, "samples": len(self.data),
                          "mean_pressure_Pa": float(np.mean(self.data.p_gauge_Pa))},
                 "input": "contraction x_m", "output": "force_N", "fit": self.chosen.to_json(),
                 "elements": "given" if self.elements_given else "chosen by BIC",
+                "models": {name: f.to_json() for name, f in self.models.items()},
                 "comparison": self.comparison_rows()}
 
 
@@ -159,13 +160,13 @@ def fit_hysteresis(data: LoopData, model: str = "maxwell_slip", elements: int | 
         raise checks.InputError(f"model = {model!r}: choose from {', '.join(MODELS)}")
     counts = [checks.count("elements", elements)] if elements is not None else \
         range(1, checks.count("max_elements", max_elements) + 1)
-    thresholds = None if thresholds_m is None else PrandtlIshlinskii(thresholds_m, np.zeros(np.size(thresholds_m)))
+    plays = checks.count("plays", plays)
+    if thresholds_m is not None:  # the operator's own checks: 1 to 100, at least 0, strictly increasing
+        thresholds_m = PrandtlIshlinskii(thresholds_m, np.zeros(np.size(thresholds_m))).thresholds
     if exponent is not None:
         exponent = checks.number("exponent", exponent, 0.0, strict=True)
     scan = [fit_maxwell_slip(data, n) for n in counts]
-    models = {"maxwell_slip": min(scan, key=lambda f: f.bic),
-              "pi": fit_pi(data, checks.count("plays", plays),
-                           None if thresholds is None else thresholds.thresholds),
+    models = {"maxwell_slip": min(scan, key=lambda f: f.bic), "pi": fit_pi(data, plays, thresholds_m),
               "bouc_wen": fit_bouc_wen(data, exponent)}
     return HysteresisFit(data, models[model], models, scan, elements is not None)
 

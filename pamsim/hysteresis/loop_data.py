@@ -46,8 +46,14 @@ class LoopData:
 
 
 def check_loop(data: LoopData) -> None:
-    """Refuse a loop too short or without :data:`MIN_REVERSALS` reversals of its input, naming the file."""
+    """Refuse a loop whose columns are not finite 1-D arrays of one length, or too short, or without
+    :data:`MIN_REVERSALS` reversals of its input, naming the file (the arrays are made float arrays)."""
     where = data.origin
+    for key in ("t_s", "p_gauge_Pa", "x_m", "force_N"):
+        values = np.asarray(getattr(data, key), dtype=float)
+        object.__setattr__(data, key, values)
+        if values.shape != (data.x_m.size,) or not np.all(np.isfinite(values)):
+            raise DataError(f"{where}: {key}: need {np.size(data.x_m)} finite values, one per sample of x_m")
     if data.x_m.size < MIN_ROWS:
         raise DataError(f"{where}: {data.x_m.size} rows: a loop needs at least {MIN_ROWS}")
     span = float(np.ptp(data.x_m))

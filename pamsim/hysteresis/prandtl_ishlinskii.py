@@ -4,9 +4,10 @@ with its analytic inverse (docs/hysteresis.md).
 ``y = y0 + sum_j w_j P_rj[g(u)]``, ``P_r`` the play of half-width ``r`` (:mod:`.play`), thresholds
 ``0 <= r_0 < r_1 < ...`` and the envelope ``g(u) = s tanh(u / s)`` of scale ``s`` (``s = inf``: ``g(u) = u``,
 the classical operator).  A play of an envelope, ``P_r[g(u)]``, is the generalized play with equal rising and
-falling envelopes of Al Janaideh, Rakheja and Su; the tanh envelope is the shape they use.  The inverse of the
+falling envelopes of Al Janaideh, Rakheja and Su, here with a tanh envelope (docs/hysteresis.md gives the
+sources and what was checked).  The inverse of the
 classical part is again a Prandtl-Ishlinskii operator whose thresholds and weights follow in closed form
-(Kuhnen's inverse): with the slopes ``W_j = w_0 + ... + w_j``,
+(Kuhnen's inverse): with the slopes ``W_j = w_0 + ... + w_j``::
 
     r'_j = sum_{i<=j} w_i (r_j - r_i),   w'_0 = 1 / w_0,   w'_j = -w_j / (W_j W_{j-1}),
 
