@@ -20,7 +20,7 @@ PACKAGE = Path(pamsim.__file__).resolve().parent
 EXPECTED_LAYERS = [
     "__main__",
     "cli",
-    "api",
+    "api | hysteresis",
     "sweep | identification | control | atlas | export | envs | coupling",
     "backends | joints",
     "native",

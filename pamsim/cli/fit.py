@@ -1,5 +1,5 @@
-"""``pamsim fit static`` and ``pamsim fit dynamic``: identify a muscle from measurements
-(docs/identification.md)."""
+"""``pamsim fit static``, ``pamsim fit dynamic`` and ``pamsim fit hysteresis``: identify a muscle from measurements
+(docs/identification.md, docs/hysteresis.md)."""
 
 from __future__ import annotations
 
@@ -72,12 +72,13 @@ def check_output_dir(directory: str) -> None:
 
 
 def register(sub) -> None:
-    """Add ``pamsim fit static`` and ``pamsim fit dynamic`` and their options to ``sub``, the subparsers of
+    """Add ``pamsim fit static``, ``pamsim fit dynamic`` and ``pamsim fit hysteresis`` and their options to ``sub``, the subparsers of
     :func:`pamsim.cli.build_parser`.
     """
-    p = sub.add_parser("fit", help="identify a muscle from static tests or step responses",
-                       description="Fit static force coefficients to static tests (fit static) or friction and "
-                                   "damping coefficients to step responses (fit dynamic).")
+    p = sub.add_parser("fit", help="identify a muscle from static tests, step responses or hysteresis loops",
+                       description="Fit static force coefficients to static tests (fit static), friction and "
+                                   "damping coefficients to step responses (fit dynamic), or a hysteresis model "
+                                   "to a force-contraction loop (fit hysteresis).")
     fsub = p.add_subparsers(dest="fit_kind", required=True, metavar="KIND")
     s = fsub.add_parser("static", help="fit a static force model to static tests",
                         description="Fit a static force model to static tests (pressure, contraction, hung weight "
@@ -140,6 +141,7 @@ def register(sub) -> None:
     d.add_argument("--json", action="store_true", help="print fit.json to stdout")
     figure_args.add_arguments(d)
     d.set_defaults(func=run_dynamic)
+    register_hysteresis(fsub)
 
 
 def _print_warnings(uncertainty) -> None:
@@ -243,4 +245,122 @@ def run_dynamic(args: argparse.Namespace) -> int:
         print(f"  {name} = {value:.6g}")
     _print_warnings(fit.uncertainty)
     print(f"wrote {', '.join(str(Path(args.output) / n) for n in names)}")
+    return 0
+
+
+# ------------------------------------------------------------------ pamsim fit hysteresis
+def _numbers(text: str) -> list[float]:
+    try:
+        return [float(v) for v in text.split(",")]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: give numbers, comma-separated, e.g. 0,1,2.5") from None
+
+
+def _check_hysteresis_options(args: argparse.Namespace) -> None:
+    """Refuse a count, threshold list or exponent out of range with one line naming the option (exit 2)."""
+    from ..errors import InputError
+    from ..hysteresis import checks
+
+    for key in ("elements", "max_elements", "plays"):
+        if getattr(args, key) is not None:
+            checks.count("--" + key.replace("_", "-"), getattr(args, key))
+    r = args.thresholds_mm
+    if r is not None:
+        text = ",".join(f"{v:g}" for v in r)
+        bad = [i for i in range(1, len(r)) if not r[i] > r[i - 1]]
+        if bad:
+            raise InputError(f"--thresholds-mm = {text!r}: thresholds must increase strictly (threshold {bad[0]}, "
+                             f"{r[bad[0]]:g} mm, follows {r[bad[0] - 1]:g} mm)")
+        if not r[0] >= 0:
+            raise InputError(f"--thresholds-mm = {text!r}: the first threshold must be at least 0")
+    if args.exponent is not None:
+        checks.number("--exponent", args.exponent, 0.0, strict=True)
+    if not args.noise_N >= 0:
+        raise InputError(f"--noise-N = {args.noise_N!r}: must be at least 0")
+
+
+def _parameters(text: str) -> dict[str, float]:
+    out = {}
+    for key, value in _columns(text).items():
+        try:
+            out[key] = float(value)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{key}={value!r}: the value is not a number") from None
+    return out
+
+
+def register_hysteresis(fsub) -> None:
+    """Add ``pamsim fit hysteresis`` to ``fsub``, the subparsers of ``pamsim fit``."""
+    from ..hysteresis import MODELS
+
+    h = fsub.add_parser("hysteresis", help="fit a hysteresis model to a force-contraction loop",
+                        description="Fit Maxwell-slip, Prandtl-Ishlinskii and Bouc-Wen models to a loop (contraction "
+                                    "in, force out), report the chosen one's parameters with confidence intervals "
+                                    "and AIC/BIC across the models and across N, and write fit.json, report.md, "
+                                    "compare.csv and figures (docs/hysteresis.md).  With --write-synthetic, write "
+                                    "a synthetic loop to DATA instead.")
+    h.add_argument("data", help="loop CSV: t_s, a pressure (p_*_Pa, _kPa, _bar), a contraction (x_m or x_mm) and "
+                                "force_N")
+    h.add_argument("--model", choices=MODELS, default="maxwell_slip", help="the model reported (default maxwell_slip)")
+    h.add_argument("--elements", type=int, help="Maxwell-slip elements N, 1 to 100 (default: chosen by BIC)")
+    h.add_argument("--max-elements", type=int, default=6, help="largest N tried for the BIC (default 6)")
+    h.add_argument("--plays", type=int, default=8,
+                   help="Prandtl-Ishlinskii play operators on the default threshold grid (default 8)")
+    h.add_argument("--thresholds-mm", type=_numbers,
+                   help="Prandtl-Ishlinskii thresholds [mm], strictly increasing from 0 (default: a grid of --plays)")
+    h.add_argument("--exponent", type=finite_float, help="Bouc-Wen exponent n, fixed (default: fitted)")
+    h.add_argument("--columns", type=_columns, default={},
+                   help="map quantities to other column names: time=NAME,pressure=NAME,contraction=NAME,force=NAME")
+    h.add_argument("-o", "--output", help="output directory (required to fit)")
+    h.add_argument("--json", action="store_true", help="print fit.json to stdout")
+    h.add_argument("--write-synthetic", action="store_true",
+                   help="write a synthetic loop of --model with --parameters to DATA (no fit)")
+    h.add_argument("--parameters", type=_parameters, default={},
+                   help="with --write-synthetic: NAME=VALUE,... named as the fit reports them")
+    h.add_argument("--noise-N", type=finite_float, default=0.0, help="with --write-synthetic: force noise [N]")
+    h.add_argument("--seed", type=_count, default=0, help="with --write-synthetic: seed of the noise (default 0)")
+    figure_args.add_arguments(h)
+    h.set_defaults(func=run_hysteresis)
+
+
+def run_hysteresis(args: argparse.Namespace) -> int:
+    """``pamsim fit hysteresis``: fit the loop of ``DATA`` (or write a synthetic one); exit code 0."""
+    from ..errors import InputError
+
+    _check_hysteresis_options(args)
+    thresholds_m = None if args.thresholds_mm is None else [v * 1e-3 for v in args.thresholds_mm]
+    if args.write_synthetic:
+        return _write_synthetic(args, thresholds_m)
+    if args.output is None:
+        raise InputError("-o/--output: required to fit (the folder for fit.json, report.md and the figures)")
+    from ..hysteresis import fit_hysteresis, read_loop
+    from ..hysteresis.report import summary_lines, write_hysteresis_fit
+
+    figures = figure_args.options(args)
+    check_output_dir(args.output)
+    data = read_loop(args.data, args.columns)
+    fit = fit_hysteresis(data, args.model, elements=args.elements, max_elements=args.max_elements,
+                         plays=args.plays, thresholds_m=thresholds_m, exponent=args.exponent)
+    names = write_hysteresis_fit(fit, args.output, *figures)
+    if args.json:
+        from ..identification.report import json_text
+
+        print(json_text(fit.to_json()), end="")
+        return 0
+    print("\n".join(summary_lines(fit)))
+    print(f"wrote {', '.join(str(Path(args.output) / n) for n in names)}")
+    return 0
+
+
+def _write_synthetic(args: argparse.Namespace, thresholds_m) -> int:
+    """``--write-synthetic``: the loop of ``--model`` with ``--parameters`` over the default cycle, to DATA."""
+    from ..atomic import atomic_path
+    from ..hysteresis.loop_data import write_loop_csv
+    from ..hysteresis.synthetic import pull_from_parameters, synthetic_loop
+
+    pull = pull_from_parameters(args.model, args.parameters, thresholds_m)
+    loop = synthetic_loop(pull, args.noise_N, args.seed, label=f"synthetic {args.model}")
+    with atomic_path(args.data) as tmp:
+        write_loop_csv(loop, tmp)
+    print(f"wrote {args.data}: {len(loop)} samples of {args.model} with noise {args.noise_N:g} N (seed {args.seed})")
     return 0

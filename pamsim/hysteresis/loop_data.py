@@ -1,0 +1,91 @@
+"""A measured hysteresis loop: a CSV with time, pressure, contraction and force columns, read into SI units.
+
+The loop is a prescribed-length cycle at one pressure: the contraction is the models' input (the test drives
+it) and the force their output (the test measures it).  The column names carry their units as the other
+measurement files do (:mod:`pamsim.identification.columns`): ``t_s``, a pressure (``p_*`` or ``pressure*``
+ending in ``_Pa``, ``_kPa``, ``_bar`` or ``_psi``), a contraction (``x_*`` or ``contraction*`` ending in
+``_m`` or ``_mm``) and ``force_N``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Mapping
+
+import numpy as np
+
+from ..identification.columns import (LENGTH_UNITS_M, PRESSURE_UNITS_PA, DataError, _check_columns_map, _finite,
+                                      _table, _unit_column)
+from .play import reversals
+
+MIN_ROWS = 20
+"""Fewest samples of a loop: two reversals and the branches between them need more than a handful."""
+MIN_REVERSALS = 2
+"""A loop needs the input to turn back twice: one reversal shows a branch and its return, not a closed loop."""
+REVERSAL_DEAD_BAND = 0.01
+"""A reversal counts when the input moves back by more than this fraction of its range (noise does not)."""
+
+
+@dataclass(frozen=True)
+class LoopData:
+    """One loop, SI units: the input ``x_m`` (contraction) and the output ``force_N`` at times ``t_s``."""
+
+    t_s: np.ndarray
+    p_gauge_Pa: np.ndarray
+    x_m: np.ndarray
+    force_N: np.ndarray
+    origin: str = "<arrays>"
+    sha256: str = ""
+
+    def __post_init__(self):
+        check_loop(self)
+
+    def __len__(self) -> int:
+        return self.x_m.size
+
+
+def check_loop(data: LoopData) -> None:
+    """Refuse a loop whose columns are not finite 1-D arrays of one length, or too short, or without
+    :data:`MIN_REVERSALS` reversals of its input, naming the file (the arrays are made float arrays)."""
+    where = data.origin
+    for key in ("t_s", "p_gauge_Pa", "x_m", "force_N"):
+        values = np.asarray(getattr(data, key), dtype=float)
+        object.__setattr__(data, key, values)
+        if values.shape != (data.x_m.size,) or not np.all(np.isfinite(values)):
+            raise DataError(f"{where}: {key}: need {np.size(data.x_m)} finite values, one per sample of x_m")
+    if data.x_m.size < MIN_ROWS:
+        raise DataError(f"{where}: {data.x_m.size} rows: a loop needs at least {MIN_ROWS}")
+    span = float(np.ptp(data.x_m))
+    turns = reversals(data.x_m, REVERSAL_DEAD_BAND * span)
+    if turns < MIN_REVERSALS:
+        raise DataError(f"{where}: the contraction (the input) reverses {turns} time(s) by more than "
+                        f"{REVERSAL_DEAD_BAND:.0%} of its range: a loop needs at least {MIN_REVERSALS}")
+
+
+def read_loop(path: str | Path, columns: Mapping[str, str] | None = None) -> LoopData:
+    """Read a loop CSV (see the module's docstring); ``columns`` maps ``time``, ``pressure``, ``contraction``
+    or ``force`` to other column names (which must still end in a unit)."""
+    path = Path(path)
+    columns = dict(columns or {})
+    _check_columns_map(columns, path)
+    header, rows, digest = _table(path)
+    found = {
+        "time": _unit_column(path, header, "time", {"_s": 1.0}, ("t_", "time"), columns),
+        "pressure": _unit_column(path, header, "pressure", PRESSURE_UNITS_PA, ("p_", "pressure"), columns),
+        "contraction": _unit_column(path, header, "contraction", LENGTH_UNITS_M, ("x_", "contraction"), columns),
+        "force": _unit_column(path, header, "force", {"_N": 1.0}, ("force", "F_"), columns),
+    }
+    values = {q: _finite(path, name, rows[:, header.index(name)] * k) for q, (name, k) in found.items()}
+    t = values["time"]
+    bad = np.flatnonzero(np.diff(t) <= 0)
+    if bad.size:
+        raise DataError(f"{path}: column {found['time'][0]}, data row {int(bad[0]) + 2}: time {t[bad[0] + 1]:g} "
+                        f"does not increase (previous {t[bad[0]]:g})")
+    return LoopData(t, values["pressure"], values["contraction"], values["force"], str(path), digest)
+
+
+def write_loop_csv(data: LoopData, path: str | Path) -> None:
+    """Write ``data`` in the format :func:`read_loop` reads (SI columns)."""
+    table = np.column_stack([data.t_s, data.p_gauge_Pa, data.x_m, data.force_N])
+    np.savetxt(path, table, delimiter=",", header="t_s,p_gauge_Pa,x_m,force_N", comments="", fmt="%.10g")
