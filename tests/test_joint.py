@@ -637,6 +637,7 @@ def test_a_joint_scenario_run_again_on_native_reuses_its_case_by_the_object():
     first = simulate_joint(scenario, "native")
     kept = native._PREPARED.get(scenario)
     assert kept is not None and native._prepared(scenario) is kept
+    assert not kept[2].segment_u.flags.writeable and not kept[2].params.flags.writeable
     again = simulate_joint(scenario, "native")
     assert all(np.array_equal(first.signals[k], again.signals[k]) for k in ("joint.theta_rad", "flexor_chamber.p_abs_Pa"))
     twin = load_joint_scenario(PAIR_FILE)

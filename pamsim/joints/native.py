@@ -75,6 +75,8 @@ def _prepared(scenario: JointScenario) -> tuple:
     case = EngineCase(np.array(assembly.parameter_values()), native_rtol(opts),
                       opts.max_step_s if np.isfinite(opts.max_step_s) else MAX_STEP_S, MAX_INTERNAL_STEPS,
                       scenario.duration_s, n, starts, u, event_capacity(opts.max_events), du)
+    for array in (case.params, case.segment_t_s, case.segment_u, case.segment_du):
+        array.flags.writeable = False  # kept for the next run: no run may change it
     kept = (assembly, library, case, muscles)
     _PREPARED.put(scenario, kept)
     return kept
