@@ -21,6 +21,7 @@ from ..components import CoulombFriction, MuscleStaticForce, ViscousDamping
 from ..components.linear_slider import LinearSlider
 from ..components.pulley import LeverAttachment, Pulley, SliderTendon
 from ..components.rotary_joint import RotaryJoint
+from ..components.series_tendon import MuscleEndDamping, SeriesTendon
 from ..modeling import Assembly
 from .one_muscle import rewired, source_parts
 
@@ -44,6 +45,9 @@ class JointMuscle:
     lever: dict | None = None
     """A lever attachment's parameters (:class:`pamsim.components.pulley.LeverAttachment`, ``side`` and
     ``g_m_s2`` aside) in place of the pulley (``radius_m`` and ``x_at_zero_m`` then unused)."""
+    tendon_stiffness_N_per_m: float | None = None
+    """The stiffness of a spring in series with the muscle (:class:`pamsim.components.series_tendon.SeriesTendon`);
+    None: a rigid tendon."""
 
 
 def attachment_name(m: JointMuscle, body: str = "joint") -> str:
@@ -109,22 +113,45 @@ def _body_assembly(body, muscles, attach, external: str, name: str, friction_loa
     return Assembly(parts, wiring, inputs, name=name)
 
 
+def series_spring_name(m: JointMuscle) -> str:
+    """The name of the spring in series with muscle ``m`` (:class:`SeriesTendon`), when its tendon is elastic."""
+    return f"{m.name}_series_spring"
+
+
 def _muscle_parts(m: JointMuscle, attach, body, friction_load: str | None) -> tuple[list, list, dict]:
-    """A muscle's components, wiring and model inputs, its components prefixed with its name."""
-    pulley = attach.name
+    """A muscle's components, wiring and model inputs, its components prefixed with its name.
+
+    With a rigid tendon the attachment is the node of the muscle's flange, and the muscle's friction
+    reads the body's slip and adds its level to the body's; with an elastic one a :class:`SeriesTendon`
+    is, the attachment's flange carries the spring's pull, and the friction reads the muscle's own motion.
+    """
+    pulley, elastic = attach.name, m.tendon_stiffness_N_per_m is not None
     source = rewired(source_parts(m.source, m.p0_gauge_Pa), pulley, m.name)
+    damping = (MuscleEndDamping if elastic else ViscousDamping)(f"{m.name}_damping", m.damping)
     parts = [*source.parts, MuscleStaticForce(f"{m.name}_muscle", m.static_force),
-             CoulombFriction(f"{m.name}_friction", m.friction), ViscousDamping(f"{m.name}_damping", m.damping), attach]
+             CoulombFriction(f"{m.name}_friction", m.friction), damping, attach]
     p = f"{source.pressure}.p_gauge_Pa"
     port = attach.body.name
+    node, moves = pulley, f"{pulley}.direction"
+    wiring = [*source.wiring, (f"{pulley}.{port}", f"{body.name}.{port}")]
+    if elastic:
+        node = spring = series_spring_name(m)
+        parts.append(SeriesTendon(spring, {"k_N_per_m": m.tendon_stiffness_N_per_m}))
+        moves = f"{spring}.direction"
+        wiring += [(f"{spring}.path", f"{pulley}.flange"), (f"{spring}.level_on_body_N", f"{pulley}.friction_level_N"),
+                   (f"{m.name}_friction.level_N", f"{spring}.friction_level_N"),
+                   (f"{m.name}_muscle.F_static_N", f"{spring}.F_static_N"),
+                   (f"{spring}.F_free_N", f"{m.name}_damping.F_free_N"),
+                   (f"{m.name}_damping.v_free_m_s", f"{spring}.v_free_m_s")]
+    else:
+        wiring.append((f"{m.name}_friction.level_N", f"{pulley}.friction_level_N"))
     # The flange adds the forces in the one-muscle rig's order: static, damping, friction.
-    wiring = [*source.wiring, (f"{pulley}.{port}", f"{body.name}.{port}"), (f"{pulley}.flange", f"{m.name}_muscle.flange"),
-              (f"{pulley}.flange", f"{m.name}_damping.flange"), (f"{pulley}.flange", f"{m.name}_friction.flange"),
-              (p, f"{m.name}_muscle.p_gauge_Pa"), (p, f"{m.name}_friction.p_gauge_Pa"),
-              (friction_load or f"{pulley}.load_mass_kg", f"{m.name}_friction.mass_kg"),
-              (f"{pulley}.direction", f"{m.name}_friction.direction"),
-              (f"{m.name}_friction.level_N", f"{pulley}.friction_level_N"),
-              (f"{m.name}_muscle.F_static_N", f"{pulley}.F_static_N"),
-              (f"{body.name}.slip_direction", f"{pulley}.joint_direction")]
+    wiring += [(f"{node}.flange", f"{m.name}_muscle.flange"),
+               (f"{node}.flange", f"{m.name}_damping.flange"), (f"{node}.flange", f"{m.name}_friction.flange"),
+               (p, f"{m.name}_muscle.p_gauge_Pa"), (p, f"{m.name}_friction.p_gauge_Pa"),
+               (friction_load or f"{pulley}.load_mass_kg", f"{m.name}_friction.mass_kg"),
+               (moves, f"{m.name}_friction.direction"),
+               (f"{m.name}_muscle.F_static_N", f"{pulley}.F_static_N"),
+               (f"{body.name}.slip_direction", f"{pulley}.joint_direction")]
     inputs = {f"{m.name}.{k}": v for k, v in source.inputs.items()}
     return parts, wiring, inputs

@@ -247,6 +247,12 @@ def _slide_body(j: dict) -> str:
 def joint_muscles(scenario) -> list[CoupledMuscle]:
     """The muscles of a joint (slider) scenario on the actuators of :func:`joint_mjcf`: each muscle's length
     is its tendon's MuJoCo length plus an offset, its rest length less its contraction at angle (position)
-    zero on a fixed tendon, less the tendon's own length on a lever's spatial one."""
+    zero on a fixed tendon, less the tendon's own length on a lever's spatial one.  A muscle on an elastic
+    tendon is refused: MuJoCo's tendon is the rigid path, and a spring in series would need the muscle's end
+    as a state of pamsim's, between two MuJoCo steps."""
+    for t, _ in scenario.muscles:
+        if t.get("tendon_stiffness_N_per_m") is not None:
+            raise InputError(f"{scenario.origin}: muscle {t['name']!r}.tendon_stiffness_N_per_m = "
+                             f"{t['tendon_stiffness_N_per_m']:g}: the MuJoCo coupling drives rigid tendons only")
     return [CoupledMuscle(t["name"], sc, t["name"], sc.parameters["L0_m"] - t["x_at_zero_m"] if t["lever"] is None
                           else -t["lever"]["tendon_length_m"]) for t, sc in scenario.muscles]

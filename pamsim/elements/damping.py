@@ -8,6 +8,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Mapping
 
+from ..modeling.smath import sqrt
 from .contracts import NO_OPTIONS, Builder, Damping, ElementOptions
 
 
@@ -32,6 +33,13 @@ class PaperDamping:
         """Damping force [N]: ``(D1 + D2 |v|) v``."""
         return (self.D1_N_s_per_m + self.D2_N_s2_per_m2 * abs(v_m_s)) * v_m_s
 
+    def velocity_m_s(self, F_N):
+        """The velocity [m/s] at which the force is ``F_N``: the root of ``D2 v|v| + D1 v = F`` of the
+        sign of ``F``, ``2 F / (D1 + sqrt(D1^2 + 4 D2 |F|))`` (the form without cancellation).  Unique
+        only for ``D1 > 0``, ``D2 >= 0`` (:func:`increasing`)."""
+        D1, D2 = self.D1_N_s_per_m, self.D2_N_s2_per_m2
+        return 2.0 * F_N / (D1 + sqrt(D1 * D1 + 4.0 * D2 * abs(F_N)))
+
 
 @dataclass(frozen=True)
 class LinearDamping:
@@ -49,6 +57,10 @@ class LinearDamping:
         """Damping force [N]: ``c v``."""
         return self.c_N_s_per_m * v_m_s
 
+    def velocity_m_s(self, F_N):
+        """The velocity [m/s] at which the force is ``F_N``: ``F / c``."""
+        return F_N / self.c_N_s_per_m
+
 
 @dataclass(frozen=True)
 class NoDamping:
@@ -64,6 +76,18 @@ class NoDamping:
     def force_N(self, v_m_s):
         """Zero, of the shape of ``v_m_s``."""
         return 0.0 * v_m_s
+
+
+def increasing(damping) -> bool:
+    """Whether ``damping``'s force grows strictly with velocity through zero, so that a force gives one
+    velocity (:meth:`PaperDamping.velocity_m_s`): what a massless muscle end needs (its velocity is the one
+    at which damping takes the force that friction and the tendon leave).  The paper's ``D1 < 0`` is not:
+    its force falls with speed below ``|D1| / D2``."""
+    if isinstance(damping, PaperDamping):
+        return damping.D1_N_s_per_m > 0.0 and damping.D2_N_s2_per_m2 >= 0.0
+    if isinstance(damping, LinearDamping):
+        return damping.c_N_s_per_m > 0.0
+    return False
 
 
 DAMPING_MODELS: dict[str, Builder[Damping]] = {

@@ -77,10 +77,17 @@ def linearize_joint(scenario: JointScenario, p_gauge_Pa) -> JointLinearModel:
     Raises
     ------
     InputError
-        A muscle fed by a valve, pressures that push the link onto a limit (no equilibrium inside), or a
-        static force without a symbolic form.
+        A muscle fed by a valve or on an elastic tendon, pressures that push the link onto a limit (no
+        equilibrium inside), or a static force without a symbolic form.
     """
     muscles = _prescribed(scenario)
+    for m in muscles:
+        if m.tendon_stiffness_N_per_m is not None:
+            # Its state and the stiffness output would need the muscle's end at its own rest (JointStatics
+            # finds it) and the stiffness through it as a function of the state: not written yet.
+            raise InputError(f"{scenario.origin}: muscle {m.name!r}.tendon_stiffness_N_per_m = "
+                             f"{m.tendon_stiffness_N_per_m:g}: a joint on elastic tendons is not linearised yet "
+                             "(its statics and stiffness are: pamsim joint-map)")
     eq = JointStatics(scenario).equilibrium(p_gauge_Pa)
     if eq.on_limit:
         raise InputError(f"{scenario.origin}: at {[p / 1e5 for p in p_gauge_Pa]} bar the link rests on its "

@@ -98,10 +98,13 @@ class JointResult:
     def muscle(self, name: str, quantity: str) -> np.ndarray:
         """A muscle's signal: ``p_gauge_Pa`` (its pressure), ``x_m`` (contraction), ``F_tendon_N``,
         ``tau_Nm`` (its torque on the joint; on a slider ``F_N``, its force on the carriage), ``taut``,
-        ``moment_arm_m``, ``F_static_N``; ``KeyError`` for an unknown one."""
+        ``moment_arm_m``, ``F_static_N``, and on an elastic tendon ``stretch_m``; ``KeyError`` for an
+        unknown one."""
         attach = next(a for a in ATTACHMENTS if f"{name}_{a}.x_m" in self.signals)
-        where = {"p_gauge_Pa": "pressure", "x_m": attach, "F_tendon_N": attach, "tau_Nm": attach, "F_N": attach,
-                 "taut": attach, "moment_arm_m": attach, "F_static_N": "muscle"}
+        # On an elastic tendon the muscle's own end is the spring's node; its attachment's x_m is the path's.
+        end = "series_spring" if f"{name}_series_spring.x_m" in self.signals else attach
+        where = {"p_gauge_Pa": "pressure", "x_m": end, "F_tendon_N": attach, "tau_Nm": attach, "F_N": attach,
+                 "taut": attach, "moment_arm_m": attach, "F_static_N": "muscle", "stretch_m": "series_spring"}
         if quantity == "p_gauge_Pa":
             found = [k for k in self.signals if k.startswith(f"{name}_") and k.endswith(".p_gauge_Pa")
                      and k.split(".")[0] in (f"{name}_chamber", f"{name}_pressure")]
@@ -117,7 +120,8 @@ class JointResult:
 
         ``residual_J`` = work in - (kinetic + potential gain + bearing friction + impacts); ``relative``
         divides it by the largest term.  Per muscle, ``<name>.slack_J`` is the work of its forces that
-        no tendon passed on (nonzero only where it went slack): static work - damping - friction - tendon.
+        no tendon passed on (nonzero only where it went slack): static work - damping - friction - tendon,
+        less what an elastic tendon stored.
         """
         s = self.signals
         d = lambda key: float(s[key][-1] - s[key][0])  # noqa: E731
@@ -130,7 +134,8 @@ class JointResult:
         residual = (sum(terms[f"{m}.W_tendon_J"] for m in self.muscles) + terms["W_external_J"] - terms["dKE_J"]
                     - terms["dPE_J"] - terms["E_viscous_J"] - terms["E_coulomb_J"] - terms["E_impacts_J"])
         slack = {f"{m}.slack_J": float(s[f"{m}_muscle.W_muscle_J"][-1] - s[f"{m}_damping.E_damping_J"][-1]
-                                       - s[f"{m}_friction.E_friction_J"][-1] - s[tendon[m]][-1])
+                                       - s[f"{m}_friction.E_friction_J"][-1] - s[tendon[m]][-1]
+                                       - (d(k) if (k := f"{m}_series_spring.E_elastic_J") in s else 0.0))
                  for m in self.muscles}
         scale = max(abs(v) for v in terms.values()) or 1.0
         return {**terms, **slack, "residual_J": float(residual), "relative": float(abs(residual) / scale)}

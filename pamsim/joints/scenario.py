@@ -34,6 +34,7 @@ from typing import Any, Mapping
 
 from ..assemblies.joint import SLIDER_FRICTION_LOADS, JointMuscle, joint_assembly, slider_assembly
 from ..components.pulley import LeverAttachment, Pulley, SliderTendon
+from ..elements.damping import increasing
 from ..scenario import Scenario, ScenarioError
 from ..signal_tables import signal_from_table
 from ..signals import Constant
@@ -51,7 +52,7 @@ JOINT_KEYS: dict[str, tuple[float | None, str]] = {
 (9.81 m/s^2, as the one-muscle scenarios); min_rebound_speed_rad_s is assumed (a slower rebound than 1 mrad/s
 moves the link by less than any angle a figure resolves)."""
 MUSCLE_KEYS = {"name", "side", "radius_m", "x_at_zero_m", "model", "parameters", "pressure", "attachment",
-               "link_attach_m", "base_attach_m", "angle_at_zero_rad", "tendon_length_m"}
+               "link_attach_m", "base_attach_m", "angle_at_zero_rad", "tendon_length_m", "tendon_stiffness_N_per_m"}
 LEVER_KEYS = {"link_attach_m": "positive", "base_attach_m": "positive", "angle_at_zero_rad": "positive",
               "tendon_length_m": "non_negative"}
 """A lever attachment's keys in a ``[[muscle]]`` table (``attachment = "lever"``) and their ranges."""
@@ -65,7 +66,7 @@ otherwise (the paper's rig); min_rebound_speed_m_s is assumed (a rebound slower 
 carriage by less than a figure resolves).  Besides these, ``weight_N`` in place of ``mass_kg`` (the mass is
 then ``weight_N / g_m_s2``, as a one-muscle scenario's ``[load]``), ``friction_load`` (:data:`SLIDER_FRICTION_LOADS`,
 default ``"static_force"``) and an ``external_force`` signal table."""
-SLIDER_MUSCLE_KEYS = {"name", "side", "x_at_zero_m", "model", "parameters", "pressure"}
+SLIDER_MUSCLE_KEYS = {"name", "side", "x_at_zero_m", "model", "parameters", "pressure", "tendon_stiffness_N_per_m"}
 TOP_KEYS = {"name", "description", "joint", "slider", "muscle", "simulation", "solver", "controller"}
 CONTROLLER_KEYS: dict[str, tuple[object, str]] = {
     "kind": (None, "text"), "sample_rate_Hz": (1000.0, "positive"), "stiffness_Nm_per_rad": (None, "positive"),
@@ -185,7 +186,7 @@ class JointScenario:
             lever = ({**table["lever"], "muscle_L0_m": sc.parameters["L0_m"]} if table["lever"] is not None else None)
             out.append(JointMuscle(table["name"], m.static_force, m.friction, m.damping, m.source,
                                    table["radius_m"], table["side"], table["x_at_zero_m"], sc.initial_pressure_gauge_Pa,
-                                   lever))
+                                   lever, table["tendon_stiffness_N_per_m"]))
         return tuple(out)
 
     def joint_values(self) -> dict[str, float]:
@@ -334,7 +335,25 @@ def _muscle(origin: str, where: str, table: dict, shared: dict, base_dir: Path, 
         values["lever"] = {k: _number(origin, f"{where}.{k}", table.get(k), kind) for k, kind in LEVER_KEYS.items()}
     one = {"model": table.get("model", {}), "parameters": table.get("parameters", {}), "pressure": table["pressure"],
            "load": PLACEHOLDER_LOAD, **shared}
-    return values, Scenario.from_dict(one, name=table["name"], base_dir=base_dir, origin=f"{origin}: {where}")
+    scenario = Scenario.from_dict(one, name=table["name"], base_dir=base_dir, origin=f"{origin}: {where}")
+    values["tendon_stiffness_N_per_m"] = _tendon_stiffness(origin, where, table, scenario)
+    return values, scenario
+
+
+def _tendon_stiffness(origin: str, where: str, table: dict, scenario: Scenario) -> float | None:
+    """A muscle's ``tendon_stiffness_N_per_m`` (None: a rigid tendon), checked: positive, and the muscle's
+    damping one that a massless muscle end can move under (:func:`pamsim.elements.damping.increasing`)."""
+    key = "tendon_stiffness_N_per_m"
+    if key not in table:
+        return None
+    k = _number(origin, f"{where}.{key}", table[key], "positive")
+    damping = scenario.build_model().damping
+    if not increasing(damping):
+        _fail(origin, f"{where}.model.damping", getattr(damping, "name", type(damping).__name__),
+              f"a muscle on an elastic tendon ({key} = {k:g}) needs damping that grows with speed through zero "
+              "(its end is massless and moves at the speed its damping allows): use damping = 'linear', or "
+              "'paper' with D1_N_s_per_m > 0")
+    return k
 
 
 def _controller(origin: str, table, joint: dict, muscles) -> dict:

@@ -5,6 +5,11 @@ torque is the joint's output ``tau_net_Nm`` in its held mode (no velocity, so no
 friction), and the stiffness ``k = -d tau_net / d theta`` is its exact derivative (CasADi's Jacobian
 of the same output).  At an equilibrium ``k`` is the joint's stiffness against a small rotation: the
 slope of the muscles' torques and of gravity; co-contraction raises it without moving the angle.
+
+A muscle on an elastic tendon (:class:`pamsim.components.series_tendon.SeriesTendon`) rests where its
+static force equals its tendon's pull, without friction (the middle of the band its friction holds it
+in): at each angle its contraction is that root, and the stiffness is the total derivative through it
+(the muscle and its tendon in series).
 """
 
 from __future__ import annotations
@@ -13,7 +18,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..assemblies.joint import joint_assembly
+from ..assemblies.joint import attachment_name, joint_assembly
 from ..components.stick_slip import BodyMode
 from ..elements.pressure_source import PrescribedPressure
 from ..errors import InputError
@@ -57,13 +62,48 @@ class JointStatics:
         self._net = self.code.names["outputs"].index("joint.tau_net_Nm")
         self._n_states = len(states)
         self._limits = (scenario.joint["theta_min_rad"], scenario.joint["theta_max_rad"])
+        outputs = self.code.names["outputs"]
+        self._springs = [(states.index(f"{m.name}_series_spring.x_m"), outputs.index(f"{m.name}_muscle.F_static_N"),
+                          outputs.index(f"{m.name}_series_spring.F_tendon_N"), outputs.index(f"{attachment_name(m)}.x_m"),
+                          m.name)
+                         for m in muscles if m.tendon_stiffness_N_per_m is not None]
 
     def _point(self, theta_rad: float, p_gauge_Pa) -> tuple[list, list]:
         if len(p_gauge_Pa) != len(self.names):
             raise ValueError(f"{len(p_gauge_Pa)} pressures for the muscles {self.names}")
         x = [0.0] * self._n_states
         x[self._theta] = float(theta_rad)
-        return x, [float(p) for p in p_gauge_Pa] + [0.0]  # then the external torque
+        u = [float(p) for p in p_gauge_Pa] + [0.0]  # then the external torque
+        for spring in self._springs:
+            x[spring[0]] = self._muscle_at_rest(x, u, spring)
+        return x, u
+
+    def _muscle_at_rest(self, x: list, u: list, spring: tuple) -> float:
+        """The contraction at which a muscle on an elastic tendon pulls what its tendon does, the link at
+        ``x``: the root of ``F_static - T``, which falls as the muscle contracts (its force drops, its
+        tendon stretches).  Bracketed from the tendon's unstretched length outward."""
+        from scipy.optimize import brentq
+
+        index, static, tendon, path_x, name = spring
+
+        def gap(x_m: float) -> float:
+            y = list(x)
+            y[index] = x_m
+            out = self.code.y(y, u, self.p, (float(BodyMode.STICK),))[0]
+            return float(out[static] - out[tendon])
+
+        path = self.code.y(x, u, self.p, (float(BodyMode.STICK),))[0][path_x]
+        step = 1e-3
+        low, high = path, path
+        while gap(high) > 0.0:
+            low, high, step = high, high + step, 2.0 * step
+            if step > 1.0:
+                raise InputError(f"muscle {name!r}: no contraction within 1 m at which it pulls what its tendon does")
+        while gap(low) < 0.0:
+            low, high, step = low - step, low, 2.0 * step
+            if step > 1.0:
+                raise InputError(f"muscle {name!r}: no contraction within 1 m at which it pulls what its tendon does")
+        return low if gap(low) == 0.0 else brentq(gap, low, high, xtol=1e-15, rtol=4 * np.finfo(float).eps)
 
     def net_torque_Nm(self, theta_rad: float, p_gauge_Pa) -> float:
         """Net torque on the link at rest at ``theta_rad`` with the muscles at ``p_gauge_Pa`` (in the
@@ -75,7 +115,12 @@ class JointStatics:
         """``-d tau_net / d theta`` at rest [N m/rad], exactly."""
         x, u = self._point(theta_rad, p_gauge_Pa)
         C = self.code.jacobian(x, u, self.p, (float(BodyMode.STICK),))[2]
-        return float(-C[self._net, self._theta])
+        k = -C[self._net, self._theta]
+        for index, static, tendon, _, _ in self._springs:
+            # The muscle follows the link so that F_static - T stays zero: dx/dtheta = -g_theta / g_x.
+            g_theta, g_x = C[static, self._theta] - C[tendon, self._theta], C[static, index] - C[tendon, index]
+            k -= C[self._net, index] * (-g_theta / g_x)
+        return float(k)
 
     def equilibrium(self, p_gauge_Pa) -> Equilibrium:
         """The angle where the net torque vanishes between the limits (the stable one: torque falling

@@ -1,0 +1,200 @@
+"""Muscles on elastic tendons (:class:`pamsim.components.series_tendon.SeriesTendon`): the rigid tendon as
+the limit of a stiff one, the muscle's end at rest against hand calculations, the statics and its series
+stiffness, the energy balance with the tendon's stored energy, slack, the backends, and bad input."""
+
+from __future__ import annotations
+
+import copy
+import math
+import subprocess
+import sys
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+from pamsim.elements.damping import LinearDamping, PaperDamping, increasing
+from pamsim.joints.run import simulate_joint
+from pamsim.joints.scenario import JointScenario, load_joint_scenario
+from pamsim.joints.static import JointStatics
+from pamsim.scenario import ScenarioError
+
+ROOT = Path(__file__).resolve().parents[1]
+ELASTIC = ROOT / "scenarios" / "antagonistic_elastic.toml"
+SPEC = tomllib.loads(ELASTIC.read_text())
+
+
+def _scenario(k_N_per_m=2000.0, duration_s=None, pressures_bar=None) -> JointScenario:
+    """The shipped elastic pair with tendon stiffness ``k_N_per_m`` (None: rigid tendons)."""
+    spec = copy.deepcopy(SPEC)
+    for m, p in zip(spec["muscle"], pressures_bar or (None, None)):
+        if k_N_per_m is None:
+            m.pop("tendon_stiffness_N_per_m")
+        else:
+            m["tendon_stiffness_N_per_m"] = k_N_per_m
+        if p is not None:
+            m["pressure"]["supply_gauge_bar"] = p
+    if duration_s is not None:
+        spec["simulation"]["duration_s"] = duration_s
+    return JointScenario.from_dict(spec, origin="elastic.toml", base_dir=ELASTIC.parent)
+
+
+@pytest.fixture(scope="module")
+def elastic():
+    return simulate_joint(load_joint_scenario(ELASTIC), "python")
+
+
+def test_the_inverse_damping_laws_give_back_the_force():
+    """``velocity_m_s`` inverts ``force_N`` for the increasing laws; the paper's D1 < 0 is not increasing."""
+    for law in (PaperDamping(1.01, 0.8), PaperDamping(0.3, 0.0), LinearDamping(1.01)):
+        assert increasing(law)
+        for F in (-25.0, -1e-3, 0.0, 2e-6, 0.7, 40.0):
+            v = law.velocity_m_s(F)
+            assert law.force_N(v) == pytest.approx(F, rel=1e-13, abs=1e-18)
+    assert not increasing(PaperDamping(-1.01, 0.8))
+
+
+def test_a_stiff_tendon_tends_to_the_rigid_one():
+    """The link's angle on tendons of 1e4 and 1e5 N/m against the rigid pair's: the largest gap falls by
+    about the ratio of the stiffnesses (the tendon's stretch, T / k, is what separates them)."""
+    rigid = simulate_joint(_scenario(None), "python")
+    gaps = []
+    for k in (1e4, 1e5):
+        res = simulate_joint(_scenario(k), "python")
+        gaps.append(np.max(np.abs(np.interp(rigid.t_s, res.t_s, res.theta_rad) - rigid.theta_rad)))
+    assert gaps[1] < 0.02 and 0.05 < gaps[1] / gaps[0] < 0.25, gaps
+
+
+def test_each_muscle_end_rests_where_its_forces_balance_by_hand(elastic):
+    """At the end of the run, with the link held: each tendon's pull is k times its stretch from the pulley's
+    geometry (x_at_zero + side r theta, by hand), the muscle's static force (its element, called directly)
+    differs from that pull by no more than its friction holds, and the tendons' torques and gravity balance
+    within the bearing's Coulomb torque."""
+    sc = load_joint_scenario(ELASTIC)
+    theta = elastic.theta_rad[-1]
+    torque = -SPEC["joint"]["link_mass_kg"] * 9.81 * SPEC["joint"]["com_distance_m"] * math.sin(theta)
+    for table, (_, one) in zip(SPEC["muscle"], sc.muscles):
+        name, k = table["name"], table["tendon_stiffness_N_per_m"]
+        x = elastic.muscle(name, "x_m")[-1]
+        path = table["x_at_zero_m"] + table["side"] * table["radius_m"] * theta
+        T = k * max(x - path, 0.0)
+        assert elastic.muscle(name, "F_tendon_N")[-1] == pytest.approx(T, rel=1e-12)
+        F_static = one.build_model().static_force.force_N(x, elastic.muscle(name, "p_gauge_Pa")[-1])
+        level = elastic.signals[f"{name}_friction.level_N"][-1]
+        # The paper's level is zero where the load (F_static / g) outweighs the pressure (the extensor's at
+        # 2 bar): that end creeps toward F_static = T and has reached it by the end.
+        assert abs(F_static - T) <= level + 1e-9 * T and T > 10.0, (name, F_static, T, level)
+        torque += table["side"] * table["radius_m"] * T
+    assert elastic.final_mode.label == "stick"
+    assert abs(torque) <= SPEC["joint"]["tau_coulomb_Nm"] * (1 + 1e-9)
+
+
+def test_a_held_muscle_end_does_not_move_at_all(elastic):
+    """Inside its friction band the muscle's end is held exactly (velocity zero, contraction constant bit
+    for bit): no creep, as a regularised friction would give.  (The flexor's: the extensor's friction level
+    is zero at its load, the paper's law clipped, so it has no band to be held in.)"""
+    for name in ("flexor",):
+        held = elastic.signals[f"{name}_series_spring.direction"] == 0.0
+        x = elastic.muscle(name, "x_m")
+        late = held & (elastic.t_s > 2.0)
+        assert late.sum() > 100 and np.all(elastic.signals[f"{name}_series_spring.v_m_s"][held] == 0.0)
+        runs = np.nonzero(late[:-1] & late[1:])[0]
+        assert np.all(x[runs + 1] == x[runs])
+
+
+def test_the_energy_balance_counts_what_the_tendons_store(elastic):
+    """Work of the muscles' static forces = damping + friction + work on the link + the springs' energy
+    (``slack_J`` is the remainder, zero while no tendon goes slack), and the link's own balance holds."""
+    balance = elastic.energy_balance()
+    assert balance["relative"] < 2e-5
+    for name in ("flexor", "extensor"):
+        stored = elastic.signals[f"{name}_series_spring.E_elastic_J"][-1]
+        T = elastic.muscle(name, "F_tendon_N")[-1]
+        assert stored == pytest.approx(T * T / (2 * 2000.0), rel=1e-12) and stored > 0.05
+        assert abs(balance[f"{name}.slack_J"]) < 1e-6 * stored
+
+
+def test_statics_find_the_series_equilibrium_and_its_stiffness_by_hand():
+    """JointStatics on elastic tendons against a hand solution at three pressure pairs: each muscle's
+    contraction from F_static(x) = k (x - x_path) (brentq on the element), the torque balance, and the
+    stiffness of muscle and tendon in series, sum r^2 k_m k / (k_m + k) + m g d cos(theta), k_m = -dF/dx
+    by central differences; and the exact stiffness against finite differences of the net torque."""
+    sc = load_joint_scenario(ELASTIC)
+    statics = JointStatics(sc)
+    J = SPEC["joint"]
+    mgd = J["link_mass_kg"] * 9.81 * J["com_distance_m"]
+    for pressures in ((2.2e5, 2.0e5), (3.0e5, 3.0e5), (2.4e5, 2.7e5)):
+        eq = statics.equilibrium(pressures)
+        theta, tau, k_hand = eq.theta_rad, -mgd * math.sin(eq.theta_rad), mgd * math.cos(eq.theta_rad)
+        for table, (_, one), p in zip(SPEC["muscle"], sc.muscles, pressures):
+            force, k = one.build_model().static_force.force_N, table["tendon_stiffness_N_per_m"]
+            path = table["x_at_zero_m"] + table["side"] * table["radius_m"] * theta
+            x = brentq(lambda x: force(x, p) - k * max(x - path, 0.0), path, path + 0.05, xtol=1e-15)
+            h = 1e-7
+            k_m = -(force(x + h, p) - force(x - h, p)) / (2 * h)
+            tau += table["side"] * table["radius_m"] * force(x, p)
+            k_hand += table["radius_m"] ** 2 * k_m * k / (k_m + k)
+        assert eq.on_limit is None and abs(tau) < 1e-9
+        assert eq.k_Nm_per_rad == pytest.approx(k_hand, rel=1e-6)
+        h = 1e-6
+        fd = -(statics.net_torque_Nm(theta + h, pressures) - statics.net_torque_Nm(theta - h, pressures)) / (2 * h)
+        assert eq.k_Nm_per_rad == pytest.approx(fd, rel=1e-6)
+
+
+def test_a_slack_tendon_pulls_nothing_and_nothing_is_nan():
+    """The extensor at no pressure, the flexor at 4 bar: the link swings to the flexor's side, the extensor's
+    path lengthens past its muscle and its tendon goes slack, pulling exactly nothing."""
+    res = simulate_joint(_scenario(2000.0, duration_s=1.5, pressures_bar=(4.0, 0.0)), "python")
+    stretch = res.muscle("extensor", "stretch_m")
+    T = res.muscle("extensor", "F_tendon_N")
+    assert all(np.all(np.isfinite(v)) for v in res.signals.values())
+    assert np.any(stretch < 0.0) and np.all(T[stretch <= 0.0] == 0.0) and np.all(T >= 0.0)
+
+
+@pytest.mark.parametrize("backend", ["native", "fmu-cs"])
+def test_the_backends_agree_on_elastic_tendons(elastic, backend):
+    """The generated C (native engine, and the co-simulation FMU) follows the python run of the shipped file."""
+    other = simulate_joint(load_joint_scenario(ELASTIC), backend)
+    assert abs(other.theta_rad[-1] - elastic.theta_rad[-1]) < 1e-5
+    for name in ("flexor", "extensor"):
+        assert abs(other.muscle(name, "x_m")[-1] - elastic.muscle(name, "x_m")[-1]) < 1e-6
+
+
+@pytest.mark.parametrize("change, key", [
+    (lambda m: m.update(tendon_stiffness_N_per_m=0.0), "tendon_stiffness_N_per_m"),
+    (lambda m: m.update(tendon_stiffness_N_per_m="stiff"), "tendon_stiffness_N_per_m"),
+    (lambda m: m["model"].update(damping="paper"), "model.damping"),
+    (lambda m: m["model"].update(damping="none"), "model.damping"),
+])
+def test_bad_tendons_are_refused_by_key(tmp_path, change, key):
+    """A stiffness that is not a positive number, and a damping law a massless muscle end cannot move under,
+    are refused naming the muscle and the key; the command line exits 2 without a traceback."""
+    spec = copy.deepcopy(SPEC)
+    change(spec["muscle"][1])
+    with pytest.raises(ScenarioError, match=f"muscle 'extensor'.{key}"):
+        JointScenario.from_dict(spec, origin="elastic.toml", base_dir=ELASTIC.parent)
+    if key == "model.damping" and spec["muscle"][1]["model"]["damping"] == "paper":
+        path = tmp_path / "bad.toml"
+        path.write_text(ELASTIC.read_text().replace('damping = "linear"', 'damping = "paper"'))
+        done = subprocess.run([sys.executable, "-m", "pamsim", "run", str(path), "-o", str(tmp_path / "out")],
+                              capture_output=True, text=True)
+        assert done.returncode == 2 and "model.damping" in done.stderr and "Traceback" not in done.stderr
+        assert not (tmp_path / "out").exists()
+
+
+def test_linearize_and_the_mujoco_coupling_refuse_elastic_tendons():
+    """Neither writes a muscle's end as a state of its own yet: both name the muscle and the key rather
+    than drop the spring."""
+    from pamsim.coupling.mujoco import joint_muscles
+    from pamsim.errors import InputError
+    from pamsim.joints.linear import linearize_joint
+
+    spec = copy.deepcopy(SPEC)
+    for m in spec["muscle"]:
+        m["pressure"] = {"source": "prescribed", "prescribed": {"kind": "constant", "value_gauge_bar": 2.0}}
+    scenario = JointScenario.from_dict(spec, origin="elastic.toml")
+    for call in (lambda: linearize_joint(scenario, [2e5, 2e5]), lambda: joint_muscles(scenario)):
+        with pytest.raises(InputError, match="muscle 'flexor'.tendon_stiffness_N_per_m = 2000"):
+            call()
