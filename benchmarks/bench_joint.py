@@ -1,8 +1,9 @@
 """Muscles on a joint against one muscle on its hanging load, on both backends, in the same run.
 
 The antagonistic pair (``scenarios/antagonistic_pair.toml``, run for 5 s) and the ACRA 2012 Figure 4
-scenario (one muscle, 8 s), then the Festo pair and Figure 4 as a slider against Figure 4: the median wall time of N runs after warm-up, with the engine's own time for
-the native runs, and the ratio pair / one muscle per backend.  Targets for the pair: native <= 2 ms,
+scenario (one muscle, 8 s), then the Festo pair, Figure 4 as a slider and the pair on elastic tendons
+against Figure 4: the median wall time of N runs after warm-up, with the engine's own time for the
+native runs, and the ratio pair / one muscle per backend.  Targets for the pair: native <= 2 ms,
 python <= 80 ms.  A joint run's outputs (torques, flows) are computed when first read, as a one-muscle
 run's force columns are; the timed runs read the angle only.
 
@@ -58,7 +59,8 @@ def main() -> None:
           f"final angle {res.theta_rad[-1]:.4f} rad")
     # The other shipped bodies, against Figure 4 on the same backend in the same run.
     others = {"Festo pair (Ogden), 3 s": load_joint_scenario(ROOT / "scenarios" / "antagonistic_festo.toml"),
-              "Figure 4 as a slider, 8 s": load_joint_scenario(ROOT / "scenarios" / "acra2012_fig4_slider.toml")}
+              "Figure 4 as a slider, 8 s": load_joint_scenario(ROOT / "scenarios" / "acra2012_fig4_slider.toml"),
+              "pair on 2 kN/m tendons, 3 s": load_joint_scenario(ROOT / "scenarios" / "antagonistic_elastic.toml")}
     print(f"{'scenario':28} {'backend':8} {'[ms]':>9} {'/ fig4':>7}")
     for backend in ("native", "python"):
         f_ms, _ = median_ms(lambda: pamsim.simulate(fig4, backend=backend), args.repeats)
