@@ -34,6 +34,7 @@ class MuscleEndDamping(ViscousDamping):
     outputs = ViscousDamping.outputs + (Var("v_free_m_s", "m/s", "velocity at which the damping force is F_free_N"),)
 
     def equations(self, s: Symbols) -> Equations:
+        """The damping's equations, and the inverse of its law at ``F_free_N``."""
         eq = super().equations(s)
         eq.outputs["v_free_m_s"] = self.element_call(s, "velocity_m_s", s.u["F_free_N"])
         return eq
@@ -67,6 +68,7 @@ class SeriesTendon(Component):
                Var("level_on_body_N", "N", "Coulomb level the muscle brings to the body's stick/slip (none)"))
 
     def equations(self, s: Symbols) -> Equations:
+        """The muscle end's velocity from its dead zone, the tendon's pull on both sides."""
         k, path = s.p["k_N_per_m"], s.port["path"]
         x, level = s.x["x_m"], s.u["friction_level_N"]
         stretch = x - path["x_m"]
