@@ -16,11 +16,12 @@ from pathlib import Path
 from typing import Any, Mapping
 
 
+from .assemblies.one_muscle import source_parts
 from .constants import PA_PER_BAR
 from .errors import InputError
 from .elements.chamber import CHAMBER_LAWS, IsothermalChamber, MuscleChamber, ThermalChamber
 from .elements.damping import DAMPING_MODELS
-from .elements.friction import FRICTION_MODELS, NEGATIVE_LEVEL_CHOICES
+from .elements.friction import FRICTION_MODELS, NEGATIVE_LEVEL_CHOICES, NoCoulomb
 from .elements.load import HangingLoad
 from .elements.pressure_source import PrescribedPressure, ValveChamberSource
 from .elements.force_clip import NEGATIVE_FORCE_CHOICES
@@ -32,7 +33,7 @@ from .muscle_setup import applicable_model, model_inputs, with_overrides
 from .muscles import Muscle, load_muscle, shipped_names
 from .paperdata import STEADY_STATE_SETS, SteadyState, steady_state
 from .parameters import CHAMBER_DEFAULTS, CHAMBER_LAW_KEYS, LOAD_MASS, ParameterSet, dynamics_parameters
-from .scenario_components import added_components, check_wiring
+from .scenario_components import added_components, check_wiring, hysteresis_component
 from .static_models import REGISTRY
 from .signal_tables import signal_from_table, signal_range
 from .signals import Constant, Step
@@ -44,7 +45,7 @@ from .table_checks import TableChecker, choices_hint, did_you_mean
 _SCHEMA: dict[str, dict[str, Any]] = {
     "": {"name": str, "description": str, "model": dict, "parameters": dict, "load": dict, "pressure": dict,
          "simulation": dict, "solver": dict, "controller": dict, "component": list, "measured": dict,
-         "chamber": dict},
+         "chamber": dict, "hysteresis": dict},
     "model": {"muscle": str, "parameter_set": str, "static_force": str, "static_force_variant": str,
               "static_force_negative": str, "friction": str, "damping": str, "friction_negative_level": str,
               "upper_stop": str},
@@ -190,7 +191,12 @@ class Scenario:
             object.__setattr__(self, "_static_force", self._build_static_force())
         except ValueError as exc:  # an implicit model that cannot be tabulated over the muscle's range
             v.fail("model.static_force", self.spec["model"]["static_force"], str(exc))
-        object.__setattr__(self, "_added", added_components(v, self.spec.get("component", [])))
+        added = added_components(v, self.spec.get("component", []))
+        if "hysteresis" in self.spec:
+            m = self.spec["model"]
+            added += (hysteresis_component(v, self.spec["hysteresis"], FRICTION_MODELS[m["friction"]](self.parameters, m),
+                                           source_parts(self._source, None).pressure, added),)
+        object.__setattr__(self, "_added", added)
         if self._added:
             check_wiring(self, ScenarioError)
 
@@ -299,7 +305,8 @@ class Scenario:
         domain = self._static_force.domain
         return MuscleModel(
             static_force=self._static_force,
-            friction=FRICTION_MODELS[m["friction"]](p, m),
+            # Maxwell-slip elements take the friction law's place, reading its level ([hysteresis]).
+            friction=NoCoulomb() if "hysteresis" in self.spec else FRICTION_MODELS[m["friction"]](p, m),
             damping=DAMPING_MODELS[m["damping"]](p, m),
             load=HangingLoad(self.mass_kg, p["g_m_s2"], self._external_force),
             stops=self._stops,

@@ -23,6 +23,7 @@ from typing import Any
 
 from .assemblies.one_muscle import RIG_COMPONENTS, AddedComponent, scenario_assembly
 from .components.catalogue import COMPONENT_TYPES
+from .components.maxwell_slip import MAX_ELEMENTS, MaxwellSlip
 from .modeling import AssemblyError
 from .table_checks import did_you_mean
 
@@ -84,6 +85,51 @@ def _component_values(v, where: str, kind: str, parameters, entry: dict) -> dict
         if key not in values:
             v.fail(f"{where}.{key}", None, f"missing: {kind} needs {', '.join(declared)}")
     return values
+
+
+HYSTERESIS_MODELS = ("maxwell_slip",)
+"""The hysteresis models a ``[hysteresis]`` table puts in the muscle's force balance."""
+
+
+def hysteresis_component(v, table: dict, law, pressure: str, added: tuple) -> AddedComponent:
+    """The ``[hysteresis]`` table's elements in place of the rig's Coulomb friction, reading the level of
+    its law ``law`` (the ``[model] friction`` one) from the muscle's pressure (``<pressure>.p_gauge_Pa``) and
+    the load's mass; ``added``: the ``[[component]]`` s, whose names it must not take.
+
+    ::
+
+        [hysteresis]
+        model = "maxwell_slip"
+        slip_displacement_m = [2e-4, 1e-3]   # per element, > 0
+        share = [0.5, 0.5]                   # per element, >= 0: its part of the friction law's level
+    """
+    keys = ["model", "slip_displacement_m", "share", "damping_N_s_per_m"]
+    for key in sorted(set(table) - set(keys)):
+        v.fail(f"hysteresis.{key}", table[key], "unknown key", choices=keys)
+    if table.get("model") not in HYSTERESIS_MODELS:
+        v.fail("hysteresis.model", table.get("model"), "unknown hysteresis model", choices=HYSTERESIS_MODELS)
+    lists = {}
+    for key in ("slip_displacement_m", "share"):
+        values = table.get(key)
+        if not isinstance(values, list) or not 1 <= len(values) <= MAX_ELEMENTS:
+            v.fail(f"hysteresis.{key}", values, f"must be an array of 1 to {MAX_ELEMENTS} numbers, one per element")
+        lists[key] = [v.number(f"hysteresis.{key}[{i}]", x) for i, x in enumerate(values)]
+    deltas, shares = lists["slip_displacement_m"], lists["share"]
+    if len(deltas) != len(shares):
+        v.fail("hysteresis.share", table["share"], f"has {len(shares)} values for {len(deltas)} elements")
+    for i, (d, w) in enumerate(zip(deltas, shares)):
+        if d <= 0:
+            v.fail(f"hysteresis.slip_displacement_m[{i}]", d, "must be > 0 (the element's stiffness is its slip "
+                   "force over it)")
+        if w < 0:
+            v.fail(f"hysteresis.share[{i}]", w, "must be >= 0 (a negative slip force)")
+    if any(a.component.name == "hysteresis" for a in added):
+        v.fail("component", "hysteresis", "the name is taken by the [hysteresis] table's elements")
+    c = v.number("hysteresis.damping_N_s_per_m", table.get("damping_N_s_per_m", 0.0))
+    if c < 0:
+        v.fail("hysteresis.damping_N_s_per_m", c, "must be >= 0")
+    return AddedComponent(MaxwellSlip("hysteresis", law, deltas, shares, c),
+                          {"flange": "load.flange", "p_gauge_Pa": f"{pressure}.p_gauge_Pa", "mass_kg": "load.mass_kg"})
 
 
 def refuse_added(scenario: Any, what: str, error: type[Exception]) -> None:

@@ -233,6 +233,12 @@ class GeneratedCode:
         self.assembly = assembly
         self.code = compiled_by_mode(assembly, hybrid, RUN_FUNCTIONS)
         self.nominal = np.asarray(nominal, dtype=float)
+        # The indicators are the components', in their order: the hybrid one's own start at an offset, and
+        # the others (components whose state jumps at an event, without modes) watch in every mode.
+        indicators = assembly.indicator_names()
+        self.own_indicators = next((k for k, (c, _) in enumerate(indicators) if c == hybrid), 0)
+        self.other_indicators = [(f"{c}.{n}", k) for k, (c, n) in enumerate(indicators) if c != hybrid]
+        self.n_indicators = len(indicators)
         self.p = assembly.parameter_values()
         self.kinetic = self.code[Mode.STICK].names["outputs"].index(f"{hybrid}.kinetic_energy_J")
         self.t_left = math.inf  # inputs are read at min(t, t_left): the left limit at a segment's end
@@ -283,9 +289,8 @@ class GeneratedCode:
         z, inputs, p = code.z, self.inputs, self.p
         no_inputs = None if code.reads_inputs["z"] else [0.0] * len(code.names["inputs"])
         out = []
-        for k, name in enumerate(EVENT_NAMES[mode]):
-            if name is None:
-                continue
+        own = [(name, self.own_indicators + k) for k, name in enumerate(EVENT_NAMES[mode]) if name is not None]
+        for name, k in own + self.other_indicators:
 
             def indicator(t, y, k=k):
                 return z(y.tolist(), no_inputs or inputs(min(t, self.t_left)), p, ())[0][k]
@@ -296,7 +301,7 @@ class GeneratedCode:
         """The state and mode after indicator ``k_fired`` crossed at ``t``, and the kinetic energy the
         jump removed [J] (an inelastic impact, a velocity reset)."""
         code, u = self.code[mode], self.inputs(t)
-        fired = [1.0 if k == k_fired else 0.0 for k in range(len(EVENT_NAMES[mode]))]
+        fired = [1.0 if k == k_fired else 0.0 for k in range(self.n_indicators)]
         x_next, (q_next,) = code.transition(list(y), u, self.p, (), fired)
         q = Mode(int(q_next))
         mode_next = self.rest_mode(q, t, x_next)

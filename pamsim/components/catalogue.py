@@ -8,9 +8,10 @@ built on pamsim adds its own with :func:`register_component`.
 from __future__ import annotations
 
 from ..modeling import Component
+from .elasto_slide import ElastoSlide
 from .spring import LinearSpring
 
-COMPONENT_TYPES: dict[str, type[Component]] = {"linear_spring": LinearSpring}
+COMPONENT_TYPES: dict[str, type[Component]] = {"linear_spring": LinearSpring, "elasto_slide": ElastoSlide}
 """``{type name: component class}``."""
 
 

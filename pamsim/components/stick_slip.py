@@ -48,10 +48,13 @@ EVENT_NAMES = {
 """What a crossing of each indicator means in each mode (None: that indicator never crosses there)."""
 
 
-def event_name(mode: BodyMode, fired: int, to: BodyMode) -> str:
+def event_name(mode: BodyMode, fired: int, to: BodyMode, others: tuple[str, ...] = ()) -> str:
     """The name of an event that left ``mode`` for ``to`` with the indicators in the bit mask ``fired``:
     a stop reached takes precedence over a velocity reaching zero (as in the transition), and a
-    release is named by the direction the body takes."""
+    release is named by the direction the body takes.  Bits past the body's two are the indicators of
+    other components, named ``others`` (an element's slip): an event of theirs alone takes its name."""
+    if not fired & 3 and fired >> 2 and mode == to:
+        return others[(fired >> 2).bit_length() - 1]
     if mode.is_slip:
         return EVENT_NAMES[mode][1] if fired & 2 else EVENT_NAMES[mode][0]
     return "release_up" if to == BodyMode.SLIP_UP else "release_down"

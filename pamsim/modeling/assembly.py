@@ -171,6 +171,15 @@ class Assembly:
         if len(units) > 1:
             raise AssemblyError(f"model input {model_input!r} drives inputs of different units {sorted(units)}")
 
+    def indicator_names(self) -> list[tuple[str, str]]:
+        """``(component, name)`` of each event indicator of the flat model, in its order: a hybrid component's
+        are ``indicator<k>`` (its modes name its events), another's its :attr:`Component.indicator_names`."""
+        out = []
+        for c in self.components:
+            names = () if c.modes is not None else c.indicator_names
+            out += [(c.name, names[k] if k < len(names) else f"indicator{k}") for k in range(c.n_indicators)]
+        return out
+
     def structure_key(self) -> tuple:
         """Equal for two assemblies that generate the same code (they may differ in parameter values)."""
         if self._key is None:  # kept: an assembly does not change after it is made
@@ -257,7 +266,7 @@ class _Flattening:
         elif c.modes is not None:
             mode = self.mode_syms[c.name] = self.ca.SX.sym(f"{c.name}.mode")
         fired = ()
-        if c.modes is not None:
+        if c.n_indicators:
             fired = tuple(self.ca.SX.sym(f"{c.name}.fired{k}") for k in range(c.n_indicators))
             self.fired_syms += fired
         return mode, fired
@@ -290,7 +299,10 @@ class _Flattening:
         # the order in which CasADi's nodes are made can change the generated code.
         state_exprs = self._state_expressions()
         outputs = [self._flat(self.equations[c.name].outputs[v.name]) for c in self.components for v in c.outputs]
-        mode_exprs = self._mode_expressions(hybrid, state_exprs["x0"])
+        # Components with events but no modes (their state jumps at a crossing, as an elasto-slide element's
+        # deflection is held at its slip limit) list their indicators among the hybrid ones, in component order.
+        mode_exprs = self._indicators([c for c in self.components if c.n_indicators])
+        mode_exprs.update(self._mode_expressions(hybrid, state_exprs["x0"]))
         externals = [External(e.name, e.fn, e.symbol, [self._flat(a) for a in e.args], e.casadi) for e in self.externals]
         return FlatModel(name=name, inputs=inputs, u=u, y=outputs, tol=self.tol, externals=externals,
                          **self._variables(), **self._symbol_lists(hybrid), **state_exprs, **mode_exprs)
@@ -317,13 +329,16 @@ class _Flattening:
                 "settle_x": [self._flat(eq[c.name].settle.get(v.name, sym)) for c, v, sym in states],
                 "f": [self._flat(eq[c.name].der[v.name]) for c, v, _ in states]}
 
+    def _indicators(self, eventful: list[Component]) -> dict:
+        """The indicators of the components that have them, and their margins, in the components' order."""
+        eq, flat = self.equations, self._flat
+        return {"z": [flat(z) for c in eventful for z in eq[c.name].indicators],
+                "z_margin": [flat(m) for c in eventful for m in (eq[c.name].indicator_margins or (0.0,) * c.n_indicators)]}
+
     def _mode_expressions(self, hybrid: list[Component], initial: list) -> dict:
-        """Per hybrid component: its indicators and their margins, its mode after an event, at rest and at the start."""
+        """Per hybrid component: its mode after an event, at rest and at the start."""
         ca, eq, flat = self.ca, self.equations, self._flat
-        out = {"z": [flat(z) for c in hybrid for z in eq[c.name].indicators],
-               "z_margin": [flat(m) for c in hybrid
-                            for m in (eq[c.name].indicator_margins or (0.0,) * c.n_indicators)],
-               "transition_q": [flat(eq[c.name].transition.get("mode", self._mode_of(c))) for c in hybrid],
+        out = {"transition_q": [flat(eq[c.name].transition.get("mode", self._mode_of(c))) for c in hybrid],
                "rest_q": [flat(eq[c.name].rest_mode) for c in hybrid]}
         out["q0"] = [flat(ca.substitute([ca.SX(eq[c.name].initial.get("mode", 0.0))],
                                         [sym for _, _, sym in self.states], initial)[0]) for c in hybrid]
@@ -432,10 +447,11 @@ def _checked(c: Component, eq: Equations) -> Equations:
     for pt in c.ports:
         given = pt.kind.across if pt.role == "node" else pt.kind.through
         need(f"port {pt.name} variable", eq.port.get(pt.name, {}), [v.name for v in given])
-    if c.modes is not None:
-        if len(eq.indicators) != c.n_indicators or eq.rest_mode is None:
-            raise AssemblyError(f"component {c.name} ({type(c).__name__}) has modes but gives "
-                                f"{len(eq.indicators)} of {c.n_indicators} indicators or no rest mode")
+    if c.modes is not None and eq.rest_mode is None:
+        raise AssemblyError(f"component {c.name} ({type(c).__name__}) has modes but gives no rest mode")
+    if len(eq.indicators) != c.n_indicators:
+        raise AssemblyError(f"component {c.name} ({type(c).__name__}) gives {len(eq.indicators)} of its "
+                            f"{c.n_indicators} indicators")
     return eq
 
 

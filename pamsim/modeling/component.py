@@ -97,6 +97,9 @@ class Component:
     ports: ClassVar[tuple[Port, ...]] = ()
     modes: ClassVar[type[IntEnum] | None] = None
     n_indicators: ClassVar[int] = 0
+    indicator_names: ClassVar[tuple[str, ...]] = ()
+    """What a crossing of each indicator of a component without modes means (an event's name in results);
+    a hybrid component's events are named by its modes."""
 
     def __init__(self, name: str, values: Mapping[str, float] | None = None):
         self.name = name

@@ -183,7 +183,7 @@ def refuse_unsupported(scenario: Scenario) -> None:
         table = spec if not section else spec.get(section, {})
         extra = table.keys() - keys  # most tables have none: sorted only when there are
         for key in sorted(extra) if extra else ():
-            if not section and key == "component":
+            if not section and key in ("component", "hysteresis"):
                 continue  # the generated model holds them
             name = f"{section}.{key}" if section else key
             raise InputError(f"{where}: {name}: the native backend cannot honour this key; "
@@ -441,9 +441,13 @@ _MODES = {int(m): m for m in Mode}  # a dict look-up costs less than calling the
 _event_names: dict[tuple[int, int, int], str] = {}  # a few modes and indicators: a few names
 
 
-def _event_name(mode: int, fired: int, to: int) -> str:
-    """:func:`event_name` of an event by the modes' and mask's numbers, kept for the next event."""
-    _event_names[(mode, fired, to)] = name = event_name(_MODES[mode], fired, _MODES[to])
+def _event_name(mode: int, fired: int, to: int, assembly) -> str:
+    """:func:`event_name` of an event by the modes' and mask's numbers, kept for the next event (an event of
+    an added component's indicator alone is named after it: kept only without such components)."""
+    others = tuple(f"{c}.{n}" for c, n in assembly.indicator_names()[2:])
+    name = event_name(_MODES[mode], fired, _MODES[to], others)
+    if not others:
+        _event_names[(mode, fired, to)] = name
     return name
 
 
@@ -484,7 +488,7 @@ def _engine_result(scenario: Scenario, case: CaseInputs, out: dict, i: int, wall
     transitions, losses = [], []
     for e in rows:
         mode, to, fired = int(e[1]), int(e[2]), int(e[3])
-        name = _event_names.get((mode, fired, to)) or _event_name(mode, fired, to)
+        name = _event_names.get((mode, fired, to)) or _event_name(mode, fired, to, case.assembly)
         transitions.append(TransitionEvent(e[0], name, labels[mode], labels[to], e[after + x_at]))
         losses.append((e[0], e[4 + ke_at] - e[after + ke_at]))
     stats["events"] = len(transitions)

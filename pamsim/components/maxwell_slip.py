@@ -1,0 +1,83 @@
+"""The Maxwell-slip model of a muscle's friction: N elasto-slide elements (:mod:`.elasto_slide`) in parallel
+on the load's flange, whose slip forces are shares of a friction law's level.
+
+Element ``i`` has a slip displacement ``delta_i`` and a share ``w_i``: its slip force is ``w_i F_c`` and its
+stiffness ``w_i F_c / delta_i``, with ``F_c(x, p, m)`` the level of any law of :mod:`pamsim.elements.friction`
+(the paper's load-dependent law scales with pressure and load).  With one element of share 1, as
+``delta -> 0`` it is that law's Coulomb friction: the stiff spring holds the load where Coulomb friction
+sticks it, and slips at the same level.  It takes the place of the rig's Coulomb friction, whose law it
+reads (:class:`pamsim.components.CoulombFriction` is then ``"none"``).
+"""
+
+from __future__ import annotations
+
+from ..modeling import TRANSLATIONAL, Component, Equations, Port, Symbols, Var, non_negative, positive
+from ..modeling.smath import if_else
+from .elasto_slide import element
+from .element import ElementParameters
+from .friction import PROBE_POINTS, _level_N
+
+MAX_ELEMENTS = 100
+"""The most elements a model takes (each is two states and an event indicator)."""
+
+
+class MaxwellSlip(ElementParameters, Component):
+    """``N = len(deltas_m)`` elements on the flange, the level from the friction law ``element``.
+
+    Parameters ``delta<i>_m`` and ``share<i>`` per element (``i`` from 1), and the law's.  Inputs: the
+    muscle's gauge pressure and the load's mass, as the law reads them.  States per element: ``z<i>_m``,
+    its spring's deflection, and ``E_element<i>_J``, the work the load has done on it (spring energy plus slip
+    losses).  Outputs: the total force ``F_N``, the level ``level_N``, each element's force and whether it
+    slips.
+    """
+
+    ports = (Port("flange", TRANSLATIONAL, "branch"),)
+    inputs = (Var("p_gauge_Pa", "Pa", "gauge pressure in the muscle"), Var("mass_kg", "kg", "load mass"))
+    indicator_names: tuple[str, ...] = ()
+
+    def __init__(self, name: str, element, deltas_m, shares, damping_N_s_per_m: float = 0.0):
+        if not 1 <= len(deltas_m) <= MAX_ELEMENTS or len(shares) != len(deltas_m):
+            raise ValueError(f"{len(deltas_m)} slip displacements and {len(shares)} shares: give 1 to "
+                             f"{MAX_ELEMENTS} of each")
+        n = self.n_elements = len(deltas_m)
+        idx = range(1, n + 1)
+        self.extra_parameters = (*(positive(f"delta{i}_m", "m", f"slip displacement of element {i}") for i in idx),
+                                 *(non_negative(f"share{i}", "1", f"element {i}'s share of the friction level")
+                                   for i in idx),
+                                 non_negative("damping_N_s_per_m", "N s/m", "presliding damping, shared as the level"))
+        self.states = (*(Var(f"z{i}_m", "m", f"deflection of element {i}'s spring", 1e-3) for i in idx),
+                       *(Var(f"E_element{i}_J", "J", f"work done by the load on element {i}", 0.1) for i in idx))
+        self.outputs = (Var("F_N", "N", "the elements' force on the load along x"),
+                        Var("level_N", "N", "the friction law's level, the elements' slip forces' sum over shares"),
+                        *(Var(f"F{i}_N", "N", f"element {i}'s force on the load") for i in idx),
+                        *(Var(f"slipping{i}", "1", f"1 while element {i} slips") for i in idx))
+        self.n_indicators = n
+        self.indicator_names = tuple(f"slip{i}" for i in idx)
+        values = self.wrap(element, _level_N, PROBE_POINTS)
+        values.update({f"delta{i}_m": float(d) for i, d in zip(idx, deltas_m)})
+        values.update({f"share{i}": float(w) for i, w in zip(idx, shares)})
+        values["damping_N_s_per_m"] = float(damping_N_s_per_m)
+        super().__init__(name, values)
+
+    def structure_key(self) -> tuple:
+        """The key of :class:`ElementParameters`, with the number of elements: it shapes the code."""
+        return super().structure_key() + (self.n_elements,)
+
+    def equations(self, s: Symbols) -> Equations:
+        """Each element of :func:`~pamsim.components.elasto_slide.element` at its share of the law's level."""
+        u, flange = s.u, s.port["flange"]
+        v = flange["v_m_s"]
+        level = self.element_call(s, "level_N", flange["x_m"], u["p_gauge_Pa"], u["mass_kg"])
+        der, outputs, jumps, indicators, total = {}, {"level_N": level}, {}, [], 0.0
+        for i in range(1, self.n_elements + 1):
+            delta = s.p[f"delta{i}_m"]
+            share = s.p[f"share{i}"]
+            e = element(s.x[f"z{i}_m"], v, share * level / delta, delta, s.fired[i - 1], share * s.p["damping_N_s_per_m"])
+            der.update({f"z{i}_m": e.rate, f"E_element{i}_J": -e.force * v})
+            outputs.update({f"F{i}_N": e.force, f"slipping{i}": if_else(e.slipping, 1.0, 0.0)})
+            jumps[f"z{i}_m"] = e.jump
+            indicators.append(e.indicator)
+            total = total + e.force
+        outputs["F_N"] = total
+        return Equations(der=der, outputs=outputs, port={"flange": {"F_N": total}}, indicators=tuple(indicators),
+                         transition=jumps, initial={v.name: 0.0 for v in self.states})

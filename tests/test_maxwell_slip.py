@@ -1,0 +1,148 @@
+"""Maxwell-slip elements in the muscle's force balance (``[hysteresis]``, :class:`pamsim.components.MaxwellSlip`):
+Coulomb friction as the limit of one stiff element, on Figure 4 and the 66 paper tests; exact slip events;
+the energy balance; every backend; element events named in results; and bad tables refused by key."""
+
+from __future__ import annotations
+
+import copy
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import pamsim
+from pamsim.api import simulate
+from pamsim.scenario import Scenario, ScenarioError
+from pamsim.sweep.spec import load_sweep
+
+ROOT = Path(__file__).resolve().parents[1]
+FIG4 = ROOT / "scenarios" / "acra2012_fig4.toml"
+
+
+def _with_elements(scenario: Scenario, deltas, shares, **extra) -> Scenario:
+    spec = copy.deepcopy(dict(scenario.spec))
+    spec["hysteresis"] = {"model": "maxwell_slip", "slip_displacement_m": list(deltas), "share": list(shares), **extra}
+    return Scenario.from_dict(spec, name=scenario.name, base_dir=scenario.base_dir)
+
+
+@pytest.fixture(scope="module")
+def fig4():
+    return pamsim.load_scenario(FIG4)
+
+
+def test_one_stiff_element_tends_to_the_coulomb_friction_it_replaces(fig4):
+    """Figure 4 with the paper's load-dependent friction replaced by one element of share 1: the largest gap
+    to the Coulomb model falls as the slip displacement does (tenfold per hundredfold: 1.3 mm at 100 um,
+    0.13 mm at 1 um); python and native give the same run."""
+    coulomb = simulate(fig4, backend="native")
+    gaps = []
+    for delta in (1e-4, 1e-6):
+        res = simulate(_with_elements(fig4, [delta], [1.0]), backend="native")
+        gaps.append(float(np.max(np.abs(res.x_m - coulomb.x_m))))
+    assert gaps[1] < 2e-4 and gaps[1] < gaps[0] / 8, gaps
+    py = simulate(_with_elements(fig4, [1e-4], [1.0]), backend="python")
+    nat = simulate(_with_elements(fig4, [1e-4], [1.0]), backend="native")
+    assert np.max(np.abs(py.x_m - nat.x_m)) < 1e-6
+
+
+def test_the_66_paper_tests_with_one_stiff_element_match_coulomb_friction():
+    """Every ACRA 2012 test of the grid on the native engine, its friction one element of 1 um: the trace
+    stays within 0.2 mm of the Coulomb model's (the paper's own fit is 2.61 mm RMS)."""
+    sweep = load_sweep(ROOT / "scenarios" / "acra2012_grid.toml")
+    worst = 0.0
+    for case in sweep.cases:
+        sc = sweep.case_scenario(case, "load_dependent")
+        a, b = simulate(sc, backend="native"), simulate(_with_elements(sc, [1e-6], [1.0]), backend="native")
+        worst = max(worst, float(np.max(np.abs(a.x_m - b.x_m))))
+    assert len(sweep.cases) == 66 and worst < 2e-4, worst
+
+
+@pytest.fixture(scope="module")
+def three(fig4):
+    """Figure 4 on three elements (50, 200 and 1000 um; shares 0.2, 0.3, 0.5) with linear damping."""
+    spec = copy.deepcopy(dict(fig4.spec))
+    spec["model"]["damping"] = "linear"
+    base = Scenario.from_dict(spec, name="three", base_dir=fig4.base_dir)
+    return _with_elements(base, [5e-5, 2e-4, 1e-3], [0.2, 0.3, 0.5])
+
+
+def test_a_slipping_element_sits_exactly_on_its_limit(three):
+    """At every sample where an element slips, its deflection is its slip displacement to the last bit (the
+    event's jump put it there, and it does not move while it slips), and no element is ever past it."""
+    res = simulate(three, backend="python")
+    for i, delta in enumerate((5e-5, 2e-4, 1e-3), start=1):
+        z, slipping = res.signals[f"hysteresis.z{i}_m"], res.signals[f"hysteresis.slipping{i}"] == 1.0
+        assert slipping.sum() > 10
+        assert np.all(np.abs(z[slipping]) == delta) and np.all(np.abs(z) <= delta)
+    kinds = [e.kind for e in res.transitions]
+    assert {"hysteresis.slip1", "hysteresis.slip2", "hysteresis.slip3"} <= set(kinds)
+
+
+@pytest.mark.parametrize("backend", ["python", "native"])
+def test_the_energy_balance_holds_with_elements(three, backend):
+    """The work the load does on the elements (their springs' energy and their slip losses) closes the rig's
+    balance, as a Coulomb friction's losses do."""
+    res = simulate(three, backend=backend)
+    balance = res.energy_balance()
+    assert balance["relative"] < 1e-5 and sum(v for k, v in balance.items() if k.startswith("hysteresis.")) > 0.01
+
+
+def test_every_backend_runs_the_elements_alike(three):
+    """native and both FMU kinds against python: the same contraction within 1e-6 m, and native names the
+    elements' events as python does."""
+    py = simulate(three, backend="python")
+    for backend in ("native", "fmu-cs", "fmu-me"):
+        other = simulate(three, backend=backend)
+        assert np.max(np.abs(other.x_m - py.x_m)) < 1e-6, backend
+    native = simulate(three, backend="native")
+    assert [e.kind for e in native.transitions] == [e.kind for e in py.transitions]
+
+
+def test_the_element_force_is_its_share_of_the_level_where_it_slips(three):
+    """A slipping element pulls its share of the friction law's level, against the motion; a sticking one
+    less; the elements' total is their sum."""
+    res = simulate(three, backend="python")
+    s = res.signals
+    level, total = s["hysteresis.level_N"], s["hysteresis.F_N"]
+    parts = sum(s[f"hysteresis.F{i}_N"] for i in (1, 2, 3))
+    assert np.allclose(total, parts, rtol=0, atol=1e-12)
+    for i, share in enumerate((0.2, 0.3, 0.5), start=1):
+        F, slipping = s[f"hysteresis.F{i}_N"], s[f"hysteresis.slipping{i}"] == 1.0
+        assert np.allclose(np.abs(F[slipping]), share * level[slipping], rtol=1e-12, atol=0)
+        assert np.all(np.abs(F) <= share * level * (1 + 1e-12) + 1e-12)
+
+
+@pytest.mark.parametrize("change, key", [
+    (lambda h: h.update(slip_displacement_m=[]), "hysteresis.slip_displacement_m"),
+    (lambda h: h.update(slip_displacement_m=[1e-4] * 101, share=[0.01] * 101), "hysteresis.slip_displacement_m"),
+    (lambda h: h.update(slip_displacement_m=[1e-4, -1e-4], share=[0.5, 0.5]), "hysteresis.slip_displacement_m[1]"),
+    (lambda h: h.update(share=[-0.1]), "hysteresis.share[0]"),
+    (lambda h: h.update(share=[0.5, 0.5]), "hysteresis.share"),
+    (lambda h: h.update(model="preisach"), "hysteresis.model"),
+    (lambda h: h.update(damping_N_s_per_m=-1.0), "hysteresis.damping_N_s_per_m"),
+    (lambda h: h.update(stiffness=3.0), "hysteresis.stiffness"),
+])
+def test_bad_hysteresis_tables_are_refused_by_key(fig4, change, key):
+    """No elements or more than 100, a slip displacement that is not positive (its stiffness would be
+    infinite or negative), a negative share (a negative slip force), lists of different lengths, an unknown
+    model or key: refused naming the key."""
+    table = {"model": "maxwell_slip", "slip_displacement_m": [1e-4], "share": [1.0]}
+    change(table)
+    spec = copy.deepcopy(dict(fig4.spec))
+    spec["hysteresis"] = table
+    with pytest.raises(ScenarioError, match=key.replace("[", r"\[").replace("]", r"\]")):
+        Scenario.from_dict(spec, name="bad", base_dir=fig4.base_dir)
+
+
+def test_the_command_line_refuses_a_bad_table_with_exit_2(tmp_path):
+    """``pamsim run`` on a scenario with a negative slip displacement: exit 2, the key named, no traceback,
+    nothing written."""
+    text = FIG4.read_text() + '\n[hysteresis]\nmodel = "maxwell_slip"\nslip_displacement_m = [-1e-4]\nshare = [1.0]\n'
+    path = tmp_path / "bad.toml"
+    path.write_text(text.replace('parameter_set = ', 'parameter_set = ', 1))
+    done = subprocess.run([sys.executable, "-m", "pamsim", "run", str(path), "-o", str(tmp_path / "out")],
+                          capture_output=True, text=True, cwd=ROOT / "scenarios")
+    assert done.returncode == 2 and "hysteresis.slip_displacement_m[0]" in done.stderr
+    assert "Traceback" not in done.stderr and not (tmp_path / "out").exists()
