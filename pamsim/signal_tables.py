@@ -26,6 +26,7 @@ SIGNAL_KINDS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
     "lag": (("time_s", "tau_s"), ("initial", "final")),
     "trace": (("file", "time_column", "value_column"), ()),
     "steps": (("times_s",), ("values",)),
+    "linear": (("times_s",), ("values",)),
     "pwm": (("start_s", "end_s", "frequency_Hz", "duty", "delay_on_s", "delay_off_s", "rise_s", "fall_s"),
             ("low", "high")),
 }
@@ -42,7 +43,10 @@ def signal_from_table(v, where: str, spec: Any, suffix: str, scale: float, base_
     suffixes = [(suffix, scale)] + ([alt_suffix] if alt_suffix else [])
     _check_keys(v, where, spec, kind, suffixes)
     if kind == "steps":
-        return _steps(v, where, spec, suffixes)
+        return PiecewiseConstant(*_knots(v, where, spec, suffixes))
+    if kind == "linear":  # straight lines between the knots: cycles of any shape (triangles, minor loops)
+        times, values = _knots(v, where, spec, suffixes)
+        return Trace(np.array(times), np.array(values), "linear")
     if kind == "trace":
         return _trace(v, where, spec, suffixes, base_dir)
     return _SHAPES[kind](_Entries(v, where, spec, suffixes))
@@ -141,7 +145,8 @@ def _numbers(v, key: str, value: Any) -> list[float]:
     return [v.number(f"{key}[{k}]", x) for k, x in enumerate(value)]
 
 
-def _steps(v, where: str, spec: Mapping, suffixes) -> PiecewiseConstant:
+def _knots(v, where: str, spec: Mapping, suffixes) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """A ``steps`` or ``linear`` table's times (not negative, increasing) and values (in SI), as many of each."""
     times = _numbers(v, f"{where}.times_s", v.required(spec, "times_s", prefix=f"{where}."))
     given = [(f"values{s}", k) for s, k in suffixes if f"values{s}" in spec]
     if not given:
@@ -155,7 +160,7 @@ def _steps(v, where: str, spec: Mapping, suffixes) -> PiecewiseConstant:
     for k in range(1, len(times)):
         if times[k] <= times[k - 1]:
             v.fail(f"{where}.times_s[{k}]", times[k], f"must be after times_s[{k - 1}] = {times[k - 1]:g}")
-    return PiecewiseConstant(tuple(times), tuple(values))
+    return tuple(times), tuple(values)
 
 
 def _trace(v, where: str, spec: Mapping, suffixes, base_dir: Path) -> Trace:

@@ -333,7 +333,7 @@ def _prescribed(table):
 @pytest.mark.parametrize("table, message", [
     ({"kind": "stp"}, "pressure.prescribed.kind = 'stp': unknown signal kind (did you mean 'step'?)"),
     ({"kind": 3}, "pressure.prescribed.kind = 3: unknown signal kind (choose from constant, step, ramp, lag, trace, "
-     "steps, pwm)"),
+     "steps, linear, pwm)"),
     ({"kind": "constant", "value": 1.0}, "unknown key pressure.prescribed.value for kind = 'constant' (known: kind, "
      "value_gauge_bar, value_gauge_Pa)"),
     ({"kind": "step", "time_s": 1, "final_gauge_bar": 2, "tau_s": 1}, "unknown key pressure.prescribed.tau_s for "
@@ -348,6 +348,8 @@ def _prescribed(table):
     ({"kind": "lag", "time_s": 0.1, "tau_s": 0.2}, "missing key pressure.prescribed.final_gauge_bar"),
     ({"kind": "steps", "times_s": [0, 1], "values_gauge_bar": [1]},
      "pressure.prescribed.values_gauge_bar = '1 values': must be as many as times_s (2)"),
+    ({"kind": "linear", "times_s": [0, 2, 1], "values_gauge_bar": [1, 2, 1]},
+     "pressure.prescribed.times_s[2] = 1.0: must be after times_s[1] = 2"),
 ])
 def test_a_bad_signal_table_is_refused_naming_the_key(table, message):
     with pytest.raises(InputError) as err:
