@@ -23,6 +23,7 @@ from typing import Any
 
 from .assemblies.one_muscle import RIG_COMPONENTS, AddedComponent, scenario_assembly
 from .components.catalogue import COMPONENT_TYPES
+from .components.bouc_wen import BoucWenFriction
 from .components.maxwell_slip import MAX_ELEMENTS, MaxwellSlip
 from .modeling import AssemblyError
 from .table_checks import did_you_mean
@@ -87,14 +88,15 @@ def _component_values(v, where: str, kind: str, parameters, entry: dict) -> dict
     return values
 
 
-HYSTERESIS_MODELS = ("maxwell_slip",)
-"""The hysteresis models a ``[hysteresis]`` table puts in the muscle's force balance."""
+HYSTERESIS_KEYS = {"maxwell_slip": ("slip_displacement_m", "share", "damping_N_s_per_m"),
+                   "bouc_wen": ("beta_per_m_n", "gamma_per_m_n", "exponent")}
+"""The hysteresis models a ``[hysteresis]`` table puts in the muscle's force balance, and their keys."""
 
 
 def hysteresis_component(v, table: dict, law, pressure: str, added: tuple) -> AddedComponent:
-    """The ``[hysteresis]`` table's elements in place of the rig's Coulomb friction, reading the level of
-    its law ``law`` (the ``[model] friction`` one) from the muscle's pressure (``<pressure>.p_gauge_Pa``) and
-    the load's mass; ``added``: the ``[[component]]`` s, whose names it must not take.
+    """The ``[hysteresis]`` table's model in place of the rig's Coulomb friction, reading the level of its law
+    ``law`` (the ``[model] friction`` one) from the muscle's pressure (``<pressure>.p_gauge_Pa``) and the
+    load's mass; ``added``: the ``[[component]]`` s, whose names it must not take.
 
     ::
 
@@ -102,12 +104,27 @@ def hysteresis_component(v, table: dict, law, pressure: str, added: tuple) -> Ad
         model = "maxwell_slip"
         slip_displacement_m = [2e-4, 1e-3]   # per element, > 0
         share = [0.5, 0.5]                   # per element, >= 0: its part of the friction law's level
+
+        [hysteresis]
+        model = "bouc_wen"
+        beta_per_m_n = 500.0                 # beta + gamma > 0
+        gamma_per_m_n = 500.0
+        exponent = 1.0                       # n > 0
     """
-    keys = ["model", "slip_displacement_m", "share", "damping_N_s_per_m"]
+    model = table.get("model")
+    if model not in HYSTERESIS_KEYS:
+        v.fail("hysteresis.model", model, "unknown hysteresis model", choices=list(HYSTERESIS_KEYS))
+    keys = ["model", *HYSTERESIS_KEYS[model]]
     for key in sorted(set(table) - set(keys)):
-        v.fail(f"hysteresis.{key}", table[key], "unknown key", choices=keys)
-    if table.get("model") not in HYSTERESIS_MODELS:
-        v.fail("hysteresis.model", table.get("model"), "unknown hysteresis model", choices=HYSTERESIS_MODELS)
+        v.fail(f"hysteresis.{key}", table[key], f"unknown key for model = {model!r}", choices=keys)
+    if any(a.component.name == "hysteresis" for a in added):
+        v.fail("component", "hysteresis", "the name is taken by the [hysteresis] table's model")
+    component = (_maxwell_slip if model == "maxwell_slip" else _bouc_wen)(v, table, law)
+    return AddedComponent(component, {"flange": "load.flange", "p_gauge_Pa": f"{pressure}.p_gauge_Pa",
+                                      "mass_kg": "load.mass_kg"})
+
+
+def _maxwell_slip(v, table: dict, law) -> MaxwellSlip:
     lists = {}
     for key in ("slip_displacement_m", "share"):
         values = table.get(key)
@@ -123,13 +140,21 @@ def hysteresis_component(v, table: dict, law, pressure: str, added: tuple) -> Ad
                    "force over it)")
         if w < 0:
             v.fail(f"hysteresis.share[{i}]", w, "must be >= 0 (a negative slip force)")
-    if any(a.component.name == "hysteresis" for a in added):
-        v.fail("component", "hysteresis", "the name is taken by the [hysteresis] table's elements")
     c = v.number("hysteresis.damping_N_s_per_m", table.get("damping_N_s_per_m", 0.0))
     if c < 0:
         v.fail("hysteresis.damping_N_s_per_m", c, "must be >= 0")
-    return AddedComponent(MaxwellSlip("hysteresis", law, deltas, shares, c),
-                          {"flange": "load.flange", "p_gauge_Pa": f"{pressure}.p_gauge_Pa", "mass_kg": "load.mass_kg"})
+    return MaxwellSlip("hysteresis", law, deltas, shares, c)
+
+
+def _bouc_wen(v, table: dict, law) -> BoucWenFriction:
+    values = {key: v.number(f"hysteresis.{key}", v.required(table, key, prefix="hysteresis."))
+              for key in HYSTERESIS_KEYS["bouc_wen"]}
+    if values["exponent"] <= 0:
+        v.fail("hysteresis.exponent", values["exponent"], "must be > 0")
+    if values["beta_per_m_n"] + values["gamma_per_m_n"] <= 0:
+        v.fail("hysteresis.gamma_per_m_n", values["gamma_per_m_n"], f"beta + gamma must be > 0 (beta = "
+               f"{values['beta_per_m_n']:g}): else z grows without bound on loading")
+    return BoucWenFriction("hysteresis", law, **values)
 
 
 def refuse_added(scenario: Any, what: str, error: type[Exception]) -> None:

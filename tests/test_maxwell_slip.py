@@ -188,3 +188,49 @@ def test_the_loops_scenario_shows_return_point_memory():
     major, minor = width((12.2, 23.4), (1.0, 12.2), 2.4), width((30.6, 35.4), (23.4, 30.6), 2.4)
     assert 0.0 < minor < major
     assert sum(e.kind.startswith("hysteresis.slip") for e in res.transitions) >= 10
+
+
+@pytest.fixture(scope="module")
+def bouc_wen(fig4):
+    """Figure 4 with Bouc-Wen friction (n = 1, beta = gamma = 5000 m^-1: z_u = 0.1 mm) and linear damping."""
+    spec = copy.deepcopy(dict(fig4.spec))
+    spec["model"]["damping"] = "linear"
+    spec["hysteresis"] = {"model": "bouc_wen", "beta_per_m_n": 5000.0, "gamma_per_m_n": 5000.0, "exponent": 1.0}
+    return Scenario.from_dict(spec, name="bouc_wen", base_dir=fig4.base_dir)
+
+
+@pytest.mark.parametrize("backend", ["python", "native"])
+def test_bouc_wen_follows_its_loading_branch_in_closed_form(bouc_wen, backend):
+    """On the first rise (the load leaves its stop at 1.03 s with z = 0, and climbs until it turns), n = 1 gives
+    dz/dx = 1 - (beta + gamma) z, so z = z_u (1 - exp(-(x - x0) / z_u)) with z_u = 1 / (beta + gamma); the
+    force is the level times z / z_u; the energy balances."""
+    res = simulate(bouc_wen, backend=backend)
+    turn = next(e.t_s for e in res.transitions if e.kind == "velocity_zero")
+    rise = (res.t_s > 1.0) & (res.t_s < turn)
+    x, z = res.x_m[rise], res.signals["hysteresis.z_m"][rise]
+    z_u = 1.0 / 10000.0
+    assert np.max(np.abs(z - z_u * (1.0 - np.exp(-(x - x[0]) / z_u)))) < 1e-3 * z_u
+    F, level = res.signals["hysteresis.F_N"], res.signals["hysteresis.level_N"]
+    assert np.allclose(F, -level * res.signals["hysteresis.z_m"] / z_u, rtol=1e-12, atol=1e-12)
+    assert res.energy_balance()["relative"] < 1e-5
+
+
+def test_bouc_wen_runs_alike_on_every_backend(bouc_wen):
+    """native and the co-simulation FMU against python, within 1e-5 m."""
+    py = simulate(bouc_wen, backend="python")
+    for backend in ("native", "fmu-cs"):
+        assert np.max(np.abs(simulate(bouc_wen, backend=backend).x_m - py.x_m)) < 1e-5, backend
+
+
+@pytest.mark.parametrize("change, key", [
+    ({"exponent": 0.0}, "hysteresis.exponent"),
+    ({"exponent": -1.0}, "hysteresis.exponent"),
+    ({"beta_per_m_n": -10.0, "gamma_per_m_n": 5.0}, "hysteresis.gamma_per_m_n"),
+    ({"slip_displacement_m": [1e-4]}, "hysteresis.slip_displacement_m"),
+])
+def test_bad_bouc_wen_tables_are_refused_by_key(fig4, change, key):
+    """n <= 0, beta + gamma <= 0 (z would grow without bound on loading), a Maxwell-slip key: refused by key."""
+    spec = copy.deepcopy(dict(fig4.spec))
+    spec["hysteresis"] = {"model": "bouc_wen", "beta_per_m_n": 10.0, "gamma_per_m_n": 10.0, "exponent": 1.0, **change}
+    with pytest.raises(ScenarioError, match=key):
+        Scenario.from_dict(spec, name="bad", base_dir=fig4.base_dir)
