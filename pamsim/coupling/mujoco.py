@@ -91,7 +91,11 @@ class MujocoMuscles:
     def _start(self, m: CoupledMuscle, rtol: float) -> None:
         sc = m.scenario
         model = sc.build_model()
-        assembly = muscle_only_assembly(model, sc.parameters["L0_m"], sc.parameters["g_m_s2"], sc.initial_pressure_gauge_Pa)
+        try:
+            assembly = muscle_only_assembly(model, sc.parameters["L0_m"], sc.parameters["g_m_s2"],
+                                            sc.initial_pressure_gauge_Pa, sc.added_components)
+        except ValueError as exc:
+            raise InputError(f"muscle {m.name!r}: {exc}") from None
         library = engine_library(assembly)
         m._session = library.session()
         names = library.names

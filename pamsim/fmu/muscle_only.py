@@ -3,7 +3,8 @@ output (:mod:`pamsim.assemblies.muscle_only`), for an importer that owns the mec
 Simscape, OpenModelica, Dymola, a multibody engine).
 
 Built from a one-muscle scenario: its muscle, static force model, friction and damping laws, pressure
-source and their values; its load and stops are not used (the importer's mechanics take their place).
+source, the components it adds (its ``[hysteresis]`` among them) and their values; its load and stops
+are not used (the importer's mechanics take their place).
 The pressure inputs follow the scenario's signals and the length holds at the scenario's start
 (``input_source = scenario``) until the importer drives them (``input_source = importer``).
 """
@@ -39,7 +40,11 @@ def muscle_only_spec(scenario, fmi_version: int = 2) -> FmuSpec:
                          "drives its pressure inputs")
     model = scenario.build_model()
     L0 = scenario.parameters["L0_m"]
-    assembly = muscle_only_assembly(model, L0, scenario.parameters["g_m_s2"], scenario.initial_pressure_gauge_Pa)
+    try:
+        assembly = muscle_only_assembly(model, L0, scenario.parameters["g_m_s2"], scenario.initial_pressure_gauge_Pa,
+                                        scenario.added_components)
+    except ValueError as exc:
+        raise InputError(f"{scenario.origin}: component: {exc}") from None
     motion = {"length_m": Constant(L0 - scenario.initial_contraction_m), "lengthening_velocity_m_s": Constant(0.0)}
 
     def signals_of(names):
