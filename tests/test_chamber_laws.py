@@ -336,3 +336,23 @@ def test_the_slider_form_of_a_rig_refuses_another_law_rather_than_drop_it():
     with pytest.raises(InputError, match=r"chamber.law = 'thermal': a slider's muscles have the polytropic chamber"):
         slider_of_rig(sc)
     assert slider_of_rig(sc.with_changes({"chamber": {"law": "polytropic"}})).muscles
+
+
+@pytest.mark.parametrize("kind", ["CoSimulation", "ModelExchange"])
+def test_a_changed_wall_temperature_moves_the_fmus_start_with_it(tmp_path, kind):
+    """The thermal chamber's gas starts at its wall's temperature: an importer that sets chamber.T_wall_K to
+    320 K finds the gas at 320 K at the start (it started at the build's 293.15 K, the separate start
+    parameter, before), and the air mass that pressure and volume take at that temperature."""
+    from fmpy import simulate_fmu
+
+    path = tmp_path / "thermal.fmu"
+    done = subprocess.run([sys.executable, "-m", "pamsim", "fmu", "build", "--scenario",
+                           str(SCENARIOS / "thermal_drift.toml"), "-o", str(path)], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    res = simulate_fmu(str(path), fmi_type=kind, stop_time=0.1, output_interval=0.01, validate=False,
+                       start_values={"chamber.T_wall_K": 320.0},
+                       output=["chamber.gas_temperature_K", "chamber.p_abs_Pa", "chamber.volume_m3", "chamber.air_mass_kg"])
+    assert res["chamber.gas_temperature_K"][0] == pytest.approx(320.0, rel=1e-12)
+    R = 287.05  # the specific gas constant of dry air in pamsim's parameters
+    p, V, m = (res[k][0] for k in ("chamber.p_abs_Pa", "chamber.volume_m3", "chamber.air_mass_kg"))
+    assert m == pytest.approx(p * V / (R * 320.0), rel=1e-3)

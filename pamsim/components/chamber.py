@@ -45,7 +45,8 @@ class Chamber(ElementParameters, Component):
     outputs = OUTPUTS
     extra_parameters = (positive("p_atm_Pa", "Pa", "ambient pressure"),
                         non_negative("initial_pressure_gauge_Pa", "Pa", "chamber gauge pressure at the start"),
-                        positive("T_initial_K", "K", "gas temperature at the start"))
+                        positive("T_initial_K", "K", "gas temperature at the start under the polytropic law (the "
+                                 "isothermal and thermal laws start at their wall's)"))
 
     def __init__(self, name: str, element, p_atm_Pa: float, initial_pressure_gauge_Pa: float, T_initial_K: float):
         if getattr(element, "law", "") == "thermal":
@@ -78,6 +79,8 @@ class Chamber(ElementParameters, Component):
             der={"p_abs_Pa": dp, "air_mass_kg": flow["mdot_kg_s"]},
             outputs=outputs,
             port={"port": {"p_abs_Pa": p, "T_K": T_gas}},
-            initial={"p_abs_Pa": p0, "air_mass_kg": ch.air_mass_kg(p0, V, s.p["T_initial_K"])},
+            # The law says where the gas starts: at the wall (isothermal, thermal: their own T_wall_K, so that an
+            # FMU's changed wall temperature moves the start with it) or at T_initial_K (polytropic: the supply's).
+            initial={"p_abs_Pa": p0, "air_mass_kg": ch.air_mass_kg(p0, V, ch.start_temperature_K(s.p["T_initial_K"]))},
             settle={"p_abs_Pa": if_else(near, target, p),
                     "air_mass_kg": if_else(near, m + dp_settle * flow["mdot_kg_s"] / rate_held, m)})
