@@ -23,8 +23,8 @@ from typing import Any
 
 from .assemblies.one_muscle import RIG_COMPONENTS, AddedComponent, scenario_assembly
 from .components.catalogue import COMPONENT_TYPES
-from .components.bouc_wen import BoucWenFriction
-from .components.maxwell_slip import MAX_ELEMENTS, MaxwellSlip
+from .components.bouc_wen_friction import BoucWenFriction
+from .components.maxwell_slip_friction import MAX_ELEMENTS, MaxwellSlip
 from .modeling import AssemblyError
 from .table_checks import did_you_mean
 

@@ -12,7 +12,7 @@ crosses zero) whose jump puts ``z`` exactly on it; exactly there, the element sl
 outward, a condition of the state alone, so an element needs no mode of its own.  Letting go needs no
 event: ``dz/dt`` there is ``v`` on one side of ``v = 0`` and ``0`` on the other, continuous, and the load's
 turning is its own event while it slides.  ``delta`` is a constant, so a slip force that follows the
-pressure and the load (:class:`MaxwellSlip`) moves the spring's stiffness with it and never the limit.
+pressure and the load (:class:`~pamsim.components.maxwell_slip_friction.MaxwellSlip`) moves the spring's stiffness with it and never the limit.
 """
 
 from __future__ import annotations
