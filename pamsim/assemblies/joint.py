@@ -14,6 +14,7 @@ rig's: a valve and chamber, a prescribed pressure), its components named after i
 
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass
 from typing import Any
 
@@ -48,6 +49,9 @@ class JointMuscle:
     tendon_stiffness_N_per_m: float | None = None
     """The stiffness of a spring in series with the muscle (:class:`pamsim.components.series_tendon.SeriesTendon`);
     None: a rigid tendon."""
+    added: tuple = ()
+    """Components on the muscle, wired as on the one-muscle rig's load (:class:`pamsim.assemblies.one_muscle.AddedComponent`
+    s: its ``[hysteresis]``), renamed ``<muscle>_<name>``."""
 
 
 def attachment_name(m: JointMuscle, body: str = "joint") -> str:
@@ -153,5 +157,30 @@ def _muscle_parts(m: JointMuscle, attach, body, friction_load: str | None) -> tu
                (moves, f"{m.name}_friction.direction"),
                (f"{m.name}_muscle.F_static_N", f"{pulley}.F_static_N"),
                (f"{body.name}.slip_direction", f"{pulley}.joint_direction")]
+    extra, extra_wiring = _added_parts(m, source, node, friction_load or f"{pulley}.load_mass_kg")
     inputs = {f"{m.name}.{k}": v for k, v in source.inputs.items()}
-    return parts, wiring, inputs
+    return parts + extra, wiring + extra_wiring, inputs
+
+
+def _added_parts(m: JointMuscle, source, node: str, mass: str) -> tuple[list, list]:
+    """The components on muscle ``m``, renamed after it, what they read of the rig's load read of the muscle's
+    flange node ``node`` and the friction's load ``mass``, and of its pressure source of the muscle's own."""
+    own = {c.name.removeprefix(f"{m.name}_"): c.name for c in source.parts}  # "chamber" -> "<muscle>_chamber"
+    load = {"load.flange": f"{node}.flange", "load.x_m": f"{node}.x_m", "load.v_m_s": f"{node}.v_m_s",
+            "load.mass_kg": mass}
+    parts, wiring = [], []
+    for a in m.added:
+        c = copy.copy(a.component)
+        c.name = f"{m.name}_{a.component.name}"
+        parts.append(c)
+        for port, target in a.connect.items():
+            owner, _, rest = target.partition(".")
+            if target in load:
+                target = load[target]
+            elif owner in own:
+                target = f"{own[owner]}.{rest}"
+            else:
+                raise ValueError(f"muscle {m.name!r}: component {a.component.name!r}: {port} = {target!r}: on a joint "
+                                 f"it reads {', '.join(load)} and its pressure source")
+            wiring.append((target, f"{c.name}.{port}"))
+    return parts, wiring

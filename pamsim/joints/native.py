@@ -95,10 +95,11 @@ def _result(scenario: JointScenario, assembly, muscles, names: dict, out: dict, 
     theta, ke = outputs.index(f"{body.name}.{body.position}"), outputs.index(f"{body.name}.kinetic_energy_J")
     ny = len(outputs)
     events, losses = [], []
+    others = tuple(f"{c}.{n}" for c, n in assembly.indicator_names()[2:])  # the muscles' hysteresis elements'
     for e in out["events"][:int(out["n_events"][0])].tolist():
         before, after = e[4:4 + ny], e[4 + ny:4 + 2 * ny]
         mode, to = BodyMode(int(e[1])), BodyMode(int(e[2]))
-        events.append(JointEvent(e[0], event_name(mode, int(e[3]), to), mode.label, to.label, after[theta]))
+        events.append(JointEvent(e[0], event_name(mode, int(e[3]), to, others), mode.label, to.label, after[theta]))
         if before[ke] != after[ke]:
             losses.append(before[ke] - after[ke])
     high, low = out["extremes"][0][:ny], out["extremes"][0][ny:]

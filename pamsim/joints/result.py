@@ -121,7 +121,7 @@ class JointResult:
         ``residual_J`` = work in - (kinetic + potential gain + bearing friction + impacts); ``relative``
         divides it by the largest term.  Per muscle, ``<name>.slack_J`` is the work of its forces that
         no tendon passed on (nonzero only where it went slack): static work - damping - friction - tendon,
-        less what an elastic tendon stored.
+        less what an elastic tendon stored and what the muscle's hysteresis took.
         """
         s = self.signals
         d = lambda key: float(s[key][-1] - s[key][0])  # noqa: E731
@@ -135,7 +135,8 @@ class JointResult:
                     - terms["dPE_J"] - terms["E_viscous_J"] - terms["E_coulomb_J"] - terms["E_impacts_J"])
         slack = {f"{m}.slack_J": float(s[f"{m}_muscle.W_muscle_J"][-1] - s[f"{m}_damping.E_damping_J"][-1]
                                        - s[f"{m}_friction.E_friction_J"][-1] - s[tendon[m]][-1]
-                                       - (d(k) if (k := f"{m}_series_spring.E_elastic_J") in s else 0.0))
+                                       - (d(k) if (k := f"{m}_series_spring.E_elastic_J") in s else 0.0)
+                                       - sum(float(s[k][-1]) for k in s if k.startswith(f"{m}_hysteresis.E_")))
                  for m in self.muscles}
         scale = max(abs(v) for v in terms.values()) or 1.0
         return {**terms, **slack, "residual_J": float(residual), "relative": float(abs(residual) / scale)}

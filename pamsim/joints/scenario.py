@@ -52,7 +52,8 @@ JOINT_KEYS: dict[str, tuple[float | None, str]] = {
 (9.81 m/s^2, as the one-muscle scenarios); min_rebound_speed_rad_s is assumed (a slower rebound than 1 mrad/s
 moves the link by less than any angle a figure resolves)."""
 MUSCLE_KEYS = {"name", "side", "radius_m", "x_at_zero_m", "model", "parameters", "pressure", "attachment",
-               "link_attach_m", "base_attach_m", "angle_at_zero_rad", "tendon_length_m", "tendon_stiffness_N_per_m"}
+               "link_attach_m", "base_attach_m", "angle_at_zero_rad", "tendon_length_m", "tendon_stiffness_N_per_m",
+               "hysteresis"}
 LEVER_KEYS = {"link_attach_m": "positive", "base_attach_m": "positive", "angle_at_zero_rad": "positive",
               "tendon_length_m": "non_negative"}
 """A lever attachment's keys in a ``[[muscle]]`` table (``attachment = "lever"``) and their ranges."""
@@ -66,7 +67,8 @@ otherwise (the paper's rig); min_rebound_speed_m_s is assumed (a rebound slower 
 carriage by less than a figure resolves).  Besides these, ``weight_N`` in place of ``mass_kg`` (the mass is
 then ``weight_N / g_m_s2``, as a one-muscle scenario's ``[load]``), ``friction_load`` (:data:`SLIDER_FRICTION_LOADS`,
 default ``"static_force"``) and an ``external_force`` signal table."""
-SLIDER_MUSCLE_KEYS = {"name", "side", "x_at_zero_m", "model", "parameters", "pressure", "tendon_stiffness_N_per_m"}
+SLIDER_MUSCLE_KEYS = {"name", "side", "x_at_zero_m", "model", "parameters", "pressure", "tendon_stiffness_N_per_m",
+                      "hysteresis"}
 TOP_KEYS = {"name", "description", "joint", "slider", "muscle", "simulation", "solver", "controller"}
 CONTROLLER_KEYS: dict[str, tuple[object, str]] = {
     "kind": (None, "text"), "sample_rate_Hz": (1000.0, "positive"), "stiffness_Nm_per_rad": (None, "positive"),
@@ -186,7 +188,7 @@ class JointScenario:
             lever = ({**table["lever"], "muscle_L0_m": sc.parameters["L0_m"]} if table["lever"] is not None else None)
             out.append(JointMuscle(table["name"], m.static_force, m.friction, m.damping, m.source,
                                    table["radius_m"], table["side"], table["x_at_zero_m"], sc.initial_pressure_gauge_Pa,
-                                   lever, table["tendon_stiffness_N_per_m"]))
+                                   lever, table["tendon_stiffness_N_per_m"], sc.added_components))
         return tuple(out)
 
     def joint_values(self) -> dict[str, float]:
@@ -314,6 +316,19 @@ def _muscle(origin: str, where: str, table: dict, shared: dict, base_dir: Path, 
         _fail(origin, f"{where}.{key}", table[key], f"unknown key; a [[muscle]] on a {body.name} has {sorted(allowed)}")
     if "pressure" not in table:
         raise ScenarioError(f"{origin}: {where} has no [muscle.pressure] table: every muscle needs a pressure input")
+    values = _attachment(origin, where, table, body)
+    one = {"model": table.get("model", {}), "parameters": table.get("parameters", {}), "pressure": table["pressure"],
+           "load": PLACEHOLDER_LOAD, **shared}
+    if "hysteresis" in table:  # read as a one-muscle scenario's: its elements take the muscle's friction's place
+        one["hysteresis"] = _table(origin, f"{where}.hysteresis", table["hysteresis"])
+    scenario = Scenario.from_dict(one, name=table["name"], base_dir=base_dir, origin=f"{origin}: {where}")
+    values["tendon_stiffness_N_per_m"] = _tendon_stiffness(origin, where, table, scenario)
+    return values, scenario
+
+
+def _attachment(origin: str, where: str, table: dict, body: Body) -> dict:
+    """A muscle's name, side and attachment (a pulley's radius and contraction at zero, or a lever's geometry;
+    on a slider, its contraction at zero), checked."""
     side = table.get("side")
     if side not in (1, -1) or isinstance(side, bool):
         _fail(origin, f"{where}.side", side, f"must be 1 (it moves the {body.name} toward larger {body.noun}s) or -1")
@@ -333,11 +348,7 @@ def _muscle(origin: str, where: str, table: dict, shared: dict, base_dir: Path, 
         values["x_at_zero_m"] = _number(origin, f"{where}.x_at_zero_m", table.get("x_at_zero_m", 0.0), "any")
     else:
         values["lever"] = {k: _number(origin, f"{where}.{k}", table.get(k), kind) for k, kind in LEVER_KEYS.items()}
-    one = {"model": table.get("model", {}), "parameters": table.get("parameters", {}), "pressure": table["pressure"],
-           "load": PLACEHOLDER_LOAD, **shared}
-    scenario = Scenario.from_dict(one, name=table["name"], base_dir=base_dir, origin=f"{origin}: {where}")
-    values["tendon_stiffness_N_per_m"] = _tendon_stiffness(origin, where, table, scenario)
-    return values, scenario
+    return values
 
 
 def _tendon_stiffness(origin: str, where: str, table: dict, scenario: Scenario) -> float | None:
