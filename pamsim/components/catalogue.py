@@ -9,9 +9,13 @@ from __future__ import annotations
 
 from ..modeling import Component
 from .elasto_slide import ElastoSlide
+from .reservoir import Reservoir
 from .spring import LinearSpring
+from .supply import RegulatedSupply
+from .tube import Tube
 
-COMPONENT_TYPES: dict[str, type[Component]] = {"linear_spring": LinearSpring, "elasto_slide": ElastoSlide}
+COMPONENT_TYPES: dict[str, type[Component]] = {"linear_spring": LinearSpring, "elasto_slide": ElastoSlide,
+                                               "supply": RegulatedSupply, "reservoir": Reservoir, "tube": Tube}
 """``{type name: component class}``."""
 
 
