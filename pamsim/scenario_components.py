@@ -98,9 +98,10 @@ def _component_values(v, where: str, kind: str, parameters, entry: dict, default
         if why:
             v.fail(f"{where}.{key}", value, why)
         values[key] = float(value)
-    for key in declared:
-        if key not in values and key not in (defaults or {}):
-            v.fail(f"{where}.{key}", None, f"missing: {kind} needs {', '.join(k for k in declared if k not in (defaults or {}))}")
+    needed = [key for key in declared if key not in (defaults or {})]
+    for key in needed:
+        if key not in values:
+            v.fail(f"{where}.{key}", None, f"missing: {kind} needs {', '.join(needed)}")
     return values
 
 

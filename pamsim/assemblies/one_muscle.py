@@ -90,6 +90,8 @@ def rig_assembly(load: HangingLoad, source: "SourceParts", forces: tuple, added:
                ("friction.level_N", "load.friction_level_N"), ("external.F_external_N", "load.F_external_N"),
                ("load.v_m_s", "external.v_m_s")]
     inputs["external_force_N"] = "external.F_N"
+    if any(target == "chamber.port" for extra in added for target in extra.connect.values()):
+        wiring = _unsettled(wiring)
     for extra in added:
         parts.append(extra.component)
         for own, target in extra.connect.items():
@@ -98,6 +100,14 @@ def rig_assembly(load: HangingLoad, source: "SourceParts", forces: tuple, added:
             else:
                 _drive(inputs, target, f"{extra.component.name}.{own}")
     return Assembly(parts, wiring, inputs, name=name)
+
+
+def _unsettled(wiring: list) -> list:
+    """``wiring`` with the chamber settling onto its own pressure (not at all) instead of its valve's: an
+    added component feeds it too (a tube from a reservoir), so the pressure it approaches is not the
+    valve's supply pressure, and settling onto that would make air."""
+    own = ("chamber.p_abs_Pa", "chamber.p_settle_abs_Pa")
+    return [own if b == "chamber.p_settle_abs_Pa" else (a, b) for a, b in wiring]
 
 
 def _drive(inputs: dict, model_input: str, ref: str) -> None:
