@@ -65,6 +65,7 @@ class SuppliedValve(ProportionalValve):
     inputs = (Var("command", "1", "valve command in [-1, 1]"),)
 
     def equations(self, s: Symbols) -> Equations:
+        """The valve's flow into ``port``, drawn from ``supply`` while it is open to it."""
         valve = self.symbolic_element(s.p)
         p, T = s.port["port"]["p_abs_Pa"], s.port["port"]["T_K"]
         p_up, T_up = s.port["supply"]["p_abs_Pa"], s.port["supply"]["T_K"]
