@@ -293,3 +293,30 @@ def test_an_unknown_law_or_inlet_is_refused_with_the_choices():
                               inlet="node")])
     with pytest.raises(InputError, match=r"component\[0\]\.h_W_per_m2_K.*not a parameter"):
         _scenario([_component("reservoir", "reservoir", volume_m3=2e-5, h_W_per_m2_K=10.0)])
+
+
+# ---------------------------------------------------------------- linearize
+def test_linearize_takes_an_ideal_supply_on_the_valves_supply_port_as_the_rigs_supply(tmp_path):
+    """An ideal supply node at the set pressure is what the valve's supply input was: ``pamsim linearize``
+    gives Figure 4's matrices for Figure 4 with its valve on such a supply (the supply's delivered mass is
+    a work-like integral the control model leaves out); a line with volumes of its own is refused by name."""
+    import json
+
+    text = (SCENARIOS / "acra2012_fig4.toml").read_text().replace(
+        "[pressure]\n", '[pressure]\nsupply_port = "supply.port"\n', 1)
+    text += '\n[[component]]\nname = "supply"\ntype = "supply"\n[component.connect]\np_set_gauge_Pa = "supply_pressure_gauge_Pa"\n'
+    line = tmp_path / "fig4_on_a_supply.toml"
+    line.write_text(text)
+
+    def matrices(path):
+        proc = subprocess.run([sys.executable, "-m", "pamsim", "linearize", str(path), "--json"],
+                              capture_output=True, text=True)
+        assert proc.returncode == 0, proc.stderr
+        return json.loads(proc.stdout)
+
+    plain, supplied = matrices(SCENARIOS / "acra2012_fig4.toml"), matrices(line)
+    for key in ("A", "B", "C", "D"):
+        np.testing.assert_allclose(supplied[key], plain[key], rtol=1e-12, atol=0.0)
+    proc = subprocess.run([sys.executable, "-m", "pamsim", "linearize", str(SCENARIOS / "supply_chain.toml")],
+                          capture_output=True, text=True)
+    assert proc.returncode == 2 and "component 'feed'" in proc.stderr and "states of their own" in proc.stderr
