@@ -49,13 +49,11 @@ for k, (label, res) in enumerate(results.items()):
     style = {"color": f"C{k}", "linestyle": ("-", "--", "-.")[k], "label": label}
     ax_m.plot(res.t_s, res.p_gauge_Pa / 1e5, **style)
     ax_x.plot(res.t_s, res.x_m * 1e3, **style)
-ax_p.set_ylabel("pressure drop [kPa]")
-ax_m.set_ylabel("muscle pressure [bar]")
-ax_x.set_ylabel("contraction [mm]")
-ax_x.set_xlabel("time [s]")
-for ax in (ax_p, ax_m, ax_x):
+for ax, label in ((ax_p, "pressure drop [kPa]"), (ax_m, "muscle pressure [bar]"), (ax_x, "contraction [mm]")):
+    ax.set(ylabel=label)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
+ax_x.set_xlabel("time [s]")
 fig.savefig("supply_chain.png", dpi=110)
 
 # %%

@@ -299,7 +299,7 @@ def test_an_unknown_law_or_inlet_is_refused_with_the_choices():
 def test_linearize_takes_an_ideal_supply_on_the_valves_supply_port_as_the_rigs_supply(tmp_path):
     """An ideal supply node at the set pressure is what the valve's supply input was: ``pamsim linearize``
     gives Figure 4's matrices for Figure 4 with its valve on such a supply (the supply's delivered mass is
-    a work-like integral the control model leaves out); a line with volumes of its own is refused by name."""
+    a work-like integral the control model leaves out)."""
     import json
 
     text = (SCENARIOS / "acra2012_fig4.toml").read_text().replace(
@@ -317,6 +317,49 @@ def test_linearize_takes_an_ideal_supply_on_the_valves_supply_port_as_the_rigs_s
     plain, supplied = matrices(SCENARIOS / "acra2012_fig4.toml"), matrices(line)
     for key in ("A", "B", "C", "D"):
         np.testing.assert_allclose(supplied[key], plain[key], rtol=1e-12, atol=0.0)
-    proc = subprocess.run([sys.executable, "-m", "pamsim", "linearize", str(SCENARIOS / "supply_chain.toml")],
-                          capture_output=True, text=True)
-    assert proc.returncode == 2 and "component 'feed'" in proc.stderr and "states of their own" in proc.stderr
+
+
+def test_linearize_carries_the_lines_volumes_with_their_laminar_conductances():
+    """At the open valve's equilibrium every volume of supply_chain.toml rests at the supply's pressure p:
+    each air mass feeds nothing back and is dropped, and the pressures' rows are the laminar conductances
+    by hand.  The feed hose (2 m, a T cell) has ``g = pi d^4 p / (64 mu L R T)`` per half: its bore's
+    row is ``(-2 g, g) R T / V_hose`` on (its own, the reservoir's) pressure and ``g R T / V_hose`` on the supply
+    input; the reservoir's row ``g R T / V_res`` on the hose's pressure.  The tube (1 m, volume first) has
+    ``pi d^4 p / (128 mu L R T)`` between its bore and the muscle."""
+    from pamsim.control.exact import rest_pull
+    from pamsim.control.linear import linearize
+    from pamsim.control.operating_point import open_valve_equilibrium
+
+    sc = pamsim.load_scenario(SCENARIOS / "supply_chain.toml")
+    model, added = sc.build_model(), sc.added_components
+    lin = linearize(model, open_valve_equilibrium(model, 3.6e5, pull=rest_pull(model, added)), added=added)
+    names = list(lin.sys.state_labels)
+    assert names == ["x_m", "v_m_s", "p_abs_Pa", "feed.p_abs_Pa", "reservoir.p_abs_Pa", "tube.p_abs_Pa"]
+    assert set(lin.dropped_states) == {"air_mass_kg", "feed.air_mass_kg", "reservoir.air_mass_kg", "tube.air_mass_kg"}
+    A, B = lin.sys.A, lin.sys.B
+    RT, p, d = R_AIR * 293.15, 3.6e5 + P_ATM, 0.004
+    g = math.pi * d ** 4 * p / (64 * MU_AIR * 2.0 * RT)
+    V_hose, V_res, V_tube = math.pi * d ** 2 / 4 * 2.0, 1e-4, math.pi * d ** 2 / 4 * 1.0
+    i = {n: k for k, n in enumerate(names)}
+    assert A[i["feed.p_abs_Pa"], i["feed.p_abs_Pa"]] == pytest.approx(-2 * g * RT / V_hose, rel=1e-9)
+    assert A[i["feed.p_abs_Pa"], i["reservoir.p_abs_Pa"]] == pytest.approx(g * RT / V_hose, rel=1e-9)
+    assert B[i["feed.p_abs_Pa"], 1] == pytest.approx(g * RT / V_hose, rel=1e-9)
+    assert A[i["reservoir.p_abs_Pa"], i["feed.p_abs_Pa"]] == pytest.approx(g * RT / V_res, rel=1e-9)
+    g_tube = math.pi * d ** 4 * p / (128 * MU_AIR * 1.0 * RT)
+    assert A[i["tube.p_abs_Pa"], i["p_abs_Pa"]] == pytest.approx(g_tube * RT / V_tube, rel=1e-9)
+    assert np.max(np.abs(lin.residual)) < 1e-6  # an equilibrium: nothing flows
+
+
+def test_linearize_takes_a_lines_states_from_its_run_and_refuses_a_held_line():
+    proc = subprocess.run([sys.executable, "-m", "pamsim", "linearize", str(SCENARIOS / "supply_chain.toml"),
+                           "--at-time", "0.7", "--json"], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    import json
+
+    out = json.loads(proc.stdout)
+    line = out["operating_point"]["line_states"]
+    assert line["reservoir.p_abs_Pa"] > line["tube.p_abs_Pa"] + 1e5  # the valve still filling the tube at 0.7 s
+    assert "tube.p_abs_Pa" in out["states"]
+    proc = subprocess.run([sys.executable, "-m", "pamsim", "linearize", str(SCENARIOS / "supply_chain.toml"),
+                           "--contraction-mm", "30"], capture_output=True, text=True)
+    assert proc.returncode == 2 and "held_pressure" in proc.stderr and "Traceback" not in proc.stderr

@@ -56,6 +56,10 @@ class Reservoir(ElementParameters, Component):
         area = (positive("wall_area_m2", "m^2", "inner surface of the wall"),) if law == "thermal" else ()
         return (positive("volume_m3", "m^3", "the reservoir's volume"), *area) + gas_volume.law_parameters(law)
 
+    def held_state(self, p_abs_Pa: float) -> dict[str, float]:
+        """Its states at rest at the absolute pressure ``p_abs_Pa`` (an operating point of a line)."""
+        return gas_volume.held_state(self, p_abs_Pa)
+
     def equations(self, s: Symbols) -> Equations:
         gas = self.symbolic_element(s.p)
         p, m = s.x["p_abs_Pa"], s.x["air_mass_kg"]

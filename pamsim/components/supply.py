@@ -61,6 +61,14 @@ class RegulatedSupply(Component):
         """The class and the response."""
         return super().structure_key() + (self.response,)
 
+    def held_state(self, p_abs_Pa: float) -> dict[str, float]:
+        """Its states at rest with its output at the absolute pressure ``p_abs_Pa`` (an operating point of a
+        line): the first-order regulator's output there, nothing delivered."""
+        held = {"delivered_mass_kg": 0.0}
+        if self.response == "first_order":
+            held["p_abs_Pa"] = float(p_abs_Pa)
+        return held
+
     def equations(self, s: Symbols) -> Equations:
         p_atm, flow = s.p["p_atm_Pa"], s.port["port"]
         target = p_atm + s.u["p_set_gauge_Pa"]

@@ -86,6 +86,10 @@ class Tube(ElementParameters, Component):
         """The class, the element's form (its law) and the inlet's role."""
         return super().structure_key() + (self.inlet,)
 
+    def held_state(self, p_abs_Pa: float) -> dict[str, float]:
+        """Its states at rest at the absolute pressure ``p_abs_Pa`` (an operating point of a line)."""
+        return gas_volume.held_state(self, p_abs_Pa)
+
     def equations(self, s: Symbols) -> Equations:
         bore = self.symbolic_element(s.p)
         p, m = s.x["p_abs_Pa"], s.x["air_mass_kg"]
