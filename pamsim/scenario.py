@@ -23,7 +23,7 @@ from .elements.chamber import CHAMBER_LAWS, IsothermalChamber, MuscleChamber, Th
 from .elements.damping import DAMPING_MODELS
 from .elements.friction import FRICTION_MODELS, NEGATIVE_LEVEL_CHOICES, NoCoulomb
 from .elements.load import HangingLoad
-from .elements.pressure_source import PrescribedPressure, ValveChamberSource
+from .elements.pressure_source import LineValveSource, PrescribedPressure, ValveChamberSource
 from .elements.force_clip import NEGATIVE_FORCE_CHOICES
 from .elements.static_force import STATIC_FORCE_MODELS
 from .elements.stops import UPPER_STOPS, EndStops
@@ -51,7 +51,8 @@ _SCHEMA: dict[str, dict[str, Any]] = {
               "upper_stop": str},
     "load": {"weight_N": float, "mass_kg": float, "external_force": dict},
     "pressure": {"source": str, "supply_gauge_bar": float, "supply_gauge_Pa": float, "valve_open_time_s": float,
-                 "command": dict, "prescribed": dict, "initial_gauge_bar": float},
+                 "command": dict, "prescribed": dict, "initial_gauge_bar": float, "supply_port": str,
+                 "outlet_port": str},
     "simulation": {"duration_s": float, "sample_rate_Hz": float, "initial_contraction_m": float},
     "solver": {"method": str, "rtol": float, "max_events": int, "max_step_s": float, "native_rtol_factor": float},
     "measured": {"steady_state": str},
@@ -197,7 +198,7 @@ class Scenario:
             added += (hysteresis_component(v, self.spec["hysteresis"], FRICTION_MODELS[m["friction"]](self.parameters, m),
                                            source_parts(self._source, None).pressure, added),)
         object.__setattr__(self, "_added", added)
-        if self._added:
+        if self._added or isinstance(self._source, LineValveSource):
             check_wiring(self, ScenarioError)
 
     @property
@@ -229,7 +230,7 @@ class Scenario:
     def _valve_source(self, v: "_Validator", pr: Mapping[str, Any]) -> ValveChamberSource:
         p = self.parameters
         v.allowed("pressure", pr, {"source", "supply_gauge_bar", "supply_gauge_Pa", "valve_open_time_s",
-                                   "command", "initial_gauge_bar"})
+                                   "command", "initial_gauge_bar", "supply_port", "outlet_port"})
         supply = self._supply_gauge_Pa(v, pr)
         if "initial_gauge_bar" in pr:
             rating = p["rated_pressure_gauge_Pa"]
@@ -238,9 +239,10 @@ class Scenario:
                 v.fail("pressure.initial_gauge_bar", pr["initial_gauge_bar"],
                        f"must lie between 0 and the rating, {rating / PA_PER_BAR:g} bar")
         command = self._valve_command(v, pr)
-        return ValveChamberSource(ProportionalValve33(Iso6358Orifice.from_parameters(p)),
-                                  _chamber(v, self.spec.get("chamber", {}), p), Constant(supply), command,
-                                  p["T_supply_K"], p["p_atm_Pa"])
+        parts = (ProportionalValve33(Iso6358Orifice.from_parameters(p)), _chamber(v, self.spec.get("chamber", {}), p),
+                 Constant(supply), command, p["T_supply_K"], p["p_atm_Pa"])
+        ports = {key: _port_ref(v, f"pressure.{key}", pr[key]) for key in ("supply_port", "outlet_port") if key in pr}
+        return LineValveSource(*parts, **ports) if ports else ValveChamberSource(*parts)
 
     def _supply_gauge_Pa(self, v: "_Validator", pr: Mapping[str, Any]) -> float:
         """The valve's supply pressure [Pa gauge], given in bar or in Pa, within the muscle's rating."""
@@ -420,6 +422,15 @@ def _default_choices(v: "_Validator", model: dict) -> None:
 def _key(kind: str, name: str) -> str:
     return {"parameter": f"parameters.{name}", "model": "model.static_force",
             "variant": "model.static_force_variant"}[kind]
+
+
+def _port_ref(v: "_Validator", key: str, value: Any) -> str:
+    """``value`` as a reference to a port of a component added to the rig (``"reservoir.port"``); whether
+    that component and port exist is the assembly's check (:func:`pamsim.scenario_components.check_wiring`)."""
+    name, _, port = str(value).partition(".")
+    if not (isinstance(value, str) and name.isidentifier() and port.isidentifier()):
+        v.fail(key, value, 'must name a port of a [[component]] as "name.port"')
+    return value
 
 
 # ---------------------------------------------------------------- chamber section

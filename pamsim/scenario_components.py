@@ -48,12 +48,27 @@ def added_components(v, entries: list) -> tuple[AddedComponent, ...]:
         if kind not in COMPONENT_TYPES:
             v.fail(f"{where}.type", kind, "unknown component type", choices=sorted(COMPONENT_TYPES))
         cls = COMPONENT_TYPES[kind]
-        values = _component_values(v, where, kind, cls.parameters, entry)
+        options = _component_options(v, where, cls, entry)
+        declared = cls.scenario_parameters(options) if hasattr(cls, "scenario_parameters") else cls.parameters
+        values = _component_values(v, where, kind, declared, {k: e for k, e in entry.items() if k not in options},
+                                   getattr(cls, "defaults", {}))
         connect = entry.get("connect", {})
         if not isinstance(connect, dict) or not all(isinstance(t, str) for t in connect.values()):
             v.fail(f"{where}.connect", connect, 'must be a table of its ports and inputs, e.g. {flange = "load.flange"}')
-        out.append(AddedComponent(cls(name, values), dict(connect)))
+        out.append(AddedComponent(cls(name, values, **options), dict(connect)))
     return tuple(out)
+
+
+def _component_options(v, where: str, cls, entry: dict) -> dict[str, str]:
+    """The entry's choices of form (a reservoir's ``law``, a tube's ``inlet``): each one of the names the
+    class offers (its ``choices``, the first the default when the key is left out)."""
+    options = {}
+    for key, names in getattr(cls, "choices", {}).items():
+        if key in entry:
+            if entry[key] not in names:
+                v.fail(f"{where}.{key}", entry[key], "unknown choice", choices=names)
+            options[key] = entry[key]
+    return options
 
 
 def _component_name(v, where: str, entry: dict, taken: set) -> str:
@@ -66,8 +81,9 @@ def _component_name(v, where: str, entry: dict, taken: set) -> str:
     return name
 
 
-def _component_values(v, where: str, kind: str, parameters, entry: dict) -> dict[str, float]:
-    """The entry's parameter values: each declared, a finite number in its range, none missing."""
+def _component_values(v, where: str, kind: str, parameters, entry: dict, defaults=None) -> dict[str, float]:
+    """The entry's parameter values: each declared, a finite number in its range, none missing that has
+    no default (``defaults``: the class's)."""
     declared = {p.name: p for p in parameters}
     values: dict[str, float] = {}
     for key, value in entry.items():
@@ -82,9 +98,10 @@ def _component_values(v, where: str, kind: str, parameters, entry: dict) -> dict
         if why:
             v.fail(f"{where}.{key}", value, why)
         values[key] = float(value)
-    for key in declared:
+    needed = [key for key in declared if key not in (defaults or {})]
+    for key in needed:
         if key not in values:
-            v.fail(f"{where}.{key}", None, f"missing: {kind} needs {', '.join(declared)}")
+            v.fail(f"{where}.{key}", None, f"missing: {kind} needs {', '.join(needed)}")
     return values
 
 

@@ -21,9 +21,9 @@ import numpy as np
 from ..components.element import kept_component
 from ..components.hanging_load import LoadMode
 from ..components import (Chamber, CoulombFriction, ExternalForce, HangingLoad, MuscleStaticForce,
-                          PressureSignal, ProportionalValve, ViscousDamping)
-from ..elements.pressure_source import PrescribedPressure, ValveChamberSource
-from ..modeling import Assembly
+                          PressureSignal, ProportionalValve, SuppliedValve, ViscousDamping)
+from ..elements.pressure_source import LineValveSource, PrescribedPressure, ValveChamberSource
+from ..modeling import Assembly, AssemblyError
 from ..modeling.pygen import compiled_by_mode, outputs_by_mode
 from ..signals import Constant
 
@@ -90,10 +90,34 @@ def rig_assembly(load: HangingLoad, source: "SourceParts", forces: tuple, added:
                ("friction.level_N", "load.friction_level_N"), ("external.F_external_N", "load.F_external_N"),
                ("load.v_m_s", "external.v_m_s")]
     inputs["external_force_N"] = "external.F_N"
+    if any(target == "chamber.port" for extra in added for target in extra.connect.values()):
+        wiring = _unsettled(wiring)
     for extra in added:
         parts.append(extra.component)
-        wiring += [(target, f"{extra.component.name}.{own}") for own, target in extra.connect.items()]
+        for own, target in extra.connect.items():
+            if "." in target:
+                wiring.append((target, f"{extra.component.name}.{own}"))
+            else:
+                _drive(inputs, target, f"{extra.component.name}.{own}")
     return Assembly(parts, wiring, inputs, name=name)
+
+
+def _unsettled(wiring: list) -> list:
+    """``wiring`` with the chamber settling onto its own pressure (not at all) instead of its valve's: an
+    added component feeds it too (a tube from a reservoir), so the pressure it approaches is not the
+    valve's supply pressure, and settling onto that would make air."""
+    own = ("chamber.p_abs_Pa", "chamber.p_settle_abs_Pa")
+    return [own if b == "chamber.p_settle_abs_Pa" else (a, b) for a, b in wiring]
+
+
+def _drive(inputs: dict, model_input: str, ref: str) -> None:
+    """Let the model input ``model_input`` drive the component input ``ref`` too (a connection's target
+    without a component: one of the rig's model inputs, such as a supply's set pressure)."""
+    if model_input not in inputs:
+        raise AssemblyError(f"connection of {ref}: {model_input!r} is neither a component's port or output "
+                            f"(\"name.port\") nor a model input of the rig ({', '.join(inputs)})")
+    drives = inputs[model_input]
+    inputs[model_input] = ((drives,) if isinstance(drives, str) else tuple(drives)) + (ref,)
 
 
 VALVE_CHAMBER_WIRING = (("chamber.port", "valve.port"), ("load.x_m", "chamber.x_m"), ("load.v_m_s", "chamber.v_m_s"),
@@ -110,13 +134,35 @@ def _valve_parts(src: ValveChamberSource, p0_gauge_Pa: float | None) -> SourcePa
         {"valve_command": "valve.command", "supply_pressure_gauge_Pa": "valve.supply_gauge_Pa"}, "chamber")
 
 
+def _line_valve_parts(src: LineValveSource, p0_gauge_Pa: float | None) -> SourceParts:
+    """The valve and chamber of a line: the valve's supply side on ``src.supply_port`` (if given), its outlet
+    on ``src.outlet_port`` (if given, else the chamber).  The chamber settles onto its valve's pressure only
+    where that valve feeds it directly from a supply input, as :func:`_valve_parts` wires it; otherwise the
+    pressure it approaches is a volume's that moves (a tube's, a reservoir's), and it settles onto its own
+    pressure, that is not at all."""
+    plain = _valve_parts(src, p0_gauge_Pa)
+    if not (src.supply_port or src.outlet_port):
+        return plain
+    chamber, valve = plain.parts
+    inputs = dict(plain.inputs)
+    if src.supply_port:
+        valve = kept_component(SuppliedValve, "valve", src.valve, src.T_supply_K, src.p_atm_Pa,
+                               src.chamber.R_J_per_kg_K)
+        inputs["supply_pressure_gauge_Pa"] = ()
+    wiring = [(src.outlet_port or "chamber.port", "valve.port"), ("load.x_m", "chamber.x_m"),
+              ("load.v_m_s", "chamber.v_m_s"), ("chamber.p_abs_Pa", "chamber.p_settle_abs_Pa")]
+    if src.supply_port:
+        wiring.append((src.supply_port, "valve.supply"))
+    return SourceParts([chamber, valve], wiring, inputs, "chamber")
+
+
 def _prescribed_parts(src: PrescribedPressure, p0_gauge_Pa: float | None) -> SourceParts:
     return SourceParts([kept_component(PressureSignal, "pressure")], [], {"prescribed_pressure_gauge_Pa": "pressure.p_in_gauge_Pa"},
                        "pressure")
 
 
 SOURCE_PARTS: dict[type, Callable[[Any, float | None], SourceParts]] = {
-    ValveChamberSource: _valve_parts, PrescribedPressure: _prescribed_parts}
+    ValveChamberSource: _valve_parts, LineValveSource: _line_valve_parts, PrescribedPressure: _prescribed_parts}
 """``{pressure source class: parts(source, initial gauge pressure or None)}``.  A source defined above
 this layer (a controller's) registers its own with :func:`register_source`."""
 

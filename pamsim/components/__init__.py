@@ -15,13 +15,16 @@ from .hanging_load import HangingLoad, LoadMode
 from .linear_slider import LinearSlider
 from .pressure import PressureSignal
 from .pulley import Pulley, SliderTendon
+from .reservoir import Reservoir
 from .rotary_joint import RotaryJoint
 from .spring import LinearSpring
 from .static_force import MuscleStaticForce
-from .valve import ProportionalValve
+from .supply import RegulatedSupply
+from .tube import Tube
+from .valve import ProportionalValve, SuppliedValve
 
 __all__ = ["COMPONENT_TYPES", "Chamber", "CoulombFriction", "ExternalForce", "HangingLoad", "LinearSlider",
            "LinearSpring", "LoadMode",
-           "MuscleStaticForce", "PressureSignal", "ProportionalValve", "Pulley", "RotaryJoint",
-           "SliderTendon", "ViscousDamping",
+           "MuscleStaticForce", "PressureSignal", "ProportionalValve", "Pulley", "RegulatedSupply", "Reservoir",
+           "RotaryJoint", "SliderTendon", "SuppliedValve", "Tube", "ViscousDamping",
            "register_component"]

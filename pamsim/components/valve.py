@@ -49,3 +49,33 @@ class ProportionalValve(ElementParameters, Component):
         return Equations(outputs={"mass_flow_kg_s": mdot,
                                   "p_settle_abs_Pa": if_else(u > 0.0, p_supply, if_else(u < 0.0, p_atm, p))},
                          port={"port": {"mdot_kg_s": mdot, "flow_work_W": s.p["R_J_per_kg_K"] * T_in * mdot}})
+
+
+class SuppliedValve(ProportionalValve):
+    """:class:`ProportionalValve` whose supply side is a pneumatic port (a branch on a supply's, a
+    reservoir's or a tube's node) instead of an input: what it lets into its ``port`` it takes from its
+    ``supply`` port, at that node's pressure and temperature.
+
+    The exhaust path (``command < 0``) vents to the ambient and draws nothing from the supply.  Output
+    ``p_settle_abs_Pa`` is the port's own pressure: the volume it feeds is not settled onto the supply's
+    pressure, which moves (a reservoir empties, a regulator lags), and settling it would make air.
+    """
+
+    ports = (Port("port", PNEUMATIC, "branch"), Port("supply", PNEUMATIC, "branch"))
+    inputs = (Var("command", "1", "valve command in [-1, 1]"),)
+
+    def equations(self, s: Symbols) -> Equations:
+        """The valve's flow into ``port``, drawn from ``supply`` while it is open to it."""
+        valve = self.symbolic_element(s.p)
+        p, T = s.port["port"]["p_abs_Pa"], s.port["port"]["T_K"]
+        p_up, T_up = s.port["supply"]["p_abs_Pa"], s.port["supply"]["T_K"]
+        u, p_atm = s.u["command"], s.p["p_atm_Pa"]
+        # The exhaust's air, drawn in below ambient, is at the supply's temperature parameter, as for the
+        # valve with a supply input.
+        T_source = if_else(u >= 0.0, T_up, s.p["T_supply_K"])
+        mdot = valve.inflow_kg_s(u, p, T, p_up, T_source, p_atm)
+        work = s.p["R_J_per_kg_K"] * if_else(mdot >= 0.0, T_source, T) * mdot
+        drawn = if_else(u >= 0.0, 1.0, 0.0)
+        return Equations(outputs={"mass_flow_kg_s": mdot, "p_settle_abs_Pa": p},
+                         port={"port": {"mdot_kg_s": mdot, "flow_work_W": work},
+                               "supply": {"mdot_kg_s": -drawn * mdot, "flow_work_W": -drawn * work}})

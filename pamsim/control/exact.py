@@ -64,28 +64,23 @@ class FrictionDirection(Component):
 
 
 def control_functions(model, friction: FrictionTreatment, added: tuple = ()):
-    """CasADi functions ``(x, u) -> (f, y)`` and ``(x, u) -> (df/dx, df/du, dy/dx, dy/du)`` of the four
-    control states ``(x_m, v_m_s, p_abs_Pa, air_mass_kg)``, inputs ``(valve_command, supply_gauge_Pa,
-    F_ext_N)`` and outputs ``(contraction_m, p_gauge_Pa, F_tendon_N)``, with ``model``'s parameter
-    values as constants.  ``added`` (:class:`~pamsim.assemblies.one_muscle.AddedComponent` s, a
-    scenario's ``[[component]]`` tables) act on the rig too; they may add forces and work integrals,
-    not states of their own.
+    """CasADi functions ``(x, u) -> (f, y)`` and ``(x, u) -> (df/dx, df/du, dy/dx, dy/du)`` of the control
+    states, the rig's four ``(x_m, v_m_s, p_abs_Pa, air_mass_kg)`` then those of the added components
+    (:func:`line_states`), inputs ``(valve_command, supply_gauge_Pa, F_ext_N)`` and outputs
+    ``(contraction_m, p_gauge_Pa, F_tendon_N)``, with ``model``'s parameter values as constants.
+    ``added`` (:class:`~pamsim.assemblies.one_muscle.AddedComponent` s, a scenario's ``[[component]]``
+    tables) act on the rig too: forces and work integrals, and the volumes of a supply line.
 
     Raises
     ------
     InputError
-        For an added component with states the control model would have to carry.
+        For an added component with states the control model cannot carry (:func:`line_states`).
     """
     import casadi as ca
 
-    treatment = (AddedComponent(FrictionDirection("treatment", friction), {"v_m_s": "load.v_m_s"}),)
-    assembly = one_muscle_assembly(model, added=tuple(added) + treatment, friction_direction="treatment.direction")
-    flat = assembly.flatten({"load": int(LoadMode.SLIP_UP)})
-    if flat.externals:  # an element called on floats: CasADi would take it for a constant
-        raise NotImplementedError(f"no exact Jacobian through {', '.join(e.name for e in flat.externals)}")
+    flat = _control_flat(model, friction, added)
     names = [v.name for v in flat.states]
-    keep = [names.index(n) for n in CONTROL_STATES]
-    _refuse_added_states(names, keep, flat.quadratures(), added)
+    keep = [names.index(n) for n in (*CONTROL_STATES, *_carried(flat, added))]
     x = ca.vertcat(*[flat.x[i] for i in keep])
     u = ca.vertcat(*flat.u)
     p = dict(zip([v.name for v in flat.parameters], flat.p))
@@ -102,14 +97,56 @@ def control_functions(model, friction: FrictionTreatment, added: tuple = ()):
     return values_fn, jac
 
 
-def _refuse_added_states(names, keep, quadratures, added) -> None:
-    """The control model carries the rig's four states: an added component's own must be work integrals."""
-    own = {a.component.name for a in added}
-    extra = [names[i] for i in range(len(names)) if i not in keep and i not in quadratures
-             and names[i].split(".", 1)[0] in own]
-    if extra:
-        raise InputError(f"component {extra[0].split('.', 1)[0]!r}: pamsim linearize takes added components that "
-                         f"act on the rig with forces, not ones with states of their own ({', '.join(extra)})")
+def _control_flat(model, friction: FrictionTreatment, added: tuple):
+    """The rig's flat model with the load sliding and the Coulomb term's direction from ``friction``."""
+    treatment = (AddedComponent(FrictionDirection("treatment", friction), {"v_m_s": "load.v_m_s"}),)
+    assembly = one_muscle_assembly(model, added=tuple(added) + treatment, friction_direction="treatment.direction")
+    flat = assembly.flatten({"load": int(LoadMode.SLIP_UP)})
+    if flat.externals:  # an element called on floats: CasADi would take it for a constant
+        raise NotImplementedError(f"no exact Jacobian through {', '.join(e.name for e in flat.externals)}")
+    return flat
+
+
+def line_states(model, added: tuple) -> tuple[tuple[str, float], ...]:
+    """``(name, nominal scale)`` of each state the control model carries besides the rig's four: the added
+    components' own (a supply line's pressures and air masses), not the integrals that nothing reads (their
+    work), in the assembly's order.
+
+    Raises
+    ------
+    InputError
+        For a component with such states that cannot say where they rest (a ``held_state(p_abs_Pa)``).
+    """
+    if not any(a.component.states for a in added):
+        return ()
+    flat = _control_flat(model, FrictionTreatment("dropped"), added)
+    nominal = {v.name: v.nominal for v in flat.states}
+    return tuple((name, nominal[name]) for name in _carried(flat, added))
+
+
+def _carried(flat, added) -> list[str]:
+    """The names of the added components' states the control model carries (see :func:`line_states`)."""
+    own = {a.component.name: a.component for a in added}
+    quadratures = flat.quadratures()
+    extra = [v.name for i, v in enumerate(flat.states) if i not in quadratures and v.name.split(".", 1)[0] in own]
+    for name in extra:
+        component = own[name.split(".", 1)[0]]
+        if not callable(getattr(component, "held_state", None)):
+            raise InputError(f"component {component.name!r}: pamsim linearize takes added components that act on the "
+                             "rig with forces, or the volumes of a supply line, not ones with other states of their "
+                             f"own ({', '.join(n for n in extra if n.startswith(component.name + '.'))})")
+    return extra
+
+
+def held_line_states(model, added: tuple, p_abs_Pa: float) -> np.ndarray:
+    """The values of :func:`line_states` with every volume of the line at rest at ``p_abs_Pa`` (the valve open
+    on a supply at that pressure: no flow anywhere)."""
+    by_name = {a.component.name: a.component for a in added}
+    values = []
+    for name, _ in line_states(model, added):
+        owner, _, state = name.partition(".")
+        values.append(by_name[owner].held_state(p_abs_Pa)[state])
+    return np.asarray(values, dtype=float)
 
 
 def rest_pull(model, added: tuple):
@@ -154,7 +191,8 @@ class _RestPull:
 
 
 def exact_jacobians(model, states, inputs, friction: FrictionTreatment, valve_slope: str, added: tuple = ()):
-    """``(A, B, C, D)`` of the control model at ``states``, ``inputs`` (numpy arrays).
+    """``(A, B, C, D)`` of the control model at ``states``, ``inputs`` (numpy arrays; the states the rig's four,
+    then :func:`line_states`).
 
     Each column is the mean of the analytic derivative just either side of the point, a step of
     :data:`TIE_STEP` of the variable's typical scale away: where a branch of the model switches exactly
@@ -166,6 +204,7 @@ def exact_jacobians(model, states, inputs, friction: FrictionTreatment, valve_sl
     from .system import INPUT_SCALES, STATE_SCALES
 
     _, jac = control_functions(model, friction, added)
+    scales = tuple(STATE_SCALES) + tuple(nominal for _, nominal in line_states(model, added))
     x0 = np.asarray(states, dtype=float)
     u0 = np.asarray(inputs, dtype=float)
 
@@ -183,7 +222,7 @@ def exact_jacobians(model, states, inputs, friction: FrictionTreatment, valve_sl
         return np.mean([a for a, _ in cols], axis=0), np.mean([c for _, c in cols], axis=0)
 
     A, B, C, D = at(x0, u0)
-    for i, scale in enumerate(STATE_SCALES):
+    for i, scale in enumerate(scales):
         A[:, i], C[:, i] = column(i, True, (x0[i] + TIE_STEP * scale, x0[i] - TIE_STEP * scale))
     for j, scale in enumerate(INPUT_SCALES):
         points = (u0[j] + TIE_STEP * scale, u0[j] - TIE_STEP * scale)

@@ -38,7 +38,7 @@ import numpy as np
 from ..errors import InputError
 from ..model import MuscleModel
 from .choices import VALVE_SLOPES
-from .exact import control_functions, exact_jacobians
+from .exact import control_functions, exact_jacobians, held_line_states, line_states
 from .operating_point import OperatingPoint
 from .system import INPUT_SCALES, INPUTS, OUTPUTS, STATE_SCALES, STATES, FrictionTreatment, MusclePlant
 
@@ -238,8 +238,10 @@ def linearize(model: MuscleModel, op: OperatingPoint, friction: FrictionTreatmen
     plant = MusclePlant(model)
     if valve_slope not in VALVE_SLOPES:
         raise InputError(f"valve slope {valve_slope!r}: choose from {', '.join(VALVE_SLOPES)}")
+    lines = line_states(model, added) if added else ()
+    x0 = _state_vector(model, op, added, lines)
     try:
-        A, B, C, D = exact_jacobians(model, op.states, op.inputs, friction, valve_slope, added)
+        A, B, C, D = exact_jacobians(model, x0, op.inputs, friction, valve_slope, added)
         method = "exact"
     except NotImplementedError as exc:  # an element called on floats
         if added:  # the difference quotients are the composed model's, which has no added components
@@ -247,17 +249,47 @@ def linearize(model: MuscleModel, op: OperatingPoint, friction: FrictionTreatmen
         A, B, C, D = jacobians(plant, op, friction, valve_slope)
         method = "central differences"
     residual = (plant.rhs(op.states, op.inputs, friction) if not added
-                else np.asarray(control_functions(model, friction, added)[0](op.states, op.inputs)[0]).ravel())
-    keep = list(range(len(STATES)))
-    k_m = STATES.index("air_mass_kg")
-    dropped: tuple[str, ...] = ()
-    if drop_unobservable_air_mass:
-        # Compare in scaled variables so that kg and Pa columns are commensurable.
-        scaled_A = A * np.asarray(STATE_SCALES)[None, :] / np.asarray(STATE_SCALES)[:, None]
-        others = [k for k in keep if k != k_m]
-        coupling = np.max(np.abs(np.delete(scaled_A[:, k_m], k_m))) + np.max(np.abs(C[:, k_m])) * STATE_SCALES[k_m]
-        if coupling <= 1e-9 * np.max(np.abs(scaled_A[np.ix_(others, others)])):
-            keep, dropped = others, ("air_mass_kg",)
-    sys = ct.ss(A[np.ix_(keep, keep)], B[keep], C[:, keep], D, states=[STATES[k] for k in keep],
+                else np.asarray(control_functions(model, friction, added)[0](x0, op.inputs)[0]).ravel())
+    names = list(STATES) + [name for name, _ in lines]
+    scales = np.asarray(list(STATE_SCALES) + [nominal for _, nominal in lines])
+    keep, dropped = _kept_states(A, C, names, scales) if drop_unobservable_air_mass else (list(range(len(names))), [])
+    sys = ct.ss(A[np.ix_(keep, keep)], B[keep], C[:, keep], D, states=[names[k] for k in keep],
                 inputs=list(INPUTS), outputs=list(OUTPUTS), name="muscle_linear")
-    return LinearModel(sys, op, friction, valve_slope, residual, dropped, method)
+    return LinearModel(sys, op, friction, valve_slope, residual, tuple(dropped), method)
+
+
+def _kept_states(A: np.ndarray, C: np.ndarray, names: list, scales: np.ndarray) -> tuple[list, list]:
+    """``(indices kept, names dropped)``: every air mass (the chamber's, a line volume's) that feeds nothing
+    back is dropped."""
+    keep, dropped = list(range(len(names))), []
+    for k in [k for k, n in enumerate(names) if n.split(".")[-1] == "air_mass_kg"]:
+        if _uncoupled(A, C, scales, k, keep):
+            keep.remove(k)
+            dropped.append(names[k])
+    return keep, dropped
+
+
+def _uncoupled(A: np.ndarray, C: np.ndarray, scales: np.ndarray, k: int, keep: list) -> bool:
+    """Whether state ``k`` (an air mass) feeds nothing back: its column of A (but its own entry) and of C is
+    zero beside the rest of the kept states' A, compared in scaled variables so that kg and Pa columns are
+    commensurable."""
+    scaled_A = A * scales[None, :] / scales[:, None]
+    others = [i for i in keep if i != k]
+    coupling = np.max(np.abs(scaled_A[others, k])) + np.max(np.abs(C[:, k])) * scales[k]
+    return bool(coupling <= 1e-9 * np.max(np.abs(scaled_A[np.ix_(others, others)])))
+
+
+def _state_vector(model, op: OperatingPoint, added: tuple, lines: tuple) -> np.ndarray:
+    """The rig's four states at ``op``, then the states of the components added to it (``lines``): the
+    operating point's own (a run's), or the components at rest at the chamber's pressure where the valve is
+    open on its supply (every volume of the line there, no flow)."""
+    if not lines:
+        return np.asarray(op.states, dtype=float)
+    if all(name in op.line_states for name, _ in lines):
+        extra = np.array([op.line_states[name] for name, _ in lines], dtype=float)
+    elif op.kind == "open_valve":
+        extra = held_line_states(model, added, float(op.states[2]))
+    else:
+        raise InputError(f"operating point {op.kind!r}: a supply line ({', '.join(n for n, _ in lines)}) is "
+                         "linearised at the open valve's equilibrium or at a time of its run (--at-time)")
+    return np.concatenate([np.asarray(op.states, dtype=float), extra])

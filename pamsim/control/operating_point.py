@@ -20,7 +20,7 @@ Three kinds:
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.optimize import brentq
@@ -37,7 +37,10 @@ from .system import MusclePlant
 class OperatingPoint:
     """States ``(x_m, v_m_s, p_abs_Pa, air_mass_kg)`` and inputs ``(valve_command, supply_gauge_Pa, F_ext_N)``.
 
-    ``mode`` is the hybrid mode of the load there (stick for an equilibrium).
+    ``mode`` is the hybrid mode of the load there (stick for an equilibrium).  ``line_states``: the states
+    of the components added to the rig there (``{"reservoir.p_abs_Pa": ...}``), where the operating point
+    knows them (a run's); an equilibrium's come from the components at rest
+    (:func:`pamsim.control.exact.held_line_states`).
     """
 
     states: np.ndarray
@@ -45,11 +48,15 @@ class OperatingPoint:
     kind: str
     mode: Mode
     description: str
+    line_states: dict = field(default_factory=dict)
 
     def as_dict(self) -> dict:
         """The operating point as JSON-ready values: kind, mode, description, states and inputs."""
-        return {"kind": self.kind, "mode": self.mode.label, "description": self.description,
-                "states": [float(v) for v in self.states], "inputs": [float(v) for v in self.inputs]}
+        out = {"kind": self.kind, "mode": self.mode.label, "description": self.description,
+               "states": [float(v) for v in self.states], "inputs": [float(v) for v in self.inputs]}
+        if self.line_states:
+            out["line_states"] = {k: float(v) for k, v in self.line_states.items()}
+        return out
 
 
 def _load_N(model: MuscleModel, F_ext_N: float) -> float:
@@ -181,7 +188,10 @@ def trajectory_point(scenario, time_s: float) -> OperatingPoint:
     states = np.array([result.x_m[-1], result.v_m_s[-1], p_abs, result.signals["air_mass_kg"][-1]], dtype=float)
     command, supply = model.source.inputs(float(time_s))
     mode = result.final_mode
+    added = {f"{a.component.name}.{v.name}" for a in scenario.added_components for v in a.component.states}
+    line = {name: float(values[-1]) for name, values in result.signals.items() if name in added}
     return OperatingPoint(states, np.array([command, supply, model.load.external_N(float(time_s))], dtype=float),
                           "trajectory", mode,
                           f"state of the simulation at t = {time_s:g} s ({mode.label}): x = {states[0] * 1e3:.3f} mm, "
-                          f"v = {states[1] * 1e3:.3f} mm/s, p = {(p_abs - model.source.p_atm_Pa) / PA_PER_BAR:.4f} bar")
+                          f"v = {states[1] * 1e3:.3f} mm/s, p = {(p_abs - model.source.p_atm_Pa) / PA_PER_BAR:.4f} bar",
+                          line)

@@ -99,6 +99,18 @@ class ValveChamberSource:
 
 
 @dataclass(frozen=True)
+class LineValveSource(ValveChamberSource):
+    """:class:`ValveChamberSource` in a line of components: the valve's supply side connected to the port
+    ``supply_port`` of a component added to the rig (a supply's, a reservoir's node), in place of its
+    supply input, and its outlet to ``outlet_port`` (a tube's inlet) in place of the chamber.  An empty
+    string keeps that side as :class:`ValveChamberSource` has it.  The physics is the same; only the
+    wiring differs (:func:`pamsim.assemblies.one_muscle.source_parts`)."""
+
+    supply_port: str = ""
+    outlet_port: str = ""
+
+
+@dataclass(frozen=True)
 class PrescribedPressure:
     """Gauge pressure imposed as a signal ``p_gauge_Pa(t)``: step, ramp, lag or measured trace."""
 
