@@ -325,3 +325,11 @@ def test_a_joints_muscles_take_elements_too():
         assert balance["relative"] < 1e-5 and all(abs(balance[f"{n}.slack_J"]) < 1e-9 for n in ("flexor", "extensor"))
         gaps.append(float(np.max(np.abs(runs["native"].theta_rad - coulomb.theta_rad))))
     assert gaps[1] < gaps[0] / 30 and gaps[1] < 2e-4, gaps
+
+
+def test_linearize_refuses_a_prescribed_pressure_with_added_components():
+    """``pamsim linearize`` on the loops scenario (a prescribed pressure, a [hysteresis] table) names the
+    source and exits 2; it ended in a traceback before (reading the valve's ambient pressure)."""
+    done = subprocess.run([sys.executable, "-m", "pamsim", "linearize", str(ROOT / "scenarios" / "hysteresis_loops.toml")],
+                          capture_output=True, text=True)
+    assert done.returncode == 2 and "valve source" in done.stderr and "Traceback" not in done.stderr

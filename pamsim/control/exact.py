@@ -22,7 +22,7 @@ from ..assemblies.one_muscle import AddedComponent, one_muscle_assembly
 from ..components.hanging_load import LoadMode
 from ..errors import InputError
 from ..modeling import Component, Equations, Symbols, Var
-from .system import FrictionTreatment
+from .system import FrictionTreatment, require_valve_source
 
 CONTROL_STATES = ("load.x_m", "load.v_m_s", "chamber.p_abs_Pa", "chamber.air_mass_kg")
 """The control model's states in the assembly (:data:`pamsim.control.system.STATES`)."""
@@ -153,7 +153,10 @@ def rest_pull(model, added: tuple):
     """The force the muscle and the ``added`` components pull the load with at rest, as a static force
     model (``force_N(x_m, p_gauge_Pa)``, :mod:`pamsim.static`): the muscle's static force plus what
     the added components exert on the load at rest, from the assembly's generated net force."""
-    return model.static_force if not added else _RestPull(model, tuple(added))
+    if not added:
+        return model.static_force
+    require_valve_source(model)  # the added components' force is read at the chamber's pressure
+    return _RestPull(model, tuple(added))
 
 
 class _RestPull:

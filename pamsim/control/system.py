@@ -87,6 +87,14 @@ class FrictionTreatment:
         return f"Coulomb friction linearised about sliding {'up' if self.direction > 0 else 'down'}"
 
 
+def require_valve_source(model: MuscleModel) -> None:
+    """Raise :class:`InputError` for a ``model`` whose pressure is not fed by a valve: a control model's input
+    is the valve's command."""
+    if not isinstance(model.source, ValveChamberSource):
+        raise InputError(f"control models need a valve source (source = 'valve'); this model uses "
+                         f"{getattr(model.source, 'name', type(model.source).__name__)!r}")
+
+
 class MusclePlant:
     """The state equations of a :class:`MuscleModel` with a valve source, with explicit inputs.
 
@@ -102,9 +110,7 @@ class MusclePlant:
     """
 
     def __init__(self, model: MuscleModel):
-        if not isinstance(model.source, ValveChamberSource):
-            raise InputError(f"control models need a valve source (source = 'valve'); this model uses "
-                             f"{getattr(model.source, 'name', type(model.source).__name__)!r}")
+        require_valve_source(model)
         self.model = model
         self._zeros = np.zeros(N_WORK)
 
