@@ -116,8 +116,9 @@ def simulate(scenario: "Scenario | str | os.PathLike", backend: str = "python",
 
         return simulate_python(scenario, progress, model)
     if (model is None and backend in ("fmu-cs", "fmu-me")
-            and (scenario.added_components or scenario.chamber_law != "polytropic")):
-        # The one-muscle FMU has the rig alone, with the polytropic chamber: the assembly's FMU carries the rest.
+            and (scenario.added_components or scenario.chamber_law != "polytropic" or scenario.pwm_model == "averaged")):
+        # The one-muscle FMU has the rig alone, with the polytropic chamber and the proportional valve: the
+        # assembly's FMU carries the rest.
         model = scenario.build_model()
     if model is None:
         return get_backend(backend)(scenario)
