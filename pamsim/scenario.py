@@ -363,6 +363,11 @@ class Scenario:
             return None
         return command.get("model", "switching")
 
+    def with_pwm_averaged(self) -> "Scenario":
+        """This scenario with its PWM valve command run by the averaged valve (``model = "averaged"``)."""
+        command = self.spec["pressure"]["command"]
+        return self.with_changes({"pressure": {"command": {**command, "model": "averaged"}}})
+
     @property
     def initial_pressure_gauge_Pa(self) -> float | None:
         """Initial chamber pressure of a valve source [Pa gauge], or None for ambient."""

@@ -130,6 +130,35 @@ class AveragedPwmSource(ValveChamberSource):
     """A :class:`ValveChamberSource` whose valve is a :class:`PwmAveragedValve` and whose command is the
     duty (:func:`duty_signal`): the averaged model of the switching source it was made from."""
 
+    @property
+    def duty(self) -> float:
+        """The duty the command holds while the PWM runs (0 before and after)."""
+        return max(self.command.values)
+
+    def balance_pressure_Pa(self, duty: float, T_chamber_K: float) -> float:
+        """The absolute chamber pressure [Pa] at which the two paths' mean flows cancel at ``duty`` (gas at
+        ``T_chamber_K``): the supply's while only the supply path opens, the exhaust's while only the
+        exhaust path does.
+
+        Raises
+        ------
+        ValueError
+            If neither path ever opens at ``duty`` (a 2/2 valve at duty 0): any pressure is held.
+        """
+        from scipy.optimize import brentq
+
+        p_supply = float(self.supply_gauge_Pa.final_value) + self.p_atm_Pa
+        w_supply, w_exhaust = self.valve.shares(duty)
+        if w_supply == 0.0 and w_exhaust == 0.0:
+            raise ValueError(f"at duty {duty:g} the valve never opens: every pressure is held")
+        if w_exhaust == 0.0 or w_supply == 0.0:
+            return p_supply if w_exhaust == 0.0 else self.p_atm_Pa
+
+        def flow(p):
+            return self.valve.inflow_kg_s(duty, p, T_chamber_K, p_supply, self.T_supply_K, self.p_atm_Pa)
+
+        return float(brentq(flow, self.p_atm_Pa, p_supply, xtol=1e-9, rtol=1e-14))
+
     def derivatives(self, s, x_m, v_m_s, inputs) -> tuple[float, float]:
         """(dp/dt [Pa/s], dm/dt [kg/s]) of the chamber, each path's flow carrying its own temperature."""
         p, m = s[0], s[1]
