@@ -23,6 +23,7 @@ class AveragedPwmValve(ProportionalValve):
               Var("supply_gauge_Pa", "Pa", "supply gauge pressure"))
 
     def equations(self, s: Symbols) -> Equations:
+        """The two paths' mean flows into the port, their flow work, and the pressure the port settles at."""
         valve = self.symbolic_element(s.p)
         p, T = s.port["port"]["p_abs_Pa"], s.port["port"]["T_K"]
         T_supply, p_atm = s.p["T_supply_K"], s.p["p_atm_Pa"]
