@@ -363,6 +363,13 @@ class Scenario:
             return None
         return command.get("model", "switching")
 
+    @property
+    def beyond_one_muscle_fmu(self) -> bool:
+        """Whether the one-muscle FMU, with the rig alone, the polytropic chamber and the proportional valve,
+        lacks something this scenario has (components added to the rig, another chamber law, an averaged
+        PWM valve): the FMU of its assembly then runs it."""
+        return bool(self.added_components) or self.chamber_law != "polytropic" or self.pwm_model == "averaged"
+
     def with_pwm_averaged(self) -> "Scenario":
         """This scenario with its PWM valve command run by the averaged valve (``model = "averaged"``)."""
         command = self.spec["pressure"]["command"]

@@ -325,3 +325,11 @@ def test_valve_slope_is_refused_for_a_pwm_valve(tmp_path, cli):
     assert proc.returncode == 2
     assert "--valve-slope" in proc.stderr and "duty" in proc.stderr
     assert not (tmp_path / "out").exists()
+
+
+def test_the_fmu_backends_run_the_averaged_valve_through_the_assemblys_fmu():
+    """The one-muscle FMU has the proportional valve: a scenario with the averaged valve goes to its
+    assembly's FMU (pamsim run --backend fmu-*, pamsim fmu build --scenario), a switching one does not."""
+    assert _scenario(COMMAND, model="averaged").beyond_one_muscle_fmu
+    assert not _scenario(COMMAND).beyond_one_muscle_fmu
+    assert not _scenario(COMMAND, model="switching").beyond_one_muscle_fmu
