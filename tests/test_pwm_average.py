@@ -333,3 +333,17 @@ def test_the_fmu_backends_run_the_averaged_valve_through_the_assemblys_fmu():
     assert _scenario(COMMAND, model="averaged").beyond_one_muscle_fmu
     assert not _scenario(COMMAND).beyond_one_muscle_fmu
     assert not _scenario(COMMAND, model="switching").beyond_one_muscle_fmu
+
+
+def test_the_averaged_valve_is_refused_in_a_supply_line(tmp_path, cli):
+    """The averaged valve takes its supply input and feeds the chamber: wired into a line of components
+    (``supply_port``, ``outlet_port``) it is refused naming the key, not run without the line."""
+    chain = SCENARIOS / "supply_chain.toml"
+    bad = tmp_path / "chain.toml"
+    bad.write_text(chain.read_text().replace(
+        "valve_open_time_s = 0.5\n", 'command = {kind = "pwm", start_s = 0.5, end_s = 2.5, frequency_Hz = 50.0, '
+        'duty = 0.5, high = 1.0, low = -1.0, model = "averaged"}\n'))
+    proc = cli("run", bad, "-o", tmp_path / "out")
+    assert proc.returncode == 2, proc.stderr
+    assert "pressure.supply_port" in proc.stderr and "averaged PWM valve" in proc.stderr
+    assert len(proc.stderr.strip().splitlines()) == 1
