@@ -115,9 +115,7 @@ def simulate(scenario: "Scenario | str | os.PathLike", backend: str = "python",
         from .simulator import simulate_python
 
         return simulate_python(scenario, progress, model)
-    if (model is None and backend in ("fmu-cs", "fmu-me")
-            and (scenario.added_components or scenario.chamber_law != "polytropic")):
-        # The one-muscle FMU has the rig alone, with the polytropic chamber: the assembly's FMU carries the rest.
+    if model is None and backend in ("fmu-cs", "fmu-me") and scenario.beyond_one_muscle_fmu:
         model = scenario.build_model()
     if model is None:
         return get_backend(backend)(scenario)

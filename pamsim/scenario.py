@@ -24,6 +24,7 @@ from .elements.damping import DAMPING_MODELS
 from .elements.friction import FRICTION_MODELS, NEGATIVE_LEVEL_CHOICES, NoCoulomb
 from .elements.load import HangingLoad
 from .elements.pressure_source import LineValveSource, PrescribedPressure, ValveChamberSource
+from .elements.pwm_average import PWM_MODELS, averaged_source
 from .elements.force_clip import NEGATIVE_FORCE_CHOICES
 from .elements.static_force import STATIC_FORCE_MODELS
 from .elements.stops import UPPER_STOPS, EndStops
@@ -242,6 +243,11 @@ class Scenario:
         parts = (ProportionalValve33(Iso6358Orifice.from_parameters(p)), _chamber(v, self.spec.get("chamber", {}), p),
                  Constant(supply), command, p["T_supply_K"], p["p_atm_Pa"])
         ports = {key: _port_ref(v, f"pressure.{key}", pr[key]) for key in ("supply_port", "outlet_port") if key in pr}
+        if _pwm_model(v, pr) == "averaged":
+            if ports:
+                v.fail(f"pressure.{next(iter(ports))}", pr[next(iter(ports))], "the averaged PWM valve takes its "
+                       "supply input and feeds the chamber: it is not wired into a line (use model = 'switching')")
+            return averaged_source(ValveChamberSource(*parts), command)
         return LineValveSource(*parts, **ports) if ports else ValveChamberSource(*parts)
 
     def _supply_gauge_Pa(self, v: "_Validator", pr: Mapping[str, Any]) -> float:
@@ -264,7 +270,10 @@ class Scenario:
         if ("command" in pr) == ("valve_open_time_s" in pr):
             raise ScenarioError(f"{self.origin}: [pressure] needs exactly one of valve_open_time_s or [pressure.command]")
         if "command" in pr:
-            command = signal_from_table(v, "pressure.command", pr["command"], "", 1.0, self.base_dir)
+            table = pr["command"]
+            if isinstance(table, dict) and "model" in table:  # the valve's choice, not the signal's
+                table = {k: val for k, val in table.items() if k != "model"}
+            command = signal_from_table(v, "pressure.command", table, "", 1.0, self.base_dir)
             lo, hi = signal_range(command)
             if lo < -1 or hi > 1:
                 v.fail("pressure.command", f"{lo:g}..{hi:g}", "valve command must stay within [-1, 1]")
@@ -344,6 +353,27 @@ class Scenario:
         if name is None or self.spec["pressure"]["source"] != "valve":
             return None
         return steady_state(name, self.final_pressure_gauge_Pa / PA_PER_BAR, self.mass_kg * self.parameters["g_m_s2"])
+
+    @property
+    def pwm_model(self) -> str | None:
+        """How the valve's ``pwm`` command runs: ``"switching"``, ``"averaged"``
+        (:mod:`pamsim.elements.pwm_average`), or None without a PWM command."""
+        command = self.spec["pressure"].get("command")
+        if not isinstance(command, dict) or command.get("kind") != "pwm":
+            return None
+        return command.get("model", "switching")
+
+    @property
+    def beyond_one_muscle_fmu(self) -> bool:
+        """Whether the one-muscle FMU, with the rig alone, the polytropic chamber and the proportional valve,
+        lacks something this scenario has (components added to the rig, another chamber law, an averaged
+        PWM valve): the FMU of its assembly then runs it."""
+        return bool(self.added_components) or self.chamber_law != "polytropic" or self.pwm_model == "averaged"
+
+    def with_pwm_averaged(self) -> "Scenario":
+        """This scenario with its PWM valve command run by the averaged valve (``model = "averaged"``)."""
+        command = self.spec["pressure"]["command"]
+        return self.with_changes({"pressure": {"command": {**command, "model": "averaged"}}})
 
     @property
     def initial_pressure_gauge_Pa(self) -> float | None:
@@ -576,3 +606,17 @@ class _Validator(TableChecker):
         if not value > 0:
             self.fail(key, value, "must be positive")
         return value
+
+
+def _pwm_model(v: "_Validator", pr: Mapping[str, Any]) -> str:
+    """How a ``pwm`` valve command runs (``[pressure.command] model``): its switching (the default), or
+    the averaged valve, whose input is the duty."""
+    command = pr.get("command")
+    if not isinstance(command, dict) or "model" not in command:
+        return "switching"
+    model = command["model"]
+    if command.get("kind") != "pwm":
+        v.fail("pressure.command.model", model, f"only a pwm command has a model, not kind = {command.get('kind')!r}")
+    if not isinstance(model, str) or model not in PWM_MODELS:
+        v.fail("pressure.command.model", model, "unknown PWM model", choices=PWM_MODELS)
+    return model

@@ -22,7 +22,9 @@ from ..components.element import kept_component
 from ..components.hanging_load import LoadMode
 from ..components import (Chamber, CoulombFriction, ExternalForce, HangingLoad, MuscleStaticForce,
                           PressureSignal, ProportionalValve, SuppliedValve, ViscousDamping)
+from ..components.pwm_valve import AveragedPwmValve
 from ..elements.pressure_source import LineValveSource, PrescribedPressure, ValveChamberSource
+from ..elements.pwm_average import AveragedPwmSource
 from ..modeling import Assembly, AssemblyError
 from ..modeling.pygen import compiled_by_mode, outputs_by_mode
 from ..signals import Constant
@@ -125,13 +127,23 @@ VALVE_CHAMBER_WIRING = (("chamber.port", "valve.port"), ("load.x_m", "chamber.x_
 """How a ``chamber`` on the load's flange and the ``valve`` that fills it are wired."""
 
 
-def _valve_parts(src: ValveChamberSource, p0_gauge_Pa: float | None) -> SourceParts:
+def _chamber_and_valve(src: ValveChamberSource, p0_gauge_Pa: float | None, valve_class, command: str) -> SourceParts:
+    """The ``chamber`` of ``src`` and its ``valve`` (a component of ``valve_class`` around ``src.valve``), the
+    valve's first input taking the model input named ``command``."""
     return SourceParts(
         [kept_component(Chamber, "chamber", src.chamber, src.p_atm_Pa, p0_gauge_Pa or 0.0,
                         src.chamber.start_temperature_K(src.T_supply_K)),
-         kept_component(ProportionalValve, "valve", src.valve, src.T_supply_K, src.p_atm_Pa, src.chamber.R_J_per_kg_K)],
+         kept_component(valve_class, "valve", src.valve, src.T_supply_K, src.p_atm_Pa, src.chamber.R_J_per_kg_K)],
         list(VALVE_CHAMBER_WIRING),
-        {"valve_command": "valve.command", "supply_pressure_gauge_Pa": "valve.supply_gauge_Pa"}, "chamber")
+        {command: f"valve.{valve_class.inputs[0].name}", "supply_pressure_gauge_Pa": "valve.supply_gauge_Pa"}, "chamber")
+
+
+def _valve_parts(src: ValveChamberSource, p0_gauge_Pa: float | None) -> SourceParts:
+    return _chamber_and_valve(src, p0_gauge_Pa, ProportionalValve, "valve_command")
+
+
+def _averaged_pwm_parts(src: AveragedPwmSource, p0_gauge_Pa: float | None) -> SourceParts:
+    return _chamber_and_valve(src, p0_gauge_Pa, AveragedPwmValve, "pwm_duty")
 
 
 def _line_valve_parts(src: LineValveSource, p0_gauge_Pa: float | None) -> SourceParts:
@@ -162,7 +174,8 @@ def _prescribed_parts(src: PrescribedPressure, p0_gauge_Pa: float | None) -> Sou
 
 
 SOURCE_PARTS: dict[type, Callable[[Any, float | None], SourceParts]] = {
-    ValveChamberSource: _valve_parts, LineValveSource: _line_valve_parts, PrescribedPressure: _prescribed_parts}
+    ValveChamberSource: _valve_parts, LineValveSource: _line_valve_parts, AveragedPwmSource: _averaged_pwm_parts,
+    PrescribedPressure: _prescribed_parts}
 """``{pressure source class: parts(source, initial gauge pressure or None)}``.  A source defined above
 this layer (a controller's) registers its own with :func:`register_source`."""
 

@@ -96,9 +96,7 @@ def run_build(args: argparse.Namespace) -> int:
             return _build_joint(scenario, args)
         if args.muscle_only:
             return _build_muscle_only(scenario, args)
-        # The one-muscle FMU has the rig's own components with the polytropic chamber: anything else is generated.
-        if (scenario.added_components or args.generated or "controller" in scenario.spec
-                or scenario.chamber_law != "polytropic"):
+        if scenario.beyond_one_muscle_fmu or args.generated or "controller" in scenario.spec:
             return _build_assembly(scenario, args)
     preset = _preset(args, scenario, by_muscle)
     path = build(args.output, int(args.fmi), preset=preset)

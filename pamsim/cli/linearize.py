@@ -81,7 +81,7 @@ def report(lin) -> dict:
         "mechanical_poles": [_complex(z) for z in mode.poles],
         "dc_gain": dc,
         "integrator_gain_per_s": integ,
-        "bode_valve_to_contraction": lin.bode("valve_command", "contraction_m", omega),
+        "bode_valve_to_contraction": lin.bode(sys.input_labels[0], "contraction_m", omega),
         "operating_point": lin.op.as_dict(),
         "residual_f_x0_u0": [float(v) for v in lin.residual],
         "friction": lin.friction.describe(),
@@ -159,24 +159,47 @@ def _linearize_joint(scenario, args: argparse.Namespace) -> int:
 
 
 def _linearize(scenario, args: argparse.Namespace):
-    """Linearise at the operating point the arguments choose: (model, report)."""
+    """Linearise at the operating point the arguments choose: (model, report).  A scenario whose valve is
+    driven by PWM is linearised through its averaged valve, its input the duty."""
     from ..control.exact import rest_pull
     from ..control.linear import linearize
-    from ..control.operating_point import held_equilibrium, open_valve_equilibrium, trajectory_point
     from ..control.system import FrictionTreatment
+    from ..errors import InputError
 
+    pwm = scenario.pwm_model is not None
+    if pwm:
+        if args.valve_slope != "mean":
+            raise InputError(f"--valve-slope {args.valve_slope}: a PWM valve is linearised through its averaged "
+                             "model, whose input is the duty; it has no command kink to choose a slope at")
+        scenario = scenario.with_pwm_averaged()
     model = scenario.build_model()
     added = scenario.added_components
-    supply = scenario.final_pressure_gauge_Pa
-    if args.at_time is not None:
-        op = trajectory_point(scenario, args.at_time)
-    elif args.contraction_mm is not None:
-        op = held_equilibrium(model, args.contraction_mm * 1e-3, supply, pull=rest_pull(model, added))
-    else:
-        op = open_valve_equilibrium(model, supply, pull=rest_pull(model, added))
+    op = _operating_point(scenario, model, rest_pull(model, added), args)
     friction = FrictionTreatment(args.friction, args.friction_velocity_mm_s * 1e-3)
     lin = linearize(model, op, friction, args.valve_slope, added=added)
-    return lin, report(lin)
+    rep = report(lin)
+    rep["valve_model"] = (f"the averaged model of the on/off valve under {model.source.valve.frequency_Hz:g} Hz PWM "
+                          "(the mean of its supply and exhaust paths' flows over a period), input pwm_duty [1]; "
+                          "pamsim run runs its switching" if pwm
+                          else f"proportional 3/3 valve, slope at command 0: {lin.valve_slope}")
+    return lin, rep
+
+
+def _operating_point(scenario, model, pull, args: argparse.Namespace):
+    """The operating point the arguments choose, the averaged PWM valve's for a model that has one."""
+    from ..control.operating_point import (averaged_pwm_equilibrium, averaged_pwm_held, held_equilibrium,
+                                           open_valve_equilibrium, trajectory_point)
+
+    supply = scenario.final_pressure_gauge_Pa
+    pwm = scenario.pwm_model is not None
+    if args.at_time is not None:
+        return trajectory_point(scenario, args.at_time)
+    if args.contraction_mm is not None:
+        x_m = args.contraction_mm * 1e-3
+        return averaged_pwm_held(model, x_m, pull=pull) if pwm else held_equilibrium(model, x_m, supply, pull=pull)
+    if pwm:
+        return averaged_pwm_equilibrium(model, model.source.duty, pull=pull)
+    return open_valve_equilibrium(model, supply, pull=pull)
 
 
 def _linearize_and_plot(scenario, args: argparse.Namespace, out: Path):
@@ -199,8 +222,12 @@ def _print_text(lin, rep: dict) -> None:
 
     np.set_printoptions(precision=6, linewidth=140)
     print(f"operating point: {lin.op.description}")
-    print(f"friction: {rep['friction']}; valve slope at command 0: {lin.valve_slope}; "
-          f"Jacobians: {lin.jacobian_method}")
+    if rep["inputs"][0] == "pwm_duty":
+        print(f"friction: {rep['friction']}; Jacobians: {lin.jacobian_method}")
+        print(f"valve: {rep['valve_model']}")
+    else:
+        print(f"friction: {rep['friction']}; valve slope at command 0: {lin.valve_slope}; "
+              f"Jacobians: {lin.jacobian_method}")
     if lin.dropped_states:
         print(f"dropped (unobservable, decoupled): {', '.join(lin.dropped_states)}")
     print(f"states:  {', '.join(rep['states'])}")
@@ -212,15 +239,22 @@ def _print_text(lin, rep: dict) -> None:
     mode = lin.mechanical_mode()
     print(f"mechanical mode: natural frequency {mode.natural_frequency_Hz:.4g} Hz, "
           f"damping ratio {mode.damping_ratio:.4g}")
-    g0 = rep["dc_gain"]["valve_command->contraction_m"]
-    if g0 is None:
-        k = rep["integrator_gain_per_s"]["valve_command->contraction_m"]
-        print(f"DC gain valve_command -> contraction: infinite (the closed valve integrates the command); "
-              f"integrator gain {k * 1e3:.4g} mm/s per unit command")
-    else:
-        print(f"DC gain valve_command -> contraction: {g0 * 1e3:.4g} mm per unit command")
-    for key, value in rep["dc_gain"].items():
-        if key.endswith("contraction_m") and not key.startswith("valve_command"):
-            print(f"DC gain {key}: " + ("infinite" if value is None else f"{value:.6g} m per SI unit"))
+    _print_dc_gains(rep)
     if np.max(np.abs(lin.residual)) > 0 and lin.op.kind == "trajectory":
         print("note: not an equilibrium; f(x0, u0) = " + ", ".join(f"{v:.4g}" for v in lin.residual))
+
+
+def _print_dc_gains(rep: dict) -> None:
+    """The DC gains to the contraction, the valve's input first (per unit duty or command)."""
+    first = rep["inputs"][0]
+    unit = "duty" if first == "pwm_duty" else "command"
+    g0 = rep["dc_gain"][f"{first}->contraction_m"]
+    if g0 is None:
+        k = rep["integrator_gain_per_s"][f"{first}->contraction_m"]
+        print(f"DC gain {first} -> contraction: infinite (the closed valve integrates the {unit}); "
+              f"integrator gain {k * 1e3:.4g} mm/s per unit {unit}")
+    else:
+        print(f"DC gain {first} -> contraction: {g0 * 1e3:.4g} mm per unit {unit}")
+    for key, value in rep["dc_gain"].items():
+        if key.endswith("contraction_m") and not key.startswith(first):
+            print(f"DC gain {key}: " + ("infinite" if value is None else f"{value:.6g} m per SI unit"))

@@ -40,7 +40,7 @@ from ..model import MuscleModel
 from .choices import VALVE_SLOPES
 from .exact import control_functions, exact_jacobians, held_line_states, line_states
 from .operating_point import OperatingPoint
-from .system import INPUT_SCALES, INPUTS, OUTPUTS, STATE_SCALES, STATES, FrictionTreatment, MusclePlant
+from .system import INPUT_SCALES, INPUTS, OUTPUTS, STATE_SCALES, STATES, FrictionTreatment, MusclePlant, input_names
 
 RELATIVE_STEP = 1e-5
 """Finite-difference step as a fraction of each variable's typical magnitude."""
@@ -135,6 +135,11 @@ class LinearModel:
     jacobian_method: str = "exact"
     """``exact`` (CasADi's derivatives of the generated expressions) or ``central differences``."""
 
+    @property
+    def valve_input(self) -> str:
+        """The valve's input: ``valve_command``, or ``pwm_duty`` for the averaged PWM valve."""
+        return self.sys.input_labels[0]
+
     def mechanical_mode(self) -> MechanicalMode:
         """The two poles with the largest participation of the velocity state.
 
@@ -154,9 +159,9 @@ class LinearModel:
         zeta = -(p1 + p2).real / (2.0 * omega) if omega > 0 else math.nan
         return MechanicalMode(omega, zeta, tuple(sorted((p1, p2), key=lambda p: p.imag)))
 
-    def gain_at_zero(self, input_name: str = "valve_command",
+    def gain_at_zero(self, input_name: str | None = None,
                      output_name: str = "contraction_m") -> tuple[float | None, float]:
-        """(DC gain, integrator gain) of one channel.
+        """(DC gain, integrator gain) of one channel (``input_name`` None: the valve's input).
 
         If the channel contains a free integrator (the closed valve integrates
         the command into air mass) the DC gain is infinite and returned as
@@ -164,7 +169,7 @@ class LinearModel:
         rate of the output per unit input.  Both come from ``G`` evaluated at
         two small real ``s`` and extrapolated (``G(s) = K_i / s + G_0 + O(s)``).
         """
-        g = self.sys[output_name, input_name]
+        g = self.sys[output_name, input_name or self.valve_input]
         scale = max(self.mechanical_mode().omega_n_rad_s, 1.0)
         eps = 1e-7 * scale
         a = eps * float(np.real(g(eps)))
@@ -207,7 +212,8 @@ def linearize(model: MuscleModel, op: OperatingPoint, friction: FrictionTreatmen
         Default ``dropped``.  ``sliding`` needs a moving load (its direction
         is taken from the sign of the velocity at ``op``).
     valve_slope : {"mean", "fill", "vent"}
-        Slope of the valve at command 0 (see the module notes).
+        Slope of the valve at command 0 (see the module notes).  The averaged PWM valve's input is the
+        duty, whose slope at 0 is always taken into its range (``fill``).
     drop_unobservable_air_mass : bool
         The air mass feeds back only through the gas temperature of venting
         air; where its column of A and C is zero (closed or filling valve, or
@@ -240,6 +246,8 @@ def linearize(model: MuscleModel, op: OperatingPoint, friction: FrictionTreatmen
         raise InputError(f"valve slope {valve_slope!r}: choose from {', '.join(VALVE_SLOPES)}")
     lines = line_states(model, added) if added else ()
     x0 = _state_vector(model, op, added, lines)
+    if input_names(model) != INPUTS:  # the duty: its derivative at 0 is the one into its range [0, 1]
+        valve_slope = "fill"
     try:
         A, B, C, D = exact_jacobians(model, x0, op.inputs, friction, valve_slope, added)
         method = "exact"
@@ -254,7 +262,7 @@ def linearize(model: MuscleModel, op: OperatingPoint, friction: FrictionTreatmen
     scales = np.asarray(list(STATE_SCALES) + [nominal for _, nominal in lines])
     keep, dropped = _kept_states(A, C, names, scales) if drop_unobservable_air_mass else (list(range(len(names))), [])
     sys = ct.ss(A[np.ix_(keep, keep)], B[keep], C[:, keep], D, states=[names[k] for k in keep],
-                inputs=list(INPUTS), outputs=list(OUTPUTS), name="muscle_linear")
+                inputs=list(input_names(model)), outputs=list(OUTPUTS), name="muscle_linear")
     return LinearModel(sys, op, friction, valve_slope, residual, tuple(dropped), method)
 
 

@@ -16,17 +16,23 @@ Three kinds:
     The state of a scenario's hybrid simulation at a given time, with the
     inputs at that time.  It need not be an equilibrium; the residual
     ``f(x0, u0)`` is reported.
+``pwm_averaged`` and ``pwm_averaged_held``
+    The averaged model of an on/off valve under PWM (:mod:`pamsim.elements.pwm_average`), its input
+    the duty: at the scenario's duty, the chamber where the mean flows of the supply and exhaust paths
+    cancel and the load at rest there; or a target contraction held at the duty whose mean flow
+    cancels at the holding pressure.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy.optimize import brentq
 
 from ..backends import simulate
 from ..constants import PA_PER_BAR
+from ..elements.pwm_average import AveragedPwmSource
 from ..errors import InputError
 from ..model import Mode, MuscleModel
 from ..static import equilibrium_contraction_m, max_load_N
@@ -195,3 +201,68 @@ def trajectory_point(scenario, time_s: float) -> OperatingPoint:
                           f"state of the simulation at t = {time_s:g} s ({mode.label}): x = {states[0] * 1e3:.3f} mm, "
                           f"v = {states[1] * 1e3:.3f} mm/s, p = {(p_abs - model.source.p_atm_Pa) / PA_PER_BAR:.4f} bar",
                           line)
+
+
+
+def _averaged_source(model: MuscleModel) -> AveragedPwmSource:
+    if not isinstance(model.source, AveragedPwmSource):
+        raise InputError("this operating point is the averaged PWM valve's: the model needs a PWM command run "
+                         "with model = 'averaged'")
+    return model.source
+
+
+def averaged_pwm_equilibrium(model: MuscleModel, duty: float, F_ext_N: float = 0.0, pull=None) -> OperatingPoint:
+    """The load at rest with the averaged PWM valve at ``duty``: the chamber at the pressure where the supply
+    and exhaust paths' mean flows cancel (the supply's for a 2/2 valve), the load where ``pull`` (see
+    :func:`open_valve_equilibrium`) holds it there.
+
+    Raises
+    ------
+    InputError
+        If the valve never opens at ``duty``, or the load finds no free equilibrium at that pressure.
+    """
+    src = _averaged_source(model)
+    try:
+        p_abs = src.balance_pressure_Pa(duty, src.chamber.start_temperature_K(src.T_supply_K))
+    except ValueError as exc:
+        raise InputError(f"duty {duty:g}: {exc}; no equilibrium to linearise about") from None
+    op = open_valve_equilibrium(model, p_abs - src.p_atm_Pa, F_ext_N, pull)
+    supply = float(src.supply_gauge_Pa.final_value)
+    w_supply, w_exhaust = src.valve.shares(duty)
+    return replace(op, inputs=np.array([duty, supply, F_ext_N]), kind="pwm_averaged",
+                   description=f"PWM averaged at duty {duty:g} (supply path open {w_supply:.4g}, exhaust path "
+                               f"{w_exhaust:.4g} of a period), chamber at {(p_abs - src.p_atm_Pa) / PA_PER_BAR:.4f} "
+                               f"bar where their mean flows cancel, load {_load_N(model, F_ext_N):.2f} N at rest at "
+                               f"{op.states[0] * 1e3:.3f} mm")
+
+
+def averaged_pwm_held(model: MuscleModel, x_m: float, F_ext_N: float = 0.0, pull=None) -> OperatingPoint:
+    """The load held at contraction ``x_m`` by the averaged PWM valve: the chamber at the holding pressure
+    (:func:`held_equilibrium`) and the duty at which the two paths' mean flows cancel there (0 for a 2/2
+    valve, which then stays closed).
+
+    Raises
+    ------
+    InputError
+        As :func:`held_equilibrium`, or if no duty in [0, 1] holds that pressure.
+    """
+    src = _averaged_source(model)
+    supply = float(src.supply_gauge_Pa.final_value)
+    op = held_equilibrium(model, x_m, supply, F_ext_N, pull)
+    p_abs = float(op.states[2])
+    T = src.chamber.start_temperature_K(src.T_supply_K)
+
+    def flow(duty):
+        return src.valve.inflow_kg_s(duty, p_abs, T, supply + src.p_atm_Pa, src.T_supply_K, src.p_atm_Pa)
+
+    if flow(0.0) == 0.0:
+        duty = 0.0
+    elif flow(0.0) < 0.0 < flow(1.0):
+        duty = float(brentq(flow, 0.0, 1.0, xtol=1e-12))
+    else:
+        raise InputError(f"no duty in [0, 1] holds {(p_abs - src.p_atm_Pa) / PA_PER_BAR:.4f} bar at {x_m * 1e3:g} mm "
+                         "with this PWM valve: its mean flow does not change sign")
+    return replace(op, inputs=np.array([duty, supply, F_ext_N]), kind="pwm_averaged_held",
+                   description=f"PWM averaged at duty {duty:.6g}, chamber holding "
+                               f"{(p_abs - src.p_atm_Pa) / PA_PER_BAR:.4f} bar, load {_load_N(model, F_ext_N):.2f} N "
+                               f"at rest at {x_m * 1e3:g} mm")

@@ -9,8 +9,9 @@ from ..figure_style import series
 from ..plotting import X_LABEL, shade_held
 from .linear import LinearModel
 
-_BODE_CHANNELS = (("valve_command", "contraction_m"), ("valve_command", "p_gauge_Pa"),
+_BODE_CHANNELS = ((None, "contraction_m"), (None, "p_gauge_Pa"),
                   ("supply_gauge_Pa", "contraction_m"), ("F_ext_N", "contraction_m"))
+"""The channels drawn, None for the valve's input (its command, or an averaged PWM valve's duty)."""
 
 
 def bode_figure(lin: LinearModel) -> Figure:
@@ -19,6 +20,7 @@ def bode_figure(lin: LinearModel) -> Figure:
     fig = Figure(figsize=(8, 7), constrained_layout=True)
     ax_m, ax_p = fig.subplots(2, 1, sharex=True)
     for k, (inp, out) in enumerate(_BODE_CHANNELS):  # a channel keeps its style whichever others are drawn
+        inp = inp or lin.valve_input
         data = lin.bode(inp, out, omega)
         mag = np.asarray(data["magnitude"])
         if not np.any(mag > 0):
@@ -43,7 +45,7 @@ def pole_zero_figure(lin: LinearModel) -> Figure:
     fig = Figure(figsize=(6.5, 5.5), constrained_layout=True)
     ax = fig.subplots()
     poles = lin.sys.poles()
-    channel = lin.sys["contraction_m", "valve_command"]
+    channel = lin.sys["contraction_m", lin.valve_input]
     # A channel the operating point switches off (saturated valve) has no zeros to show.
     zeros = channel.zeros() if np.any(channel.B) else np.array([])
     zeros = zeros[np.isfinite(zeros)]

@@ -19,6 +19,7 @@ import control as ct
 import numpy as np
 
 from ..elements.pressure_source import ValveChamberSource
+from ..elements.pwm_average import AveragedPwmSource
 from .choices import FRICTION_KINDS
 from ..errors import InputError
 from ..model import N_WORK, STATE_SCALES as _SCALES, MuscleModel
@@ -27,6 +28,8 @@ STATES = ("x_m", "v_m_s", "p_abs_Pa", "air_mass_kg")
 """State names of the control model (contraction, velocity, absolute chamber pressure, air mass)."""
 INPUTS = ("valve_command", "supply_gauge_Pa", "F_ext_N")
 """Input names: valve command (dimensionless, -1 exhaust .. +1 supply), supply gauge pressure, external force."""
+PWM_INPUTS = ("pwm_duty",) + INPUTS[1:]
+"""Input names of the averaged PWM valve's model: its first input is the duty [1] in place of the command."""
 OUTPUTS = ("contraction_m", "p_gauge_Pa", "F_tendon_N")
 """Output names: contraction, chamber gauge pressure, tendon force (static minus damping minus friction;
 not the static force alone, which the simulator and the FMU call ``F_static_N``)."""
@@ -170,3 +173,8 @@ def muscle_nlsys(model: MuscleModel, friction: FrictionTreatment | None = None,
 
     return ct.nlsys(update, output, states=list(STATES), inputs=list(INPUTS), outputs=list(OUTPUTS),
                     name=name, params={"friction": default})
+
+
+def input_names(model: MuscleModel) -> tuple[str, ...]:
+    """The control model's input names: :data:`PWM_INPUTS` for the averaged PWM valve, else :data:`INPUTS`."""
+    return PWM_INPUTS if isinstance(model.source, AveragedPwmSource) else INPUTS

@@ -172,7 +172,7 @@ def for_muscle(scenario: Scenario) -> Preset:
     return Preset(f"muscle {model['muscle']}", starts, sources, table, static_force=model["static_force"])
 
 
-SIGNAL_UNITS = {"valve_command": "", "supply_pressure_gauge_Pa": "Pa", "prescribed_pressure_gauge_Pa": "Pa",
+SIGNAL_UNITS = {"valve_command": "", "pwm_duty": "", "supply_pressure_gauge_Pa": "Pa", "prescribed_pressure_gauge_Pa": "Pa",
                 "load_mass_kg": "kg", "external_force_N": "N", "reference_m": "m", "feedforward_gauge_Pa": "Pa"}
 """The unit of each input a scenario can drive, as the signals' descriptions show it (the last two: a
 position controller's, :mod:`pamsim.control.closed_loop`)."""

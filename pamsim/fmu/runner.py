@@ -95,10 +95,10 @@ REPRESENTED = {
 
 def check_scenario(scenario: Scenario) -> None:
     """Raise :class:`~pamsim.errors.InputError` for a scenario the FMU backends cannot run: through this FMU
-    (:func:`start_values`), or, for a chamber law other than the polytropic or components added to the rig,
-    through the FMU of its assembly (:func:`pamsim.backends.simulate` routes it there), which carries them
-    and refuses, when it is built, an input it cannot carry."""
-    if scenario.chamber_law == "polytropic" and not scenario.added_components:
+    (:func:`start_values`), or, for what it lacks (:attr:`Scenario.beyond_one_muscle_fmu`), through the
+    FMU of its assembly (:func:`pamsim.backends.simulate` routes it there), which carries them and refuses,
+    when it is built, an input it cannot carry."""
+    if not scenario.beyond_one_muscle_fmu:
         start_values(scenario)
 
 

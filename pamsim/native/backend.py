@@ -224,7 +224,7 @@ def _signals(model: MuscleModel) -> tuple[tuple[str, ...], tuple]:
     no such input) for the sources the core has, else the flat model's (a source only the generic engine
     runs, such as a controller's)."""
     src = model.source
-    if isinstance(src, ValveChamberSource):
+    if type(src) is ValveChamberSource:  # not a subclass with inputs of its own (an averaged PWM valve's)
         return lib.INPUTS, (src.command, src.supply_gauge_Pa, None, None, model.load.external_force_N)
     if isinstance(src, PrescribedPressure):
         return lib.INPUTS, (None, None, src.p_gauge_Pa, None, model.load.external_force_N)

@@ -1,0 +1,179 @@
+"""The averaged model of an on/off valve under PWM: the mean mass flow over one period.
+
+The switching model (a ``pwm`` command on :class:`~pamsim.elements.valve.ProportionalValve33`) drives
+the valve's opening ``level(t)`` in [0, 1] through a trace of straight pieces: 0 until the opening
+takes effect ``delay_on_s`` after the period starts, up to 1 over ``rise_s``, held, down to 0 over
+``fall_s`` from ``delay_off_s`` after the commanded close, held.  The valve's command is
+``c = low + (high - low) level`` and its flow is ``|c|`` times the full orifice's flow on the side
+``c`` points to (the supply for ``c > 0``, the exhaust for ``c < 0``).  With the chamber's state
+frozen over one period, the mean flow is therefore exactly
+
+    mean mdot = W_supply mdot(+1) + W_exhaust mdot(-1),
+    W_supply = mean of max(c(t), 0),  W_exhaust = mean of max(-c(t), 0)
+
+over the period: the shares of a period each path is open, weighted by its opening.  Each is a sum
+over the trace's straight pieces; on a piece from command ``c1`` to ``c2`` the mean of ``max(c, 0)``
+is ``(F(c2) - F(c1)) / (c2 - c1)`` with ``F(c) = max(c, 0)^2 / 2``.
+
+With the time ``a = duty / f + delay_off_s - delay_on_s`` from the opening's to the closing's taking
+effect, held within one period ``T = 1 / f``, and ``g = T - a``, the trace has one of three shapes:
+
+* full: the valve opens and closes fully (``a >= rise_s`` and ``g >= fall_s``);
+* a short pulse: the closing starts at ``lambda = a / rise_s`` open (``a < rise_s``, ``a fall_s <= g rise_s``);
+* a short gap: the opening starts at ``1 - mu`` open, ``mu = g / fall_s`` (``g < fall_s``, otherwise).
+
+For a 2/2 valve (``low = 0``, ``high = 1``) in the full shape ``W_supply`` is the mean opening, the
+effective duty ``duty + f (delay_off_s - delay_on_s) + f (fall_s - rise_s) / 2``.  For a 3/2 valve
+(``low = -1``) the command passes through the closed centre while it switches, and each switch
+loses ``(rise_s + fall_s) / 4`` of a period from each path.  It is not the proportional valve at
+command ``2 duty - 1``: the orifice's flow is not linear in the chamber pressure, so the mean of the
+two paths' flows is not the flow of one path at the mean opening.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..modeling.smath import clip, fmax, if_else
+from ..signals import PiecewiseConstant
+from .pressure_source import ValveChamberSource
+from .valve import ProportionalValve33
+
+PWM_MODELS = ("switching", "averaged")
+"""How a PWM command runs (``[pressure.command] model``): every switch as an event, or this module's
+averaged valve."""
+TINY_S = 1e-300
+"""A duration [s] that keeps a ramp's rate finite when the ramp takes no time (that shape is not chosen then)."""
+
+
+def _pos(c):
+    return 0.5 * (c + abs(c))
+
+
+def _mean_pos(c1, c2):
+    """Mean of ``max(c, 0)`` along a straight piece from command ``c1`` to ``c2``."""
+    dc = c2 - c1
+    flat = abs(dc) <= 1e-12
+    return if_else(flat, 0.5 * (_pos(c1) + _pos(c2)),
+                   0.5 * (_pos(c2) ** 2 - _pos(c1) ** 2) / if_else(flat, 1.0, dc))
+
+
+@dataclass(frozen=True)
+class PwmAveragedValve:
+    """:class:`~pamsim.elements.valve.ProportionalValve33` under a PWM command with its timing (as
+    :class:`pamsim.signals.Pwm` defines it), averaged over one period; its input is the duty."""
+
+    valve: ProportionalValve33
+    frequency_Hz: float
+    low_command: float
+    high_command: float
+    delay_on_s: float = 0.0
+    delay_off_s: float = 0.0
+    rise_s: float = 0.0
+    fall_s: float = 0.0
+
+    @classmethod
+    def of_pwm(cls, valve: ProportionalValve33, pwm) -> "PwmAveragedValve":
+        """The averaged ``valve`` under the PWM signal ``pwm`` (:class:`pamsim.signals.Pwm`)."""
+        return cls(valve, pwm.frequency_Hz, pwm.low, pwm.high, pwm.delay_on_s, pwm.delay_off_s, pwm.rise_s, pwm.fall_s)
+
+    def _share(self, duty, sign: float):
+        """Mean over a period of ``max(sign c(t), 0)``: the supply path's share (+1), the exhaust's (-1)."""
+        period = 1.0 / self.frequency_Hz
+        r, q = self.rise_s, self.fall_s
+        c0, c1 = sign * self.low_command, sign * self.high_command
+        a = clip(duty * period + self.delay_off_s - self.delay_on_s, 0.0, period)
+        g = period - a
+        lam = clip(a / fmax(r, TINY_S), 0.0, 1.0)
+        mu = clip(g / fmax(q, TINY_S), 0.0, 1.0)
+        full = (r + q) * _mean_pos(c0, c1) + (a - r) * _pos(c1) + (g - q) * _pos(c0)
+        c_lam = c0 + (c1 - c0) * lam
+        short_pulse = (a + lam * q) * _mean_pos(c0, c_lam) + (g - lam * q) * _pos(c0)
+        c_mu = c1 + (c0 - c1) * mu
+        short_gap = (g + mu * r) * _mean_pos(c1, c_mu) + (a - mu * r) * _pos(c1)
+        # Where the pulse's rise and the gap's fall balance (a / r = g / q) the level swings up from
+        # closed, as the switching model's does from its start: a rounding must not tip it the other way.
+        tie = 1e-9 * period * (r + q)
+        pulse = (a < r) * (a * q <= g * r + tie)
+        gap = (g < q) * (a * q > g * r + tie)
+        switching = if_else(pulse, short_pulse, if_else(gap, short_gap, full)) / period
+        # No switching at all at the duty's ends: the command holds low (0) or high (1) for good.
+        return if_else(duty <= 0.0, _pos(c0), if_else(duty >= 1.0, _pos(c1), switching))
+
+    def shares(self, duty) -> tuple:
+        """``(W_supply, W_exhaust)``: each path's opening averaged over a period at ``duty`` (see the module)."""
+        return self._share(duty, 1.0), self._share(duty, -1.0)
+
+    def path_flows_kg_s(self, duty, p_chamber_Pa, T_chamber_K, p_supply_Pa, T_supply_K, p_exhaust_Pa) -> tuple:
+        """Mean mass flows into the chamber [kg/s] through the supply path and through the exhaust path."""
+        w_supply, w_exhaust = self.shares(duty)
+        full = self.valve.inflow_kg_s
+        return (w_supply * full(1.0, p_chamber_Pa, T_chamber_K, p_supply_Pa, T_supply_K, p_exhaust_Pa),
+                w_exhaust * full(-1.0, p_chamber_Pa, T_chamber_K, p_supply_Pa, T_supply_K, p_exhaust_Pa))
+
+    def inflow_kg_s(self, duty, p_chamber_Pa, T_chamber_K, p_supply_Pa, T_supply_K, p_exhaust_Pa):
+        """Mean mass flow into the chamber [kg/s] over a period at ``duty`` (absolute pressures)."""
+        supply, exhaust = self.path_flows_kg_s(duty, p_chamber_Pa, T_chamber_K, p_supply_Pa, T_supply_K, p_exhaust_Pa)
+        return supply + exhaust
+
+
+def duty_signal(pwm) -> PiecewiseConstant:
+    """The duty the averaged valve takes in place of the PWM command ``pwm``: ``pwm.duty`` from its start
+    to its end, 0 (the valve held at its ``low`` command) before and after."""
+    if pwm.start_s > 0.0:
+        return PiecewiseConstant((0.0, pwm.start_s, pwm.end_s), (0.0, pwm.duty, 0.0))
+    return PiecewiseConstant((pwm.start_s, pwm.end_s), (pwm.duty, 0.0))
+
+
+@dataclass(frozen=True)
+class AveragedPwmSource(ValveChamberSource):
+    """A :class:`ValveChamberSource` whose valve is a :class:`PwmAveragedValve` and whose command is the
+    duty (:func:`duty_signal`): the averaged model of the switching source it was made from."""
+
+    @property
+    def duty(self) -> float:
+        """The duty the command holds while the PWM runs (0 before and after)."""
+        return max(self.command.values)
+
+    def balance_pressure_Pa(self, duty: float, T_chamber_K: float) -> float:
+        """The absolute chamber pressure [Pa] at which the two paths' mean flows cancel at ``duty`` (gas at
+        ``T_chamber_K``): the supply's while only the supply path opens, the exhaust's while only the
+        exhaust path does.
+
+        Raises
+        ------
+        ValueError
+            If neither path ever opens at ``duty`` (a 2/2 valve at duty 0): any pressure is held.
+        """
+        from scipy.optimize import brentq
+
+        p_supply = float(self.supply_gauge_Pa.final_value) + self.p_atm_Pa
+        w_supply, w_exhaust = self.valve.shares(duty)
+        if w_supply == 0.0 and w_exhaust == 0.0:
+            raise ValueError(f"at duty {duty:g} the valve never opens: every pressure is held")
+        if w_exhaust == 0.0 or w_supply == 0.0:
+            return p_supply if w_exhaust == 0.0 else self.p_atm_Pa
+
+        def flow(p):
+            return self.valve.inflow_kg_s(duty, p, T_chamber_K, p_supply, self.T_supply_K, self.p_atm_Pa)
+
+        return float(brentq(flow, self.p_atm_Pa, p_supply, xtol=1e-9, rtol=1e-14))
+
+    def derivatives(self, s, x_m, v_m_s, inputs) -> tuple[float, float]:
+        """(dp/dt [Pa/s], dm/dt [kg/s]) of the chamber, each path's flow carrying its own temperature."""
+        p, m = s[0], s[1]
+        V = self.chamber.volume_m3(x_m)
+        T_gas = self.chamber.gas_temperature_K(p, V, m)
+        duty, supply_gauge_Pa = inputs
+        flows = self.valve.path_flows_kg_s(duty, p, T_gas, supply_gauge_Pa + self.p_atm_Pa, self.T_supply_K,
+                                           self.p_atm_Pa)
+        work = sum(self.chamber.flow_work_W(float(mdot), self.T_supply_K if mdot >= 0.0 else T_gas) for mdot in flows)
+        mdot = float(sum(flows))
+        dV = self.chamber.dvolume_dx_m2(x_m) * v_m_s
+        return self.chamber.pressure_rate_of_flows_Pa_s(p, V, dV, mdot, work, m, x_m), mdot
+
+
+def averaged_source(source: ValveChamberSource, pwm) -> AveragedPwmSource:
+    """The averaged model of ``source`` driven by the PWM command ``pwm`` (:class:`pamsim.signals.Pwm`)."""
+    return AveragedPwmSource(PwmAveragedValve.of_pwm(source.valve, pwm), source.chamber, source.supply_gauge_Pa,
+                             duty_signal(pwm), source.T_supply_K, source.p_atm_Pa)
