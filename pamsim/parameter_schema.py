@@ -29,8 +29,8 @@ SUFFIX_UNITS = (  # longest first: "_N_per_bar_m2" before "_m2" before "_m"
     ("_N_s2_per_m2", "N s^2/m^2"), ("_N_s_per_m", "N s/m"), ("_N_per_m2", "N/m^2"), ("_N_per_m", "N/m"),
     ("_N_per_Pa", "N/Pa"), ("_m3_per_s_Pa", "m^3/(s Pa)"), ("_J_per_kg_K", "J/(kg K)"), ("_bar_per_kg", "bar/kg"),
     ("_W_per_m2_K", "W/(m^2 K)"), ("_m2_per_Pa", "m^2/Pa"), ("_per_Pa", "1/Pa"), ("_per_K", "1/K"), ("_kg_m3", "kg/m^3"), ("_m_s2", "m/s^2"),
-    ("_N_s", "N s"), ("_Pa", "Pa"), ("_m3", "m^3"), ("_m2", "m^2"), ("_deg", "deg"), ("_N", "N"), ("_K", "K"),
-    ("_m", "m"),
+    ("_N_s", "N s"), ("_Pa_s", "Pa s"), ("_m_s", "m/s"), ("_Hz", "Hz"), ("_s", "s"), ("_Pa", "Pa"), ("_m3", "m^3"),
+    ("_m2", "m^2"), ("_deg", "deg"), ("_N", "N"), ("_K", "K"), ("_m", "m"),
 )
 
 

@@ -555,6 +555,18 @@ def test_base_units_against_hand_conversions():
     assert base_unit("J/(kg K)") == (1.0, {"m": 2, "s": -2, "K": -1})
     assert base_unit("m^3/(s Pa)") == (1.0, {"kg": -1, "m": 4, "s": 1})
     assert base_unit("N s^2/m^2") == (1.0, {"kg": 1, "m": -1})
+    assert base_unit("Hz") == (1.0, {"s": -1}) and base_unit("Pa s") == (1.0, {"kg": 1, "m": -1, "s": -1})
+
+
+@pytest.mark.parametrize("name, unit", [("frequency_Hz", "Hz"), ("delay_on_s", "s"), ("rise_s", "s"),
+                                        ("min_rebound_speed_m_s", "m/s"), ("viscosity_Pa_s", "Pa s"),
+                                        ("D1_N_s_per_m", "N s/m"), ("C_m3_per_s_Pa", "m^3/(s Pa)"), ("gamma", "1")])
+def test_a_parameters_unit_is_read_from_its_name(name, unit):
+    """The suffixes of frequencies, times, speeds and viscosities give their units (they read "1" before, so
+    an FMU declared an averaged valve's frequency and delays dimensionless); longer suffixes first."""
+    from pamsim.parameter_schema import unit_of
+
+    assert unit_of(name) == unit
 
 
 @pytest.mark.parametrize("version", [2, 3])
