@@ -441,10 +441,9 @@ _MODES = {int(m): m for m in Mode}  # a dict look-up costs less than calling the
 _event_names: dict[tuple[int, int, int], str] = {}  # a few modes and indicators: a few names
 
 
-def _event_name(mode: int, fired: int, to: int, assembly) -> str:
+def _event_name(mode: int, fired: int, to: int, others: tuple[str, ...]) -> str:
     """:func:`event_name` of an event by the modes' and mask's numbers, kept for the next event (an event of
-    an added component's indicator alone is named after it: kept only without such components)."""
-    others = tuple(f"{c}.{n}" for c, n in assembly.indicator_names()[2:])
+    an added component's indicator alone is named after it, from ``others``: kept only without them)."""
     name = event_name(_MODES[mode], fired, _MODES[to], others)
     if not others:
         _event_names[(mode, fired, to)] = name
@@ -486,9 +485,11 @@ def _engine_result(scenario: Scenario, case: CaseInputs, out: dict, i: int, wall
     x_at, ke_at = outputs.index("load.x_m"), outputs.index("load.kinetic_energy_J")
     labels, after = _MODE_LABELS, 4 + n_y  # a row: t, modes before and after, fired mask, outputs before, after
     transitions, losses = [], []
+    # The added components' indicators' names (an element's slip), once per run rather than per event.
+    others = tuple(f"{c}.{n}" for c, n in case.assembly.indicator_names()[2:]) if rows else ()
     for e in rows:
         mode, to, fired = int(e[1]), int(e[2]), int(e[3])
-        name = _event_names.get((mode, fired, to)) or _event_name(mode, fired, to, case.assembly)
+        name = _event_names.get((mode, fired, to)) or _event_name(mode, fired, to, others)
         transitions.append(TransitionEvent(e[0], name, labels[mode], labels[to], e[after + x_at]))
         losses.append((e[0], e[4 + ke_at] - e[after + ke_at]))
     stats["events"] = len(transitions)
