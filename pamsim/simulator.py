@@ -479,6 +479,10 @@ class HybridRun:
 
         opts, mode, t, y = self.opts, self.mode, self.t, self.y
         named = self.gen.events(mode)
+        if math.isfinite(self.hold_until):
+            # A hold is the time the load is held whatever its forces do (see _HOLD_S): a release inside
+            # it would start the same slip that just ended at its own start, and reset the hold's doubling.
+            named = [e for e in named if not e[0].startswith("release")]
         # An input that jumps at t_break belongs to the next segment: this one sees its left limit,
         # so a jump cannot hide a crossing that happened before it.
         self.t_left = self.gen.t_left = float(np.nextafter(t_break, -math.inf))

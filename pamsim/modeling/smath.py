@@ -1,10 +1,13 @@
 """Elementary functions for code that runs on floats and on CasADi symbols alike.
 
 A float takes Python's own operation (the result is bit for bit what the plain code gives); anything
-else CasADi's.  :mod:`math` itself must not see a symbol: it converts it to ``nan`` silently.
+else CasADi's (``fmin``, ``fmax`` and ``clip`` also take numpy arrays, elementwise: CasADi would make a column
+of a row).  :mod:`math` itself must not see a symbol: it converts it to ``nan`` silently.
 """
 
 from __future__ import annotations
+
+import numpy as np
 
 
 def _casadi():
@@ -12,14 +15,24 @@ def _casadi():
     return casadi
 
 
+def _arrays(a, b) -> bool:
+    """Whether ``a`` and ``b`` are numbers with at least one numpy array (a trace's samples), no symbol."""
+    numeric = (int, float, np.ndarray)
+    return isinstance(a, numeric) and isinstance(b, numeric) and (isinstance(a, np.ndarray) or isinstance(b, np.ndarray))
+
+
 def fmin(a, b):
-    """The smaller of ``a`` and ``b`` (C's ``fmin``), on floats or symbols."""
-    return min(a, b) if isinstance(a, (int, float)) and isinstance(b, (int, float)) else _casadi().fmin(a, b)
+    """The smaller of ``a`` and ``b`` (C's ``fmin``), on floats, arrays (elementwise, their shape kept) or symbols."""
+    if isinstance(a, (int, float)) and isinstance(b, (int, float)):
+        return min(a, b)
+    return np.fmin(a, b) if _arrays(a, b) else _casadi().fmin(a, b)
 
 
 def fmax(a, b):
-    """The larger of ``a`` and ``b`` (C's ``fmax``), on floats or symbols."""
-    return max(a, b) if isinstance(a, (int, float)) and isinstance(b, (int, float)) else _casadi().fmax(a, b)
+    """The larger of ``a`` and ``b`` (C's ``fmax``), on floats, arrays (elementwise, their shape kept) or symbols."""
+    if isinstance(a, (int, float)) and isinstance(b, (int, float)):
+        return max(a, b)
+    return np.fmax(a, b) if _arrays(a, b) else _casadi().fmax(a, b)
 
 
 def clip(a, low, high):
