@@ -174,11 +174,14 @@ def _bouc_wen(v, table: dict, law) -> BoucWenFriction:
     return BoucWenFriction("hysteresis", law, **values)
 
 
-def refuse_added(scenario: Any, what: str, error: type[Exception]) -> None:
+def refuse_added(scenario: Any, what: str, error: type[Exception], hysteresis: bool = False) -> None:
     """Raise ``error`` if ``scenario`` adds components to the rig: ``what`` (a command, a study) works
-    on the rig alone and would leave them out without a word."""
-    if scenario.added_components:
-        names = ", ".join(repr(a.component.name) for a in scenario.added_components)
+    on the rig alone and would leave them out without a word.  ``hysteresis``: the ``[hysteresis]`` table's
+    model is welcome (``what`` runs it, and designs without the muscle's friction anyway)."""
+    added = [a for a in scenario.added_components
+             if not (hysteresis and "hysteresis" in scenario.spec and a.component.name == "hysteresis")]
+    if added:
+        names = ", ".join(repr(a.component.name) for a in added)
         raise error(f"{scenario.origin}: component: {what} takes the rig alone, not the components added to it "
                     f"({names}); run the scenario with `pamsim run` (python or native backend)")
 

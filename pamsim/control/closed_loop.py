@@ -44,7 +44,7 @@ from ..modeling import Component, Equations, Symbols, Var, smath
 from ..result import Result
 from ..scenario import Scenario, load_scenario
 from ..scenario_components import refuse_added
-from ..signals import Step
+from ..signals import Constant, Step, max_step_hint_s
 from ..backends import simulate
 from .linear import LinearModel, linearize
 from .operating_point import held_equilibrium, holding_pressure_Pa
@@ -97,7 +97,8 @@ class ControllerConfig:
             Naming the file and key for a missing, unknown or non-positive entry.
         """
         where = scenario.origin
-        refuse_added(scenario, "the closed loop's controller design", InputError)
+        # The design drops the muscle's friction, so Maxwell-slip or Bouc-Wen friction changes the plant, not it.
+        refuse_added(scenario, "the closed loop's controller design", InputError, hysteresis=True)
         table = _controller_table(scenario.spec.get("controller"), where)
         # The numbers in the order of _CONTROLLER_KEYS, then the spec: the first mistake is the one reported.
         values = {_si_name(key): _controller_number(table, key, where) * factor
@@ -219,16 +220,21 @@ class ClosedLoopValveSource:
     States: chamber pressure [Pa], air mass [kg], error integral ``z`` [m s]
     and the position filter ``x_f`` [m] of the velocity estimate
     ``(x - x_f) / tau``.  Inputs at time t: reference [m], feedforward
-    holding pressure [Pa gauge], supply pressure [Pa gauge].
+    holding pressure [Pa gauge], supply pressure [Pa gauge], the reference's
+    velocity [m/s] (0 for a step: its impulse is left out, as the design's
+    step response assumes) and the valve command that keeps the chamber on the
+    feedforward pressure (0 for a step).
     """
 
     plant: ValveChamberSource
     K: tuple[float, float, float, float]
-    reference_m: Step
-    feedforward_gauge_Pa: Step
+    reference_m: Any
+    feedforward_gauge_Pa: Any
     velocity_filter_time_s: float
     deadband_m: float
     antiwindup_time_s: float
+    reference_velocity_m_s: Any = Constant(0.0)
+    feedforward_command: Any = Constant(0.0)
     name: str = "closed_loop_valve"
     state_names: tuple[str, ...] = ("p_abs_Pa", "air_mass_kg", "z_error_integral_m_s", "x_filter_m")
 
@@ -243,13 +249,17 @@ class ClosedLoopValveSource:
         return self.plant.initial_state(x_m, p) + [0.0, x_m]
 
     def inputs(self, t_s) -> tuple:
-        """``(reference [m], feedforward gauge pressure [Pa], supply gauge pressure [Pa])`` at ``t_s`` [s]."""
-        return self.reference_m(t_s), self.feedforward_gauge_Pa(t_s), self.plant.supply_gauge_Pa(t_s)
+        """``(reference [m], feedforward gauge pressure [Pa], supply gauge pressure [Pa], reference velocity
+        [m/s], feedforward command [1])`` at ``t_s`` [s]."""
+        return (self.reference_m(t_s), self.feedforward_gauge_Pa(t_s), self.plant.supply_gauge_Pa(t_s),
+                self.reference_velocity_m_s(t_s), self.feedforward_command(t_s))
 
     @property
     def signals(self) -> tuple:
-        """The signals of :meth:`inputs`, in its order: reference [m], feedforward and supply gauge pressures [Pa]."""
-        return self.reference_m, self.feedforward_gauge_Pa, self.plant.supply_gauge_Pa
+        """The signals of :meth:`inputs`, in its order: reference [m], feedforward and supply gauge pressures [Pa],
+        reference velocity [m/s], feedforward command [1]."""
+        return (self.reference_m, self.feedforward_gauge_Pa, self.plant.supply_gauge_Pa, self.reference_velocity_m_s,
+                self.feedforward_command)
 
     def pressure_gauge_Pa(self, s, inputs):
         """Gauge pressure [Pa] of the chamber: its absolute pressure state less the ambient pressure."""
@@ -261,10 +271,10 @@ class ClosedLoopValveSource:
 
     def command(self, s, x_m, inputs):
         """(clipped, unclipped) valve command for source states ``s`` at contraction ``x_m``."""
-        r, p_ff, _ = inputs
+        r, p_ff, _, v_ref, u_ff = inputs
         Kx, Kv, Kp, Kz = self.K
         v_hat = (x_m - s[3]) / self.velocity_filter_time_s
-        raw = -(Kx * (x_m - r) + Kv * v_hat + Kp * (s[0] - self.p_atm_Pa - p_ff) + Kz * s[2])
+        raw = u_ff - (Kx * (x_m - r) + Kv * (v_hat - v_ref) + Kp * (s[0] - self.p_atm_Pa - p_ff) + Kz * s[2])
         return smath.clip(raw, -1.0, 1.0), raw
 
     def controller_rates(self, s, x_m, inputs, u, raw) -> tuple:
@@ -284,6 +294,12 @@ class ClosedLoopValveSource:
         u, raw = self.command(s, x_m, inputs)
         dp, dm = self.plant.derivatives(s[:2], x_m, v_m_s, (float(u), inputs[2]))
         return (dp, dm) + self.controller_rates(s, x_m, inputs, u, raw)
+
+    @property
+    def max_input_step_s(self) -> float:
+        """Longest step over which every input is monotonic: a held load's solver must not step over a rise
+        and fall of the reference (a sampled reference's spacing), or it misses the release."""
+        return min(self.plant.max_input_step_s, max_step_hint_s(*self.signals))
 
     @property
     def breakpoints(self) -> tuple[float, ...]:
@@ -322,7 +338,9 @@ class PositionController(Component):
                   Var("p_atm_Pa", "Pa", "ambient pressure"))
     inputs = (Var("x_m", "m", "contraction"), Var("p_abs_Pa", "Pa", "absolute chamber pressure"),
               Var("reference_m", "m", "contraction reference"),
-              Var("feedforward_gauge_Pa", "Pa", "holding pressure of the reference"))
+              Var("feedforward_gauge_Pa", "Pa", "holding pressure of the reference"),
+              Var("reference_velocity_m_s", "m/s", "velocity of the reference (0 for a step)"),
+              Var("feedforward_command", "1", "valve command that keeps the chamber on the feedforward pressure"))
     states = (Var("z_error_integral_m_s", "m s", "integral of the position error", 0.1),
               Var("x_filter_m", "m", "position filter of the velocity estimate", 1e-2))
     outputs = (Var("command", "1", "valve command, clipped to [-1, 1]"),)
@@ -346,7 +364,8 @@ class PositionController(Component):
                                   plant=dataclasses.replace(self.source.plant, p_atm_Pa=P["p_atm_Pa"]))
         x = s.u["x_m"]
         states = (s.u["p_abs_Pa"], 0.0, s.x["z_error_integral_m_s"], s.x["x_filter_m"])
-        inputs = (s.u["reference_m"], s.u["feedforward_gauge_Pa"], 0.0)
+        inputs = (s.u["reference_m"], s.u["feedforward_gauge_Pa"], 0.0, s.u["reference_velocity_m_s"],
+                  s.u["feedforward_command"])
         u, raw = law.command(states, x, inputs)
         dz, dxf = law.controller_rates(states, x, inputs, u, raw)
         return Equations(der={"z_error_integral_m_s": dz, "x_filter_m": dxf}, outputs={"command": u},
@@ -365,7 +384,9 @@ def _closed_loop_parts(source: "ClosedLoopValveSource", p0_gauge_Pa: float | Non
     wiring = [*VALVE_CHAMBER_WIRING, ("load.x_m", "controller.x_m"), ("chamber.p_abs_Pa", "controller.p_abs_Pa"),
               ("controller.command", "valve.command")]
     inputs = {"reference_m": "controller.reference_m", "feedforward_gauge_Pa": "controller.feedforward_gauge_Pa",
-              "supply_pressure_gauge_Pa": "valve.supply_gauge_Pa"}
+              "supply_pressure_gauge_Pa": "valve.supply_gauge_Pa",
+              "reference_velocity_m_s": "controller.reference_velocity_m_s",
+              "feedforward_command": "controller.feedforward_command"}
     return SourceParts(parts, wiring, inputs, "chamber")
 
 

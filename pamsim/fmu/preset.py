@@ -173,8 +173,9 @@ def for_muscle(scenario: Scenario) -> Preset:
 
 
 SIGNAL_UNITS = {"valve_command": "", "pwm_duty": "", "supply_pressure_gauge_Pa": "Pa", "prescribed_pressure_gauge_Pa": "Pa",
-                "load_mass_kg": "kg", "external_force_N": "N", "reference_m": "m", "feedforward_gauge_Pa": "Pa"}
-"""The unit of each input a scenario can drive, as the signals' descriptions show it (the last two: a
+                "load_mass_kg": "kg", "external_force_N": "N", "reference_m": "m", "feedforward_gauge_Pa": "Pa",
+                "reference_velocity_m_s": "m/s", "feedforward_command": ""}
+"""The unit of each input a scenario can drive, as the signals' descriptions show it (the last four: a
 position controller's, :mod:`pamsim.control.closed_loop`)."""
 
 
