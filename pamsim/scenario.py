@@ -46,7 +46,7 @@ from .table_checks import TableChecker, choices_hint, did_you_mean
 _SCHEMA: dict[str, dict[str, Any]] = {
     "": {"name": str, "description": str, "model": dict, "parameters": dict, "load": dict, "pressure": dict,
          "simulation": dict, "solver": dict, "controller": dict, "component": list, "measured": dict,
-         "chamber": dict, "hysteresis": dict},
+         "chamber": dict, "hysteresis": dict, "compensation": dict},
     "model": {"muscle": str, "parameter_set": str, "static_force": str, "static_force_variant": str,
               "static_force_negative": str, "friction": str, "damping": str, "friction_negative_level": str,
               "upper_stop": str},

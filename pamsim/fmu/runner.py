@@ -81,7 +81,8 @@ def force_table_for(scenario: Scenario) -> ForceTable | None:
 # assembly (pamsim.backends.simulate), which the check below lets through.
 REPRESENTED = {
     "": {"name", "description", "model", "parameters", "load", "pressure", "simulation", "solver", "controller",
-         "measured", "chamber"},  # [measured] names what the figure draws beside the run, not the model
+         "measured", "chamber", "compensation"},  # [measured] names what the figure draws beside the run, not the
+    # model; [compensation] is a study (pamsim.hysteresis.compensation) that runs the scenario's closed loop
     "model": {"muscle", "parameter_set", "static_force", "static_force_negative", "friction", "damping",
               "friction_negative_level", "upper_stop"},
     "load": {"weight_N", "mass_kg", "external_force"},

@@ -1,14 +1,17 @@
-"""Figures of a hysteresis fit (kept apart from the fit): the loop measured and fitted, and the residuals."""
+"""Figures of a hysteresis fit (kept apart from the fit): the loop measured and fitted, the residuals, and a
+compensation study's identification and tracking errors."""
 
 from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+import numpy as np
 from matplotlib.figure import Figure
 
 from ..figure_style import REFERENCE, save, series
 
 if TYPE_CHECKING:
+    from .compensation import CompensationStudy
     from .fit import HysteresisFit
 
 
@@ -48,4 +51,32 @@ def plot_residuals(fit: "HysteresisFit", path=None, dpi: int | None = None) -> F
     return fig
 
 
-__all__ = ["plot_loop", "plot_residuals"]
+def plot_compensation(study: "CompensationStudy", path=None, dpi: int | None = None) -> Figure:
+    """The identification loop with the compensator's fit, then at each frequency the tracking error without
+    and with compensation."""
+    runs = study.runs
+    fig = Figure(figsize=(7, 2.6 * (1 + len(runs))), constrained_layout=True)
+    axes = fig.subplots(1 + len(runs), 1)
+    d, c = study.identification.loop, study.identification.compensator
+    axes[0].plot(d.x_m * 1e3, d.force_N, ".", color="0.6", markersize=1.5, label="identification loop (noisy)")
+    axes[0].plot(d.x_m * 1e3, c.force_N, **series(1), label=f"compensator {c.label}: RMS {c.rms_N:.3g} N")
+    axes[0].set_xlabel("contraction [mm]")
+    axes[0].set_ylabel("W - F_static [N]")
+    axes[0].legend(fontsize="small")
+    for ax, run in zip(axes[1:], runs):
+        for i, (kind, res) in enumerate(run.results.items()):
+            error_mm = (res.x_m - np.interp(res.t_s, run.signals[kind].t_s, run.signals[kind].reference_m)) * 1e3
+            ax.plot(res.t_s, error_mm, **series(i), label=f"{kind}: RMS {run.rms_m[kind] * 1e3:.3f} mm")
+        ax.axhline(0.0, **REFERENCE)
+        ax.axvline(run.from_s, **REFERENCE)
+        ax.set_title(f"{run.frequency_Hz:g} Hz: {run.reduction_percent:.0f} % lower with compensation "
+                     f"({study.backend})", fontsize="medium")
+        ax.set_xlabel("time [s]")
+        ax.set_ylabel("x - r [mm]")
+        ax.legend(fontsize="small")
+    if path is not None:
+        save(fig, path, dpi=dpi)
+    return fig
+
+
+__all__ = ["plot_compensation", "plot_loop", "plot_residuals"]
