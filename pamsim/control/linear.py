@@ -39,6 +39,7 @@ from ..errors import InputError
 from ..model import MuscleModel
 from .choices import VALVE_SLOPES
 from .exact import control_functions, exact_jacobians, held_line_states, line_states
+from .loop_point import LoopPoint, hold_hysteresis
 from .operating_point import OperatingPoint
 from .system import INPUT_SCALES, INPUTS, OUTPUTS, STATE_SCALES, STATES, FrictionTreatment, MusclePlant, input_names
 
@@ -134,6 +135,8 @@ class LinearModel:
     dropped_states: tuple[str, ...]
     jacobian_method: str = "exact"
     """``exact`` (CasADi's derivatives of the generated expressions) or ``central differences``."""
+    hysteresis: LoopPoint | None = None
+    """The branch and stick states a scenario's hysteresis was linearised in (:mod:`.loop_point`)."""
 
     @property
     def valve_input(self) -> str:
@@ -145,13 +148,19 @@ class LinearModel:
 
         Participation factors ``|w_k v_k|`` (left and right eigenvectors with
         ``w^T v = 1``) pick the load's pole pair even when the regularised
-        friction makes it overdamped (two real poles).
+        friction makes it overdamped (two real poles).  The left eigenvectors are
+        LAPACK's own, not the inverse of the right ones: sticking hysteresis
+        elements add a repeated pole at 0 (their deflections move with the
+        contraction), whose right eigenvectors LAPACK may return parallel.
         """
+        from scipy.linalg import eig
+
         A = self.sys.A
-        lam, right = np.linalg.eig(A)
-        left = np.linalg.inv(right)
+        lam, left, right = eig(A, left=True, right=True)
         k_v = list(self.sys.state_labels).index("v_m_s")
-        participation = np.abs(left[:, k_v] * right[k_v, :])
+        scale = np.einsum("ik,ik->k", left.conj(), right)  # w_k^H v_k: 0 for a defective pole, which takes no part
+        with np.errstate(divide="ignore", invalid="ignore"):
+            participation = np.nan_to_num(np.abs(left[k_v, :].conj() * right[k_v, :] / scale))
         i, j = np.argsort(participation)[-2:]
         p1, p2 = complex(lam[i]), complex(lam[j])
         prod = (p1 * p2).real
@@ -244,6 +253,7 @@ def linearize(model: MuscleModel, op: OperatingPoint, friction: FrictionTreatmen
     plant = MusclePlant(model)
     if valve_slope not in VALVE_SLOPES:
         raise InputError(f"valve slope {valve_slope!r}: choose from {', '.join(VALVE_SLOPES)}")
+    added, op, loop = hold_hysteresis(model, op, added)
     lines = line_states(model, added) if added else ()
     x0 = _state_vector(model, op, added, lines)
     if input_names(model) != INPUTS:  # the duty: its derivative at 0 is the one into its range [0, 1]
@@ -263,7 +273,8 @@ def linearize(model: MuscleModel, op: OperatingPoint, friction: FrictionTreatmen
     keep, dropped = _kept_states(A, C, names, scales) if drop_unobservable_air_mass else (list(range(len(names))), [])
     sys = ct.ss(A[np.ix_(keep, keep)], B[keep], C[:, keep], D, states=[names[k] for k in keep],
                 inputs=list(input_names(model)), outputs=list(OUTPUTS), name="muscle_linear")
-    return LinearModel(sys, op, friction, valve_slope, residual, tuple(dropped), method)
+    dropped = tuple(dropped) + (loop.dropped if loop else ())
+    return LinearModel(sys, op, friction, valve_slope, residual, dropped, method, loop)
 
 
 def _kept_states(A: np.ndarray, C: np.ndarray, names: list, scales: np.ndarray) -> tuple[list, list]:
