@@ -10,9 +10,11 @@ Richardson extrapolation step, the step of each variable scaled by its typical m
 variable, which is 1e-11 of a pressure in Pa and 10 % of an air mass in kg; hence this
 module.
 
-Two non-smooth points are handled explicitly:
+Three non-smooth points are handled explicitly:
 
 * Coulomb friction, by the :class:`~pamsim.control.system.FrictionTreatment`.
+* A scenario's hysteresis (Maxwell-slip elements' stick/slip, Bouc-Wen's ``|v|``), held in the stick
+  state and on the branch of the operating point (:mod:`pamsim.control.loop_point`).
 * The valve command at 0, where the 3/3 valve switches from the exhaust
   orifice to the supply orifice: the flow is continuous but its slope jumps
   from the venting to the filling conductance.  ``valve_slope`` picks
@@ -230,7 +232,9 @@ def linearize(model: MuscleModel, op: OperatingPoint, friction: FrictionTreatmen
         is dropped, which leaves every transfer function unchanged.
     added : tuple of AddedComponent, optional
         Components a scenario adds to the rig (``Scenario.added_components``): forces on the load and
-        work integrals, linearised exactly with the rig (no difference quotients for them).
+        work integrals, linearised exactly with the rig (no difference quotients for them).  A
+        ``[hysteresis]`` model among them is held in the stick state of ``op``
+        (:func:`~pamsim.control.loop_point.hold_hysteresis`); ``LinearModel.hysteresis`` says which.
 
     Returns
     -------
