@@ -88,6 +88,7 @@ def report(lin) -> dict:
         "valve_slope": lin.valve_slope,
         "jacobians": lin.jacobian_method,
         "dropped_states": list(lin.dropped_states),
+        **({"hysteresis": lin.hysteresis.as_dict()} if lin.hysteresis else {}),
     }
 
 
@@ -174,6 +175,9 @@ def _linearize(scenario, args: argparse.Namespace):
         scenario = scenario.with_pwm_averaged()
     model = scenario.build_model()
     added = scenario.added_components
+    if "hysteresis" in scenario.spec and args.friction != "dropped":
+        raise InputError(f"--friction {args.friction}: the scenario's [hysteresis] elements take the Coulomb "
+                         "friction's place; they are linearised in their stick state at the operating point")
     op = _operating_point(scenario, model, rest_pull(model, added), args)
     friction = FrictionTreatment(args.friction, args.friction_velocity_mm_s * 1e-3)
     lin = linearize(model, op, friction, args.valve_slope, added=added)
@@ -230,6 +234,8 @@ def _print_text(lin, rep: dict) -> None:
               f"Jacobians: {lin.jacobian_method}")
     if lin.dropped_states:
         print(f"dropped (unobservable, decoupled): {', '.join(lin.dropped_states)}")
+    if lin.hysteresis:
+        print("\n".join(lin.hysteresis.lines()))
     print(f"states:  {', '.join(rep['states'])}")
     print(f"inputs:  {', '.join(rep['inputs'])}")
     print(f"outputs: {', '.join(rep['outputs'])}")

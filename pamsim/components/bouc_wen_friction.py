@@ -35,10 +35,28 @@ class BoucWenFriction(ElementParameters, Component):
     extra_parameters = (Var("beta_per_m_n", "1", "Bouc-Wen beta [m^-n]"), Var("gamma_per_m_n", "1", "Bouc-Wen gamma [m^-n]"),
                         positive("exponent", "1", "Bouc-Wen n, the sharpness of the transition"))
 
-    def __init__(self, name: str, element, beta_per_m_n: float, gamma_per_m_n: float, exponent: float):
+    def __init__(self, name: str, element, beta_per_m_n: float, gamma_per_m_n: float, exponent: float,
+                 branch: int | None = None):
+        if branch not in (None, 1, -1):
+            raise ValueError(f"branch {branch}: None, +1 (the contraction grows) or -1")
+        self.branch = branch
         values = self.wrap(element, _level_N, PROBE_POINTS)
         values.update(beta_per_m_n=beta_per_m_n, gamma_per_m_n=gamma_per_m_n, exponent=exponent)
         super().__init__(name, values)
+
+    def structure_key(self) -> tuple:
+        """The key of :class:`ElementParameters`, with the branch held: it shapes the code."""
+        return super().structure_key() + (self.branch,)
+
+    def held(self, branch: int) -> "BoucWenFriction":
+        """This model on one branch: ``|v|`` taken as ``branch * v`` (+1 or -1), differentiable at ``v = 0``;
+        what a linearisation there differentiates (the branch of the last motion)."""
+        values = {k: self.values[k] for k in ("beta_per_m_n", "gamma_per_m_n", "exponent")}
+        return BoucWenFriction(self.name, self.element, **values, branch=branch)
+
+    def held_state(self, p_abs_Pa: float) -> dict[str, float]:
+        """The states at rest, relaxed (``z = 0``), whatever the pressure ``p_abs_Pa``."""
+        return {"z_m": 0.0, "E_hysteresis_J": 0.0}
 
     def equations(self, s: Symbols) -> Equations:
         """The Bouc-Wen law in time, its force the level times ``z / z_u``."""
@@ -48,7 +66,7 @@ class BoucWenFriction(ElementParameters, Component):
         n = P["exponent"]
         magnitude = if_else(z >= 0.0, z, -z) ** n  # |z|^n; |z|^(n-1) z is its sign times it
         sign_z = if_else(z >= 0.0, 1.0, -1.0)
-        speed = if_else(v >= 0.0, v, -v)
+        speed = if_else(v >= 0.0, v, -v) if self.branch is None else self.branch * v
         rate = v - P["beta_per_m_n"] * speed * sign_z * magnitude - P["gamma_per_m_n"] * v * magnitude
         z_u = (1.0 / (P["beta_per_m_n"] + P["gamma_per_m_n"])) ** (1.0 / n)
         force = -level * z / z_u

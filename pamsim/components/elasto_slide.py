@@ -36,16 +36,18 @@ class Element:
     jump: Any
 
 
-def element(z, v, k, delta, fired, c=0.0) -> Element:
+def element(z, v, k, delta, fired, c=0.0, stuck=None) -> Element:
     """An elasto-slide element at deflection ``z`` under a load moving at ``v``, of stiffness ``k`` >= 0 and
     slip displacement ``delta`` > 0 (slip force ``k delta``); ``fired``: its indicator crossed (at an event).
     ``c``: a damper beside the spring, that acts while the element sticks (presliding damping, as in
-    the generalized Maxwell-slip model): ``-c dz/dt``, zero while it slips."""
+    the generalized Maxwell-slip model): ``-c dz/dt``, zero while it slips.  ``stuck``: None, the element
+    switches as above; True or False, it is held sticking or slipping whatever its state (a linearisation
+    within one stick state: the same equations, the switch left out)."""
     # On the limit means there, where the event's jump put it (to the last bits: an integrator's dense output
     # can round a held deflection a few ulps outward): a state further past it inside a step keeps the
     # indicator below zero, so that the crossing is found.
     at_limit = (z * z >= delta * delta) * (z * z <= delta * delta * (1.0 + 1e-12))
-    slipping = at_limit * (v * z > 0.0)
+    slipping = at_limit * (v * z > 0.0) if stuck is None else (not stuck)
     # Clipped, so that a trial state past the limit inside a step never pulls more than F.
     rate = if_else(slipping, 0.0, v)
     force = -k * clip(z, -delta, delta) - c * rate

@@ -21,6 +21,16 @@ MAX_ELEMENTS = 100
 """The most elements a model takes (each is two states and an event indicator)."""
 
 
+def _branches(branches, n: int) -> tuple[int, ...] | None:
+    """``branches`` as a tuple of ``n`` stick states (see :class:`MaxwellSlip`), or None."""
+    if branches is None:
+        return None
+    out = tuple(int(b) for b in branches)
+    if len(out) != n or not set(out) <= {-1, 0, 1}:
+        raise ValueError(f"branches {branches}: one of 0 (stick), +1 or -1 (slip that way) per element")
+    return out
+
+
 class MaxwellSlip(ElementParameters, Component):
     """``N = len(deltas_m)`` elements on the flange, the level from the friction law ``element``.
 
@@ -29,30 +39,36 @@ class MaxwellSlip(ElementParameters, Component):
     its spring's deflection, and ``E_element<i>_J``, the work the load has done on it (spring energy plus slip
     losses).  Outputs: the total force ``F_N``, the level ``level_N``, each element's force and whether it
     slips.
+
+    ``branches`` (:meth:`held`): each element held in one stick state, for a linearisation: 0 sticking,
+    +1 or -1 slipping that way, its deflection then the constant ``+-delta<i>_m`` and no state; no events.
     """
 
     ports = (Port("flange", TRANSLATIONAL, "branch"),)
     inputs = (Var("p_gauge_Pa", "Pa", "gauge pressure in the muscle"), Var("mass_kg", "kg", "load mass"))
     indicator_names: tuple[str, ...] = ()
 
-    def __init__(self, name: str, element, deltas_m, shares, damping_N_s_per_m: float = 0.0):
+    def __init__(self, name: str, element, deltas_m, shares, damping_N_s_per_m: float = 0.0, branches=None):
         if not 1 <= len(deltas_m) <= MAX_ELEMENTS or len(shares) != len(deltas_m):
             raise ValueError(f"{len(deltas_m)} slip displacements and {len(shares)} shares: give 1 to "
                              f"{MAX_ELEMENTS} of each")
         n = self.n_elements = len(deltas_m)
         idx = range(1, n + 1)
+        self.branches = _branches(branches, n)
         self.extra_parameters = (*(positive(f"delta{i}_m", "m", f"slip displacement of element {i}") for i in idx),
                                  *(non_negative(f"share{i}", "1", f"element {i}'s share of the friction level")
                                    for i in idx),
                                  non_negative("damping_N_s_per_m", "N s/m", "presliding damping, shared as the level"))
-        self.states = (*(Var(f"z{i}_m", "m", f"deflection of element {i}'s spring", 1e-3) for i in idx),
+        # Held slipping, an element's deflection is a constant: it is no state (a linearisation drops it).
+        self.states = (*(Var(f"z{i}_m", "m", f"deflection of element {i}'s spring", 1e-3) for i in idx
+                         if not self._held_slipping(i)),
                        *(Var(f"E_element{i}_J", "J", f"work done by the load on element {i}", 0.1) for i in idx))
         self.outputs = (Var("F_N", "N", "the elements' force on the load along x"),
                         Var("level_N", "N", "the friction law's level, the elements' slip forces' sum over shares"),
                         *(Var(f"F{i}_N", "N", f"element {i}'s force on the load") for i in idx),
                         *(Var(f"slipping{i}", "1", f"1 while element {i} slips") for i in idx))
-        self.n_indicators = n
-        self.indicator_names = tuple(f"slip{i}" for i in idx)
+        self.n_indicators = n if self.branches is None else 0  # held in their stick states: no switch
+        self.indicator_names = tuple(f"slip{i}" for i in idx)[:self.n_indicators]
         values = self.wrap(element, _level_N, PROBE_POINTS)
         values.update({f"delta{i}_m": float(d) for i, d in zip(idx, deltas_m)})
         values.update({f"share{i}": float(w) for i, w in zip(idx, shares)})
@@ -61,7 +77,24 @@ class MaxwellSlip(ElementParameters, Component):
 
     def structure_key(self) -> tuple:
         """The key of :class:`ElementParameters`, with the number of elements: it shapes the code."""
-        return super().structure_key() + (self.n_elements,)
+        return super().structure_key() + (self.n_elements, self.branches)
+
+    def _held_slipping(self, i: int) -> bool:
+        """Whether element ``i`` (from 1) is held slipping (``branches``)."""
+        return self.branches is not None and self.branches[i - 1] != 0
+
+    def held(self, branches) -> "MaxwellSlip":
+        """This model with each element held in a stick state (``branches``: per element 0 sticking, +1 or -1
+        slipping that way, at its slip displacement), its equations otherwise the same, and no events: what a
+        linearisation within one stick state differentiates."""
+        n = self.n_elements
+        return MaxwellSlip(self.name, self.element, [self.values[f"delta{i}_m"] for i in range(1, n + 1)],
+                           [self.values[f"share{i}"] for i in range(1, n + 1)], self.values["damping_N_s_per_m"],
+                           branches)
+
+    def held_state(self, p_abs_Pa: float) -> dict[str, float]:
+        """The states at rest, relaxed (every deflection 0), whatever the pressure ``p_abs_Pa``."""
+        return {v.name: 0.0 for v in self.states}
 
     def equations(self, s: Symbols) -> Equations:
         """Each element of :func:`~pamsim.components.elasto_slide.element` at its share of the law's level."""
@@ -72,11 +105,17 @@ class MaxwellSlip(ElementParameters, Component):
         for i in range(1, self.n_elements + 1):
             delta = s.p[f"delta{i}_m"]
             share = s.p[f"share{i}"]
-            e = element(s.x[f"z{i}_m"], v, share * level / delta, delta, s.fired[i - 1], share * s.p["damping_N_s_per_m"])
-            der.update({f"z{i}_m": e.rate, f"E_element{i}_J": -e.force * v})
+            branch = None if self.branches is None else self.branches[i - 1]
+            z = branch * delta if self._held_slipping(i) else s.x[f"z{i}_m"]
+            e = element(z, v, share * level / delta, delta, s.fired[i - 1] if branch is None else 0.0,
+                        share * s.p["damping_N_s_per_m"], None if branch is None else branch == 0)
+            if not self._held_slipping(i):
+                der[f"z{i}_m"] = e.rate
+            der[f"E_element{i}_J"] = -e.force * v
             outputs.update({f"F{i}_N": e.force, f"slipping{i}": if_else(e.slipping, 1.0, 0.0)})
-            jumps[f"z{i}_m"] = e.jump
-            indicators.append(e.indicator)
+            if branch is None:
+                jumps[f"z{i}_m"] = e.jump
+                indicators.append(e.indicator)
             total = total + e.force
         outputs["F_N"] = total
         return Equations(der=der, outputs=outputs, port={"flange": {"F_N": total}}, indicators=tuple(indicators),

@@ -10,9 +10,11 @@ Richardson extrapolation step, the step of each variable scaled by its typical m
 variable, which is 1e-11 of a pressure in Pa and 10 % of an air mass in kg; hence this
 module.
 
-Two non-smooth points are handled explicitly:
+Three non-smooth points are handled explicitly:
 
 * Coulomb friction, by the :class:`~pamsim.control.system.FrictionTreatment`.
+* A scenario's hysteresis (Maxwell-slip elements' stick/slip, Bouc-Wen's ``|v|``), held in the stick
+  state and on the branch of the operating point (:mod:`pamsim.control.loop_point`).
 * The valve command at 0, where the 3/3 valve switches from the exhaust
   orifice to the supply orifice: the flow is continuous but its slope jumps
   from the venting to the filling conductance.  ``valve_slope`` picks
@@ -39,6 +41,7 @@ from ..errors import InputError
 from ..model import MuscleModel
 from .choices import VALVE_SLOPES
 from .exact import control_functions, exact_jacobians, held_line_states, line_states
+from .loop_point import LoopPoint, hold_hysteresis
 from .operating_point import OperatingPoint
 from .system import INPUT_SCALES, INPUTS, OUTPUTS, STATE_SCALES, STATES, FrictionTreatment, MusclePlant, input_names
 
@@ -134,6 +137,8 @@ class LinearModel:
     dropped_states: tuple[str, ...]
     jacobian_method: str = "exact"
     """``exact`` (CasADi's derivatives of the generated expressions) or ``central differences``."""
+    hysteresis: LoopPoint | None = None
+    """The branch and stick states a scenario's hysteresis was linearised in (:mod:`.loop_point`)."""
 
     @property
     def valve_input(self) -> str:
@@ -145,13 +150,19 @@ class LinearModel:
 
         Participation factors ``|w_k v_k|`` (left and right eigenvectors with
         ``w^T v = 1``) pick the load's pole pair even when the regularised
-        friction makes it overdamped (two real poles).
+        friction makes it overdamped (two real poles).  The left eigenvectors are
+        LAPACK's own, not the inverse of the right ones: sticking hysteresis
+        elements add a repeated pole at 0 (their deflections move with the
+        contraction), whose right eigenvectors LAPACK may return parallel.
         """
+        from scipy.linalg import eig
+
         A = self.sys.A
-        lam, right = np.linalg.eig(A)
-        left = np.linalg.inv(right)
+        lam, left, right = eig(A, left=True, right=True)
         k_v = list(self.sys.state_labels).index("v_m_s")
-        participation = np.abs(left[:, k_v] * right[k_v, :])
+        scale = np.einsum("ik,ik->k", left.conj(), right)  # w_k^H v_k: 0 for a defective pole, which takes no part
+        with np.errstate(divide="ignore", invalid="ignore"):
+            participation = np.nan_to_num(np.abs(left[k_v, :].conj() * right[k_v, :] / scale))
         i, j = np.argsort(participation)[-2:]
         p1, p2 = complex(lam[i]), complex(lam[j])
         prod = (p1 * p2).real
@@ -221,7 +232,9 @@ def linearize(model: MuscleModel, op: OperatingPoint, friction: FrictionTreatmen
         is dropped, which leaves every transfer function unchanged.
     added : tuple of AddedComponent, optional
         Components a scenario adds to the rig (``Scenario.added_components``): forces on the load and
-        work integrals, linearised exactly with the rig (no difference quotients for them).
+        work integrals, linearised exactly with the rig (no difference quotients for them).  A
+        ``[hysteresis]`` model among them is held in the stick state of ``op``
+        (:func:`~pamsim.control.loop_point.hold_hysteresis`); ``LinearModel.hysteresis`` says which.
 
     Returns
     -------
@@ -244,6 +257,7 @@ def linearize(model: MuscleModel, op: OperatingPoint, friction: FrictionTreatmen
     plant = MusclePlant(model)
     if valve_slope not in VALVE_SLOPES:
         raise InputError(f"valve slope {valve_slope!r}: choose from {', '.join(VALVE_SLOPES)}")
+    added, op, loop = hold_hysteresis(model, op, added)
     lines = line_states(model, added) if added else ()
     x0 = _state_vector(model, op, added, lines)
     if input_names(model) != INPUTS:  # the duty: its derivative at 0 is the one into its range [0, 1]
@@ -263,7 +277,8 @@ def linearize(model: MuscleModel, op: OperatingPoint, friction: FrictionTreatmen
     keep, dropped = _kept_states(A, C, names, scales) if drop_unobservable_air_mass else (list(range(len(names))), [])
     sys = ct.ss(A[np.ix_(keep, keep)], B[keep], C[:, keep], D, states=[names[k] for k in keep],
                 inputs=list(input_names(model)), outputs=list(OUTPUTS), name="muscle_linear")
-    return LinearModel(sys, op, friction, valve_slope, residual, tuple(dropped), method)
+    dropped = tuple(dropped) + (loop.dropped if loop else ())
+    return LinearModel(sys, op, friction, valve_slope, residual, dropped, method, loop)
 
 
 def _kept_states(A: np.ndarray, C: np.ndarray, names: list, scales: np.ndarray) -> tuple[list, list]:

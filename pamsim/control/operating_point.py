@@ -46,7 +46,9 @@ class OperatingPoint:
     ``mode`` is the hybrid mode of the load there (stick for an equilibrium).  ``line_states``: the states
     of the components added to the rig there (``{"reservoir.p_abs_Pa": ...}``), where the operating point
     knows them (a run's); an equilibrium's come from the components at rest
-    (:func:`pamsim.control.exact.held_line_states`).
+    (:func:`pamsim.control.exact.held_line_states`).  ``motion_sign``: the sign of the load's last nonzero
+    velocity up to a run's point (+1 contracting, -1 extending), 0 where it never moved or at an
+    equilibrium; the branch of a hysteresis at rest (:mod:`pamsim.control.loop_point`).
     """
 
     states: np.ndarray
@@ -55,6 +57,7 @@ class OperatingPoint:
     mode: Mode
     description: str
     line_states: dict = field(default_factory=dict)
+    motion_sign: int = 0
 
     def as_dict(self) -> dict:
         """The operating point as JSON-ready values: kind, mode, description, states and inputs."""
@@ -196,11 +199,12 @@ def trajectory_point(scenario, time_s: float) -> OperatingPoint:
     mode = result.final_mode
     added = {f"{a.component.name}.{v.name}" for a in scenario.added_components for v in a.component.states}
     line = {name: float(values[-1]) for name, values in result.signals.items() if name in added}
+    moved = np.flatnonzero(result.v_m_s != 0.0)
     return OperatingPoint(states, np.array([command, supply, model.load.external_N(float(time_s))], dtype=float),
                           "trajectory", mode,
                           f"state of the simulation at t = {time_s:g} s ({mode.label}): x = {states[0] * 1e3:.3f} mm, "
                           f"v = {states[1] * 1e3:.3f} mm/s, p = {(p_abs - model.source.p_atm_Pa) / PA_PER_BAR:.4f} bar",
-                          line)
+                          line, int(np.sign(result.v_m_s[moved[-1]])) if moved.size else 0)
 
 
 
