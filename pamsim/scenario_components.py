@@ -24,7 +24,7 @@ from typing import Any
 from .assemblies.one_muscle import RIG_COMPONENTS, AddedComponent, scenario_assembly
 from .components.catalogue import COMPONENT_TYPES
 from .components.bouc_wen_friction import BoucWenFriction
-from .components.maxwell_slip_friction import MAX_ELEMENTS, MaxwellSlip
+from .components.maxwell_slip_friction import MAX_ELEMENTS, MaxwellSlip, prandtl_ishlinskii
 from .modeling import AssemblyError
 from .table_checks import did_you_mean
 
@@ -106,7 +106,8 @@ def _component_values(v, where: str, kind: str, parameters, entry: dict, default
 
 
 HYSTERESIS_KEYS = {"maxwell_slip": ("slip_displacement_m", "share", "damping_N_s_per_m"),
-                   "bouc_wen": ("beta_per_m_n", "gamma_per_m_n", "exponent")}
+                   "bouc_wen": ("beta_per_m_n", "gamma_per_m_n", "exponent"),
+                   "pi": ("thresholds_m", "weights_N_per_m", "envelope_scale_m")}
 """The hysteresis models a ``[hysteresis]`` table puts in the muscle's force balance, and their keys."""
 
 
@@ -127,6 +128,12 @@ def hysteresis_component(v, table: dict, law, pressure: str, added: tuple) -> Ad
         beta_per_m_n = 500.0                 # beta + gamma > 0
         gamma_per_m_n = 500.0
         exponent = 1.0                       # n > 0
+
+        [hysteresis]
+        model = "pi"                         # generalized Prandtl-Ishlinskii, its hysteretic (stop) part
+        thresholds_m = [2e-4, 1e-3, 4e-3]    # r_j, strictly increasing, > 0
+        weights_N_per_m = [3750, 750, 250]   # w_j >= 0
+        envelope_scale_m = 0.05              # optional: s of g(x) = s tanh(x / s); none, g(x) = x
     """
     model = table.get("model")
     if model not in HYSTERESIS_KEYS:
@@ -136,7 +143,7 @@ def hysteresis_component(v, table: dict, law, pressure: str, added: tuple) -> Ad
         v.fail(f"hysteresis.{key}", table[key], f"unknown key for model = {model!r}", choices=keys)
     if any(a.component.name == "hysteresis" for a in added):
         v.fail("component", "hysteresis", "the name is taken by the [hysteresis] table's model")
-    component = (_maxwell_slip if model == "maxwell_slip" else _bouc_wen)(v, table, law)
+    component = {"maxwell_slip": _maxwell_slip, "bouc_wen": _bouc_wen, "pi": _prandtl_ishlinskii}[model](v, table, law)
     return AddedComponent(component, {"flange": "load.flange", "p_gauge_Pa": f"{pressure}.p_gauge_Pa",
                                       "mass_kg": "load.mass_kg"})
 
@@ -161,6 +168,34 @@ def _maxwell_slip(v, table: dict, law) -> MaxwellSlip:
     if c < 0:
         v.fail("hysteresis.damping_N_s_per_m", c, "must be >= 0")
     return MaxwellSlip("hysteresis", law, deltas, shares, c)
+
+
+def _element_list(v, table: dict, key: str) -> list[float]:
+    """``hysteresis.KEY``: an array of 1 to :data:`MAX_ELEMENTS` numbers."""
+    values = table.get(key)
+    if not isinstance(values, list) or not 1 <= len(values) <= MAX_ELEMENTS:
+        v.fail(f"hysteresis.{key}", values, f"must be an array of 1 to {MAX_ELEMENTS} numbers, one per element")
+    return [v.number(f"hysteresis.{key}[{i}]", x) for i, x in enumerate(values)]
+
+
+def _prandtl_ishlinskii(v, table: dict, law) -> MaxwellSlip:
+    """The ``pi`` model: its forces are its own weights and thresholds, not the friction law's level."""
+    r, w = _element_list(v, table, "thresholds_m"), _element_list(v, table, "weights_N_per_m")
+    if len(w) != len(r):
+        v.fail("hysteresis.weights_N_per_m", table["weights_N_per_m"], f"has {len(w)} values for {len(r)} thresholds")
+    if r[0] <= 0:
+        v.fail("hysteresis.thresholds_m[0]", r[0], "must be > 0 (a play of threshold 0 has no hysteretic part)")
+    for i in range(1, len(r)):
+        if r[i] <= r[i - 1]:
+            v.fail(f"hysteresis.thresholds_m[{i}]", r[i], f"thresholds must increase strictly "
+                   f"(thresholds_m[{i - 1}] = {r[i - 1]!r})")
+    for i, x in enumerate(w):
+        if x < 0:
+            v.fail(f"hysteresis.weights_N_per_m[{i}]", x, "must be >= 0")
+    s = table.get("envelope_scale_m")
+    if s is not None and v.number("hysteresis.envelope_scale_m", s) <= 0:
+        v.fail("hysteresis.envelope_scale_m", s, "must be > 0 (leave it out for the classical operator)")
+    return prandtl_ishlinskii("hysteresis", r, w, None if s is None else float(s))
 
 
 def _bouc_wen(v, table: dict, law) -> BoucWenFriction:

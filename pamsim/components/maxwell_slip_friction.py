@@ -7,12 +7,20 @@ stiffness ``w_i F_c / delta_i``, with ``F_c(x, p, m)`` the level of any law of :
 ``delta -> 0`` it is that law's Coulomb friction: the stiff spring holds the load where Coulomb friction
 sticks it, and slips at the same level.  It takes the place of the rig's Coulomb friction, whose law it
 reads (:class:`pamsim.components.CoulombFriction` is then ``"none"``).
+
+The same elements on an envelope of the contraction are the generalized Prandtl-Ishlinskii operator in its
+stop form: element ``j``'s deflection is the stop ``E_rj[g(x)] = g(x) - P_rj[g(x)]`` of threshold ``r_j`` on
+``g(x) = s tanh(x / s)``, and its force ``-w_j E_rj``, so the elements' force is the operator
+``sum w_j P_rj[g(x)]`` less its elastic part ``sum w_j g(x)`` (which the muscle's static force holds).  With a
+constant level of 1 N, shares ``w_j r_j`` and slip displacements ``r_j`` give stiffnesses ``w_j``
+(:func:`prandtl_ishlinskii`).
 """
 
 from __future__ import annotations
 
+from ..elements.friction import ConstantCoulomb
 from ..modeling import TRANSLATIONAL, Component, Equations, Port, Symbols, Var, non_negative, positive
-from ..modeling.smath import if_else
+from ..modeling.smath import if_else, tanh
 from .elasto_slide import element
 from .element import ElementParameters
 from .friction import PROBE_POINTS, _level_N
@@ -29,6 +37,16 @@ def _branches(branches, n: int) -> tuple[int, ...] | None:
     if len(out) != n or not set(out) <= {-1, 0, 1}:
         raise ValueError(f"branches {branches}: one of 0 (stick), +1 or -1 (slip that way) per element")
     return out
+
+
+def _parameters(n: int, envelope: bool) -> tuple:
+    """The declared parameters of ``n`` elements, and the envelope's scale if they deflect on one."""
+    idx = range(1, n + 1)
+    scale = (positive("envelope_scale_m", "m", "scale s of the envelope s tanh(x / s) the elements deflect on"),)
+    return (*(positive(f"delta{i}_m", "m", f"slip displacement of element {i}") for i in idx),
+            *(non_negative(f"share{i}", "1", f"element {i}'s share of the friction level") for i in idx),
+            non_negative("damping_N_s_per_m", "N s/m", "presliding damping, shared as the level"),
+            *(scale if envelope else ()))
 
 
 class MaxwellSlip(ElementParameters, Component):
@@ -48,17 +66,19 @@ class MaxwellSlip(ElementParameters, Component):
     inputs = (Var("p_gauge_Pa", "Pa", "gauge pressure in the muscle"), Var("mass_kg", "kg", "load mass"))
     indicator_names: tuple[str, ...] = ()
 
-    def __init__(self, name: str, element, deltas_m, shares, damping_N_s_per_m: float = 0.0, branches=None):
+    model_name = "maxwell_slip"
+    """The ``[hysteresis] model`` these elements are (``pi`` for :func:`prandtl_ishlinskii`)."""
+
+    def __init__(self, name: str, element, deltas_m, shares, damping_N_s_per_m: float = 0.0, branches=None,
+                 envelope_scale_m: float | None = None):
         if not 1 <= len(deltas_m) <= MAX_ELEMENTS or len(shares) != len(deltas_m):
             raise ValueError(f"{len(deltas_m)} slip displacements and {len(shares)} shares: give 1 to "
                              f"{MAX_ELEMENTS} of each")
         n = self.n_elements = len(deltas_m)
         idx = range(1, n + 1)
         self.branches = _branches(branches, n)
-        self.extra_parameters = (*(positive(f"delta{i}_m", "m", f"slip displacement of element {i}") for i in idx),
-                                 *(non_negative(f"share{i}", "1", f"element {i}'s share of the friction level")
-                                   for i in idx),
-                                 non_negative("damping_N_s_per_m", "N s/m", "presliding damping, shared as the level"))
+        self.envelope_scale_m = envelope_scale_m
+        self.extra_parameters = _parameters(n, envelope_scale_m is not None)
         # Held slipping, an element's deflection is a constant: it is no state (a linearisation drops it).
         self.states = (*(Var(f"z{i}_m", "m", f"deflection of element {i}'s spring", 1e-3) for i in idx
                          if not self._held_slipping(i)),
@@ -73,11 +93,13 @@ class MaxwellSlip(ElementParameters, Component):
         values.update({f"delta{i}_m": float(d) for i, d in zip(idx, deltas_m)})
         values.update({f"share{i}": float(w) for i, w in zip(idx, shares)})
         values["damping_N_s_per_m"] = float(damping_N_s_per_m)
+        if envelope_scale_m is not None:
+            values["envelope_scale_m"] = float(envelope_scale_m)
         super().__init__(name, values)
 
     def structure_key(self) -> tuple:
         """The key of :class:`ElementParameters`, with the number of elements: it shapes the code."""
-        return super().structure_key() + (self.n_elements, self.branches)
+        return super().structure_key() + (self.n_elements, self.branches, self.envelope_scale_m is None)
 
     def _held_slipping(self, i: int) -> bool:
         """Whether element ``i`` (from 1) is held slipping (``branches``)."""
@@ -88,9 +110,11 @@ class MaxwellSlip(ElementParameters, Component):
         slipping that way, at its slip displacement), its equations otherwise the same, and no events: what a
         linearisation within one stick state differentiates."""
         n = self.n_elements
-        return MaxwellSlip(self.name, self.element, [self.values[f"delta{i}_m"] for i in range(1, n + 1)],
+        held = MaxwellSlip(self.name, self.element, [self.values[f"delta{i}_m"] for i in range(1, n + 1)],
                            [self.values[f"share{i}"] for i in range(1, n + 1)], self.values["damping_N_s_per_m"],
-                           branches)
+                           branches, self.values.get("envelope_scale_m"))
+        held.model_name = self.model_name
+        return held
 
     def held_state(self, p_abs_Pa: float) -> dict[str, float]:
         """The states at rest, relaxed (every deflection 0), whatever the pressure ``p_abs_Pa``."""
@@ -100,6 +124,11 @@ class MaxwellSlip(ElementParameters, Component):
         """Each element of :func:`~pamsim.components.elasto_slide.element` at its share of the law's level."""
         u, flange = s.u, s.port["flange"]
         v = flange["v_m_s"]
+        if self.envelope_scale_m is not None:  # the elements deflect on g(x) = s tanh(x / s): at g'(x) v
+            slope = tanh(flange["x_m"] / s.p["envelope_scale_m"])
+            v_elements = v * (1.0 - slope * slope)
+        else:
+            v_elements = v
         level = self.element_call(s, "level_N", flange["x_m"], u["p_gauge_Pa"], u["mass_kg"])
         der, outputs, jumps, indicators, total = {}, {"level_N": level}, {}, [], 0.0
         for i in range(1, self.n_elements + 1):
@@ -107,7 +136,7 @@ class MaxwellSlip(ElementParameters, Component):
             share = s.p[f"share{i}"]
             branch = None if self.branches is None else self.branches[i - 1]
             z = branch * delta if self._held_slipping(i) else s.x[f"z{i}_m"]
-            e = element(z, v, share * level / delta, delta, s.fired[i - 1] if branch is None else 0.0,
+            e = element(z, v_elements, share * level / delta, delta, s.fired[i - 1] if branch is None else 0.0,
                         share * s.p["damping_N_s_per_m"], None if branch is None else branch == 0)
             if not self._held_slipping(i):
                 der[f"z{i}_m"] = e.rate
@@ -120,3 +149,13 @@ class MaxwellSlip(ElementParameters, Component):
         outputs["F_N"] = total
         return Equations(der=der, outputs=outputs, port={"flange": {"F_N": total}}, indicators=tuple(indicators),
                          transition=jumps, initial={v.name: 0.0 for v in self.states})
+
+
+def prandtl_ishlinskii(name: str, thresholds_m, weights_N_per_m, envelope_scale_m: float | None = None) -> MaxwellSlip:
+    """The generalized Prandtl-Ishlinskii operator's hysteretic part on the load's flange (see the module's
+    docstring): thresholds ``r_j`` [m] (> 0), weights ``w_j`` [N/m] (>= 0), the envelope's scale [m] (None:
+    the classical operator, ``g(x) = x``).  Its forces are its own, not a friction law's."""
+    pi = MaxwellSlip(name, ConstantCoulomb(1.0), list(thresholds_m),
+                     [float(w) * float(r) for w, r in zip(weights_N_per_m, thresholds_m)], 0.0, None, envelope_scale_m)
+    pi.model_name = "pi"
+    return pi

@@ -125,7 +125,7 @@ def _maxwell_slip(component: MaxwellSlip, state: dict, sign: int, level: float):
         else:
             entry.update(damping_N_s_per_m=share * c, margin_m=delta - abs(z))
         elements.append(entry)
-    return component.held(branches), LoopPoint("maxwell_slip", "", "", tuple(elements), tuple(dropped))
+    return component.held(branches), LoopPoint(component.model_name, "", "", tuple(elements), tuple(dropped))
 
 
 def _bouc_wen(component: BoucWenFriction, state: dict, sign: int, level: float):

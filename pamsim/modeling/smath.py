@@ -62,6 +62,7 @@ def _unary(name: str, doc: str):
 cos = _unary("cos", "``cos(a)`` (radians), on floats (:func:`math.cos`) or symbols.")
 sin = _unary("sin", "``sin(a)`` (radians), on floats (:func:`math.sin`) or symbols.")
 sqrt = _unary("sqrt", "``sqrt(a)``, on floats (:func:`math.sqrt`) or symbols.")
+tanh = _unary("tanh", "``tanh(a)``, on floats (:func:`math.tanh`) or symbols.")
 
 
 def radians(degrees):
