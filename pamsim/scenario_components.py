@@ -136,7 +136,7 @@ def hysteresis_component(v, table: dict, law, pressure: str, added: tuple) -> Ad
         envelope_scale_m = 0.05              # optional: s of g(x) = s tanh(x / s); none, g(x) = x
     """
     model = table.get("model")
-    if model not in HYSTERESIS_KEYS:
+    if not isinstance(model, str) or model not in HYSTERESIS_KEYS:
         v.fail("hysteresis.model", model, "unknown hysteresis model", choices=list(HYSTERESIS_KEYS))
     keys = ["model", *HYSTERESIS_KEYS[model]]
     for key in sorted(set(table) - set(keys)):

@@ -92,7 +92,8 @@ and its mode decided again from the forces at the end of the hold.  The motion
 lost is of the order of the integrator's velocity tolerance times the hold.
 """
 _MAX_ZERO_LENGTH = 30
-"""Zero-length segments in a row (the last hold is then 2**29 ns, about 0.5 s) before it is a solver failure."""
+"""Zero-length segments in a row with no time between them before it is a solver failure; also the
+longest hold's doubling (2**29 ns, about 0.5 s)."""
 
 
 def simulate_python(scenario, progress: Callable[[float], None] | None = None,
@@ -452,7 +453,7 @@ class HybridRun:
         self.ts, self.ys, self.modes = [], [], []
         self.transitions: list[TransitionEvent] = []
         self.impact_loss_J = []  # (t, J): kinetic energy removed by inelastic impacts and velocity resets
-        self.nfev = self.n_segments = self.n_zero = self.next_sample = 0
+        self.nfev = self.n_segments = self.n_zero = self.n_stuck = self.next_sample = 0
         self.hold_until = math.inf  # end of a short hold after a slip too small to resolve (see _HOLD_S)
         # Over every integrator step and event, not the samples.
         self.low_x, self.peak_x = math.inf, -math.inf
@@ -526,8 +527,11 @@ class HybridRun:
         t_event = float(sol.t_events[k][0])
         y = np.array(sol.y_events[k][0], dtype=float)
         zero_length = t_event - self.t <= 1e-12 * max(1.0, self.t)
+        # n_zero: zero-length slips since the load last moved (the holds' doubling); n_stuck: zero-length
+        # events with no time passed between them (a hold that ran is progress).
         self.n_zero = self.n_zero + 1 if zero_length else 0
-        if self.n_zero > _MAX_ZERO_LENGTH:
+        self.n_stuck = self.n_stuck + 1 if zero_length else 0
+        if self.n_stuck > _MAX_ZERO_LENGTH:
             raise SolverFailure(f"event switching made no progress at t = {t_event:.9g} s ({kind})")
         old = self.mode
         self.y, self.mode, lost_J = self.gen.jump(old, indicator, t_event, y)
@@ -536,7 +540,7 @@ class HybridRun:
         self.hold_until = math.inf
         if kind == "velocity_zero" and zero_length and self.mode.is_slip:
             self.mode = Mode.STICK
-            self.hold_until = t_event + _HOLD_S * 2.0 ** (self.n_zero - 1)
+            self.hold_until = t_event + _HOLD_S * 2.0 ** (min(self.n_zero, _MAX_ZERO_LENGTH) - 1)
         self.transitions.append(TransitionEvent(t_event, kind, old.label, self.mode.label, float(self.y[0])))
         if len(self.transitions) > self.opts.max_events:
             raise too_many_events(self.opts.max_events, f" by t = {t_event:.6g} s")
@@ -546,6 +550,7 @@ class HybridRun:
         """The segment reached an input breakpoint: a held load's mode is decided again there."""
         self.t = t_break
         self.hold_until = math.inf
+        self.n_stuck = 0
         self.y = sol.y[:, -1].copy()
         if self.mode in _REST:
             self.mode = self.gen.rest_mode(self.mode, self.t, self.y)
