@@ -176,3 +176,48 @@ def test_the_script_exits_2_as_a_process():
     assert done.stdout == ""
     assert done.stderr == "fidelity_pneumatics.py: error: argument --lengths-m: '0': every length must be a " \
                           "finite number > 0\n"
+
+
+def test_a_frequency_study_that_replaces_the_lines_valve_is_refused(tmp_path):
+    """``[frequency.pressure]`` prescribes the muscle's pressure: the line's supply then has no set pressure to
+    read; refused before anything runs, exit 2, nothing written."""
+    from conftest import run_main
+
+    sweep = _line_sweep(tmp_path)
+    sweep.write_text(sweep.read_text() + '[frequency]\npressure_bar = 3.6\nweight_N = [12.74]\n'
+                     '[frequency.pressure]\nsource = "prescribed"\n'
+                     'prescribed = { kind = "step", time_s = 1.0, final_gauge_bar = 3.6 }\n')
+    done = run_main("sweep", sweep, "-o", tmp_path / "out")
+    assert done.returncode == 2
+    assert "[frequency.pressure]" in done.stderr and "supply.p_set_gauge_Pa" in done.stderr
+    assert done.stderr.count("\n") == 1
+    assert not (tmp_path / "out").exists()
+
+
+def _row(error_mm, within=True, at_rest=True, settled=1.5, x_settled=1.2, ringing_mm=0.0, step=1.2, weight=12.74):
+    return {"within_capability": within, "measured_contraction_m": 0.03, "error_m": error_mm * 1e-3,
+            "settled_time_s": settled, "contraction_settled_time_s": x_settled, "at_rest": at_rest,
+            "last_second_peak_to_peak_m": ringing_mm * 1e-3, "pressure_step_bar": step, "weight_N": weight,
+            "final_contraction_m": 0.03 + error_mm * 1e-3}
+
+
+def test_the_summary_of_a_configuration_by_hand(fidelity):
+    """Four cases, three within capability (errors 3, -4 and 0 mm): RMS sqrt(25/3) = 2.887 mm, largest 4 mm,
+    mean -1/3 mm; the settling medians over the stuck ones (1.2 and 1.4 s -> 1.3 s, less the valve's 1 s)
+    and the ringing one (3.0 s) apart; the case outside capability counts only for rest and ringing."""
+    rows = [_row(3.0, x_settled=1.2), _row(-4.0, at_rest=False, x_settled=3.0, ringing_mm=0.5, settled=1.3),
+            _row(0.0, x_settled=1.4, step=3.6, weight=22.74, settled=1.1),
+            _row(9.0, within=False, at_rest=False, ringing_mm=0.1)]
+    today = [dict(r, final_contraction_m=r["final_contraction_m"] + d * 1e-3) for r, d in zip(rows, (1, -2, 0, 0))]
+    s = fidelity.summarise(rows, 1.0, today)
+    assert s["n_within"] == 3
+    assert s["rms_mm"] == pytest.approx(np.sqrt(25 / 3))
+    assert s["max_mm"] == pytest.approx(4.0)
+    assert s["mean_mm"] == pytest.approx(-1 / 3)
+    assert s["pressure_settling_s"] == pytest.approx(0.3)
+    assert s["stuck_settling_s"] == pytest.approx(0.3)
+    assert s["ringing_settling_s"] == pytest.approx(2.0)
+    assert s["figure4_settling_s"] == pytest.approx(0.4)
+    assert (s["at_rest"], s["n_cases"]) == (2, 4)
+    assert s["ringing_mm"] == pytest.approx(0.3)
+    assert s["largest_change_mm"] == pytest.approx(2.0)
