@@ -25,7 +25,7 @@ from .assemblies.one_muscle import RIG_COMPONENTS, AddedComponent, scenario_asse
 from .components.catalogue import COMPONENT_TYPES
 from .components.bouc_wen_friction import BoucWenFriction
 from .components.maxwell_slip_friction import MAX_ELEMENTS, MaxwellSlip, prandtl_ishlinskii
-from .modeling import AssemblyError
+from .modeling import PNEUMATIC, AssemblyError
 from .table_checks import did_you_mean
 
 RESERVED_KEYS = ("name", "type", "connect")
@@ -209,16 +209,30 @@ def _bouc_wen(v, table: dict, law) -> BoucWenFriction:
     return BoucWenFriction("hysteresis", law, **values)
 
 
-def refuse_added(scenario: Any, what: str, error: type[Exception], hysteresis: bool = False) -> None:
+def refuse_added(scenario: Any, what: str, error: type[Exception], hysteresis: bool = False,
+                 lines_allowed: bool = False) -> None:
     """Raise ``error`` if ``scenario`` adds components to the rig: ``what`` (a command, a study) works
     on the rig alone and would leave them out without a word.  ``hysteresis``: the ``[hysteresis]`` table's
-    model is welcome (``what`` runs it, and designs without the muscle's friction anyway)."""
-    added = [a for a in scenario.added_components
-             if not (hysteresis and "hysteresis" in scenario.spec and a.component.name == "hysteresis")]
-    if added:
-        names = ", ".join(repr(a.component.name) for a in added)
-        raise error(f"{scenario.origin}: component: {what} takes the rig alone, not the components added to it "
+    model is welcome (``what`` runs it, and designs without the muscle's friction anyway).
+
+    With ``lines_allowed``, components whose every port is pneumatic (a supply, a reservoir, a tube: a
+    line to the valve or from it) pass: ``what`` takes the chamber at the supply's pressure, where such a
+    line leaves it once its flows have stopped, and it needs nothing else of them.
+    """
+    refused = [a for a in scenario.added_components
+               if not (hysteresis and "hysteresis" in scenario.spec and a.component.name == "hysteresis")
+               and not (lines_allowed and is_line_component(a.component))]
+    if refused:
+        names = ", ".join(repr(a.component.name) for a in refused)
+        alone = "the rig and its pneumatic line alone" if lines_allowed else "the rig alone"
+        raise error(f"{scenario.origin}: component: {what} takes {alone}, not the components added to it "
                     f"({names}); run the scenario with `pamsim run` (python or native backend)")
+
+
+def is_line_component(component: Any) -> bool:
+    """Whether every port of ``component`` is pneumatic (a supply, a reservoir, a tube): it adds no force
+    to the load and changes no static equilibrium."""
+    return bool(component.ports) and all(port.kind is PNEUMATIC for port in component.ports)
 
 
 def check_wiring(scenario: Any, error: type[Exception]) -> None:

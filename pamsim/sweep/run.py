@@ -740,7 +740,8 @@ def _stopped(progress: _Progress, total: int) -> str:
 
 
 _RUN_COLUMNS = ("final_contraction_m", "peak_contraction_m", "error_m", "at_rest", "final_mode",
-                "last_second_peak_to_peak_m", "frequency_Hz", "damping_ratio", "n_half_cycles", "failure")
+                "last_second_peak_to_peak_m", "frequency_Hz", "damping_ratio", "n_half_cycles",
+                "settled_time_s", "contraction_settled_time_s", "failure")
 
 
 def _case_row(spec: SweepSpec, i: int, case: SweepCase, by_key: Mapping, scenarios: Mapping) -> dict:

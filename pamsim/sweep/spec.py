@@ -119,7 +119,7 @@ def sweep_from_dict(spec: Mapping[str, Any], base_dir: str | Path = ".", origin:
     check.check_keys("the top level", "", spec, _TOP_KEYS)
     base_name = check.required(spec, "base_scenario", str)
     base = load_scenario(_resolve(base_dir, base_name))
-    refuse_added(base, "a sweep's static analysis", SweepError)
+    refuse_added(base, "a sweep's static analysis", SweepError, lines_allowed=True)
     frictions = _friction_models(check, spec.get("friction_models", [base.spec["model"]["friction"]]))
     threshold_mm = check.number("capability_min_equilibrium_mm", spec.get("capability_min_equilibrium_mm", 5.0))
     measured = _read_measured(check, base_dir, spec["measured"]) if "measured" in spec else None
