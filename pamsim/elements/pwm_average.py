@@ -161,16 +161,24 @@ class AveragedPwmSource(ValveChamberSource):
 
     def derivatives(self, s, x_m, v_m_s, inputs) -> tuple[float, float]:
         """(dp/dt [Pa/s], dm/dt [kg/s]) of the chamber, each path's flow carrying its own temperature."""
-        p, m = s[0], s[1]
-        V = self.chamber.volume_m3(x_m)
-        T_gas = self.chamber.gas_temperature_K(p, V, m)
         duty, supply_gauge_Pa = inputs
-        flows = self.valve.path_flows_kg_s(duty, p, T_gas, supply_gauge_Pa + self.p_atm_Pa, self.T_supply_K,
-                                           self.p_atm_Pa)
-        work = sum(self.chamber.flow_work_W(float(mdot), self.T_supply_K if mdot >= 0.0 else T_gas) for mdot in flows)
-        mdot = float(sum(flows))
-        dV = self.chamber.dvolume_dx_m2(x_m) * v_m_s
-        return self.chamber.pressure_rate_of_flows_Pa_s(p, V, dV, mdot, work, m, x_m), mdot
+        return chamber_rates_of_paths(self, s, x_m, v_m_s, duty, supply_gauge_Pa)
+
+
+def chamber_rates_of_paths(source, s, x_m, v_m_s, opening, supply_gauge_Pa) -> tuple[float, float]:
+    """(dp/dt [Pa/s], dm/dt [kg/s]) of ``source``'s chamber (states ``s[0]``, ``s[1]``) fed by a valve with a
+    supply and an exhaust path open at once (``source.valve.path_flows_kg_s(opening, ...)``: the averaged
+    PWM valve at its duty, a spool valve at its position), each path's flow carrying its own temperature."""
+    p, m = s[0], s[1]
+    chamber = source.chamber
+    V = chamber.volume_m3(x_m)
+    T_gas = chamber.gas_temperature_K(p, V, m)
+    flows = source.valve.path_flows_kg_s(opening, p, T_gas, supply_gauge_Pa + source.p_atm_Pa, source.T_supply_K,
+                                         source.p_atm_Pa)
+    work = sum(chamber.flow_work_W(float(mdot), source.T_supply_K if mdot >= 0.0 else T_gas) for mdot in flows)
+    mdot = float(sum(flows))
+    dV = chamber.dvolume_dx_m2(x_m) * v_m_s
+    return chamber.pressure_rate_of_flows_Pa_s(p, V, dV, mdot, work, m, x_m), mdot
 
 
 def averaged_source(source: ValveChamberSource, pwm) -> AveragedPwmSource:
