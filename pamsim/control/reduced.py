@@ -21,6 +21,7 @@ import numpy as np
 
 from ..elements.pressure_source import LineValveSource, ValveChamberSource
 from ..errors import InputError
+from ..scenario_components import refuse_added
 from .linear import LinearModel, linearize
 from .operating_point import OperatingPoint
 from .system import FrictionTreatment
@@ -43,18 +44,16 @@ def reduced_model(model):
 
 
 def refuse_unsupported_line(scenario) -> None:
-    """Raise :class:`InputError` for what the reduced design cannot hold at rest: a component added to the rig
-    that is not a volume of a line (a force, a hysteresis element's states), or a valve that draws from a line
+    """Raise :class:`InputError` for what the reduced design cannot hold at rest: components added to the rig
+    of which one is not a volume of a line (a force, a hysteresis element), as
+    :func:`pamsim.scenario_components.refuse_added` says it, or a valve that draws from a line
     (``supply_port``: its volumes rest at the supply's pressure, not at the chamber's)."""
     src = scenario.build_model().source
     if isinstance(src, LineValveSource) and src.supply_port:
         raise InputError(f"{scenario.origin}: pressure.supply_port = {src.supply_port!r}: the closed loop's design "
                          "holds the line at the chamber's pressure; a valve that draws from a line is not taken")
-    for extra in scenario.added_components:
-        if not callable(getattr(extra.component, "held_state", None)):
-            raise InputError(f"{scenario.origin}: component: the closed loop's controller design takes the volumes of "
-                             f"a line the valve feeds, not {extra.component.name!r}; run the scenario with "
-                             "`pamsim run` without [controller]")
+    if not all(callable(getattr(a.component, "held_state", None)) for a in scenario.added_components):
+        refuse_added(scenario, "the closed loop's controller design", InputError)
 
 
 def full_linearisation(model, held: OperatingPoint, added: tuple) -> LinearModel:
