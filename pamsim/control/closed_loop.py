@@ -336,7 +336,9 @@ class ClosedLoopValveSource:
         feedforward, error integral and velocity estimate.
         """
         inputs = self.inputs(t_s)
-        u, _ = self.command(S, x_m, inputs)
+        # numpy's clip: smath's takes arrays for CasADi's and gives a column, which made the column a square
+        _, raw = self.command(S, x_m, inputs)
+        u = np.clip(np.asarray(raw, dtype=float), -1.0, 1.0)
         mdot, T_gas = self.plant.inflow_kg_s(_plant_states(S), self.plant.chamber.volume_m3(x_m), (u, inputs[2]))
         zero = 0.0 * np.asarray(t_s, dtype=float)
         spool = dict(zip(self.plant.state_names[2:], S[4:]))
