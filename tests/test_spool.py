@@ -61,7 +61,8 @@ def test_spool_step_matches_the_second_order_step_response(zeta, backend):
     assert np.max(np.abs(result.signals["spool_position"][after] - expected)) < tolerance
     assert np.all(result.signals["spool_position"][~after] == 0.0)
     if zeta < 1.0:  # the overshoot past the stroke is the lag's own: the position is not clipped
-        assert np.max(result.signals["spool_position"]) == pytest.approx(1.0 + math.exp(-math.pi * zeta / math.sqrt(1 - zeta ** 2)), abs=tolerance)
+        peak = 1.0 + math.exp(-math.pi * zeta / math.sqrt(1 - zeta ** 2))
+        assert np.max(result.signals["spool_position"]) == pytest.approx(peak, abs=tolerance)
 
 
 # ---------------------------------------------------------------- a second implementation
@@ -232,6 +233,24 @@ def test_the_loop_meets_its_spec_on_every_backend(loops):
     # the spool moved and the tube carried the air: the loop ran through both
     assert np.max(np.abs(ref.signals["spool_position"])) > 0.5
     assert np.max(ref.signals["tube.outlet_mass_flow_kg_s"]) > 1e-5
+
+
+@pytest.mark.parametrize("name", ["proportional_valve", "closed_loop_position"])
+def test_every_column_of_a_closed_loop_has_one_value_per_sample(name, loops, tmp_path, cli):
+    """The valve command's column was a square (samples x samples) array, and the CSV's rows as long: the
+    controller's clip on arrays went through CasADi.  Each column now has one value per sample, in the
+    result and in the CSV that ``pamsim run`` writes."""
+    from pamsim.control.closed_loop import run_closed_loop
+
+    run = loops["python"] if name == "proportional_valve" else run_closed_loop(SCENARIOS / f"{name}.toml")
+    for key, values in run.result.signals.items():
+        assert np.shape(values) == np.shape(run.result.t_s), key
+    command = run.result.signals["valve_command"]
+    assert np.all(np.abs(command) <= 1.0) and np.max(np.abs(command)) == 1.0  # saturated during the step
+    proc = cli("run", SCENARIOS / f"{name}.toml", "-o", tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    lines = (tmp_path / f"{name}.csv").read_text().splitlines()
+    assert {len(line.split(",")) for line in lines} == {len(lines[0].split(","))}
 
 
 def test_the_design_is_checked_on_the_full_linearisation(loops):
