@@ -317,6 +317,7 @@ def _state_vector(model, op: OperatingPoint, added: tuple, lines: tuple) -> np.n
     elif op.kind == "open_valve":
         extra = held_line_states(model, added, float(op.states[2]), known)
     else:
-        raise InputError(f"operating point {op.kind!r}: a supply line ({', '.join(n for n, _ in lines)}) is "
+        unknown = ", ".join(n for n, _ in lines if n not in known)
+        raise InputError(f"operating point {op.kind!r}: a supply line ({unknown}) is "
                          "linearised at the open valve's equilibrium or at a time of its run (--at-time)")
     return np.concatenate([np.asarray(op.states, dtype=float), extra])
