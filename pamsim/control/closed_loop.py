@@ -536,12 +536,15 @@ class ClosedLoopRun:
         return [msg.format(value, s[key]) for key, value, msg in checks if key in s and not value <= s[key]]
 
     def summary(self) -> dict:
-        """The run as JSON-ready figures: gains, design poles, metrics of the run and of the linear prediction,
-        the specification and what the run misses, events and wall time.
+        """The run as JSON-ready figures: gains, design poles (and the loop's around the full linearisation, for a
+        reduced design), metrics of the run and of the linear prediction, the specification and what the run
+        misses, events and wall time.
         """
         return {"scenario": self.result.name, "gains_K": [float(k) for k in self.design.K],
                 "gain_order": ["x_m", "v_m_s", "p_gauge_Pa", "z_error_integral_m_s"],
                 "design_poles": [[float(p.real), float(p.imag)] for p in self.design.closed_loop_poles],
+                **({} if self.design.full_loop_poles is None else {"full_loop_poles": [
+                    [float(p.real), float(p.imag)] for p in np.sort_complex(self.design.full_loop_poles)]}),
                 "metrics": self.metrics, "linear_prediction_metrics": self.linear_metrics,
                 "spec": dict(self.config.spec), "meets_spec": not self.failures(), "failures": self.failures(),
                 "events": int(self.result.stats["events"]), "wall_time_s": float(self.result.wall_time_s)}
