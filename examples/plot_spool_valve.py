@@ -13,6 +13,7 @@ position.
 3. ``scenarios/proportional_valve.toml``: the closed position loop (20 -> 40 mm) through the spool valve and
    1 m of tube, against the same loop through the spool valve alone and through the rig's proportional
    valve (``closed_loop_position.toml``).  The figure draws the spool's steps and the three loops.
+4. The design's check on the full linearisation (spool and tube): a spool too slow for the loop is refused.
 """
 
 import copy
@@ -26,6 +27,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import pamsim
+from pamsim.control.closed_loop import design_closed_loop
+from pamsim.errors import InputError
 
 fig4 = pamsim.load_scenario("../scenarios/acra2012_fig4.toml")
 fig, (ax_s, ax_x) = plt.subplots(2, 1, figsize=(8, 7.5), constrained_layout=True)
@@ -74,6 +77,15 @@ for k, (label, scenario) in enumerate(loops.items()):
     print(f"{label}: rise {m['rise_time_s'] * 1e3:.1f} ms, overshoot {m['overshoot_percent']:.2f} %, settling "
           f"{m['settling_time_s'] * 1e3:.1f} ms, error {m['steady_state_error_mm']:.3f} mm; meets spec: {not run.failures}")
     ax_x.plot(run.result.t_s, run.result.x_m * 1e3, color=f"C{k}", linestyle=("-", "--", "-.")[k], label=label)
+print("4. the design checked on the full linearisation, with slower spools")
+for f in (35.0, 30.0):
+    slow = pamsim.Scenario.from_dict({**spec, "pressure": {**spec["pressure"], "spool": {"natural_frequency_Hz": f}}},
+                                     base_dir="../scenarios")
+    try:
+        poles = design_closed_loop(slow).design.full_loop_poles
+        print(f"{f:.0f} Hz spool: accepted, slowest pole of the full loop {max(poles.real):.3f} 1/s")
+    except InputError as exc:
+        print(f"{f:.0f} Hz spool: refused: {exc}")
 ax_x.set_xlim(0.4, 1.2)
 ax_x.set_xlabel("time [s]")
 ax_x.set_ylabel("contraction [mm]")

@@ -36,9 +36,9 @@ from .pwm_average import chamber_rates_of_paths
 from .valve import ProportionalValve33, _max, _min
 
 SPOOL_DEFAULTS = {
-    "natural_frequency_Hz": (125.0, "assumed: the critical frequency of the Festo MPYE-M5 that the control "
-                                    "literature quotes (about 125 Hz); its data sheet was not found in the "
-                                    "sources searched"),
+    "natural_frequency_Hz": (125.0, "assumed: about 125 Hz, the critical frequency given for the Festo MPYE-M5; "
+                                    "not checked against its data sheet, which was not found in the sources "
+                                    "searched"),
     "damping_ratio": (0.7, "assumed: a position-controlled spool tuned for little overshoot (4.6 % at 0.7); "
                            "no data sheet gives it"),
     "overlap": (0.0, "assumed: a zero-lapped spool, the MPYE's metering as a control valve"),
