@@ -37,7 +37,7 @@ from dataclasses import dataclass
 from ..modeling.smath import clip, fmax, if_else
 from ..signals import PiecewiseConstant
 from .pressure_source import ValveChamberSource
-from .valve import ProportionalValve33
+from .valve import ProportionalValve33, TwoPathValve
 
 PWM_MODELS = ("switching", "averaged")
 """How a PWM command runs (``[pressure.command] model``): every switch as an event, or this module's
@@ -59,9 +59,10 @@ def _mean_pos(c1, c2):
 
 
 @dataclass(frozen=True)
-class PwmAveragedValve:
+class PwmAveragedValve(TwoPathValve):
     """:class:`~pamsim.elements.valve.ProportionalValve33` under a PWM command with its timing (as
-    :class:`pamsim.signals.Pwm` defines it), averaged over one period; its input is the duty."""
+    :class:`pamsim.signals.Pwm` defines it), averaged over one period; its input is the duty, and its paths'
+    flows (:class:`~pamsim.elements.valve.TwoPathValve`) are their mean flows over a period at the duty."""
 
     valve: ProportionalValve33
     frequency_Hz: float
@@ -103,18 +104,6 @@ class PwmAveragedValve:
     def shares(self, duty) -> tuple:
         """``(W_supply, W_exhaust)``: each path's opening averaged over a period at ``duty`` (see the module)."""
         return self._share(duty, 1.0), self._share(duty, -1.0)
-
-    def path_flows_kg_s(self, duty, p_chamber_Pa, T_chamber_K, p_supply_Pa, T_supply_K, p_exhaust_Pa) -> tuple:
-        """Mean mass flows into the chamber [kg/s] through the supply path and through the exhaust path."""
-        w_supply, w_exhaust = self.shares(duty)
-        full = self.valve.inflow_kg_s
-        return (w_supply * full(1.0, p_chamber_Pa, T_chamber_K, p_supply_Pa, T_supply_K, p_exhaust_Pa),
-                w_exhaust * full(-1.0, p_chamber_Pa, T_chamber_K, p_supply_Pa, T_supply_K, p_exhaust_Pa))
-
-    def inflow_kg_s(self, duty, p_chamber_Pa, T_chamber_K, p_supply_Pa, T_supply_K, p_exhaust_Pa):
-        """Mean mass flow into the chamber [kg/s] over a period at ``duty`` (absolute pressures)."""
-        supply, exhaust = self.path_flows_kg_s(duty, p_chamber_Pa, T_chamber_K, p_supply_Pa, T_supply_K, p_exhaust_Pa)
-        return supply + exhaust
 
 
 def duty_signal(pwm) -> PiecewiseConstant:

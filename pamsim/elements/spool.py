@@ -33,7 +33,7 @@ import numpy as np
 
 from .pressure_source import ValveChamberSource
 from .pwm_average import chamber_rates_of_paths
-from .valve import ProportionalValve33, _max, _min
+from .valve import ProportionalValve33, TwoPathValve, _max, _min
 
 SPOOL_DEFAULTS = {
     "natural_frequency_Hz": (125.0, "assumed: about 125 Hz, the critical frequency given for the Festo MPYE-M5; "
@@ -56,11 +56,12 @@ def _ramp(z, overlap):
 
 
 @dataclass(frozen=True)
-class SpoolValve33:
+class SpoolValve33(TwoPathValve):
     """A 3/3 spool valve: the spool's dynamics and its two paths' conductances (see the module).
 
     ``valve`` is the full opening's valve (its orifice's ``C`` is the conductance at the end of the
-    stroke); ``leakage_C_m3_per_s_Pa`` is each path's conductance at every position besides it.
+    stroke); ``leakage_C_m3_per_s_Pa`` is each path's conductance at every position besides it.  Its paths'
+    flows (:class:`~pamsim.elements.valve.TwoPathValve`) take the spool's position.
     """
 
     valve: ProportionalValve33
@@ -84,19 +85,6 @@ class SpoolValve33:
         """``(W_supply, W_exhaust)``: each path's conductance as a share of the full ``C`` at ``position``."""
         leak = self.leakage_C_m3_per_s_Pa / self.valve.orifice.C_m3_per_s_Pa
         return _ramp(position, self.overlap) + leak, _ramp(-position, self.overlap) + leak
-
-    def path_flows_kg_s(self, position, p_chamber_Pa, T_chamber_K, p_supply_Pa, T_supply_K, p_exhaust_Pa) -> tuple:
-        """Mass flows into the chamber [kg/s] through the supply path and through the exhaust path."""
-        w_supply, w_exhaust = self.shares(position)
-        full = self.valve.inflow_kg_s
-        return (w_supply * full(1.0, p_chamber_Pa, T_chamber_K, p_supply_Pa, T_supply_K, p_exhaust_Pa),
-                w_exhaust * full(-1.0, p_chamber_Pa, T_chamber_K, p_supply_Pa, T_supply_K, p_exhaust_Pa))
-
-    def inflow_kg_s(self, position, p_chamber_Pa, T_chamber_K, p_supply_Pa, T_supply_K, p_exhaust_Pa):
-        """Net mass flow into the chamber [kg/s] at spool ``position`` (absolute pressures)."""
-        supply, exhaust = self.path_flows_kg_s(position, p_chamber_Pa, T_chamber_K, p_supply_Pa, T_supply_K,
-                                               p_exhaust_Pa)
-        return supply + exhaust
 
 
 @dataclass(frozen=True)
