@@ -217,7 +217,7 @@ def test_the_loop_meets_its_spec_on_every_backend(loops):
     """The scenario's [controller.spec] (closed_loop_position.toml's, not changed for the spool) on python,
     native and fmu-cs, and the same run on each: within 1e-6 m and 10 Pa of python at every sample, a hundred
     times the integrators' local tolerance on the states' scales (rtol 1e-6 of 10 mm and of 1 bar; measured
-    3e-8 m and 0.7 Pa)."""
+    1.7e-8 m and 0.6 Pa)."""
     spec = loops["python"].config.spec
     assert set(spec) >= {"rise_time_max_s", "overshoot_max_percent", "settling_time_max_s", "steady_state_error_max_mm"}
     ref = loops["python"].result
