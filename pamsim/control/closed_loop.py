@@ -46,7 +46,8 @@ from ..signals import Constant, Step, max_step_hint_s
 from ..backends import simulate
 from .linear import LinearModel, linearize
 from .operating_point import held_equilibrium, holding_pressure_Pa
-from .reduced import full_linearisation, loop_poles, needs_reduction, reduced_model, refuse_unsupported_line
+from .reduced import (full_linearisation, line_components, loop_poles, needs_reduction, reduced_model,
+                      refuse_unsupported_line)
 from .system import FrictionTreatment, MusclePlant
 
 # [controller] keys: name -> (default or None if required, unit factor to SI)
@@ -336,9 +337,7 @@ class ClosedLoopValveSource:
         feedforward, error integral and velocity estimate.
         """
         inputs = self.inputs(t_s)
-        # numpy's clip: smath's takes arrays for CasADi's and gives a column, which made the column a square
-        _, raw = self.command(S, x_m, inputs)
-        u = np.clip(np.asarray(raw, dtype=float), -1.0, 1.0)
+        u, _ = self.command(S, x_m, inputs)
         mdot, T_gas = self.plant.inflow_kg_s(_plant_states(S), self.plant.chamber.volume_m3(x_m), (u, inputs[2]))
         zero = 0.0 * np.asarray(t_s, dtype=float)
         spool = dict(zip(self.plant.state_names[2:], S[4:]))
@@ -584,7 +583,7 @@ def design_closed_loop(scenario: Scenario | str, overrides: Mapping[str, Any] | 
         spec["controller"] = {**spec.get("controller", {}), **overrides}
         scenario = Scenario.from_dict(spec, scenario.name, scenario.base_dir, scenario.origin)
     config = ControllerConfig.from_scenario(scenario)
-    design = design_lqr(scenario.build_model(), config, scenario.final_pressure_gauge_Pa, scenario.added_components)
+    design = design_lqr(scenario.build_model(), config, scenario.final_pressure_gauge_Pa, line_components(scenario))
     return ClosedLoopDesign(scenario, config, design, closed_loop_model(scenario, config, design))
 
 

@@ -15,6 +15,7 @@ whose full loop is unstable.
 from __future__ import annotations
 
 import dataclasses
+from types import SimpleNamespace
 
 import control as ct
 import numpy as np
@@ -43,17 +44,25 @@ def reduced_model(model):
     return dataclasses.replace(model, source=plain)
 
 
+def line_components(scenario) -> tuple:
+    """The components added to ``scenario``'s rig that are volumes of a line (a tube, a reservoir: they say where
+    they rest, ``held_state``)."""
+    return tuple(a for a in scenario.added_components if callable(getattr(a.component, "held_state", None)))
+
+
 def refuse_unsupported_line(scenario) -> None:
-    """Raise :class:`InputError` for what the reduced design cannot hold at rest: components added to the rig
-    of which one is not a volume of a line (a force, a hysteresis element), as
+    """Raise :class:`InputError` for what the closed loop's design cannot take: components added to the rig
+    other than the volumes of a line and the ``[hysteresis]`` model (whose friction the design drops), as
     :func:`pamsim.scenario_components.refuse_added` says it, or a valve that draws from a line
     (``supply_port``: its volumes rest at the supply's pressure, not at the chamber's)."""
     src = scenario.build_model().source
     if isinstance(src, LineValveSource) and src.supply_port:
         raise InputError(f"{scenario.origin}: pressure.supply_port = {src.supply_port!r}: the closed loop's design "
                          "holds the line at the chamber's pressure; a valve that draws from a line is not taken")
-    if not all(callable(getattr(a.component, "held_state", None)) for a in scenario.added_components):
-        refuse_added(scenario, "the closed loop's controller design", InputError)
+    lines = line_components(scenario)
+    others = SimpleNamespace(origin=scenario.origin, spec=scenario.spec,
+                             added_components=tuple(a for a in scenario.added_components if a not in lines))
+    refuse_added(others, "the closed loop's controller design", InputError, hysteresis=True)
 
 
 def full_linearisation(model, held: OperatingPoint, added: tuple) -> LinearModel:
