@@ -22,6 +22,7 @@ import numpy as np
 
 from ..elements.pressure_source import LineValveSource, ValveChamberSource
 from ..errors import InputError
+from ..modeling import PNEUMATIC
 from ..scenario_components import refuse_added
 from .linear import LinearModel, linearize
 from .operating_point import OperatingPoint
@@ -45,9 +46,11 @@ def reduced_model(model):
 
 
 def line_components(scenario) -> tuple:
-    """The components added to ``scenario``'s rig that are volumes of a line (a tube, a reservoir: they say where
-    they rest, ``held_state``)."""
-    return tuple(a for a in scenario.added_components if callable(getattr(a.component, "held_state", None)))
+    """The components added to ``scenario``'s rig that are volumes of a line: pneumatic components with states
+    (a tube, a reservoir) that say where they rest (``held_state``)."""
+    return tuple(a for a in scenario.added_components
+                 if any(port.kind is PNEUMATIC for port in a.component.ports) and a.component.states
+                 and callable(getattr(a.component, "held_state", None)))
 
 
 def refuse_unsupported_line(scenario) -> None:
