@@ -260,17 +260,19 @@ def linearize(model: MuscleModel, op: OperatingPoint, friction: FrictionTreatmen
     added, op, loop = hold_hysteresis(model, op, added)
     lines = line_states(model, added)
     x0 = _state_vector(model, op, added, lines)
+    # Beyond the composed model's four states (added components, a spool): only the exact derivatives have them.
+    beyond_rig = bool(added or lines)
     if input_names(model) != INPUTS:  # the duty: its derivative at 0 is the one into its range [0, 1]
         valve_slope = "fill"
     try:
         A, B, C, D = exact_jacobians(model, x0, op.inputs, friction, valve_slope, added)
         method = "exact"
     except NotImplementedError as exc:  # an element called on floats
-        if added or lines:  # the difference quotients are the composed model's four states' alone
+        if beyond_rig:
             raise InputError(f"pamsim linearize with added components needs exact derivatives: {exc}") from None
         A, B, C, D = jacobians(plant, op, friction, valve_slope)
         method = "central differences"
-    residual = (plant.rhs(op.states, op.inputs, friction) if not (added or lines)
+    residual = (plant.rhs(op.states, op.inputs, friction) if not beyond_rig
                 else np.asarray(control_functions(model, friction, added)[0](x0, op.inputs)[0]).ravel())
     names = list(STATES) + [name for name, _ in lines]
     scales = np.asarray(list(STATE_SCALES) + [nominal for _, nominal in lines])
