@@ -2,6 +2,9 @@
 
     python benchmarks/bench_closed_loop.py [--rounds N] [--calls N]
 
+Last, one row for ``scenarios/proportional_valve.toml`` (the same loop through a spool valve and a tube):
+its run alone on python and native, median over N rounds, and the right-hand-side evaluations it takes.
+
 For each backend: ``pamsim.run(scenarios/closed_loop_position.toml, backend)``, the whole call (the
 controller's design, the run, the metrics and the linear prediction) and the run alone (the Result's
 ``wall_time_s``: the python integration, the native library call, or fmpy driving the FMU), each the
@@ -23,6 +26,7 @@ from pathlib import Path
 import pamsim
 
 SCENARIO = Path(__file__).resolve().parents[1] / "scenarios" / "closed_loop_position.toml"
+SPOOL_SCENARIO = SCENARIO.with_name("proportional_valve.toml")
 BACKENDS = ("python", "native", "fmu-cs", "fmu-me")
 METRICS = ("rise_time_s", "overshoot_percent", "settling_time_s", "steady_state_error_mm")
 
@@ -68,6 +72,22 @@ def main(argv=None) -> None:
         print(f"{b:8} {values}, {runs[b].result.x_m[-1] * 1e3:.5f} mm ({dx_um:+.3f} um); "
               f"meets spec: {not runs[b].failures}")
     plain_fmpy(ref)
+    spool_row(args.rounds)
+
+
+def spool_row(rounds: int) -> None:
+    """Time the closed loop through the spool valve and the tube (its run alone) on python and native."""
+    alone = {b: [] for b in ("python", "native")}
+    rhs = {}
+    for b in alone:
+        pamsim.run(SPOOL_SCENARIO, backend=b)  # warm-up: the generated code and the native library
+    for _ in range(rounds):
+        for b in alone:
+            run = pamsim.run(SPOOL_SCENARIO, backend=b)
+            alone[b].append(run.result.wall_time_s)
+            rhs[b] = run.result.stats["rhs_evaluations"]
+    print(f"\nproportional_valve (spool valve and tube, 20 -> 40 mm, 3 s), run alone, median of {rounds}: "
+          + ", ".join(f"{b} {statistics.median(v) * 1e3:.1f} ms ({rhs[b]} RHS evaluations)" for b, v in alone.items()))
 
 
 def plain_fmpy(ref) -> None:

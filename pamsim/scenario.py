@@ -25,6 +25,7 @@ from .elements.friction import FRICTION_MODELS, NEGATIVE_LEVEL_CHOICES, NoCoulom
 from .elements.load import HangingLoad
 from .elements.pressure_source import LineValveSource, PrescribedPressure, ValveChamberSource
 from .elements.pwm_average import PWM_MODELS, averaged_source
+from .elements.spool import spool_source
 from .elements.force_clip import NEGATIVE_FORCE_CHOICES
 from .elements.static_force import STATIC_FORCE_MODELS
 from .elements.stops import UPPER_STOPS, EndStops
@@ -53,7 +54,7 @@ _SCHEMA: dict[str, dict[str, Any]] = {
     "load": {"weight_N": float, "mass_kg": float, "external_force": dict},
     "pressure": {"source": str, "supply_gauge_bar": float, "supply_gauge_Pa": float, "valve_open_time_s": float,
                  "command": dict, "prescribed": dict, "initial_gauge_bar": float, "supply_port": str,
-                 "outlet_port": str},
+                 "outlet_port": str, "spool": dict},
     "simulation": {"duration_s": float, "sample_rate_Hz": float, "initial_contraction_m": float},
     "solver": {"method": str, "rtol": float, "max_events": int, "max_step_s": float, "native_rtol_factor": float},
     "measured": {"steady_state": str},
@@ -231,7 +232,7 @@ class Scenario:
     def _valve_source(self, v: "_Validator", pr: Mapping[str, Any]) -> ValveChamberSource:
         p = self.parameters
         v.allowed("pressure", pr, {"source", "supply_gauge_bar", "supply_gauge_Pa", "valve_open_time_s",
-                                   "command", "initial_gauge_bar", "supply_port", "outlet_port"})
+                                   "command", "initial_gauge_bar", "supply_port", "outlet_port", "spool"})
         supply = self._supply_gauge_Pa(v, pr)
         if "initial_gauge_bar" in pr:
             rating = p["rated_pressure_gauge_Pa"]
@@ -243,6 +244,8 @@ class Scenario:
         parts = (ProportionalValve33(Iso6358Orifice.from_parameters(p)), _chamber(v, self.spec.get("chamber", {}), p),
                  Constant(supply), command, p["T_supply_K"], p["p_atm_Pa"])
         ports = {key: _port_ref(v, f"pressure.{key}", pr[key]) for key in ("supply_port", "outlet_port") if key in pr}
+        if "spool" in pr:
+            return spool_source(v, pr, parts, ports)
         if _pwm_model(v, pr) == "averaged":
             if ports:
                 v.fail(f"pressure.{next(iter(ports))}", pr[next(iter(ports))], "the averaged PWM valve takes its "
@@ -367,8 +370,9 @@ class Scenario:
     def beyond_one_muscle_fmu(self) -> bool:
         """Whether the one-muscle FMU, with the rig alone, the polytropic chamber and the proportional valve,
         lacks something this scenario has (components added to the rig, another chamber law, an averaged
-        PWM valve): the FMU of its assembly then runs it."""
-        return bool(self.added_components) or self.chamber_law != "polytropic" or self.pwm_model == "averaged"
+        PWM valve, a spool valve): the FMU of its assembly then runs it."""
+        return (bool(self.added_components) or self.chamber_law != "polytropic" or self.pwm_model == "averaged"
+                or "spool" in self.spec["pressure"])
 
     def with_pwm_averaged(self) -> "Scenario":
         """This scenario with its PWM valve command run by the averaged valve (``model = "averaged"``)."""

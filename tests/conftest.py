@@ -74,6 +74,15 @@ def run_cli(*args, cwd=None):
                           cwd=cwd, timeout=300)
 
 
+def assert_refused(proc, key: str, output=None) -> None:
+    """``proc`` (a :func:`run_main` result) exited 2 with one line naming ``key``, no traceback, and wrote
+    nothing to ``output`` (if given)."""
+    assert proc.returncode == 2, proc.stderr
+    assert key in proc.stderr and "Traceback" not in proc.stderr
+    assert len(proc.stderr.strip().splitlines()) == 1
+    assert output is None or not output.exists()
+
+
 def run_main(*args):
     """Run ``pamsim ARGS`` in this process (the console script's ``main()``); returns a CompletedProcess.
 

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 import pamsim
-from conftest import SCENARIOS
+from conftest import SCENARIOS, assert_refused
 from pamsim.control import FrictionTreatment, MusclePlant, linearize
 from pamsim.control.exact import exact_jacobians
 from pamsim.control.linear import jacobians
@@ -303,11 +303,7 @@ def test_bad_pwm_input_exits_2_naming_the_key(tmp_path, cli, change, key, model,
         text = text.replace(line, f"{name} = {json.dumps(value)}") if name != "model" else \
             text.replace(f'model = "{model}"', f'model = "{value}"')
     bad.write_text(text)
-    proc = cli(command, bad, "-o", tmp_path / "out")
-    assert proc.returncode == 2, proc.stderr
-    assert key in proc.stderr and "Traceback" not in proc.stderr
-    assert len(proc.stderr.strip().splitlines()) == 1
-    assert not (tmp_path / "out").exists()
+    assert_refused(cli(command, bad, "-o", tmp_path / "out"), key, tmp_path / "out")
 
 
 def test_model_is_refused_on_a_command_that_is_not_pwm(tmp_path, cli):

@@ -23,8 +23,10 @@ from ..components.hanging_load import LoadMode
 from ..components import (Chamber, CoulombFriction, ExternalForce, HangingLoad, MuscleStaticForce,
                           PressureSignal, ProportionalValve, SuppliedValve, ViscousDamping)
 from ..components.pwm_valve import AveragedPwmValve
+from ..components.spool_valve import SpoolValve
 from ..elements.pressure_source import LineValveSource, PrescribedPressure, ValveChamberSource
 from ..elements.pwm_average import AveragedPwmSource
+from ..elements.spool import SpoolValveSource
 from ..modeling import Assembly, AssemblyError
 from ..modeling.pygen import compiled_by_mode, outputs_by_mode
 from ..signals import Constant
@@ -146,6 +148,17 @@ def _averaged_pwm_parts(src: AveragedPwmSource, p0_gauge_Pa: float | None) -> So
     return _chamber_and_valve(src, p0_gauge_Pa, AveragedPwmValve, "pwm_duty")
 
 
+def _spool_parts(src: SpoolValveSource, p0_gauge_Pa: float | None) -> SourceParts:
+    """The chamber and the spool valve that fills it, or that discharges into ``src.outlet_port`` (a tube's
+    inlet), where the chamber settles onto its own pressure (see :func:`_line_valve_parts`)."""
+    plain = _chamber_and_valve(src, p0_gauge_Pa, SpoolValve, "valve_command")
+    if not src.outlet_port:
+        return plain
+    wiring = [(src.outlet_port, "valve.port"), ("load.x_m", "chamber.x_m"), ("load.v_m_s", "chamber.v_m_s"),
+              ("chamber.p_abs_Pa", "chamber.p_settle_abs_Pa")]
+    return SourceParts(plain.parts, wiring, plain.inputs, "chamber")
+
+
 def _line_valve_parts(src: LineValveSource, p0_gauge_Pa: float | None) -> SourceParts:
     """The valve and chamber of a line: the valve's supply side on ``src.supply_port`` (if given), its outlet
     on ``src.outlet_port`` (if given, else the chamber).  The chamber settles onto its valve's pressure only
@@ -175,7 +188,7 @@ def _prescribed_parts(src: PrescribedPressure, p0_gauge_Pa: float | None) -> Sou
 
 SOURCE_PARTS: dict[type, Callable[[Any, float | None], SourceParts]] = {
     ValveChamberSource: _valve_parts, LineValveSource: _line_valve_parts, AveragedPwmSource: _averaged_pwm_parts,
-    PrescribedPressure: _prescribed_parts}
+    SpoolValveSource: _spool_parts, PrescribedPressure: _prescribed_parts}
 """``{pressure source class: parts(source, initial gauge pressure or None)}``.  A source defined above
 this layer (a controller's) registers its own with :func:`register_source`."""
 

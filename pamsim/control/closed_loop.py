@@ -34,8 +34,7 @@ from typing import Any, Callable, Mapping
 import control as ct
 import numpy as np
 
-from ..assemblies.one_muscle import VALVE_CHAMBER_WIRING, SourceParts, register_source
-from ..components import Chamber, ProportionalValve
+from ..assemblies.one_muscle import SourceParts, register_source, source_parts
 from ..constants import PA_PER_BAR
 from ..elements.pressure_source import ValveChamberSource
 from ..errors import InputError
@@ -43,11 +42,12 @@ from ..model import MuscleModel
 from ..modeling import Component, Equations, Symbols, Var, smath
 from ..result import Result
 from ..scenario import Scenario, load_scenario
-from ..scenario_components import refuse_added
 from ..signals import Constant, Step, max_step_hint_s
 from ..backends import simulate
 from .linear import LinearModel, linearize
 from .operating_point import held_equilibrium, holding_pressure_Pa
+from .reduced import (full_linearisation, line_components, loop_poles, needs_reduction, reduced_model,
+                      refuse_unsupported_line)
 from .system import FrictionTreatment, MusclePlant
 
 # [controller] keys: name -> (default or None if required, unit factor to SI)
@@ -97,8 +97,9 @@ class ControllerConfig:
             Naming the file and key for a missing, unknown or non-positive entry.
         """
         where = scenario.origin
-        # The design drops the muscle's friction, so Maxwell-slip or Bouc-Wen friction changes the plant, not it.
-        refuse_added(scenario, "the closed loop's controller design", InputError, hysteresis=True)
+        # The design drops the muscle's friction, so Maxwell-slip or Bouc-Wen friction changes the plant, not it;
+        # the volumes of a line the valve feeds are designed without and checked with (pamsim.control.reduced).
+        refuse_unsupported_line(scenario)
         table = _controller_table(scenario.spec.get("controller"), where)
         # The numbers in the order of _CONTROLLER_KEYS, then the spec: the first mistake is the one reported.
         values = {_si_name(key): _controller_number(table, key, where) * factor
@@ -179,25 +180,36 @@ class LqrDesign:
     """Gains ``K = [K_x, K_v, K_p, K_z]`` of ``u = -K [x - r, v, p - p_ff(r), z]`` with ``z' = x - r``.
 
     ``linear`` is the plant linearisation it was designed on, ``closed_loop_poles``
-    the poles of the linear loop with the state feedback (ideal velocity).
+    the poles of the linear loop with the state feedback (ideal velocity).  For a valve with a spool or a
+    line (:mod:`pamsim.control.reduced`), ``linear`` is the reduced model's, ``full_linear`` the full
+    linearisation and ``full_loop_poles`` the poles of the controller (velocity filter included) around it.
     """
 
     K: np.ndarray
     linear: LinearModel
     closed_loop_poles: np.ndarray
     model: MuscleModel
+    full_linear: LinearModel | None = None
+    full_loop_poles: np.ndarray | None = None
 
 
-def design_lqr(model: MuscleModel, config: ControllerConfig, supply_gauge_Pa: float) -> LqrDesign:
+def design_lqr(model: MuscleModel, config: ControllerConfig, supply_gauge_Pa: float, added: tuple = ()) -> LqrDesign:
     """LQR with integral action on the held-pressure linearisation at the design contraction.
 
     Bryson's rule sets the weights: each state and the command are divided by
     their largest acceptable value.  Coulomb friction is dropped from the
     design model (no linearisation at rest); the valve slope at command 0 is
-    the mean of filling and venting.
+    the mean of filling and venting.  A spool valve or a line the valve feeds (``added``) is designed on
+    the reduced model and checked on the full one (:mod:`pamsim.control.reduced`).
+
+    Raises
+    ------
+    InputError
+        If the controller designed on the reduced model does not stabilise the full linearisation.
     """
     op = held_equilibrium(model, config.design_contraction_m, supply_gauge_Pa)
-    lin = linearize(model, op, FrictionTreatment("dropped"), "mean")
+    reduced = needs_reduction(model, added)
+    lin = linearize(reduced_model(model) if reduced else model, op, FrictionTreatment("dropped"), "mean")
     plant = lin.sys[["contraction_m", "p_gauge_Pa"], "valve_command"]
     labels = list(lin.sys.state_labels)
     if labels != ["x_m", "v_m_s", "p_abs_Pa"]:
@@ -210,7 +222,20 @@ def design_lqr(model: MuscleModel, config: ControllerConfig, supply_gauge_Pa: fl
                  config.max_pressure_error_Pa ** -2, config.max_integral_m_s ** -2])
     R = np.array([[config.max_command ** -2]])
     K, _, poles = ct.lqr(A_aug, B_aug, Q, R)
-    return LqrDesign(np.asarray(K, dtype=float).ravel(), lin, np.asarray(poles), model)
+    design = LqrDesign(np.asarray(K, dtype=float).ravel(), lin, np.asarray(poles), model)
+    return _checked_on_full(design, config, op, added) if reduced else design
+
+
+def _checked_on_full(design: LqrDesign, config: ControllerConfig, op, added: tuple) -> LqrDesign:
+    """``design`` with the full linearisation of its model at ``op`` and the poles of its loop around it."""
+    full = full_linearisation(design.model, op, added)
+    poles = loop_poles(full, controller_system(design, config))
+    if np.max(poles.real) >= 0.0:
+        worst = poles[np.argmax(poles.real)]
+        raise InputError(f"the controller designed on the reduced model (spool instant, no line) does not stabilise "
+                         f"the full linearisation: pole {worst:.4g} 1/s (a spool or a line slower than the loop: "
+                         "raise pressure.spool.natural_frequency_Hz or slow the loop down)")
+    return dataclasses.replace(design, full_linear=full, full_loop_poles=poles)
 
 
 @dataclass(frozen=True)
@@ -246,7 +271,8 @@ class ClosedLoopValveSource:
     def initial_state(self, x_m: float, p_gauge_Pa: float | None = None) -> list[float]:
         """At rest at ``x_m`` with the chamber at the feedforward (holding) pressure of the initial reference."""
         p = self.feedforward_gauge_Pa(0.0) if p_gauge_Pa is None else p_gauge_Pa
-        return self.plant.initial_state(x_m, p) + [0.0, x_m]
+        plant = self.plant.initial_state(x_m, p)
+        return plant[:2] + [0.0, x_m] + plant[2:]  # a spool's states after the controller's, as the parts have them
 
     def inputs(self, t_s) -> tuple:
         """``(reference [m], feedforward gauge pressure [Pa], supply gauge pressure [Pa], reference velocity
@@ -292,8 +318,8 @@ class ClosedLoopValveSource:
         (clipped) command.
         """
         u, raw = self.command(s, x_m, inputs)
-        dp, dm = self.plant.derivatives(s[:2], x_m, v_m_s, (float(u), inputs[2]))
-        return (dp, dm) + self.controller_rates(s, x_m, inputs, u, raw)
+        plant = self.plant.derivatives(_plant_states(s), x_m, v_m_s, (float(u), inputs[2]))
+        return tuple(plant[:2]) + self.controller_rates(s, x_m, inputs, u, raw) + tuple(plant[2:])
 
     @property
     def max_input_step_s(self) -> float:
@@ -312,13 +338,20 @@ class ClosedLoopValveSource:
         """
         inputs = self.inputs(t_s)
         u, _ = self.command(S, x_m, inputs)
-        mdot, T_gas = self.plant.inflow_kg_s(S[:2], self.plant.chamber.volume_m3(x_m), (u, inputs[2]))
+        mdot, T_gas = self.plant.inflow_kg_s(_plant_states(S), self.plant.chamber.volume_m3(x_m), (u, inputs[2]))
         zero = 0.0 * np.asarray(t_s, dtype=float)
-        return {"air_mass_kg": S[1], "valve_mass_flow_kg_s": np.asarray(mdot, dtype=float) + zero,
+        spool = dict(zip(self.plant.state_names[2:], S[4:]))
+        return {**spool, "air_mass_kg": S[1], "valve_mass_flow_kg_s": np.asarray(mdot, dtype=float) + zero,
                 "valve_command": np.asarray(u, dtype=float) + zero, "supply_gauge_Pa": inputs[2] + zero,
                 "gas_temperature_K": T_gas, "reference_m": np.asarray(inputs[0], dtype=float) + zero,
                 "feedforward_gauge_Pa": np.asarray(inputs[1], dtype=float) + zero,
                 "z_error_integral_m_s": S[2], "velocity_estimate_m_s": (x_m - S[3]) / self.velocity_filter_time_s}
+
+
+def _plant_states(s) -> list:
+    """The plant's states among a :class:`ClosedLoopValveSource`'s: the chamber's two, then a spool's (after the
+    controller's two)."""
+    return [s[0], s[1], *s[4:]]
 
 
 class PositionController(Component):
@@ -375,19 +408,18 @@ class PositionController(Component):
 def _closed_loop_parts(source: "ClosedLoopValveSource", p0_gauge_Pa: float | None) -> SourceParts:
     """The closed loop's pressure source as components: the chamber (starting at ``p0_gauge_Pa``, or
     the feedforward pressure of the first reference), the controller, and the valve it drives."""
-    plant = source.plant
     p0 = source.feedforward_gauge_Pa(0.0) if p0_gauge_Pa is None else p0_gauge_Pa
-    T0 = plant.chamber.start_temperature_K(plant.T_supply_K)
-    parts = [Chamber("chamber", plant.chamber, plant.p_atm_Pa, p0, T0),
-             PositionController("controller", source),
-             ProportionalValve("valve", plant.valve, plant.T_supply_K, plant.p_atm_Pa, plant.chamber.R_J_per_kg_K)]
-    wiring = [*VALVE_CHAMBER_WIRING, ("load.x_m", "controller.x_m"), ("chamber.p_abs_Pa", "controller.p_abs_Pa"),
+    # The plant's own chamber and valve (a spool valve, one that discharges into a line), wired as without the
+    # controller, which takes the valve's command input.
+    plant = source_parts(source.plant, p0)
+    chamber, valve = plant.parts
+    wiring = [*plant.wiring, ("load.x_m", "controller.x_m"), ("chamber.p_abs_Pa", "controller.p_abs_Pa"),
               ("controller.command", "valve.command")]
     inputs = {"reference_m": "controller.reference_m", "feedforward_gauge_Pa": "controller.feedforward_gauge_Pa",
-              "supply_pressure_gauge_Pa": "valve.supply_gauge_Pa",
+              "supply_pressure_gauge_Pa": plant.inputs["supply_pressure_gauge_Pa"],
               "reference_velocity_m_s": "controller.reference_velocity_m_s",
               "feedforward_command": "controller.feedforward_command"}
-    return SourceParts(parts, wiring, inputs, "chamber")
+    return SourceParts([chamber, PositionController("controller", source), valve], wiring, inputs, "chamber")
 
 
 register_source(ClosedLoopValveSource, _closed_loop_parts)
@@ -406,7 +438,9 @@ def closed_loop_model(scenario: Scenario, config: ControllerConfig, design: LqrD
     source = ClosedLoopValveSource(model.source, tuple(float(k) for k in design.K),
                                    Step(config.step_time_s, x0, config.target_contraction_m),
                                    Step(config.step_time_s, p0, p1), config.velocity_filter_time_s,
-                                   config.integrator_deadband_m, config.antiwindup_time_s)
+                                   config.integrator_deadband_m, config.antiwindup_time_s,
+                                   state_names=(*model.source.state_names[:2], "z_error_integral_m_s", "x_filter_m",
+                                                *model.source.state_names[2:]))
     return dataclasses.replace(model, source=source)
 
 
@@ -469,7 +503,7 @@ def linear_step_prediction(design: LqrDesign, config: ControllerConfig, x0_m: fl
     The controller, with its velocity filter, is built as a python-control
     system and closed around the plant linearisation by signal name.
     """
-    model_plant = design.linear.sys[["contraction_m", "p_gauge_Pa"], :]
+    model_plant = (design.full_linear or design.linear).sys[["contraction_m", "p_gauge_Pa"], :]
     ctrl = controller_system(design, config)
     loop = ct.interconnect([model_plant, ctrl], inplist=["r_m", "supply_gauge_Pa", "F_ext_N"],
                            outlist=["contraction_m", "valve_command"], inputs=["r_m", "supply_gauge_Pa", "F_ext_N"],
@@ -501,12 +535,15 @@ class ClosedLoopRun:
         return [msg.format(value, s[key]) for key, value, msg in checks if key in s and not value <= s[key]]
 
     def summary(self) -> dict:
-        """The run as JSON-ready figures: gains, design poles, metrics of the run and of the linear prediction,
-        the specification and what the run misses, events and wall time.
+        """The run as JSON-ready figures: gains, design poles (and the loop's around the full linearisation, for a
+        reduced design), metrics of the run and of the linear prediction, the specification and what the run
+        misses, events and wall time.
         """
         return {"scenario": self.result.name, "gains_K": [float(k) for k in self.design.K],
                 "gain_order": ["x_m", "v_m_s", "p_gauge_Pa", "z_error_integral_m_s"],
                 "design_poles": [[float(p.real), float(p.imag)] for p in self.design.closed_loop_poles],
+                **({} if self.design.full_loop_poles is None else {"full_loop_poles": [
+                    [float(p.real), float(p.imag)] for p in np.sort_complex(self.design.full_loop_poles)]}),
                 "metrics": self.metrics, "linear_prediction_metrics": self.linear_metrics,
                 "spec": dict(self.config.spec), "meets_spec": not self.failures(), "failures": self.failures(),
                 "events": int(self.result.stats["events"]), "wall_time_s": float(self.result.wall_time_s)}
@@ -546,7 +583,7 @@ def design_closed_loop(scenario: Scenario | str, overrides: Mapping[str, Any] | 
         spec["controller"] = {**spec.get("controller", {}), **overrides}
         scenario = Scenario.from_dict(spec, scenario.name, scenario.base_dir, scenario.origin)
     config = ControllerConfig.from_scenario(scenario)
-    design = design_lqr(scenario.build_model(), config, scenario.final_pressure_gauge_Pa)
+    design = design_lqr(scenario.build_model(), config, scenario.final_pressure_gauge_Pa, line_components(scenario))
     return ClosedLoopDesign(scenario, config, design, closed_loop_model(scenario, config, design))
 
 

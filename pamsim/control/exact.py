@@ -117,7 +117,7 @@ def line_states(model, added: tuple) -> tuple[tuple[str, float], ...]:
     InputError
         For a component with such states that cannot say where they rest (a ``held_state(p_abs_Pa)``).
     """
-    if not any(a.component.states for a in added):
+    if not any(a.component.states for a in added) and len(model.source.state_names) <= 2:
         return ()
     flat = _control_flat(model, FrictionTreatment("dropped"), added)
     nominal = {v.name: v.nominal for v in flat.states}
@@ -125,27 +125,31 @@ def line_states(model, added: tuple) -> tuple[tuple[str, float], ...]:
 
 
 def _carried(flat, added) -> list[str]:
-    """The names of the added components' states the control model carries (see :func:`line_states`)."""
+    """The names of the states the control model carries besides the rig's four (see :func:`line_states`):
+    the valve's own (a spool's position and velocity), then the added components'."""
     own = {a.component.name: a.component for a in added}
     quadratures = flat.quadratures()
-    extra = [v.name for i, v in enumerate(flat.states) if i not in quadratures and v.name.split(".", 1)[0] in own]
+    owner = [v.name.split(".", 1)[0] for v in flat.states]
+    spool = [v.name for i, v in enumerate(flat.states) if i not in quadratures and owner[i] == "valve"]
+    extra = [v.name for i, v in enumerate(flat.states) if i not in quadratures and owner[i] in own]
     for name in extra:
         component = own[name.split(".", 1)[0]]
         if not callable(getattr(component, "held_state", None)):
             raise InputError(f"component {component.name!r}: pamsim linearize takes added components that act on the "
                              "rig with forces, or the volumes of a supply line, not ones with other states of their "
                              f"own ({', '.join(n for n in extra if n.startswith(component.name + '.'))})")
-    return extra
+    return spool + extra
 
 
-def held_line_states(model, added: tuple, p_abs_Pa: float) -> np.ndarray:
+def held_line_states(model, added: tuple, p_abs_Pa: float, known: dict | None = None) -> np.ndarray:
     """The values of :func:`line_states` with every volume of the line at rest at ``p_abs_Pa`` (the valve open
-    on a supply at that pressure: no flow anywhere)."""
+    on a supply at that pressure: no flow anywhere), those in ``known`` (a spool's) as it gives them."""
     by_name = {a.component.name: a.component for a in added}
+    known = known or {}
     values = []
     for name, _ in line_states(model, added):
         owner, _, state = name.partition(".")
-        values.append(by_name[owner].held_state(p_abs_Pa)[state])
+        values.append(known[name] if name in known else by_name[owner].held_state(p_abs_Pa)[state])
     return np.asarray(values, dtype=float)
 
 

@@ -258,19 +258,21 @@ def linearize(model: MuscleModel, op: OperatingPoint, friction: FrictionTreatmen
     if valve_slope not in VALVE_SLOPES:
         raise InputError(f"valve slope {valve_slope!r}: choose from {', '.join(VALVE_SLOPES)}")
     added, op, loop = hold_hysteresis(model, op, added)
-    lines = line_states(model, added) if added else ()
+    lines = line_states(model, added)
     x0 = _state_vector(model, op, added, lines)
+    # Beyond the composed model's four states (added components, a spool): only the exact derivatives have them.
+    beyond_rig = bool(added or lines)
     if input_names(model) != INPUTS:  # the duty: its derivative at 0 is the one into its range [0, 1]
         valve_slope = "fill"
     try:
         A, B, C, D = exact_jacobians(model, x0, op.inputs, friction, valve_slope, added)
         method = "exact"
     except NotImplementedError as exc:  # an element called on floats
-        if added:  # the difference quotients are the composed model's, which has no added components
+        if beyond_rig:
             raise InputError(f"pamsim linearize with added components needs exact derivatives: {exc}") from None
         A, B, C, D = jacobians(plant, op, friction, valve_slope)
         method = "central differences"
-    residual = (plant.rhs(op.states, op.inputs, friction) if not added
+    residual = (plant.rhs(op.states, op.inputs, friction) if not beyond_rig
                 else np.asarray(control_functions(model, friction, added)[0](x0, op.inputs)[0]).ravel())
     names = list(STATES) + [name for name, _ in lines]
     scales = np.asarray(list(STATE_SCALES) + [nominal for _, nominal in lines])
@@ -308,11 +310,16 @@ def _state_vector(model, op: OperatingPoint, added: tuple, lines: tuple) -> np.n
     open on its supply (every volume of the line there, no flow)."""
     if not lines:
         return np.asarray(op.states, dtype=float)
-    if all(name in op.line_states for name, _ in lines):
-        extra = np.array([op.line_states[name] for name, _ in lines], dtype=float)
+    # A spool at rest stands at its command; a run's operating point has its own (op.line_states).
+    known = {f"valve.{k}": v for k, v in model.source.held_spool(op.inputs[0]).items()} if any(
+        name.startswith("valve.") for name, _ in lines) else {}
+    known.update(op.line_states)
+    if all(name in known for name, _ in lines):
+        extra = np.array([known[name] for name, _ in lines], dtype=float)
     elif op.kind == "open_valve":
-        extra = held_line_states(model, added, float(op.states[2]))
+        extra = held_line_states(model, added, float(op.states[2]), known)
     else:
-        raise InputError(f"operating point {op.kind!r}: a supply line ({', '.join(n for n, _ in lines)}) is "
+        unknown = ", ".join(n for n, _ in lines if n not in known)
+        raise InputError(f"operating point {op.kind!r}: a supply line ({unknown}) is "
                          "linearised at the open valve's equilibrium or at a time of its run (--at-time)")
     return np.concatenate([np.asarray(op.states, dtype=float), extra])

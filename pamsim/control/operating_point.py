@@ -90,7 +90,8 @@ def _shares(pull, x_m: float, p_gauge_Pa: float) -> str:
 
 
 def _rest_states(model: MuscleModel, x_m: float, p_gauge_Pa: float) -> np.ndarray:
-    return np.array([x_m, 0.0, *model.source.initial_state(x_m, p_gauge_Pa)], dtype=float)
+    # The chamber's two states: a spool's come with the inputs (pamsim.control.linear)
+    return np.array([x_m, 0.0, *model.source.initial_state(x_m, p_gauge_Pa)[:2]], dtype=float)
 
 
 def open_valve_equilibrium(model: MuscleModel, supply_gauge_Pa: float, F_ext_N: float = 0.0,
@@ -199,6 +200,7 @@ def trajectory_point(scenario, time_s: float) -> OperatingPoint:
     mode = result.final_mode
     added = {f"{a.component.name}.{v.name}" for a in scenario.added_components for v in a.component.states}
     line = {name: float(values[-1]) for name, values in result.signals.items() if name in added}
+    line.update({f"valve.{name}": float(result.signals[name][-1]) for name in model.source.state_names[2:]})
     moved = np.flatnonzero(result.v_m_s != 0.0)
     return OperatingPoint(states, np.array([command, supply, model.load.external_N(float(time_s))], dtype=float),
                           "trajectory", mode,

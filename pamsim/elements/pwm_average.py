@@ -37,7 +37,7 @@ from dataclasses import dataclass
 from ..modeling.smath import clip, fmax, if_else
 from ..signals import PiecewiseConstant
 from .pressure_source import ValveChamberSource
-from .valve import ProportionalValve33
+from .valve import ProportionalValve33, TwoPathValve
 
 PWM_MODELS = ("switching", "averaged")
 """How a PWM command runs (``[pressure.command] model``): every switch as an event, or this module's
@@ -59,9 +59,10 @@ def _mean_pos(c1, c2):
 
 
 @dataclass(frozen=True)
-class PwmAveragedValve:
+class PwmAveragedValve(TwoPathValve):
     """:class:`~pamsim.elements.valve.ProportionalValve33` under a PWM command with its timing (as
-    :class:`pamsim.signals.Pwm` defines it), averaged over one period; its input is the duty."""
+    :class:`pamsim.signals.Pwm` defines it), averaged over one period; its input is the duty, and its paths'
+    flows (:class:`~pamsim.elements.valve.TwoPathValve`) are their mean flows over a period at the duty."""
 
     valve: ProportionalValve33
     frequency_Hz: float
@@ -103,18 +104,6 @@ class PwmAveragedValve:
     def shares(self, duty) -> tuple:
         """``(W_supply, W_exhaust)``: each path's opening averaged over a period at ``duty`` (see the module)."""
         return self._share(duty, 1.0), self._share(duty, -1.0)
-
-    def path_flows_kg_s(self, duty, p_chamber_Pa, T_chamber_K, p_supply_Pa, T_supply_K, p_exhaust_Pa) -> tuple:
-        """Mean mass flows into the chamber [kg/s] through the supply path and through the exhaust path."""
-        w_supply, w_exhaust = self.shares(duty)
-        full = self.valve.inflow_kg_s
-        return (w_supply * full(1.0, p_chamber_Pa, T_chamber_K, p_supply_Pa, T_supply_K, p_exhaust_Pa),
-                w_exhaust * full(-1.0, p_chamber_Pa, T_chamber_K, p_supply_Pa, T_supply_K, p_exhaust_Pa))
-
-    def inflow_kg_s(self, duty, p_chamber_Pa, T_chamber_K, p_supply_Pa, T_supply_K, p_exhaust_Pa):
-        """Mean mass flow into the chamber [kg/s] over a period at ``duty`` (absolute pressures)."""
-        supply, exhaust = self.path_flows_kg_s(duty, p_chamber_Pa, T_chamber_K, p_supply_Pa, T_supply_K, p_exhaust_Pa)
-        return supply + exhaust
 
 
 def duty_signal(pwm) -> PiecewiseConstant:
@@ -161,16 +150,24 @@ class AveragedPwmSource(ValveChamberSource):
 
     def derivatives(self, s, x_m, v_m_s, inputs) -> tuple[float, float]:
         """(dp/dt [Pa/s], dm/dt [kg/s]) of the chamber, each path's flow carrying its own temperature."""
-        p, m = s[0], s[1]
-        V = self.chamber.volume_m3(x_m)
-        T_gas = self.chamber.gas_temperature_K(p, V, m)
         duty, supply_gauge_Pa = inputs
-        flows = self.valve.path_flows_kg_s(duty, p, T_gas, supply_gauge_Pa + self.p_atm_Pa, self.T_supply_K,
-                                           self.p_atm_Pa)
-        work = sum(self.chamber.flow_work_W(float(mdot), self.T_supply_K if mdot >= 0.0 else T_gas) for mdot in flows)
-        mdot = float(sum(flows))
-        dV = self.chamber.dvolume_dx_m2(x_m) * v_m_s
-        return self.chamber.pressure_rate_of_flows_Pa_s(p, V, dV, mdot, work, m, x_m), mdot
+        return chamber_rates_of_paths(self, s, x_m, v_m_s, duty, supply_gauge_Pa)
+
+
+def chamber_rates_of_paths(source, s, x_m, v_m_s, opening, supply_gauge_Pa) -> tuple[float, float]:
+    """(dp/dt [Pa/s], dm/dt [kg/s]) of ``source``'s chamber (states ``s[0]``, ``s[1]``) fed by a valve with a
+    supply and an exhaust path open at once (``source.valve.path_flows_kg_s(opening, ...)``: the averaged
+    PWM valve at its duty, a spool valve at its position), each path's flow carrying its own temperature."""
+    p, m = s[0], s[1]
+    chamber = source.chamber
+    V = chamber.volume_m3(x_m)
+    T_gas = chamber.gas_temperature_K(p, V, m)
+    flows = source.valve.path_flows_kg_s(opening, p, T_gas, supply_gauge_Pa + source.p_atm_Pa, source.T_supply_K,
+                                         source.p_atm_Pa)
+    work = sum(chamber.flow_work_W(float(mdot), source.T_supply_K if mdot >= 0.0 else T_gas) for mdot in flows)
+    mdot = float(sum(flows))
+    dV = chamber.dvolume_dx_m2(x_m) * v_m_s
+    return chamber.pressure_rate_of_flows_Pa_s(p, V, dV, mdot, work, m, x_m), mdot
 
 
 def averaged_source(source: ValveChamberSource, pwm) -> AveragedPwmSource:

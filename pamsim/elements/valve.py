@@ -76,3 +76,24 @@ class ProportionalValve33:
         p_port = p_exhaust_Pa + (p_supply_Pa - p_exhaust_Pa) * to_supply
         opening = _min(abs(u), 1.0)
         return opening * self.orifice.mass_flow_kg_s(p_port, p_chamber_Pa, T_supply_K, T_chamber_K)
+
+
+class TwoPathValve:
+    """A valve whose supply and exhaust paths may be open at once, each a share of the full opening of its
+    ``valve`` (a :class:`ProportionalValve33`): a mixin for a dataclass with a ``valve`` field and a method
+    ``shares(opening) -> (W_supply, W_exhaust)`` (the averaged PWM valve at its duty, a spool valve at its
+    position)."""
+
+    def path_flows_kg_s(self, opening, p_chamber_Pa, T_chamber_K, p_supply_Pa, T_supply_K, p_exhaust_Pa) -> tuple:
+        """Mass flows into the chamber [kg/s] through the supply path and through the exhaust path: each the
+        full opening's flow on its side, times that path's share."""
+        w_supply, w_exhaust = self.shares(opening)
+        full = self.valve.inflow_kg_s
+        return (w_supply * full(1.0, p_chamber_Pa, T_chamber_K, p_supply_Pa, T_supply_K, p_exhaust_Pa),
+                w_exhaust * full(-1.0, p_chamber_Pa, T_chamber_K, p_supply_Pa, T_supply_K, p_exhaust_Pa))
+
+    def inflow_kg_s(self, opening, p_chamber_Pa, T_chamber_K, p_supply_Pa, T_supply_K, p_exhaust_Pa):
+        """Net mass flow into the chamber [kg/s] (absolute pressures): the two paths' sum."""
+        supply, exhaust = self.path_flows_kg_s(opening, p_chamber_Pa, T_chamber_K, p_supply_Pa, T_supply_K,
+                                               p_exhaust_Pa)
+        return supply + exhaust
