@@ -168,6 +168,7 @@ BAD = [
     ("compensation.amplitude_mm", lambda s: s["compensation"].update(amplitude_mm=40.0)),
     ("compensation.elements", lambda s: s["compensation"].update(elements=0)),
     ("compensation.model", lambda s: s["compensation"].update(model="preisach")),
+    ("compensation.feedforward", lambda s: s["compensation"].update(feedforward=["static"])),
     ("compensation.frequencies_Hz", lambda s: s["compensation"].update(frequencies_Hz=[0.2, -1.0])),
     ("compensation.wobble", lambda s: s["compensation"].update(wobble=1.0)),
     ("compensation.identification.pressures_bar", lambda s: s["compensation"]["identification"].update(

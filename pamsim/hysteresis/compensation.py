@@ -111,10 +111,10 @@ class CompensationConfig:
                 v.fail(f"controller.{key}", scenario.spec["controller"][key],
                        "a tracking study takes its reference from [compensation] (center_mm, amplitude_mm)")
         model = table.get("model", "maxwell_slip")
-        if model not in MODELS:
+        if not isinstance(model, str) or model not in MODELS:
             v.fail("compensation.model", model, "unknown hysteresis model", choices=list(MODELS))
         feedforward = table.get("feedforward", FEEDFORWARDS[0])
-        if feedforward not in FEEDFORWARDS:
+        if not isinstance(feedforward, str) or feedforward not in FEEDFORWARDS:
             v.fail("compensation.feedforward", feedforward, "unknown feedforward", choices=list(FEEDFORWARDS))
         return cls(model, _elements(v, table), feedforward, _frequencies(v, table), *_reference(v, table),
                    _positive(v, table, "periods", 3.0), _positive(v, table, "start_s", 0.5),
