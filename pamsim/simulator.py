@@ -166,7 +166,8 @@ def _with_missed_crossing(sol, named):
     for i in _steps_to_check(sol):
         taus = np.linspace(t[i], t[i + 1], LONG_STEP_CHECKS + 1)
         for lo, hi in zip(taus[:-2], taus[1:-1]):  # the step's end is what solve_ivp checked
-            fired = [k for k, (_, fun, _) in enumerate(named) if fun(hi, sol.sol(hi)) < 0.0]
+            y_hi = sol.sol(hi)
+            fired = [k for k, (_, fun, _) in enumerate(named) if fun(hi, y_hi) < 0.0]
             if fired:
                 return _cut_at(sol, named, fired, lo, hi)
     return sol
@@ -291,10 +292,19 @@ class GeneratedCode:
         no_inputs = None if code.reads_inputs["z"] else [0.0] * len(code.names["inputs"])
         out = []
         own = [(name, self.own_indicators + k) for k, name in enumerate(EVENT_NAMES[mode]) if name is not None]
+        # solve_ivp asks each event function in turn at the same point, and z gives every indicator at once:
+        # one evaluation serves them all (with ten Maxwell-slip elements, z was 12 times the run's cost).
+        last = [None, None]
+
+        def indicators(t, y):
+            key = (t, y.tobytes())
+            if last[0] != key:
+                last[0], last[1] = key, z(y.tolist(), no_inputs or inputs(min(t, self.t_left)), p, ())[0]
+            return last[1]
         for name, k in own + self.other_indicators:
 
             def indicator(t, y, k=k):
-                return z(y.tolist(), no_inputs or inputs(min(t, self.t_left)), p, ())[0][k]
+                return indicators(t, y)[k]
             out.append((name, _event(indicator, -1.0), k))
         return out
 
