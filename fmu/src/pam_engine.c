@@ -186,6 +186,48 @@ static unsigned first_crossing(PamEngine *e, const PamStages *s, double t, const
     return 0;
 }
 
+/* The smallest of the indicators `which` at the fraction th of the accepted step from t (y1 at its end). */
+static double indicator_on_step(PamEngine *e, const PamStages *s, double t, const double *y, const double *y1,
+                                double h, unsigned which, double th) {
+    double ye[PM_NX];
+    if (th >= 1.0) {
+        inputs_at(e, t + h, 1);
+        return min_indicator_of(e, y1, which);
+    }
+    dp_dense(s, y, h, th, ye);
+    inputs_at(e, t + th * h, 1);
+    return min_indicator_of(e, ye, which);
+}
+
+/* Narrows [lo, hi] (fractions of the step; the indicators `which` above zero at lo, at or below it at hi)
+ * onto their first crossing on the dense output, to 1e-15 of the time, keeping hi on the far side so that
+ * the event test holds there.  The Illinois variant of regula falsi: the dense output is a smooth
+ * polynomial, so it needs a handful of evaluations where bisection needed some fifty, and an event's cost
+ * was mostly its location (ten Maxwell-slip elements switch tens of times a second).  It halves the value
+ * kept at an end that stays twice, and bisects where the secant leaves the bracket. */
+static void locate_crossing(PamEngine *e, const PamStages *s, double t, const double *y, const double *y1,
+                            double h, unsigned which, double *lo, double *hi) {
+    double g_lo = indicator_on_step(e, s, t, y, y1, h, which, *lo);
+    double g_hi = indicator_on_step(e, s, t, y, y1, h, which, *hi);
+    int it, kept = 0; /* +1: lo was kept last time, -1: hi was */
+    for (it = 0; it < 100 && (*hi - *lo) * h > 1e-15 * fmax(1.0, fabs(t)); it++) {
+        double mid = g_lo > 0.0 && g_hi <= 0.0 ? (*lo * g_hi - *hi * g_lo) / (g_hi - g_lo) : 0.5 * (*lo + *hi), g;
+        if (!(mid > *lo && mid < *hi)) mid = 0.5 * (*lo + *hi);
+        g = indicator_on_step(e, s, t, y, y1, h, which, mid);
+        if (g <= 0.0) {
+            *hi = mid;
+            g_hi = g;
+            if (kept == 1) g_lo *= 0.5;
+            kept = 1;
+        } else {
+            *lo = mid;
+            g_lo = g;
+            if (kept == -1) g_hi *= 0.5;
+            kept = -1;
+        }
+    }
+}
+
 /* A held model within the integrator's tolerance of the steady state it approaches is set to it
  * (the model's settle function), so that its derivatives are exactly zero: the rest of an
  * exponential approach is below the tolerance, and an explicit integrator would follow it in steps
@@ -299,14 +341,7 @@ int pam_engine_do_step(PamEngine *e, double t_end) {
             /* Locate the first crossing of the indicators that crossed on the dense output; keep the
              * far side so that the event test holds. */
             double ye[PM_NX], t_event;
-            int it;
-            for (it = 0; it < 100 && (hi - lo) * h > 1e-15 * fmax(1.0, fabs(t)); it++) {
-                double mid = 0.5 * (lo + hi);
-                dp_dense(&s, y, h, mid, ye);
-                inputs_at(e, t + mid * h, 1);
-                if (min_indicator_of(e, ye, crossed) <= 0.0) hi = mid;
-                else lo = mid;
-            }
+            locate_crossing(e, &s, t, y, y1, h, crossed, &lo, &hi);
             if (hi < 1.0) dp_dense(&s, y, h, hi, ye);
             else memcpy(ye, y1, sizeof ye);
             t_event = hi < 1.0 ? t + hi * h : (last ? t_piece : t + h);
