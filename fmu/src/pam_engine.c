@@ -165,7 +165,7 @@ static void dp_dense(const PamStages *s, const double *y0, double h, double th, 
  * turn back), so a long one is also checked at PAM_ENGINE_HELD_CHECKS points of its dense output.
  * As in solve_ivp and CVODE, an indicator crosses where its sign changes between two checked points:
  * one that dips below zero and back between them is no event, even where another indicator's
- * crossing brings the bisection there.  A free swing that turns back at its stop, grazing it, so
+ * crossing brings the root finding there.  A free swing that turns back at its stop, grazing it, so
  * records the turn (the stop, if the turn lies beyond it, as at_event decides) where the dense output
  * puts it, instead of an impact whose time moves with the square root of the integration error. */
 static unsigned first_crossing(PamEngine *e, const PamStages *s, double t, const double *y, const double *y1,
