@@ -11,7 +11,7 @@ from __future__ import annotations
 import copy
 import math
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Mapping
 
@@ -56,7 +56,8 @@ _SCHEMA: dict[str, dict[str, Any]] = {
                  "command": dict, "prescribed": dict, "initial_gauge_bar": float, "supply_port": str,
                  "outlet_port": str, "spool": dict},
     "simulation": {"duration_s": float, "sample_rate_Hz": float, "initial_contraction_m": float},
-    "solver": {"method": str, "rtol": float, "max_events": int, "max_step_s": float, "native_rtol_factor": float},
+    "solver": {"method": str, "rtol": float, "max_events": int, "max_step_s": float, "native_rtol_factor": float,
+               "stick_margin_N": float, "release_margin_N": float},
     "measured": {"steady_state": str},
     "chamber": {"law": str, **{key: float for key in CHAMBER_DEFAULTS if key != "law"}},
 }
@@ -199,9 +200,26 @@ class Scenario:
             m = self.spec["model"]
             added += (hysteresis_component(v, self.spec["hysteresis"], FRICTION_MODELS[m["friction"]](self.parameters, m),
                                            source_parts(self._source, None).pressure, added),)
+            object.__setattr__(self, "solver", self._margins_without_coulomb())
         object.__setattr__(self, "_added", added)
         if self._added or isinstance(self._source, LineValveSource):
             check_wiring(self, ScenarioError)
+
+    def _margins_without_coulomb(self) -> SolverOptions:
+        """The solver's options with the load's stick and release margins for a rig whose friction is a
+        ``[hysteresis]`` model's alone.
+
+        The load then has no Coulomb level of its own: it sticks where its velocity reaches zero with a net
+        force within the stick margin, and only the elements' springs and dampers bring it to rest, the
+        swing decaying for ever.  The margins of the Coulomb rig (1e-7 N) lie far below what the integrator
+        resolves of the forces, so the swing was followed, and a held load released and stuck again on the
+        integrator's noise in the pressure, long after it had come to rest within the tolerance.  Here the
+        load is held where its net force is within ``rtol`` of its weight (the forces' resolution at the
+        integrator's tolerance) and released at twice that (docs/hysteresis.md, "Where the load rests")."""
+        if {"stick_margin_N", "release_margin_N"} & set(self.spec.get("solver", {})):
+            return self.solver  # the scenario's own
+        resolution_N = self.solver.rtol * self.mass_kg * self.parameters["g_m_s2"]
+        return replace(self.solver, stick_margin_N=resolution_N, release_margin_N=2.0 * resolution_N)
 
     @property
     def upper_stop(self) -> str:
@@ -522,7 +540,23 @@ def _solver_options(v: "_Validator", solver: dict, duration: float, sample_rate:
         v.fail("solver.max_step_s", max_step, f"must be at least {smallest_step:.3g} s (1 us, and no more than "
                f"{MAX_STEPS:.0e} steps over duration_s = {duration:g} s)")
     return SolverOptions(method=method, rtol=rtol, sample_rate_Hz=sample_rate, max_events=int(max_events),
-                         max_step_s=max_step, native_rtol_factor=_native_rtol_factor(v, solver))
+                         max_step_s=max_step, native_rtol_factor=_native_rtol_factor(v, solver),
+                         **_margins(v, solver))
+
+
+def _margins(v: "_Validator", solver: dict) -> dict:
+    """``solver.stick_margin_N`` and ``solver.release_margin_N`` where given: ``0 <= stick < release``."""
+    given = {key: v.number(f"solver.{key}", solver[key]) for key in ("stick_margin_N", "release_margin_N")
+             if key in solver}
+    defaults = SolverOptions()
+    stick = given.get("stick_margin_N", defaults.stick_margin_N)
+    release = given.get("release_margin_N", defaults.release_margin_N)
+    if stick < 0.0:
+        v.fail("solver.stick_margin_N", stick, "must be >= 0")
+    if not release > stick:
+        key = "release_margin_N" if "release_margin_N" in given else "stick_margin_N"
+        v.fail(f"solver.{key}", given[key], f"the release margin must exceed the stick margin ({stick:g} N)")
+    return given
 
 
 def _native_rtol_factor(v: "_Validator", solver: dict) -> float:

@@ -136,6 +136,53 @@ def test_bad_hysteresis_tables_are_refused_by_key(fig4, change, key):
         Scenario.from_dict(spec, name="bad", base_dir=fig4.base_dir)
 
 
+# ---------------------------------------------------------------- where the load rests
+TEN_DELTAS = list(np.geomspace(1e-4, 5e-3, 10))
+
+
+def test_a_rig_without_coulomb_friction_takes_margins_of_the_forces_resolution(fig4):
+    """With a ``[hysteresis]`` table the load's margins are ``rtol`` times its weight and twice that (by hand
+    from the scenario's own rtol, mass and g); the Coulomb rig keeps 1e-7 N and 2e-7 N; margins given in
+    ``[solver]`` are kept as given."""
+    assert (fig4.solver.stick_margin_N, fig4.solver.release_margin_N) == (1e-7, 2e-7)
+    sc = _with_elements(fig4, [1e-4], [1.0])
+    weight = fig4.spec["load"]["weight_N"]
+    assert sc.solver.stick_margin_N == pytest.approx(1e-6 * weight, rel=1e-12)
+    assert sc.solver.release_margin_N == pytest.approx(2e-6 * weight, rel=1e-12)
+    loose = sc.with_changes({"solver": {"rtol": 1e-4}})
+    assert loose.solver.stick_margin_N == pytest.approx(1e-4 * weight, rel=1e-12)
+    own = sc.with_changes({"solver": {"stick_margin_N": 1e-7, "release_margin_N": 2e-7}})
+    assert (own.solver.stick_margin_N, own.solver.release_margin_N) == (1e-7, 2e-7)
+
+
+@pytest.mark.parametrize("backend", ["python", "native"])
+def test_a_load_at_rest_on_its_elements_is_held_not_released_again(fig4, backend):
+    """Figure 4 with ten damped elements: the load comes to rest on its elements' springs and is held once,
+    with no release after it (with the Coulomb rig's 1e-7 N margins python released it 127 times, on its
+    integrator's noise in the pressure, and native never held it), where the Coulomb rig's margins leave it
+    to within 0.1 um."""
+    sc = _with_elements(fig4, TEN_DELTAS, [0.1] * 10, damping_N_s_per_m=100.0)
+    res = simulate(sc, backend=backend)
+    holds = [e for e in res.transitions if e.to_mode == "stick"]
+    assert len(holds) == 1 and 1.5 < holds[0].t_s < 2.5, holds
+    assert not [e for e in res.transitions if e.t_s > holds[0].t_s]
+    assert res.final_mode == 0  # held (stick) at the end
+    fine = simulate(sc.with_changes({"solver": {"stick_margin_N": 1e-7, "release_margin_N": 2e-7}}), backend=backend)
+    assert abs(res.x_m[-1] - fine.x_m[-1]) < 1e-7
+
+
+@pytest.mark.parametrize("solver, key", [({"stick_margin_N": -1e-7}, "solver.stick_margin_N"),
+                                         ({"release_margin_N": 1e-7}, "solver.release_margin_N"),
+                                         ({"stick_margin_N": 1e-3}, "solver.stick_margin_N"),
+                                         ({"release_margin_N": "big"}, "solver.release_margin_N")])
+def test_bad_margins_are_refused_by_key(fig4, solver, key):
+    """A negative stick margin, a release margin not above the stick margin, or one that is not a number."""
+    spec = copy.deepcopy(dict(fig4.spec))
+    spec["solver"] = solver
+    with pytest.raises(ScenarioError, match=key):
+        Scenario.from_dict(spec, name="bad", base_dir=fig4.base_dir)
+
+
 def test_the_command_line_refuses_a_bad_table_with_exit_2(tmp_path):
     """``pamsim run`` on a scenario with a negative slip displacement: exit 2, the key named, no traceback,
     nothing written."""

@@ -89,7 +89,8 @@ REPRESENTED = {
     "pressure": {"source", "supply_gauge_bar", "supply_gauge_Pa", "valve_open_time_s", "command", "prescribed",
                  "initial_gauge_bar", "supply_port", "outlet_port", "spool"},  # supply_port, outlet_port: a line
     "simulation": {"duration_s", "sample_rate_Hz", "initial_contraction_m"},
-    "solver": {"method", "rtol", "max_events", "max_step_s", "native_rtol_factor"},
+    "solver": {"method", "rtol", "max_events", "max_step_s", "native_rtol_factor", "stick_margin_N",
+               "release_margin_N"},
     "chamber": set(CHAMBER_DEFAULTS),
 }
 
