@@ -24,7 +24,7 @@ integrates to::
 
 and the laminar law is ``p_a^2 - p_b^2 = K_l mdot``, ``K_l = 256 mu L R T / (pi d^4)``.  The bore takes the
 larger of the two drops for a flow (the larger friction factor: Blasius's exceeds ``64 / Re`` above
-``Re = (64 / 0.316)^(4/3) = 1187``), a continuous law with a kink in its slope where the two meet, and its
+``Re = (64 / 0.316)^(4/3) = 1189``), a continuous law with a kink in its slope where the two meet, and its
 inverse, the flow of a drop, is the smaller of the two flows, in closed form::
 
     mdot = (p_a^2 - p_b^2) min(1 / K_l, K_t^(-4/7) max(|p_a^2 - p_b^2|, D*)^(-3/7))
