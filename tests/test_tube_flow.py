@@ -12,7 +12,7 @@ contraction, each against a formula written here by hand.
 
 from __future__ import annotations
 
-import copy
+import functools
 import json
 import math
 import subprocess
@@ -25,6 +25,7 @@ import pytest
 import pamsim
 from conftest import SCENARIOS
 from pamsim.errors import InputError
+from test_lines import _scenario as line_scenario
 
 R_AIR, P_ATM, T_ROOM = 287.05, 101325.0, 293.15
 MU_AIR = 1.81e-5  # Pa s, air at 20 C (White, Fluid Mechanics, Table A.2)
@@ -35,12 +36,7 @@ FIG4 = {"model": {"muscle": "shadow_6x300_acra2012"}, "load": {"weight_N": 22.74
 SUPPLY_SET = {"p_set_gauge_Pa": "supply_pressure_gauge_Pa"}
 
 
-def _scenario(components, base=FIG4, **sections):
-    spec = copy.deepcopy(base)
-    spec["component"] = components
-    for section, values in sections.items():
-        spec.setdefault(section, {}).update(values)
-    return pamsim.Scenario.from_dict(spec, base_dir=SCENARIOS)
+_scenario = functools.partial(line_scenario, base=FIG4)
 
 
 def _tube(name="tube", connect=None, **keys):

@@ -261,8 +261,7 @@ def linearize(model: MuscleModel, op: OperatingPoint, friction: FrictionTreatmen
     added, op, loop = hold_hysteresis(model, op, added)
     lines = line_states(model, added)
     x0 = _state_vector(model, op, added, lines)
-    if op.kind == "held_pressure" and lines:  # where the line rests, for the report
-        op = replace(op, line_states={**dict(zip((n for n, _ in lines), map(float, x0[4:]))), **op.line_states})
+    op = _with_line_states(op, lines, x0)
     # Beyond the composed model's four states (added components, a spool): only the exact derivatives have them.
     beyond_rig = bool(added or lines)
     if input_names(model) != INPUTS:  # the duty: its derivative at 0 is the one into its range [0, 1]
@@ -284,6 +283,14 @@ def linearize(model: MuscleModel, op: OperatingPoint, friction: FrictionTreatmen
                 inputs=list(input_names(model)), outputs=list(OUTPUTS), name="muscle_linear")
     dropped = tuple(dropped) + (loop.dropped if loop else ())
     return LinearModel(sys, op, friction, valve_slope, residual, dropped, method, loop)
+
+
+def _with_line_states(op: OperatingPoint, lines: tuple, x0: np.ndarray) -> OperatingPoint:
+    """``op`` with where a held line rests (the states after the rig's four in ``x0``), for the report."""
+    if op.kind != "held_pressure" or not lines:
+        return op
+    rest = {name: float(value) for (name, _), value in zip(lines, x0[4:])}
+    return replace(op, line_states={**rest, **op.line_states})
 
 
 def _kept_states(A: np.ndarray, C: np.ndarray, names: list, scales: np.ndarray) -> tuple[list, list]:
