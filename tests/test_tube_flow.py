@@ -289,6 +289,19 @@ def test_linearize_holds_a_line_at_a_contraction():
     assert np.array(out["A"])[i["tube.p_abs_Pa"], i["p_abs_Pa"]] == pytest.approx(g * R_AIR * T_ROOM / V_t, rel=1e-9)
 
 
+def test_linearize_holds_a_line_behind_a_spool_valve():
+    """scenarios/proportional_valve.toml (a spool valve discharging into a tube before the muscle) held at 30
+    mm: the spool at rest in its centre, the tube at the muscle's holding pressure, nothing moving."""
+    proc = subprocess.run([sys.executable, "-m", "pamsim", "linearize", str(SCENARIOS / "proportional_valve.toml"),
+                           "--contraction-mm", "30", "--json"], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    out = json.loads(proc.stdout)
+    op = out["operating_point"]
+    assert op["line_states"]["tube.p_abs_Pa"] == op["states"][2]
+    assert op["line_states"]["valve.spool_position"] == 0.0 == op["line_states"]["valve.spool_velocity"]
+    assert np.max(np.abs(out["residual_f_x0_u0"])) < 1e-9
+
+
 @pytest.mark.parametrize("components, pressure, name, why", [
     ([{"name": "tank", "type": "reservoir", "volume_m3": 1e-4, "initial_gauge_Pa": 4e5},
       {"name": "supply", "type": "supply", "connect": SUPPLY_SET}],  # a regulator on its own, feeding nothing

@@ -149,9 +149,12 @@ def held_line_states(model, added: tuple, p_abs_Pa, known: dict | None = None) -
     known = known or {}
     values = []
     for name, _ in line_states(model, added):
+        if name in known:
+            values.append(known[name])
+            continue
         owner, _, state = name.partition(".")
         p = p_abs_Pa[owner] if isinstance(p_abs_Pa, dict) else p_abs_Pa
-        values.append(known[name] if name in known else by_name[owner].held_state(p)[state])
+        values.append(by_name[owner].held_state(p)[state])
     return np.asarray(values, dtype=float)
 
 
