@@ -10,6 +10,10 @@ The same test runs three ways: the line as shipped; without the tube (the valve 
 muscle, the reservoir still before it); and without the line (the valve on an ideal supply, the rig as
 it always was).  The figure draws the pressure drop across each element of the line (from the pressure of
 every volume, columns of the run), the muscle's pressure and the contraction.
+
+Then the shipped line again with the hose's and the tube's turbulent law (``resistance = "turbulent"``: the
+fill's Reynolds numbers are near 8000), and with the tube in 10 cells whose gas has inertia as well
+(``segments = 10``, ``inertia = true``: pressure waves along it at the speed of sound).
 """
 
 import copy
@@ -68,3 +72,29 @@ for label, res in results.items():
 re_tube = line.signals["tube.reynolds_number"].max()
 re_feed = line.signals["feed.reynolds_number"].max()
 print(f"largest Reynolds number: tube {re_tube:.0f}, feed hose {re_feed:.0f} (laminar below about 2300)")
+
+# %%
+# The turbulent law, and the tube's gas's inertia.  Each tube of the line takes the larger of the laminar and
+# Blasius drops for its flow; then the muscle's tube is cut into 10 cells with a mass-flow state each.
+
+
+def tubes(base, **keys):
+    out = copy.deepcopy(base)
+    for c in out["component"]:
+        if c["type"] == "tube" and (c["name"] == "tube" or "segments" not in keys):
+            c.update(keys)
+    return out
+
+
+turbulent = tubes(spec, resistance="turbulent")
+variants = {"turbulent hose and tube": turbulent,
+            "turbulent, the tube in 10 cells with inertia": tubes(turbulent, segments=10, inertia=True)}
+for label, s in variants.items():
+    res = pamsim.simulate(pamsim.Scenario.from_dict(s, base_dir="../scenarios"))
+    sig = res.signals
+    t90 = res.t_s[np.argmax(res.p_gauge_Pa >= 0.9 * 3.6e5)] - 0.5
+    drop = np.max(sig["tube.p_gauge_Pa"] - res.p_gauge_Pa) / 1e3
+    print(f"{label}: 90 % after {t90 * 1e3:.0f} ms, peak {res.x_m.max() * 1e3:.2f} mm, final {res.x_m[-1] * 1e3:.2f} mm, "
+          f"largest drop along the tube {drop:.2f} kPa, Reynolds number up to {sig['tube.reynolds_number'].max():.0f}")
+drop_laminar = np.max(line.signals["tube.p_gauge_Pa"] - line.p_gauge_Pa) / 1e3
+print(f"laminar line: largest drop along the tube {drop_laminar:.2f} kPa")

@@ -61,12 +61,19 @@ def added_components(v, entries: list) -> tuple[AddedComponent, ...]:
 
 def _component_options(v, where: str, cls, entry: dict) -> dict[str, str]:
     """The entry's choices of form (a reservoir's ``law``, a tube's ``inlet``): each one of the names the
-    class offers (its ``choices``, the first the default when the key is left out)."""
+    class offers (its ``choices``, the first the default when the key is left out), and its ``settings``
+    (a tube's ``segments``), each checked by the class's own test of it."""
     options = {}
     for key, names in getattr(cls, "choices", {}).items():
         if key in entry:
             if entry[key] not in names:
                 v.fail(f"{where}.{key}", entry[key], "unknown choice", choices=names)
+            options[key] = entry[key]
+    for key, violation in getattr(cls, "settings", {}).items():
+        if key in entry:
+            why = violation(entry[key])
+            if why:
+                v.fail(f"{where}.{key}", entry[key], why)
             options[key] = entry[key]
     return options
 

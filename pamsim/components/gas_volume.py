@@ -78,10 +78,11 @@ def checked_law(law: str) -> str:
 
 
 
-def held_state(component, p_abs_Pa: float) -> dict[str, float]:
+def held_state(component, p_abs_Pa: float, element=None) -> dict[str, float]:
     """The states of the rigid volume ``component`` at rest at the absolute pressure ``p_abs_Pa``: that
     pressure, and the air mass it holds there at its law's starting temperature (its wall's, or
-    ``T_initial_K``; at rest the thermal gas stands at its wall's)."""
-    element = component.element
+    ``T_initial_K``; at rest the thermal gas stands at its wall's).  ``element``: the volume's, if not the
+    component's own (a tube's cell)."""
+    element = element if element is not None else component.element
     T = element.start_temperature_K(component.values["T_initial_K"])
     return {"p_abs_Pa": float(p_abs_Pa), "air_mass_kg": float(element.air_mass_kg(p_abs_Pa, element.volume_m3(0.0), T))}

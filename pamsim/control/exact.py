@@ -141,15 +141,20 @@ def _carried(flat, added) -> list[str]:
     return spool + extra
 
 
-def held_line_states(model, added: tuple, p_abs_Pa: float, known: dict | None = None) -> np.ndarray:
+def held_line_states(model, added: tuple, p_abs_Pa, known: dict | None = None) -> np.ndarray:
     """The values of :func:`line_states` with every volume of the line at rest at ``p_abs_Pa`` (the valve open
-    on a supply at that pressure: no flow anywhere), those in ``known`` (a spool's) as it gives them."""
+    on a supply at that pressure: no flow anywhere), or each at its own (``{component name: p_abs_Pa}``,
+    :func:`pamsim.control.line_rest.held_line_pressures`), those in ``known`` (a spool's) as it gives them."""
     by_name = {a.component.name: a.component for a in added}
     known = known or {}
     values = []
     for name, _ in line_states(model, added):
+        if name in known:
+            values.append(known[name])
+            continue
         owner, _, state = name.partition(".")
-        values.append(known[name] if name in known else by_name[owner].held_state(p_abs_Pa)[state])
+        p = p_abs_Pa[owner] if isinstance(p_abs_Pa, dict) else p_abs_Pa
+        values.append(by_name[owner].held_state(p)[state])
     return np.asarray(values, dtype=float)
 
 

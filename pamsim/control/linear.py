@@ -32,7 +32,7 @@ ISO 6358 subsonic law; the Jacobian simply differentiates that branch.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import control as ct
 import numpy as np
@@ -41,6 +41,7 @@ from ..errors import InputError
 from ..model import MuscleModel
 from .choices import VALVE_SLOPES
 from .exact import control_functions, exact_jacobians, held_line_states, line_states
+from .line_rest import held_line_pressures
 from .loop_point import LoopPoint, hold_hysteresis
 from .operating_point import OperatingPoint
 from .system import INPUT_SCALES, INPUTS, OUTPUTS, STATE_SCALES, STATES, FrictionTreatment, MusclePlant, input_names
@@ -260,6 +261,7 @@ def linearize(model: MuscleModel, op: OperatingPoint, friction: FrictionTreatmen
     added, op, loop = hold_hysteresis(model, op, added)
     lines = line_states(model, added)
     x0 = _state_vector(model, op, added, lines)
+    op = _with_line_states(op, lines, x0)
     # Beyond the composed model's four states (added components, a spool): only the exact derivatives have them.
     beyond_rig = bool(added or lines)
     if input_names(model) != INPUTS:  # the duty: its derivative at 0 is the one into its range [0, 1]
@@ -283,11 +285,19 @@ def linearize(model: MuscleModel, op: OperatingPoint, friction: FrictionTreatmen
     return LinearModel(sys, op, friction, valve_slope, residual, dropped, method, loop)
 
 
+def _with_line_states(op: OperatingPoint, lines: tuple, x0: np.ndarray) -> OperatingPoint:
+    """``op`` with where a held line rests (the states after the rig's four in ``x0``), for the report."""
+    if op.kind != "held_pressure" or not lines:
+        return op
+    rest = {name: float(value) for (name, _), value in zip(lines, x0[4:])}
+    return replace(op, line_states={**rest, **op.line_states})
+
+
 def _kept_states(A: np.ndarray, C: np.ndarray, names: list, scales: np.ndarray) -> tuple[list, list]:
     """``(indices kept, names dropped)``: every air mass (the chamber's, a line volume's) that feeds nothing
     back is dropped."""
     keep, dropped = list(range(len(names))), []
-    for k in [k for k, n in enumerate(names) if n.split(".")[-1] == "air_mass_kg"]:
+    for k in [k for k, n in enumerate(names) if n.split(".")[-1].endswith("air_mass_kg")]:
         if _uncoupled(A, C, scales, k, keep):
             keep.remove(k)
             dropped.append(names[k])
@@ -307,7 +317,8 @@ def _uncoupled(A: np.ndarray, C: np.ndarray, scales: np.ndarray, k: int, keep: l
 def _state_vector(model, op: OperatingPoint, added: tuple, lines: tuple) -> np.ndarray:
     """The rig's four states at ``op``, then the states of the components added to it (``lines``): the
     operating point's own (a run's), or the components at rest at the chamber's pressure where the valve is
-    open on its supply (every volume of the line there, no flow)."""
+    open on its supply (every volume of the line there, no flow), or, the valve closed on a held contraction,
+    each volume at the pressure its resistances join it to (:mod:`pamsim.control.line_rest`)."""
     if not lines:
         return np.asarray(op.states, dtype=float)
     # A spool at rest stands at its command; a run's operating point has its own (op.line_states).
@@ -318,8 +329,11 @@ def _state_vector(model, op: OperatingPoint, added: tuple, lines: tuple) -> np.n
         extra = np.array([known[name] for name, _ in lines], dtype=float)
     elif op.kind == "open_valve":
         extra = held_line_states(model, added, float(op.states[2]), known)
+    elif op.kind == "held_pressure":
+        extra = held_line_states(model, added, held_line_pressures(added, float(op.states[2]), float(op.inputs[1])),
+                                 known)
     else:
         unknown = ", ".join(n for n, _ in lines if n not in known)
-        raise InputError(f"operating point {op.kind!r}: a supply line ({unknown}) is "
-                         "linearised at the open valve's equilibrium or at a time of its run (--at-time)")
+        raise InputError(f"operating point {op.kind!r}: a supply line ({unknown}) is linearised at the open "
+                         "valve's equilibrium, at a held contraction or at a time of its run (--at-time)")
     return np.concatenate([np.asarray(op.states, dtype=float), extra])

@@ -24,6 +24,7 @@ from ..elements.pressure_source import LineValveSource, ValveChamberSource
 from ..errors import InputError
 from ..modeling import PNEUMATIC
 from ..scenario_components import refuse_added
+from .line_rest import held_line_pressures
 from .linear import LinearModel, linearize
 from .operating_point import OperatingPoint
 from .system import FrictionTreatment
@@ -70,11 +71,12 @@ def refuse_unsupported_line(scenario) -> None:
 
 def full_linearisation(model, held: OperatingPoint, added: tuple) -> LinearModel:
     """The linearisation of ``model`` with its spool and the ``added`` line at the held operating point ``held``
-    (valve closed): the spool at rest in its centre, every volume of the line at the chamber's pressure (the
-    closed valve lets nothing through, so there is no flow)."""
+    (valve closed): the spool at rest in its centre, every volume of the line at the pressure its resistances
+    join it to (the chamber's, behind the closed valve: :mod:`pamsim.control.line_rest`), so nothing flows."""
     p_abs = float(held.states[2])
+    rest = held_line_pressures(added, p_abs, float(held.inputs[1]))
     line = {f"{a.component.name}.{k}": v for a in added if a.component.states
-            for k, v in a.component.held_state(p_abs).items()}
+            for k, v in a.component.held_state(rest.get(a.component.name, p_abs)).items()}
     return linearize(model, dataclasses.replace(held, line_states=line), FrictionTreatment("dropped"), "mean",
                      added=added)
 
