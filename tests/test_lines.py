@@ -71,6 +71,21 @@ def test_a_closed_line_reservoir_tube_muscle_keeps_its_air(backend):
     assert moved > 0.05 and res.x_m.max() > 0.01  # the muscle filled and lifted: the balance is not trivial
 
 
+@pytest.mark.parametrize("backend", ["python", "native"])
+def test_a_charged_reservoir_alone_drives_the_muscle_through_the_valve(backend):
+    """A tank on the valve's supply side and no supply anywhere (the rig's supply input then drives nothing;
+    the scenario failed to build with an IndexError before): the valve opens at 0.1 s, the muscle fills and
+    lifts its load, and the air in reservoir and muscle stays constant to 1e-12 of it."""
+    sc = _scenario([_component("reservoir", "reservoir", volume_m3=1e-4, initial_gauge_Pa=3.6e5)],
+                   load={"weight_N": 22.74}, pressure={"supply_port": "reservoir.port"},
+                   simulation={"duration_s": 1.0, "sample_rate_Hz": 1000.0})
+    res = pamsim.simulate(sc, backend=backend)
+    s = res.signals
+    total = s["reservoir.air_mass_kg"] + s["air_mass_kg"]
+    assert np.max(np.abs(total / total[0] - 1.0)) < 1e-12
+    assert s["air_mass_kg"][-1] > 2 * s["air_mass_kg"][0] and res.x_m.max() > 0.01
+
+
 @pytest.mark.parametrize("backend, bound", [("python", 1e-12), ("native", 1e-8)])
 def test_a_supplied_line_gains_what_the_supply_delivers(backend, bound):
     """Ideal supply -> valve -> tube -> muscle: the air in tube and muscle grows by the supply's delivered mass

@@ -214,9 +214,11 @@ class Assembly:
         return work.flat_model(self.name, self._input_vars(), list(model_inputs.values()))
 
     def _input_vars(self) -> list[Var]:
-        """The model's inputs, each with the unit of the (first) component input it drives."""
-        return [Var(n, _var(self._endpoint(refs[0]).component.inputs, self._endpoint(refs[0]).name).unit)
-                for n, refs in self.inputs.items()]
+        """The model's inputs, each with the unit of the (first) component input it drives; one that drives
+        none (the supply pressure of a valve whose supply side is a volume of a line) keeps its place, with
+        the unit its name ends in (``_Pa``)."""
+        return [Var(n, _var(self._endpoint(refs[0]).component.inputs, self._endpoint(refs[0]).name).unit if refs
+                    else n.rsplit("_", 1)[-1]) for n, refs in self.inputs.items()]
 
 
 class _Flattening:
