@@ -182,7 +182,9 @@ def _linearize(scenario, args: argparse.Namespace):
     friction = FrictionTreatment(args.friction, args.friction_velocity_mm_s * 1e-3)
     lin = linearize(model, op, friction, args.valve_slope, added=added)
     rep = report(lin)
-    rep["valve_model"] = (f"the averaged model of the on/off valve under {model.source.valve.frequency_Hz:g} Hz PWM "
+    valves = ("the inlet and exhaust 2/2 valves (the exhaust complementary)" if "inlet" in scenario.spec["pressure"]
+              else "the on/off valve")
+    rep["valve_model"] = (f"the averaged model of {valves} under {model.source.valve.frequency_Hz:g} Hz PWM "
                           "(the mean of its supply and exhaust paths' flows over a period), input pwm_duty [1]; "
                           "pamsim run runs its switching" if pwm
                           else f"proportional 3/3 valve, slope at command 0: {lin.valve_slope}")
