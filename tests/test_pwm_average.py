@@ -24,8 +24,8 @@ from pamsim.control.operating_point import averaged_pwm_equilibrium, averaged_pw
 from pamsim.elements.pwm_average import PwmAveragedValve
 from pamsim.signals import Pwm
 
-PWM_ONOFF = SCENARIOS / "pwm_onoff.toml"
-BASE = pamsim.load_scenario(PWM_ONOFF)
+PWM_3_2 = SCENARIOS / "pwm_3_2.toml"
+BASE = pamsim.load_scenario(PWM_3_2)
 COMMAND = dict(BASE.spec["pressure"]["command"])
 IDEAL = {**COMMAND, "delay_on_s": 0.0, "delay_off_s": 0.0, "rise_s": 0.0, "fall_s": 0.0}
 """The scenario's valve switching at once: its averaged model does not depend on the frequency."""
@@ -269,7 +269,7 @@ def test_dc_gain_in_duty_is_the_slope_of_switching_runs_mean_pressure():
 def test_cli_linearize_uses_the_averaged_model(tmp_path, cli):
     """``pamsim linearize`` on the switching PWM scenario: the duty is the input, the output says so, and the
     operating point is the averaged model's balance (a rest: the residual is nil)."""
-    proc = cli("linearize", PWM_ONOFF, "--json")
+    proc = cli("linearize", PWM_3_2, "--json")
     assert proc.returncode == 0, proc.stderr
     rep = json.loads(proc.stdout)
     assert rep["inputs"] == ["pwm_duty", "supply_gauge_Pa", "F_ext_N"]
@@ -277,7 +277,7 @@ def test_cli_linearize_uses_the_averaged_model(tmp_path, cli):
     assert rep["operating_point"]["kind"] == "pwm_averaged"
     assert np.max(np.abs(rep["residual_f_x0_u0"][2:])) < 1e-3
     assert rep["dc_gain"]["pwm_duty->contraction_m"] > 0
-    text = cli("linearize", PWM_ONOFF, "-o", tmp_path)
+    text = cli("linearize", PWM_3_2, "-o", tmp_path)
     assert text.returncode == 0, text.stderr
     assert "valve: the averaged model of the on/off valve under 50 Hz PWM" in text.stdout
     assert "DC gain pwm_duty -> contraction" in text.stdout
@@ -297,7 +297,7 @@ def test_cli_linearize_uses_the_averaged_model(tmp_path, cli):
 @pytest.mark.parametrize("command", ["run", "linearize"])
 def test_bad_pwm_input_exits_2_naming_the_key(tmp_path, cli, change, key, model, command):
     bad = tmp_path / "bad.toml"
-    text = PWM_ONOFF.read_text().replace('duty = 0.5\n', f'duty = 0.5\nmodel = "{model}"\n')
+    text = PWM_3_2.read_text().replace('duty = 0.5\n', f'duty = 0.5\nmodel = "{model}"\n')
     for name, value in change.items():
         line = next(ln for ln in text.splitlines() if ln.startswith(f"{name} ="))
         text = text.replace(line, f"{name} = {json.dumps(value)}") if name != "model" else \
@@ -308,16 +308,16 @@ def test_bad_pwm_input_exits_2_naming_the_key(tmp_path, cli, change, key, model,
 
 def test_model_is_refused_on_a_command_that_is_not_pwm(tmp_path, cli):
     bad = tmp_path / "step.toml"
-    bad.write_text(PWM_ONOFF.read_text().split("[pressure.command]")[0]
+    bad.write_text(PWM_3_2.read_text().split("[pressure.command]")[0]
                    + '[pressure.command]\nkind = "step"\ntime_s = 0.5\nfinal = 1.0\nmodel = "averaged"\n'
-                   + "[simulation]" + PWM_ONOFF.read_text().split("[simulation]")[1])
+                   + "[simulation]" + PWM_3_2.read_text().split("[simulation]")[1])
     proc = cli("run", bad, "-o", tmp_path / "out")
     assert proc.returncode == 2
     assert "pressure.command.model" in proc.stderr and "only a pwm command" in proc.stderr
 
 
 def test_valve_slope_is_refused_for_a_pwm_valve(tmp_path, cli):
-    proc = cli("linearize", PWM_ONOFF, "--valve-slope", "fill", "-o", tmp_path / "out")
+    proc = cli("linearize", PWM_3_2, "--valve-slope", "fill", "-o", tmp_path / "out")
     assert proc.returncode == 2
     assert "--valve-slope" in proc.stderr and "duty" in proc.stderr
     assert not (tmp_path / "out").exists()
