@@ -157,16 +157,7 @@ def on_off_command(v, where: str, spec: Any, timing: Mapping[str, float], inlet=
 
     ``v`` refuses, naming the key: an unknown kind, a timing or level key in the command (they are the
     valve's), a value other than 0 or 1, a complementary inlet or one with keys besides its kind."""
-    if not isinstance(spec, dict):
-        v.fail(where, spec, "must be a table with a 'kind'")
-    kind = v.required(spec, "kind", prefix=f"{where}.")
-    allowed = ON_OFF_KINDS if inlet is not None else ON_OFF_KINDS[:-1]
-    if not isinstance(kind, str) or kind not in allowed:
-        v.fail(f"{where}.kind", kind, "unknown command of an on/off valve", choices=allowed)
-    for key in spec:
-        if key in VALVE_TIMING or key in ("low", "high"):
-            v.fail(f"{where}.{key}", spec[key], f"an on/off valve opens (1) and closes (0); its {'timing' if key in VALVE_TIMING else 'levels'} "
-                   f"are keys of its own table ({where.rsplit('.', 1)[0]}), not of its command")
+    kind = _on_off_kind(v, where, spec, inlet is not None)
     if kind == "complementary":
         for key in spec:
             if key != "kind":
@@ -182,6 +173,23 @@ def on_off_command(v, where: str, spec: Any, timing: Mapping[str, float], inlet=
     commands = tuple(zip(signal.times_s, states)) if isinstance(signal, PiecewiseConstant) else (
         ((signal.time_s, states[-1]),) if isinstance(signal, Step) else ())
     return OnOff(commands, float(states[0]), **timing)
+
+
+def _on_off_kind(v, where: str, spec: Any, exhaust: bool) -> str:
+    """The ``kind`` of an on/off valve's command table (``complementary`` for the ``exhaust``'s alone), its
+    timing and level keys refused (they are the valve's)."""
+    if not isinstance(spec, dict):
+        v.fail(where, spec, "must be a table with a 'kind'")
+    kind = v.required(spec, "kind", prefix=f"{where}.")
+    allowed = ON_OFF_KINDS if exhaust else ON_OFF_KINDS[:-1]
+    if not isinstance(kind, str) or kind not in allowed:
+        v.fail(f"{where}.kind", kind, "unknown command of an on/off valve", choices=allowed)
+    for key in spec:
+        if key in VALVE_TIMING or key in ("low", "high"):
+            what = "timing is a key" if key in VALVE_TIMING else "levels are no keys"
+            v.fail(f"{where}.{key}", spec[key], f"an on/off valve opens (1) and closes (0); its {what} of its own "
+                   f"table ({where.rsplit('.', 1)[0]}), not of its command")
+    return kind
 
 
 def _boolean_states(v, where: str, signal) -> list[int]:

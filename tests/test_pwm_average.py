@@ -21,7 +21,7 @@ from pamsim.control import FrictionTreatment, MusclePlant, linearize
 from pamsim.control.exact import exact_jacobians
 from pamsim.control.linear import jacobians
 from pamsim.control.operating_point import averaged_pwm_equilibrium, averaged_pwm_held
-from pamsim.elements.pwm_average import PwmAveragedValve
+from pamsim.elements.pwm_average import PwmAveragedValve, PwmShare
 from pamsim.signals import Pwm
 
 PWM_3_2 = SCENARIOS / "pwm_3_2.toml"
@@ -77,7 +77,7 @@ def test_shares_are_the_switching_traces_means(frequency_Hz, low, high):
             if not 1e-9 < a < 1.0 / frequency_Hz - 1e-9:
                 continue
             pwm = Pwm(0.0, 30.0 / frequency_Hz, frequency_Hz, duty, low, high, *timing)
-            got = PwmAveragedValve(None, frequency_Hz, low, high, *timing).shares(duty)
+            got = PwmAveragedValve(None, PwmShare(frequency_Hz, low, high, *timing)).shares(duty)
             assert got == pytest.approx(_trace_shares(pwm), abs=1e-12), (duty, timing)
             checked += 1
     assert checked >= 10
@@ -85,7 +85,7 @@ def test_shares_are_the_switching_traces_means(frequency_Hz, low, high):
 
 def test_shares_at_the_duty_ends_hold_the_levels():
     """No switching at duty 0 (the ``low`` command) or 1 (``high``), whatever the valve's timing."""
-    valve = PwmAveragedValve(None, 50.0, -0.5, 0.8, 1e-3, 2e-3, 2e-3, 1e-3)
+    valve = PwmAveragedValve(None, PwmShare(50.0, -0.5, 0.8, 1e-3, 2e-3, 2e-3, 1e-3))
     assert valve.shares(0.0) == (0.0, 0.5)
     assert valve.shares(1.0) == (0.8, 0.0)
 
@@ -96,7 +96,7 @@ def test_effective_duty_of_a_3_2_valve_by_hand():
     ``d + f (delay_off - delay_on) - f rise + f (rise + fall) / 4`` and the exhaust's
     ``1 - d - f (delay_off - delay_on) - f fall + f (rise + fall) / 4``."""
     f, d, on, off, r, q = 100.0, 0.4, 1e-3, 1.5e-3, 2e-3, 1e-3
-    supply, exhaust = PwmAveragedValve(None, f, -1.0, 1.0, on, off, r, q).shares(d)
+    supply, exhaust = PwmAveragedValve(None, PwmShare(f, -1.0, 1.0, on, off, r, q)).shares(d)
     assert supply == pytest.approx(d + f * (off - on) - f * r + f * (r + q) / 4, rel=1e-14)
     assert exhaust == pytest.approx(1 - d - f * (off - on) - f * q + f * (r + q) / 4, rel=1e-14)
 

@@ -108,24 +108,21 @@ class PwmAveragedValve(TwoPathValve):
     flows (:class:`~pamsim.elements.valve.TwoPathValve`) are their mean flows over a period at the duty."""
 
     valve: ProportionalValve33
-    frequency_Hz: float
-    low_command: float
-    high_command: float
-    delay_on_s: float = 0.0
-    delay_off_s: float = 0.0
-    rise_s: float = 0.0
-    fall_s: float = 0.0
+    timing: PwmShare
 
     @classmethod
     def of_pwm(cls, valve: ProportionalValve33, pwm) -> "PwmAveragedValve":
         """The averaged ``valve`` under the PWM signal ``pwm`` (:class:`pamsim.signals.Pwm`)."""
-        return cls(valve, pwm.frequency_Hz, pwm.low, pwm.high, pwm.delay_on_s, pwm.delay_off_s, pwm.rise_s, pwm.fall_s)
+        return cls(valve, PwmShare.of_pwm(pwm))
+
+    @property
+    def frequency_Hz(self) -> float:
+        """The PWM frequency [Hz]."""
+        return self.timing.frequency_Hz
 
     def shares(self, duty) -> tuple:
         """``(W_supply, W_exhaust)``: each path's opening averaged over a period at ``duty`` (see the module)."""
-        timing = PwmShare(self.frequency_Hz, self.low_command, self.high_command, self.delay_on_s, self.delay_off_s,
-                          self.rise_s, self.fall_s)
-        return timing.share(duty, 1.0), timing.share(duty, -1.0)
+        return self.timing.share(duty, 1.0), self.timing.share(duty, -1.0)
 
 
 @dataclass(frozen=True)
