@@ -263,6 +263,10 @@ class Scenario:
         timing and its command (the exhaust's may be the inlet's inverted); with ``model = "averaged"`` in
         the inlet's PWM command, their averaged model (the exhaust then complementary)."""
         p = self.parameters
+        for section in ("controller", "compensation"):
+            if section in self.spec:
+                v.fail("pressure.inlet", "{...}", f"a [{section}] table drives the rig's single valve: two 2/2 valves "
+                       "take their commands from their own tables")
         for key in ("command", "valve_open_time_s", "spool", "supply_port", "outlet_port", *PATH_KEYS):
             if key in pr:
                 v.fail(f"pressure.{key}", pr[key], "two 2/2 valves ([pressure.inlet], [pressure.exhaust]) take "

@@ -118,6 +118,19 @@ def test_per_path_keys_equal_to_the_muscles_valve_give_its_run():
     assert np.max(np.abs(a.x_m - b.x_m)) < 1e-9 and np.max(np.abs(a.p_gauge_Pa - b.p_gauge_Pa)) < 1e-3
 
 
+def test_a_spools_leakage_is_a_share_of_each_paths_own_c():
+    """A spool valve whose exhaust path has its own C: at position 0.6 with overlap 0.2 the supply path opens
+    (0.6 - 0.2) / 0.8 = 0.5 of its stroke, and the leakage of 1e-11 m^3/(s Pa) is 1e-11 / 1e-9 = 0.01 of the
+    supply path's C and 1e-11 / 4e-10 = 0.025 of the exhaust path's."""
+    from pamsim.elements.spool import SpoolValve33
+    from pamsim.elements.valve import Iso6358Orifice, ProportionalValve33
+
+    supply = Iso6358Orifice(1e-9, 0.3, 0.999, 1.185, 293.15)
+    exhaust = Iso6358Orifice(4e-10, 0.4, 0.999, 1.185, 293.15)
+    spool = SpoolValve33(ProportionalValve33(supply, exhaust), 125.0, 0.7, 0.2, 1e-11)
+    assert spool.shares(0.6) == pytest.approx((0.51, 0.025), abs=1e-15)
+
+
 # ---------------------------------------------------------------- the switches: exact on both valves
 
 
@@ -345,3 +358,27 @@ def test_bad_3_2_path_keys_exit_2_naming_the_key(tmp_path, cli, key, value, mess
     path = tmp_path / "bad.toml"
     path.write_text(text)
     assert_refused(cli("run", path, "-o", tmp_path / "out"), message, tmp_path / "out")
+
+
+def test_linearize_refuses_a_pair_without_pwm(tmp_path, cli):
+    """Two valves under boolean commands have no averaged model to linearise: refused naming the inlet's kind
+    (at the default operating point and at a run's time alike)."""
+    path = _bad(tmp_path, ('kind = "pwm"\nstart_s = 0.5\nend_s = 4.5\n', 'kind = "step"\ntime_s = 0.5\nfinal = 1.0\n'),
+                ("frequency_Hz = 50.0", "#"), ("duty = 0.5\n", "\n"))
+    assert cli("run", path, "-o", tmp_path / "ok").returncode == 0
+    for extra in ((), ("--at-time", "1.0")):
+        assert_refused(cli("linearize", path, *extra, "-o", tmp_path / "out"), "pressure.inlet.command.kind",
+                       tmp_path / "out")
+
+
+def test_a_closed_loop_on_two_valves_is_refused(tmp_path, cli):
+    """A ``[controller]`` drives the rig's single valve: with two 2/2 valves it is refused naming
+    ``pressure.inlet``."""
+    loop = (SCENARIOS / "closed_loop_position.toml").read_text()
+    start = loop.index("[pressure]")
+    end = loop.index("\n[", start + 1)
+    pair = PWM_ONOFF.read_text()
+    block = pair[pair.index("[pressure]"):pair.index("[simulation]")]
+    path = tmp_path / "loop.toml"
+    path.write_text(loop[:start] + block + loop[end + 1:])
+    assert_refused(cli("run", path, "-o", tmp_path / "out"), "pressure.inlet", tmp_path / "out")

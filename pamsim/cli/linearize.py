@@ -168,6 +168,10 @@ def _linearize(scenario, args: argparse.Namespace):
     from ..errors import InputError
 
     pwm = scenario.pwm_model is not None
+    if "inlet" in scenario.spec["pressure"] and not pwm:
+        kind = scenario.spec["pressure"]["inlet"]["command"].get("kind")
+        raise InputError(f"{scenario.origin}: pressure.inlet.command.kind = {kind!r}: pamsim linearize takes two 2/2 "
+                         "valves through their averaged model, under a pwm inlet command and a complementary exhaust")
     if pwm:
         if args.valve_slope != "mean":
             raise InputError(f"--valve-slope {args.valve_slope}: a PWM valve is linearised through its averaged "
