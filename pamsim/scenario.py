@@ -39,7 +39,7 @@ from .parameters import CHAMBER_DEFAULTS, CHAMBER_LAW_KEYS, LOAD_MASS, Parameter
 from .scenario_components import added_components, check_wiring, hysteresis_component
 from .static_models import REGISTRY
 from .signal_tables import VALVE_TIMING, on_off_command, signal_from_table, signal_range
-from .signals import Constant, Pwm, Step
+from .signals import Constant, Step
 from .simulator import MIN_MAX_STEP_S, MIN_RTOL, NATIVE_RTOL_FACTOR, SolverOptions
 from .table_checks import TableChecker, choices_hint, did_you_mean
 
