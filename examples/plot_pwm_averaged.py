@@ -2,7 +2,7 @@
 The averaged model of the PWM valve
 ===================================
 
-``scenarios/pwm_onoff.toml`` drives the Shadow muscle through a 3/2 on/off valve under PWM.  With
+``scenarios/pwm_3_2.toml`` drives the Shadow muscle through a 3/2 on/off valve under PWM.  With
 ``model = "averaged"`` in its ``[pressure.command]`` table the valve runs as the mean of its supply and
 exhaust paths' flows over a period, its input the duty.  This compares, on the native backend, the mean
 chamber pressure of the switching runs (over the whole periods from 3.5 to 4.5 s, sampled at 50 kHz)
@@ -25,7 +25,7 @@ import numpy as np  # noqa: E402
 
 import pamsim  # noqa: E402
 
-base = pamsim.load_scenario("../scenarios/pwm_onoff.toml")
+base = pamsim.load_scenario("../scenarios/pwm_3_2.toml")
 timed = dict(base.spec["pressure"]["command"])
 instant = {**timed, "delay_on_s": 0.0, "delay_off_s": 0.0, "rise_s": 0.0, "fall_s": 0.0}
 
@@ -77,5 +77,5 @@ ax.plot(duties * 100, rows[:, 2], "s--", color="C2", label="proportional valve a
 ax.set_xlabel("duty [%]")
 ax.set_ylabel("mean gauge pressure, 3.5-4.5 s [bar]")
 ax.legend(loc="upper left")
-fig.suptitle("pwm_onoff: the averaged valve against switching runs")
+fig.suptitle("pwm_3_2: the averaged valve against switching runs")
 fig.savefig("plot_pwm_averaged.png", dpi=110)

@@ -29,7 +29,8 @@ from .elements.spool import spool_source
 from .elements.force_clip import NEGATIVE_FORCE_CHOICES
 from .elements.static_force import STATIC_FORCE_MODELS
 from .elements.stops import UPPER_STOPS, EndStops
-from .elements.valve import Iso6358Orifice, ProportionalValve33
+from .elements.valve import Iso6358Orifice, OnOffValvePair, ProportionalValve33
+from .elements.valve_pair import VALVE_DEFAULTS, ValvePairSource
 from .model import FitRange, MuscleModel
 from .muscle_setup import applicable_model, model_inputs, with_overrides
 from .muscles import Muscle, load_muscle, shipped_names
@@ -37,7 +38,7 @@ from .paperdata import STEADY_STATE_SETS, SteadyState, steady_state
 from .parameters import CHAMBER_DEFAULTS, CHAMBER_LAW_KEYS, LOAD_MASS, ParameterSet, dynamics_parameters
 from .scenario_components import added_components, check_wiring, hysteresis_component
 from .static_models import REGISTRY
-from .signal_tables import signal_from_table, signal_range
+from .signal_tables import VALVE_TIMING, on_off_command, signal_from_table, signal_range
 from .signals import Constant, Step
 from .simulator import MIN_MAX_STEP_S, MIN_RTOL, NATIVE_RTOL_FACTOR, SolverOptions
 from .table_checks import TableChecker, choices_hint, did_you_mean
@@ -54,7 +55,8 @@ _SCHEMA: dict[str, dict[str, Any]] = {
     "load": {"weight_N": float, "mass_kg": float, "external_force": dict},
     "pressure": {"source": str, "supply_gauge_bar": float, "supply_gauge_Pa": float, "valve_open_time_s": float,
                  "command": dict, "prescribed": dict, "initial_gauge_bar": float, "supply_port": str,
-                 "outlet_port": str, "spool": dict},
+                 "outlet_port": str, "spool": dict, "inlet": dict, "exhaust": dict, "supply_C_m3_per_s_Pa": float,
+                 "supply_b": float, "exhaust_C_m3_per_s_Pa": float, "exhaust_b": float},
     "simulation": {"duration_s": float, "sample_rate_Hz": float, "initial_contraction_m": float},
     "solver": {"method": str, "rtol": float, "max_events": int, "max_step_s": float, "native_rtol_factor": float,
                "stick_margin_N": float, "release_margin_N": float},
@@ -250,7 +252,8 @@ class Scenario:
     def _valve_source(self, v: "_Validator", pr: Mapping[str, Any]) -> ValveChamberSource:
         p = self.parameters
         v.allowed("pressure", pr, {"source", "supply_gauge_bar", "supply_gauge_Pa", "valve_open_time_s",
-                                   "command", "initial_gauge_bar", "supply_port", "outlet_port", "spool"})
+                                   "command", "initial_gauge_bar", "supply_port", "outlet_port", "spool", "inlet",
+                                   "exhaust", *PATH_KEYS})
         supply = self._supply_gauge_Pa(v, pr)
         if "initial_gauge_bar" in pr:
             rating = p["rated_pressure_gauge_Pa"]
@@ -258,8 +261,10 @@ class Scenario:
             if not 0.0 <= p0 <= rating:
                 v.fail("pressure.initial_gauge_bar", pr["initial_gauge_bar"],
                        f"must lie between 0 and the rating, {rating / PA_PER_BAR:g} bar")
+        if "inlet" in pr or "exhaust" in pr:
+            return self._valve_pair_source(v, pr, supply)
         command = self._valve_command(v, pr)
-        parts = (ProportionalValve33(Iso6358Orifice.from_parameters(p)), _chamber(v, self.spec.get("chamber", {}), p),
+        parts = (_three_way_valve(v, pr, p), _chamber(v, self.spec.get("chamber", {}), p),
                  Constant(supply), command, p["T_supply_K"], p["p_atm_Pa"])
         ports = {key: _port_ref(v, f"pressure.{key}", pr[key]) for key in ("supply_port", "outlet_port") if key in pr}
         if "spool" in pr:
@@ -270,6 +275,47 @@ class Scenario:
                        "supply input and feeds the chamber: it is not wired into a line (use model = 'switching')")
             return averaged_source(ValveChamberSource(*parts), command)
         return LineValveSource(*parts, **ports) if ports else ValveChamberSource(*parts)
+
+    def _valve_pair_source(self, v: "_Validator", pr: Mapping[str, Any], supply: float):
+        """Two 2/2 valves, ``[pressure.inlet]`` and ``[pressure.exhaust]``, each with its ISO 6358 (C, b), its
+        timing and its command (the exhaust's may be the inlet's inverted); with ``model = "averaged"`` in
+        the inlet's PWM command, their averaged model (the exhaust then complementary)."""
+        p = self.parameters
+        for section in ("controller", "compensation"):
+            if section in self.spec:
+                v.fail("pressure.inlet", "{...}", f"a [{section}] table drives the rig's single valve: two 2/2 valves "
+                       "take their commands from their own tables")
+        for key in ("command", "valve_open_time_s", "spool", "supply_port", "outlet_port", *PATH_KEYS):
+            if key in pr:
+                v.fail(f"pressure.{key}", pr[key], "two 2/2 valves ([pressure.inlet], [pressure.exhaust]) take "
+                       "their commands and (C, b) in their own tables, and feed the chamber from the supply input")
+        tables, orifices, timings = {}, {}, {}
+        for name in ("inlet", "exhaust"):
+            table = v.required(pr, name, prefix="pressure.")
+            if not isinstance(table, dict):
+                v.fail(f"pressure.{name}", table, "must be a table of the valve's C_m3_per_s_Pa, b, timing and command")
+            for key in table:
+                if key not in ("C_m3_per_s_Pa", "b", "command", *VALVE_TIMING):
+                    v.fail(f"pressure.{name}.{key}", table[key], "unknown key of an on/off valve",
+                           choices=("C_m3_per_s_Pa", "b", "command", *VALVE_TIMING))
+            tables[name] = table
+            orifices[name] = _orifice(v, f"pressure.{name}.", table.get("C_m3_per_s_Pa"), table.get("b"), p)
+            timings[name] = {key: _not_negative(v, f"pressure.{name}.{key}", table.get(key, default))
+                             for key, (default, _) in VALVE_DEFAULTS.items()}
+        inlet = on_off_command(v, "pressure.inlet.command", v.required(tables["inlet"], "command", prefix="pressure.inlet."),
+                               timings["inlet"])
+        exhaust_table = v.required(tables["exhaust"], "command", prefix="pressure.exhaust.")
+        exhaust = on_off_command(v, "pressure.exhaust.command", exhaust_table, timings["exhaust"], inlet=inlet)
+        valve = ProportionalValve33(orifices["inlet"], orifices["exhaust"])
+        parts = (OnOffValvePair(valve), _chamber(v, self.spec.get("chamber", {}), p), Constant(supply), inlet,
+                 p["T_supply_K"], p["p_atm_Pa"])
+        if _pwm_model(v, tables["inlet"], "pressure.inlet.command") != "averaged":
+            _pwm_model(v, tables["exhaust"], "pressure.exhaust.command")
+            return ValvePairSource(*parts, exhaust_command=exhaust)
+        if isinstance(exhaust_table, dict) and exhaust_table.get("kind") != "complementary":
+            v.fail("pressure.exhaust.command.kind", exhaust_table.get("kind"), "the averaged model of two valves takes "
+                   "the inlet's duty: the exhaust's command must be complementary")
+        return averaged_source(ValveChamberSource(valve, *parts[1:]), inlet, exhaust)
 
     def _supply_gauge_Pa(self, v: "_Validator", pr: Mapping[str, Any]) -> float:
         """The valve's supply pressure [Pa gauge], given in bar or in Pa, within the muscle's rating."""
@@ -379,7 +425,8 @@ class Scenario:
     def pwm_model(self) -> str | None:
         """How the valve's ``pwm`` command runs: ``"switching"``, ``"averaged"``
         (:mod:`pamsim.elements.pwm_average`), or None without a PWM command."""
-        command = self.spec["pressure"].get("command")
+        pressure = self.spec["pressure"]
+        command = pressure["inlet"].get("command") if "inlet" in pressure else pressure.get("command")
         if not isinstance(command, dict) or command.get("kind") != "pwm":
             return None
         return command.get("model", "switching")
@@ -388,14 +435,20 @@ class Scenario:
     def beyond_one_muscle_fmu(self) -> bool:
         """Whether the one-muscle FMU, with the rig alone, the polytropic chamber and the proportional valve,
         lacks something this scenario has (components added to the rig, another chamber law, an averaged
-        PWM valve, a spool valve): the FMU of its assembly then runs it."""
+        PWM valve, a spool valve, valve paths with their own (C, b), two 2/2 valves): the FMU of its assembly
+        then runs it."""
+        pressure = self.spec["pressure"]
         return (bool(self.added_components) or self.chamber_law != "polytropic" or self.pwm_model == "averaged"
-                or "spool" in self.spec["pressure"])
+                or any(key in pressure for key in ("spool", "inlet", *PATH_KEYS)))
 
     def with_pwm_averaged(self) -> "Scenario":
         """This scenario with its PWM valve command run by the averaged valve (``model = "averaged"``)."""
-        command = self.spec["pressure"]["command"]
-        return self.with_changes({"pressure": {"command": {**command, "model": "averaged"}}})
+        pressure = self.spec["pressure"]
+        if "inlet" in pressure:
+            inlet = pressure["inlet"]
+            return self.with_changes({"pressure": {"inlet": {**inlet, "command": {**inlet["command"],
+                                                                                   "model": "averaged"}}}})
+        return self.with_changes({"pressure": {"command": {**pressure["command"], "model": "averaged"}}})
 
     @property
     def initial_pressure_gauge_Pa(self) -> float | None:
@@ -646,15 +699,49 @@ class _Validator(TableChecker):
         return value
 
 
-def _pwm_model(v: "_Validator", pr: Mapping[str, Any]) -> str:
-    """How a ``pwm`` valve command runs (``[pressure.command] model``): its switching (the default), or
-    the averaged valve, whose input is the duty."""
+def _pwm_model(v: "_Validator", pr: Mapping[str, Any], where: str = "pressure.command") -> str:
+    """How a ``pwm`` valve command runs (``[pressure.command] model``, or the table at ``where``): its
+    switching (the default), or the averaged valve, whose input is the duty."""
     command = pr.get("command")
     if not isinstance(command, dict) or "model" not in command:
         return "switching"
     model = command["model"]
     if command.get("kind") != "pwm":
-        v.fail("pressure.command.model", model, f"only a pwm command has a model, not kind = {command.get('kind')!r}")
+        v.fail(f"{where}.model", model, f"only a pwm command has a model, not kind = {command.get('kind')!r}")
     if not isinstance(model, str) or model not in PWM_MODELS:
-        v.fail("pressure.command.model", model, "unknown PWM model", choices=PWM_MODELS)
+        v.fail(f"{where}.model", model, "unknown PWM model", choices=PWM_MODELS)
     return model
+
+
+PATH_KEYS = ("supply_C_m3_per_s_Pa", "supply_b", "exhaust_C_m3_per_s_Pa", "exhaust_b")
+"""``[pressure]`` keys of the 3/2 (and spool) valve's paths' own ISO 6358 (C, b); each defaults to the muscle's
+``valve_C_m3_per_s_Pa`` or ``valve_b``."""
+
+
+def _three_way_valve(v: "_Validator", pr: Mapping[str, Any], p) -> ProportionalValve33:
+    """The rig's valve of the muscle's parameters, its paths with their own (C, b) where :data:`PATH_KEYS`
+    give them (without any, the one orifice of both paths, as it always was)."""
+    if not any(key in pr for key in PATH_KEYS):
+        return ProportionalValve33(Iso6358Orifice.from_parameters(p))
+    return ProportionalValve33(*(_orifice(v, f"pressure.{path}_", pr.get(f"{path}_C_m3_per_s_Pa"), pr.get(f"{path}_b"), p)
+                                 for path in ("supply", "exhaust")))
+
+
+def _orifice(v: "_Validator", prefix: str, C, b, p) -> Iso6358Orifice:
+    """The muscle's valve orifice with sonic conductance ``C`` and critical ratio ``b`` where given (not
+    None), named in a refusal as ``<prefix>C_m3_per_s_Pa`` and ``<prefix>b``: C > 0, 0 <= b < 1 and b below
+    the laminar ratio."""
+    muscle = Iso6358Orifice.from_parameters(p)
+    if C is not None and not v.number(f"{prefix}C_m3_per_s_Pa", C) > 0.0:
+        v.fail(f"{prefix}C_m3_per_s_Pa", C, "must be > 0: a sonic conductance")
+    if b is not None and not 0.0 <= v.number(f"{prefix}b", b) < min(1.0, muscle.laminar_ratio):
+        v.fail(f"{prefix}b", b, f"must lie in [0, 1) and below the valve's laminar ratio {muscle.laminar_ratio:g}")
+    return replace(muscle, C_m3_per_s_Pa=muscle.C_m3_per_s_Pa if C is None else float(C),
+                   b=muscle.b if b is None else float(b))
+
+
+def _not_negative(v: "_Validator", key: str, value: Any) -> float:
+    """``value`` as a number of seconds that is not negative, refused naming ``key``."""
+    if v.number(key, value) < 0.0:
+        v.fail(key, value, "must not be negative")
+    return float(value)

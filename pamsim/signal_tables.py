@@ -14,8 +14,10 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from .signals import (MAX_PWM_FREQUENCY_HZ, MAX_PWM_SWITCHES, Constant, FirstOrderLag, PiecewiseConstant, Pwm, Ramp,
-                      Step, Trace)
+import dataclasses
+
+from .signals import (MAX_PWM_FREQUENCY_HZ, MAX_PWM_SWITCHES, Constant, FirstOrderLag, OnOff, PiecewiseConstant, Pwm,
+                      Ramp, Step, Trace, complementary)
 from .table_checks import choices_hint
 
 # Signal kind -> (keys without a unit, value keys that take the unit suffix of where the signal is used).
@@ -137,6 +139,68 @@ _SHAPES = {
     "lag": _lag,
     "pwm": _pwm,
 }
+
+
+ON_OFF_KINDS = ("constant", "step", "steps", "pwm", "complementary")
+"""The commands of an on/off valve (``[pressure.inlet.command]``, ``[pressure.exhaust.command]``): a boolean
+held, stepped once or stepped at times (0 closed, 1 open), PWM, or the inlet's command inverted (the
+exhaust's alone)."""
+VALVE_TIMING = ("delay_on_s", "delay_off_s", "rise_s", "fall_s")
+"""An on/off valve's delays and opening and closing times, keys of its own table (not of its command)."""
+
+
+def on_off_command(v, where: str, spec: Any, timing: Mapping[str, float], inlet=None):
+    """The opening of an on/off valve (0 closed, 1 open) as it follows the command table ``spec`` at ``where``,
+    with the valve's ``timing`` (:data:`VALVE_TIMING`, seconds): a :class:`~pamsim.signals.Pwm` from 0 to 1,
+    or an :class:`~pamsim.signals.OnOff` of a boolean ``constant``, ``step`` or ``steps``; with ``inlet`` (the
+    inlet's opening), ``kind = "complementary"`` is that command inverted (:func:`~pamsim.signals.complementary`).
+
+    ``v`` refuses, naming the key: an unknown kind, a timing or level key in the command (they are the
+    valve's), a value other than 0 or 1, a complementary inlet or one with keys besides its kind."""
+    kind = _on_off_kind(v, where, spec, inlet is not None)
+    if kind == "complementary":
+        for key in spec:
+            if key != "kind":
+                v.fail(f"{where}.{key}", spec[key], "a complementary command takes no keys: it is the inlet's inverted")
+        return complementary(inlet, **timing)
+    table = {k: x for k, x in spec.items() if k != "model"}
+    if kind == "pwm":
+        table["high"] = 1.0  # open while on, closed (low 0) while off
+    signal = signal_from_table(v, where, table, "", 1.0, Path("."))
+    if isinstance(signal, Pwm):
+        return dataclasses.replace(signal, **timing)
+    states = _boolean_states(v, where, signal)
+    commands = tuple(zip(signal.times_s, states)) if isinstance(signal, PiecewiseConstant) else (
+        ((signal.time_s, states[-1]),) if isinstance(signal, Step) else ())
+    return OnOff(commands, float(states[0]), **timing)
+
+
+def _on_off_kind(v, where: str, spec: Any, exhaust: bool) -> str:
+    """The ``kind`` of an on/off valve's command table (``complementary`` for the ``exhaust``'s alone), its
+    timing and level keys refused (they are the valve's)."""
+    if not isinstance(spec, dict):
+        v.fail(where, spec, "must be a table with a 'kind'")
+    kind = v.required(spec, "kind", prefix=f"{where}.")
+    allowed = ON_OFF_KINDS if exhaust else ON_OFF_KINDS[:-1]
+    if not isinstance(kind, str) or kind not in allowed:
+        v.fail(f"{where}.kind", kind, "unknown command of an on/off valve", choices=allowed)
+    for key in spec:
+        if key in VALVE_TIMING or key in ("low", "high"):
+            what = "timing is a key" if key in VALVE_TIMING else "levels are no keys"
+            v.fail(f"{where}.{key}", spec[key], f"an on/off valve opens (1) and closes (0); its {what} of its own "
+                   f"table ({where.rsplit('.', 1)[0]}), not of its command")
+    return kind
+
+
+def _boolean_states(v, where: str, signal) -> list[int]:
+    """The states (0 or 1) a boolean ``constant``, ``step`` or ``steps`` signal takes, in order; any other
+    value is refused naming ``where``."""
+    values = (signal.values if isinstance(signal, PiecewiseConstant)
+              else (signal.initial, signal.final) if isinstance(signal, Step) else (signal.value,))
+    for value in values:
+        if value not in (0.0, 1.0):
+            v.fail(where, value, "an on/off valve's command is 0 (closed) or 1 (open)")
+    return [int(x) for x in values]
 
 
 def _numbers(v, key: str, value: Any) -> list[float]:

@@ -166,35 +166,9 @@ MAX_PWM_SWITCHES = 1_000_000
 """The most switching instants a PWM signal may have (a run's memory for its knots)."""
 
 
-@dataclass(frozen=True)
-class Pwm(_Signal):
-    """A pulse-width-modulated on/off command as the valve it drives follows it: ``high`` for ``duty`` of
-    each period ``1 / frequency_Hz`` from ``start_s`` until ``end_s``, ``low`` otherwise; each switch takes
-    effect ``delay_on_s`` or ``delay_off_s`` after it is commanded and moves linearly over ``rise_s`` or
-    ``fall_s`` (a valve's opening and closing times).  A pulse shorter than the opening time does not
-    open the valve fully; the closing starts from where the opening got.
-
-    Every knot of the piecewise-linear trace is a breakpoint, so each switching instant starts a new
-    integration segment: the switches are exact, not sampled.
-    """
-
-    start_s: float
-    end_s: float
-    frequency_Hz: float
-    duty: float
-    low: float = 0.0
-    high: float = 1.0
-    delay_on_s: float = 0.0
-    delay_off_s: float = 0.0
-    rise_s: float = 0.0
-    fall_s: float = 0.0
-    knots_t_s: tuple = field(default=(), repr=False, compare=False)
-    knots: tuple = field(default=(), repr=False, compare=False)
-
-    def __post_init__(self):
-        t, level = pwm_levels(self)
-        object.__setattr__(self, "knots_t_s", tuple(t))
-        object.__setattr__(self, "knots", tuple(self.low + (self.high - self.low) * x for x in level))
+class _Knotted(_Signal):
+    """A valve's opening as knots ``(knots_t_s, knots)`` of a piecewise-linear trace, held before the first
+    and after the last; a jump is two knots at one time, and every knot is a breakpoint."""
 
     def __call__(self, t):
         ts, vs = self.knots_t_s, self.knots
@@ -223,6 +197,37 @@ class Pwm(_Signal):
         """The value after the last knot."""
         return self.knots[-1]
 
+
+@dataclass(frozen=True)
+class Pwm(_Knotted):
+    """A pulse-width-modulated on/off command as the valve it drives follows it: ``high`` for ``duty`` of
+    each period ``1 / frequency_Hz`` from ``start_s`` until ``end_s``, ``low`` otherwise; each switch takes
+    effect ``delay_on_s`` or ``delay_off_s`` after it is commanded and moves linearly over ``rise_s`` or
+    ``fall_s`` (a valve's opening and closing times).  A pulse shorter than the opening time does not
+    open the valve fully; the closing starts from where the opening got.
+
+    Every knot of the piecewise-linear trace is a breakpoint, so each switching instant starts a new
+    integration segment: the switches are exact, not sampled.
+    """
+
+    start_s: float
+    end_s: float
+    frequency_Hz: float
+    duty: float
+    low: float = 0.0
+    high: float = 1.0
+    delay_on_s: float = 0.0
+    delay_off_s: float = 0.0
+    rise_s: float = 0.0
+    fall_s: float = 0.0
+    knots_t_s: tuple = field(default=(), repr=False, compare=False)
+    knots: tuple = field(default=(), repr=False, compare=False)
+
+    def __post_init__(self):
+        t, level = pwm_levels(self)
+        object.__setattr__(self, "knots_t_s", tuple(t))
+        object.__setattr__(self, "knots", tuple(self.low + (self.high - self.low) * x for x in level))
+
     @property
     def switch_times_s(self) -> tuple[float, ...]:
         """The commanded switching instants: on at each period's start, off ``duty`` of a period later."""
@@ -248,24 +253,32 @@ def pwm_levels(p: Pwm) -> tuple[list[float], list[float]]:
     """The valve's opening (0 closed, 1 open) under ``p``'s commands as knots ``(times, levels)``: each
     command takes effect after its delay and ramps at ``1 / rise_s`` or ``1 / fall_s`` toward its level
     until it gets there or the next command comes (a zero ramp: a jump, two knots at one time)."""
-    events = sorted((t + (p.delay_on_s if on else p.delay_off_s), on) for t, on in _pwm_commands(p))
-    times, levels = [0.0], [0.0]
-    level, target, now = 0.0, 0.0, 0.0
+    return switching_levels(_pwm_commands(p), 0.0, p)
+
+
+def switching_levels(commands, initial: float, timing) -> tuple[list[float], list[float]]:
+    """The opening (0 closed, 1 open) of a valve at ``initial`` at time 0 under the commanded instants and
+    states ``commands`` (``[(t_s, 1 on or 0 off), ...]``) with the delays and opening and closing times of
+    ``timing`` (``delay_on_s``, ``delay_off_s``, ``rise_s``, ``fall_s``), as knots ``(times, levels)``
+    (see :func:`pwm_levels`)."""
+    events = sorted((t + (timing.delay_on_s if on else timing.delay_off_s), on) for t, on in commands)
+    times, levels = [0.0], [initial]
+    level, target, now = initial, initial, 0.0
     for t_event, on in events:
-        level, now = _ramp_until(times, levels, level, target, now, t_event, p)
+        level, now = _ramp_until(times, levels, level, target, now, t_event, timing)
         if (times[-1], levels[-1]) != (t_event, level):  # where the level stood when the command came
             times.append(t_event)
             levels.append(level)
         target = float(on)
-        if (p.rise_s if on else p.fall_s) == 0.0 and level != target:
+        if (timing.rise_s if on else timing.fall_s) == 0.0 and level != target:
             times.append(t_event)
             levels.append(target)
             level = target
-    _ramp_until(times, levels, level, target, now, math.inf, p)
+    _ramp_until(times, levels, level, target, now, math.inf, timing)
     return times, levels
 
 
-def _ramp_until(times, levels, level, target, now, t_end, p: Pwm) -> tuple[float, float]:
+def _ramp_until(times, levels, level, target, now, t_end, p) -> tuple[float, float]:
     """Move ``level`` toward ``target`` from ``now`` until ``t_end`` at the ramp's rate, adding the knots."""
     if level == target:
         return level, t_end if math.isfinite(t_end) else now
@@ -277,6 +290,49 @@ def _ramp_until(times, levels, level, target, now, t_end, p: Pwm) -> tuple[float
         return target, t_end if math.isfinite(t_end) else reach
     level += (t_end - now) / ramp * (1.0 if target > level else -1.0)
     return level, t_end
+
+
+@dataclass(frozen=True)
+class OnOff(_Knotted):
+    """An on/off valve's opening (0 closed, 1 open) under a boolean command: ``initial`` (0 or 1) from time 0,
+    then each of ``commands`` (``((t_s, 1 on or 0 off), ...)``), taking effect ``delay_on_s`` or
+    ``delay_off_s`` after it is commanded and moving linearly over ``rise_s`` or ``fall_s``, as
+    :class:`Pwm` does.  Every knot is a breakpoint: the switches are exact, not sampled."""
+
+    commands: tuple
+    initial: float = 0.0
+    delay_on_s: float = 0.0
+    delay_off_s: float = 0.0
+    rise_s: float = 0.0
+    fall_s: float = 0.0
+    knots_t_s: tuple = field(default=(), repr=False, compare=False)
+    knots: tuple = field(default=(), repr=False, compare=False)
+
+    def __post_init__(self):
+        t, level = switching_levels(self.commands, self.initial, self)
+        object.__setattr__(self, "knots_t_s", tuple(t))
+        object.__setattr__(self, "knots", tuple(level))
+
+    @property
+    def switch_times_s(self) -> tuple[float, ...]:
+        """The commanded switching instants."""
+        return tuple(t for t, _ in self.commands)
+
+
+def complementary(command, delay_on_s: float = 0.0, delay_off_s: float = 0.0, rise_s: float = 0.0,
+                  fall_s: float = 0.0):
+    """The opening of a valve commanded open whenever ``command`` (a :class:`Pwm` from 0 to 1, or an
+    :class:`OnOff`) is commanded closed and closed whenever it is open, with this valve's own delays and
+    opening and closing times: the exhaust of a pair of 2/2 valves driven as one 3/2 valve.
+
+    Of a :class:`Pwm` it is a :class:`Pwm` from 1 down to 0 (so that its averaged model derives its share
+    from its own trace): its rising command closes this valve, so it takes this valve's closing delay and
+    time, and its falling command the opening's."""
+    if isinstance(command, Pwm):
+        return Pwm(command.start_s, command.end_s, command.frequency_Hz, command.duty, low=1.0, high=0.0,
+                   delay_on_s=delay_off_s, delay_off_s=delay_on_s, rise_s=fall_s, fall_s=rise_s)
+    return OnOff(tuple((t, 1 - on) for t, on in command.commands), 1.0 - command.initial, delay_on_s, delay_off_s,
+                 rise_s, fall_s)
 
 
 def max_step_hint_s(*signals) -> float:

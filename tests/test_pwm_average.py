@@ -21,11 +21,11 @@ from pamsim.control import FrictionTreatment, MusclePlant, linearize
 from pamsim.control.exact import exact_jacobians
 from pamsim.control.linear import jacobians
 from pamsim.control.operating_point import averaged_pwm_equilibrium, averaged_pwm_held
-from pamsim.elements.pwm_average import PwmAveragedValve
+from pamsim.elements.pwm_average import PwmAveragedValve, PwmShare
 from pamsim.signals import Pwm
 
-PWM_ONOFF = SCENARIOS / "pwm_onoff.toml"
-BASE = pamsim.load_scenario(PWM_ONOFF)
+PWM_3_2 = SCENARIOS / "pwm_3_2.toml"
+BASE = pamsim.load_scenario(PWM_3_2)
 COMMAND = dict(BASE.spec["pressure"]["command"])
 IDEAL = {**COMMAND, "delay_on_s": 0.0, "delay_off_s": 0.0, "rise_s": 0.0, "fall_s": 0.0}
 """The scenario's valve switching at once: its averaged model does not depend on the frequency."""
@@ -77,7 +77,7 @@ def test_shares_are_the_switching_traces_means(frequency_Hz, low, high):
             if not 1e-9 < a < 1.0 / frequency_Hz - 1e-9:
                 continue
             pwm = Pwm(0.0, 30.0 / frequency_Hz, frequency_Hz, duty, low, high, *timing)
-            got = PwmAveragedValve(None, frequency_Hz, low, high, *timing).shares(duty)
+            got = PwmAveragedValve(None, PwmShare(frequency_Hz, low, high, *timing)).shares(duty)
             assert got == pytest.approx(_trace_shares(pwm), abs=1e-12), (duty, timing)
             checked += 1
     assert checked >= 10
@@ -85,7 +85,7 @@ def test_shares_are_the_switching_traces_means(frequency_Hz, low, high):
 
 def test_shares_at_the_duty_ends_hold_the_levels():
     """No switching at duty 0 (the ``low`` command) or 1 (``high``), whatever the valve's timing."""
-    valve = PwmAveragedValve(None, 50.0, -0.5, 0.8, 1e-3, 2e-3, 2e-3, 1e-3)
+    valve = PwmAveragedValve(None, PwmShare(50.0, -0.5, 0.8, 1e-3, 2e-3, 2e-3, 1e-3))
     assert valve.shares(0.0) == (0.0, 0.5)
     assert valve.shares(1.0) == (0.8, 0.0)
 
@@ -96,7 +96,7 @@ def test_effective_duty_of_a_3_2_valve_by_hand():
     ``d + f (delay_off - delay_on) - f rise + f (rise + fall) / 4`` and the exhaust's
     ``1 - d - f (delay_off - delay_on) - f fall + f (rise + fall) / 4``."""
     f, d, on, off, r, q = 100.0, 0.4, 1e-3, 1.5e-3, 2e-3, 1e-3
-    supply, exhaust = PwmAveragedValve(None, f, -1.0, 1.0, on, off, r, q).shares(d)
+    supply, exhaust = PwmAveragedValve(None, PwmShare(f, -1.0, 1.0, on, off, r, q)).shares(d)
     assert supply == pytest.approx(d + f * (off - on) - f * r + f * (r + q) / 4, rel=1e-14)
     assert exhaust == pytest.approx(1 - d - f * (off - on) - f * q + f * (r + q) / 4, rel=1e-14)
 
@@ -269,7 +269,7 @@ def test_dc_gain_in_duty_is_the_slope_of_switching_runs_mean_pressure():
 def test_cli_linearize_uses_the_averaged_model(tmp_path, cli):
     """``pamsim linearize`` on the switching PWM scenario: the duty is the input, the output says so, and the
     operating point is the averaged model's balance (a rest: the residual is nil)."""
-    proc = cli("linearize", PWM_ONOFF, "--json")
+    proc = cli("linearize", PWM_3_2, "--json")
     assert proc.returncode == 0, proc.stderr
     rep = json.loads(proc.stdout)
     assert rep["inputs"] == ["pwm_duty", "supply_gauge_Pa", "F_ext_N"]
@@ -277,7 +277,7 @@ def test_cli_linearize_uses_the_averaged_model(tmp_path, cli):
     assert rep["operating_point"]["kind"] == "pwm_averaged"
     assert np.max(np.abs(rep["residual_f_x0_u0"][2:])) < 1e-3
     assert rep["dc_gain"]["pwm_duty->contraction_m"] > 0
-    text = cli("linearize", PWM_ONOFF, "-o", tmp_path)
+    text = cli("linearize", PWM_3_2, "-o", tmp_path)
     assert text.returncode == 0, text.stderr
     assert "valve: the averaged model of the on/off valve under 50 Hz PWM" in text.stdout
     assert "DC gain pwm_duty -> contraction" in text.stdout
@@ -297,7 +297,7 @@ def test_cli_linearize_uses_the_averaged_model(tmp_path, cli):
 @pytest.mark.parametrize("command", ["run", "linearize"])
 def test_bad_pwm_input_exits_2_naming_the_key(tmp_path, cli, change, key, model, command):
     bad = tmp_path / "bad.toml"
-    text = PWM_ONOFF.read_text().replace('duty = 0.5\n', f'duty = 0.5\nmodel = "{model}"\n')
+    text = PWM_3_2.read_text().replace('duty = 0.5\n', f'duty = 0.5\nmodel = "{model}"\n')
     for name, value in change.items():
         line = next(ln for ln in text.splitlines() if ln.startswith(f"{name} ="))
         text = text.replace(line, f"{name} = {json.dumps(value)}") if name != "model" else \
@@ -308,16 +308,16 @@ def test_bad_pwm_input_exits_2_naming_the_key(tmp_path, cli, change, key, model,
 
 def test_model_is_refused_on_a_command_that_is_not_pwm(tmp_path, cli):
     bad = tmp_path / "step.toml"
-    bad.write_text(PWM_ONOFF.read_text().split("[pressure.command]")[0]
+    bad.write_text(PWM_3_2.read_text().split("[pressure.command]")[0]
                    + '[pressure.command]\nkind = "step"\ntime_s = 0.5\nfinal = 1.0\nmodel = "averaged"\n'
-                   + "[simulation]" + PWM_ONOFF.read_text().split("[simulation]")[1])
+                   + "[simulation]" + PWM_3_2.read_text().split("[simulation]")[1])
     proc = cli("run", bad, "-o", tmp_path / "out")
     assert proc.returncode == 2
     assert "pressure.command.model" in proc.stderr and "only a pwm command" in proc.stderr
 
 
 def test_valve_slope_is_refused_for_a_pwm_valve(tmp_path, cli):
-    proc = cli("linearize", PWM_ONOFF, "--valve-slope", "fill", "-o", tmp_path / "out")
+    proc = cli("linearize", PWM_3_2, "--valve-slope", "fill", "-o", tmp_path / "out")
     assert proc.returncode == 2
     assert "--valve-slope" in proc.stderr and "duty" in proc.stderr
     assert not (tmp_path / "out").exists()

@@ -86,11 +86,25 @@ int fmu_exit_initialization_mode(FmuInstance *in, const char *function) {
     return 0;
 }
 
+/* A breakpoint within a relative 1e-9 of the time is this event's: an importer may take a time event as reached
+ * at a point that close to it (fmpy's math.isclose does), and a next event time a few roundings later would have
+ * it integrate over nothing (CVode: "tout too close to t0").  The event is then at that breakpoint. */
+#define PAM_SAME_INSTANT 1e-9
+
+static double event_instant(const PamCore *c, double t_s) {
+    double next = pam_next_breakpoint(c, t_s);
+    while (isfinite(next) && next - t_s <= PAM_SAME_INSTANT * fmax(fabs(t_s), fabs(next))) {
+        t_s = next;
+        next = pam_next_breakpoint(c, t_s);
+    }
+    return t_s;
+}
+
 int fmu_enter_event_mode(FmuInstance *in, const char *function) {
     if (!fmu_allowed(in, function, FMU_EVENT | FMU_CONT) || in->is_cs) return -1;
     in->state = FMU_EVENT;
-    in->core.event_time_s = in->core.time_s;
-    pam_inputs_at(&in->core, in->core.time_s, 0); /* an event sees the signals' values after a breakpoint */
+    in->core.event_time_s = event_instant(&in->core, in->core.time_s);
+    pam_inputs_at(&in->core, in->core.event_time_s, 0); /* an event sees the signals' values after a breakpoint */
     return 0;
 }
 
@@ -436,7 +450,7 @@ int fmu_update_discrete_states(FmuInstance *in, const char *function, int *state
     if (!fmu_allowed(in, function, FMU_EVENT)) return -1;
     *states_changed = pam_event_update(&in->core);
     /* The signals' breakpoints are time events: a held load is checked again there, as in co-simulation. */
-    *next_time = pam_next_breakpoint(&in->core, in->core.time_s);
+    *next_time = pam_next_breakpoint(&in->core, fmax(in->core.time_s, in->core.event_time_s));
     *next_time_defined = isfinite(*next_time);
     if (!*next_time_defined) *next_time = 0.0;
     return 0;
@@ -453,8 +467,9 @@ int fmu_set_time(FmuInstance *in, const char *function, double time) {
     in->core.time_s = time;
     /* Continuous time runs from the last event, where it sees the signals from the right, to the next
      * time event, where it sees them from the left; the event itself sees them from the right. */
-    if (in->state == FMU_EVENT) in->core.event_time_s = time;
-    pam_inputs_at(&in->core, time, in->state == FMU_CONT && time > in->core.event_time_s);
+    if (in->state == FMU_EVENT) in->core.event_time_s = event_instant(&in->core, time);
+    /* Up to the event's breakpoint (a few roundings after the time, see event_instant) it is the event's values. */
+    pam_inputs_at(&in->core, fmax(time, in->core.event_time_s), in->state == FMU_CONT && time > in->core.event_time_s);
     return 0;
 }
 

@@ -24,9 +24,11 @@ from ..components import (Chamber, CoulombFriction, ExternalForce, HangingLoad, 
                           PressureSignal, ProportionalValve, SuppliedValve, ViscousDamping)
 from ..components.pwm_valve import AveragedPwmValve
 from ..components.spool_valve import SpoolValve
+from ..components.valve_pair import ValvePair
 from ..elements.pressure_source import LineValveSource, PrescribedPressure, ValveChamberSource
 from ..elements.pwm_average import AveragedPwmSource
 from ..elements.spool import SpoolValveSource
+from ..elements.valve_pair import ValvePairSource
 from ..modeling import Assembly, AssemblyError
 from ..modeling.pygen import compiled_by_mode, outputs_by_mode
 from ..signals import Constant
@@ -159,6 +161,15 @@ def _spool_parts(src: SpoolValveSource, p0_gauge_Pa: float | None) -> SourcePart
     return SourceParts(plain.parts, wiring, plain.inputs, "chamber")
 
 
+def _valve_pair_parts(src: ValvePairSource, p0_gauge_Pa: float | None) -> SourceParts:
+    """The chamber and the two 2/2 valves that fill and vent it: the model input ``valve_command`` drives the
+    inlet, ``exhaust_command`` the exhaust."""
+    plain = _chamber_and_valve(src, p0_gauge_Pa, ValvePair, "valve_command")
+    inputs = {"valve_command": "valve.inlet_command", "exhaust_command": "valve.exhaust_command",
+              "supply_pressure_gauge_Pa": "valve.supply_gauge_Pa"}
+    return SourceParts(plain.parts, plain.wiring, inputs, "chamber")
+
+
 def _line_valve_parts(src: LineValveSource, p0_gauge_Pa: float | None) -> SourceParts:
     """The valve and chamber of a line: the valve's supply side on ``src.supply_port`` (if given), its outlet
     on ``src.outlet_port`` (if given, else the chamber).  The chamber settles onto its valve's pressure only
@@ -188,7 +199,7 @@ def _prescribed_parts(src: PrescribedPressure, p0_gauge_Pa: float | None) -> Sou
 
 SOURCE_PARTS: dict[type, Callable[[Any, float | None], SourceParts]] = {
     ValveChamberSource: _valve_parts, LineValveSource: _line_valve_parts, AveragedPwmSource: _averaged_pwm_parts,
-    SpoolValveSource: _spool_parts, PrescribedPressure: _prescribed_parts}
+    SpoolValveSource: _spool_parts, ValvePairSource: _valve_pair_parts, PrescribedPressure: _prescribed_parts}
 """``{pressure source class: parts(source, initial gauge pressure or None)}``.  A source defined above
 this layer (a controller's) registers its own with :func:`register_source`."""
 

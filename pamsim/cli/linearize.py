@@ -168,6 +168,10 @@ def _linearize(scenario, args: argparse.Namespace):
     from ..errors import InputError
 
     pwm = scenario.pwm_model is not None
+    if "inlet" in scenario.spec["pressure"] and not pwm:
+        kind = scenario.spec["pressure"]["inlet"]["command"].get("kind")
+        raise InputError(f"{scenario.origin}: pressure.inlet.command.kind = {kind!r}: pamsim linearize takes two 2/2 "
+                         "valves through their averaged model, under a pwm inlet command and a complementary exhaust")
     if pwm:
         if args.valve_slope != "mean":
             raise InputError(f"--valve-slope {args.valve_slope}: a PWM valve is linearised through its averaged "
@@ -182,7 +186,9 @@ def _linearize(scenario, args: argparse.Namespace):
     friction = FrictionTreatment(args.friction, args.friction_velocity_mm_s * 1e-3)
     lin = linearize(model, op, friction, args.valve_slope, added=added)
     rep = report(lin)
-    rep["valve_model"] = (f"the averaged model of the on/off valve under {model.source.valve.frequency_Hz:g} Hz PWM "
+    valves = ("the inlet and exhaust 2/2 valves (the exhaust complementary)" if "inlet" in scenario.spec["pressure"]
+              else "the on/off valve")
+    rep["valve_model"] = (f"the averaged model of {valves} under {model.source.valve.frequency_Hz:g} Hz PWM "
                           "(the mean of its supply and exhaust paths' flows over a period), input pwm_duty [1]; "
                           "pamsim run runs its switching" if pwm
                           else f"proportional 3/3 valve, slope at command 0: {lin.valve_slope}")

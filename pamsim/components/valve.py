@@ -34,8 +34,11 @@ class ProportionalValve(ElementParameters, Component):
                         positive("p_atm_Pa", "Pa", "ambient (exhaust) pressure"),
                         positive("R_J_per_kg_K", "J/(kg K)", "specific gas constant of air"))
 
+    probe = staticmethod(_inflow_kg_s)
+    """How the element is called on floats and on symbols to check that it takes symbols."""
+
     def __init__(self, name: str, element, T_supply_K: float, p_atm_Pa: float, R_J_per_kg_K: float):
-        values = self.wrap(element, _inflow_kg_s, PROBE_POINTS, required="valve")
+        values = self.wrap(element, self.probe, PROBE_POINTS, required="valve")
         values.update(T_supply_K=T_supply_K, p_atm_Pa=p_atm_Pa, R_J_per_kg_K=R_J_per_kg_K)
         super().__init__(name, values)
 

@@ -59,12 +59,11 @@ def _mean_pos(c1, c2):
 
 
 @dataclass(frozen=True)
-class PwmAveragedValve(TwoPathValve):
-    """:class:`~pamsim.elements.valve.ProportionalValve33` under a PWM command with its timing (as
-    :class:`pamsim.signals.Pwm` defines it), averaged over one period; its input is the duty, and its paths'
-    flows (:class:`~pamsim.elements.valve.TwoPathValve`) are their mean flows over a period at the duty."""
+class PwmShare:
+    """The timing of a PWM command as :class:`pamsim.signals.Pwm` defines it (its frequency, its ``low`` and
+    ``high`` commands, the valve's delays and opening and closing times), and each path's share of a
+    period at a duty that follows from it (see the module)."""
 
-    valve: ProportionalValve33
     frequency_Hz: float
     low_command: float
     high_command: float
@@ -74,11 +73,11 @@ class PwmAveragedValve(TwoPathValve):
     fall_s: float = 0.0
 
     @classmethod
-    def of_pwm(cls, valve: ProportionalValve33, pwm) -> "PwmAveragedValve":
-        """The averaged ``valve`` under the PWM signal ``pwm`` (:class:`pamsim.signals.Pwm`)."""
-        return cls(valve, pwm.frequency_Hz, pwm.low, pwm.high, pwm.delay_on_s, pwm.delay_off_s, pwm.rise_s, pwm.fall_s)
+    def of_pwm(cls, pwm) -> "PwmShare":
+        """The timing of the PWM signal ``pwm`` (:class:`pamsim.signals.Pwm`)."""
+        return cls(pwm.frequency_Hz, pwm.low, pwm.high, pwm.delay_on_s, pwm.delay_off_s, pwm.rise_s, pwm.fall_s)
 
-    def _share(self, duty, sign: float):
+    def share(self, duty, sign: float):
         """Mean over a period of ``max(sign c(t), 0)``: the supply path's share (+1), the exhaust's (-1)."""
         period = 1.0 / self.frequency_Hz
         r, q = self.rise_s, self.fall_s
@@ -101,9 +100,50 @@ class PwmAveragedValve(TwoPathValve):
         # No switching at all at the duty's ends: the command holds low (0) or high (1) for good.
         return if_else(duty <= 0.0, _pos(c0), if_else(duty >= 1.0, _pos(c1), switching))
 
+
+@dataclass(frozen=True)
+class PwmAveragedValve(TwoPathValve):
+    """:class:`~pamsim.elements.valve.ProportionalValve33` under a PWM command with its timing (as
+    :class:`pamsim.signals.Pwm` defines it), averaged over one period; its input is the duty, and its paths'
+    flows (:class:`~pamsim.elements.valve.TwoPathValve`) are their mean flows over a period at the duty."""
+
+    valve: ProportionalValve33
+    timing: PwmShare
+
+    @classmethod
+    def of_pwm(cls, valve: ProportionalValve33, pwm) -> "PwmAveragedValve":
+        """The averaged ``valve`` under the PWM signal ``pwm`` (:class:`pamsim.signals.Pwm`)."""
+        return cls(valve, PwmShare.of_pwm(pwm))
+
+    @property
+    def frequency_Hz(self) -> float:
+        """The PWM frequency [Hz]."""
+        return self.timing.frequency_Hz
+
     def shares(self, duty) -> tuple:
         """``(W_supply, W_exhaust)``: each path's opening averaged over a period at ``duty`` (see the module)."""
-        return self._share(duty, 1.0), self._share(duty, -1.0)
+        return self.timing.share(duty, 1.0), self.timing.share(duty, -1.0)
+
+
+@dataclass(frozen=True)
+class AveragedValvePair(TwoPathValve):
+    """Two 2/2 on/off valves (:class:`~pamsim.elements.valve.OnOffValvePair`) under PWM, averaged over one
+    period: the inlet under a PWM command (``inlet``, from 0 to 1), the exhaust under its complementary
+    command (``exhaust``, from 1 down to 0 with its own delays and times, :func:`pamsim.signals.complementary`),
+    both at the inlet's duty, each path's share derived from its own valve's trace."""
+
+    valve: ProportionalValve33
+    inlet: PwmShare
+    exhaust: PwmShare
+
+    @property
+    def frequency_Hz(self) -> float:
+        """The PWM frequency [Hz] (the pair's, one period for both)."""
+        return self.inlet.frequency_Hz
+
+    def shares(self, duty) -> tuple:
+        """``(W_supply, W_exhaust)``: each valve's opening averaged over a period at the inlet's ``duty``."""
+        return self.inlet.share(duty, 1.0), self.exhaust.share(duty, 1.0)
 
 
 def duty_signal(pwm) -> PiecewiseConstant:
@@ -170,7 +210,11 @@ def chamber_rates_of_paths(source, s, x_m, v_m_s, opening, supply_gauge_Pa) -> t
     return chamber.pressure_rate_of_flows_Pa_s(p, V, dV, mdot, work, m, x_m), mdot
 
 
-def averaged_source(source: ValveChamberSource, pwm) -> AveragedPwmSource:
-    """The averaged model of ``source`` driven by the PWM command ``pwm`` (:class:`pamsim.signals.Pwm`)."""
-    return AveragedPwmSource(PwmAveragedValve.of_pwm(source.valve, pwm), source.chamber, source.supply_gauge_Pa,
-                             duty_signal(pwm), source.T_supply_K, source.p_atm_Pa)
+def averaged_source(source: ValveChamberSource, pwm, exhaust_pwm=None) -> AveragedPwmSource:
+    """The averaged model of ``source`` driven by the PWM command ``pwm`` (:class:`pamsim.signals.Pwm`); with
+    ``exhaust_pwm`` (the complementary command of a pair of 2/2 valves), of the pair (:class:`AveragedValvePair`:
+    ``source.valve`` holds the inlet's and the exhaust's orifices)."""
+    valve = (PwmAveragedValve.of_pwm(source.valve, pwm) if exhaust_pwm is None
+             else AveragedValvePair(source.valve, PwmShare.of_pwm(pwm), PwmShare.of_pwm(exhaust_pwm)))
+    return AveragedPwmSource(valve, source.chamber, source.supply_gauge_Pa, duty_signal(pwm), source.T_supply_K,
+                             source.p_atm_Pa)

@@ -83,8 +83,13 @@ class SpoolValve33(TwoPathValve):
 
     def shares(self, position) -> tuple:
         """``(W_supply, W_exhaust)``: each path's conductance as a share of the full ``C`` at ``position``."""
-        leak = self.leakage_C_m3_per_s_Pa / self.valve.orifice.C_m3_per_s_Pa
-        return _ramp(position, self.overlap) + leak, _ramp(-position, self.overlap) + leak
+        leak = self.leakage_C_m3_per_s_Pa
+        if self.valve.exhaust_orifice is None:
+            leak = leak / self.valve.orifice.C_m3_per_s_Pa
+            return _ramp(position, self.overlap) + leak, _ramp(-position, self.overlap) + leak
+        # Paths of their own: the leakage is a conductance, so each path's share is of its own C.
+        return (_ramp(position, self.overlap) + leak / self.valve.orifice.C_m3_per_s_Pa,
+                _ramp(-position, self.overlap) + leak / self.valve.exhaust_orifice.C_m3_per_s_Pa)
 
 
 @dataclass(frozen=True)

@@ -62,20 +62,35 @@ def _max(a, b):
 @dataclass(frozen=True)
 class ProportionalValve33:
     """3/3 proportional valve: command u in [-1, 1] scales the conductance
-    to supply (u > 0) or to exhaust (u < 0); u = 0 closes it."""
+    to supply (u > 0) or to exhaust (u < 0); u = 0 closes it.
+
+    ``orifice`` is the supply path's (and the exhaust path's too while ``exhaust_orifice`` is None);
+    ``exhaust_orifice``, if given, is the exhaust path's own ISO 6358 (C, b): a valve whose two paths
+    differ, as a solenoid valve's seats do."""
 
     orifice: Iso6358Orifice
+    exhaust_orifice: Iso6358Orifice | None = None
+
+    @property
+    def exhaust_path(self) -> Iso6358Orifice:
+        """The exhaust path's orifice: its own, else the supply path's."""
+        return self.orifice if self.exhaust_orifice is None else self.exhaust_orifice
 
     def inflow_kg_s(self, u, p_chamber_Pa, T_chamber_K, p_supply_Pa, T_supply_K, p_exhaust_Pa):
         """Mass flow into the chamber [kg/s] (absolute pressures).
 
-        Only one path is open at a time, so the orifice is evaluated once,
-        against the supply for u >= 0 and against the exhaust for u < 0.
+        Only one path is open at a time, so with one orifice for both it is evaluated once,
+        against the supply for u >= 0 and against the exhaust for u < 0; with a path of its own the
+        exhaust's orifice is evaluated against the exhaust and the one the command points to is taken.
         """
         to_supply = u >= 0.0
-        p_port = p_exhaust_Pa + (p_supply_Pa - p_exhaust_Pa) * to_supply
         opening = _min(abs(u), 1.0)
-        return opening * self.orifice.mass_flow_kg_s(p_port, p_chamber_Pa, T_supply_K, T_chamber_K)
+        if self.exhaust_orifice is None:
+            p_port = p_exhaust_Pa + (p_supply_Pa - p_exhaust_Pa) * to_supply
+            return opening * self.orifice.mass_flow_kg_s(p_port, p_chamber_Pa, T_supply_K, T_chamber_K)
+        fill = self.orifice.mass_flow_kg_s(p_supply_Pa, p_chamber_Pa, T_supply_K, T_chamber_K)
+        vent = self.exhaust_orifice.mass_flow_kg_s(p_exhaust_Pa, p_chamber_Pa, T_supply_K, T_chamber_K)
+        return opening * (vent + (fill - vent) * to_supply)
 
 
 class TwoPathValve:
@@ -97,3 +112,18 @@ class TwoPathValve:
         supply, exhaust = self.path_flows_kg_s(opening, p_chamber_Pa, T_chamber_K, p_supply_Pa, T_supply_K,
                                                p_exhaust_Pa)
         return supply + exhaust
+
+
+@dataclass(frozen=True)
+class OnOffValvePair(TwoPathValve):
+    """Two 2/2 on/off valves on one port: an inlet from the supply and an exhaust to the ambient, each
+    with its own ISO 6358 orifice (``valve.orifice`` the inlet's, ``valve.exhaust_path`` the exhaust's).
+    Their openings are the pair ``(inlet, exhaust)``, each in [0, 1]; both may be open at once, and then
+    their flows add (:class:`TwoPathValve`)."""
+
+    valve: ProportionalValve33
+
+    def shares(self, opening) -> tuple:
+        """``(W_supply, W_exhaust)``: each valve's opening, held to [0, 1]."""
+        inlet, exhaust = opening
+        return _min(_max(inlet, 0.0), 1.0), _min(_max(exhaust, 0.0), 1.0)

@@ -26,7 +26,7 @@ from typing import Mapping
 from ..assemblies.one_muscle import input_signals
 from ..errors import InputError
 from ..scenario import Scenario
-from ..signals import Constant, FirstOrderLag, PiecewiseConstant, Pwm, Ramp, Step, Trace
+from ..signals import Constant, FirstOrderLag, OnOff, PiecewiseConstant, Pwm, Ramp, Step, Trace
 from .force_table import ForceTable
 from .runner import ScenarioInputs, force_table_for, start_values, upper_stop_start
 from .variables import INPUT_SOURCE_CHOICES, INPUTS, VARIABLES
@@ -108,6 +108,9 @@ def input_signal(signal, unit: str) -> InputSignal:
         return InputSignal(signal.knots_t_s, signal.knots,
                            text=f"pwm {q(signal.low)} / {q(signal.high)} at {signal.frequency_Hz:g} Hz, duty "
                                 f"{signal.duty:g}, {signal.start_s:g} to {signal.end_s:g} s")
+    if isinstance(signal, OnOff):  # an on/off valve's opening: its knots too
+        return InputSignal(signal.knots_t_s, signal.knots,
+                           text=f"on/off valve opening, {len(signal.commands)} commanded switches")
     raise InputError(f"the FMU can carry only constant, step, ramp, lag, trace, steps and pwm signals, not {signal!r}")
 
 
@@ -172,7 +175,7 @@ def for_muscle(scenario: Scenario) -> Preset:
     return Preset(f"muscle {model['muscle']}", starts, sources, table, static_force=model["static_force"])
 
 
-SIGNAL_UNITS = {"valve_command": "", "pwm_duty": "", "supply_pressure_gauge_Pa": "Pa", "prescribed_pressure_gauge_Pa": "Pa",
+SIGNAL_UNITS = {"valve_command": "", "pwm_duty": "", "exhaust_command": "", "supply_pressure_gauge_Pa": "Pa", "prescribed_pressure_gauge_Pa": "Pa",
                 "load_mass_kg": "kg", "external_force_N": "N", "reference_m": "m", "feedforward_gauge_Pa": "Pa",
                 "reference_velocity_m_s": "m/s", "feedforward_command": ""}
 """The unit of each input a scenario can drive, as the signals' descriptions show it (the last four: a

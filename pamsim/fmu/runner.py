@@ -87,7 +87,9 @@ REPRESENTED = {
               "friction_negative_level", "upper_stop"},
     "load": {"weight_N", "mass_kg", "external_force"},
     "pressure": {"source", "supply_gauge_bar", "supply_gauge_Pa", "valve_open_time_s", "command", "prescribed",
-                 "initial_gauge_bar", "supply_port", "outlet_port", "spool"},  # supply_port, outlet_port: a line
+                 "initial_gauge_bar", "supply_port", "outlet_port", "spool", "inlet", "exhaust", "supply_C_m3_per_s_Pa",
+                 "supply_b", "exhaust_C_m3_per_s_Pa", "exhaust_b"},  # supply_port, outlet_port: a line; the rest:
+    # valves the FMU of the scenario's assembly carries (Scenario.beyond_one_muscle_fmu)
     "simulation": {"duration_s", "sample_rate_Hz", "initial_contraction_m"},
     "solver": {"method", "rtol", "max_events", "max_step_s", "native_rtol_factor", "stick_margin_N",
                "release_margin_N"},
