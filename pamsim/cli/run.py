@@ -17,6 +17,7 @@ from ..atomic import atomic_outputs, output_folder
 from ..backends import BACKENDS, DESCRIPTIONS, check_backend
 from ..errors import InputError
 from . import figure_args, finite_float
+from .length_run import check_length_drive, is_length_driven, run_length_drive
 
 MAX_CSV_MB = 200.0
 """Default limit of ``pamsim run --max-csv-MB``: a CSV beyond it is refused before the run."""
@@ -83,6 +84,9 @@ def run(args: argparse.Namespace) -> int:
         seen[sc.name] = sc.origin
         if is_joint(sc):
             _check_joint(sc, args)
+            continue
+        if is_length_driven(sc):
+            check_length_drive(sc, args)
             continue
         _check_csv_size(sc, args.max_csv_MB)
         check_backend(args.backend, sc)  # a setting the backend cannot honour, before any run
@@ -255,8 +259,10 @@ def _run_one(scenario, args: argparse.Namespace, out: Path) -> list[str]:
     """Run one scenario and write its files; returns the controller specification items it misses."""
     from tqdm import tqdm
 
-    if "compensation" in scenario.spec:
+    if "compensation" in scenario.spec and "motion" not in scenario.spec:
         return _run_compensation(scenario, args, out)
+    if is_length_driven(scenario):
+        return run_length_drive(scenario, args, out)
 
     from ..api import run as run_scenario
     from ..figure_style import save

@@ -1,0 +1,51 @@
+"""``pamsim run`` of a scenario with a ``[motion]`` table: the muscle alone driven by its length."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+from ..atomic import atomic_outputs
+from ..errors import InputError
+
+
+def is_length_driven(scenario) -> bool:
+    """Whether ``scenario`` drives a muscle alone by its length (a ``[motion]`` table)."""
+    return "motion" in getattr(scenario, "spec", {})
+
+
+def check_length_drive(scenario, args: argparse.Namespace) -> None:
+    """Refuse, before any run, a bad ``[motion]`` table or a backend that does not run it."""
+    from ..muscle_alone import BACKENDS, motion_of
+
+    if args.backend not in BACKENDS:
+        raise InputError(f"{scenario.origin}: --backend {args.backend}: a muscle driven by its length runs on "
+                         f"{', '.join(BACKENDS)}")
+    motion_of(scenario)
+
+
+def run_length_drive(scenario, args: argparse.Namespace, out: Path) -> list[str]:
+    """Run the muscle along its motion and write NAME.csv (its first columns the loop ``pamsim fit hysteresis``
+    reads), NAME.json and the figure."""
+    from ..figure_style import save
+    from ..muscle_alone import simulate_length_drive
+    from ..muscle_alone.plots import length_drive_figure
+
+    result = simulate_length_drive(scenario, args.backend)
+    fmt, dpi = args.figures
+    names = [f"{scenario.name}.csv", f"{scenario.name}.json"] + ([] if args.no_plot else [f"{scenario.name}.{fmt}"])
+    summary = result.summary()
+    with atomic_outputs(out, names) as tmp:
+        result.to_csv(tmp[names[0]])
+        tmp[names[1]].write_text(json.dumps(summary, indent=2) + "\n")
+        if not args.no_plot:
+            save(length_drive_figure(result), tmp[names[2]], fmt=fmt, dpi=dpi)
+    lo, hi = summary["force_range_N"]
+    x0, x1 = summary["contraction_range_m"]
+    print(f"{scenario.name} ({args.backend}): {summary['motion']} motion over {x0 * 1e3:.2f} to {x1 * 1e3:.2f} mm, "
+          f"force {lo:.3f} to {hi:.3f} N, final {summary['final_force_N']:.3f} N; work done on the muscle "
+          f"{summary['work_on_muscle_J'] * 1e3:.4f} mJ; {len(summary['events'])} events, "
+          f"{summary['stats']['rhs_evaluations']} RHS evaluations, {summary['stats']['wall_time_s'] * 1e3:.0f} ms")
+    print(f"wrote {', '.join(str(out / n) for n in names)}")
+    return []
