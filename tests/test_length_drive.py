@@ -235,3 +235,25 @@ def test_a_sine_is_its_knots_and_the_velocity_their_slope():
     inside = (r.t_s > m.t_s[0]) & (r.t_s < m.t_s[-1]) & ~np.isin(np.round(r.t_s, 9), np.round(m.t_s, 9))
     leg = np.searchsorted(m.t_s, r.t_s[inside]) - 1
     assert np.allclose(r.velocity_m_s[inside], m.velocity_m_s[leg], rtol=1e-12)
+
+
+def test_the_fit_recovers_the_elements_from_the_written_loop(tmp_path):
+    """``pamsim fit hysteresis`` on the CSV ``pamsim run`` writes for the shipped scenario: the BIC picks the three
+    elements, each stiffness ``w_i F_c / delta_i`` and slip force ``w_i F_c`` (F_c = 2.5 N) within 5 %, and the
+    linear static part's slope within 5 % of the static force's chord over 20 to 40 mm at 3 bar (its curvature
+    and the damping are what the fit's linear part misses)."""
+    run = subprocess.run([sys.executable, "-m", "pamsim", "run", SHIPPED, "-o", str(tmp_path), "--no-plot",
+                          "--no-progress"], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    fit = subprocess.run([sys.executable, "-m", "pamsim", "fit", "hysteresis", str(tmp_path / "hysteresis_force_cycles.csv"),
+                          "-o", str(tmp_path / "fit"), "--model", "maxwell_slip"], capture_output=True, text=True)
+    assert fit.returncode == 0, fit.stderr
+    got = json.loads((tmp_path / "fit" / "fit.json").read_text())["fit"]
+    assert got["label"] == "maxwell_slip N=3"
+    values = {k: v["value"] for k, v in got["parameters"].items()}
+    for i, (w, d) in enumerate(zip(SHARES, DELTAS), start=1):
+        assert values[f"k{i}_N_per_m"] == pytest.approx(w * LEVEL_N / d, rel=0.05)
+        assert values[f"F{i}_N"] == pytest.approx(w * LEVEL_N, rel=0.05)
+    static = pamsim.load_scenario(SHIPPED).build_model().static_force
+    chord = (float(static.force_N(0.04, P_PA)) - float(static.force_N(0.02, P_PA))) / 0.02
+    assert values["k0_N_per_m"] == pytest.approx(chord, rel=0.05)
