@@ -3,11 +3,10 @@
 from __future__ import annotations
 
 import argparse
-import json
 from pathlib import Path
 
-from ..atomic import atomic_outputs
 from ..errors import InputError
+from .outputs import write_run_files
 
 
 def is_length_driven(scenario) -> bool:
@@ -28,19 +27,12 @@ def check_length_drive(scenario, args: argparse.Namespace) -> None:
 def run_length_drive(scenario, args: argparse.Namespace, out: Path) -> list[str]:
     """Run the muscle along its motion and write NAME.csv (its first columns the loop ``pamsim fit hysteresis``
     reads), NAME.json and the figure."""
-    from ..figure_style import save
     from ..muscle_alone import simulate_length_drive
     from ..muscle_alone.plots import length_drive_figure
 
     result = simulate_length_drive(scenario, args.backend)
-    fmt, dpi = args.figures
-    names = [f"{scenario.name}.csv", f"{scenario.name}.json"] + ([] if args.no_plot else [f"{scenario.name}.{fmt}"])
     summary = result.summary()
-    with atomic_outputs(out, names) as tmp:
-        result.to_csv(tmp[names[0]])
-        tmp[names[1]].write_text(json.dumps(summary, indent=2) + "\n")
-        if not args.no_plot:
-            save(length_drive_figure(result), tmp[names[2]], fmt=fmt, dpi=dpi)
+    names = write_run_files(out, scenario.name, args, result.to_csv, summary, lambda: length_drive_figure(result))
     lo, hi = summary["force_range_N"]
     x0, x1 = summary["contraction_range_m"]
     print(f"{scenario.name} ({args.backend}): {summary['motion']} motion over {x0 * 1e3:.2f} to {x1 * 1e3:.2f} mm, "

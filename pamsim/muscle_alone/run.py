@@ -96,61 +96,67 @@ def simulate_length_drive(scenario, backend: str = "python") -> LengthDrivenResu
     return run(drive, backend)
 
 
-def _python(drive: LengthDrive, backend: str) -> LengthDrivenResult:
-    """``solve_ivp`` from knot to knot, stopping at each indicator's crossing for its jump."""
+def _segment(drive: LengthDrive, gen, p, t: float, y: np.ndarray, t_break: float, atol: np.ndarray):
+    """``solve_ivp`` of the generated model from ``t`` to ``t_break`` or its first indicator's crossing, its
+    inputs at their left limit at ``t_break`` (a jump there belongs to the next segment)."""
     from scipy.integrate import solve_ivp
 
+    opts = drive.scenario.solver
+    t_left = float(np.nextafter(t_break, -math.inf))
+
+    def rhs(tt, yy):
+        return gen.f(yy.tolist(), drive.inputs(min(tt, t_left)), p, ())[0]
+
+    def indicator(k):
+        return _event(lambda tt, yy: gen.z(yy.tolist(), drive.inputs(min(tt, t_left)), p, ())[0][k], -1.0)
+
+    n = len(drive.assembly.indicator_names())
+    try:
+        sol = solve_ivp(rhs, (t, t_break), y, method=opts.method, dense_output=True,
+                        events=[_from_start(indicator(k), t, y) for k in range(n)], rtol=opts.rtol, atol=atol,
+                        max_step=opts.max_step_s)
+    except Exception as exc:  # solve_ivp's numerical trouble comes as plain exceptions: a solver failure (exit 3)
+        raise SolverFailure(f"solve_ivp raised {type(exc).__name__} at t = {t:.6g} s: {exc}") from exc
+    if sol.status == -1:
+        raise SolverFailure(f"solve_ivp failed at t = {t:.6g} s: {sol.message}")
+    return sol
+
+
+def _python(drive: LengthDrive, backend: str) -> LengthDrivenResult:
+    """``solve_ivp`` from knot to knot, stopping at each indicator's crossing for its jump."""
     sc, opts = drive.scenario, drive.scenario.solver
     wall0 = time.perf_counter()
     gen, p = drive.code()[0], drive.assembly.parameter_values()
     names = [f"{c}.{n}" for c, n in drive.assembly.indicator_names()]
     atol = opts.rtol * np.array([v.nominal for v in drive.assembly.flatten().states])
     grid = np.linspace(0.0, sc.duration_s, n_samples(sc.duration_s, opts.sample_rate_Hz))
-    t = 0.0
-    y = np.array(gen.x0(drive.inputs(0.0), p)[0], dtype=float)
-    ts, ys, events, nfev, segments, next_sample = [], [], [], 0, 0, 0
+    t, y = 0.0, np.array(gen.x0(drive.inputs(0.0), p)[0], dtype=float)
+    ys, events, nfev, segments, next_sample = [], [], 0, 0, 0
     for t_break in _distinct_breaks(drive.breakpoints, sc.duration_s):
-        t_left = float(np.nextafter(t_break, -math.inf))  # a segment sees its inputs' left limit at its end
         while t < t_break:
-            def rhs(tt, yy):
-                return gen.f(yy.tolist(), drive.inputs(min(tt, t_left)), p, ())[0]
-
-            def indicator(tt, yy, k):
-                return gen.z(yy.tolist(), drive.inputs(min(tt, t_left)), p, ())[0][k]
-
-            watch = [_from_start(_event(lambda tt, yy, k=k: indicator(tt, yy, k), -1.0), t, y) for k in range(len(names))]
-            try:
-                sol = solve_ivp(rhs, (t, t_break), y, method=opts.method, dense_output=True, events=watch,
-                                rtol=opts.rtol, atol=atol, max_step=opts.max_step_s)
-            except Exception as exc:
-                raise SolverFailure(f"solve_ivp raised {type(exc).__name__} at t = {t:.6g} s: {exc}") from exc
-            if sol.status == -1:
-                raise SolverFailure(f"solve_ivp failed at t = {t:.6g} s: {sol.message}")
+            sol = _segment(drive, gen, p, t, y, t_break, atol)
             nfev, segments = nfev + sol.nfev, segments + 1
             j = np.searchsorted(grid, sol.t[-1], side="right")
-            if j > next_sample:
-                ts.append(grid[next_sample:j])
-                ys.append(sol.sol(grid[next_sample:j]))
-                next_sample = j
+            ys.append(sol.sol(grid[next_sample:j]))
+            next_sample = j
             if sol.status != 1:
                 t, y = t_break, sol.y[:, -1].copy()
                 continue
             k = next(i for i, te in enumerate(sol.t_events) if len(te))
             t = float(sol.t_events[k][0])
             fired = [1.0 if i == k else 0.0 for i in range(len(names))]
-            y = np.array(gen.transition(list(sol.y_events[k][0]), drive.inputs(min(t, t_left)), p, (), fired)[0])
+            y = np.array(gen.transition(list(sol.y_events[k][0]), drive.inputs(t), p, (), fired)[0])
             events.append((t, names[k]))
             if len(events) > opts.max_events:
                 raise too_many_events(opts.max_events, f" by t = {t:.6g} s")
     stats = {"rhs_evaluations": int(nfev), "events": len(events), "segments": segments, "method": opts.method,
              "rtol": opts.rtol}
-    return drive.result(backend, np.concatenate(ts), np.concatenate(ys, axis=1), events, stats,
-                        time.perf_counter() - wall0)
+    return drive.result(backend, grid, np.concatenate(ys, axis=1), events, stats, time.perf_counter() - wall0)
 
 
 def _native(drive: LengthDrive, backend: str) -> LengthDrivenResult:
     """The generic C engine compiled with the assembly's generated C, its inputs cut into exact segments."""
-    from ..native.backend import METHOD_LABEL, event_capacity, exact_segments, native_rtol
+    from ..native.backend import METHOD_LABEL, check_status, event_capacity, exact_segments, native_rtol
     from ..native.engine import EngineCase, engine_library
 
     sc, opts = drive.scenario, drive.scenario.solver
@@ -170,13 +176,7 @@ def _native(drive: LengthDrive, backend: str) -> LengthDrivenResult:
     wall0 = time.perf_counter()
     out = library.run([case])
     wall = time.perf_counter() - wall0
-    status, message = int(out["status"][0]), out["messages"][0]
-    if status == 1:
-        raise InputError(f"{sc.origin}: {message}")
-    if status == 2:
-        raise SolverFailure(f"native backend: {message}")
-    if status == 3 or int(out["n_events"][0]) > opts.max_events:
-        raise too_many_events(opts.max_events)
+    check_status(out, 0, sc.origin, opts.max_events)
     ns = len(library.names["states"])
     Y = np.array(out["samples"][:ns * n].reshape(ns, n))
     names = [f"{c}.{k}" for c, k in drive.assembly.indicator_names()]
