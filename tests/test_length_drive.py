@@ -8,6 +8,7 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -18,7 +19,7 @@ from pamsim.hysteresis.maxwell_slip import MaxwellSlip
 from pamsim.muscle_alone import simulate_length_drive
 from pamsim.scenario import Scenario
 
-SHIPPED = "scenarios/hysteresis_force_cycles.toml"
+SHIPPED = str(Path(__file__).resolve().parents[1] / "scenarios" / "hysteresis_force_cycles.toml")
 DELTAS, SHARES, LEVEL_N, P_PA = (2e-4, 1e-3, 4e-3), (0.3, 0.3, 0.4), 2.5, 3e5
 
 
@@ -257,3 +258,14 @@ def test_the_fit_recovers_the_elements_from_the_written_loop(tmp_path):
     static = pamsim.load_scenario(SHIPPED).build_model().static_force
     chord = (float(static.force_N(0.04, P_PA)) - float(static.force_N(0.02, P_PA))) / 0.02
     assert values["k0_N_per_m"] == pytest.approx(chord, rel=0.05)
+
+
+@pytest.mark.parametrize("command", [["linearize", SHIPPED], ["fmu", "build", "--scenario", SHIPPED, "-o", "x.fmu"]])
+def test_the_rigs_tools_refuse_a_length_driven_scenario(tmp_path, command):
+    """A scenario with ``[motion]`` has no load: the tools of the hanging-load rig refuse it naming ``[motion]``
+    with exit code 2 (the muscle-only FMU, ``--muscle-only``, takes it), and so does ``pamsim.simulate``."""
+    done = subprocess.run([sys.executable, "-m", "pamsim", *command], capture_output=True, text=True, cwd=tmp_path)
+    assert done.returncode == 2 and "[motion]" in done.stderr and len(done.stderr.strip().splitlines()) == 1
+    assert list(tmp_path.iterdir()) == []
+    with pytest.raises(pamsim.errors.InputError, match=r"\[motion\]"):
+        pamsim.simulate(SHIPPED)

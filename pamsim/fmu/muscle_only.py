@@ -65,15 +65,17 @@ def muscle_only_spec(scenario, fmi_version: int = 2, motion=None) -> FmuSpec:
                             f"the muscle of scenario {scenario.name} ({scenario.origin})", fmi_version)
 
 
-def build_muscle_only(scenario, output_path: str | os.PathLike | None = None, fmi_version: int = 2) -> Path:
-    """Generate, compile and zip the muscle-only FMU of ``scenario`` (default ``pamsim_assembly_fmi<version>.fmu``).
+def build_muscle_only(scenario, output_path: str | os.PathLike | None = None, fmi_version: int = 2,
+                      motion=None) -> Path:
+    """Generate, compile and zip the muscle-only FMU of ``scenario`` (default ``pamsim_assembly_fmi<version>.fmu``),
+    following ``motion`` (see :func:`muscle_only_spec`) until the importer drives it.
 
     Raises :class:`~pamsim.errors.InputError` for an unknown FMI version, a scenario the FMU cannot carry, a
     missing C compiler or a failed compilation.
     """
     if fmi_version not in FMI_VERSIONS:
         raise InputError(f"FMI version must be 2 or 3, not {fmi_version!r}")
-    spec = muscle_only_spec(scenario, fmi_version)
+    spec = muscle_only_spec(scenario, fmi_version, motion)
     return build_spec(Path(output_path) if output_path else Path(f"{spec.identifier}_fmi{fmi_version}.fmu"), spec)
 
 

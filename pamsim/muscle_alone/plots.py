@@ -19,8 +19,8 @@ def length_drive_figure(result) -> Figure:
     ax_loop.set_xlabel("contraction [mm]")
     ax_loop.set_ylabel("force the muscle pulls with [N]")
     p = result.p_gauge_Pa / PA_PER_BAR
-    ax_loop.set_title(f"{result.name} ({result.backend}): {p.min():.3g} to {p.max():.3g} bar, "
-                      f"{len(result.events)} events")
+    pressure = f"{p.min():.3g} bar" if p.min() == p.max() else f"{p.min():.3g} to {p.max():.3g} bar"
+    ax_loop.set_title(f"{result.name} ({result.backend}): {pressure}, {len(result.events)} events")
     ax_t.plot(result.t_s, F, label="force [N]", **series(0))
     ax_t.set_xlabel("time [s]")
     ax_t.set_ylabel("force [N]")
