@@ -566,7 +566,7 @@ def _check_sections(v: "_Validator", spec: dict) -> None:
         # there would be a load the run silently ignores.
         raise ScenarioError(f"{v.origin}: [load] = {spec['load']!r}: a muscle driven by its length ([motion]) has "
                             "no load; leave [load] out")
-    for section in ("pressure", "simulation") + (() if "motion" in spec else ("load",)):
+    for section in [s for s in ("load", "pressure", "simulation") if s != "load" or "motion" not in spec]:
         if section not in spec:
             raise ScenarioError(f"{v.origin}: missing section [{section}]")
 
