@@ -260,6 +260,15 @@ def test_the_fit_recovers_the_elements_from_the_written_loop(tmp_path):
     assert values["k0_N_per_m"] == pytest.approx(chord, rel=0.05)
 
 
+def test_a_csv_above_the_limit_is_refused_before_the_run(tmp_path):
+    """``--max-csv-MB`` holds for a muscle driven by its length too: 2401 samples of 29 columns are about 1.3 MB
+    at most, refused at 1 MB naming the sample rate, exit code 2, nothing written."""
+    out = tmp_path / "out"
+    done = subprocess.run([sys.executable, "-m", "pamsim", "run", SHIPPED, "-o", str(out), "--max-csv-MB", "1"],
+                          capture_output=True, text=True)
+    assert done.returncode == 2 and "simulation.sample_rate_Hz" in done.stderr and not out.exists()
+
+
 @pytest.mark.parametrize("command", [["linearize", SHIPPED], ["fmu", "build", "--scenario", SHIPPED, "-o", "x.fmu"]])
 def test_the_rigs_tools_refuse_a_length_driven_scenario(tmp_path, command):
     """A scenario with ``[motion]`` has no load: the tools of the hanging-load rig refuse it naming ``[motion]``

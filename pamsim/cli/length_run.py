@@ -14,14 +14,27 @@ def is_length_driven(scenario) -> bool:
     return "motion" in getattr(scenario, "spec", {})
 
 
+CSV_BYTES_PER_VALUE = 18
+"""The most characters a value takes in the CSV (10 significant digits, sign, exponent, comma)."""
+
+
 def check_length_drive(scenario, args: argparse.Namespace) -> None:
-    """Refuse, before any run, a bad ``[motion]`` table or a backend that does not run it."""
-    from ..muscle_alone import BACKENDS, motion_of
+    """Refuse, before any run, a bad ``[motion]`` table, a backend that does not run it, or a CSV above
+    ``--max-csv-MB``."""
+    from ..muscle_alone import BACKENDS, LengthDrive
+    from ..simulator import n_samples
 
     if args.backend not in BACKENDS:
         raise InputError(f"{scenario.origin}: --backend {args.backend}: a muscle driven by its length runs on "
                          f"{', '.join(BACKENDS)}")
-    motion_of(scenario)
+    flat = LengthDrive(scenario).assembly.flatten()
+    rate = scenario.solver.sample_rate_Hz
+    n = n_samples(scenario.duration_s, rate)
+    size_MB = n * (len(flat.states) + len(flat.outputs) + 2) * CSV_BYTES_PER_VALUE / 1e6
+    if size_MB > args.max_csv_MB:
+        raise InputError(f"{scenario.origin}: simulation.sample_rate_Hz = {rate:g}: {n} samples make a CSV of up to "
+                         f"{size_MB:.3g} MB, above the limit of {args.max_csv_MB:g} MB (lower the rate, or raise the "
+                         "limit with --max-csv-MB)")
 
 
 def run_length_drive(scenario, args: argparse.Namespace, out: Path) -> list[str]:
