@@ -111,6 +111,11 @@ def simulate(scenario: "Scenario | str | os.PathLike", backend: str = "python",
         components; None runs the scenario's own model.
     """
     scenario = as_scenario(scenario)
+    if "motion" in scenario.spec:
+        from .errors import InputError
+
+        raise InputError(f"{scenario.origin}: [motion]: a muscle driven by its length is not the hanging-load rig; "
+                         "run it with `pamsim run` or pamsim.muscle_alone.simulate_length_drive")
     if backend == "python":
         from .simulator import simulate_python
 

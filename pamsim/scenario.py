@@ -48,7 +48,7 @@ from .table_checks import TableChecker, choices_hint, did_you_mean
 _SCHEMA: dict[str, dict[str, Any]] = {
     "": {"name": str, "description": str, "model": dict, "parameters": dict, "load": dict, "pressure": dict,
          "simulation": dict, "solver": dict, "controller": dict, "component": list, "measured": dict,
-         "chamber": dict, "hysteresis": dict, "compensation": dict},
+         "chamber": dict, "hysteresis": dict, "compensation": dict, "motion": dict},
     "model": {"muscle": str, "parameter_set": str, "static_force": str, "static_force_variant": str,
               "static_force_negative": str, "friction": str, "damping": str, "friction_negative_level": str,
               "upper_stop": str},
@@ -63,6 +63,11 @@ _SCHEMA: dict[str, dict[str, Any]] = {
     "measured": {"steady_state": str},
     "chamber": {"law": str, **{key: float for key in CHAMBER_DEFAULTS if key != "law"}},
 }
+NO_LOAD_MASS_KG = 1.0
+"""The mass [kg] of the hanging load a scenario without one (a muscle driven by its length, ``[motion]``)
+puts in its :class:`~pamsim.model.MuscleModel`, which has a load by construction.  No run of such a
+scenario reads it: the muscle alone (:mod:`pamsim.assemblies.muscle_only`) has no load, and its friction
+law's mass is the static force over g."""
 _MAX_SAMPLES = 1e7  # 8 s at 1 kHz is 8,001; beyond this the output would not fit in memory comfortably
 MAX_STEPS = 1e7
 """``solver.max_step_s`` may not ask for more steps than this over the run (minutes of computing)."""
@@ -160,7 +165,9 @@ class Scenario:
     @property
     def mass_kg(self) -> float:
         """Mass of the load [kg], given or from its weight."""
-        load = self.spec["load"]
+        load = self.spec.get("load")
+        if load is None:  # a muscle driven by its length
+            return NO_LOAD_MASS_KG
         return load["mass_kg"] if "mass_kg" in load else load["weight_N"] / self.parameters["g_m_s2"]
 
     @property
@@ -171,6 +178,8 @@ class Scenario:
         return float(signal.final_value)
 
     def _check_load(self, v: "_Validator") -> None:
+        if "load" not in self.spec:  # a muscle driven by its length ([motion]; _check_sections)
+            return
         load = self.spec["load"]
         if ("weight_N" in load) == ("mass_kg" in load):
             raise ScenarioError(f"{self.origin}: [load] needs exactly one of weight_N or mass_kg")
@@ -185,7 +194,7 @@ class Scenario:
     def _build_elements(self, v: "_Validator", x0: float) -> None:
         """Build the pressure source, external force, static force and added components once, here, so that
         a bad pressure section, trace file or external force fails now, not at run time."""
-        ext = self.spec["load"].get("external_force")
+        ext = self.spec.get("load", {}).get("external_force")
         object.__setattr__(self, "_source", self._build_source(v))
         object.__setattr__(self, "_external_force",
                            signal_from_table(v, "load.external_force", ext, "_N", 1.0, self.base_dir) if ext else None)
@@ -639,7 +648,12 @@ def _check_sections(v: "_Validator", spec: dict) -> None:
             v.check_table(section, spec[section])
     if "measured" in spec:
         _check_measured(v, spec["measured"])
-    for section in ("load", "pressure", "simulation"):
+    if "motion" in spec and "load" in spec:
+        # Decided: the length is prescribed, so nothing hangs on the muscle; a weight or an external force
+        # there would be a load the run silently ignores.
+        raise ScenarioError(f"{v.origin}: [load] = {spec['load']!r}: a muscle driven by its length ([motion]) has "
+                            "no load; leave [load] out")
+    for section in [s for s in ("load", "pressure", "simulation") if s != "load" or "motion" not in spec]:
         if section not in spec:
             raise ScenarioError(f"{v.origin}: missing section [{section}]")
 

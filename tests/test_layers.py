@@ -22,7 +22,7 @@ EXPECTED_LAYERS = [
     "cli",
     "api | hysteresis",
     "sweep | identification | control | atlas | export | envs | coupling",
-    "backends | joints",
+    "backends | joints | muscle_alone",
     "native",
     "fmu",
     "scenario",

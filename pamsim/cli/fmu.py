@@ -96,6 +96,9 @@ def run_build(args: argparse.Namespace) -> int:
             return _build_joint(scenario, args)
         if args.muscle_only:
             return _build_muscle_only(scenario, args)
+        if "motion" in scenario.spec:
+            raise InputError(f"{args.scenario}: [motion]: a muscle driven by its length has no load; build its "
+                             "FMU with --muscle-only")
         if scenario.beyond_one_muscle_fmu or args.generated or "controller" in scenario.spec:
             return _build_assembly(scenario, args)
     preset = _preset(args, scenario, by_muscle)
@@ -122,10 +125,13 @@ def _build_joint(scenario, args: argparse.Namespace) -> int:
 def _build_muscle_only(scenario, args: argparse.Namespace) -> int:
     """The muscle-only FMU of a one-muscle scenario (:mod:`pamsim.fmu.muscle_only`)."""
     from ..fmu.muscle_only import build_muscle_only
+    from ..muscle_alone import motion_of
 
-    path = build_muscle_only(scenario, args.output, int(args.fmi))
+    motion = motion_of(scenario) if "motion" in scenario.spec else None
+    path = build_muscle_only(scenario, args.output, int(args.fmi), motion)
     print(f"wrote {path} (FMI {args.fmi}.0, Model Exchange and Co-Simulation, the muscle of scenario {scenario.name} "
-          "alone: inputs length_m and lengthening_velocity_m_s, its force the output motion.F_N)")
+          "alone: inputs length_m and lengthening_velocity_m_s, its force the output motion.F_N"
+          + (", following the scenario's [motion] until the importer drives it)" if motion else ")"))
     return 0
 
 

@@ -16,6 +16,7 @@ from pathlib import Path
 
 from ..atomic import atomic_outputs, output_folder
 from ..control.choices import FRICTION_KINDS, VALVE_SLOPES
+from ..errors import InputError
 from . import figure_args, finite_float
 
 DEFAULT_OUTPUT = "out"
@@ -103,6 +104,9 @@ def run(args: argparse.Namespace) -> int:
     scenario = load_any_scenario(Path(args.scenario))
     if is_joint(scenario):
         return _linearize_joint(scenario, args)
+    if "motion" in scenario.spec:
+        raise InputError(f"{args.scenario}: [motion]: a muscle driven by its length has no load whose dynamics "
+                         "to linearise")
     if args.json and args.output is None:  # the numbers only: no file written, nothing on stderr
         print(json.dumps(_linearize(scenario, args)[1], indent=2))
         return 0

@@ -17,6 +17,8 @@ from ..atomic import atomic_outputs, output_folder
 from ..backends import BACKENDS, DESCRIPTIONS, check_backend
 from ..errors import InputError
 from . import figure_args, finite_float
+from .length_run import check_length_drive, is_length_driven, run_length_drive
+from .outputs import write_run_files
 
 MAX_CSV_MB = 200.0
 """Default limit of ``pamsim run --max-csv-MB``: a CSV beyond it is refused before the run."""
@@ -83,6 +85,9 @@ def run(args: argparse.Namespace) -> int:
         seen[sc.name] = sc.origin
         if is_joint(sc):
             _check_joint(sc, args)
+            continue
+        if is_length_driven(sc):
+            check_length_drive(sc, args)
             continue
         _check_csv_size(sc, args.max_csv_MB)
         check_backend(args.backend, sc)  # a setting the backend cannot honour, before any run
@@ -161,7 +166,6 @@ def _check_joint(scenario, args: argparse.Namespace) -> None:
 
 def _run_joint(scenario, args: argparse.Namespace, out: Path) -> list[str]:
     """Run muscles on a joint and write NAME.csv, NAME.json and the figure."""
-    from ..figure_style import save
     from ..joints import simulate_joint
     from ..joints.plots import joint_figure
     from ..joints.static import JointStatics
@@ -169,19 +173,13 @@ def _run_joint(scenario, args: argparse.Namespace, out: Path) -> list[str]:
     if scenario.controller is not None:
         return _run_joint_controller(scenario, args, out)
     result = simulate_joint(scenario, args.backend)
-    fmt, dpi = args.figures
-    names = [f"{scenario.name}.csv", f"{scenario.name}.json"] + ([] if args.no_plot else [f"{scenario.name}.{fmt}"])
     summary = result.summary()
     joint = scenario.body.name == "joint"
     if joint:  # a slider's statics are its muscles' force balance, which pamsim static gives per muscle
         eq = JointStatics(scenario).equilibrium([v["p_gauge_Pa"] for v in summary["muscles"].values()])
         summary["equilibrium_at_final_pressures"] = {"theta_rad": eq.theta_rad, "k_Nm_per_rad": eq.k_Nm_per_rad,
                                                      "on_limit": eq.on_limit}
-    with atomic_outputs(out, names) as tmp:
-        result.to_csv(tmp[names[0]])
-        tmp[names[1]].write_text(json.dumps(summary, indent=2) + "\n")
-        if not args.no_plot:
-            save(joint_figure(result), tmp[names[2]], fmt=fmt, dpi=dpi)
+    names = write_run_files(out, scenario.name, args, result.to_csv, summary, lambda: joint_figure(result))
     muscles = ", ".join(f"{m} {v['p_gauge_Pa'] / 1e5:.3f} bar, {v['F_tendon_N']:.2f} N" for m, v in summary["muscles"].items())
     pos = scenario.body.position
     final = f"final angle {summary[f'final_{pos}']:.4f} rad" if joint else f"final position {summary[f'final_{pos}'] * 1e3:.3f} mm"
@@ -255,11 +253,12 @@ def _run_one(scenario, args: argparse.Namespace, out: Path) -> list[str]:
     """Run one scenario and write its files; returns the controller specification items it misses."""
     from tqdm import tqdm
 
+    if is_length_driven(scenario):
+        return run_length_drive(scenario, args, out)
     if "compensation" in scenario.spec:
         return _run_compensation(scenario, args, out)
 
     from ..api import run as run_scenario
-    from ..figure_style import save
 
     # Shown only for runs that last over a second; cleared when done.
     with tqdm(total=scenario.duration_s, desc=scenario.name, unit="s simulated", delay=1.0, leave=False,
@@ -267,14 +266,9 @@ def _run_one(scenario, args: argparse.Namespace, out: Path) -> list[str]:
               "[{elapsed}<{remaining}]") as bar:
         outcome = run_scenario(scenario, args.backend, progress=lambda t: bar.update(t - bar.n))
     result = outcome.result
-    fmt, dpi = args.figures
-    names = [f"{scenario.name}.csv", f"{scenario.name}.json"] + ([] if args.no_plot else [f"{scenario.name}.{fmt}"])
     summary = outcome.summary()
-    with atomic_outputs(out, names) as tmp:
-        result.to_csv(tmp[names[0]])
-        tmp[names[1]].write_text(json.dumps(summary, indent=2) + "\n")
-        if not args.no_plot:
-            save(outcome.figure(measured=not args.no_measured), tmp[names[2]], dpi=dpi)
+    names = write_run_files(out, scenario.name, args, result.to_csv, summary,
+                            lambda: outcome.figure(measured=not args.no_measured))
     for warning in result.warnings + _measured_warnings(scenario, outcome):
         print(f"pamsim: warning: {scenario.name}: {warning}", file=sys.stderr)
     s = summary

@@ -68,10 +68,11 @@ def simulate_assembly(scenario, model, interface: str = "cs", fmi_version: int =
                              outputs=RigOutputs(assembly, model, t, Y, modes))
 
 
-def run_trace(path: Path, interface: str, duration_s: float, opts, states, mode: str):
+def run_trace(path: Path, interface: str, duration_s: float, opts, states, mode: str | None):
     """Run the FMU at ``path`` with fmpy (``interface`` ``"cs"`` or ``"me"``) over ``duration_s`` at the
     solver settings ``opts`` (its ``rtol``, ``max_step_s`` and output rate) and return the output grid's
-    times [s], the ``states`` (one row each), the hybrid component's ``mode`` variable and the wall time [s].
+    times [s], the ``states`` (one row each), the hybrid component's ``mode`` variable (zeros for an assembly
+    without one, ``mode`` None) and the wall time [s].
 
     Raises
     ------
@@ -88,13 +89,13 @@ def run_trace(path: Path, interface: str, duration_s: float, opts, states, mode:
     try:
         res = simulate_fmu(str(path), fmi_type=KINDS[interface], solver="CVode", start_time=0.0,
                            stop_time=duration_s, output_interval=dt, relative_tolerance=opts.rtol,
-                           start_values=start, output=[*states, mode], validate=False)
+                           start_values=start, output=[*states, *([mode] if mode else [])], validate=False)
     except Exception as exc:  # fmpy raises a bare Exception carrying the FMI status
         raise SolverFailure(f"FMU {KINDS[interface]} of {Path(path).name} failed: {exc}") from None
     wall = time.perf_counter() - wall0
     rows = grid_rows(res["time"], dt)
     return (np.asarray(res["time"][rows], dtype=float), np.array([np.asarray(res[n][rows], dtype=float) for n in states]),
-            np.asarray(res[mode][rows], dtype=int), wall)
+            np.asarray(res[mode][rows], dtype=int) if mode else np.zeros(len(rows), dtype=int), wall)
 
 
 def simulate_cs(scenario, model) -> Result:

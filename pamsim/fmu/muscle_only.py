@@ -26,8 +26,12 @@ MOTION_UNITS = {"length_m": "m", "lengthening_velocity_m_s": "m/s"}
 """The units of the inputs that move the muscle."""
 
 
-def muscle_only_spec(scenario, fmi_version: int = 2) -> FmuSpec:
+def muscle_only_spec(scenario, fmi_version: int = 2, motion=None) -> FmuSpec:
     """The :class:`~pamsim.fmu.spec.FmuSpec` of the muscle-only FMU of a one-muscle ``scenario``.
+
+    ``motion``: the scenario's :class:`~pamsim.muscle_alone.motion.Motion`, whose length and its derivative
+    the FMU then follows by itself (``input_source = scenario``); None, the length holds at the scenario's
+    start until the importer drives it.
 
     Raises
     ------
@@ -45,7 +49,10 @@ def muscle_only_spec(scenario, fmi_version: int = 2) -> FmuSpec:
                                         scenario.added_components)
     except ValueError as exc:
         raise InputError(f"{scenario.origin}: component: {exc}") from None
-    motion = {"length_m": Constant(L0 - scenario.initial_contraction_m), "lengthening_velocity_m_s": Constant(0.0)}
+    if motion is None:
+        motion = {"length_m": Constant(L0 - scenario.initial_contraction_m), "lengthening_velocity_m_s": Constant(0.0)}
+    else:
+        motion = {"length_m": motion.length_signal(), "lengthening_velocity_m_s": motion.velocity_signal()}
 
     def signals_of(names):
         pressure = [n for n in names if n not in MOTION_INPUTS]
@@ -58,15 +65,17 @@ def muscle_only_spec(scenario, fmi_version: int = 2) -> FmuSpec:
                             f"the muscle of scenario {scenario.name} ({scenario.origin})", fmi_version)
 
 
-def build_muscle_only(scenario, output_path: str | os.PathLike | None = None, fmi_version: int = 2) -> Path:
-    """Generate, compile and zip the muscle-only FMU of ``scenario`` (default ``pamsim_assembly_fmi<version>.fmu``).
+def build_muscle_only(scenario, output_path: str | os.PathLike | None = None, fmi_version: int = 2,
+                      motion=None) -> Path:
+    """Generate, compile and zip the muscle-only FMU of ``scenario`` (default ``pamsim_assembly_fmi<version>.fmu``),
+    following ``motion`` (see :func:`muscle_only_spec`) until the importer drives it.
 
     Raises :class:`~pamsim.errors.InputError` for an unknown FMI version, a scenario the FMU cannot carry, a
     missing C compiler or a failed compilation.
     """
     if fmi_version not in FMI_VERSIONS:
         raise InputError(f"FMI version must be 2 or 3, not {fmi_version!r}")
-    spec = muscle_only_spec(scenario, fmi_version)
+    spec = muscle_only_spec(scenario, fmi_version, motion)
     return build_spec(Path(output_path) if output_path else Path(f"{spec.identifier}_fmi{fmi_version}.fmu"), spec)
 
 

@@ -9,13 +9,12 @@ import time
 import numpy as np
 
 from ..components.stick_slip import BodyMode, event_name
-from ..errors import InputError, SolverFailure
+from ..errors import InputError
 from ..assemblies.one_muscle import RUN_FUNCTIONS
 from ..modeling.pygen import compiled_by_mode
-from ..native.backend import (METHOD_LABEL, SCENARIO_CACHE_SIZE, KeptByObject, event_capacity, exact_segments,
-                              native_rtol)
+from ..native.backend import (METHOD_LABEL, SCENARIO_CACHE_SIZE, KeptByObject, check_status, event_capacity,
+                              exact_segments, native_rtol)
 from ..native.engine import EngineCase, engine_library
-from ..simulator import too_many_events
 from .result import JointEvent, JointResult
 from .scenario import JointScenario
 from .simulate import JointInputs, sampled_signals
@@ -43,13 +42,7 @@ def simulate_joint_native(scenario: JointScenario) -> JointResult:
     wall0 = time.perf_counter()
     out = library.run([case])
     wall = time.perf_counter() - wall0
-    status, message = int(out["status"][0]), out["messages"][0]
-    if status == 1:
-        raise InputError(f"{scenario.origin}: {message}")
-    if status == 2:
-        raise SolverFailure(f"native backend: {message}")
-    if status == 3 or int(out["n_events"][0]) > opts.max_events:
-        raise too_many_events(opts.max_events)
+    check_status(out, 0, scenario.origin, opts.max_events)
     return _result(scenario, assembly, muscles, library.names, out, np.linspace(0.0, scenario.duration_s, case.n_samples),
                    wall)
 

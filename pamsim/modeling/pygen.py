@@ -411,9 +411,10 @@ BY_MODE_CACHE_SIZE = 32
 """Structures kept per process (a sweep's runs share one)."""
 
 
-def compiled_by_mode(assembly, component: str, names=("f", "z", "transition", "rest_mode")) -> dict:
+def compiled_by_mode(assembly, component: str | None, names=("f", "z", "transition", "rest_mode")) -> dict:
     """``{mode: GeneratedModel}``: the assembly flattened and generated once for each mode of its hybrid
-    component ``component``, with no mode logic left in the code an integrator runs in that mode.
+    component ``component``, with no mode logic left in the code an integrator runs in that mode; for an
+    assembly without one (``component`` None), ``{0: GeneratedModel}``.
 
     Cached by the assembly's structure, so runs that differ only in parameter values (or the assembly's
     name, which the code does not use) share the code,
@@ -439,9 +440,12 @@ def _by_mode_from_disk(key) -> dict | None:
         return None
 
 
-def _generate_by_mode(assembly, component: str, names, key) -> dict:
-    modes = assembly.by_name[component].modes
-    generated = {int(m): GeneratedModel(assembly.flatten({component: int(m)}), names) for m in modes}
+def _generate_by_mode(assembly, component: str | None, names, key) -> dict:
+    if component is None:  # no hybrid component: one mode, 0, as the C engine numbers it
+        generated = {0: GeneratedModel(assembly.flatten(), names)}
+    else:
+        modes = assembly.by_name[component].modes
+        generated = {int(m): GeneratedModel(assembly.flatten({component: int(m)}), names) for m in modes}
     if not any(g.has_externals for g in generated.values()):
         code_cache.store(key, {str(mode): g.payload() for mode, g in generated.items()})
     return generated

@@ -438,6 +438,19 @@ _MODE_LABELS = {int(m): m.label for m in Mode}
 _MODES = {int(m): m for m in Mode}  # a dict look-up costs less than calling the enum
 
 
+def check_status(out: dict, i: int, origin: str, max_events: int) -> None:
+    """Raise what case ``i`` of an engine's output ended with, if not a run: :class:`InputError` for a bad value
+    the engine found (naming ``origin``), :class:`SolverFailure` for a failed integration or more than
+    ``max_events`` events."""
+    status, message = int(out["status"][i]), out["messages"][i]
+    if status == 1:
+        raise InputError(f"{origin}: {message}")
+    if status == 2:
+        raise SolverFailure(f"native backend: {message}")
+    if status == 3 or int(out["n_events"][i]) > max_events:
+        raise too_many_events(max_events)
+
+
 _event_names: dict[tuple[int, int, int], str] = {}  # a few modes and indicators: a few names
 
 

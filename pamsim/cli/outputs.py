@@ -1,0 +1,26 @@
+"""The files ``pamsim run`` writes for one run: NAME.csv, NAME.json and the figure."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+from typing import Callable
+
+
+def write_run_files(out: Path, name: str, args: argparse.Namespace, to_csv: Callable, summary: dict,
+                    figure: Callable) -> list[str]:
+    """Write ``NAME.csv`` (``to_csv(path)``), ``NAME.json`` (``summary``) and, without ``--no-plot``, the figure
+    ``figure()`` in ``--format`` at ``--dpi``, all or none (:func:`pamsim.atomic.atomic_outputs`); return the
+    files' names."""
+    from ..atomic import atomic_outputs
+    from ..figure_style import save
+
+    fmt, dpi = args.figures
+    names = [f"{name}.csv", f"{name}.json"] + ([] if args.no_plot else [f"{name}.{fmt}"])
+    with atomic_outputs(out, names) as tmp:
+        to_csv(tmp[names[0]])
+        tmp[names[1]].write_text(json.dumps(summary, indent=2) + "\n")
+        if not args.no_plot:
+            save(figure(), tmp[names[2]], fmt=fmt, dpi=dpi)
+    return names

@@ -1,0 +1,216 @@
+"""A muscle alone driven by its length (``[motion]``), on the python backend (``solve_ivp``), the native engine and
+the muscle-only FMU: the one generated assembly (:mod:`pamsim.assemblies.muscle_only`) on each.
+
+Its inputs are exactly linear between the knots of the motion and of the pressure's signals, so each backend
+integrates from knot to knot; an element's reaching its slip displacement is an event inside a leg, located by
+the integrator and followed by the element's jump onto its limit (the rig's treatment).  The muscle-only
+assembly has no hybrid component, so there are no modes: the python loop below integrates its one set of
+generated functions and applies the jump of whichever indicator crossed.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..assemblies.muscle_only import MOTION_INPUTS, muscle_only_assembly
+from ..assemblies.one_muscle import RUN_FUNCTIONS, input_signals, source_parts
+from ..errors import InputError, SolverFailure
+from ..modeling.pygen import compiled_by_mode, outputs_by_mode
+from ..simulator import _distinct_breaks, _event, _from_start, n_samples, too_many_events
+from .motion import Motion, motion_of
+from .result import LengthDrivenResult
+
+BACKENDS = ("python", "native", "fmu-cs", "fmu-me")
+"""The backends that run a muscle driven by its length."""
+
+MAX_INTERNAL_STEPS = 1_000_000
+"""Integrator steps the native engine may take per input segment before it gives up."""
+
+
+@dataclass
+class LengthDrive:
+    """A scenario's muscle alone, driven along its ``[motion]``: the motion, the model, the assembly and the
+    model's inputs by name (signals of time, in the flat model's order)."""
+
+    scenario: object
+    motion: Motion = field(init=False)
+
+    def __post_init__(self):
+        sc = self.scenario
+        self.motion = motion_of(sc)
+        self.model = sc.build_model()
+        try:
+            self.assembly = muscle_only_assembly(self.model, sc.parameters["L0_m"], sc.parameters["g_m_s2"],
+                                                 sc.initial_pressure_gauge_Pa, sc.added_components)
+        except ValueError as exc:
+            raise InputError(f"{sc.origin}: component: {exc}") from None
+        self.pressure_output = f"{source_parts(self.model.source, None).pressure}.p_gauge_Pa"
+        source = {k: s for k, s in input_signals(self.model).items() if k != "external_force_N"}
+        signals = {**source, "length_m": self.motion.length_signal(), "lengthening_velocity_m_s":
+                   self.motion.velocity_signal()}
+        names = list(self.assembly.inputs)
+        if sorted(names) != sorted(signals) or names[-2:] != list(MOTION_INPUTS):
+            raise ValueError(f"the muscle-only assembly's inputs {names} are not the signals' {list(signals)}")
+        self.signals = [signals[n] for n in names]
+        self.breakpoints = (*self.motion.breakpoints, *self.model.source.breakpoints)
+
+    def inputs(self, t) -> list:
+        """The model's inputs at ``t`` [s] (a float, or an array of times: one row each)."""
+        return [s(t) for s in self.signals]
+
+    def code(self) -> dict:
+        """The generated python code of the assembly, ``{0: GeneratedModel}`` (no modes)."""
+        return compiled_by_mode(self.assembly, None, RUN_FUNCTIONS)
+
+    def result(self, backend: str, t: np.ndarray, Y: np.ndarray, events: list, stats: dict,
+               wall_s: float) -> LengthDrivenResult:
+        """The run's :class:`LengthDrivenResult`: every state sampled and every output computed from the states
+        and inputs at the samples by the python backend's generated code."""
+        code = self.code()
+        outputs = outputs_by_mode(code, self.assembly.parameter_values(), list(Y), self.inputs(t),
+                                  np.zeros(len(t), dtype=int))
+        states = dict(zip(code[0].names["states"], Y))
+        return LengthDrivenResult(self.scenario.name, backend, self.motion, t, {**states, **outputs},
+                                  self.pressure_output, events, stats, wall_s)
+
+
+def simulate_length_drive(scenario, backend: str = "python") -> LengthDrivenResult:
+    """Run the muscle of ``scenario`` along its ``[motion]`` on ``backend`` (:data:`BACKENDS`).
+
+    Raises
+    ------
+    InputError
+        A bad ``[motion]`` table, a backend that does not run it, a model the backend cannot carry.
+    SolverFailure
+        The integrator failed, or the run had more than ``solver.max_events`` events.
+    """
+    if backend not in BACKENDS:
+        raise InputError(f"{scenario.origin}: --backend {backend}: a muscle driven by its length runs on "
+                         f"{', '.join(BACKENDS)}")
+    drive = LengthDrive(scenario)
+    run = {"python": _python, "native": _native, "fmu-cs": _fmu, "fmu-me": _fmu}[backend]
+    return run(drive, backend)
+
+
+def _segment(drive: LengthDrive, gen, p, t: float, y: np.ndarray, t_break: float, atol: np.ndarray):
+    """``solve_ivp`` of the generated model from ``t`` to ``t_break`` or its first indicator's crossing, its
+    inputs at their left limit at ``t_break`` (a jump there belongs to the next segment)."""
+    from scipy.integrate import solve_ivp
+
+    opts = drive.scenario.solver
+    t_left = float(np.nextafter(t_break, -math.inf))
+
+    def rhs(tt, yy):
+        return gen.f(yy.tolist(), drive.inputs(min(tt, t_left)), p, ())[0]
+
+    def indicator(k):
+        return _event(lambda tt, yy: gen.z(yy.tolist(), drive.inputs(min(tt, t_left)), p, ())[0][k], -1.0)
+
+    n = len(drive.assembly.indicator_names())
+    try:
+        sol = solve_ivp(rhs, (t, t_break), y, method=opts.method, dense_output=True,
+                        events=[_from_start(indicator(k), t, y) for k in range(n)], rtol=opts.rtol, atol=atol,
+                        max_step=opts.max_step_s)
+    except Exception as exc:  # solve_ivp's numerical trouble comes as plain exceptions: a solver failure (exit 3)
+        raise SolverFailure(f"solve_ivp raised {type(exc).__name__} at t = {t:.6g} s: {exc}") from exc
+    if sol.status == -1:
+        raise SolverFailure(f"solve_ivp failed at t = {t:.6g} s: {sol.message}")
+    return sol
+
+
+def _python(drive: LengthDrive, backend: str) -> LengthDrivenResult:
+    """``solve_ivp`` from knot to knot, stopping at each indicator's crossing for its jump."""
+    sc, opts = drive.scenario, drive.scenario.solver
+    wall0 = time.perf_counter()
+    gen, p = drive.code()[0], drive.assembly.parameter_values()
+    names = [f"{c}.{n}" for c, n in drive.assembly.indicator_names()]
+    atol = opts.rtol * np.array([v.nominal for v in drive.assembly.flatten().states])
+    grid = np.linspace(0.0, sc.duration_s, n_samples(sc.duration_s, opts.sample_rate_Hz))
+    t, y = 0.0, np.array(gen.x0(drive.inputs(0.0), p)[0], dtype=float)
+    ys, events, nfev, segments, next_sample = [], [], 0, 0, 0
+    for t_break in _distinct_breaks(drive.breakpoints, sc.duration_s):
+        while t < t_break:
+            sol = _segment(drive, gen, p, t, y, t_break, atol)
+            nfev, segments = nfev + sol.nfev, segments + 1
+            j = np.searchsorted(grid, sol.t[-1], side="right")
+            ys.append(sol.sol(grid[next_sample:j]))
+            next_sample = j
+            if sol.status != 1:
+                t, y = t_break, sol.y[:, -1].copy()
+                continue
+            k = next(i for i, te in enumerate(sol.t_events) if len(te))
+            t = float(sol.t_events[k][0])
+            fired = [1.0 if i == k else 0.0 for i in range(len(names))]
+            y = np.array(gen.transition(list(sol.y_events[k][0]), drive.inputs(t), p, (), fired)[0])
+            events.append((t, names[k]))
+            if len(events) > opts.max_events:
+                raise too_many_events(opts.max_events, f" by t = {t:.6g} s")
+    stats = {"rhs_evaluations": int(nfev), "events": len(events), "segments": segments, "method": opts.method,
+             "rtol": opts.rtol}
+    return drive.result(backend, grid, np.concatenate(ys, axis=1), events, stats, time.perf_counter() - wall0)
+
+
+def _native(drive: LengthDrive, backend: str) -> LengthDrivenResult:
+    """The generic C engine compiled with the assembly's generated C, its inputs cut into exact segments."""
+    from ..native.backend import METHOD_LABEL, check_status, event_capacity, exact_segments, native_rtol
+    from ..native.engine import EngineCase, engine_library
+
+    sc, opts = drive.scenario, drive.scenario.solver
+    try:
+        library = engine_library(drive.assembly)
+    except NotImplementedError as exc:
+        raise InputError(f"{sc.origin}: the native backend cannot run this muscle: {exc}") from None
+    pieces = exact_segments(drive.signals, sc.duration_s)
+    if pieces is None:
+        raise InputError(f"{sc.origin}: a pressure input is a Python function, which the native backend cannot "
+                         "carry; run it with the python backend")
+    starts, u, du = pieces
+    n = n_samples(sc.duration_s, opts.sample_rate_Hz)
+    max_step = opts.max_step_s if math.isfinite(opts.max_step_s) else sc.duration_s
+    case = EngineCase(np.array(drive.assembly.parameter_values()), native_rtol(opts), max_step, MAX_INTERNAL_STEPS,
+                      sc.duration_s, n, starts, u, event_capacity(opts.max_events), du)
+    wall0 = time.perf_counter()
+    out = library.run([case])
+    wall = time.perf_counter() - wall0
+    check_status(out, 0, sc.origin, opts.max_events)
+    ns = len(library.names["states"])
+    Y = np.array(out["samples"][:ns * n].reshape(ns, n))
+    names = [f"{c}.{k}" for c, k in drive.assembly.indicator_names()]
+    # e[3] is the bit mask of the indicators that fired: one event each, as the python loop reports them
+    events = [(float(e[0]), name) for e in out["events"][:int(out["n_events"][0])].tolist()
+              for k, name in enumerate(names) if int(e[3]) >> k & 1]
+    stats = {"rhs_evaluations": int(out["stats"][0][0]), "events": len(events), "segments": int(out["stats"][0][2]),
+             "method": METHOD_LABEL, "rtol": native_rtol(opts)}
+    return drive.result(backend, np.linspace(0.0, sc.duration_s, n), Y, events, stats, wall)
+
+
+def _fmu(drive: LengthDrive, backend: str) -> LengthDrivenResult:
+    """The muscle-only FMU following the scenario's signals and the motion itself (``input_source =
+    scenario``), run by fmpy; the FMU does not report its events, so an element's slip is counted where its
+    ``slipping`` output rises between two samples."""
+    from ..fmu.assembly_runner import run_trace
+    from ..fmu.build import build_spec, temp_fmu
+    from ..fmu.muscle_only import muscle_only_spec
+
+    sc = drive.scenario
+    spec = muscle_only_spec(sc, motion=drive.motion)
+    path = temp_fmu(spec.token, f"{spec.identifier}_fmi2.fmu", lambda out: build_spec(out, spec))
+    interface = backend.split("-")[1]
+    t, Y, _, wall = run_trace(path, interface, sc.duration_s, sc.solver, spec.states, None)
+    # Model exchange may record an event a few ulps off a grid time as well as the grid time: the last row of
+    # each output tick is kept (after the event), as on one time.
+    ticks = np.round(t * sc.solver.sample_rate_Hz)
+    last = np.r_[ticks[1:] != ticks[:-1], True]
+    t, Y = ticks[last] / sc.solver.sample_rate_Hz, Y[:, last]
+    result = drive.result(backend, t, Y, [], {}, wall)
+    slipping = [k for k in result.signals if k.split(".")[-1].startswith("slipping")]
+    events = [(float(t[j + 1]), name.replace("slipping", "slip")) for name in slipping
+              for j in np.flatnonzero(np.diff(result.signals[name]) > 0.5)]
+    result.events = sorted(events)
+    result.stats = {"rhs_evaluations": 0, "events": len(events), "segments": 0, "method": backend,
+                    "rtol": sc.solver.rtol}
+    return result
