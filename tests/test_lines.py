@@ -230,17 +230,19 @@ def chain_runs():
     return sc, pamsim.simulate(sc)
 
 
-@pytest.mark.parametrize("backend, bound_Pa", [("native", 10.0), ("fmu-cs", 10.0), ("fmu-me", 30.0)])
-def test_every_backend_runs_the_line_as_python_does(chain_runs, backend, bound_Pa):
+@pytest.mark.parametrize("backend, rtol, bound_m, bound_Pa", [("native", None, 1e-6, 10.0), ("fmu-cs", None, 1e-6, 10.0),
+                                                              ("fmu-me", None, 6e-6, 45.0), ("fmu-me", 1e-8, 1e-6, 10.0)])
+def test_every_backend_runs_the_line_as_python_does(chain_runs, backend, rtol, bound_m, bound_Pa):
     """The final contraction within 1 um of the python run's, as for the chamber's laws, and the pressure of
-    every volume along the line within 10 Pa (measured: native 0.82, fmu-cs 1.2 Pa); the model-exchange FMU,
-    integrated by fmpy's own solver, within 30 Pa (measured 21.5 Pa, during the muscle's fast fill at 0.74 s;
-    its final contraction 0.78 um away)."""
+    every volume along the line within 10 Pa (measured: native 0.82, fmu-cs 1.2 Pa).  The model-exchange FMU is
+    integrated by fmpy's CVode, whose error at the scenario's rtol = 1e-6 is larger: within 6 um and 45 Pa
+    (measured 3.1 um and 29.8 Pa, in the muscle's fast fill after 0.74 s); at rtol = 1e-8 it is the other
+    backends' (measured 0.05 um, 0.74 Pa), so the difference is CVode's tolerance and not the FMU's equations."""
     if backend.startswith("fmu"):
         pytest.importorskip("fmpy")
     sc, py = chain_runs
-    res = pamsim.simulate(sc, backend=backend)
-    assert abs(res.x_m[-1] - py.x_m[-1]) < 1e-6
+    res = pamsim.simulate(sc if rtol is None else sc.with_changes({"solver": {"rtol": rtol}}), backend=backend)
+    assert abs(res.x_m[-1] - py.x_m[-1]) < bound_m
     assert np.max(np.abs(res.p_gauge_Pa - py.p_gauge_Pa)) < bound_Pa
     for name in ("tube.p_gauge_Pa", "reservoir.p_gauge_Pa", "feed.p_gauge_Pa", "supply.p_gauge_Pa"):
         assert np.max(np.abs(res.signals[name] - py.signals[name])) < bound_Pa

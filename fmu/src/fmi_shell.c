@@ -465,11 +465,14 @@ int fmu_completed_integrator_step(FmuInstance *in, const char *function) {
 int fmu_set_time(FmuInstance *in, const char *function, double time) {
     if (!fmu_allowed(in, function, FMU_EVENT | FMU_CONT)) return -1;
     in->core.time_s = time;
-    /* Continuous time runs from the last event, where it sees the signals from the right, to the next
-     * time event, where it sees them from the left; the event itself sees them from the right. */
-    if (in->state == FMU_EVENT) in->core.event_time_s = event_instant(&in->core, time);
-    /* Up to the event's breakpoint (a few roundings after the time, see event_instant) it is the event's values. */
-    pam_inputs_at(&in->core, fmax(time, in->core.event_time_s), in->state == FMU_CONT && time > in->core.event_time_s);
+    /* An event sees the signals from the right of its breakpoint (a few roundings after the time, see
+     * event_instant).  Continuous time from it follows the piece it began, continued past the next time
+     * event until that event is handled: an integrator that steps past the event before it stops there
+     * (CVode does, and interpolates back) meets no jump, as the continuous equations have none. */
+    if (in->state == FMU_EVENT) {
+        in->core.event_time_s = event_instant(&in->core, time);
+        pam_inputs_at(&in->core, fmax(time, in->core.event_time_s), 0);
+    } else pam_inputs_on_piece(&in->core, in->core.event_time_s, time);
     return 0;
 }
 

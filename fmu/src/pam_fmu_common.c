@@ -76,22 +76,33 @@ static int scheduled(const PamCore *c) {
 
 /* pamsim.fmu.preset.InputSignal: knots interpolated as numpy.interp does and held outside them, a knot
  * time given twice being a step; or a step through a first-order lag (pamsim.signals.FirstOrderLag).
- * `left`: the value from the left of t, which the integrator takes up to a breakpoint. */
-static double signal_value(const PamSignal *s, double t, int left) {
+ * Its pieces run between breakpoints; the piece of t_piece (`left`: the one that ends at t_piece if a
+ * breakpoint is there, else the one that starts there) evaluated at t, its formula continued beyond
+ * its ends. */
+static double signal_on_piece(const PamSignal *s, double t_piece, int left, double t) {
     int lo = 0, hi = s->n, k;
     if (s->n == 0) {
-        if (t < s->time_s) return s->initial;
+        if (left ? t_piece <= s->time_s : t_piece < s->time_s) return s->initial;
         return s->final + (s->initial - s->final) * exp(-(t - s->time_s) / s->tau_s);
     }
-    while (lo < hi) { /* lo: the knots before t (left) or at or before it (right) */
+    while (lo < hi) { /* lo: the knots before t_piece (left) or at or before it (right) */
         int mid = (lo + hi) / 2;
-        if (left ? s->t_s[mid] < t : s->t_s[mid] <= t) lo = mid + 1;
+        if (left ? s->t_s[mid] < t_piece : s->t_s[mid] <= t_piece) lo = mid + 1;
         else hi = mid;
     }
     k = lo - 1;
     if (k < 0) return s->value[0];
     if (k == s->n - 1) return s->value[k];
     return (s->value[k + 1] - s->value[k]) / (s->t_s[k + 1] - s->t_s[k]) * (t - s->t_s[k]) + s->value[k];
+}
+
+/* `left`: the value from the left of t, which the integrator takes up to a breakpoint. */
+static double signal_value(const PamSignal *s, double t, int left) { return signal_on_piece(s, t, left, t); }
+
+void pam_inputs_on_piece(PamCore *c, double t_piece_s, double t_s) {
+    int k;
+    if (!scheduled(c)) return;
+    for (k = 0; k < PAM_NSIG; k++) c->r[PAM_SIGNALS[k].r] = signal_on_piece(&PAM_SIGNALS[k], t_piece_s, 0, t_s);
 }
 
 /* The signals at t_s, but for the inputs in `keep` (bit k: signal k). */

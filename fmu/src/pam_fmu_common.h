@@ -80,6 +80,9 @@ int pam_check_parameter_ranges(PamCore *c);
  * pam_variables.h); otherwise these do nothing.  pam_inputs_at sets them at t_s, their values from the
  * left of t_s (left != 0: the end of an interval) or from the right (an event, a start). */
 void pam_inputs_at(PamCore *c, double t_s, int left);
+/* The signals on the piece that begins at or before t_piece_s (from the right), its formula continued to t_s
+ * however far past the piece's end t_s is (model exchange between two events). */
+void pam_inputs_on_piece(PamCore *c, double t_piece_s, double t_s);
 /* The same, but for the inputs in `keep` (bit k: signal k), which the importer set and keep their value. */
 void pam_apply_signals(PamCore *c, double t_s, int left, unsigned keep);
 /* 1 if input `vr` follows a signal, its value now (from the right) in *value; else 0. */
