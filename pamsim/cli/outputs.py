@@ -24,3 +24,10 @@ def write_run_files(out: Path, name: str, args: argparse.Namespace, to_csv: Call
         if not args.no_plot:
             save(figure(), tmp[names[2]], fmt=fmt, dpi=dpi)
     return names
+
+
+def wall_time_text(wall_time_s: float) -> str:
+    """A run's wall time for its summary line, to three figures: a native run takes a fraction of a
+    millisecond, which whole milliseconds printed as 0 ms."""
+    ms = wall_time_s * 1e3
+    return f"{ms:.0f} ms" if ms >= 100.0 else f"{ms:.3g} ms"

@@ -18,7 +18,7 @@ from ..backends import BACKENDS, DESCRIPTIONS, check_backend
 from ..errors import InputError
 from . import figure_args, finite_float
 from .length_run import check_length_drive, is_length_driven, run_length_drive
-from .outputs import write_run_files
+from .outputs import wall_time_text, write_run_files
 
 MAX_CSV_MB = 200.0
 """Default limit of ``pamsim run --max-csv-MB``: a CSV beyond it is refused before the run."""
@@ -185,7 +185,7 @@ def _run_joint(scenario, args: argparse.Namespace, out: Path) -> list[str]:
     final = f"final angle {summary[f'final_{pos}']:.4f} rad" if joint else f"final position {summary[f'final_{pos}'] * 1e3:.3f} mm"
     print(f"{scenario.name}: {final} ({summary['final_mode']}), {muscles}; "
           f"{len(summary['events'])} events, {result.stats['rhs_evaluations']} RHS evaluations, "
-          f"{result.wall_time_s * 1e3:.0f} ms")
+          f"{wall_time_text(result.wall_time_s)}")
     if joint:
         print(f"  at rest at these pressures the joint balances at {eq.theta_rad:.4f} rad"
               + (f" (on its {eq.on_limit} limit)" if eq.on_limit else "") + f", stiffness {eq.k_Nm_per_rad:.4g} N m/rad")
@@ -275,7 +275,7 @@ def _run_one(scenario, args: argparse.Namespace, out: Path) -> list[str]:
     print(f"{scenario.name}: final contraction {s['final_contraction_m'] * 1e3:.2f} mm "
           f"(peak {s['peak_contraction_m'] * 1e3:.2f} mm), final pressure {s['final_pressure_gauge_Pa'] / 1e5:.3f} bar, "
           f"{'at rest' if s['at_rest_at_end'] else 'still moving'} ({s['final_mode']}), {s['events']} events, "
-          f"{s['rhs_evaluations']} RHS evaluations, {s['wall_time_s'] * 1e3:.0f} ms")
+          f"{s['rhs_evaluations']} RHS evaluations, {wall_time_text(s['wall_time_s'])}")
     if outcome.closed_loop is not None:
         c = s["controller"]
         m = c["metrics"]
