@@ -6,8 +6,9 @@
 A refactor of the model changes no result: run ``save`` on the commit before it (a git worktree of
 that commit, with ``PYTHONPATH`` pointing at it), then ``compare`` on the new code.  The cases are the
 66 steady-state tests of the ACRA 2012 paper with both friction models of ``acra2012_grid.toml``
-(132 runs), its frequency study (14), the figure scenarios and the closed-loop example (python
-backend only: the others have no controller).  Per backend, ``compare`` prints the largest difference
+(132 runs), its frequency study (14), the figure scenarios and the closed-loop example (on every
+backend: the native engine and the assembly's FMU carry its controller).  Not the other scenario files
+(the supply chain, the joints, the length-driven cycles): their own tests hold them.  Per backend, ``compare`` prints the largest difference
 of the final and the peak contraction [mm], of the sampled contraction [mm], of the event times [s]
 and the number of cases whose event sequence (kinds and modes) differs, against the bounds:
 final and peak contraction 1e-6 mm, the first ``BOUNDED_EVENTS`` events of each case 1e-9 s.  It

@@ -73,19 +73,6 @@ int fmu_enter_initialization_mode(FmuInstance *in, const char *function) {
     return transition(in, function, FMU_INSTANTIATED, FMU_INIT);
 }
 
-int fmu_exit_initialization_mode(FmuInstance *in, const char *function) {
-    if (!fmu_allowed(in, function, FMU_INIT)) return -1;
-    if (pam_check_parameters(&in->core)) {
-        in->state = FMU_ERROR;
-        return -1;
-    }
-    pam_initialize(&in->core);
-    in->core.event_time_s = in->core.time_s;
-    in->core.inputs_set = 0; /* input_source is fixed from here: a set input is checked when it is set */
-    in->state = in->is_cs ? FMU_STEP : FMU_EVENT;
-    return 0;
-}
-
 /* A breakpoint within a relative 1e-9 of the time is this event's: an importer may take a time event as reached
  * at a point that close to it (fmpy's math.isclose does), and a next event time a few roundings later would have
  * it integrate over nothing (CVode: "tout too close to t0").  The event is then at that breakpoint. */
@@ -100,11 +87,31 @@ static double event_instant(const PamCore *c, double t_s) {
     return t_s;
 }
 
+/* The model-exchange event at the time: at its breakpoint (event_instant), where it sees the signals from
+ * the right. */
+static void enter_event_instant(FmuInstance *in) {
+    in->core.event_time_s = event_instant(&in->core, in->core.time_s);
+    pam_inputs_at(&in->core, in->core.event_time_s, 0);
+}
+
+int fmu_exit_initialization_mode(FmuInstance *in, const char *function) {
+    if (!fmu_allowed(in, function, FMU_INIT)) return -1;
+    if (pam_check_parameters(&in->core)) {
+        in->state = FMU_ERROR;
+        return -1;
+    }
+    pam_initialize(&in->core);
+    in->core.event_time_s = in->core.time_s;
+    in->core.inputs_set = 0; /* input_source is fixed from here: a set input is checked when it is set */
+    in->state = in->is_cs ? FMU_STEP : FMU_EVENT;
+    if (!in->is_cs) enter_event_instant(in);
+    return 0;
+}
+
 int fmu_enter_event_mode(FmuInstance *in, const char *function) {
     if (!fmu_allowed(in, function, FMU_EVENT | FMU_CONT) || in->is_cs) return -1;
     in->state = FMU_EVENT;
-    in->core.event_time_s = event_instant(&in->core, in->core.time_s);
-    pam_inputs_at(&in->core, in->core.event_time_s, 0); /* an event sees the signals' values after a breakpoint */
+    enter_event_instant(in);
     return 0;
 }
 
@@ -469,10 +476,8 @@ int fmu_set_time(FmuInstance *in, const char *function, double time) {
      * event_instant).  Continuous time from it follows the piece it began, continued past the next time
      * event until that event is handled: an integrator that steps past the event before it stops there
      * (CVode does, and interpolates back) meets no jump, as the continuous equations have none. */
-    if (in->state == FMU_EVENT) {
-        in->core.event_time_s = event_instant(&in->core, time);
-        pam_inputs_at(&in->core, fmax(time, in->core.event_time_s), 0);
-    } else pam_inputs_on_piece(&in->core, in->core.event_time_s, time);
+    if (in->state == FMU_EVENT) enter_event_instant(in);
+    else pam_inputs_on_piece(&in->core, in->core.event_time_s, fmax(time, in->core.event_time_s));
     return 0;
 }
 

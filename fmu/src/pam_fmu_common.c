@@ -76,9 +76,9 @@ static int scheduled(const PamCore *c) {
 
 /* pamsim.fmu.preset.InputSignal: knots interpolated as numpy.interp does and held outside them, a knot
  * time given twice being a step; or a step through a first-order lag (pamsim.signals.FirstOrderLag).
- * Its pieces run between breakpoints; the piece of t_piece (`left`: the one that ends at t_piece if a
- * breakpoint is there, else the one that starts there) evaluated at t, its formula continued beyond
- * its ends. */
+ * Its pieces run between breakpoints.  The piece of t_piece is the one that contains it; where t_piece is a
+ * breakpoint, the one that ends there (`left`) or the one that starts there.  It is evaluated at t, its
+ * formula continued beyond its ends. */
 static double signal_on_piece(const PamSignal *s, double t_piece, int left, double t) {
     int lo = 0, hi = s->n, k;
     if (s->n == 0) {
@@ -126,7 +126,7 @@ int pam_input_scheduled(const PamCore *c, unsigned vr, double *value) {
     if (!scheduled(c)) return 0;
     for (k = 0; k < PAM_NSIG; k++)
         if (PAM_SIGNALS[k].vr == vr) {
-            *value = signal_value(&PAM_SIGNALS[k], c->time_s, 0);
+            *value = c->r[PAM_SIGNALS[k].r];
             return 1;
         }
     return 0;

@@ -85,7 +85,8 @@ void pam_inputs_at(PamCore *c, double t_s, int left);
 void pam_inputs_on_piece(PamCore *c, double t_piece_s, double t_s);
 /* The same, but for the inputs in `keep` (bit k: signal k), which the importer set and keep their value. */
 void pam_apply_signals(PamCore *c, double t_s, int left, unsigned keep);
-/* 1 if input `vr` follows a signal, its value now (from the right) in *value; else 0. */
+/* 1 if input `vr` follows a signal, the value the FMU applies now in *value (its signal's at the time, from the
+ * right; in model exchange's continuous time the last event's piece); else 0. */
 int pam_input_scheduled(const PamCore *c, unsigned vr, double *value);
 /* Before the end of initialisation the importer may still choose input_source: an input it sets is
  * marked here, keeps its value, and is checked against its signal by pam_check_signals. */

@@ -93,8 +93,8 @@ def run_trace(path: Path, interface: str, duration_s: float, opts, states, mode:
     except Exception as exc:  # fmpy raises a bare Exception carrying the FMI status
         raise SolverFailure(f"FMU {KINDS[interface]} of {Path(path).name} failed: {exc}") from None
     wall = time.perf_counter() - wall0
-    rows = grid_rows(res["time"], dt)
-    return (np.asarray(res["time"][rows], dtype=float), np.array([np.asarray(res[n][rows], dtype=float) for n in states]),
+    rows, t = grid_rows(res["time"], dt)
+    return (t, np.array([np.asarray(res[n][rows], dtype=float) for n in states]),
             np.asarray(res[mode][rows], dtype=int) if mode else np.zeros(len(rows), dtype=int), wall)
 
 

@@ -308,9 +308,9 @@ def run_me(scenario: Scenario, fmi_version: int = 2, fmu_path: Path | None = Non
     except Exception as exc:
         raise SolverFailure(f"FMU model exchange failed: {exc}") from None
     t = res["time"]
-    on_grid = grid_rows(t, dt)
+    on_grid, out_t = grid_rows(t, dt)
     out = {name: np.asarray(res[name][on_grid], dtype=float) for name in OUTPUTS}
-    out["t_s"] = np.asarray(t[on_grid], dtype=float)
+    out["t_s"] = out_t
     out["friction_mode"] = np.asarray(res["friction_mode"][on_grid], dtype=int)
     return out
 
@@ -319,18 +319,21 @@ N_WORK_STATES = 4
 """The work integrals after the states: the muscle's, friction's, damping's and the external force's."""
 
 
-def grid_rows(t_s: np.ndarray, dt_s: float) -> np.ndarray:
-    """The rows of an fmpy result (times ``t_s`` [s]) on the output grid of interval ``dt_s`` [s].
+def grid_rows(t_s: np.ndarray, dt_s: float) -> tuple[np.ndarray, np.ndarray]:
+    """The rows of an fmpy result (times ``t_s`` [s]) on the output grid of interval ``dt_s`` [s], and their
+    grid times ``k dt_s`` [s].
 
     fmpy records both sides of an event at one time, and model exchange may record an event a few
-    roundings off a grid time (a load released 4e-10 s after a time event that opens a valve) as well as
-    the grid time: of the rows within 1e-6 of an interval of a grid time, the last is kept (after the
-    events), one row per grid time.
+    roundings after a grid time as well as the grid time (a load released 4e-10 s after the time event of a
+    step at 0.5 s that opens a valve): of the rows within rounding of a grid time (1e-9 of the time or of
+    the interval, the FMU's own tolerance for one instant), the last is kept (after the events), one row
+    per grid time, at that grid time.
     """
-    ticks = np.asarray(t_s, dtype=float) / dt_s
-    tick = np.round(ticks)
-    idx = np.flatnonzero(np.abs(ticks - tick) < 1e-6)
-    return idx[np.r_[tick[idx][1:] != tick[idx][:-1], True]]
+    t = np.asarray(t_s, dtype=float)
+    k = np.round(t / dt_s)
+    idx = np.flatnonzero(np.abs(t - k * dt_s) <= 1e-9 * np.maximum(np.abs(t), dt_s))
+    rows = idx[np.r_[k[idx][1:] != k[idx][:-1], True]]
+    return rows, k[rows] * dt_s
 
 
 def trace_stats(modes: np.ndarray, backend: str, rtol: float) -> dict:
