@@ -73,8 +73,9 @@ static int rest_mode(const PamEngine *e, int mode, const double *y) {
 }
 
 /* The jump at an event whose indicators `fired` (bit k: indicator k) have crossed: new states in y,
- * new mode in e->mode; returns 1 if a state changed. */
-static int transition(PamEngine *e, double *y, unsigned fired) {
+ * new mode in e->mode (*jump_mode: the jump's own, before the held mode is decided afresh); returns 1
+ * if a state changed. */
+static int transition(PamEngine *e, double *y, unsigned fired, int *jump_mode) {
     double flags[PM_NZ > 0 ? PM_NZ : 1], next[PM_NX], q = PM_MODE_VALUE[e->mode];
     int k, jumped = 0;
     for (k = 0; k < PM_NZ; k++) flags[k] = (fired >> k) & 1u ? 1.0 : 0.0;
@@ -83,7 +84,8 @@ static int transition(PamEngine *e, double *y, unsigned fired) {
         jumped |= next[k] != y[k];
         y[k] = next[k];
     }
-    e->mode = rest_mode(e, mode_of(q), y);
+    *jump_mode = mode_of(q);
+    e->mode = rest_mode(e, *jump_mode, y);
     return jumped;
 }
 
@@ -100,6 +102,8 @@ static unsigned fired_indicators(const PamEngine *e, const double *y) {
 
 void pam_engine_reset(PamEngine *e) {
     memset(e, 0, sizeof *e);
+    e->hold_until_s = -HUGE_VAL;
+    e->since_s = -HUGE_VAL;
     e->rtol = 1e-6;
     e->max_step_s = 1e-3;
     e->max_steps = 1000000;
@@ -251,13 +255,33 @@ static int step_failed(PamEngine *e, double t, const double *y) {
     return -1;
 }
 
+/* The first hold [s] of a model whose slip from rest ended where it began, doubled at each repetition up to
+ * PAM_ENGINE_MAX_HOLD_DOUBLINGS times (pamsim.simulator._HOLD_S, the python backend's rule).  A body at rest
+ * whose net force beats friction by a little, but whose forces turn as it moves (a controller venting, two
+ * muscles' load-dependent frictions), slips and stops again within a time and speed below the integrator's
+ * resolution; deciding its mode again from the same forces would repeat that for ever.  It is held for the
+ * hold, whatever its forces do, and its mode decided again at the hold's end. */
+#define PAM_ENGINE_HOLD_S 1e-9
+#define PAM_ENGINE_MAX_HOLD_DOUBLINGS 29 /* the longest hold, 2^29 ns: about 0.54 s */
+
 /* The event located at y (time t): the jump and the new mode; -1 if events make no progress. */
 static int at_event(PamEngine *e, double t, double *y, int *zero_length) {
     double y_before[PM_NX];
-    int old = e->mode, jumped;
+    int old = e->mode, jumped, jump_mode;
     unsigned fired = fired_indicators(e, y);
+    /* Within a hold's first length of its start: a slip that short moved the body by at most that time times
+     * the velocity tolerance (python takes 1e-12 s relative; a slip from rest that turns back at once can
+     * last a little longer where the forces that turn it are weak, and would then be decided again at once). */
+    int instant = t - e->since_s <= fmax(1e-12 * fmax(1.0, fabs(t)), PAM_ENGINE_HOLD_S);
     memcpy(y_before, y, sizeof y_before);
-    jumped = transition(e, y, fired);
+    jumped = transition(e, y, fired, &jump_mode);
+    e->n_zero = instant ? e->n_zero + 1 : 0;
+    e->since_s = t;
+    if (instant && PM_MODE_HELD[jump_mode] && !PM_MODE_HELD[old] && !held(e)) {
+        int doublings = (e->n_zero <= PAM_ENGINE_MAX_HOLD_DOUBLINGS ? e->n_zero : PAM_ENGINE_MAX_HOLD_DOUBLINGS + 1) - 1;
+        e->mode = jump_mode;
+        e->hold_until_s = t + ldexp(PAM_ENGINE_HOLD_S, doublings);
+    }
     if (!jumped && e->mode == old) {
         if (++*zero_length > PAM_ENGINE_MAX_ZERO_LENGTH) {
             engine_logf(e, PAM_ENGINE_ERROR, "event switching made no progress at t = %.9g s", t);
@@ -271,10 +295,18 @@ static int at_event(PamEngine *e, double t, double *y, int *zero_length) {
     return 0;
 }
 
-/* A held model's mode decided again where its inputs jump or reach a breakpoint. */
-static void recheck_held(PamEngine *e, const double *y) {
+/* 1 while a hold (PAM_ENGINE_HOLD_S) runs at t. */
+static int holding(const PamEngine *e, double t) { return t < e->hold_until_s; }
+
+/* The end of the piece from t that the integrator crosses next: piece_end's, or a running hold's end. */
+static double next_piece_end(const PamEngine *e, double t, double t_end) {
+    return holding(e, t) ? fmin(piece_end(e, t, t_end), e->hold_until_s) : piece_end(e, t, t_end);
+}
+
+/* A held model's mode decided again where its inputs jump or reach a breakpoint, unless a hold runs. */
+static void recheck_held(PamEngine *e, double t, const double *y) {
     int old = e->mode;
-    if (!held(e)) return;
+    if (!held(e) || holding(e, t)) return;
     e->mode = rest_mode(e, e->mode, y);
     if (e->mode != old) e->n_events++;
 }
@@ -292,22 +324,23 @@ int pam_engine_do_step(PamEngine *e, double t_end) {
     int zero_length = 0, n;
     memcpy(y, e->x, sizeof y);
     inputs_at(e, t, 0);
-    if (e->inputs_changed || at_breakpoint(e, t)) recheck_held(e, y);
+    if (e->inputs_changed || at_breakpoint(e, t)) recheck_held(e, t, y);
     e->inputs_changed = 0;
     rhs(e, y, s.k[0]);
-    t_piece = piece_end(e, t, t_end);
+    t_piece = next_piece_end(e, t, t_end);
     /* A remainder below the time resolution (left by an event located just before t_end) is not a step. */
     while (t_end - t > 1e-13 * fmax(1.0, fabs(t_end))) {
         double h, err, factor, lo = 0.0, hi = 1.0;
         unsigned crossed;
         int last, at_rest = held(e);
         if (t_piece - t <= 1e-13 * fmax(1.0, fabs(t_piece))) {
-            /* A breakpoint of the signals: they take their values from the right. */
+            /* A breakpoint of the signals (they take their values from the right), or a hold's end. */
             t = t_piece;
+            e->since_s = t;
             inputs_at(e, t, 0);
-            recheck_held(e, y);
+            recheck_held(e, t, y);
             rhs(e, y, s.k[0]);
-            t_piece = piece_end(e, t, t_end);
+            t_piece = next_piece_end(e, t, t_end);
             continue;
         }
         inputs_at(e, t, 0); /* a rejected trial step left them at its end */
@@ -337,7 +370,7 @@ int pam_engine_do_step(PamEngine *e, double t_end) {
         }
         factor = err == 0.0 ? 10.0 : fmin(10.0, fmax(0.2, 0.9 * pow(err, -0.2)));
         e->n_steps++;
-        if ((crossed = first_crossing(e, &s, t, y, y1, h, &lo, &hi)) != 0) {
+        if (!holding(e, t) && (crossed = first_crossing(e, &s, t, y, y1, h, &lo, &hi)) != 0) {
             /* Locate the first crossing of the indicators that crossed on the dense output; keep the
              * far side so that the event test holds. */
             double ye[PM_NX], t_event;
@@ -351,6 +384,7 @@ int pam_engine_do_step(PamEngine *e, double t_end) {
             memcpy(y, ye, sizeof y);
             memcpy(e->x, y, sizeof y);
             if (at_event(e, t, y, &zero_length)) return step_failed(e, t, y);
+            t_piece = next_piece_end(e, t, t_end); /* a hold may have begun */
             e->h_s = fmax(fmin(h * hi, h_max), 1e-6);
             rhs(e, y, s.k[0]);
             continue;

@@ -59,6 +59,9 @@ typedef struct {
     long max_steps;         /* internal steps per call of pam_engine_do_step */
     double h_s;             /* next step */
     int inputs_changed;     /* a held model's mode is decided again at the next step */
+    double hold_until_s;    /* a short hold of a slip too small to resolve runs until here (-HUGE_VAL: none) */
+    double since_s;         /* the last event or breakpoint, from which an event's time is measured */
+    int n_zero;             /* slips in a row that ended where they began (the hold's doubling) */
     long n_steps, n_rhs, n_events;
     PamEngineLogFn log;
     void *log_env;

@@ -56,6 +56,9 @@ void pam_reset(PamCore *c) {
     c->n_steps = c->n_rhs = c->n_events = 0;
     c->event_time_s = 0.0;
     c->inputs_set = 0;
+    c->hold_until_s = -HUGE_VAL; /* no hold, as pam_engine_reset leaves it */
+    c->since_s = -HUGE_VAL;
+    c->n_zero = 0;
 }
 
 #ifdef PAM_NCHECKS
@@ -160,6 +163,9 @@ static void engine_load(PamCore *c, EngineRun *run) {
     e->max_steps = c->i[I_cs_max_internal_steps];
     e->h_s = c->h_s;
     e->inputs_changed = c->inputs_changed;
+    e->hold_until_s = c->hold_until_s;
+    e->since_s = c->since_s;
+    e->n_zero = c->n_zero;
     e->n_steps = c->n_steps;
     e->n_rhs = c->n_rhs;
     e->n_events = c->n_events;
@@ -187,6 +193,9 @@ static void engine_store(PamCore *c, const EngineRun *run) {
     c->mode = e->mode;
     c->h_s = e->h_s;
     c->inputs_changed = e->inputs_changed;
+    c->hold_until_s = e->hold_until_s;
+    c->since_s = e->since_s;
+    c->n_zero = e->n_zero;
     c->n_steps = e->n_steps;
     c->n_rhs = e->n_rhs;
     c->n_events = e->n_events;
@@ -234,9 +243,9 @@ void pam_note_table_edge(PamCore *c) { (void)c; }
 
 int pam_event_update(PamCore *c) {
     EngineRun run;
-    int old = c->mode, jumped;
+    int old = c->mode, jumped, jump_mode; /* model exchange: the importer's solver decides what follows */
     engine_load(c, &run);
-    jumped = transition(&run.e, run.e.x, fired_indicators(&run.e, run.e.x));
+    jumped = transition(&run.e, run.e.x, fired_indicators(&run.e, run.e.x), &jump_mode);
     if (jumped || run.e.mode != old) run.e.n_events++;
     engine_store(c, &run);
     c->inputs_changed = 0;

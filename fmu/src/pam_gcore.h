@@ -29,10 +29,21 @@ typedef struct PamCore {
     void *log_env;
     double event_time_s;   /* model exchange: the last event, where continuous time starts from */
     unsigned inputs_set;   /* before the end of initialisation: the signals (bit k) whose input the importer set */
+    double hold_until_s;   /* co-simulation: the engine's hold of a slip too small to resolve (pam_engine.h) */
+    double since_s;        /* co-simulation: the engine's last event or breakpoint */
+    int n_zero;            /* co-simulation: the engine's slips in a row that ended where they began */
 } PamCore;
 
-/* The values a serialized FMU state holds (fmi_shell.c): those of pam_fmu_common.h, no more. */
-#define PAM_CORE_SERIAL_FIELDS(dir, io, core) PAM_COMMON_SERIAL_FIELDS(dir, io, core)
+/* The values a serialized FMU state holds (fmi_shell.c): those of pam_fmu_common.h, then the engine's hold. */
+#define PAM_CORE_SERIAL_FIELDS(dir, io, core)                 \
+    do {                                                      \
+        int32_t n_zero_ = (core)->n_zero;                     \
+        PAM_COMMON_SERIAL_FIELDS(dir, io, core);              \
+        dir(io, &(core)->hold_until_s, sizeof(double));       \
+        dir(io, &(core)->since_s, sizeof(double));            \
+        dir(io, &n_zero_, sizeof n_zero_);                    \
+        (core)->n_zero = n_zero_;                             \
+    } while (0)
 
 #if defined(__GNUC__)
 #pragma GCC visibility pop
