@@ -101,10 +101,10 @@ int fmu_exit_initialization_mode(FmuInstance *in, const char *function) {
         return -1;
     }
     pam_initialize(&in->core);
-    in->core.event_time_s = in->core.time_s;
     in->core.inputs_set = 0; /* input_source is fixed from here: a set input is checked when it is set */
     in->state = in->is_cs ? FMU_STEP : FMU_EVENT;
-    if (!in->is_cs) enter_event_instant(in);
+    if (in->is_cs) in->core.event_time_s = in->core.time_s;
+    else enter_event_instant(in);
     return 0;
 }
 

@@ -278,9 +278,8 @@ static int at_event(PamEngine *e, double t, double *y, int *zero_length) {
     e->n_zero = instant ? e->n_zero + 1 : 0;
     e->since_s = t;
     if (instant && PM_MODE_HELD[jump_mode] && !PM_MODE_HELD[old] && !held(e)) {
-        int doublings = (e->n_zero <= PAM_ENGINE_MAX_HOLD_DOUBLINGS ? e->n_zero : PAM_ENGINE_MAX_HOLD_DOUBLINGS + 1) - 1;
         e->mode = jump_mode;
-        e->hold_until_s = t + ldexp(PAM_ENGINE_HOLD_S, doublings);
+        e->hold_until_s = t + ldexp(PAM_ENGINE_HOLD_S, (int)fmin(e->n_zero - 1, PAM_ENGINE_MAX_HOLD_DOUBLINGS));
     }
     if (!jumped && e->mode == old) {
         if (++*zero_length > PAM_ENGINE_MAX_ZERO_LENGTH) {
@@ -384,7 +383,7 @@ int pam_engine_do_step(PamEngine *e, double t_end) {
             memcpy(y, ye, sizeof y);
             memcpy(e->x, y, sizeof y);
             if (at_event(e, t, y, &zero_length)) return step_failed(e, t, y);
-            t_piece = next_piece_end(e, t, t_end); /* a hold may have begun */
+            if (holding(e, t)) t_piece = fmin(t_piece, e->hold_until_s); /* a hold began */
             e->h_s = fmax(fmin(h * hi, h_max), 1e-6);
             rhs(e, y, s.k[0]);
             continue;
