@@ -308,11 +308,21 @@ class GeneratedCode:
             out.append((name, _event(indicator, -1.0), k))
         return out
 
-    def jump(self, mode: Mode, k_fired: int, t: float, y: np.ndarray) -> tuple[np.ndarray, Mode, float]:
-        """The state and mode after indicator ``k_fired`` crossed at ``t``, and the kinetic energy the
-        jump removed [J] (an inelastic impact, a velocity reset)."""
+    def also_fired(self, mode: Mode, k_fired: int, t: float, y: np.ndarray) -> list[tuple[str, int]]:
+        """The other components' indicators, besides ``k_fired``, at or below zero where ``k_fired`` crossed at
+        ``t``: they crossed at the same instant (the two muscles' elements of a symmetric pair), and fire with it,
+        as in the native engine.  ``solve_ivp`` reports the first; one left behind would start the next segment
+        below zero, where no crossing can be found, and its element would never slip."""
+        if not self.other_indicators:
+            return []
+        z = self.code[mode].z(list(y), self.inputs(t), self.p, ())[0]
+        return [(name, k) for name, k in self.other_indicators if k != k_fired and z[k] <= 0.0]
+
+    def jump(self, mode: Mode, k_fired: int, t: float, y: np.ndarray, also: tuple[int, ...] = ()) -> tuple[np.ndarray, Mode, float]:
+        """The state and mode after indicator ``k_fired`` (and the indicators ``also``) crossed at ``t``, and the
+        kinetic energy the jump removed [J] (an inelastic impact, a velocity reset)."""
         code, u = self.code[mode], self.inputs(t)
-        fired = [1.0 if k == k_fired else 0.0 for k in range(self.n_indicators)]
+        fired = [1.0 if k == k_fired or k in also else 0.0 for k in range(self.n_indicators)]
         x_next, (q_next,) = code.transition(list(y), u, self.p, (), fired)
         q = Mode(int(q_next))
         mode_next = self.rest_mode(q, t, x_next)
@@ -544,7 +554,8 @@ class HybridRun:
         if self.n_stuck > _MAX_ZERO_LENGTH:
             raise SolverFailure(f"event switching made no progress at t = {t_event:.9g} s ({kind})")
         old = self.mode
-        self.y, self.mode, lost_J = self.gen.jump(old, indicator, t_event, y)
+        also = self.gen.also_fired(old, indicator, t_event, y)
+        self.y, self.mode, lost_J = self.gen.jump(old, indicator, t_event, y, tuple(k for _, k in also))
         if not np.array_equal(self.y, y):
             self.impact_loss_J.append((t_event, lost_J))
         self.hold_until = math.inf
@@ -552,6 +563,8 @@ class HybridRun:
             self.mode = Mode.STICK
             self.hold_until = t_event + _HOLD_S * 2.0 ** (min(self.n_zero, _MAX_ZERO_LENGTH) - 1)
         self.transitions.append(TransitionEvent(t_event, kind, old.label, self.mode.label, float(self.y[0])))
+        self.transitions.extend(TransitionEvent(t_event, name, self.mode.label, self.mode.label, float(self.y[0]))
+                                for name, _ in also)
         if len(self.transitions) > self.opts.max_events:
             raise too_many_events(self.opts.max_events, f" by t = {t_event:.6g} s")
         self.t = t_event
