@@ -451,12 +451,17 @@ def test_a_valve_fed_chamber_drives_the_force_of_a_length_driven_muscle(valve_dr
 def test_every_backend_runs_the_valve_fed_length_drive(valve_driven, backend, tol_N):
     """Each backend's force within its bound of python's at every sample (measured: native 1.5e-4, fmu-cs
     1.6e-4, fmu-me 1.2e-3 N: the chamber's fill at 3 bar through the valve, integrated to rtol 1e-6), the same
-    17 slips."""
+    17 slips.  At 18 s the largest element's deflection meets its slip displacement exactly at a turn (the
+    shipped cycles' design): an integrator may leave it a hair short there or put it a hair past, a slip of no
+    length (python does, here); that instant is left out of the comparison."""
     _, runs = valve_driven
     ref, r = runs["python"], runs[backend]
     assert r.t_s.size == ref.t_s.size
     assert np.max(np.abs(r.force_N - ref.force_N)) < tol_N
-    assert [k for _, k in r.events] == [k for _, k in ref.events] and len(ref.events) == 17
+
+    def slips(run):
+        return [k for t, k in run.events if abs(t - 18.0) > 1e-6]
+    assert slips(r) == slips(ref) and len(slips(ref)) == 17
 
 
 def test_slips_between_two_samples_leave_pieces_without_a_sample():

@@ -304,14 +304,17 @@ share = [0.2, 0.3, 0.5]
 """A muscle alone on three elements sharing the paper's constant friction level (2.5 N), without damping."""
 
 
-@pytest.mark.parametrize("kind, rel, past", [("CoSimulation", 1e-4, 1e-12), ("ModelExchange", 5e-3, 1e-6)])
-def test_a_length_cycle_of_the_muscle_alone_dissipates_the_loop_area(tmp_path, kind, rel, past):
+@pytest.mark.parametrize("kind, rel, past, rtol", [("CoSimulation", 1e-4, 1e-12, None),
+                                                   ("ModelExchange", 1e-3, 1e-6, 1e-7)])
+def test_a_length_cycle_of_the_muscle_alone_dissipates_the_loop_area(tmp_path, kind, rel, past, rtol):
     """The muscle-only FMU carries the elements: driven along a 1 Hz sinusoid of contraction of amplitude
     A = 10 mm, each element i dissipates per cycle the area of its parallelogram, 4 F_i (A - delta_i), with
     F_i its share of 2.5 N (the property: dissipated energy = loop area).  Over the second cycle the
     elements' work equals the hand sum (0.073 J) to ``rel``, and the area of the force-contraction loop
     (trapezoids over 1 ms samples) to 1 %; every deflection stays within its slip displacement (to ``past``:
-    fmpy's model-exchange integrator reports the state where it located the event, before the jump)."""
+    fmpy's model-exchange integrator reports the state where it located the event, before the jump).  In
+    model exchange fmpy's CVode integrates at ``rtol`` (measured 1.1e-4 from the hand sum at 1e-7; at the
+    FMU's default 1e-6 it is 7e-3: CVode steps past a slip and locates it from there)."""
     from fmpy import simulate_fmu
 
     src = tmp_path / "alone.toml"
@@ -330,7 +333,7 @@ def test_a_length_cycle_of_the_muscle_alone_dissipates_the_loop_area(tmp_path, k
     names = [f"hysteresis.E_element{i}_J" for i in (1, 2, 3)] + [f"hysteresis.z{i}_m" for i in (1, 2, 3)]
     res = simulate_fmu(str(path), fmi_type=kind, start_time=0.0, stop_time=2.0, output_interval=1e-3, input=inputs,
                        start_values={"input_source": 0}, output=["motion.x_m", "hysteresis.F_N", *names],
-                       validate=False)
+                       validate=False, relative_tolerance=rtol)
     second = res["time"] >= 1.0
     work = sum(res[n][-1] - res[n][second][0] for n in names[:3])
     hand = sum(4 * w * 2.5 * (A - d) for w, d in zip((0.2, 0.3, 0.5), (5e-4, 2e-3, 4e-3)))

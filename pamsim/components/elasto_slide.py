@@ -21,7 +21,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from ..modeling import TRANSLATIONAL, Component, Equations, Port, Symbols, Var, positive
-from ..modeling.smath import clip, if_else
+from ..modeling.smath import if_else
 
 
 @dataclass(frozen=True)
@@ -48,9 +48,11 @@ def element(z, v, k, delta, fired, c=0.0, stuck=None) -> Element:
     # indicator below zero, so that the crossing is found.
     at_limit = (z * z >= delta * delta) * (z * z <= delta * delta * (1.0 + 1e-12))
     slipping = at_limit * (v * z > 0.0) if stuck is None else (not stuck)
-    # Clipped, so that a trial state past the limit inside a step never pulls more than F.
     rate = if_else(slipping, 0.0, v)
-    force = -k * clip(z, -delta, delta) - c * rate
+    # Not clipped at the limit: a trial state past it inside a step (the event lies in that step, and the
+    # step ends where it is located) sees the spring's force go on smoothly.  Clipped, the force had a kink
+    # there, and the native engine's error estimate rejected two or three steps at every element's slip.
+    force = -k * z - c * rate
     return Element(rate=rate, force=force, slipping=slipping,
                    indicator=if_else(at_limit, 1.0, delta - if_else(z >= 0.0, z, -z)),
                    jump=if_else(fired, if_else(z >= 0.0, delta, -delta), z))
