@@ -451,15 +451,21 @@ def check_status(out: dict, i: int, origin: str, max_events: int) -> None:
         raise too_many_events(max_events)
 
 
-_event_names: dict[tuple[int, int, int], str] = {}  # a few modes and indicators: a few names
+_event_names: dict[tuple, str] = {}  # a few modes, indicators and added components: a few names
+_EVENT_NAMES_KEPT = 4096
+"""Most event names kept (a sweep over many added components' names would otherwise grow the table)."""
 
 
 def _event_name(mode: int, fired: int, to: int, others: tuple[str, ...]) -> str:
-    """:func:`event_name` of an event by the modes' and mask's numbers, kept for the next event (an event of
-    an added component's indicator alone is named after it, from ``others``: kept only without them)."""
-    name = event_name(_MODES[mode], fired, _MODES[to], others)
-    if not others:
-        _event_names[(mode, fired, to)] = name
+    """:func:`event_name` of an event by the modes' and mask's numbers and the added components' indicators'
+    names ``others``, kept for the next event."""
+    key = (mode, fired, to, others)
+    name = _event_names.get(key)
+    if name is None:
+        name = event_name(_MODES[mode], fired, _MODES[to], others)
+        if len(_event_names) >= _EVENT_NAMES_KEPT:
+            _event_names.clear()
+        _event_names[key] = name
     return name
 
 
@@ -494,17 +500,19 @@ def _engine_result(scenario: Scenario, case: CaseInputs, out: dict, i: int, wall
     first, ns = int(out["sample_offset"][i]), len(names["states"])
     Y = out["samples"][ns * first:ns * (first + n)].reshape(ns, n)
     first_event = int(out["event_offset"][i])
-    rows = out["events"][first_event:first_event + int(out["n_events"][i])].tolist()  # floats: no numpy scalars
     x_at, ke_at = outputs.index("load.x_m"), outputs.index("load.kinetic_energy_J")
-    labels, after = _MODE_LABELS, 4 + n_y  # a row: t, modes before and after, fired mask, outputs before, after
-    transitions, losses = [], []
+    after = 4 + n_y  # a row: t, modes before and after, fired mask, outputs before, after
+    # Column by column, as Python numbers (no numpy scalars): the rows' other outputs stay unread.
+    rows = out["events"][first_event:first_event + int(out["n_events"][i])]
+    t_s, x_m = rows[:, 0].tolist(), rows[:, after + x_at].tolist()
+    lost = (rows[:, 4 + ke_at] - rows[:, after + ke_at]).tolist()
+    modes, tos, fired = (rows[:, k].astype(np.int64).tolist() for k in (1, 2, 3))
     # The added components' indicators' names (an element's slip), once per run rather than per event.
-    others = tuple(f"{c}.{n}" for c, n in case.assembly.indicator_names()[2:]) if rows else ()
-    for e in rows:
-        mode, to, fired = int(e[1]), int(e[2]), int(e[3])
-        name = _event_names.get((mode, fired, to)) or _event_name(mode, fired, to, others)
-        transitions.append(TransitionEvent(e[0], name, labels[mode], labels[to], e[after + x_at]))
-        losses.append((e[0], e[4 + ke_at] - e[after + ke_at]))
+    others = tuple(f"{c}.{n}" for c, n in case.assembly.indicator_names()[2:]) if t_s else ()
+    labels = _MODE_LABELS
+    transitions = [TransitionEvent(t, _event_name(m, f, to, others), labels[m], labels[to], x)
+                   for t, m, to, f, x in zip(t_s, modes, tos, fired, x_m)]
+    losses = list(zip(t_s, lost))
     stats["events"] = len(transitions)
     high, low = out["extremes"][i][:n_y], out["extremes"][i][n_y:]
     pressure = next(a for a, b in case.assembly.connections if b == "muscle.p_gauge_Pa")
