@@ -318,7 +318,8 @@ class GeneratedCode:
         z = self.code[mode].z(list(y), self.inputs(t), self.p, ())[0]
         return [(name, k) for name, k in self.other_indicators if k != k_fired and z[k] <= 0.0]
 
-    def jump(self, mode: Mode, k_fired: int, t: float, y: np.ndarray, also: tuple[int, ...] = ()) -> tuple[np.ndarray, Mode, float]:
+    def jump(self, mode: Mode, k_fired: int, t: float, y: np.ndarray,
+             also: tuple[int, ...] = ()) -> tuple[np.ndarray, Mode, float]:
         """The state and mode after indicator ``k_fired`` (and the indicators ``also``) crossed at ``t``, and the
         kinetic energy the jump removed [J] (an inelastic impact, a velocity reset)."""
         code, u = self.code[mode], self.inputs(t)

@@ -229,7 +229,8 @@ def _mean_gauge_Pa(scenario, frequency_Hz: float, t0: float = 4.5, t1: float = 5
     return float(np.trapezoid(res.p_gauge_Pa[w], res.t_s[w]) / (res.t_s[w][-1] - res.t_s[w][0]))
 
 
-def _balanced_pair(frequency_Hz: float, model: str, duty: float = 0.5, weight_N: float | None = None) -> pamsim.Scenario:
+def _balanced_pair(frequency_Hz: float, model: str, duty: float = 0.5,
+                   weight_N: float | None = None) -> pamsim.Scenario:
     """The pair of different valves (switching at once), the inlet under PWM, the exhaust complementary;
     ``weight_N`` in place of the scenario's load, if given."""
     inlet, exhaust = DIFFERENT
