@@ -472,3 +472,19 @@ def test_slips_between_two_samples_leave_pieces_without_a_sample():
     assert py.t_s.size == native.t_s.size == 49
     assert [k for _, k in py.events] == [k for _, k in native.events] and len(py.events) == 17
     assert np.max(np.abs(py.force_N - native.force_N)) < 1e-6
+
+
+def test_elements_that_reach_their_limits_together_slip_together_on_python():
+    """Two elements of equal slip displacement (1 mm, shares 0.3 and 0.3 of 2.5 N) reach their limits at the same
+    instant. ``solve_ivp`` reports one crossing; the other must fire with it, or it starts the next piece below
+    zero, is never found, and its deflection (and, unclipped, its force) grows past the limit (15 times it,
+    11.25 N, before).  Every deflection stays on its limit to 1e-12 relative, each element's force within its
+    slip force, both slips named at the same instants, and python's force within 1e-6 N of native's."""
+    sc = _shipped_with({"model": "maxwell_slip", "slip_displacement_m": [1e-3, 1e-3, 4e-3], "share": [0.3, 0.3, 0.4]})
+    py, native = simulate_length_drive(sc, "python"), simulate_length_drive(sc, "native")
+    for i, (delta, share) in enumerate(((1e-3, 0.3), (1e-3, 0.3), (4e-3, 0.4)), start=1):
+        assert np.max(np.abs(py.signals[f"hysteresis.z{i}_m"])) <= delta * (1.0 + 1e-12)
+        assert np.max(np.abs(py.signals[f"hysteresis.F{i}_N"])) <= share * 2.5 * (1.0 + 1e-9)
+    slips = {k: [t for t, name in py.events if name == k] for k in ("hysteresis.slip1", "hysteresis.slip2")}
+    assert slips["hysteresis.slip1"] and slips["hysteresis.slip1"] == slips["hysteresis.slip2"]
+    assert np.max(np.abs(py.force_N - native.force_N)) < 1e-6

@@ -145,9 +145,15 @@ def _python(drive: LengthDrive, backend: str) -> LengthDrivenResult:
                 continue
             k = next(i for i, te in enumerate(sol.t_events) if len(te))
             t = float(sol.t_events[k][0])
-            fired = [1.0 if i == k else 0.0 for i in range(len(names))]
-            y = np.array(gen.transition(list(sol.y_events[k][0]), drive.inputs(t), p, (), fired)[0])
-            events.append((t, names[k]))
+            y_event, u = list(sol.y_events[k][0]), drive.inputs(t)
+            # Every indicator at or below zero there crossed at this instant (elements of equal slip displacements
+            # reach their limits together) and fires with the one solve_ivp reports, as in the native engine:
+            # one left behind would start the next segment below zero, where no crossing can be found.
+            z = gen.z(y_event, u, p, ())[0]
+            crossed = [k] + [i for i in range(len(names)) if i != k and z[i] <= 0.0]
+            fired = [1.0 if i in crossed else 0.0 for i in range(len(names))]
+            y = np.array(gen.transition(y_event, u, p, (), fired)[0])
+            events.extend((t, names[i]) for i in crossed)
             if len(events) > opts.max_events:
                 raise too_many_events(opts.max_events, f" by t = {t:.6g} s")
     stats = {"rhs_evaluations": int(nfev), "events": len(events), "segments": segments, "method": opts.method,
