@@ -145,6 +145,15 @@ def _from_start(fun, t0: float, y0: np.ndarray):
     return _event(guarded, fun.direction)
 
 
+def fired_together(z, k_fired: int, candidates) -> list[int]:
+    """``k_fired`` and every indicator of ``candidates`` at or below zero in ``z``, the indicators where
+    ``solve_ivp`` reported ``k_fired``'s crossing: they crossed at the same instant (two elements of equal slip
+    displacement, the two muscles' elements of a symmetric pair), and fire together, as in the native engine.
+    ``solve_ivp`` reports one; one left behind would start the next segment below zero, where no crossing can
+    be found."""
+    return [k_fired] + [k for k in candidates if k != k_fired and z[k] <= 0.0]
+
+
 LONG_STEP_S = 0.01
 """A step longer than this [s] is checked inside for a crossing that its two ends do not show (the C
 engine's default longest step while the load slides, the FMU's ``cs_max_step_s``).  So is a step of any
@@ -309,14 +318,12 @@ class GeneratedCode:
         return out
 
     def also_fired(self, mode: Mode, k_fired: int, t: float, y: np.ndarray) -> list[tuple[str, int]]:
-        """The other components' indicators, besides ``k_fired``, at or below zero where ``k_fired`` crossed at
-        ``t``: they crossed at the same instant (the two muscles' elements of a symmetric pair), and fire with it,
-        as in the native engine.  ``solve_ivp`` reports the first; one left behind would start the next segment
-        below zero, where no crossing can be found, and its element would never slip."""
+        """The other components' indicators that fire with ``k_fired`` at ``t`` (:func:`fired_together`)."""
         if not self.other_indicators:
             return []
         z = self.code[mode].z(list(y), self.inputs(t), self.p, ())[0]
-        return [(name, k) for name, k in self.other_indicators if k != k_fired and z[k] <= 0.0]
+        names = dict((k, name) for name, k in self.other_indicators)
+        return [(names[k], k) for k in fired_together(z, k_fired, names)[1:]]
 
     def jump(self, mode: Mode, k_fired: int, t: float, y: np.ndarray,
              also: tuple[int, ...] = ()) -> tuple[np.ndarray, Mode, float]:

@@ -20,7 +20,7 @@ from ..assemblies.muscle_only import MOTION_INPUTS, muscle_only_assembly
 from ..assemblies.one_muscle import RUN_FUNCTIONS, input_signals, source_parts
 from ..errors import InputError, SolverFailure
 from ..modeling.pygen import compiled_by_mode, outputs_by_mode
-from ..simulator import _distinct_breaks, _event, _from_start, n_samples, too_many_events
+from ..simulator import _distinct_breaks, _event, _from_start, fired_together, n_samples, too_many_events
 from .motion import Motion, motion_of
 from .result import LengthDrivenResult
 
@@ -146,11 +146,7 @@ def _python(drive: LengthDrive, backend: str) -> LengthDrivenResult:
             k = next(i for i, te in enumerate(sol.t_events) if len(te))
             t = float(sol.t_events[k][0])
             y_event, u = list(sol.y_events[k][0]), drive.inputs(t)
-            # Every indicator at or below zero there crossed at this instant (elements of equal slip displacements
-            # reach their limits together) and fires with the one solve_ivp reports, as in the native engine:
-            # one left behind would start the next segment below zero, where no crossing can be found.
-            z = gen.z(y_event, u, p, ())[0]
-            crossed = [k] + [i for i in range(len(names)) if i != k and z[i] <= 0.0]
+            crossed = fired_together(gen.z(y_event, u, p, ())[0], k, range(len(names)))
             fired = [1.0 if i in crossed else 0.0 for i in range(len(names))]
             y = np.array(gen.transition(y_event, u, p, (), fired)[0])
             events.extend((t, names[i]) for i in crossed)
