@@ -1,8 +1,8 @@
 """Hybrid stick/slip integration of a :class:`~pamsim.model.MuscleModel` with
-``scipy.integrate.solve_ivp``.
+scipy's integrators (``solve_ivp``'s methods, stepped by :mod:`pamsim.stepping`).
 
 The load is in one of the :class:`~pamsim.model.Mode` s.  Each mode is a
-smooth ODE; ``solve_ivp`` integrates it until a terminal event (velocity
+smooth ODE; the integrator steps it until a terminal event (velocity
 reaching zero, a stop reached, the friction margin exceeded) or a breakpoint
 of the inputs, and the simulator then decides the next mode from the forces
 (MODEL_NOTES sec. 4).  Two thresholds keep the switching free of chatter: a
@@ -18,7 +18,6 @@ samples from the dense output (docs/model.md sec. 4).
 from __future__ import annotations
 
 import math
-from types import SimpleNamespace
 import time
 from dataclasses import dataclass
 from typing import Callable
@@ -32,6 +31,7 @@ from .errors import InputError, SolverFailure
 from .model import STATE_SCALES, Mode, MuscleModel
 from .modeling.pygen import compiled_by_mode
 from .result import Result, TransitionEvent
+from .stepping import integrate_segment
 
 
 MIN_RTOL = 1e-13
@@ -154,67 +154,10 @@ def fired_together(z, k_fired: int, candidates) -> list[int]:
     return [k_fired] + [k for k in candidates if k != k_fired and z[k] <= 0.0]
 
 
-LONG_STEP_S = 0.01
-"""A step longer than this [s] is checked inside for a crossing that its two ends do not show (the C
-engine's default longest step while the load slides, the FMU's ``cs_max_step_s``).  So is a step of any
-length in which the load turns back (:func:`_steps_to_check`)."""
-LONG_STEP_CHECKS = 16
-"""Points of a long step's dense output checked for a crossing (as the C engine checks a held load's)."""
-
-
-def _with_missed_crossing(sol, named):
-    """``sol``, or where an indicator went below zero and back inside one long step, ``sol`` cut at the
-    first such crossing as if ``solve_ivp`` had found it.
-
-    ``solve_ivp`` finds an event where an indicator changes sign between two step ends.  A free swing at
-    a tight tolerance can take a step long enough for the load to reach a stop and come back within it
-    (RK45 at rtol 1e-10 took 0.17 s and carried the load 24 mm through its upper stop); such a step's
-    dense output is checked at :data:`LONG_STEP_CHECKS` points.  Ordinary steps are far shorter, and a
-    run without a long step is left exactly as it was."""
-    t = sol.t
-    for i in _steps_to_check(sol):
-        taus = np.linspace(t[i], t[i + 1], LONG_STEP_CHECKS + 1)
-        for lo, hi in zip(taus[:-2], taus[1:-1]):  # the step's end is what solve_ivp checked
-            y_hi = sol.sol(hi)
-            fired = [k for k, (_, fun, _) in enumerate(named) if fun(hi, y_hi) < 0.0]
-            if fired:
-                return _cut_at(sol, named, fired, lo, hi)
-    return sol
-
-
 _V_ROW = 1
-"""Row of the load's velocity in the state vector (``MuscleModel.state_names`` begins ``x_m, v_m_s``)."""
-
-
-def _steps_to_check(sol) -> np.ndarray:
-    """Indices of the steps checked inside for a crossing: those longer than :data:`LONG_STEP_S`, and
-    those in which the load's velocity changes sign.
-
-    A position indicator (a stop) can go below zero and back within one step only if the load turns
-    back inside it, whatever the step's length, so a fixed length alone would miss a fast, stiff
-    swing's turn at a stop in a short step.  Where a velocity event ends the segment (a load with
-    friction) no step inside it turns, so this costs nothing there."""
-    v = sol.y[_V_ROW]
-    turning = np.signbit(v[:-1]) != np.signbit(v[1:])
-    return np.flatnonzero((np.diff(sol.t) > LONG_STEP_S) | turning)
-
-
-def _cut_at(sol, named, fired, lo: float, hi: float):
-    """``sol`` ending at the first root in (lo, hi] of the indicators ``fired`` (below zero at hi)."""
-    from scipy.optimize import brentq
-
-    roots = []
-    for k in fired:
-        fun = named[k][1]
-        a = lo if fun(lo, sol.sol(lo)) > 0.0 else hi
-        roots.append((brentq(lambda tau: fun(tau, sol.sol(tau)), a, hi, xtol=1e-15) if a < hi else hi, k))
-    t_event, k_event = min(roots)
-    y_event = sol.sol(t_event)
-    keep = sol.t < t_event
-    return SimpleNamespace(t=np.append(sol.t[keep], t_event), y=np.column_stack([sol.y[:, keep], y_event]),
-                           sol=sol.sol, status=1, nfev=sol.nfev, message="a crossing inside a long step",
-                           t_events=[np.array([t_event] if k == k_event else []) for k in range(len(named))],
-                           y_events=[np.array([y_event] if k == k_event else []) for k in range(len(named))])
+"""Row of the load's velocity in the state vector (``MuscleModel.state_names`` begins ``x_m, v_m_s``): a step
+in which it changes sign is checked inside for a crossing its ends do not show
+(:func:`pamsim.stepping.missed_crossing`)."""
 
 
 BREAK_RESOLUTION = 1e-12
@@ -452,13 +395,13 @@ class SteppedRun:
             run.mode = run.gen.rest_mode(run.mode, run.t, run.y)
         while run.t < t_end_s:
             t_break = min(t_end_s, run.hold_until)
-            sol, named = run.segment(t_break)
-            if sol.status == 1:
-                run.at_event(sol, named)
+            seg, named = run.segment(t_break, sampled=False)
+            if seg.status == 1:
+                run.at_event(seg, named)
             elif t_break < t_end_s:
-                run.at_breakpoint(sol, t_break)
+                run.at_breakpoint(seg, t_break)
             else:  # the mode is decided at the next advance, with the inputs it brings
-                run.t, run.hold_until, run.y = t_break, math.inf, sol.y[:, -1].copy()
+                run.t, run.hold_until, run.y = t_break, math.inf, seg.y[:, -1].copy()
 
 
 class HybridRun:
@@ -502,10 +445,9 @@ class HybridRun:
             return fun(tt, yy)
         return rhs
 
-    def segment(self, t_break: float):
-        """Integrate the current mode from ``t`` to ``t_break`` or its first event."""
-        from scipy.integrate import solve_ivp  # here, not at the top: `pamsim --help` should not pay for it
-
+    def segment(self, t_break: float, sampled: bool = True):
+        """Integrate the current mode from ``t`` to ``t_break`` or its first event, and read the output grid's
+        samples on the way (none if not ``sampled``: a stepped run's caller reads the state)."""
         opts, mode, t, y = self.opts, self.mode, self.t, self.y
         named = self.gen.events(mode)
         if math.isfinite(self.hold_until):
@@ -517,43 +459,38 @@ class HybridRun:
         self.t_left = self.gen.t_left = float(np.nextafter(t_break, -math.inf))
         max_step = opts.max_step_s if mode.is_slip else min(opts.max_step_s, self.held_max_step)
         rhs = self.gen.rhs(mode) if self.progress is None else self._reporting(self.gen.rhs(mode))
+        samples = self.grid[self.next_sample:np.searchsorted(self.grid, t_break, side="right") if sampled else 0]
         try:
-            sol = solve_ivp(rhs, (t, t_break), y,
-                            method=opts.method, dense_output=True, events=[_from_start(f, t, y) for _, f, _ in named],
-                            rtol=opts.rtol, atol=self.atol, max_step=max_step)
+            seg = integrate_segment(rhs, t, t_break, y, opts.method, [_from_start(f, t, y) for _, f, _ in named],
+                                    samples, rtol=opts.rtol, atol=self.atol, max_step=max_step, v_row=_V_ROW)
         except (InputError, SolverFailure):
             raise
         except Exception as exc:
-            # solve_ivp and its root finder signal numerical trouble with plain exceptions (ValueError
+            # The integrator and the root finder signal numerical trouble with plain exceptions (ValueError
             # from brentq, ZeroDivisionError, LinAlgError...); to the caller it is a solver failure (exit 3).
-            raise SolverFailure(f"solve_ivp raised {type(exc).__name__} at t = {t:.6g} s in mode {mode.label}: "
-                                f"{exc}") from exc
-        self.nfev += sol.nfev
+            raise SolverFailure(f"the integrator raised {type(exc).__name__} at t = {t:.6g} s in mode "
+                                f"{mode.label}: {exc}") from exc
+        self.nfev += seg.nfev
         self.n_segments += 1
-        if sol.status == -1:
-            raise SolverFailure(f"solve_ivp failed at t = {t:.6g} s in mode {mode.label}: {sol.message}")
-        return _with_missed_crossing(sol, named), named
+        if seg.status == -1:
+            raise SolverFailure(f"the integrator failed at t = {t:.6g} s in mode {mode.label}: {seg.message}")
+        return seg, named
 
-    def record(self, sol, t_break: float) -> None:
-        """The segment's output samples (from the dense output) and extremes (over its steps)."""
-        j = np.searchsorted(self.grid, t_break, side="right")
-        samples = self.grid[self.next_sample:j]
-        samples = samples[samples <= sol.t[-1]]
-        if samples.size:
-            self.ts.append(samples)
-            self.ys.append(sol.sol(samples))
-            self.modes.append(np.full(samples.size, int(self.mode)))
-            self.next_sample += samples.size
+    def record(self, seg) -> None:
+        """The segment's output samples and extremes (over its steps)."""
+        if seg.samples_t.size:
+            self.ts.append(seg.samples_t)
+            self.ys.append(seg.samples_y)
+            self.modes.append(np.full(seg.samples_t.size, int(self.mode)))
+            self.next_sample += seg.samples_t.size
         # x is monotonic within a segment (the velocity keeps its sign between events), so its peak
         # is at a step; the pressure's peak is taken over the steps as well.
-        self.low_x, self.peak_x = min(self.low_x, float(sol.y[0].min())), max(self.peak_x, float(sol.y[0].max()))
+        self.low_x, self.peak_x = min(self.low_x, float(seg.y[0].min())), max(self.peak_x, float(seg.y[0].max()))
 
-    def at_event(self, sol, named) -> None:
+    def at_event(self, seg, named) -> None:
         """The jump at the segment's event, and the short hold of a slip too small to resolve."""
-        k = next(i for i, te in enumerate(sol.t_events) if len(te))
-        kind, _, indicator = named[k]
-        t_event = float(sol.t_events[k][0])
-        y = np.array(sol.y_events[k][0], dtype=float)
+        kind, _, indicator = named[seg.event]
+        t_event, y = seg.t_event, seg.y_event
         zero_length = t_event - self.t <= 1e-12 * max(1.0, self.t)
         # n_zero: zero-length slips since the load last moved (the holds' doubling); n_stuck: zero-length
         # events with no time passed between them (a hold that ran is progress).
@@ -577,12 +514,12 @@ class HybridRun:
             raise too_many_events(self.opts.max_events, f" by t = {t_event:.6g} s")
         self.t = t_event
 
-    def at_breakpoint(self, sol, t_break: float) -> None:
+    def at_breakpoint(self, seg, t_break: float) -> None:
         """The segment reached an input breakpoint: a held load's mode is decided again there."""
         self.t = t_break
         self.hold_until = math.inf
         self.n_stuck = 0
-        self.y = sol.y[:, -1].copy()
+        self.y = seg.y[:, -1].copy()
         if self.mode in _REST:
             self.mode = self.gen.rest_mode(self.mode, self.t, self.y)
 
@@ -591,12 +528,12 @@ class HybridRun:
         while self.t < duration_s:
             self.report(self.t)
             t_break = min(next(b for b in self.breaks if b > self.t), self.hold_until)
-            sol, named = self.segment(t_break)
-            self.record(sol, t_break)
-            if sol.status == 1:
-                self.at_event(sol, named)
+            seg, named = self.segment(t_break)
+            self.record(seg)
+            if seg.status == 1:
+                self.at_event(seg, named)
             else:
-                self.at_breakpoint(sol, t_break)
+                self.at_breakpoint(seg, t_break)
 
     def trace(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The samples' times [s], states (one row per state) and modes."""
@@ -618,13 +555,11 @@ class _Run(HybridRun):
                          model.breakpoints, model.max_input_step_s, progress)
         self.peak_p = -math.inf
 
-    def record(self, sol, t_break: float) -> None:
+    def record(self, seg) -> None:
         """The segment's samples and extremes, the pressure's over its steps among them."""
-        super().record(sol, t_break)
-        source = self.model.source
-        p_steps = source.pressure_gauge_Pa(sol.y[2:2 + self.model.n_source],
-                                           source.inputs(np.minimum(sol.t, self.t_left)))
-        self.peak_p = max(self.peak_p, float(np.max(p_steps)))
+        super().record(seg)
+        self.peak_p = max(self.peak_p, float(np.max(self.model.pressure_trace_Pa(np.minimum(seg.t, self.t_left),
+                                                                                  seg.y))))
 
     def result(self, name: str, wall_time_s: float) -> Result:
         t, Y, modes = self.trace()

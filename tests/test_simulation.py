@@ -428,26 +428,34 @@ def test_breakpoints_a_rounding_apart_are_one():
 
 
 def test_a_crossing_inside_a_short_step_where_the_load_turns_is_not_missed():
-    """A swing that turns 0.1 um beyond a stop inside one 5 ms step: both step ends are below the stop, the
+    """A swing that turns 0.1 um beyond a stop inside one 5 ms step: no step end shows the crossing, the
     step is shorter than ``LONG_STEP_S``, and the crossing is still found, at its analytic time."""
-    from types import SimpleNamespace
-
-    from pamsim.simulator import LONG_STEP_S, _with_missed_crossing
+    from pamsim.stepping import LONG_STEP_S, integrate_segment
 
     a, t_turn, x_turn, over = 10.0, 0.0124, 0.05, 1e-7  # deceleration [m/s2], turn [s], [m], overshoot [m]
     x_stop = x_turn - over
+    y0 = np.array([x_turn - 0.5 * a * t_turn ** 2, a * t_turn])
 
-    def y(t):
-        return np.array([x_turn - 0.5 * a * (t - t_turn) ** 2, -a * (t - t_turn)])
+    def fall(t, y):
+        return np.array([y[1], -a])
 
-    t = np.arange(0.0, 0.0251, 0.005)
-    assert np.diff(t).max() < LONG_STEP_S
-    sol = SimpleNamespace(t=t, y=np.column_stack([y(ti) for ti in t]), sol=y, status=0, nfev=0)
-    assert (y(t)[0] < x_stop).all()  # the ends show nothing
-    named = [("upper_stop", lambda tt, yy: x_stop - yy[0], None)]
-    cut = _with_missed_crossing(sol, named)
-    assert cut.status == 1
-    np.testing.assert_allclose(cut.t[-1], t_turn - np.sqrt(2 * over / a), rtol=0, atol=1e-12)
+    def upper_stop(t, y):
+        return x_stop - y[0]
+    upper_stop.direction = -1.0
+    samples = np.empty(0)
+    # RK45 integrates the parabola exactly, at its longest step
+    free = integrate_segment(fall, 0.0, 0.025, y0, "RK45", [], samples, rtol=1e-6, atol=1e-9, max_step=0.005, v_row=1)
+    assert np.diff(free.t).max() < LONG_STEP_S
+    assert (free.y[0] < x_stop).all()  # the step ends show nothing
+    assert np.count_nonzero(np.diff(np.signbit(free.y[1]))) == 1  # one step turns
+    seg = integrate_segment(fall, 0.0, 0.025, y0, "RK45", [upper_stop], samples, rtol=1e-6, atol=1e-9,
+                            max_step=0.005, v_row=1)
+    assert seg.status == 1 and seg.event == 0
+    np.testing.assert_allclose(seg.t_event, t_turn - np.sqrt(2 * over / a), rtol=0, atol=1e-12)
+    # without the velocity's row the short step is not looked into, as solve_ivp does not
+    blind = integrate_segment(fall, 0.0, 0.025, y0, "RK45", [upper_stop], samples, rtol=1e-6, atol=1e-9,
+                              max_step=0.005)
+    assert blind.status == 0
 
 
 def test_running_losses_are_the_cumulative_sum_at_the_last_event_at_or_before_each_sample():
