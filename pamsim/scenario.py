@@ -71,7 +71,7 @@ law's mass is the static force over g."""
 _MAX_SAMPLES = 1e7  # 8 s at 1 kHz is 8,001; beyond this the output would not fit in memory comfortably
 MAX_STEPS = 1e7
 """``solver.max_step_s`` may not ask for more steps than this over the run (minutes of computing)."""
-_METHODS = ("LSODA", "RK45", "DOP853", "Radau", "BDF", "RK23")
+_METHODS = ("LSODA", "RK45", "DOP853", "Radau", "BDF", "RK23", "DOPRI5")
 
 
 class ScenarioError(InputError):

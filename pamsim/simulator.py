@@ -17,6 +17,7 @@ samples from the dense output (docs/model.md sec. 4).
 
 from __future__ import annotations
 
+import bisect
 import math
 import time
 from dataclasses import dataclass
@@ -429,6 +430,7 @@ class HybridRun:
         # Over every integrator step and event, not the samples.
         self.low_x, self.peak_x = math.inf, -math.inf
         self.calls = 0
+        self.h_next = None  # the step DOPRI5 proposed at the last segment's end, to start the next with
         self.reached = 0.0  # reported time: the RHS is also evaluated at trial points, which need not increase
 
     def report(self, t: float) -> None:
@@ -462,7 +464,8 @@ class HybridRun:
         samples = self.grid[self.next_sample:np.searchsorted(self.grid, t_break, side="right") if sampled else 0]
         try:
             seg = integrate_segment(rhs, t, t_break, y, opts.method, [_from_start(f, t, y) for _, f, _ in named],
-                                    samples, rtol=opts.rtol, atol=self.atol, max_step=max_step, v_row=_V_ROW)
+                                    samples, rtol=opts.rtol, atol=self.atol, max_step=max_step, v_row=_V_ROW,
+                                    first_step=self.h_next)
         except (InputError, SolverFailure):
             raise
         except Exception as exc:
@@ -472,6 +475,7 @@ class HybridRun:
                                 f"{mode.label}: {exc}") from exc
         self.nfev += seg.nfev
         self.n_segments += 1
+        self.h_next = seg.h_next
         if seg.status == -1:
             raise SolverFailure(f"the integrator failed at t = {t:.6g} s in mode {mode.label}: {seg.message}")
         return seg, named
@@ -527,7 +531,7 @@ class HybridRun:
         """Integrate from where the run is to ``duration_s``, segment by segment, sampling each."""
         while self.t < duration_s:
             self.report(self.t)
-            t_break = min(next(b for b in self.breaks if b > self.t), self.hold_until)
+            t_break = min(self.breaks[bisect.bisect_right(self.breaks, self.t)], self.hold_until)
             seg, named = self.segment(t_break)
             self.record(seg)
             if seg.status == 1:

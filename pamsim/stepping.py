@@ -20,6 +20,7 @@ afterwards: only the count of right-hand-side evaluations differs.
 
 from __future__ import annotations
 
+from bisect import bisect_left, bisect_right
 from dataclasses import dataclass
 from typing import Callable, Sequence
 
@@ -47,7 +48,8 @@ class Segment:
     states there (one column per time).  ``samples_t``, ``samples_y``: the samples asked for, up to the
     segment's end, from the dense output.  ``status``: 0 at the breakpoint, 1 at an event, -1 failed
     (``message`` says why).  ``event``: the index of the event function that fired, at ``t_event`` [s]
-    with the states ``y_event``; ``nfev``: right-hand-side evaluations."""
+    with the states ``y_event``; ``nfev``: right-hand-side evaluations; ``h_next``: :data:`DOPRI5`'s proposal
+    for the next step [s] (None for scipy's methods)."""
 
     t: np.ndarray
     y: np.ndarray
@@ -59,6 +61,111 @@ class Segment:
     y_event: np.ndarray | None
     nfev: int
     message: str
+    h_next: float | None = None
+
+
+DOPRI5 = "DOPRI5"
+"""The method name of :class:`DormandPrince` (``solver.method``)."""
+
+
+class DormandPrince:
+    """Dormand and Prince's explicit Runge-Kutta pair of order 5(4), with the formulas, the error norm, the
+    step-size control and the dense output of ``scipy.integrate.RK45``, stepped without scipy's generic
+    solver around each step; the solver of ``solver.method = "DOPRI5"``.
+
+    What it does that ``RK45`` does not: a segment may start from a given step size (``first_step``, the
+    last segment's proposal: :attr:`h_next`) instead of estimating one from the start's derivatives.  A
+    run of many short segments (a valve under PWM) then does not start every one of them small.
+
+    E. Hairer, S. P. Norsett, G. Wanner, *Solving Ordinary Differential Equations I: Nonstiff Problems*,
+    Springer, 2nd ed., 1993, sec. II.4-5 (the pair, its step control and its dense output).
+    """
+
+    SAFETY, MIN_FACTOR, MAX_FACTOR, ERROR_EXPONENT = 0.9, 0.2, 10.0, -1.0 / 5.0  # as RK45's
+
+    def __init__(self, fun, t0: float, y0, t_bound: float, *, rtol: float, atol, max_step: float = np.inf,
+                 first_step: float | None = None):
+        from scipy.integrate import RK45
+
+        self.A, self.B, self.C, self.E, self.P = RK45.A, RK45.B, RK45.C, RK45.E, RK45.P
+        self.fun, self.t, self.t_bound, self.t_old = fun, float(t0), float(t_bound), None
+        self.y = np.array(y0, dtype=float)
+        self.rtol, self.atol, self.max_step = rtol, np.asarray(atol, dtype=float), max_step
+        self.f = np.asarray(fun(self.t, self.y), dtype=float)
+        self.nfev = 1
+        self.K = np.empty((len(self.B) + 1, self.y.size))
+        self.y_old = self.y
+        self.status = "running" if self.t < self.t_bound else "finished"
+        self.h_abs = first_step if first_step else self._initial_step()
+        self.h_next = self.h_abs
+        """The step the last step proposed for the next, unshortened by the end of the segment [s]."""
+
+    def _norm(self, x) -> float:
+        return float(np.sqrt(np.dot(x, x) / x.size))
+
+    def _initial_step(self) -> float:
+        """Hairer, Norsett and Wanner's starting step (sec. II.4), as ``RK45`` takes it."""
+        t0, y0, f0 = self.t, self.y, self.f
+        span = self.t_bound - t0
+        if span <= 0.0:
+            return 0.0
+        scale = self.atol + np.abs(y0) * self.rtol
+        d0, d1 = self._norm(y0 / scale), self._norm(f0 / scale)
+        h0 = min(1e-6 if d0 < 1e-5 or d1 < 1e-5 else 0.01 * d0 / d1, span)
+        f1 = np.asarray(self.fun(t0 + h0, y0 + h0 * f0), dtype=float)
+        self.nfev += 1
+        d2 = self._norm((f1 - f0) / scale) / h0
+        h1 = max(1e-6, h0 * 1e-3) if d1 <= 1e-15 and d2 <= 1e-15 else (0.01 / max(d1, d2)) ** 0.2
+        return min(100 * h0, h1, span)
+
+    def step(self) -> str | None:
+        """One accepted step (rejected trial steps inside); a message if the step became too small."""
+        t, y, K, A, C = self.t, self.y, self.K, self.A, self.C
+        min_step = 10 * abs(np.nextafter(t, np.inf) - t)
+        h_abs = min(max(self.h_abs, min_step), self.max_step)
+        rejected = False
+        while True:
+            if h_abs < min_step:
+                self.status = "failed"
+                return "Required step size is less than spacing between numbers."
+            t_new = min(t + h_abs, self.t_bound)
+            shortened = t_new == self.t_bound and t + h_abs != t_new
+            h = t_new - t
+            K[0] = self.f
+            for s in range(1, len(C)):
+                K[s] = self.fun(t + C[s] * h, y + np.dot(K[:s].T, A[s, :s]) * h)
+            y_new = y + h * np.dot(K[:-1].T, self.B)
+            K[-1] = f_new = self.fun(t_new, y_new)
+            self.nfev += len(C)
+            scale = self.atol + np.maximum(np.abs(y), np.abs(y_new)) * self.rtol
+            err = self._norm(np.dot(K.T, self.E) * h / scale)
+            if err < 1.0:
+                factor = self.MAX_FACTOR if err == 0.0 else min(self.MAX_FACTOR, self.SAFETY * err ** self.ERROR_EXPONENT)
+                proposed = h * (min(1.0, factor) if rejected else factor)
+                break
+            h_abs = h * max(self.MIN_FACTOR, self.SAFETY * err ** self.ERROR_EXPONENT)
+            rejected = True
+        self.t_old, self.y_old, self.t, self.y = t, y, t_new, y_new
+        self.f = np.asarray(f_new, dtype=float)
+        self.h_abs = proposed
+        if not shortened:
+            self.h_next = proposed
+        if t_new >= self.t_bound:
+            self.status = "finished"
+        return None
+
+    def dense_output(self):
+        """The step's quartic interpolant: a callable of a time or an array of times in it."""
+        q1, q2, q3, q4 = self.K.T.dot(self.P).T * (self.t - self.t_old)
+        t_old, y_old, h = self.t_old, self.y_old, self.t - self.t_old
+
+        def y_at(t):
+            x = (np.asarray(t, dtype=float) - t_old) / h
+            if x.ndim:
+                x = x[None, :]
+                return y_old[:, None] + x * (q1[:, None] + x * (q2[:, None] + x * (q3[:, None] + x * q4[:, None])))
+            return y_old + x * (q1 + x * (q2 + x * (q3 + x * q4)))
+        return y_at
 
 
 def missed_crossing(events: Sequence[Callable], dense, t_old: float, t: float):
@@ -113,7 +220,8 @@ def _earliest_event(events, directions, g_old, g_new, dense, t_old: float, t: fl
 
 def integrate_segment(fun: Callable, t0: float, t_end: float, y0: np.ndarray, method: str,
                       events: Sequence[Callable], samples: np.ndarray, *, rtol: float, atol, max_step: float,
-                      v_row: int | None = None) -> Segment:
+                      v_row: int | None = None, first_step: float | None = None,
+                      long_step_s: float = LONG_STEP_S) -> Segment:
     """Integrate ``fun`` from ``(t0, y0)`` to ``t_end`` or the first of the terminal ``events``.
 
     Parameters
@@ -125,7 +233,7 @@ def integrate_segment(fun: Callable, t0: float, t_end: float, y0: np.ndarray, me
     y0 : ndarray
         The states at ``t0``.
     method : str
-        A ``scipy.integrate.solve_ivp`` method name ("LSODA", "RK45"...).
+        A ``scipy.integrate.solve_ivp`` method name ("LSODA", "RK45"...), or :data:`DOPRI5`.
     events : sequence of callable
         Event functions ``g(t, y)``, each with a ``direction`` attribute, all terminal.
     samples : ndarray
@@ -134,7 +242,9 @@ def integrate_segment(fun: Callable, t0: float, t_end: float, y0: np.ndarray, me
         The solver's options.
     v_row : int, optional
         The row of the load's velocity: a step in which it changes sign (:func:`_turned`) is checked inside
-        (:func:`missed_crossing`), as is any step longer than :data:`LONG_STEP_S`.
+        (:func:`missed_crossing`), as is any step longer than ``long_step_s`` (:data:`LONG_STEP_S`).
+    first_step : float, optional
+        :data:`DOPRI5`'s first step [s] (None: estimated from the start); the other methods ignore it.
 
     Returns
     -------
@@ -142,10 +252,14 @@ def integrate_segment(fun: Callable, t0: float, t_end: float, y0: np.ndarray, me
     """
     import scipy.integrate
 
-    solver = getattr(scipy.integrate, method)(fun, float(t0), y0, float(t_end), rtol=rtol, atol=atol,
-                                              max_step=max_step)
+    if method == DOPRI5:
+        solver = DormandPrince(fun, t0, y0, t_end, rtol=rtol, atol=atol, max_step=max_step, first_step=first_step)
+    else:
+        solver = getattr(scipy.integrate, method)(fun, float(t0), y0, float(t_end), rtol=rtol, atol=atol,
+                                                  max_step=max_step)
     from_next = method in _FROM_NEXT_STEP
-    v_tol = None if v_row is None else float(np.broadcast_to(atol, np.shape(y0))[v_row])
+    v_tol = None if v_row is None else float(atol[v_row] if np.ndim(atol) else atol)
+    grid = samples.tolist()  # bisect on a list: a step's samples are few, and a numpy call costs more
     directions = [getattr(e, "direction", 0.0) for e in events]
     g = [e(solver.t, solver.y) for e in events]
     ts, ys = [solver.t], [solver.y]
@@ -161,13 +275,13 @@ def integrate_segment(fun: Callable, t0: float, t_end: float, y0: np.ndarray, me
         t_old, t, y = solver.t_old, solver.t, solver.y
         dense = None  # built only where something is read from it
         g_new = [e(t, y) for e in events]
-        if any(_crossed(a, b, d) for a, b, d in zip(g, g_new, directions)):
+        if events and any(map(_crossed, g, g_new, directions)):
             dense = solver.dense_output()
             t, event = _earliest_event(events, directions, g, g_new, dense, t_old, t)
             y, status = dense(t), 1
         g = g_new
         turned = v_row is not None and _turned(ys[-1][v_row], y[v_row], v_tol)
-        if events and (t - t_old > LONG_STEP_S or turned):
+        if events and (t - t_old > long_step_s or turned):
             dense = solver.dense_output() if dense is None else dense
             missed = missed_crossing(events, dense, t_old, t)
             if missed is not None:
@@ -177,26 +291,26 @@ def integrate_segment(fun: Callable, t0: float, t_end: float, y0: np.ndarray, me
             continue  # no time passed: solve_ivp keeps neither the point nor its dense output
         # A sample on a step boundary is read from the step solve_ivp's piecewise solution reads it from:
         # for LSODA and BDF the one that starts there, unless that one is the last and has no time.
-        n_step = int(np.searchsorted(samples, t, side="left" if from_next and status is None else "right"))
+        n_step = (bisect_left if from_next and status is None else bisect_right)(grid, t)
         if n_step > n_taken:
             dense = solver.dense_output() if dense is None else dense
             sample_ys.append(dense(samples[n_taken:n_step]))
             n_taken = n_step
-        on_end = status is None and n_step < len(samples) and samples[n_step] == t
+        on_end = status is None and n_step < len(grid) and grid[n_step] == t
         kept = None if not on_end else solver.dense_output() if dense is None else dense
         ts.append(t)
         ys.append(y)
     if status is not None and status >= 0 and kept is not None:
-        n_end = int(np.searchsorted(samples, ts[-1], side="right"))
+        n_end = bisect_right(grid, ts[-1])
         sample_ys.append(kept(samples[n_taken:n_end]))
         n_taken = n_end
     n = len(y0)
-    return Segment(t=np.array(ts, dtype=float), y=np.column_stack(ys),
+    return Segment(t=np.array(ts, dtype=float), y=np.array(ys, dtype=float).T,
                    samples_t=samples[:n_taken],
                    samples_y=np.hstack(sample_ys) if sample_ys else np.empty((n, 0)),
                    status=status, event=event, t_event=float(t) if status == 1 else None,
                    y_event=np.array(y, dtype=float) if status == 1 else None,
-                   nfev=solver.nfev, message=message or "")
+                   nfev=solver.nfev, message=message or "", h_next=getattr(solver, "h_next", None))
 
 
-__all__ = ["Segment", "integrate_segment", "missed_crossing", "LONG_STEP_S", "LONG_STEP_CHECKS"]
+__all__ = ["DOPRI5", "DormandPrince", "Segment", "integrate_segment", "missed_crossing", "LONG_STEP_S", "LONG_STEP_CHECKS"]

@@ -35,7 +35,7 @@ EXPECTED_LAYERS = [
     "static_models | parameter_schema | signals | plotting | atlas_plots | oscillation | paperdata | data",
     "core_table | table_checks | atomic | references | figure_style",
     "modeling",  # the component machinery knows no physics: anything may build on it
-    "constants | errors | gc_control",
+    "constants | errors | gc_control | stepping",
 ]
 
 

@@ -61,3 +61,66 @@ def test_the_first_of_two_events_in_one_step_fires():
                                 max_step=1.0)
         assert order[seg.event] is events[1]
         assert abs(seg.y_event[0] + 0.1) < 1e-9
+
+
+def test_dopri5_takes_rk45s_steps():
+    """pamsim's Dormand-Prince against scipy's RK45, the same formulas and step control: the same step times
+    and evaluations, states and dense output within rounding."""
+    from pamsim.stepping import DormandPrince
+
+    ref = solve_ivp(oscillator, (0.0, 3.0), Y0, method="RK45", rtol=1e-7, atol=1e-9, max_step=0.05, dense_output=True)
+    dp = DormandPrince(oscillator, 0.0, Y0, 3.0, rtol=1e-7, atol=1e-9, max_step=0.05)
+    ts, ys, dense = [0.0], [Y0], []
+    while dp.status == "running":
+        assert dp.step() is None
+        ts.append(dp.t)
+        ys.append(dp.y)
+        dense.append(dp.dense_output())
+    assert np.array_equal(ts, ref.t) and dp.nfev == ref.nfev
+    np.testing.assert_allclose(np.array(ys).T, ref.y, rtol=1e-14, atol=1e-16)
+    for k in (0, len(dense) // 2, len(dense) - 1):
+        inside = np.linspace(ts[k], ts[k + 1], 7)
+        np.testing.assert_allclose(dense[k](inside), ref.sol(inside), rtol=1e-13, atol=1e-15)
+        np.testing.assert_allclose(dense[k](inside[3]), ref.sol(inside[3]), rtol=1e-13, atol=1e-15)
+
+
+def test_dopri5_carried_across_switches_meets_the_analytic_solution():
+    """A first-order lag under a square wave of 50 Hz switched 100 times, segment by segment, each starting
+    from the last one's proposed step (or afresh): against the solution written out switch by switch."""
+    tau, period, duty = 5e-3, 0.02, 0.4
+    switches = np.sort(np.concatenate([np.arange(0, 1, period) + duty * period, np.arange(period, 1 + 1e-12, period)]))
+
+    def run(carry: bool) -> None:
+        t, y, h, x_exact = 0.0, np.array([0.0]), None, 0.0
+        for k, t_next in enumerate(switches):
+            level = 1.0 if k % 2 == 0 else 0.0
+            seg = integrate_segment(lambda t, y: np.array([(level - y[0]) / tau]), t, t_next, y, "DOPRI5", [],
+                                    np.array([t_next]), rtol=1e-8, atol=1e-10, max_step=np.inf,
+                                    first_step=h if carry else None)
+            x_exact = level + (x_exact - level) * np.exp(-(t_next - t) / tau)
+            assert abs(seg.samples_y[0, 0] - x_exact) < 1e-7
+            t, y, h = t_next, seg.y[:, -1], seg.h_next
+            assert 0.0 < h < np.inf
+    run(carry=True)
+    run(carry=False)
+
+
+def test_a_pwm_run_with_dopri5_meets_lsoda_and_the_native_engine():
+    """A second of 50 Hz PWM on a 3/2 valve (100 switches, stick/slip between them): python with DOPRI5
+    against python with LSODA and the native engine (which takes DOPRI5 as RK45, and runs it the same)."""
+    import pamsim
+
+    def scenario(method):
+        return pamsim.Scenario.from_dict({
+            "name": "pwm", "model": {"parameter_set": "shadow_6x300_acra2012"}, "load": {"weight_N": 22.74},
+            "pressure": {"source": "valve", "supply_gauge_bar": 3.6,
+                         "command": {"kind": "pwm", "start_s": 0.0, "end_s": 1.0, "frequency_Hz": 50.0, "duty": 0.4,
+                                     "low": -1.0, "high": 1.0}},
+            "simulation": {"duration_s": 1.0, "sample_rate_Hz": 1000.0}, "solver": {"method": method, "rtol": 1e-6}})
+    dopri = pamsim.simulate(scenario("DOPRI5"))
+    lsoda = pamsim.simulate(scenario("LSODA"))
+    native = pamsim.simulate(scenario("DOPRI5"), backend="native")
+    assert dopri.stats["method"] == "DOPRI5" and dopri.x_m.max() > 5e-3  # the load moves
+    assert np.abs(dopri.x_m - lsoda.x_m).max() < 1e-6 and np.abs(dopri.x_m - native.x_m).max() < 1e-6
+    assert np.abs(dopri.p_gauge_Pa - native.p_gauge_Pa).max() < 10.0
+    assert np.array_equal(native.x_m, pamsim.simulate(scenario("RK45"), backend="native").x_m)

@@ -1,4 +1,4 @@
-"""A muscle alone driven by its length (``[motion]``), on the python backend (``solve_ivp``), the native engine and
+"""A muscle alone driven by its length (``[motion]``), on the python backend (scipy's integrators), the native engine and
 the muscle-only FMU: the one generated assembly (:mod:`pamsim.assemblies.muscle_only`) on each.
 
 Its inputs are exactly linear between the knots of the motion and of the pressure's signals, so each backend
@@ -21,6 +21,7 @@ from ..assemblies.one_muscle import RUN_FUNCTIONS, input_signals, source_parts
 from ..errors import InputError, SolverFailure
 from ..modeling.pygen import compiled_by_mode, outputs_by_mode
 from ..simulator import _distinct_breaks, _event, _from_start, fired_together, n_samples, too_many_events
+from ..stepping import integrate_segment
 from .motion import Motion, motion_of
 from .result import LengthDrivenResult
 
@@ -96,34 +97,33 @@ def simulate_length_drive(scenario, backend: str = "python") -> LengthDrivenResu
     return run(drive, backend)
 
 
-def _segment(drive: LengthDrive, gen, p, t: float, y: np.ndarray, t_break: float, atol: np.ndarray):
-    """``solve_ivp`` of the generated model from ``t`` to ``t_break`` or its first indicator's crossing, its
-    inputs at their left limit at ``t_break`` (a jump there belongs to the next segment)."""
-    from scipy.integrate import solve_ivp
-
+def _segment(drive: LengthDrive, gen, p, t: float, y: np.ndarray, t_break: float, atol: np.ndarray, samples):
+    """The generated model integrated from ``t`` to ``t_break`` or its first indicator's crossing
+    (:func:`pamsim.stepping.integrate_segment`), read at ``samples`` on the way, its inputs at their left
+    limit at ``t_break`` (a jump there belongs to the next segment)."""
     opts = drive.scenario.solver
     t_left = float(np.nextafter(t_break, -math.inf))
 
     def rhs(tt, yy):
-        return gen.f(yy.tolist(), drive.inputs(min(tt, t_left)), p, ())[0]
+        return np.array(gen.f(yy.tolist(), drive.inputs(min(tt, t_left)), p, ())[0])
 
     def indicator(k):
         return _event(lambda tt, yy: gen.z(yy.tolist(), drive.inputs(min(tt, t_left)), p, ())[0][k], -1.0)
 
     n = len(drive.assembly.indicator_names())
     try:
-        sol = solve_ivp(rhs, (t, t_break), y, method=opts.method, dense_output=True,
-                        events=[_from_start(indicator(k), t, y) for k in range(n)], rtol=opts.rtol, atol=atol,
-                        max_step=opts.max_step_s)
-    except Exception as exc:  # solve_ivp's numerical trouble comes as plain exceptions: a solver failure (exit 3)
-        raise SolverFailure(f"solve_ivp raised {type(exc).__name__} at t = {t:.6g} s: {exc}") from exc
-    if sol.status == -1:
-        raise SolverFailure(f"solve_ivp failed at t = {t:.6g} s: {sol.message}")
-    return sol
+        # No step is looked into between its ends: the muscle's length is driven, and nothing turns inside one.
+        seg = integrate_segment(rhs, t, t_break, y, opts.method, [_from_start(indicator(k), t, y) for k in range(n)],
+                                samples, rtol=opts.rtol, atol=atol, max_step=opts.max_step_s, long_step_s=math.inf)
+    except Exception as exc:  # numerical trouble comes as plain exceptions: a solver failure (exit 3)
+        raise SolverFailure(f"the integrator raised {type(exc).__name__} at t = {t:.6g} s: {exc}") from exc
+    if seg.status == -1:
+        raise SolverFailure(f"the integrator failed at t = {t:.6g} s: {seg.message}")
+    return seg
 
 
 def _python(drive: LengthDrive, backend: str) -> LengthDrivenResult:
-    """``solve_ivp`` from knot to knot, stopping at each indicator's crossing for its jump."""
+    """Integrated from knot to knot, stopping at each indicator's crossing for its jump."""
     sc, opts = drive.scenario, drive.scenario.solver
     wall0 = time.perf_counter()
     gen, p = drive.code()[0], drive.assembly.parameter_values()
@@ -134,18 +134,17 @@ def _python(drive: LengthDrive, backend: str) -> LengthDrivenResult:
     ys, events, nfev, segments, next_sample = [], [], 0, 0, 0
     for t_break in _distinct_breaks(drive.breakpoints, sc.duration_s):
         while t < t_break:
-            sol = _segment(drive, gen, p, t, y, t_break, atol)
-            nfev, segments = nfev + sol.nfev, segments + 1
-            j = np.searchsorted(grid, sol.t[-1], side="right")
-            if j > next_sample:  # slips closer together than the samples leave pieces without one
-                ys.append(sol.sol(grid[next_sample:j]))
-            next_sample = j
-            if sol.status != 1:
-                t, y = t_break, sol.y[:, -1].copy()
+            samples = grid[next_sample:np.searchsorted(grid, t_break, side="right")]
+            seg = _segment(drive, gen, p, t, y, t_break, atol, samples)
+            nfev, segments = nfev + seg.nfev, segments + 1
+            if seg.samples_t.size:  # slips closer together than the samples leave pieces without one
+                ys.append(seg.samples_y)
+            next_sample += seg.samples_t.size
+            if seg.status != 1:
+                t, y = t_break, seg.y[:, -1].copy()
                 continue
-            k = next(i for i, te in enumerate(sol.t_events) if len(te))
-            t = float(sol.t_events[k][0])
-            y_event, u = list(sol.y_events[k][0]), drive.inputs(t)
+            k, t = seg.event, seg.t_event
+            y_event, u = list(seg.y_event), drive.inputs(t)
             crossed = fired_together(gen.z(y_event, u, p, ())[0], k, range(len(names)))
             fired = [1.0 if i in crossed else 0.0 for i in range(len(names))]
             y = np.array(gen.transition(y_event, u, p, (), fired)[0])

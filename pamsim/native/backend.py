@@ -57,9 +57,10 @@ from ..simulator import MIN_RTOL, too_many_events
 from . import library as lib
 from .engine import EngineCase, engine_library
 
-METHODS = ("LSODA", "RK45")
-"""``solver.method`` values the native backend honours: its Dormand-Prince 5(4) is RK45's method, and
-LSODA is the automatic choice of a non-stiff method for this non-stiff model.  Others are refused."""
+METHODS = ("LSODA", "RK45", "DOPRI5")
+"""``solver.method`` values the native backend honours: its Dormand-Prince 5(4) is RK45's and DOPRI5's
+method, and LSODA is the automatic choice of a non-stiff method for this non-stiff model.  Others are
+refused."""
 BATCH_EVENT_CAPACITY = 1024
 """Events kept per case in a batch; a case with more is run again alone, with room for ``max_events``."""
 
