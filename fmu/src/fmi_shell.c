@@ -456,8 +456,9 @@ int fmu_update_discrete_states(FmuInstance *in, const char *function, int *state
                                double *next_time) {
     if (!fmu_allowed(in, function, FMU_EVENT)) return -1;
     *states_changed = pam_event_update(&in->core);
-    /* The signals' breakpoints are time events: a held load is checked again there, as in co-simulation. */
-    *next_time = pam_next_breakpoint(&in->core, fmax(in->core.time_s, in->core.event_time_s));
+    /* The signals' breakpoints and a hold's end are time events: a held load is checked again there, as in
+     * co-simulation. */
+    *next_time = pam_next_event_time(&in->core, fmax(in->core.time_s, in->core.event_time_s));
     *next_time_defined = isfinite(*next_time);
     if (!*next_time_defined) *next_time = 0.0;
     return 0;

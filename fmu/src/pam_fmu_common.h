@@ -93,6 +93,9 @@ int pam_input_scheduled(const PamCore *c, unsigned vr, double *value);
 void pam_mark_input_set(PamCore *c, unsigned vr);
 /* The first breakpoint (knot, step, a lag's start) of the signals after t_s, or HUGE_VAL if none. */
 double pam_next_breakpoint(const PamCore *c, double t_s);
+/* Model exchange's next time event after t_s: the next breakpoint, or the end of a running hold of a slip
+ * that ended where it began (pam_event_update), whichever comes first; HUGE_VAL if neither. */
+double pam_next_event_time(const PamCore *c, double t_s);
 /* 1 if t_s is a breakpoint of the signals. */
 int pam_at_breakpoint(const PamCore *c, double t_s);
 /* 1 if no input changes from t_s to the next breakpoint. */

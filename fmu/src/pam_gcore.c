@@ -241,16 +241,36 @@ void pam_initialize(PamCore *c) {
 
 void pam_note_table_edge(PamCore *c) { (void)c; }
 
+/* Model exchange: the importer's solver decides what follows.  An event's jump and mode are the engine's
+ * (at_event), with its hold of a slip that ended where it began: the model is held, whatever its forces do,
+ * until the hold's end, a time event (pam_next_event_time), where its mode is decided again from its forces.
+ * An event inside a hold (an indicator the held forces cross, a breakpoint) changes nothing; the indicator
+ * stays on its side, so the importer meets it once. */
 int pam_event_update(PamCore *c) {
     EngineRun run;
-    int old = c->mode, jumped, jump_mode; /* model exchange: the importer's solver decides what follows */
+    double t = c->event_time_s, x_before[PAM_ARRAY(PM_NX)];
+    int zero_length = 0, jumped;
     engine_load(c, &run);
-    jumped = transition(&run.e, run.e.x, fired_indicators(&run.e, run.e.x), &jump_mode);
-    if (jumped || run.e.mode != old) run.e.n_events++;
+    memcpy(x_before, run.e.x, sizeof x_before);
+    if (holding(&run.e, t)) {
+        /* held */
+    } else if (run.e.hold_until_s > -HUGE_VAL) {
+        run.e.hold_until_s = -HUGE_VAL;
+        run.e.since_s = t;
+        recheck_held(&run.e, t, run.e.x);
+    } else {
+        at_event(&run.e, t, run.e.x, &zero_length);
+    }
+    jumped = memcmp(x_before, run.e.x, sizeof x_before) != 0;
     engine_store(c, &run);
     c->inputs_changed = 0;
     pam_evaluate(c);
     return jumped;
+}
+
+double pam_next_event_time(const PamCore *c, double t_s) {
+    double next = pam_next_breakpoint(c, t_s);
+    return c->hold_until_s > t_s ? fmin(next, c->hold_until_s) : next;
 }
 
 int pam_do_step(PamCore *c, double t_end) {
