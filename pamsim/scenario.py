@@ -24,7 +24,7 @@ from .elements.damping import DAMPING_MODELS
 from .elements.friction import FRICTION_MODELS, NEGATIVE_LEVEL_CHOICES, NoCoulomb
 from .elements.load import HangingLoad
 from .elements.pressure_source import LineValveSource, PrescribedPressure, ValveChamberSource
-from .elements.pwm_average import PWM_MODELS, averaged_source
+from .elements.pwm_average import PWM_MODELS, averaged_source, mean_opening_signal
 from .elements.spool import spool_source
 from .elements.force_clip import NEGATIVE_FORCE_CHOICES
 from .elements.static_force import STATIC_FORCE_MODELS
@@ -287,8 +287,10 @@ class Scenario:
 
     def _valve_pair_source(self, v: "_Validator", pr: Mapping[str, Any], supply: float):
         """Two 2/2 valves, ``[pressure.inlet]`` and ``[pressure.exhaust]``, each with its ISO 6358 (C, b), its
-        timing and its command (the exhaust's may be the inlet's inverted); with ``model = "averaged"`` in
-        the inlet's PWM command, their averaged model (the exhaust then complementary)."""
+        timing and its command (the exhaust's may be the inlet's inverted).  With ``model = "averaged"`` in the
+        inlet's PWM command and the exhaust complementary, their averaged model at the inlet's duty (the input
+        ``pwm_duty``); otherwise each valve whose PWM command has ``model = "averaged"`` opens by its mean
+        opening over a period (:func:`~pamsim.elements.pwm_average.mean_opening_signal`)."""
         p = self.parameters
         for section in ("controller", "compensation"):
             if section in self.spec:
@@ -318,13 +320,14 @@ class Scenario:
         valve = ProportionalValve33(orifices["inlet"], orifices["exhaust"])
         parts = (OnOffValvePair(valve), _chamber(v, self.spec.get("chamber", {}), p), Constant(supply), inlet,
                  p["T_supply_K"], p["p_atm_Pa"])
-        if _pwm_model(v, tables["inlet"], "pressure.inlet.command") != "averaged":
-            _pwm_model(v, tables["exhaust"], "pressure.exhaust.command")
-            return ValvePairSource(*parts, exhaust_command=exhaust)
-        if isinstance(exhaust_table, dict) and exhaust_table.get("kind") != "complementary":
-            v.fail("pressure.exhaust.command.kind", exhaust_table.get("kind"), "the averaged model of two valves takes "
-                   "the inlet's duty: the exhaust's command must be complementary")
-        return averaged_source(ValveChamberSource(valve, *parts[1:]), inlet, exhaust)
+        averaged = {name: _pwm_model(v, tables[name], f"pressure.{name}.command") == "averaged"
+                    for name in ("inlet", "exhaust")}
+        if averaged["inlet"] and exhaust_table.get("kind") == "complementary":
+            return averaged_source(ValveChamberSource(valve, *parts[1:]), inlet, exhaust)
+        # Each valve whose PWM command says model = "averaged" opens by its mean opening over a period.
+        if averaged["inlet"]:
+            parts = (*parts[:3], mean_opening_signal(inlet), *parts[4:])
+        return ValvePairSource(*parts, exhaust_command=mean_opening_signal(exhaust) if averaged["exhaust"] else exhaust)
 
     def _supply_gauge_Pa(self, v: "_Validator", pr: Mapping[str, Any]) -> float:
         """The valve's supply pressure [Pa gauge], given in bar or in Pa, within the muscle's rating."""

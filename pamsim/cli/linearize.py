@@ -176,6 +176,11 @@ def _linearize(scenario, args: argparse.Namespace):
         kind = scenario.spec["pressure"]["inlet"]["command"].get("kind")
         raise InputError(f"{scenario.origin}: pressure.inlet.command.kind = {kind!r}: pamsim linearize takes two 2/2 "
                          "valves through their averaged model, under a pwm inlet command and a complementary exhaust")
+    if "inlet" in scenario.spec["pressure"] and scenario.spec["pressure"]["exhaust"]["command"].get("kind") != "complementary":
+        kind = scenario.spec["pressure"]["exhaust"]["command"].get("kind")
+        raise InputError(f"{scenario.origin}: pressure.exhaust.command.kind = {kind!r}: pamsim linearize takes two 2/2 "
+                         "valves through their averaged model at the inlet's duty, the exhaust complementary; an "
+                         "exhaust with a command of its own runs averaged (pamsim run) but is not linearised")
     if pwm:
         if args.valve_slope != "mean":
             raise InputError(f"--valve-slope {args.valve_slope}: a PWM valve is linearised through its averaged "

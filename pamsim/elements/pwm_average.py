@@ -146,6 +146,18 @@ class AveragedValvePair(TwoPathValve):
         return self.inlet.share(duty, 1.0), self.exhaust.share(duty, 1.0)
 
 
+def mean_opening_signal(pwm) -> PiecewiseConstant:
+    """A 2/2 valve's opening under the PWM command ``pwm`` (from 0 to 1, with its timing) averaged over a
+    period (its share, :meth:`PwmShare.share`) from the command's start to its end, closed before and after:
+    the averaged model of one valve of a pair whose other valve has a command of its own.  Each valve's flow
+    is its opening times its full orifice's, so the pair's mean flow with the chamber's state frozen over a
+    period is the pair's flow at the two mean openings, whatever the two commands' frequencies and phases."""
+    share = float(PwmShare.of_pwm(pwm).share(pwm.duty, 1.0))
+    if pwm.start_s > 0.0:
+        return PiecewiseConstant((0.0, pwm.start_s, pwm.end_s), (0.0, share, 0.0))
+    return PiecewiseConstant((pwm.start_s, pwm.end_s), (share, 0.0))
+
+
 def duty_signal(pwm) -> PiecewiseConstant:
     """The duty the averaged valve takes in place of the PWM command ``pwm``: ``pwm.duty`` from its start
     to its end, 0 (the valve held at its ``low`` command) before and after."""
