@@ -327,7 +327,8 @@ class Scenario:
         # Each valve whose PWM command says model = "averaged" opens by its mean opening over a period.
         if averaged["inlet"]:
             parts = (*parts[:3], mean_opening_signal(inlet), *parts[4:])
-        return ValvePairSource(*parts, exhaust_command=mean_opening_signal(exhaust) if averaged["exhaust"] else exhaust)
+        return ValvePairSource(*parts, exhaust_command=mean_opening_signal(exhaust) if averaged["exhaust"] else exhaust,
+                               averaged_inlet=inlet if averaged["inlet"] else None)
 
     def _supply_gauge_Pa(self, v: "_Validator", pr: Mapping[str, Any]) -> float:
         """The valve's supply pressure [Pa gauge], given in bar or in Pa, within the muscle's rating."""

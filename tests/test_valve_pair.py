@@ -397,11 +397,32 @@ def test_bad_valve_input_exits_2_naming_the_key(tmp_path, cli, old, new, key, co
     assert_refused(cli(command, _bad(tmp_path, (old, new)), "-o", tmp_path / "out"), key, tmp_path / "out")
 
 
-def test_linearize_needs_a_complementary_exhaust(tmp_path, cli):
-    """``pamsim linearize`` takes the pair through its averaged model at the inlet's duty: an exhaust with a
-    command of its own (which ``pamsim run`` averages) is refused naming its kind."""
-    path = _bad(tmp_path, ('kind = "complementary"', 'kind = "constant"\nvalue = 1.0'))
-    assert_refused(cli("linearize", path, "-o", tmp_path / "out"), "pressure.exhaust.command.kind", tmp_path / "out")
+@pytest.mark.parametrize("exhaust, share", [
+    ('kind = "pwm"\nstart_s = 0.5\nend_s = 4.5\nfrequency_Hz = 30.0\nduty = 0.3\nmodel = "averaged"', 0.3),
+    ('kind = "constant"\nvalue = 1.0', 1.0)], ids=["own averaged PWM", "held open"])
+def test_linearize_takes_an_exhaust_of_its_own_at_its_share(tmp_path, cli, exhaust, share):
+    """``pamsim linearize`` of the pair whose exhaust has a command of its own (the inlet at duty 0.6): the pair
+    averaged at the inlet's duty, the exhaust open its share (equal 2 ms timing: the duty); the operating
+    point's pressure is where ``0.6 q_in(p) + share q_ex(p) = 0``, solved here from the formula, to 10 Pa."""
+    path = _bad(tmp_path, ('kind = "complementary"', exhaust), ("duty = 0.5\n", "duty = 0.6\n"))
+    text = cli("linearize", path, "--json", "-o", tmp_path)
+    assert text.returncode == 0, text.stderr
+    rep, _ = json.JSONDecoder().raw_decode(text.stdout)
+    assert rep["inputs"][0] == "pwm_duty" and f"exhaust open {share:g} of the time" in rep["valve_model"]
+    C, b = 5.5e-10, 0.3
+    balance = brentq(lambda p: 0.6 * _signed(p, TS, P_SUPPLY, C, b) + share * _signed(p, TS, P_ATM, C, b),
+                     P_ATM + 1.0, P_SUPPLY - 1.0, xtol=1e-6) - P_ATM
+    assert rep["operating_point"]["states"][2] - P_ATM == pytest.approx(balance, abs=10.0)
+
+
+def test_linearize_refuses_an_exhaust_whose_opening_changes_under_the_inlets_pwm(tmp_path, cli):
+    """An exhaust under a switching PWM of its own, or stepping while the inlet's PWM runs, has no share to
+    stand for it: ``pamsim linearize`` exits 2 naming its kind."""
+    for exhaust in ('kind = "pwm"\nstart_s = 0.5\nend_s = 4.5\nfrequency_Hz = 30.0\nduty = 0.3',
+                    'kind = "step"\ntime_s = 2.0\ninitial = 0\nfinal = 1'):
+        path = _bad(tmp_path, ('kind = "complementary"', exhaust))
+        assert_refused(cli("linearize", path, "-o", tmp_path / "out"), "pressure.exhaust.command.kind",
+                       tmp_path / "out")
 
 
 @pytest.mark.parametrize("key, value, message", [

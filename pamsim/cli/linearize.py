@@ -176,17 +176,12 @@ def _linearize(scenario, args: argparse.Namespace):
         kind = scenario.spec["pressure"]["inlet"]["command"].get("kind")
         raise InputError(f"{scenario.origin}: pressure.inlet.command.kind = {kind!r}: pamsim linearize takes two 2/2 "
                          "valves through their averaged model, under a pwm inlet command and a complementary exhaust")
-    if "inlet" in scenario.spec["pressure"] and scenario.spec["pressure"]["exhaust"]["command"].get("kind") != "complementary":
-        kind = scenario.spec["pressure"]["exhaust"]["command"].get("kind")
-        raise InputError(f"{scenario.origin}: pressure.exhaust.command.kind = {kind!r}: pamsim linearize takes two 2/2 "
-                         "valves through their averaged model at the inlet's duty, the exhaust complementary; an "
-                         "exhaust with a command of its own runs averaged (pamsim run) but is not linearised")
     if pwm:
         if args.valve_slope != "mean":
             raise InputError(f"--valve-slope {args.valve_slope}: a PWM valve is linearised through its averaged "
                              "model, whose input is the duty; it has no command kink to choose a slope at")
         scenario = scenario.with_pwm_averaged()
-    model = scenario.build_model()
+    model = _at_inlet_duty(scenario, scenario.build_model())
     added = scenario.added_components
     if "hysteresis" in scenario.spec and args.friction != "dropped":
         raise InputError(f"--friction {args.friction}: the scenario's [hysteresis] elements take the Coulomb "
@@ -195,13 +190,33 @@ def _linearize(scenario, args: argparse.Namespace):
     friction = FrictionTreatment(args.friction, args.friction_velocity_mm_s * 1e-3)
     lin = linearize(model, op, friction, args.valve_slope, added=added)
     rep = report(lin)
-    valves = ("the inlet and exhaust 2/2 valves (the exhaust complementary)" if "inlet" in scenario.spec["pressure"]
-              else "the on/off valve")
+    exhaust = getattr(model.source.valve, "exhaust_share", None)
+    valves = ("the on/off valve" if "inlet" not in scenario.spec["pressure"]
+              else "the inlet and exhaust 2/2 valves (the exhaust complementary)" if exhaust is None
+              else f"the inlet and exhaust 2/2 valves (the exhaust open {exhaust:.4g} of the time, by its own command)")
     rep["valve_model"] = (f"the averaged model of {valves} under {model.source.valve.frequency_Hz:g} Hz PWM "
                           "(the mean of its supply and exhaust paths' flows over a period), input pwm_duty [1]; "
                           "pamsim run runs its switching" if pwm
                           else f"proportional 3/3 valve, slope at command 0: {lin.valve_slope}")
     return lin, rep
+
+
+def _at_inlet_duty(scenario, model):
+    """``model``, or for two 2/2 valves whose exhaust has a command of its own, the pair averaged at the inlet's
+    duty with the exhaust at its share (:meth:`pamsim.elements.valve_pair.ValvePairSource.at_inlet_duty`)."""
+    import dataclasses
+
+    from ..elements.valve_pair import ValvePairSource
+    from ..errors import InputError
+
+    if not isinstance(model.source, ValvePairSource):
+        return model
+    try:
+        return dataclasses.replace(model, source=model.source.at_inlet_duty())
+    except ValueError as exc:
+        kind = scenario.spec["pressure"]["exhaust"]["command"].get("kind")
+        raise InputError(f"{scenario.origin}: pressure.exhaust.command.kind = {kind!r}: pamsim linearize takes the "
+                         f"pair averaged at the inlet's duty, the exhaust at a fixed share: {exc}") from None
 
 
 def _operating_point(scenario, model, pull, args: argparse.Namespace):

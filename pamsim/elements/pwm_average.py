@@ -126,24 +126,47 @@ class PwmAveragedValve(TwoPathValve):
 
 
 @dataclass(frozen=True)
-class AveragedValvePair(TwoPathValve):
-    """Two 2/2 on/off valves (:class:`~pamsim.elements.valve.OnOffValvePair`) under PWM, averaged over one
-    period: the inlet under a PWM command (``inlet``, from 0 to 1), the exhaust under its complementary
-    command (``exhaust``, from 1 down to 0 with its own delays and times, :func:`pamsim.signals.complementary`),
-    both at the inlet's duty, each path's share derived from its own valve's trace."""
+class _PairAtInletDuty(TwoPathValve):
+    """Two 2/2 on/off valves (:class:`~pamsim.elements.valve.OnOffValvePair`) averaged over a period of the
+    inlet's PWM command (``inlet``, from 0 to 1) at its duty, the input; the exhaust's share is the subclass's."""
 
     valve: ProportionalValve33
     inlet: PwmShare
-    exhaust: PwmShare
 
     @property
     def frequency_Hz(self) -> float:
-        """The PWM frequency [Hz] (the pair's, one period for both)."""
+        """The inlet's PWM frequency [Hz]."""
         return self.inlet.frequency_Hz
 
     def shares(self, duty) -> tuple:
         """``(W_supply, W_exhaust)``: each valve's opening averaged over a period at the inlet's ``duty``."""
-        return self.inlet.share(duty, 1.0), self.exhaust.share(duty, 1.0)
+        return self.inlet.share(duty, 1.0), self.exhaust_share_at(duty)
+
+
+@dataclass(frozen=True)
+class AveragedValvePair(_PairAtInletDuty):
+    """The pair under PWM, the exhaust under the inlet's complementary command (``exhaust``, from 1 down to 0
+    with its own delays and times, :func:`pamsim.signals.complementary`), both at the inlet's duty, each
+    path's share derived from its own valve's trace."""
+
+    exhaust: PwmShare
+
+    def exhaust_share_at(self, duty):
+        """The exhaust's opening averaged over a period at the inlet's ``duty``."""
+        return self.exhaust.share(duty, 1.0)
+
+
+@dataclass(frozen=True)
+class AveragedInletPair(_PairAtInletDuty):
+    """The pair at the inlet's duty, the exhaust open a fixed ``exhaust_share`` of the time (its own command's
+    mean opening while the inlet's PWM runs): the model ``pamsim linearize`` takes of a pair whose exhaust
+    has a command of its own."""
+
+    exhaust_share: float
+
+    def exhaust_share_at(self, duty):
+        """The exhaust's share, whatever the inlet's duty."""
+        return self.exhaust_share
 
 
 def mean_opening_signal(pwm) -> PiecewiseConstant:

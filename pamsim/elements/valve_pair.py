@@ -11,13 +11,13 @@ carrying the temperature of where it comes from.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable
+from typing import Any, Callable
 
 import numpy as np
 
 from ..signals import max_step_hint_s
 from .pressure_source import ValveChamberSource
-from .pwm_average import chamber_rates_of_paths
+from .pwm_average import AveragedInletPair, AveragedPwmSource, PwmShare, chamber_rates_of_paths, duty_signal
 from .valve import OnOffValvePair
 
 VALVE_DEFAULTS = {
@@ -37,6 +37,32 @@ class ValvePairSource(ValveChamberSource):
     is the inlet's opening in [0, 1] as it follows its command, ``exhaust_command`` the exhaust's."""
 
     exhaust_command: Callable = None
+    averaged_inlet: Any = None
+    """The inlet's PWM command (:class:`pamsim.signals.Pwm`) when ``command`` is its mean opening (run averaged,
+    :func:`~pamsim.elements.pwm_average.mean_opening_signal`); None otherwise."""
+
+    def at_inlet_duty(self) -> AveragedPwmSource:
+        """The pair averaged at the inlet's duty (its input), the exhaust open its share while the inlet's PWM
+        runs (:class:`~pamsim.elements.pwm_average.AveragedInletPair`): the model ``pamsim linearize`` takes.
+
+        Raises
+        ------
+        ValueError
+            If the inlet does not run averaged, or the exhaust's opening changes while the inlet's PWM runs
+            (a switching PWM, a step inside it): no share stands for it.
+        """
+        pwm = self.averaged_inlet
+        if pwm is None:
+            raise ValueError("the inlet's PWM does not run averaged")
+        inside = [t for t in getattr(self.exhaust_command, "breakpoints", ()) if pwm.start_s < t < pwm.end_s]
+        times = np.concatenate([np.linspace(pwm.start_s, pwm.end_s, 101)[1:-1], inside])
+        openings = np.unique(np.asarray(self.exhaust_command(times), dtype=float))
+        if openings.size != 1:
+            raise ValueError(f"the exhaust's opening takes {openings.size} values while the inlet's PWM runs "
+                             f"({pwm.start_s:g} to {pwm.end_s:g} s); run its PWM averaged, or hold it")
+        valve = AveragedInletPair(self.valve.valve, PwmShare.of_pwm(pwm), float(openings[0]))
+        return AveragedPwmSource(valve, self.chamber, self.supply_gauge_Pa, duty_signal(pwm), self.T_supply_K,
+                                 self.p_atm_Pa)
 
     def inputs(self, t_s) -> tuple:
         """(inlet opening, exhaust opening, supply gauge pressure [Pa]) at time ``t_s``."""
