@@ -97,11 +97,12 @@ class DormandPrince:
         self.y_old = self.y
         self.status = "running" if self.t < self.t_bound else "finished"
         self.h_abs = first_step if first_step else self._initial_step()
+        self._constant = False  # the last step took no time (its dense output is the state)
         self.h_next = self.h_abs
         """The step the last step proposed for the next, unshortened by the end of the segment [s]."""
 
     def _norm(self, x) -> float:
-        return float(np.sqrt(np.dot(x, x) / x.size))
+        return float(np.linalg.norm(x) / x.size ** 0.5)  # scipy's RMS norm, rounded as it rounds
 
     def _initial_step(self) -> float:
         """Hairer, Norsett and Wanner's starting step (sec. II.4), as ``RK45`` takes it."""
@@ -121,6 +122,11 @@ class DormandPrince:
     def step(self) -> str | None:
         """One accepted step (rejected trial steps inside); a message if the step became too small."""
         t, y, K, A, C = self.t, self.y, self.K, self.A, self.C
+        if t == self.t_bound:  # a segment of no time: as scipy's solvers, no step
+            self.t_old, self.y_old, self.status = t, y, "finished"
+            self._constant = True
+            return None
+        self._constant = False
         min_step = 10 * abs(np.nextafter(t, np.inf) - t)
         h_abs = min(max(self.h_abs, min_step), self.max_step)
         rejected = False
@@ -156,6 +162,9 @@ class DormandPrince:
 
     def dense_output(self):
         """The step's quartic interpolant: a callable of a time or an array of times in it."""
+        if self._constant:
+            y_end = self.y
+            return lambda t: y_end if np.ndim(t) == 0 else np.repeat(y_end[:, None], np.size(t), axis=1)
         q1, q2, q3, q4 = self.K.T.dot(self.P).T * (self.t - self.t_old)
         t_old, y_old, h = self.t_old, self.y_old, self.t - self.t_old
 
@@ -168,9 +177,11 @@ class DormandPrince:
         return y_at
 
 
-def missed_crossing(events: Sequence[Callable], dense, t_old: float, t: float):
-    """The first ``(time, index)`` inside the step ``(t_old, t]`` where one of ``events`` went below zero,
-    looked for at :data:`LONG_STEP_CHECKS` points of the step's ``dense`` output, or None.
+def missed_crossing(events: Sequence[Callable], directions: Sequence[float], g_old: Sequence[float], dense,
+                    t_old: float, t: float):
+    """The first ``(time, index)`` inside the step ``(t_old, t]`` where one of ``events`` crossed zero in its
+    ``direction`` (``solve_ivp``'s rule, :func:`_crossed`), looked for between :data:`LONG_STEP_CHECKS` points
+    of the step's ``dense`` output from the events' values ``g_old`` at ``t_old``, or None.
 
     ``solve_ivp`` finds an event where an indicator changes sign between two step ends.  A free swing at
     a tight tolerance can take a step long enough for the load to reach a stop and come back within it
@@ -178,24 +189,29 @@ def missed_crossing(events: Sequence[Callable], dense, t_old: float, t: float):
     from scipy.optimize import brentq
 
     taus = np.linspace(t_old, t, LONG_STEP_CHECKS + 1)
+    g_lo = list(g_old)
     for lo, hi in zip(taus[:-2], taus[1:-1]):  # the step's end is what the event rule checked
         y_hi = dense(hi)
-        fired = [k for k, fun in enumerate(events) if fun(hi, y_hi) < 0.0]
-        if fired:
+        g_hi = [fun(hi, y_hi) for fun in events]
+        crossed = [k for k in range(len(events)) if _crossed(g_lo[k], g_hi[k], directions[k])]
+        if crossed:
             roots = []
-            for k in fired:
+            for k in crossed:
                 fun = events[k]
-                a = lo if fun(lo, dense(lo)) > 0.0 else hi
-                roots.append((brentq(lambda tau: fun(tau, dense(tau)), a, hi, xtol=1e-15) if a < hi else hi, k))
+                before = fun(lo, dense(lo))  # the dense output's, which may round to the far side at t_old
+                roots.append((brentq(lambda tau: fun(tau, dense(tau)), lo, hi, xtol=1e-15)
+                              if before * g_hi[k] < 0.0 else hi, k))
             return min(roots)
+        g_lo = g_hi
     return None
 
 
 def _turned(v_old: float, v_new: float, v_tol: float) -> bool:
     """Whether the load's velocity went from one side of zero to the other over a step, beyond its absolute
-    tolerance ``v_tol`` on both.  A slide that starts from rest (v = 0) has not turned; nor has one that ends
-    at its velocity's zero (an event there leaves v at +-1e-17).  A turn that leaves the load slower than
-    its tolerance carries it ``v_tol^2 / (2 a)`` past where it turned, far below its position's tolerance."""
+    tolerance ``v_tol`` on both (a step from rest is judged by its start's acceleration instead, in
+    :func:`integrate_segment`).  A slide that ends at its velocity's zero (an event there leaves v at
+    +-1e-17) has not turned.  A turn that leaves the load slower than its tolerance carries it
+    ``v_tol^2 / (2 a)`` past where it turned, far below its position's tolerance."""
     return (v_old > v_tol and v_new < -v_tol) or (v_old < -v_tol and v_new > v_tol)
 
 
@@ -263,7 +279,7 @@ def integrate_segment(fun: Callable, t0: float, t_end: float, y0: np.ndarray, me
     directions = [getattr(e, "direction", 0.0) for e in events]
     g = [e(solver.t, solver.y) for e in events]
     ts, ys = [solver.t], [solver.y]
-    sample_ys, n_taken, status, event, message = [], 0, None, None, ""
+    sample_ys, n_taken, status, event, message, extra_nfev = [], 0, None, None, "", 0
     kept = None  # the last kept step's dense output, where a sample sits on its end (see below)
     while status is None:
         message = solver.step()
@@ -279,14 +295,22 @@ def integrate_segment(fun: Callable, t0: float, t_end: float, y0: np.ndarray, me
             dense = solver.dense_output()
             t, event = _earliest_event(events, directions, g, g_new, dense, t_old, t)
             y, status = dense(t), 1
-        g = g_new
-        turned = v_row is not None and _turned(ys[-1][v_row], y[v_row], v_tol)
+        turned = False
+        if v_row is not None and abs(y[v_row]) > v_tol:
+            v_old = ys[-1][v_row]
+            if v_old == 0.0:  # a slide from rest turned if it ends moving against its start's acceleration
+                a_old = float(np.asarray(fun(ts[-1], ys[-1]))[v_row])
+                extra_nfev += 1
+                turned = a_old * y[v_row] < 0.0
+            else:
+                turned = _turned(v_old, y[v_row], v_tol)
         if events and (t - t_old > long_step_s or turned):
             dense = solver.dense_output() if dense is None else dense
-            missed = missed_crossing(events, dense, t_old, t)
+            missed = missed_crossing(events, directions, g, dense, t_old, t)
             if missed is not None:
                 t, event = missed
                 y, status = dense(t), 1
+        g = g_new
         if t == ts[-1] and len(ts) > 1:
             continue  # no time passed: solve_ivp keeps neither the point nor its dense output
         # A sample on a step boundary is read from the step solve_ivp's piecewise solution reads it from:
@@ -310,7 +334,7 @@ def integrate_segment(fun: Callable, t0: float, t_end: float, y0: np.ndarray, me
                    samples_y=np.hstack(sample_ys) if sample_ys else np.empty((n, 0)),
                    status=status, event=event, t_event=float(t) if status == 1 else None,
                    y_event=np.array(y, dtype=float) if status == 1 else None,
-                   nfev=solver.nfev, message=message or "", h_next=getattr(solver, "h_next", None))
+                   nfev=solver.nfev + extra_nfev, message=message or "", h_next=getattr(solver, "h_next", None))
 
 
 __all__ = ["DOPRI5", "DormandPrince", "Segment", "integrate_segment", "missed_crossing", "LONG_STEP_S", "LONG_STEP_CHECKS"]

@@ -124,3 +124,72 @@ def test_a_pwm_run_with_dopri5_meets_lsoda_and_the_native_engine():
     assert np.abs(dopri.x_m - lsoda.x_m).max() < 1e-6 and np.abs(dopri.x_m - native.x_m).max() < 1e-6
     assert np.abs(dopri.p_gauge_Pa - native.p_gauge_Pa).max() < 10.0
     assert np.array_equal(native.x_m, pamsim.simulate(scenario("RK45"), backend="native").x_m)
+
+
+def test_a_slide_from_rest_that_turns_inside_its_first_step_meets_its_stop():
+    """From rest the load rises 6.67 um and falls back within 0.3 ms; a stop 5 um up.  DOPRI5 started with one
+    0.3 ms step (a held segment's proposal) sees no crossing at the step's ends (v from 0 to -0.15 m/s): the
+    step is looked into because it ends moving against its start's acceleration, and the stop is met at its
+    analytic time."""
+    from scipy.optimize import brentq
+
+    def rise_and_fall(t, y):
+        return np.array([y[1], 1e3 - 1e7 * t])
+
+    def stop(t, y):
+        return 5e-6 - y[0]
+    stop.direction = -1.0
+    exact = brentq(lambda t: 500.0 * t ** 2 - 1e7 / 6.0 * t ** 3 - 5e-6, 0.0, 2e-4, xtol=1e-16)
+    free = integrate_segment(rise_and_fall, 0.0, 3e-4, np.zeros(2), "DOPRI5", [], np.empty(0), rtol=1e-3,
+                             atol=1e-9, max_step=np.inf, v_row=1, first_step=3e-4)
+    assert len(free.t) == 2 and (free.y[0] < 5e-6).all()  # one step; its ends show nothing
+    seg = integrate_segment(rise_and_fall, 0.0, 3e-4, np.zeros(2), "DOPRI5", [stop], np.empty(0), rtol=1e-3,
+                            atol=1e-9, max_step=np.inf, v_row=1, first_step=3e-4)
+    assert seg.status == 1 and abs(seg.t_event - exact) < 1e-9
+
+
+@pytest.mark.parametrize("direction, method", [(1.0, "RK45"), (1.0, "LSODA"), (0.0, "RK45")])
+def test_a_long_step_is_looked_into_in_each_events_direction(direction, method):
+    """Steps without a longest step (longer than ``LONG_STEP_S``) are looked into, for a crossing in the event's
+    own direction only: the oscillator's level -0.1 crossed upwards (or either way) fires where solve_ivp's
+    does, the downward crossings before it not (direction +1)."""
+    def level(t, y):
+        return y[0] + 0.1
+    level.terminal, level.direction = True, direction
+    ref = solve_ivp(oscillator, (0.0, 3.0), Y0, method=method, events=level, rtol=1e-7, atol=1e-9)
+    seg = integrate_segment(oscillator, 0.0, 3.0, Y0, method, [level], np.empty(0), rtol=1e-7, atol=1e-9,
+                            max_step=np.inf)
+    assert seg.status == 1 == ref.status
+    assert abs(seg.t_event - ref.t_events[0][0]) < 1e-9
+
+
+@pytest.mark.parametrize("n", [1, 2, 3, 5, 9])
+def test_dopri5_takes_rk45s_steps_on_random_linear_systems(n):
+    """DOPRI5 against scipy's RK45 on damped random linear systems under a sine, at three tolerances: the same
+    step times and evaluations (the RMS error norm rounded as scipy rounds it)."""
+    from pamsim.stepping import DormandPrince
+
+    rng = np.random.default_rng(n)
+    for trial in range(3):
+        A = rng.normal(size=(n, n)) - 2.0 * np.eye(n)
+        y0 = rng.normal(size=n)
+
+        def f(t, y, A=A):
+            return A @ y + np.sin(3.0 * t)
+        for rtol in (1e-3, 1e-6, 1e-9):
+            ref = solve_ivp(f, (0.0, 5.0), y0, method="RK45", rtol=rtol, atol=1e-9)
+            dp = DormandPrince(f, 0.0, y0, 5.0, rtol=rtol, atol=1e-9)
+            ts = [0.0]
+            while dp.status == "running":
+                dp.step()
+                ts.append(dp.t)
+            assert np.array_equal(ts, ref.t) and dp.nfev == ref.nfev, (trial, rtol)
+
+
+def test_a_dopri5_segment_of_no_time_reads_its_start():
+    """A segment from t to t: no step, the sample at t is the start state, as with scipy's solvers."""
+    seg = integrate_segment(oscillator, 1.0, 1.0, Y0, "DOPRI5", [], np.array([1.0]), rtol=1e-6, atol=1e-9,
+                            max_step=np.inf)
+    ref = integrate_segment(oscillator, 1.0, 1.0, Y0, "RK45", [], np.array([1.0]), rtol=1e-6, atol=1e-9,
+                            max_step=np.inf)
+    assert seg.status == 0 and np.array_equal(seg.samples_y, ref.samples_y) and np.array_equal(seg.samples_y[:, 0], Y0)

@@ -245,7 +245,9 @@ void pam_note_table_edge(PamCore *c) { (void)c; }
  * (at_event), with its hold of a slip that ended where it began: the model is held, whatever its forces do,
  * until the hold's end, a time event (pam_next_event_time), where its mode is decided again from its forces.
  * An event inside a hold (an indicator the held forces cross, a breakpoint) changes nothing; the indicator
- * stays on its side, so the importer meets it once. */
+ * stays on its side, so the importer meets it once.  An event where no indicator is at or below zero is a
+ * time event (a breakpoint): there, as in the engine, a held model's mode is decided again and the count of
+ * slips that ended where they began is left as it is. */
 int pam_event_update(PamCore *c) {
     EngineRun run;
     double t = c->event_time_s, x_before[PAM_ARRAY(PM_NX)];
@@ -256,6 +258,10 @@ int pam_event_update(PamCore *c) {
         /* held */
     } else if (run.e.hold_until_s > -HUGE_VAL) {
         run.e.hold_until_s = -HUGE_VAL;
+        run.e.since_s = t;
+        recheck_held(&run.e, t, run.e.x);
+    } else if (fired_indicators(&run.e, run.e.x) == 0) {
+        /* A time event (a breakpoint): a held model's mode decided again, as the engine does there. */
         run.e.since_s = t;
         recheck_held(&run.e, t, run.e.x);
     } else {
