@@ -208,8 +208,9 @@ def missed_crossing(events: Sequence[Callable], directions: Sequence[float], g_o
 
 def _turned(v_old: float, v_new: float, v_tol: float) -> bool:
     """Whether the load's velocity went from one side of zero to the other over a step, beyond its absolute
-    tolerance ``v_tol`` on both (a step from rest is judged by its start's acceleration instead, in
-    :func:`integrate_segment`).  A slide that ends at its velocity's zero (an event there leaves v at
+    tolerance ``v_tol`` on both.  A step from rest is judged instead, in :func:`integrate_segment`, by its
+    velocity at the first of the points :func:`missed_crossing` looks at: a turn before it is below the
+    resolution of that look anyway.  A slide that ends at its velocity's zero (an event there leaves v at
     +-1e-17) has not turned.  A turn that leaves the load slower than its tolerance carries it
     ``v_tol^2 / (2 a)`` past where it turned, far below its position's tolerance."""
     return (v_old > v_tol and v_new < -v_tol) or (v_old < -v_tol and v_new > v_tol)
@@ -279,7 +280,7 @@ def integrate_segment(fun: Callable, t0: float, t_end: float, y0: np.ndarray, me
     directions = [getattr(e, "direction", 0.0) for e in events]
     g = [e(solver.t, solver.y) for e in events]
     ts, ys = [solver.t], [solver.y]
-    sample_ys, n_taken, status, event, message, extra_nfev = [], 0, None, None, "", 0
+    sample_ys, n_taken, status, event, message = [], 0, None, None, ""
     kept = None  # the last kept step's dense output, where a sample sits on its end (see below)
     while status is None:
         message = solver.step()
@@ -298,10 +299,9 @@ def integrate_segment(fun: Callable, t0: float, t_end: float, y0: np.ndarray, me
         turned = False
         if v_row is not None and abs(y[v_row]) > v_tol:
             v_old = ys[-1][v_row]
-            if v_old == 0.0:  # a slide from rest turned if it ends moving against its start's acceleration
-                a_old = float(np.asarray(fun(ts[-1], ys[-1]))[v_row])
-                extra_nfev += 1
-                turned = a_old * y[v_row] < 0.0
+            if v_old == 0.0:  # a slide from rest: turned if it ends moving against its motion early in the step
+                dense = solver.dense_output() if dense is None else dense
+                turned = float(dense(t_old + (t - t_old) / LONG_STEP_CHECKS)[v_row]) * y[v_row] < 0.0
             else:
                 turned = _turned(v_old, y[v_row], v_tol)
         if events and (t - t_old > long_step_s or turned):
@@ -334,7 +334,7 @@ def integrate_segment(fun: Callable, t0: float, t_end: float, y0: np.ndarray, me
                    samples_y=np.hstack(sample_ys) if sample_ys else np.empty((n, 0)),
                    status=status, event=event, t_event=float(t) if status == 1 else None,
                    y_event=np.array(y, dtype=float) if status == 1 else None,
-                   nfev=solver.nfev + extra_nfev, message=message or "", h_next=getattr(solver, "h_next", None))
+                   nfev=solver.nfev, message=message or "", h_next=getattr(solver, "h_next", None))
 
 
 __all__ = ["DOPRI5", "DormandPrince", "Segment", "integrate_segment", "missed_crossing", "LONG_STEP_S", "LONG_STEP_CHECKS"]
