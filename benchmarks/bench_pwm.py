@@ -32,13 +32,6 @@ def pwm_scenario(method: str = "LSODA") -> pamsim.Scenario:
         "simulation": {"duration_s": 5.0, "sample_rate_Hz": 1000.0}, "solver": {"method": method, "rtol": 1e-6}})
 
 
-def with_method(scenario: pamsim.Scenario, method: str) -> pamsim.Scenario:
-    """``scenario`` with ``solver.method`` set to ``method``."""
-    spec = scenario.spec
-    return pamsim.Scenario.from_dict({**spec, "solver": {**spec.get("solver", {}), "method": method}},
-                                     name=scenario.name)
-
-
 def median_ms(run, repeats: int) -> float:
     """Median wall time of ``run()`` [ms] over ``repeats`` calls after 2 warm-up calls."""
     for _ in range(2):
@@ -61,7 +54,7 @@ def main() -> None:
     print(f"{'backend':8} {'method':7} {'PWM 5 s [ms]':>13} {'target':>7} {'fig4 8 s [ms]':>14} {'PWM / fig4':>11} "
           f"{'PWM RHS':>8} {'segments':>9}")
     for backend, method in (("native", "LSODA"), ("python", "LSODA"), ("python", "DOPRI5")):
-        p_sc, f_sc = pwm_scenario(method), with_method(fig4, method)
+        p_sc, f_sc = pwm_scenario(method), fig4.with_changes({"solver": {"method": method}})
         p_ms = median_ms(lambda: pamsim.simulate(p_sc, backend=backend), args.repeats)
         f_ms = median_ms(lambda: pamsim.simulate(f_sc, backend=backend), args.repeats)
         stats = pamsim.simulate(p_sc, backend=backend).stats

@@ -106,17 +106,19 @@ def test_dopri5_carried_across_switches_meets_the_analytic_solution():
 
 
 def test_a_pwm_run_with_dopri5_meets_lsoda_and_the_native_engine():
-    """A second of 50 Hz PWM on a 3/2 valve (100 switches, stick/slip between them): python with DOPRI5
-    against python with LSODA and the native engine (which takes DOPRI5 as RK45, and runs it the same)."""
+    """A second of ``pwm_3_2.toml``'s 50 Hz PWM on a 3/2 valve switching at once (100 switches, stick/slip
+    between them): python with DOPRI5 against python with LSODA and the native engine (which takes DOPRI5 as
+    RK45, and runs it the same)."""
     import pamsim
+    from conftest import SCENARIOS
+
+    pwm = pamsim.load_scenario(SCENARIOS / "pwm_3_2.toml")
+    command = {**pwm.spec["pressure"]["command"], "start_s": 0.0, "end_s": 1.0, "duty": 0.4,
+               "delay_on_s": 0.0, "delay_off_s": 0.0, "rise_s": 0.0, "fall_s": 0.0}
 
     def scenario(method):
-        return pamsim.Scenario.from_dict({
-            "name": "pwm", "model": {"parameter_set": "shadow_6x300_acra2012"}, "load": {"weight_N": 22.74},
-            "pressure": {"source": "valve", "supply_gauge_bar": 3.6,
-                         "command": {"kind": "pwm", "start_s": 0.0, "end_s": 1.0, "frequency_Hz": 50.0, "duty": 0.4,
-                                     "low": -1.0, "high": 1.0}},
-            "simulation": {"duration_s": 1.0, "sample_rate_Hz": 1000.0}, "solver": {"method": method, "rtol": 1e-6}})
+        return pwm.with_changes({"pressure": {"command": command}, "solver": {"method": method},
+                                 "simulation": {"duration_s": 1.0, "sample_rate_Hz": 1000.0}})
     dopri = pamsim.simulate(scenario("DOPRI5"))
     lsoda = pamsim.simulate(scenario("LSODA"))
     native = pamsim.simulate(scenario("DOPRI5"), backend="native")
