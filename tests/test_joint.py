@@ -668,6 +668,9 @@ def test_a_release_turned_back_at_once_is_held_on_every_backend():
     np.testing.assert_allclose(gaps[1:] / gaps[:-1], 2.0, rtol=1e-3)
     for backend in ("native", "fmu-cs", "fmu-me"):
         res = simulate_joint(scenario, backend)
+        print(f"{backend}: final angle {abs(res.theta_rad[-1] - py.theta_rad[-1]):.2g} rad from python's, pressures "
+              + ", ".join(f"{abs(res.muscle(m, 'p_gauge_Pa')[-1] - py.muscle(m, 'p_gauge_Pa')[-1]):.2g} Pa"
+                          for m in py.muscles))
         assert res.final_mode == py.final_mode, backend
         assert abs(res.theta_rad[-1] - py.theta_rad[-1]) < 1e-3, backend
         for m in py.muscles:
