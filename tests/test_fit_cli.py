@@ -79,14 +79,15 @@ def test_fit_static_bad_input_is_one_line_and_leaves_nothing(tmp_path, args, mes
     assert not out.exists()
 
 
-def test_fit_dynamic_cli_recovers_friction_from_a_recorded_trace(tmp_path):
+@pytest.mark.parametrize("workers", ["1", "2"])  # in this process, and on a pool of worker processes
+def test_fit_dynamic_cli_recovers_friction_from_a_recorded_trace(tmp_path, workers):
     sc = pamsim.load_scenario(SCENARIOS / "acra2012_fig4.toml")
     noisy, clean = synthetic_trace(sc, {"N0_N_per_bar": 6.0}, 22.74, duration_s=2.0, seed=4)
     trace = tmp_path / "step.csv"
     write_trace_csv(noisy, trace)
     out = tmp_path / "dyn"
     proc = pamsim_cli("fit", "dynamic", trace, "--scenario", SCENARIOS / "acra2012_fig4.toml", "--free",
-                      "N0_N_per_bar", "--window", "0.9:2.0", "--workers", "1", "-o", out, "--json")
+                      "N0_N_per_bar", "--window", "0.9:2.0", "--workers", workers, "-o", out, "--json")
     assert proc.returncode == 0, proc.stderr
     body = json.loads(proc.stdout)
     assert {"parameters", "standard_errors", "correlation", "rms_contraction_mm", "n_simulations",

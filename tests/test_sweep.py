@@ -7,6 +7,9 @@ session (module fixtures); everything else reads those results.
 from __future__ import annotations
 
 import csv
+import subprocess
+import sys
+import textwrap
 import math
 from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 from pathlib import Path
@@ -388,6 +391,40 @@ def test_sigterm_stops_the_pool_workers_and_leaves_no_output_folder(tmp_path):
     # No output folder, and not the samples table's temporary file either (made beside it, the folder not
     # made yet, while the study ran).
     assert sorted(p.name for p in tmp_path.iterdir()) == ["slow.toml"]
+
+
+def test_an_interrupt_while_a_worker_sends_its_results_does_not_hang_the_pool(tmp_path):
+    """A worker killed in the middle of sending its results left half a message in the pool's results pipe;
+    the pool's manager thread waited for the rest for ever, and the command with it (a SIGTERM sweep that
+    never ended). Here each worker returns 100 MB, and the block is interrupted at several delays after the
+    first result is made, so that some interrupt falls while it is being sent (the pool before the fix hung
+    at 0.15 s and later on the machine this was written on)."""
+    script = tmp_path / "pool.py"
+    script.write_text(textwrap.dedent(f"""
+        import time
+        from pathlib import Path
+        from pamsim.cli.pool import process_pool
+
+        def big(marker):
+            result = b"x" * 100_000_000
+            Path(marker).touch()
+            return result
+
+        for delay_s in (0.0, 0.05, 0.1, 0.2, 0.3, 0.5):
+            marker = Path({str(tmp_path)!r}, f"made{{delay_s}}")
+            try:
+                with process_pool(2) as pool:
+                    futures = [pool.submit(big, marker) for i in range(3)]
+                    while not marker.exists():
+                        time.sleep(0.001)
+                    time.sleep(delay_s)
+                    raise KeyboardInterrupt
+            except KeyboardInterrupt:
+                print(delay_s, flush=True)
+        """))
+    done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0 and done.stdout.split() == ["0.0", "0.05", "0.1", "0.2", "0.3", "0.5"], \
+        (done.stdout, done.stderr)
 
 
 def test_a_killed_sweep_leaves_no_empty_output_folder(tmp_path):

@@ -11,6 +11,7 @@ from pathlib import Path
 from ..atomic import OutputError, ensure_output_dir
 from ..identification import choices
 from . import figure_args, finite_float, int_at_least
+from .pool import process_pool
 
 # The numerical modules (numpy, scipy, matplotlib) are imported by the run functions, not here:
 # `pamsim --help` must not load them.
@@ -212,8 +213,6 @@ def run_dynamic(args: argparse.Namespace) -> int:
     """``pamsim fit dynamic``: fit friction and damping to the step responses with the scenario's model (on
     ``--workers`` processes or the native backend), write the fit, the report and the figures; exit code 0.
     """
-    from concurrent.futures import ProcessPoolExecutor
-
     from ..identification import dynamic_fit, report
     from ..identification.columns import read_trace
     from ..scenario import load_scenario
@@ -232,7 +231,7 @@ def run_dynamic(args: argparse.Namespace) -> int:
     if args.workers == 1:
         fit = dynamic_fit.fit_dynamic(scenario, traces, executor=None, **options)
     else:
-        with ProcessPoolExecutor(max_workers=args.workers) as pool:
+        with process_pool(args.workers) as pool:
             fit = dynamic_fit.fit_dynamic(scenario, traces, executor=pool, **options)
     names = report.write_dynamic_fit(fit, args.output, *figures)
     _warn(fit.warnings)

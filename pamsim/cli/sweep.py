@@ -7,35 +7,18 @@ import argparse
 import contextlib
 import os
 import sys
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 from ..atomic import output_folder
 from ..backends import BACKENDS
 from . import figure_args, int_at_least
+from .pool import process_pool
 
 
 _workers = int_at_least(1)
 
 MAX_FAILURE_LINES = 10
 """Failed runs named one per line on stderr; the tables hold them all."""
-
-
-@contextlib.contextmanager
-def process_pool(workers: int):
-    """A ``ProcessPoolExecutor`` of ``workers`` processes that, if the block raises (an interrupt, SIGTERM, a
-    lost run), stops its workers at once instead of waiting for their chunks: left running, they outlived
-    the command and kept its stdout open."""
-    pool = ProcessPoolExecutor(max_workers=workers)
-    try:
-        yield pool
-    except BaseException:
-        # CPython's pool keeps {pid: process}; the chunks that have not started are dropped.
-        for process in list((getattr(pool, "_processes", None) or {}).values()):
-            process.terminate()
-        pool.shutdown(wait=True, cancel_futures=True)
-        raise
-    pool.shutdown(wait=True)
 
 
 def register(sub) -> None:
