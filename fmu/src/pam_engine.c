@@ -3,6 +3,7 @@
  * generated model. */
 #include "pam_engine.h"
 #include "pam_dopri.h"
+#include "pam_rosenbrock.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -108,6 +109,7 @@ void pam_engine_reset(PamEngine *e) {
     e->max_step_s = 1e-3;
     e->max_steps = 1000000;
     e->h_s = 1e-4;
+    e->stiff_switch = 1;
 }
 
 /* Initial states from the inputs and parameters, and the mode decided from the forces there. */
@@ -126,15 +128,17 @@ static const double DP_NODE[7] = {0.0, 1.0 / 5, 3.0 / 10, 4.0 / 5, 8.0 / 9, 1.0,
 
 /* One trial step from t0; returns the scaled RMS error norm.  k[0] must hold f(y0).  Inputs that
  * follow signals are left at their values from the left of t0 + h. */
-static double dp_step(PamEngine *e, double t0, const double *y0, double h, PamStages *s, double *y1) {
+static double dp_step(PamEngine *e, double t0, const double *y0, double h, PamStages *s, double *y1, double *y6) {
     double yt[PM_NX], err = 0.0, rtol = e->rtol;
     int st, j, n;
+    s->poly = 0;
     for (st = 1; st < 7; st++) {
         for (n = 0; n < PM_NX; n++) {
             double acc = 0.0;
             for (j = 0; j < st; j++) acc += DP_A[st][j] * s->k[j][n];
             yt[n] = y0[n] + h * acc;
         }
+        if (st == 5) memcpy(y6, yt, sizeof yt);
         inputs_at(e, t0 + DP_NODE[st] * h, 1);
         rhs(e, yt, s->k[st]);
     }
@@ -151,6 +155,10 @@ static double dp_step(PamEngine *e, double t0, const double *y0, double h, PamSt
 static void dp_dense(const PamStages *s, const double *y0, double h, double th, double *y) {
     double pw[4] = {th, th * th, th * th * th, th * th * th * th};
     int n, st, j;
+    if (s->poly) {
+        for (n = 0; n < PM_NX; n++) y[n] = y0[n] + th * (s->q[0][n] + th * (s->q[1][n] + th * (s->q[2][n] + th * s->q[3][n])));
+        return;
+    }
     for (n = 0; n < PM_NX; n++) {
         double acc = 0.0;
         for (st = 0; st < 7; st++) {
@@ -160,6 +168,103 @@ static void dp_dense(const PamStages *s, const double *y0, double h, double th, 
         }
         y[n] = y0[n] + h * acc;
     }
+}
+
+/* The scaled RMS norm of the error estimate d, as dp_step's. */
+static double error_norm(const PamEngine *e, const double *y0, const double *y1, const double *d) {
+    double err = 0.0;
+    int n;
+    for (n = 0; n < PM_NX; n++) {
+        double sc = e->rtol * PM_NOMINAL[n] + e->rtol * fmax(fabs(y0[n]), fabs(y1[n]));
+        err += (d[n] / sc) * (d[n] / sc);
+    }
+    return PM_NX > 0 ? sqrt(err / PM_NX) : 0.0;
+}
+
+/* One trial Rosenbrock step (pam_rosenbrock.h's tableau r) of a model whose inputs are constant over it; returns the
+ * scaled RMS error norm (infinite where the stage matrix is singular).  s->k[0] must hold f(y0).  An
+ * accepted step (norm <= 1) also evaluates f(y1) into s->k[6], the next step's first, and leaves as its
+ * dense output the cubic Hermite interpolant of y0, y1 and their derivatives. */
+static double ros_step(PamEngine *e, const RosTableau *r, const double *y0, double h, PamStages *s, double *y1) {
+    double jac[PM_NX * PM_NX > 0 ? PM_NX * PM_NX : 1], a[PM_NX * PM_NX > 0 ? PM_NX * PM_NX : 1];
+    double K[6][PM_NX > 0 ? PM_NX : 1], f[PM_NX > 0 ? PM_NX : 1], yt[PM_NX > 0 ? PM_NX : 1], err;
+    int piv[PM_NX > 0 ? PM_NX : 1], i, j, n, m;
+    pm_jac(e->mode, y0, e->u, e->p, jac); /* column-major: d f_n / d y_m at jac[m * PM_NX + n] */
+    e->n_jacobians++;
+    for (n = 0; n < PM_NX; n++)
+        for (m = 0; m < PM_NX; m++) a[n * PM_NX + m] = (n == m ? 1.0 / (h * r->gamma) : 0.0) - jac[m * PM_NX + n];
+    if (!ros_lu(a, piv, PM_NX)) return INFINITY;
+    memcpy(f, s->k[0], sizeof f);
+    for (i = 0; i < r->stages; i++) {
+        if (i > 0 && r->new_f[i]) {
+            for (n = 0; n < PM_NX; n++) {
+                double acc = 0.0;
+                for (j = 0; j < i; j++) acc += r->a[i][j] * K[j][n];
+                yt[n] = y0[n] + acc;
+            }
+            rhs(e, yt, f);
+        }
+        for (n = 0; n < PM_NX; n++) {
+            double acc = 0.0;
+            for (j = 0; j < i; j++) acc += r->c[i][j] * K[j][n];
+            K[i][n] = f[n] + acc / h;
+        }
+        ros_solve(a, piv, PM_NX, K[i]);
+    }
+    for (n = 0; n < PM_NX; n++) {
+        double acc = 0.0, d = 0.0;
+        for (i = 0; i < r->stages; i++) {
+            acc += r->m[i] * K[i][n];
+            d += r->e[i] * K[i][n];
+        }
+        y1[n] = y0[n] + acc;
+        yt[n] = d;
+    }
+    err = error_norm(e, y0, y1, yt);
+    if (!(err <= 1.0)) return err;
+    rhs(e, y1, s->k[6]);
+    s->poly = 1;
+    for (n = 0; n < PM_NX; n++) {
+        double dy = y1[n] - y0[n], f0 = h * s->k[0][n], f1 = h * s->k[6][n];
+        s->q[0][n] = f0;
+        s->q[1][n] = 3.0 * dy - 2.0 * f0 - f1;
+        s->q[2][n] = -2.0 * dy + f0 + f1;
+        s->q[3][n] = 0.0;
+    }
+    return err;
+}
+
+/* After an accepted Dormand-Prince step of a held model: whether its steps are bound by stability, from
+ * the estimate h |lambda| ~ h |f(y1) - f(y6)| / |y1 - y6| of its stiffest mode (stage 7 at y1, stage 6 at
+ * y6), as Hairer's DOPRI5 tests it: beyond 3.25 (the method's stability boundary) at 15 steps in a row
+ * it switches to Rodas4; 6 steps within it clear the count.  Rodas4's step costs a Jacobian and a
+ * factorisation besides its six evaluations, so where its steps stay within twice the Dormand-Prince
+ * step of the switch 5 times in a row (accuracy, not stability, binds both: a valve's flow near a pressure
+ * ratio of 1 whose Jacobian changes fast) it goes back, until the mode changes (note_rosenbrock_step). */
+static void test_stiffness(PamEngine *e, const PamStages *s, const double *y1, const double *y6, double h) {
+    double num = 0.0, den = 0.0;
+    int n;
+    for (n = 0; n < PM_NX; n++) {
+        double df = s->k[6][n] - s->k[5][n], dy = y1[n] - y6[n];
+        num += df * df;
+        den += dy * dy;
+    }
+    if (den > 0.0 && h * sqrt(num / den) > 3.25) {
+        e->n_nonstiff = 0;
+        if (++e->n_stiff >= 15) {
+            e->stiff = 1;
+            e->h_stiff_s = h;
+            e->n_slow = 0;
+        }
+    } else if (++e->n_nonstiff >= 6) {
+        e->n_stiff = 0;
+    }
+}
+
+/* After an accepted Rodas4 step h: back to Dormand-Prince where Rodas4 does not pay (test_stiffness). */
+static void note_rosenbrock_step(PamEngine *e, double h) {
+    e->n_slow = h <= 2.0 * e->h_stiff_s ? e->n_slow + 1 : 0;
+    if (e->n_slow >= 5) e->stiff = -1;
 }
 
 /* Where an indicator first reaches zero over an accepted step, as a fraction of the step in
@@ -290,6 +395,7 @@ static int at_event(PamEngine *e, double t, double *y, int *zero_length) {
     }
     *zero_length = 0;
     e->n_events++;
+    e->stiff = e->n_stiff = e->n_nonstiff = 0; /* a new mode is tested afresh */
     if (e->on_event) e->on_event(e->event_env, t, old, e->mode, fired, y_before, y);
     return 0;
 }
@@ -307,7 +413,10 @@ static void recheck_held(PamEngine *e, double t, const double *y) {
     int old = e->mode;
     if (!held(e) || holding(e, t)) return;
     e->mode = rest_mode(e, e->mode, y);
-    if (e->mode != old) e->n_events++;
+    if (e->mode != old) {
+        e->n_events++;
+        e->stiff = e->n_stiff = e->n_nonstiff = 0;
+    }
 }
 
 static int at_breakpoint(const PamEngine *e, double t_s) {
@@ -317,7 +426,7 @@ static int at_breakpoint(const PamEngine *e, double t_s) {
 /* Integrate to t_end, the inputs held or following their signals; 0 on success, -1 on failure (logged),
  * which leaves time_s, the states and the mode at the last instant reached. */
 int pam_engine_do_step(PamEngine *e, double t_end) {
-    double y[PM_NX], y1[PM_NX], t = e->time_s, h_max = e->max_step_s, t_piece;
+    double y[PM_NX], y1[PM_NX], y6[PM_NX], t = e->time_s, h_max = e->max_step_s, t_piece;
     PamStages s;
     long steps = 0;
     int zero_length = 0, n;
@@ -331,7 +440,7 @@ int pam_engine_do_step(PamEngine *e, double t_end) {
     while (t_end - t > 1e-13 * fmax(1.0, fabs(t_end))) {
         double h, err, factor, lo = 0.0, hi = 1.0;
         unsigned crossed;
-        int last, at_rest = held(e);
+        int last, at_rest = held(e), rosenbrock;
         if (t_piece - t <= 1e-13 * fmax(1.0, fabs(t_piece))) {
             /* A breakpoint of the signals (they take their values from the right), or a hold's end. */
             t = t_piece;
@@ -362,12 +471,23 @@ int pam_engine_do_step(PamEngine *e, double t_end) {
             engine_logf(e, PAM_ENGINE_ERROR, "step size underflow at t = %.9g s", t);
             return step_failed(e, t, y);
         }
-        err = dp_step(e, t, y, h, &s, y1);
-        if (!(err <= 1.0)) {
-            e->h_s = h * (isfinite(err) ? fmax(0.2, 0.9 * pow(err, -0.2)) : 0.1);
-            continue;
+        rosenbrock = e->stiff == 1 && held(e) && inputs_constant(e, t);
+        err = rosenbrock ? ros_step(e, &RODAS4, y, h, &s, y1) : dp_step(e, t, y, h, &s, y1, y6);
+        if (rosenbrock) {
+            if (!(err <= 1.0)) {
+                e->h_s = h * (isfinite(err) ? fmax(0.2, 0.9 * pow(err, -1.0 / RODAS4.elo)) : 0.1);
+                continue;
+            }
+            factor = err == 0.0 ? 6.0 : fmin(6.0, fmax(0.2, 0.9 * pow(err, -1.0 / RODAS4.elo)));
+            note_rosenbrock_step(e, h);
+        } else {
+            if (!(err <= 1.0)) {
+                e->h_s = h * (isfinite(err) ? fmax(0.2, 0.9 * pow(err, -0.2)) : 0.1);
+                continue;
+            }
+            factor = err == 0.0 ? 10.0 : fmin(10.0, fmax(0.2, 0.9 * pow(err, -0.2)));
+            if (e->stiff_switch && e->stiff == 0 && held(e) && inputs_constant(e, t)) test_stiffness(e, &s, y1, y6, h);
         }
-        factor = err == 0.0 ? 10.0 : fmin(10.0, fmax(0.2, 0.9 * pow(err, -0.2)));
         e->n_steps++;
         if (!holding(e, t) && (crossed = first_crossing(e, &s, t, y, y1, h, &lo, &hi)) != 0) {
             /* Locate the first crossing of the indicators that crossed on the dense output; keep the

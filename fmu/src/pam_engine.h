@@ -6,6 +6,11 @@
  * decided at rest and the settling of a held model.  The engine holds the inputs constant over a call
  * of pam_engine_do_step, or with an input function sets them at every time it evaluates the model, and
  * integrates with Dormand-Prince 5(4), locating each event on the dense output and switching modes there.
+ * A held model (the load at rest, the gas still moving) whose Dormand-Prince steps are bound by their
+ * stability rather than their accuracy (a thermal chamber cooling for seconds behind an open valve, whose
+ * pressure follows the supply in milliseconds) is stepped with the stiffly accurate Rosenbrock method
+ * Rodas4, with the model's exact Jacobian, while it stays held (stiff_switch, the default of
+ * pam_engine_reset).
  */
 #ifndef PAM_ENGINE_H
 #define PAM_ENGINE_H
@@ -24,8 +29,13 @@
 
 enum { PAM_ENGINE_INFO = 0, PAM_ENGINE_WARNING = 1, PAM_ENGINE_ERROR = 2 };
 
+/* One accepted step's dense output on [t0, t0 + h]: the Dormand-Prince stages k (their continuous
+ * extension, pam_dopri.h), or, where `poly` is set (a Rosenbrock step, pam_rosenbrock.h), the polynomial
+ * y(t0 + th h) = y0 + sum_j q[j] th^(j+1). */
 typedef struct {
     double k[7][PM_NX];
+    int poly;
+    double q[4][PM_NX];
 } PamStages;
 
 typedef void (*PamEngineLogFn)(void *env, int level, const char *message);
@@ -62,7 +72,13 @@ typedef struct {
     double hold_until_s;    /* a short hold of a slip too small to resolve runs until here (-HUGE_VAL: none) */
     double since_s;         /* the last event or breakpoint, from which an event's time is measured */
     int n_zero;             /* slips in a row that ended where they began (the hold's doubling) */
-    long n_steps, n_rhs, n_events;
+    int stiff_switch;       /* 1: a held model whose Dormand-Prince steps are bound by stability steps with
+                             * Rodas4 (pam_rosenbrock.h) until its mode changes; 0: Dormand-Prince only */
+    int stiff;              /* 1 while held steps are Rodas4's; -1 once Rodas4 did not pay, until the mode changes */
+    int n_stiff, n_nonstiff; /* held steps in a row that looked stiff, and not (the switch's test) */
+    double h_stiff_s;       /* the Dormand-Prince step at the switch, about its stability bound */
+    int n_slow;             /* Rodas4 steps in a row no longer than twice h_stiff_s */
+    long n_steps, n_rhs, n_events, n_jacobians;
     PamEngineLogFn log;
     void *log_env;
     PamEngineStepFn on_step;

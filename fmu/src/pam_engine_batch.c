@@ -35,6 +35,7 @@ typedef struct {
     const double *rtol;           /* n_cases */
     const double *max_step_s;     /* n_cases */
     const int64_t *max_steps;     /* n_cases: internal steps per input segment */
+    const int64_t *stiff_switch;  /* n_cases: 1 to step a stiff held model with Rodas4 (PamEngine.stiff_switch) */
     const double *duration_s;     /* n_cases */
     const int64_t *n_samples;     /* n_cases: samples at linspace(0, duration_s, n_samples) */
     const int64_t *sample_offset; /* n_cases: first sample of the case */
@@ -112,6 +113,10 @@ static void dense_poly(DensePoly *d, const PamStages *s, const double *y0, doubl
     d->t0 = t0;
     d->h = h;
     memcpy(d->y0, y0, sizeof d->y0);
+    if (s && s->poly) {
+        memcpy(d->q, s->q, sizeof d->q);
+        return;
+    }
     for (j = 0; j < 4; j++)
         for (n = 0; n < PM_NX; n++) {
             double acc = 0.0;
@@ -365,6 +370,7 @@ static int run_case(const PamEngineBatch *b, int64_t i) {
     e->rtol = b->rtol[i];
     e->max_step_s = b->max_step_s[i];
     e->max_steps = (long)b->max_steps[i];
+    e->stiff_switch = b->stiff_switch[i] != 0;
     e->log = keep_first_error;
     e->log_env = &run;
     run.inputs.at = segment_inputs_at;

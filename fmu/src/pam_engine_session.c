@@ -41,9 +41,10 @@ static void session_start(PamEngineSession *s) {
 }
 
 /* A new run at t = 0 with the parameters `params` (PM_NP), the inputs `u` (PM_NU) and the solver
- * settings; `max_steps` bounds the internal steps of one advance.  Returns an EngineStatus. */
+ * settings; `max_steps` bounds the internal steps of one advance, `stiff_switch` is PamEngine's.
+ * Returns an EngineStatus. */
 PAM_EXPORT int32_t pam_engine_session_reset(PamEngineSession *s, const double *params, const double *u, double rtol,
-                                            double max_step_s, int64_t max_steps) {
+                                            double max_step_s, int64_t max_steps, int32_t stiff_switch) {
     Run *run = &s->run;
     PamEngine *e = &run->engine;
     int k;
@@ -69,6 +70,7 @@ PAM_EXPORT int32_t pam_engine_session_reset(PamEngineSession *s, const double *p
     e->rtol = rtol;
     e->max_step_s = max_step_s;
     e->max_steps = (long)max_steps;
+    e->stiff_switch = stiff_switch != 0;
     e->log = keep_first_error;
     e->log_env = run;
     if (set_inputs(run, u)) return ENGINE_BAD_INPUT;

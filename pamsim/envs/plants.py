@@ -88,7 +88,7 @@ class NativePlant:
         self.library = library = engine_library(case.assembly)
         first = case.engine_case(library, 1)
         self._params = np.array(first.params, dtype=float)
-        self._settings = (first.rtol, first.max_step_s, first.max_steps)
+        self._settings = (first.rtol, first.max_step_s, first.max_steps, first.stiff_switch)
         self._u = np.array(first.segment_u[0], dtype=float)  # a copy: the case's own is read-only, shared by its runs
         self._k = library.names["inputs"].index(input_name)
         states, outputs = library.names["states"], library.names["outputs"]

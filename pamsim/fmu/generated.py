@@ -17,7 +17,7 @@ from .generate import WRAPPERS, c_source_dir
 from .spec import FmuSpec
 from .variables import BY_NAME, Variable
 
-SOURCES = ("pam_gcore.c", "pam_gcore.h", "pam_engine.c", "pam_engine.h", "pam_dopri.h", "pam_gauss.h", "pam_log.h",
+SOURCES = ("pam_gcore.c", "pam_gcore.h", "pam_engine.c", "pam_engine.h", "pam_dopri.h", "pam_rosenbrock.h", "pam_gauss.h", "pam_log.h",
            "pam_fmu_common.c", "pam_fmu_common.h", "fmi_shell.c", "fmi_shell.h")
 """The hand-written C an assembly FMU ships: the generic core and engine, the FMI shell (``pam_gcore.c``
 includes the engine, which includes the generated ``pam_model.c``: one translation unit)."""

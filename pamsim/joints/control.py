@@ -295,7 +295,7 @@ class _EngineStepper:
     interface of :class:`pamsim.simulator.SteppedRun` that :meth:`AngleStiffnessController.run` uses)."""
 
     def __init__(self, scenario: JointScenario, held: np.ndarray):
-        from ..native.backend import native_rtol
+        from ..native.backend import native_rtol, stiff_switch
         from ..native.engine import engine_library
 
         assembly = _pressure_assembly(scenario)
@@ -304,7 +304,7 @@ class _EngineStepper:
         self.held, self.external = held, scenario.external_torque
         opts = scenario.solver
         self.session.reset(assembly.parameter_values(), self._inputs(0.0), native_rtol(opts),
-                           opts.max_step_s if math.isfinite(opts.max_step_s) else 0.1, 1_000_000)
+                           opts.max_step_s if math.isfinite(opts.max_step_s) else 0.1, 1_000_000, stiff_switch(opts))
 
     def _inputs(self, t: float) -> list[float]:
         return [*map(float, self.held), float(self.external(t))]

@@ -12,7 +12,7 @@ from ..components.stick_slip import BodyMode, event_name
 from ..errors import InputError
 from ..assemblies.one_muscle import RUN_FUNCTIONS
 from ..modeling.pygen import compiled_by_mode
-from ..native.backend import (METHOD_LABEL, SCENARIO_CACHE_SIZE, KeptByObject, check_status, event_capacity,
+from ..native.backend import (METHOD_LABEL, stiff_switch, SCENARIO_CACHE_SIZE, KeptByObject, check_status, event_capacity,
                               exact_segments, native_rtol)
 from ..native.engine import EngineCase, engine_library
 from .result import JointEvent, JointResult
@@ -67,7 +67,7 @@ def _prepared(scenario: JointScenario) -> tuple:
     n = int(round(scenario.duration_s * opts.sample_rate_Hz)) + 1
     case = EngineCase(np.array(assembly.parameter_values()), native_rtol(opts),
                       opts.max_step_s if np.isfinite(opts.max_step_s) else MAX_STEP_S, MAX_INTERNAL_STEPS,
-                      scenario.duration_s, n, starts, u, event_capacity(opts.max_events), du)
+                      scenario.duration_s, n, starts, u, event_capacity(opts.max_events), du, stiff_switch(opts))
     for array in (case.params, case.segment_t_s, case.segment_u, case.segment_du):
         array.flags.writeable = False  # kept for the next run: no run may change it
     kept = (assembly, library, case, muscles)

@@ -9,6 +9,7 @@ left in the code the integrator runs) and has CasADi generate, as C:
 function       arguments                   results
 =============  ==========================  =====================================================
 ``f``          xd, u, p                    derivatives of the integrated states xd
+``jac``        xd, u, p                    their Jacobian by xd, dense, column-major (stiff steps)
 ``fq``         xd, u, p                    derivatives of the quadrature states (work integrals)
 ``z``          xd, u, p                    event indicators plus their margins, > 0 inside the mode
 ``tr``         xd, u, p, e                 integrated states and mode after an event (e: fired flags)
@@ -38,7 +39,7 @@ import tempfile
 
 from .lifting import lifted
 
-FUNCTIONS = ("f", "fq", "z", "tr", "rest", "settle", "y")
+FUNCTIONS = ("f", "jac", "fq", "z", "tr", "rest", "settle", "y")
 """The per-mode functions, in the order they are generated."""
 
 
@@ -101,6 +102,7 @@ class CModel:
         ext = m.externals
         return [
             _dense(ca, f"pm_f{k}", [xd, u, p], [pick(m.f, self.dynamic)], ext),
+            lifted(ca, f"pm_jac{k}", [xd, u, p], pick(m.f, self.dynamic), ext, jacobian_by=0),
             _dense(ca, f"pm_fq{k}", [xd, u, p], [pick(m.f, self.quadratures)], ext),
             _dense(ca, f"pm_z{k}", [xd, u, p], [z], ext),
             _dense(ca, f"pm_tr{k}", [xd, u, p, e], [pick(m.transition_x, self.dynamic), m.transition_q], ext),
@@ -156,7 +158,7 @@ class CModel:
                  "static int pm_mode_index(double value) {", "    switch ((int)value) {"]
         lines += [f"    case {v}: return {k};" for k, v in enumerate(self.mode_values)]
         lines += ["    default: return -1;", "    }", "}", ""]
-        calls = {"f": ("xd", "u", "p"), "fq": ("xd", "u", "p"), "z": ("xd", "u", "p"), "rest": ("xd", "u", "p"),
+        calls = {"f": ("xd", "u", "p"), "jac": ("xd", "u", "p"), "fq": ("xd", "u", "p"), "z": ("xd", "u", "p"), "rest": ("xd", "u", "p"),
                  "settle": ("xd", "u", "p", "&tol"), "y": ("x", "u", "p")}
         for name, args in calls.items():
             params = ", ".join(f"const double *{a}" if not a.startswith("&") else f"double {a[1:]}" for a in args)

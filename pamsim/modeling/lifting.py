@@ -22,7 +22,8 @@ def read_externals(ca, outs: list, externals) -> list:
     return [ext for ext in externals if any(ca.depends_on(o, ext.symbol) for o in outs)]
 
 
-def lifted(ca, name: str, args: list, outs: list, externals, jacobian: bool = False, forward: bool = False):
+def lifted(ca, name: str, args: list, outs: list, externals, jacobian_by: int | None = None,
+           forward: bool = False):
     """``name(*args) -> outs`` with every external placeholder replaced by its CasADi form of its arguments.
 
     Parameters
@@ -32,7 +33,7 @@ def lifted(ca, name: str, args: list, outs: list, externals, jacobian: bool = Fa
     args : SX column vectors of symbols, the function's arguments.
     outs : SX expressions (each a column), its results.
     externals : the flat model's :class:`~pamsim.modeling.flat.External` s.
-    jacobian : if True the one result is the dense Jacobian of ``outs`` stacked by ``args`` stacked.
+    jacobian_by : if given, the one result is the dense Jacobian of ``outs`` stacked by ``args[jacobian_by]``.
     forward : if True the function takes a seed per argument after the arguments, and its one result is
         the derivative of ``outs`` stacked along the seeds (the Jacobian times the seeds, in forward mode).
 
@@ -44,12 +45,13 @@ def lifted(ca, name: str, args: list, outs: list, externals, jacobian: bool = Fa
     if forward:
         return _forward(ca, name, args, outs, externals)
     if not read_externals(ca, outs, externals):
-        if jacobian:
-            return ca.Function(name, args, [ca.cse(ca.densify(ca.jacobian(_column(ca, outs), ca.vertcat(*args))))])
+        if jacobian_by is not None:
+            jac = ca.jacobian(_column(ca, outs), args[jacobian_by])
+            return ca.Function(name, args, [ca.cse(ca.densify(jac))])
         return ca.Function(name, args, [ca.cse(ca.densify(o)) for o in outs])
     mx, res = composed(ca, name, args, outs, externals)
-    if jacobian:
-        return ca.Function(name, mx, [ca.densify(ca.jacobian(ca.vertcat(*res), ca.vertcat(*mx)))])
+    if jacobian_by is not None:
+        return ca.Function(name, mx, [ca.densify(ca.jacobian(ca.vertcat(*res), mx[jacobian_by]))])
     return ca.Function(name, mx, [ca.densify(r) for r in res])
 
 

@@ -158,7 +158,7 @@ def _python(drive: LengthDrive, backend: str) -> LengthDrivenResult:
 
 def _native(drive: LengthDrive, backend: str) -> LengthDrivenResult:
     """The generic C engine compiled with the assembly's generated C, its inputs cut into exact segments."""
-    from ..native.backend import METHOD_LABEL, check_status, event_capacity, exact_segments, native_rtol
+    from ..native.backend import METHOD_LABEL, stiff_switch, check_status, event_capacity, exact_segments, native_rtol
     from ..native.engine import EngineCase, engine_library
 
     sc, opts = drive.scenario, drive.scenario.solver
@@ -174,7 +174,7 @@ def _native(drive: LengthDrive, backend: str) -> LengthDrivenResult:
     n = n_samples(sc.duration_s, opts.sample_rate_Hz)
     max_step = opts.max_step_s if math.isfinite(opts.max_step_s) else sc.duration_s
     case = EngineCase(np.array(drive.assembly.parameter_values()), native_rtol(opts), max_step, MAX_INTERNAL_STEPS,
-                      sc.duration_s, n, starts, u, event_capacity(opts.max_events), du)
+                      sc.duration_s, n, starts, u, event_capacity(opts.max_events), du, stiff_switch(opts))
     wall0 = time.perf_counter()
     out = library.run([case])
     wall = time.perf_counter() - wall0

@@ -59,8 +59,14 @@ from .engine import EngineCase, engine_library
 
 METHODS = ("LSODA", "RK45", "DOPRI5")
 """``solver.method`` values the native backend honours: its Dormand-Prince 5(4) is RK45's and DOPRI5's
-method, and LSODA is the automatic choice of a non-stiff method for this non-stiff model.  Others are
-refused."""
+method; LSODA, the automatic choice, is Dormand-Prince switching to the stiff Rodas4 where a held model's
+steps are bound by stability (:func:`stiff_switch`).  Others are refused."""
+
+
+def stiff_switch(opts) -> bool:
+    """Whether the engine steps a held model whose Dormand-Prince steps are bound by stability with Rodas4:
+    for ``solver.method = "LSODA"`` (the default, the automatic choice), not for ``RK45`` or ``DOPRI5``."""
+    return opts.method == "LSODA"
 BATCH_EVENT_CAPACITY = 1024
 """Events kept per case in a batch; a case with more is run again alone, with room for ``max_events``."""
 
@@ -106,6 +112,7 @@ class CaseInputs:
     assembly: object
     segment_du: np.ndarray | None = None  # exact inputs (EngineCase.segment_du), in segment_u's columns
     input_names: tuple[str, ...] = lib.INPUTS  # segment_u's columns
+    stiff_switch: bool = True  # EngineCase.stiff_switch
 
     def engine_case(self, library, capacity: int) -> EngineCase:
         """This case as the generic engine takes it: the flat model's parameters and inputs (kept for the
@@ -128,7 +135,7 @@ class CaseInputs:
         return EngineCase(np.array(self.assembly.parameter_values()), float(self.reals[lib.REAL_INDEX["cs_relative_tolerance"]]),
                           float(self.reals[lib.REAL_INDEX["cs_max_step_s"]]),
                           int(self.ints[lib.INT_INDEX["cs_max_internal_steps"]]), self.duration_s, self.n_samples,
-                          self.segment_t_s, u, int(capacity), du)
+                          self.segment_t_s, u, int(capacity), du, self.stiff_switch)
 
 
 @functools.lru_cache(maxsize=64)
@@ -360,7 +367,8 @@ def _new_case(scenario: Scenario, model: MuscleModel | None) -> CaseInputs:
     pieces = exact_segments(signals, T)
     starts, u, du = pieces if pieces is not None else (*held_segments(signals, model, T, n_samples), None)
     _set_mass(u, names, model)
-    return CaseInputs(reals, ints, T, n_samples, starts, u, opts.max_events, model, assembly, du, names)
+    return CaseInputs(reals, ints, T, n_samples, starts, u, opts.max_events, model, assembly, du, names,
+                      stiff_switch(opts))
 
 
 def core_values(scenario: Scenario, model: MuscleModel) -> tuple[np.ndarray, np.ndarray]:

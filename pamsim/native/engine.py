@@ -34,7 +34,7 @@ from ..fmu.generate import c_source_dir
 from ..modeling import code_cache
 from .build import FLAGS, cache_root, compile_library, compiler
 
-ENGINE_SOURCES = ("pam_engine_batch.c", "pam_engine_session.c", "pam_engine.c", "pam_engine.h", "pam_dopri.h", "pam_gauss.h")
+ENGINE_SOURCES = ("pam_engine_batch.c", "pam_engine_session.c", "pam_engine.c", "pam_engine.h", "pam_dopri.h", "pam_rosenbrock.h", "pam_gauss.h")
 LAYOUT = ("nx", "nq", "nu", "np", "ny", "nz", "nmodes", "ns", "event_columns", "message_bytes", "batch_bytes")
 """What ``pam_engine_layout(k)`` returns, by k."""
 STATUS = ("ok", "bad input", "solver failed", "event buffer full")
@@ -51,6 +51,7 @@ class EngineBatch(ctypes.Structure):
     """
 
     _fields_ = [("n_cases", ctypes.c_int64), ("params", _P), ("rtol", _P), ("max_step_s", _P), ("max_steps", _P),
+                ("stiff_switch", _P),
                 ("duration_s", _P), ("n_samples", _P), ("sample_offset", _P), ("n_segments", _P),
                 ("segment_offset", _P), ("segment_t_s", _P), ("segment_u", _P), ("segment_du", _P),
                 ("event_capacity", _P),
@@ -82,6 +83,7 @@ class EngineCase:
     segment_u: np.ndarray
     event_capacity: int
     segment_du: np.ndarray | None = None
+    stiff_switch: bool = True
 
 
 class EngineLibrary:
@@ -104,7 +106,8 @@ class EngineLibrary:
         lib.pam_engine_run_batch.argtypes = [ctypes.POINTER(EngineBatch)]
         # Sessions: pointers as plain addresses (c_void_p), the cheapest conversion per call.
         signatures = {"new": (_P, []), "free": (None, [_P]),
-                      "reset": (ctypes.c_int32, [_P, _P, _P, ctypes.c_double, ctypes.c_double, ctypes.c_int64]),
+                      "reset": (ctypes.c_int32, [_P, _P, _P, ctypes.c_double, ctypes.c_double, ctypes.c_int64,
+                                                 ctypes.c_int32]),
                       "advance": (ctypes.c_int32, [_P, _P, ctypes.c_double]),
                       "read": (ctypes.c_int32, [_P, _P, _P, _P]),
                       "step": (ctypes.c_int32, [_P, _P, ctypes.c_double, _P, _P]),
@@ -160,7 +163,7 @@ buffer, which is reused while it is free, they are not new arrays whose first to
 fault per 4 KiB, as a batch's results would be (they are kept, so the heap grows)."""
 _SETTINGS = ("rtol", "max_step_s", "duration_s")
 """The per-case float settings, rows of one block."""
-_COUNTS = ("max_steps", "n_samples", "sample_offset", "n_segments", "segment_offset", "event_capacity", "event_offset")
+_COUNTS = ("max_steps", "stiff_switch", "n_samples", "sample_offset", "n_segments", "segment_offset", "event_capacity", "event_offset")
 """The per-case integers, rows of one block."""
 
 
@@ -192,7 +195,8 @@ def batch_arrays(cases: Sequence[EngineCase], layout: dict, allocate=None) -> tu
     for block, rows, size in (("settings", _SETTINGS, 8 * n), ("counts", _COUNTS, 8 * n),
                               ("tallies", ("n_events", "stats"), 8 * n)):
         address.update({name: address[block] + k * size for k, name in enumerate(rows)})
-    arrays.update(sample_offset=arrays["counts"][2], event_offset=arrays["counts"][6],
+    arrays.update(sample_offset=arrays["counts"][_COUNTS.index("sample_offset")],
+                  event_offset=arrays["counts"][_COUNTS.index("event_offset")],
                   n_events=arrays["tallies"][:n], stats=arrays["tallies"][n:].reshape(n, 3))
     return arrays, address
 
@@ -202,7 +206,7 @@ def _fill_inputs(arrays: dict[str, np.ndarray], cases: Sequence[EngineCase], cou
     arrays["params"][:] = [k.params for k in cases]
     arrays["settings"][:] = [[getattr(k, name) for k in cases] for name in _SETTINGS]
     offsets = {name: [0, *itertools.accumulate(values[:-1])] for name, values in counts.items()}
-    arrays["counts"][:] = [[k.max_steps for k in cases], counts["n_samples"], offsets["n_samples"],
+    arrays["counts"][:] = [[k.max_steps for k in cases], [int(k.stiff_switch) for k in cases], counts["n_samples"], offsets["n_samples"],
                            counts["n_segments"], offsets["n_segments"], counts["event_capacity"],
                            offsets["event_capacity"]]
     start = 0
@@ -287,7 +291,7 @@ class EngineSession:
         raise SolverFailure(f"native backend: {message}")
 
     def reset(self, params: Sequence[float], inputs: Sequence[float], rtol: float, max_step_s: float,
-              max_steps: int) -> None:
+              max_steps: int, stiff_switch: bool = True) -> None:
         """Start a new run at t = 0.
 
         Parameters
@@ -302,6 +306,9 @@ class EngineSession:
             The longest step while the model moves [s].
         max_steps : int
             The most internal steps of one advance.
+        stiff_switch : bool
+            Whether a held model whose Dormand-Prince steps are bound by stability steps with Rodas4 (the
+            native backend's ``LSODA``, the automatic choice) or not (``RK45``, ``DOPRI5``).
 
         Raises
         ------
@@ -314,7 +321,7 @@ class EngineSession:
         if p.shape != (L["np"],) or u.shape != (L["nu"],):
             raise ValueError(f"expected {L['np']} parameters and {L['nu']} inputs, got {p.shape} and {u.shape}")
         status = self._lib.pam_engine_session_reset(self._handle, p.ctypes.data, u.ctypes.data, float(rtol),
-                                                    float(max_step_s), int(max_steps))
+                                                    float(max_step_s), int(max_steps), int(bool(stiff_switch)))
         self._check(status, "engine session reset")
         self.read()
 
