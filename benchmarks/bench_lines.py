@@ -4,7 +4,8 @@ Per backend (python, native) and scenario: the median wall time of N calls of ``
 warm-up, the engine's own time (``Result.wall_time_s``), and the right-hand-side evaluations.  The line
 adds stiff modes (a tube's bore exchanging air with the muscle through its resistance: a pole near
 -19000 1/s, ``pamsim linearize scenarios/supply_chain.toml``) that the python backend's LSODA steps over
-and the native engine's explicit Dormand-Prince integrator must follow.  The line again with its tubes'
+and the native engine's Rodas4 steps over while the load is held (its Dormand-Prince follows them while
+the load moves).  The line again with its tubes'
 turbulent law, and with the muscle's tube in 10 cells with inertia (acoustic modes near 2 pi 72 Hz and up
 to the cells' own, ``c / (2 h)``).
 
