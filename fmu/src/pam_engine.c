@@ -126,10 +126,21 @@ void pam_engine_initialize(PamEngine *e) {
 /* The nodes of the tableau of pam_dopri.h, where inputs that follow signals are evaluated. */
 static const double DP_NODE[7] = {0.0, 1.0 / 5, 3.0 / 10, 4.0 / 5, 8.0 / 9, 1.0, 1.0};
 
+/* The scaled RMS norm of the error estimate d of a step from y0 to y1 (absolute: rtol times each nominal). */
+static double error_norm(const PamEngine *e, const double *y0, const double *y1, const double *d) {
+    double err = 0.0;
+    int n;
+    for (n = 0; n < PM_NX; n++) {
+        double sc = e->rtol * PM_NOMINAL[n] + e->rtol * fmax(fabs(y0[n]), fabs(y1[n]));
+        err += (d[n] / sc) * (d[n] / sc);
+    }
+    return PM_NX > 0 ? sqrt(err / PM_NX) : 0.0;
+}
+
 /* One trial step from t0; returns the scaled RMS error norm.  k[0] must hold f(y0).  Inputs that
  * follow signals are left at their values from the left of t0 + h. */
 static double dp_step(PamEngine *e, double t0, const double *y0, double h, PamStages *s, double *y1, double *y6) {
-    double yt[PM_NX], err = 0.0, rtol = e->rtol;
+    double yt[PM_NX], d[PM_NX];
     int st, j, n;
     s->poly = 0;
     for (st = 1; st < 7; st++) {
@@ -143,13 +154,12 @@ static double dp_step(PamEngine *e, double t0, const double *y0, double h, PamSt
         rhs(e, yt, s->k[st]);
     }
     for (n = 0; n < PM_NX; n++) {
-        double d = 0.0, sc;
+        double acc = 0.0;
         y1[n] = yt[n]; /* stage 7 is evaluated at the 5th-order solution (FSAL) */
-        for (st = 0; st < 7; st++) d += DP_E[st] * s->k[st][n];
-        sc = rtol * PM_NOMINAL[n] + rtol * fmax(fabs(y0[n]), fabs(y1[n]));
-        err += (h * d / sc) * (h * d / sc);
+        for (st = 0; st < 7; st++) acc += DP_E[st] * s->k[st][n];
+        d[n] = h * acc;
     }
-    return PM_NX > 0 ? sqrt(err / PM_NX) : 0.0; /* no integrated state: only quadratures, exact per step */
+    return error_norm(e, y0, y1, d); /* no integrated state: only quadratures, exact per step */
 }
 
 static void dp_dense(const PamStages *s, const double *y0, double h, double th, double *y) {
@@ -168,17 +178,6 @@ static void dp_dense(const PamStages *s, const double *y0, double h, double th, 
         }
         y[n] = y0[n] + h * acc;
     }
-}
-
-/* The scaled RMS norm of the error estimate d, as dp_step's. */
-static double error_norm(const PamEngine *e, const double *y0, const double *y1, const double *d) {
-    double err = 0.0;
-    int n;
-    for (n = 0; n < PM_NX; n++) {
-        double sc = e->rtol * PM_NOMINAL[n] + e->rtol * fmax(fabs(y0[n]), fabs(y1[n]));
-        err += (d[n] / sc) * (d[n] / sc);
-    }
-    return PM_NX > 0 ? sqrt(err / PM_NX) : 0.0;
 }
 
 /* One trial Rosenbrock step (pam_rosenbrock.h's tableau r) of a model whose inputs are constant over it; returns the
@@ -438,9 +437,9 @@ int pam_engine_do_step(PamEngine *e, double t_end) {
     t_piece = next_piece_end(e, t, t_end);
     /* A remainder below the time resolution (left by an event located just before t_end) is not a step. */
     while (t_end - t > 1e-13 * fmax(1.0, fabs(t_end))) {
-        double h, err, factor, lo = 0.0, hi = 1.0;
+        double h, err, factor, grow, lo = 0.0, hi = 1.0;
         unsigned crossed;
-        int last, at_rest = held(e), rosenbrock;
+        int last, at_rest = held(e), rosenbrock, stiff_able;
         if (t_piece - t <= 1e-13 * fmax(1.0, fabs(t_piece))) {
             /* A breakpoint of the signals (they take their values from the right), or a hold's end. */
             t = t_piece;
@@ -471,23 +470,18 @@ int pam_engine_do_step(PamEngine *e, double t_end) {
             engine_logf(e, PAM_ENGINE_ERROR, "step size underflow at t = %.9g s", t);
             return step_failed(e, t, y);
         }
-        rosenbrock = e->stiff == 1 && held(e) && inputs_constant(e, t);
+        stiff_able = held(e) && (e->stiff == 1 || (e->stiff_switch && e->stiff == 0)) && inputs_constant(e, t);
+        rosenbrock = stiff_able && e->stiff == 1;
         err = rosenbrock ? ros_step(e, &RODAS4, y, h, &s, y1) : dp_step(e, t, y, h, &s, y1, y6);
-        if (rosenbrock) {
-            if (!(err <= 1.0)) {
-                e->h_s = h * (isfinite(err) ? fmax(0.2, 0.9 * pow(err, -1.0 / RODAS4.elo)) : 0.1);
-                continue;
-            }
-            factor = err == 0.0 ? 6.0 : fmin(6.0, fmax(0.2, 0.9 * pow(err, -1.0 / RODAS4.elo)));
-            note_rosenbrock_step(e, h);
-        } else {
-            if (!(err <= 1.0)) {
-                e->h_s = h * (isfinite(err) ? fmax(0.2, 0.9 * pow(err, -0.2)) : 0.1);
-                continue;
-            }
-            factor = err == 0.0 ? 10.0 : fmin(10.0, fmax(0.2, 0.9 * pow(err, -0.2)));
-            if (e->stiff_switch && e->stiff == 0 && held(e) && inputs_constant(e, t)) test_stiffness(e, &s, y1, y6, h);
+        /* the step grows by err^(-1/(q+1)), q the order of the error estimate, at most 10 times (6 for Rodas4) */
+        grow = rosenbrock ? -1.0 / RODAS4.elo : -0.2;
+        if (!(err <= 1.0)) {
+            e->h_s = h * (isfinite(err) ? fmax(0.2, 0.9 * pow(err, grow)) : 0.1);
+            continue;
         }
+        factor = err == 0.0 ? (rosenbrock ? 6.0 : 10.0) : fmin(rosenbrock ? 6.0 : 10.0, fmax(0.2, 0.9 * pow(err, grow)));
+        if (rosenbrock) note_rosenbrock_step(e, h);
+        else if (stiff_able) test_stiffness(e, &s, y1, y6, h);
         e->n_steps++;
         if (!holding(e, t) && (crossed = first_crossing(e, &s, t, y, y1, h, &lo, &hi)) != 0) {
             /* Locate the first crossing of the indicators that crossed on the dense output; keep the
