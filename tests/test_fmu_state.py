@@ -121,3 +121,31 @@ def test_an_absurd_step_bound_is_refused_at_initialisation(table_fmu, capfd):
     assert refused and time.perf_counter() - t < 1.0
     assert f"cs_max_step_s = 1e-12: must be >= {MIN_MAX_STEP_S:g}" in capfd.readouterr().out
     fmu.freeInstance()
+
+
+def test_a_state_carries_the_engines_stiff_switch(tmp_path):
+    """Thermal Figure 4's assembly FMU, stepped in co-simulation: by 2 s the load is held and the cooling gas
+    has switched the engine to Rodas4 (docs/scaling.md, Stiff held phases). A state saved there and loaded
+    into another instance goes on with Rodas4 as the saver does, bit for bit; without the switch in the
+    state the loader tested afresh with Dormand-Prince (and each communication step did, so the FMU never
+    switched at 1 ms steps)."""
+    scenario = tmp_path / "thermal_fig4.toml"
+    scenario.write_text((SCENARIOS / "acra2012_fig4.toml").read_text() + '\n[chamber]\nlaw = "thermal"\n')
+    path = tmp_path / "thermal.fmu"
+    proc = subprocess.run([sys.executable, "-m", "pamsim", "fmu", "build", "--generated", "--scenario", str(scenario),
+                           "-o", str(path)], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    names = ("load.x_m", "chamber.p_abs_Pa", "chamber.gas_temperature_K")
+    saver, vr = _started(path)
+    saver.doStep(0.0, 2.0)
+    blob = bytes(saver.serializeFMUstate(saver.getFMUstate()))
+    saver.doStep(2.0, 6.0)
+    want = saver.getReal([vr[n] for n in names])
+    loader, _ = _started(path, "loader")
+    loader.setFMUstate(loader.deSerializeFMUstate(blob))
+    loader.doStep(2.0, 6.0)
+    got = loader.getReal([vr[n] for n in names])
+    for fmu in (saver, loader):
+        fmu.terminate()
+        fmu.freeInstance()
+    assert list(got) == list(want)

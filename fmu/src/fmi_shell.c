@@ -280,7 +280,7 @@ typedef struct {
  * of everything before it.  A state is for the build that wrote it (the token), whose layout of r[]
  * and i[] it shares. */
 static const char SERIAL_MAGIC[8] = {'P', 'A', 'M', 'S', 'T', 'A', 'T', 'E'};
-#define SERIAL_VERSION 3u
+#define SERIAL_VERSION 4u
 
 typedef struct {
     unsigned char *bytes; /* NULL: only count */

@@ -59,6 +59,8 @@ void pam_reset(PamCore *c) {
     c->hold_until_s = -HUGE_VAL; /* no hold, as pam_engine_reset leaves it */
     c->since_s = -HUGE_VAL;
     c->n_zero = 0;
+    c->stiff = c->n_stiff = c->n_nonstiff = c->n_slow = 0;
+    c->h_stiff_s = 0.0;
 }
 
 #ifdef PAM_NCHECKS
@@ -166,6 +168,11 @@ static void engine_load(PamCore *c, EngineRun *run) {
     e->hold_until_s = c->hold_until_s;
     e->since_s = c->since_s;
     e->n_zero = c->n_zero;
+    e->stiff = c->stiff;
+    e->n_stiff = c->n_stiff;
+    e->n_nonstiff = c->n_nonstiff;
+    e->n_slow = c->n_slow;
+    e->h_stiff_s = c->h_stiff_s;
     e->n_steps = c->n_steps;
     e->n_rhs = c->n_rhs;
     e->n_events = c->n_events;
@@ -196,6 +203,11 @@ static void engine_store(PamCore *c, const EngineRun *run) {
     c->hold_until_s = e->hold_until_s;
     c->since_s = e->since_s;
     c->n_zero = e->n_zero;
+    c->stiff = e->stiff;
+    c->n_stiff = e->n_stiff;
+    c->n_nonstiff = e->n_nonstiff;
+    c->n_slow = e->n_slow;
+    c->h_stiff_s = e->h_stiff_s;
     c->n_steps = e->n_steps;
     c->n_rhs = e->n_rhs;
     c->n_events = e->n_events;

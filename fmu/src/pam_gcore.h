@@ -32,9 +32,14 @@ typedef struct PamCore {
     double hold_until_s;   /* co-simulation: the engine's hold of a slip too small to resolve (pam_engine.h) */
     double since_s;        /* co-simulation: the engine's last event or breakpoint */
     int n_zero;            /* co-simulation: the engine's slips in a row that ended where they began */
+    /* co-simulation: the engine's stiff switch (pam_engine.h), carried from one communication step to the
+     * next, which would otherwise each test a held model afresh and, shorter than its 15 steps, never switch */
+    int32_t stiff, n_stiff, n_nonstiff, n_slow;
+    double h_stiff_s;
 } PamCore;
 
-/* The values a serialized FMU state holds (fmi_shell.c): those of pam_fmu_common.h, then the engine's hold. */
+/* The values a serialized FMU state holds (fmi_shell.c): those of pam_fmu_common.h, then the engine's hold
+ * and its stiff switch. */
 #define PAM_CORE_SERIAL_FIELDS(dir, io, core)                 \
     do {                                                      \
         int32_t n_zero_ = (core)->n_zero;                     \
@@ -43,6 +48,11 @@ typedef struct PamCore {
         dir(io, &(core)->since_s, sizeof(double));            \
         dir(io, &n_zero_, sizeof n_zero_);                    \
         (core)->n_zero = n_zero_;                             \
+        dir(io, &(core)->stiff, sizeof(int32_t));             \
+        dir(io, &(core)->n_stiff, sizeof(int32_t));           \
+        dir(io, &(core)->n_nonstiff, sizeof(int32_t));        \
+        dir(io, &(core)->n_slow, sizeof(int32_t));            \
+        dir(io, &(core)->h_stiff_s, sizeof(double));          \
     } while (0)
 
 #if defined(__GNUC__)
