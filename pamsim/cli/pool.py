@@ -3,9 +3,7 @@
 from __future__ import annotations
 
 import contextlib
-import multiprocessing.connection
 import signal
-import time
 from concurrent.futures import ProcessPoolExecutor
 
 
@@ -34,19 +32,16 @@ def _kill_workers(pool: ProcessPoolExecutor) -> None:
     """Kill ``pool``'s workers where they are; the chunks that have not started are dropped by the shutdown.
 
     A worker killed while it sends its results leaves half a message in the results pipe, and the pool's
-    manager thread waits for the rest forever (the shutdown, and the interpreter's exit, with it). Once every
-    worker is gone, closing this process's own end of the pipe for writing turns that wait into an end of
-    file, which the pool takes for a broken pool.
+    manager thread waits for the rest for ever (the shutdown, and the interpreter's exit, with it). The
+    command never writes to that pipe, so it closes its own end for writing at once (in a ``finally``: a
+    second interrupt here must not leave it open): once the killed workers' ends are closed too, that
+    wait becomes an end of file, which the pool takes for a broken pool.
     """
     # CPython's pool keeps {pid: process} and its results queue as private attributes.
-    processes = list((getattr(pool, "_processes", None) or {}).values())
-    for process in processes:
-        process.kill()
-    running = [process.sentinel for process in processes]
-    deadline = time.monotonic() + 10.0
-    while running and time.monotonic() < deadline:  # wait() returns as soon as one of them has ended
-        ended = multiprocessing.connection.wait(running, timeout=deadline - time.monotonic())
-        running = [sentinel for sentinel in running if sentinel not in ended]
-    results = getattr(pool, "_result_queue", None)
-    if results is not None and not running:
-        results._writer.close()
+    try:
+        for process in list((getattr(pool, "_processes", None) or {}).values()):
+            process.kill()
+    finally:
+        results = getattr(pool, "_result_queue", None)
+        if results is not None:
+            results._writer.close()

@@ -10,8 +10,9 @@ Differences from the Python backend, all documented in ``docs/scaling.md``:
 
 - the integrator is the core's Dormand-Prince 5(4) at the scenario's ``rtol`` times
   ``solver.native_rtol_factor`` (:func:`native_rtol`; 0.01 unless the scenario says otherwise, so that
-  it meets LSODA's accuracy at ``rtol``) (``solver.method`` may be ``LSODA``, the automatic choice, or ``RK45``, the
-  same method; the implicit ones are refused);
+  it meets LSODA's accuracy at ``rtol``); with ``solver.method = "LSODA"``, the automatic choice, it
+  switches to the stiff Rodas4 where a held model's steps are bound by stability (:func:`stiff_switch`),
+  with ``RK45`` or ``DOPRI5`` it does not; the implicit methods are refused;
 - a static force that has no form in symbols or in CasADi (a model a user writes for
   floats alone) runs as the FMU's spline table of it (:func:`force_table`), not the
   model itself; every other static force runs as the python backend runs it;
@@ -93,6 +94,13 @@ def outgrew_batch(status: int, max_events: int) -> bool:
 HOLD_STEPS_PER_TAU = 10
 """A first-order lag is held over at most tau / 10 (and never longer than one output sample)."""
 METHOD_LABEL = "native DOPRI5(4)"
+"""``Result.stats["method"]`` of a native run that keeps Dormand-Prince alone (:func:`method_label`)."""
+
+
+def method_label(opts) -> str:
+    """``Result.stats["method"]`` of a native run with solver options ``opts``: :data:`METHOD_LABEL`, and the
+    stiff method it may switch to (:func:`stiff_switch`)."""
+    return METHOD_LABEL + ", Rodas4 where stiff" if stiff_switch(opts) else METHOD_LABEL
 _EXACT = (Constant, Step, PiecewiseConstant)  # constant between breakpoints: held exactly
 _DEFAULT_MAX_STEP_S = float(lib.REAL_DEFAULTS[lib.REAL_INDEX["cs_max_step_s"]])
 
@@ -495,7 +503,7 @@ def _result(scenario: Scenario, case: CaseInputs, out: dict, i: int, wall_time_s
     if t is None:
         t = np.linspace(0.0, case.duration_s, case.n_samples)
     stats = {"rhs_evaluations": int(out["stats"][i][0]), "segments": int(out["stats"][i][2]),
-             "method": METHOD_LABEL, "rtol": native_rtol(scenario.solver)}
+             "method": method_label(scenario.solver), "rtol": native_rtol(scenario.solver)}
     return _engine_result(scenario, case, out, i, wall_time_s, t, stats)
 
 
