@@ -12,9 +12,9 @@ of the value along the step's dense output; the earliest of those found in one s
 samples from the step ``solve_ivp``'s piecewise solution would have used.  Its steps, events and samples
 are those of ``solve_ivp``, number for number.
 
-A step that is long, or in which the load's velocity changes sign, is also checked inside for an
-indicator that went below zero and back between its ends (:func:`missed_crossing`), and the segment then
-ends there.  The run stops at that step, where ``solve_ivp`` went on to its segment's end and was cut
+A step that is long, in which the load's velocity changes sign, or in which a sliding load's indicator may
+dip to zero and back (:func:`_may_dip`), is also checked inside for an indicator that went below zero and
+back between its ends (:func:`missed_crossing`), and the segment then ends there.  The run stops at that step, where ``solve_ivp`` went on to its segment's end and was cut
 afterwards: only the count of right-hand-side evaluations differs.
 """
 
@@ -178,10 +178,11 @@ class DormandPrince:
 
 
 def missed_crossing(events: Sequence[Callable], directions: Sequence[float], g_old: Sequence[float], dense,
-                    t_old: float, t: float):
+                    t_old: float, t: float, also: Sequence[float] = ()):
     """The first ``(time, index)`` inside the step ``(t_old, t]`` where one of ``events`` crossed zero in its
     ``direction`` (``solve_ivp``'s rule, :func:`_crossed`), looked for between :data:`LONG_STEP_CHECKS` points
-    of the step's ``dense`` output from the events' values ``g_old`` at ``t_old``, or None.
+    of the step's ``dense`` output and the times ``also`` inside it from the events' values ``g_old`` at
+    ``t_old``, or None.
 
     ``solve_ivp`` finds an event where an indicator changes sign between two step ends.  A free swing at
     a tight tolerance can take a step long enough for the load to reach a stop and come back within it
@@ -189,6 +190,8 @@ def missed_crossing(events: Sequence[Callable], directions: Sequence[float], g_o
     from scipy.optimize import brentq
 
     taus = np.linspace(t_old, t, LONG_STEP_CHECKS + 1)
+    if len(also):
+        taus = np.unique(np.concatenate([taus, [a for a in also if t_old < a < t]]))
     g_lo = list(g_old)
     for lo, hi in zip(taus[:-2], taus[1:-1]):  # the step's end is what the event rule checked
         y_hi = dense(hi)
@@ -203,6 +206,31 @@ def missed_crossing(events: Sequence[Callable], directions: Sequence[float], g_o
                               if before * g_hi[k] < 0.0 else hi, k))
             return min(roots)
         g_lo = g_hi
+    return None
+
+
+def _may_dip(events: Sequence[Callable], directions: Sequence[float], g_old: Sequence[float],
+             g_new: Sequence[float], dense, t_old: float, t: float) -> list[float] | None:
+    """Where to look inside a step for an event function on the near side of zero at both ends that may
+    cross zero and come back inside it, or None: it is on the far side at the step's midpoint (look there),
+    or nearer to zero there than at both ends with the parabola through the three values reaching zero (look
+    at the parabola's lowest point too).  The C engine's ``may_dip``.  Under PWM a load comes to rest for a
+    few milliseconds between two pulses: a step of that length crossed the stick and came back from it, its
+    velocity of one sign at both ends."""
+    t_mid = 0.5 * (t_old + t)
+    y_mid = dense(t_mid)
+    for fun, a0, a1, d in zip(events, g_old, g_new, directions):
+        sign = -1.0 if d > 0 else 1.0  # the near side: positive for a falling event, negative for a rising one
+        z0, z1 = sign * a0, sign * a1
+        if not (z0 > 0.0 and z1 > 0.0):
+            continue
+        zm = sign * fun(t_mid, y_mid)
+        if zm <= 0.0:
+            return [t_mid]
+        a = 2.0 * (z0 + z1 - 2.0 * zm)  # the parabola a th^2 + b th + z0 through th = 0, 1/2, 1
+        b = z1 - z0 - a
+        if zm < min(z0, z1) and a > 0.0 and z0 - b * b / (4.0 * a) <= 0.0:
+            return [t_old - b / (2.0 * a) * (t - t_old)]
     return None
 
 
@@ -296,7 +324,7 @@ def integrate_segment(fun: Callable, t0: float, t_end: float, y0: np.ndarray, me
             dense = solver.dense_output()
             t, event = _earliest_event(events, directions, g, g_new, dense, t_old, t)
             y, status = dense(t), 1
-        turned = False
+        turned, dips = False, None
         if v_row is not None and abs(y[v_row]) > v_tol:
             v_old = ys[-1][v_row]
             if v_old == 0.0:  # a slide from rest: turned if it ends moving against its motion early in the step
@@ -304,9 +332,12 @@ def integrate_segment(fun: Callable, t0: float, t_end: float, y0: np.ndarray, me
                 turned = float(dense(t_old + (t - t_old) / LONG_STEP_CHECKS)[v_row]) * y[v_row] < 0.0
             else:
                 turned = _turned(v_old, y[v_row], v_tol)
-        if events and (t - t_old > long_step_s or turned):
+        if events and status != 1 and not turned and v_row is not None and ys[-1][v_row] * y[v_row] > 0.0:
             dense = solver.dense_output() if dense is None else dense
-            missed = missed_crossing(events, directions, g, dense, t_old, t)
+            dips = _may_dip(events, directions, g, g_new, dense, t_old, t)
+        if events and (t - t_old > long_step_s or turned or dips):
+            dense = solver.dense_output() if dense is None else dense
+            missed = missed_crossing(events, directions, g, dense, t_old, t, dips or ())
             if missed is not None:
                 t, event = missed
                 y, status = dense(t), 1

@@ -195,3 +195,45 @@ def test_a_dopri5_segment_of_no_time_reads_its_start():
     ref = integrate_segment(oscillator, 1.0, 1.0, Y0, "RK45", [], np.array([1.0]), rtol=1e-6, atol=1e-9,
                             max_step=np.inf)
     assert seg.status == 0 and np.array_equal(seg.samples_y, ref.samples_y) and np.array_equal(seg.samples_y[:, 0], Y0)
+
+
+def _dipping_speed(floor: float):
+    """A load whose speed is ``(t - 0.5)^2 + floor`` [m/s]: 0.24 + floor at both ends of [0, 1] s, and
+    ``floor`` at 0.5 s."""
+    def f(t, y):
+        return np.array([y[1], 2.0 * (t - 0.5)])
+
+    def speed(t, y):
+        return y[1]
+    speed.direction = -1.0
+    return f, speed, np.array([0.0, 0.25 + floor])
+
+
+@pytest.mark.parametrize("method", ["DOPRI5", "RK45"])
+def test_a_speed_that_falls_to_zero_and_back_inside_one_step_fires_where_it_reaches_zero(method):
+    """One step of 1 s in which the speed, 0.23 m/s at both ends, falls to -0.01 m/s and back: the step's ends
+    show no crossing, its midpoint does, and the event fires at the analytic zero, 0.4 s (the dense output of
+    a fifth-order step is exact on this quadratic).  With a floor of +0.01 m/s nothing fires.  (Steps are not
+    looked into for their length here: ``long_step_s`` is infinite.)"""
+    f, speed, y0 = _dipping_speed(-0.01)
+    seg = integrate_segment(f, 0.0, 1.0, y0, method, [speed], np.empty(0), rtol=1e-2, atol=1.0, max_step=np.inf,
+                            v_row=1, first_step=1.0, long_step_s=np.inf)
+    assert seg.status == 1 and abs(seg.t_event - 0.4) < 1e-9
+    f, speed, y0 = _dipping_speed(0.01)
+    seg = integrate_segment(f, 0.0, 1.0, y0, method, [speed], np.empty(0), rtol=1e-2, atol=1.0, max_step=np.inf,
+                            v_row=1, first_step=1.0, long_step_s=np.inf)
+    assert seg.status == 0 and seg.y[1, -1] > 0.0
+
+
+def test_a_shallow_dip_between_the_midpoint_and_an_end_fires():
+    """The speed ``(t - 0.3)^2 - 1e-4``: 0.0899 and 0.4899 m/s at the ends, 0.0399 m/s at the midpoint, zero
+    at 0.29 s.  The midpoint is above zero: the parabola through the three values finds the dip."""
+    def f(t, y):
+        return np.array([y[1], 2.0 * (t - 0.3)])
+
+    def speed(t, y):
+        return y[1]
+    speed.direction = -1.0
+    seg = integrate_segment(f, 0.0, 1.0, np.array([0.0, 0.09 - 1e-4]), "DOPRI5", [speed], np.empty(0), rtol=1e-2,
+                            atol=1.0, max_step=np.inf, v_row=1, first_step=1.0, long_step_s=np.inf)
+    assert seg.status == 1 and abs(seg.t_event - 0.29) < 1e-9

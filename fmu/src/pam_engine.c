@@ -266,32 +266,73 @@ static void note_rosenbrock_step(PamEngine *e, double h) {
     if (e->n_slow >= 5) e->stiff = -1;
 }
 
+/* Where to look inside a moving step, as a fraction of it, for an indicator above zero at both ends that
+ * may dip to zero and back inside it; -1 if none may.  It is at or below zero at the step's midpoint (look
+ * there), or lower there than at both ends with the parabola through the three values reaching zero (look
+ * at the parabola's lowest point too).  z0: the indicators at the step's start; z1 at its end.
+ * pamsim.stepping._may_dip is the python backend's. */
+static double may_dip(PamEngine *e, const PamStages *s, double t, const double *y, double h, const double *z0,
+                      const double *z1) {
+    double ym[PM_NX], zm[PM_NZ > 0 ? PM_NZ : 1];
+    int k;
+    dp_dense(s, y, h, 0.5, ym);
+    inputs_at(e, t + 0.5 * h, 1);
+    pm_z(e->mode, ym, e->u, e->p, zm);
+    for (k = 0; k < PM_NZ; k++) {
+        double a = 2.0 * (z0[k] + z1[k] - 2.0 * zm[k]), b = z1[k] - z0[k] - a; /* a th^2 + b th + z0 */
+        if (!(z0[k] > 0.0 && z1[k] > 0.0)) continue;
+        if (zm[k] <= 0.0) return 0.5;
+        if (zm[k] < fmin(z0[k], z1[k]) && a > 0.0 && z0[k] - b * b / (4.0 * a) <= 0.0) return -b / (2.0 * a);
+    }
+    return -1.0;
+}
+
 /* Where an indicator first reaches zero over an accepted step, as a fraction of the step in
- * (lo, hi], and which indicators are at or below zero at hi (0 if none is).  A moving step is checked
- * at its end (max_step_s keeps it short against a sign change and back).  A held model's step is not
- * limited by max_step_s (its states approach their sources monotonically, so its force margins seldom
- * turn back), so a long one is also checked at PAM_ENGINE_HELD_CHECKS points of its dense output.
- * As in solve_ivp and CVODE, an indicator crosses where its sign changes between two checked points:
- * one that dips below zero and back between them is no event, even where another indicator's
+ * (lo, hi], and which indicators are at or below zero at hi (0 if none is).  The indicators at the step's
+ * end go to z1.  A moving step is checked at its end, and, given the indicators at its start (z0, NULL if
+ * unknown), at PAM_ENGINE_HELD_CHECKS points of its dense output and where may_dip looks, if one may dip to
+ * zero and back inside it: under PWM a load comes to rest for a few milliseconds between two pulses, a
+ * stick that a step of that length crossed and came back from, its velocity positive at both ends.  A held
+ * model's step is not limited by max_step_s (its states approach their sources monotonically, so its force
+ * margins seldom turn back), so a long one is also checked at PAM_ENGINE_HELD_CHECKS points of its dense
+ * output.  As in solve_ivp and CVODE, an indicator crosses where its sign changes between two checked
+ * points: one that dips below zero and back between them is no event, even where another indicator's
  * crossing brings the root finding there.  A free swing that turns back at its stop, grazing it, so
  * records the turn (the stop, if the turn lies beyond it, as at_event decides) where the dense output
- * puts it, instead of an impact whose time moves with the square root of the integration error. */
+ * puts it, instead of an impact whose time moves with the square root of the integration error (its
+ * velocity changed sign over the step, so its end alone is checked). */
 static unsigned first_crossing(PamEngine *e, const PamStages *s, double t, const double *y, const double *y1,
-                               double h, double *lo, double *hi) {
+                               double h, const double *z0, double *z1, double *lo, double *hi) {
     int n = (held(e) && h > e->max_step_s) ? PAM_ENGINE_HELD_CHECKS : 1, k;
-    double ye[PM_NX];
-    for (k = 1; k <= n; k++) {
-        unsigned fired;
-        if (k < n) dp_dense(s, y, h, (double)k / n, ye);
-        inputs_at(e, t + (double)k / n * h, 1);
-        fired = fired_indicators(e, k < n ? ye : y1);
-        if (fired) {
-            *lo = (double)(k - 1) / n;
-            *hi = (double)k / n;
-            return fired;
-        }
+    double ye[PM_NX], dip = -1.0, th_lo = 0.0;
+    unsigned fired = 0;
+    if (PM_NZ == 0) return 0;
+    inputs_at(e, t + h, 1);
+    pm_z(e->mode, y1, e->u, e->p, z1);
+    for (k = 0; k < PM_NZ; k++)
+        if (z1[k] <= 0.0) fired |= 1u << k;
+    if (n == 1 && !fired && z0 != NULL && !held(e)) {
+        dip = may_dip(e, s, t, y, h, z0, z1);
+        if (dip > 0.0) n = PAM_ENGINE_HELD_CHECKS;
     }
-    return 0;
+    for (k = 1; k < n; k++) {
+        double th = (double)k / n;
+        unsigned inside;
+        if (dip > th_lo && dip < th) th = dip, k--; /* the parabola's lowest point, then this point again */
+        dp_dense(s, y, h, th, ye);
+        inputs_at(e, t + th * h, 1);
+        inside = fired_indicators(e, ye);
+        if (inside) {
+            *lo = th_lo;
+            *hi = th;
+            return inside;
+        }
+        th_lo = th;
+    }
+    inputs_at(e, t + h, 1);
+    *lo = th_lo;
+    *hi = 1.0;
+    return fired;
 }
 
 /* The smallest of the indicators `which` at the fraction th of the accepted step from t (y1 at its end). */
@@ -426,9 +467,10 @@ static int at_breakpoint(const PamEngine *e, double t_s) {
  * which leaves time_s, the states and the mode at the last instant reached. */
 int pam_engine_do_step(PamEngine *e, double t_end) {
     double y[PM_NX], y1[PM_NX], y6[PM_NX], t = e->time_s, h_max = e->max_step_s, t_piece;
+    double z0[PM_NZ > 0 ? PM_NZ : 1], z1[PM_NZ > 0 ? PM_NZ : 1]; /* the indicators at a step's two ends */
     PamStages s;
     long steps = 0;
-    int zero_length = 0, n;
+    int zero_length = 0, n, z0_known = 0;
     memcpy(y, e->x, sizeof y);
     inputs_at(e, t, 0);
     if (e->inputs_changed || at_breakpoint(e, t)) recheck_held(e, t, y);
@@ -448,10 +490,18 @@ int pam_engine_do_step(PamEngine *e, double t_end) {
             recheck_held(e, t, y);
             rhs(e, y, s.k[0]);
             t_piece = next_piece_end(e, t, t_end);
+            z0_known = 0;
             continue;
         }
         inputs_at(e, t, 0); /* a rejected trial step left them at its end */
-        if (settle(e, y)) rhs(e, y, s.k[0]);
+        if (settle(e, y)) {
+            rhs(e, y, s.k[0]);
+            z0_known = 0;
+        }
+        if (!z0_known && !held(e) && PM_NZ > 0) {
+            pm_z(e->mode, y, e->u, e->p, z0);
+            z0_known = 1;
+        }
         /* A held model whose states do not change stays as it is while the inputs are held. */
         for (n = 0; n < PM_NX && at_rest; n++) at_rest = s.k[0][n] == 0.0;
         if (at_rest && inputs_constant(e, t)) {
@@ -483,7 +533,8 @@ int pam_engine_do_step(PamEngine *e, double t_end) {
         if (rosenbrock) note_rosenbrock_step(e, h);
         else if (stiff_able) test_stiffness(e, &s, y1, y6, h);
         e->n_steps++;
-        if (!holding(e, t) && (crossed = first_crossing(e, &s, t, y, y1, h, &lo, &hi)) != 0) {
+        if (holding(e, t)) z0_known = 0;
+        else if ((crossed = first_crossing(e, &s, t, y, y1, h, z0_known ? z0 : NULL, z1, &lo, &hi)) != 0) {
             /* Locate the first crossing of the indicators that crossed on the dense output; keep the
              * far side so that the event test holds. */
             double ye[PM_NX], t_event;
@@ -500,7 +551,12 @@ int pam_engine_do_step(PamEngine *e, double t_end) {
             if (holding(e, t)) t_piece = fmin(t_piece, e->hold_until_s); /* a hold began */
             e->h_s = fmax(fmin(h * hi, h_max), 1e-6);
             rhs(e, y, s.k[0]);
+            z0_known = 0;
             continue;
+        }
+        if (!holding(e, t)) {
+            memcpy(z0, z1, sizeof z0);
+            z0_known = 1;
         }
         if (e->on_step) e->on_step(e->step_env, t, last ? t_piece : t + h, h, y, &s);
         t = last ? t_piece : t + h;
