@@ -209,28 +209,44 @@ def missed_crossing(events: Sequence[Callable], directions: Sequence[float], g_o
     return None
 
 
+def _resolution(fun: Callable, t: float, y: np.ndarray, value: float, atol: np.ndarray) -> float:
+    """How far the event function ``fun`` (``value`` at ``(t, y)``) moves when the states move by their
+    absolute tolerances ``atol``, one at a time (the sum of the moves): a value closer to zero than that is
+    below what the integration resolves."""
+    moved = 0.0
+    for n in range(y.size):
+        yd = y.copy()
+        yd[n] += atol[n]
+        moved += abs(fun(t, yd) - value)
+    return moved
+
+
 def _may_dip(events: Sequence[Callable], directions: Sequence[float], g_old: Sequence[float],
-             g_new: Sequence[float], dense, t_old: float, t: float) -> list[float] | None:
-    """Where to look inside a step for an event function on the near side of zero at both ends that may
-    cross zero and come back inside it, or None: it is on the far side at the step's midpoint (look there),
-    or nearer to zero there than at both ends with the parabola through the three values reaching zero (look
-    at the parabola's lowest point too).  The C engine's ``may_dip``.  Under PWM a load comes to rest for a
-    few milliseconds between two pulses: a step of that length crossed the stick and came back from it, its
-    velocity of one sign at both ends."""
+             g_new: Sequence[float], dense, t_old: float, t: float, atol: np.ndarray) -> list[float] | None:
+    """Where to look inside a step, as a time, for an event function on the same side of zero at both ends
+    (the side it crosses from) that may cross zero and come back inside it, or None: it is on the far side
+    at the step's midpoint (look there), or the parabola through its values at the ends and the midpoint
+    has its extreme inside the step, on the far side (look there); either by more than its resolution at
+    the midpoint (:func:`_resolution`: a velocity hovering far below its tolerance of zero is no stick).
+    The C engine's ``may_dip``.  Under PWM a load comes to rest for a few milliseconds between two pulses:
+    a step of that length crossed the stick and came back from it, its velocity of one sign at both ends."""
     t_mid = 0.5 * (t_old + t)
     y_mid = dense(t_mid)
     for fun, a0, a1, d in zip(events, g_old, g_new, directions):
-        sign = -1.0 if d > 0 else 1.0  # the near side: positive for a falling event, negative for a rising one
+        # the near side: positive for a falling event, negative for a rising one, either for one of both ways
+        sign = -1.0 if d > 0 or (d == 0 and a0 < 0.0) else 1.0
         z0, z1 = sign * a0, sign * a1
         if not (z0 > 0.0 and z1 > 0.0):
             continue
-        zm = sign * fun(t_mid, y_mid)
-        if zm <= 0.0:
-            return [t_mid]
+        value = fun(t_mid, y_mid)
+        zm = sign * value
         a = 2.0 * (z0 + z1 - 2.0 * zm)  # the parabola a th^2 + b th + z0 through th = 0, 1/2, 1
         b = z1 - z0 - a
-        if zm < min(z0, z1) and a > 0.0 and z0 - b * b / (4.0 * a) <= 0.0:
-            return [t_old - b / (2.0 * a) * (t - t_old)]
+        th, low = 0.5, zm
+        if a > 0.0 and b < 0.0 and -b < 2.0 * a and z0 - b * b / (4.0 * a) < low:
+            th, low = -b / (2.0 * a), z0 - b * b / (4.0 * a)
+        if low < 0.0 and -low > _resolution(fun, t_mid, y_mid, value, atol):
+            return [t_old + th * (t - t_old)]
     return None
 
 
@@ -304,6 +320,7 @@ def integrate_segment(fun: Callable, t0: float, t_end: float, y0: np.ndarray, me
                                                   max_step=max_step)
     from_next = method in _FROM_NEXT_STEP
     v_tol = None if v_row is None else float(atol[v_row] if np.ndim(atol) else atol)
+    atol_all = np.broadcast_to(np.asarray(atol, dtype=float), np.shape(y0))
     grid = samples.tolist()  # bisect on a list: a step's samples are few, and a numpy call costs more
     directions = [getattr(e, "direction", 0.0) for e in events]
     g = [e(solver.t, solver.y) for e in events]
@@ -334,7 +351,7 @@ def integrate_segment(fun: Callable, t0: float, t_end: float, y0: np.ndarray, me
                 turned = _turned(v_old, y[v_row], v_tol)
         if events and status != 1 and not turned and v_row is not None and ys[-1][v_row] * y[v_row] > 0.0:
             dense = solver.dense_output() if dense is None else dense
-            dips = _may_dip(events, directions, g, g_new, dense, t_old, t)
+            dips = _may_dip(events, directions, g, g_new, dense, t_old, t, atol_all)
         if events and (t - t_old > long_step_s or turned or dips):
             dense = solver.dense_output() if dense is None else dense
             missed = missed_crossing(events, directions, g, dense, t_old, t, dips or ())

@@ -270,3 +270,47 @@ def test_a_run_reuses_its_buffer_only_when_nothing_holds_the_last_one():
     third = library.run([case])
     assert third["samples"].ctypes.data == address  # nothing held the second run's arrays
     assert np.array_equal(third["samples"], kept)  # and the run is the first one's, to the bit
+
+
+class DippingSpeed(Component):
+    """A speed ``(t - center)^2 + floor`` [m/s] (a clock and the speed as states), its zero an event whose
+    jump sets it to 0.1 m/s: the speed at 1 s tells when the event fired,
+    ``center - sqrt(0.1 + (1 - center)^2 - v(1))``."""
+
+    parameters = (Var("center_s", "s"), Var("floor_m_s", "m/s"))
+    states = (Var("t_s", "s", "the time", 1.0), Var("v_m_s", "m/s", "the speed", 1e-4))
+    outputs = (Var("v_m_s", "m/s"),)
+    n_indicators = 1
+    indicator_names = ("stop",)
+
+    def equations(self, s):
+        from casadi import if_else
+
+        t, v = s.x["t_s"], s.x["v_m_s"]
+        return Equations(der={"t_s": 1.0, "v_m_s": 2.0 * (t - s.p["center_s"])}, outputs={"v_m_s": v},
+                         indicators=(v,), transition={"v_m_s": if_else(s.fired[0], 0.1, v)},
+                         initial={"t_s": 0.0, "v_m_s": s.p["center_s"] ** 2 + s.p["floor_m_s"]})
+
+
+@pytest.mark.parametrize("center, floor, fires", [(0.3, -0.01, True), (0.56, -0.01, True), (0.3, 0.01, False),
+                                                  (0.3, -1e-9, False), (0.3, -1e-5, True)],
+                         ids=["parabola", "midpoint", "above zero", "below resolution", "above resolution"])
+def test_the_engine_finds_a_zero_that_dips_and_comes_back_inside_one_step(center, floor, fires):
+    """The engine on its own, from 0 to 1 s at rtol 1e-2: its steps grow tenfold (Dormand-Prince is exact
+    on the quadratic), the last from 0.111 s to 1 s, with the speed positive at both its ends.  Centred at
+    0.3 s the dip lies between the step's start and its midpoint (the parabola through the three values
+    finds it); at 0.56 s the midpoint is below zero.  The event fires at the analytic zero,
+    ``center - sqrt(-floor)``; a dip of 1e-9 m/s, below the speed's absolute tolerance (1e-6 m/s), is no
+    event, one of 1e-5 m/s is.  (Before the engine looked into sliding steps, none of them fired.)"""
+    assembly = Assembly([DippingSpeed("dip", {"center_s": center, "floor_m_s": floor})], [])
+    session = engine_library(assembly).session()
+    session.reset(assembly.parameter_values(), [], 1e-2, 10.0, 1000)
+    session.advance([], 1.0)
+    session.read()
+    v_end = session.states[1]
+    assert session.stats["events"] == int(fires)
+    if fires:
+        t_event = center - np.sqrt(0.1 + (1.0 - center) ** 2 - v_end)
+        assert abs(t_event - (center - np.sqrt(-floor))) < 1e-9
+    else:
+        assert abs(v_end - ((1.0 - center) ** 2 + floor)) < 1e-12

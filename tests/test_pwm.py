@@ -90,14 +90,15 @@ def two_valves_reference():
     return sc, pamsim.simulate(sc.with_changes({"solver": {"rtol": 1e-8}}), backend="python")
 
 
-@pytest.mark.parametrize("backend, method, x_tol_m", [("native", "LSODA", 2e-7), ("native", "RK45", 2e-7),
-                                                       ("python", "DOPRI5", 2e-6), ("python", "LSODA", 2e-6)])
+@pytest.mark.parametrize("backend, method, x_tol_m", [("native", "LSODA", 2e-7), ("python", "DOPRI5", 2e-6),
+                                                       ("python", "RK45", 2e-6), ("python", "LSODA", 2e-6)])
 def test_the_short_sticks_between_two_pulses_are_found(two_valves_reference, backend, method, x_tol_m):
     """Between two pulses the load comes to rest for a few milliseconds, its velocity falling to zero and
     the next pulse lifting it again: a Dormand-Prince step of that length crossed the stick and came back,
     the velocity positive at both its ends.  Every event of the reference is found, in its order, within
-    0.1 ms, and the contraction follows it.  (Before the steps were looked into where an indicator may dip,
-    the native engine found 22 of the 36 and lay 41 um off over the full run; python with DOPRI5 too.)"""
+    0.1 ms, and the contraction follows it.  (Before sliding steps were looked into where an indicator may
+    dip, the native engine found 28 of the 36 (5 of the 9 sticks), python's DOPRI5 22 and RK45 fewer than
+    36; python's LSODA, whose steps there are shorter, found them all, and is kept as a cross-check.)"""
     sc, ref = two_valves_reference
     run = pamsim.simulate(sc.with_changes({"solver": {"method": method}}), backend=backend)
     sticks = [e for e in ref.transitions if e.to_mode == "stick"]

@@ -197,43 +197,59 @@ def test_a_dopri5_segment_of_no_time_reads_its_start():
     assert seg.status == 0 and np.array_equal(seg.samples_y, ref.samples_y) and np.array_equal(seg.samples_y[:, 0], Y0)
 
 
-def _dipping_speed(floor: float):
-    """A load whose speed is ``(t - 0.5)^2 + floor`` [m/s]: 0.24 + floor at both ends of [0, 1] s, and
-    ``floor`` at 0.5 s."""
+def _dipping_speed(floor: float, center: float = 0.3):
+    """A load whose speed is ``(t - center)^2 + floor`` [m/s]: lowest, ``floor``, at ``center``; a falling
+    event on the speed, and the start."""
     def f(t, y):
-        return np.array([y[1], 2.0 * (t - 0.5)])
+        return np.array([y[1], 2.0 * (t - center)])
 
     def speed(t, y):
         return y[1]
     speed.direction = -1.0
-    return f, speed, np.array([0.0, 0.25 + floor])
+    return f, speed, np.array([0.0, center ** 2 + floor])
 
 
-@pytest.mark.parametrize("method", ["DOPRI5", "RK45"])
-def test_a_speed_that_falls_to_zero_and_back_inside_one_step_fires_where_it_reaches_zero(method):
-    """One step of 1 s in which the speed, 0.23 m/s at both ends, falls to -0.01 m/s and back: the step's ends
-    show no crossing, its midpoint does, and the event fires at the analytic zero, 0.4 s (the dense output of
-    a fifth-order step is exact on this quadratic).  With a floor of +0.01 m/s nothing fires.  (Steps are not
-    looked into for their length here: ``long_step_s`` is infinite.)"""
+def _one_step(f, events, y0, method):
+    """From 0 to 1 s at rtol 1e-2 and atol 1e-6, DOPRI5 starting with one step of 1 s; steps are not looked
+    into for their length (``long_step_s`` is infinite).  Dormand-Prince is exact on these quadratics, so
+    each step is accepted and ten times longer than the last."""
+    return integrate_segment(f, 0.0, 1.0, y0, method, events, np.empty(0), rtol=1e-2, atol=1e-6, max_step=np.inf,
+                             v_row=1, first_step=1.0, long_step_s=np.inf)
+
+
+@pytest.mark.parametrize("method, center, path", [("DOPRI5", 0.3, "parabola"), ("RK45", 0.3, "parabola"),
+                                                  ("DOPRI5", 0.5, "midpoint")])
+def test_a_speed_that_falls_to_zero_and_back_inside_one_step_fires_where_it_reaches_zero(method, center, path):
+    """A speed that falls from 0.08 m/s or more to -0.01 m/s and back inside one step (DOPRI5's step of 1 s,
+    RK45's last from 0.14 s): the step's ends show no crossing.  Centred on the step, the midpoint is below
+    zero; at 0.3 s the midpoint is above zero and the parabola through the three values finds the dip.
+    The event fires at the analytic zero, ``center - 0.1`` (the dense output of a fifth-order step is
+    exact on these quadratics)."""
+    f, speed, y0 = _dipping_speed(-0.01, center)
+    seg = _one_step(f, [speed], y0, method)
+    assert seg.status == 1 and abs(seg.t_event - (center - 0.1)) < 1e-9
+    f, speed, y0 = _dipping_speed(0.01, center)  # stays above zero: nothing fires
+    assert _one_step(f, [speed], y0, method).status == 0
+
+
+def test_a_dip_below_the_integrations_resolution_is_no_event():
+    """The speed dips 1e-9 m/s below zero, a thousandth of its absolute tolerance: no event.  A dip of
+    1e-5 m/s fires at its analytic zero, ``0.3 - sqrt(1e-5)`` s."""
+    f, speed, y0 = _dipping_speed(-1e-9)
+    assert _one_step(f, [speed], y0, "DOPRI5").status == 0
+    f, speed, y0 = _dipping_speed(-1e-5)
+    seg = _one_step(f, [speed], y0, "DOPRI5")
+    assert seg.status == 1 and abs(seg.t_event - (0.3 - 1e-5 ** 0.5)) < 1e-9
+
+
+@pytest.mark.parametrize("direction", [1.0, 0.0])
+def test_a_rising_event_that_dips_from_below_fires(direction):
+    """The speed's negative, which rises from -0.08 m/s to +0.01 m/s and back inside the step: an event
+    rising through zero (or either way) fires at 0.2 s."""
     f, speed, y0 = _dipping_speed(-0.01)
-    seg = integrate_segment(f, 0.0, 1.0, y0, method, [speed], np.empty(0), rtol=1e-2, atol=1.0, max_step=np.inf,
-                            v_row=1, first_step=1.0, long_step_s=np.inf)
-    assert seg.status == 1 and abs(seg.t_event - 0.4) < 1e-9
-    f, speed, y0 = _dipping_speed(0.01)
-    seg = integrate_segment(f, 0.0, 1.0, y0, method, [speed], np.empty(0), rtol=1e-2, atol=1.0, max_step=np.inf,
-                            v_row=1, first_step=1.0, long_step_s=np.inf)
-    assert seg.status == 0 and seg.y[1, -1] > 0.0
 
-
-def test_a_shallow_dip_between_the_midpoint_and_an_end_fires():
-    """The speed ``(t - 0.3)^2 - 1e-4``: 0.0899 and 0.4899 m/s at the ends, 0.0399 m/s at the midpoint, zero
-    at 0.29 s.  The midpoint is above zero: the parabola through the three values finds the dip."""
-    def f(t, y):
-        return np.array([y[1], 2.0 * (t - 0.3)])
-
-    def speed(t, y):
-        return y[1]
-    speed.direction = -1.0
-    seg = integrate_segment(f, 0.0, 1.0, np.array([0.0, 0.09 - 1e-4]), "DOPRI5", [speed], np.empty(0), rtol=1e-2,
-                            atol=1.0, max_step=np.inf, v_row=1, first_step=1.0, long_step_s=np.inf)
-    assert seg.status == 1 and abs(seg.t_event - 0.29) < 1e-9
+    def minus_speed(t, y):
+        return -y[1]
+    minus_speed.direction = direction
+    seg = _one_step(f, [minus_speed], y0, "DOPRI5")
+    assert seg.status == 1 and abs(seg.t_event - 0.2) < 1e-9

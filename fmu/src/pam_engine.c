@@ -266,11 +266,27 @@ static void note_rosenbrock_step(PamEngine *e, double h) {
     if (e->n_slow >= 5) e->stiff = -1;
 }
 
-/* Where to look inside a moving step, as a fraction of it, for an indicator above zero at both ends that
- * may dip to zero and back inside it; -1 if none may.  It is at or below zero at the step's midpoint (look
- * there), or lower there than at both ends with the parabola through the three values reaching zero (look
- * at the parabola's lowest point too).  z0: the indicators at the step's start; z1 at its end.
- * pamsim.stepping._may_dip is the python backend's. */
+/* How far the indicator k moves when the states at y move by their absolute tolerances, one at a time
+ * (the sum of the moves): a value of it closer to zero than that is below what the integration resolves. */
+static double indicator_resolution(PamEngine *e, const double *y, const double *z, int k) {
+    double yd[PM_NX], zd[PM_NZ > 0 ? PM_NZ : 1], r = 0.0;
+    int n;
+    memcpy(yd, y, sizeof yd);
+    for (n = 0; n < PM_NX; n++) {
+        yd[n] = y[n] + e->rtol * PM_NOMINAL[n];
+        pm_z(e->mode, yd, e->u, e->p, zd);
+        r += fabs(zd[k] - z[k]);
+        yd[n] = y[n];
+    }
+    return r;
+}
+
+/* Where to look inside a moving step, as a fraction of it in (0, 1), for an indicator above zero at both
+ * ends that may dip to zero and back inside it; -1 if none may.  It is below zero at the step's midpoint
+ * (look there), or the parabola through its values at the ends and the midpoint has its lowest point
+ * inside the step, below zero (look there).  Either by more than the indicator's resolution at the
+ * midpoint (indicator_resolution): a velocity hovering far below its tolerance of zero is no stick.  z0:
+ * the indicators at the step's start; z1 at its end.  pamsim.stepping._may_dip is the python backend's. */
 static double may_dip(PamEngine *e, const PamStages *s, double t, const double *y, double h, const double *z0,
                       const double *z1) {
     double ym[PM_NX], zm[PM_NZ > 0 ? PM_NZ : 1];
@@ -280,9 +296,13 @@ static double may_dip(PamEngine *e, const PamStages *s, double t, const double *
     pm_z(e->mode, ym, e->u, e->p, zm);
     for (k = 0; k < PM_NZ; k++) {
         double a = 2.0 * (z0[k] + z1[k] - 2.0 * zm[k]), b = z1[k] - z0[k] - a; /* a th^2 + b th + z0 */
+        double th = 0.5, low = zm[k];
         if (!(z0[k] > 0.0 && z1[k] > 0.0)) continue;
-        if (zm[k] <= 0.0) return 0.5;
-        if (zm[k] < fmin(z0[k], z1[k]) && a > 0.0 && z0[k] - b * b / (4.0 * a) <= 0.0) return -b / (2.0 * a);
+        if (a > 0.0 && b < 0.0 && -b < 2.0 * a && z0[k] - b * b / (4.0 * a) < low) {
+            th = -b / (2.0 * a);
+            low = z0[k] - b * b / (4.0 * a);
+        }
+        if (low < 0.0 && -low > indicator_resolution(e, ym, zm, k)) return th;
     }
     return -1.0;
 }
@@ -290,21 +310,22 @@ static double may_dip(PamEngine *e, const PamStages *s, double t, const double *
 /* Where an indicator first reaches zero over an accepted step, as a fraction of the step in
  * (lo, hi], and which indicators are at or below zero at hi (0 if none is).  The indicators at the step's
  * end go to z1.  A moving step is checked at its end, and, given the indicators at its start (z0, NULL if
- * unknown), at PAM_ENGINE_HELD_CHECKS points of its dense output and where may_dip looks, if one may dip to
- * zero and back inside it: under PWM a load comes to rest for a few milliseconds between two pulses, a
- * stick that a step of that length crossed and came back from, its velocity positive at both ends.  A held
- * model's step is not limited by max_step_s (its states approach their sources monotonically, so its force
- * margins seldom turn back), so a long one is also checked at PAM_ENGINE_HELD_CHECKS points of its dense
- * output.  As in solve_ivp and CVODE, an indicator crosses where its sign changes between two checked
- * points: one that dips below zero and back between them is no event, even where another indicator's
- * crossing brings the root finding there.  A free swing that turns back at its stop, grazing it, so
- * records the turn (the stop, if the turn lies beyond it, as at_event decides) where the dense output
- * puts it, instead of an impact whose time moves with the square root of the integration error (its
- * velocity changed sign over the step, so its end alone is checked). */
+ * unknown), at PAM_ENGINE_HELD_CHECKS points of its dense output and where may_dip looks, if an indicator
+ * may dip to zero and back inside it: under PWM a load comes to rest for a few milliseconds between two
+ * pulses, a stick that a step of that length crossed and came back from, its velocity positive at both
+ * ends.  A held model's step is not limited by max_step_s (its states approach their sources
+ * monotonically, so its force margins seldom turn back), so a long one is also checked at
+ * PAM_ENGINE_HELD_CHECKS points of its dense output.  As in solve_ivp and CVODE, an indicator crosses
+ * where its sign changes between two checked points: one that dips below zero and back between them is
+ * no event, even where another indicator's crossing brings the root finding there.  A free swing that
+ * turns back at its stop, grazing it, so records the turn (the stop, if the turn lies beyond it, as
+ * at_event decides) where the dense output puts it, instead of an impact whose time moves with the square
+ * root of the integration error: its velocity indicator fired at the step's end, and the step is not
+ * looked into for dips. */
 static unsigned first_crossing(PamEngine *e, const PamStages *s, double t, const double *y, const double *y1,
                                double h, const double *z0, double *z1, double *lo, double *hi) {
-    int n = (held(e) && h > e->max_step_s) ? PAM_ENGINE_HELD_CHECKS : 1, k;
-    double ye[PM_NX], dip = -1.0, th_lo = 0.0;
+    int n = (held(e) && h > e->max_step_s) ? PAM_ENGINE_HELD_CHECKS : 1, m = 0, k;
+    double ye[PM_NX], dip = -1.0, at[PAM_ENGINE_HELD_CHECKS + 1];
     unsigned fired = 0;
     if (PM_NZ == 0) return 0;
     inputs_at(e, t + h, 1);
@@ -315,22 +336,25 @@ static unsigned first_crossing(PamEngine *e, const PamStages *s, double t, const
         dip = may_dip(e, s, t, y, h, z0, z1);
         if (dip > 0.0) n = PAM_ENGINE_HELD_CHECKS;
     }
-    for (k = 1; k < n; k++) {
+    /* the points inside the step, in order: k / n, and the dip's between them */
+    for (k = 1; k <= n; k++) {
         double th = (double)k / n;
+        if (dip > (m ? at[m - 1] : 0.0) && dip < th) at[m++] = dip;
+        if (k < n) at[m++] = th;
+    }
+    for (k = 0; k < m; k++) {
         unsigned inside;
-        if (dip > th_lo && dip < th) th = dip, k--; /* the parabola's lowest point, then this point again */
-        dp_dense(s, y, h, th, ye);
-        inputs_at(e, t + th * h, 1);
+        dp_dense(s, y, h, at[k], ye);
+        inputs_at(e, t + at[k] * h, 1);
         inside = fired_indicators(e, ye);
         if (inside) {
-            *lo = th_lo;
-            *hi = th;
+            *lo = k ? at[k - 1] : 0.0;
+            *hi = at[k];
             return inside;
         }
-        th_lo = th;
     }
     inputs_at(e, t + h, 1);
-    *lo = th_lo;
+    *lo = m ? at[m - 1] : 0.0;
     *hi = 1.0;
     return fired;
 }
