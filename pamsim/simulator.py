@@ -425,7 +425,7 @@ class HybridRun:
         self.ts, self.ys, self.modes = [], [], []
         self.transitions: list[TransitionEvent] = []
         self.impact_loss_J = []  # (t, J): kinetic energy removed by inelastic impacts and velocity resets
-        self.nfev = self.n_segments = self.n_zero = self.n_stuck = self.next_sample = 0
+        self.nfev = self.njev = self.n_segments = self.n_zero = self.n_stuck = self.next_sample = 0
         self.hold_until = math.inf  # end of a short hold after a slip too small to resolve (see _HOLD_S)
         # Over every integrator step and event, not the samples.
         self.low_x, self.peak_x = math.inf, -math.inf
@@ -474,6 +474,7 @@ class HybridRun:
             raise SolverFailure(f"the integrator raised {type(exc).__name__} at t = {t:.6g} s in mode "
                                 f"{mode.label}: {exc}") from exc
         self.nfev += seg.nfev
+        self.njev += seg.njev
         self.n_segments += 1
         self.h_next = seg.h_next
         if seg.status == -1:
@@ -544,9 +545,9 @@ class HybridRun:
         return np.concatenate(self.ts), np.concatenate(self.ys, axis=1), np.concatenate(self.modes)
 
     def stats(self) -> dict:
-        """Right-hand-side evaluations, events, segments, the method and its tolerance."""
+        """Right-hand-side evaluations, events, segments, Jacobians, the method and its tolerance."""
         return {"rhs_evaluations": int(self.nfev), "events": len(self.transitions), "segments": self.n_segments,
-                "method": self.opts.method, "rtol": self.opts.rtol}
+                "jacobians": int(self.njev), "method": self.opts.method, "rtol": self.opts.rtol}
 
 
 class _Run(HybridRun):

@@ -48,8 +48,9 @@ class Segment:
     states there (one column per time).  ``samples_t``, ``samples_y``: the samples asked for, up to the
     segment's end, from the dense output.  ``status``: 0 at the breakpoint, 1 at an event, -1 failed
     (``message`` says why).  ``event``: the index of the event function that fired, at ``t_event`` [s]
-    with the states ``y_event``; ``nfev``: right-hand-side evaluations; ``h_next``: :data:`DOPRI5`'s proposal
-    for the next step [s] (None for scipy's methods)."""
+    with the states ``y_event``; ``nfev``: right-hand-side evaluations; ``njev``: Jacobians the method formed
+    (scipy's count; LSODA's by finite differences, whose evaluations are among ``nfev``); ``h_next``:
+    :data:`DOPRI5`'s proposal for the next step [s] (None for scipy's methods)."""
 
     t: np.ndarray
     y: np.ndarray
@@ -62,6 +63,7 @@ class Segment:
     nfev: int
     message: str
     h_next: float | None = None
+    njev: int = 0
 
 
 DOPRI5 = "DOPRI5"
@@ -382,7 +384,8 @@ def integrate_segment(fun: Callable, t0: float, t_end: float, y0: np.ndarray, me
                    samples_y=np.hstack(sample_ys) if sample_ys else np.empty((n, 0)),
                    status=status, event=event, t_event=float(t) if status == 1 else None,
                    y_event=np.array(y, dtype=float) if status == 1 else None,
-                   nfev=solver.nfev, message=message or "", h_next=getattr(solver, "h_next", None))
+                   nfev=solver.nfev, message=message or "", h_next=getattr(solver, "h_next", None),
+                   njev=getattr(solver, "njev", 0))
 
 
 __all__ = ["DOPRI5", "DormandPrince", "Segment", "integrate_segment", "missed_crossing", "LONG_STEP_S", "LONG_STEP_CHECKS"]

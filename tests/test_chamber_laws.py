@@ -257,7 +257,7 @@ def test_a_stiff_held_thermal_chamber_steps_with_rodas4_on_native():
     py = pamsim.simulate(sc)
     T = {name: r.signals["gas_temperature_K"] for name, r in (("auto", auto), ("dp5", dp5), ("py", py))}
     print(f"\nthermal Figure 4, native: {auto.stats['rhs_evaluations']} evaluations with the switch, "
-          f"{dp5.stats['rhs_evaluations']} with RK45; largest gaps: pressure "
+          f"{dp5.stats['rhs_evaluations']} with RK45, {auto.stats['jacobians']} Jacobians; largest gaps: pressure "
           f"{np.max(np.abs(auto.p_gauge_Pa - dp5.p_gauge_Pa)):.3g} Pa, temperature {np.max(np.abs(T['auto'] - T['dp5'])):.3g} K")
     assert np.max(np.abs(auto.x_m - dp5.x_m)) < 1e-9
     assert np.max(np.abs(auto.p_gauge_Pa - dp5.p_gauge_Pa)) < 0.1  # measured 0.0105 Pa
@@ -268,6 +268,7 @@ def test_a_stiff_held_thermal_chamber_steps_with_rodas4_on_native():
     assert auto.p_gauge_Pa[-1] == pytest.approx(3.6e5, abs=1.0)
     assert 0.0 < T["auto"][-1] - 293.15 < 0.05 and T["auto"][-1] < T["auto"][-1000] < T["py"].max()
     assert auto.stats["rhs_evaluations"] < dp5.stats["rhs_evaluations"] / 3
+    assert auto.stats["jacobians"] > 0 and dp5.stats["jacobians"] == 0  # one a Rodas4 step, none without it
 
 
 @pytest.mark.parametrize("scenario", ["acra2012_fig4.toml", "acra2012_fig6a.toml"])
@@ -279,6 +280,7 @@ def test_a_non_stiff_run_is_the_same_with_or_without_the_stiff_switch(scenario):
     dp5 = pamsim.simulate(sc.with_changes({"solver": {"method": "RK45"}}), backend="native")
     assert np.array_equal(auto.x_m, dp5.x_m) and np.array_equal(auto.p_gauge_Pa, dp5.p_gauge_Pa)
     assert auto.stats["rhs_evaluations"] == dp5.stats["rhs_evaluations"]
+    assert auto.stats["jacobians"] == 0
 
 
 @pytest.mark.parametrize("h_W_per_m2_K", [1e3, 1e4])

@@ -52,7 +52,7 @@ typedef struct {
     int32_t *modes;               /* out: per sample, the mode's value */
     double *events;               /* out: event rows x PAM_ENGINE_NEV */
     int64_t *n_events;            /* out: n_cases */
-    int64_t *stats;               /* out: n_cases x 3: RHS evaluations, accepted steps, segments + events */
+    int64_t *stats;               /* out: n_cases x 4: RHS evaluations, accepted steps, segments + events, Jacobians */
     int32_t *status;              /* out: n_cases, EngineStatus */
     double *extremes;             /* out: n_cases x 2 PM_NY: each output's largest, then its smallest value */
     char *messages;               /* out: n_cases x PAM_ENGINE_MSG, the first error */
@@ -401,9 +401,10 @@ static int run_case(const PamEngineBatch *b, int64_t i) {
             e->inputs_changed = 1;
         }
     }
-    b->stats[3 * i] = e->n_rhs;
-    b->stats[3 * i + 1] = e->n_steps;
-    b->stats[3 * i + 2] = n_seg + run.n_events;
+    b->stats[4 * i] = e->n_rhs;
+    b->stats[4 * i + 1] = e->n_steps;
+    b->stats[4 * i + 2] = n_seg + run.n_events;
+    b->stats[4 * i + 3] = e->n_jacobians;
     b->n_events[i] = run.n_events;
     return ENGINE_OK;
 }
@@ -412,7 +413,7 @@ PAM_EXPORT int64_t pam_engine_run_batch(const PamEngineBatch *b) {
     int64_t i, failed = 0;
     for (i = 0; i < b->n_cases; i++) {
         b->n_events[i] = 0;
-        b->stats[3 * i] = b->stats[3 * i + 1] = b->stats[3 * i + 2] = 0;
+        b->stats[4 * i] = b->stats[4 * i + 1] = b->stats[4 * i + 2] = b->stats[4 * i + 3] = 0;
         b->status[i] = run_case(b, i);
         failed += b->status[i] != ENGINE_OK;
     }

@@ -97,6 +97,7 @@ def _result(scenario: JointScenario, assembly, muscles, names: dict, out: dict, 
             losses.append(before[ke] - after[ke])
     high, low = out["extremes"][0][:ny], out["extremes"][0][ny:]
     stats = {"rhs_evaluations": int(out["stats"][0][0]), "events": len(events), "segments": int(out["stats"][0][2]),
-             "method": method_label(scenario.solver), "rtol": native_rtol(scenario.solver)}
+             "jacobians": int(out["stats"][0][3]), "method": method_label(scenario.solver),
+             "rtol": native_rtol(scenario.solver)}
     return JointResult(scenario.name, t, signals, modes, events, losses, stats, wall_s, tuple(m.name for m in muscles),
                        {body.position: float(high[theta]), body.min_key: float(low[theta])}, body)

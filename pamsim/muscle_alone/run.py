@@ -131,12 +131,12 @@ def _python(drive: LengthDrive, backend: str) -> LengthDrivenResult:
     atol = opts.rtol * np.array([v.nominal for v in drive.assembly.flatten().states])
     grid = np.linspace(0.0, sc.duration_s, n_samples(sc.duration_s, opts.sample_rate_Hz))
     t, y = 0.0, np.array(gen.x0(drive.inputs(0.0), p)[0], dtype=float)
-    ys, events, nfev, segments, next_sample = [], [], 0, 0, 0
+    ys, events, nfev, njev, segments, next_sample = [], [], 0, 0, 0, 0
     for t_break in _distinct_breaks(drive.breakpoints, sc.duration_s):
         while t < t_break:
             samples = grid[next_sample:np.searchsorted(grid, t_break, side="right")]
             seg = _segment(drive, gen, p, t, y, t_break, atol, samples)
-            nfev, segments = nfev + seg.nfev, segments + 1
+            nfev, njev, segments = nfev + seg.nfev, njev + seg.njev, segments + 1
             if seg.samples_t.size:  # slips closer together than the samples leave pieces without one
                 ys.append(seg.samples_y)
             next_sample += seg.samples_t.size
@@ -151,8 +151,8 @@ def _python(drive: LengthDrive, backend: str) -> LengthDrivenResult:
             events.extend((t, names[i]) for i in crossed)
             if len(events) > opts.max_events:
                 raise too_many_events(opts.max_events, f" by t = {t:.6g} s")
-    stats = {"rhs_evaluations": int(nfev), "events": len(events), "segments": segments, "method": opts.method,
-             "rtol": opts.rtol}
+    stats = {"rhs_evaluations": int(nfev), "events": len(events), "segments": segments, "jacobians": int(njev),
+             "method": opts.method, "rtol": opts.rtol}
     return drive.result(backend, grid, np.concatenate(ys, axis=1), events, stats, time.perf_counter() - wall0)
 
 
@@ -186,7 +186,7 @@ def _native(drive: LengthDrive, backend: str) -> LengthDrivenResult:
     events = [(float(e[0]), name) for e in out["events"][:int(out["n_events"][0])].tolist()
               for k, name in enumerate(names) if int(e[3]) >> k & 1]
     stats = {"rhs_evaluations": int(out["stats"][0][0]), "events": len(events), "segments": int(out["stats"][0][2]),
-             "method": method_label(opts), "rtol": native_rtol(opts)}
+             "jacobians": int(out["stats"][0][3]), "method": method_label(opts), "rtol": native_rtol(opts)}
     return drive.result(backend, np.linspace(0.0, sc.duration_s, n), Y, events, stats, wall)
 
 
@@ -208,6 +208,6 @@ def _fmu(drive: LengthDrive, backend: str) -> LengthDrivenResult:
     events = [(float(t[j + 1]), name.replace("slipping", "slip")) for name in slipping
               for j in np.flatnonzero(np.diff(result.signals[name]) > 0.5)]
     result.events = sorted(events)
-    result.stats = {"rhs_evaluations": 0, "events": len(events), "segments": 0, "method": backend,
+    result.stats = {"rhs_evaluations": 0, "events": len(events), "segments": 0, "jacobians": 0, "method": backend,
                     "rtol": sc.solver.rtol}
     return result

@@ -503,7 +503,8 @@ def _result(scenario: Scenario, case: CaseInputs, out: dict, i: int, wall_time_s
     if t is None:
         t = np.linspace(0.0, case.duration_s, case.n_samples)
     stats = {"rhs_evaluations": int(out["stats"][i][0]), "segments": int(out["stats"][i][2]),
-             "method": method_label(scenario.solver), "rtol": native_rtol(scenario.solver)}
+             "jacobians": int(out["stats"][i][3]), "method": method_label(scenario.solver),
+             "rtol": native_rtol(scenario.solver)}
     return _engine_result(scenario, case, out, i, wall_time_s, t, stats)
 
 

@@ -140,7 +140,7 @@ class EngineLibrary:
     def run(self, cases: Sequence[EngineCase]) -> dict:
         """Run ``cases`` in one call.  Returns per case, concatenated: ``samples`` (a block of every state
         x its samples), ``modes``, ``events`` (rows of t, mode before, mode after, fired mask, outputs
-        before, outputs after), ``n_events``, ``stats`` (RHS evaluations, steps, segments + events),
+        before, outputs after), ``n_events``, ``stats`` (RHS evaluations, steps, segments + events, Jacobians),
         ``status``, ``extremes`` (each output's largest then smallest value over every step end and
         event), ``messages``, the offsets of each case's samples and events, and the uninitialised
         :data:`SAMPLE_ROOM`."""
@@ -183,7 +183,7 @@ def batch_arrays(cases: Sequence[EngineCase], layout: dict, allocate=None) -> tu
               "params": (_F64, (n, layout["np"])), "segment_t_s": (_F64, (segments,)),
               "segment_u": (_F64, (segments, nu)), **({"segment_du": (_F64, (segments, nu, 3))} if exact else {}),
               "samples": (_F64, (samples * layout["ns"],)), "modes": (_I32, (samples,)),
-              "events": (_F64, (max(events, 1), layout["event_columns"])), "tallies": (_I64, (4 * n,)),
+              "events": (_F64, (max(events, 1), layout["event_columns"])), "tallies": (_I64, (5 * n,)),
               "status": (_I32, (n,)), "extremes": (_F64, (n, 2 * layout["ny"])),
               **{name: (dtype, (samples,)) for name, dtype in SAMPLE_ROOM.items()}}
     arrays, address = _arena(blocks, allocate)
@@ -191,13 +191,13 @@ def batch_arrays(cases: Sequence[EngineCase], layout: dict, allocate=None) -> tu
     arrays["tallies"].fill(0)
     arrays["status"].fill(0)
     arrays["extremes"].fill(np.nan)
-    # the rows of the blocks, by field: n_events then the n x 3 stats share the tallies
+    # the rows of the blocks, by field: n_events then the n x 4 stats share the tallies
     for block, rows, size in (("settings", _SETTINGS, 8 * n), ("counts", _COUNTS, 8 * n),
                               ("tallies", ("n_events", "stats"), 8 * n)):
         address.update({name: address[block] + k * size for k, name in enumerate(rows)})
     arrays.update(sample_offset=arrays["counts"][_COUNTS.index("sample_offset")],
                   event_offset=arrays["counts"][_COUNTS.index("event_offset")],
-                  n_events=arrays["tallies"][:n], stats=arrays["tallies"][n:].reshape(n, 3))
+                  n_events=arrays["tallies"][:n], stats=arrays["tallies"][n:].reshape(n, 4))
     return arrays, address
 
 
