@@ -14,8 +14,8 @@ are those of ``solve_ivp``, number for number.
 
 A step that is long, in which the load's velocity changes sign, or in which a sliding load's indicator may
 dip to zero and back (:func:`_may_dip`), is also checked inside for an indicator that went below zero and
-back between its ends (:func:`missed_crossing`), and the segment then ends there.  The run stops at that step, where ``solve_ivp`` went on to its segment's end and was cut
-afterwards: only the count of right-hand-side evaluations differs.
+back between its ends (:func:`missed_crossing`), and the segment then ends there.  The run stops at that
+step, where ``solve_ivp`` went on to its segment's end and was cut afterwards: only the count of right-hand-side evaluations differs.
 """
 
 from __future__ import annotations

@@ -90,15 +90,21 @@ static int transition(PamEngine *e, double *y, unsigned fired, int *jump_mode) {
     return jumped;
 }
 
-static unsigned fired_indicators(const PamEngine *e, const double *y) {
-    double z[PM_NZ > 0 ? PM_NZ : 1];
+/* The indicators at or below zero in z, bit k for indicator k (the mask an event's transition takes). */
+static unsigned fired_of(const double *z) {
     unsigned fired = 0;
     int k;
-    if (PM_NZ == 0) return 0;
-    pm_z(e->mode, y, e->u, e->p, z);
     for (k = 0; k < PM_NZ; k++)
         if (z[k] <= 0.0) fired |= 1u << k;
     return fired;
+}
+
+/* fired_of the indicators at y, in the current mode with the current inputs. */
+static unsigned fired_indicators(const PamEngine *e, const double *y) {
+    double z[PM_NZ > 0 ? PM_NZ : 1];
+    if (PM_NZ == 0) return 0;
+    pm_z(e->mode, y, e->u, e->p, z);
+    return fired_of(z);
 }
 
 void pam_engine_reset(PamEngine *e) {
@@ -166,7 +172,8 @@ static void dp_dense(const PamStages *s, const double *y0, double h, double th, 
     double pw[4] = {th, th * th, th * th * th, th * th * th * th};
     int n, st, j;
     if (s->poly) {
-        for (n = 0; n < PM_NX; n++) y[n] = y0[n] + th * (s->q[0][n] + th * (s->q[1][n] + th * (s->q[2][n] + th * s->q[3][n])));
+        for (n = 0; n < PM_NX; n++)
+            y[n] = y0[n] + th * (s->q[0][n] + th * (s->q[1][n] + th * (s->q[2][n] + th * s->q[3][n])));
         return;
     }
     for (n = 0; n < PM_NX; n++) {
@@ -326,12 +333,11 @@ static unsigned first_crossing(PamEngine *e, const PamStages *s, double t, const
                                double h, const double *z0, double *z1, double *lo, double *hi) {
     int n = (held(e) && h > e->max_step_s) ? PAM_ENGINE_HELD_CHECKS : 1, m = 0, k;
     double ye[PM_NX], dip = -1.0, at[PAM_ENGINE_HELD_CHECKS + 1];
-    unsigned fired = 0;
+    unsigned fired;
     if (PM_NZ == 0) return 0;
     inputs_at(e, t + h, 1);
     pm_z(e->mode, y1, e->u, e->p, z1);
-    for (k = 0; k < PM_NZ; k++)
-        if (z1[k] <= 0.0) fired |= 1u << k;
+    fired = fired_of(z1);
     if (n == 1 && !fired && z0 != NULL && !held(e)) {
         dip = may_dip(e, s, t, y, h, z0, z1);
         if (dip > 0.0) n = PAM_ENGINE_HELD_CHECKS;
@@ -433,6 +439,12 @@ static int step_failed(PamEngine *e, double t, const double *y) {
 #define PAM_ENGINE_HOLD_S 1e-9
 #define PAM_ENGINE_MAX_HOLD_DOUBLINGS 29 /* the longest hold, 2^29 ns: about 0.54 s */
 
+/* An event or a held model's new mode: counted, and the new mode tested afresh for stiffness. */
+static void mode_changed(PamEngine *e) {
+    e->n_events++;
+    e->stiff = e->n_stiff = e->n_nonstiff = 0;
+}
+
 /* The event located at y (time t): the jump and the new mode; -1 if events make no progress. */
 static int at_event(PamEngine *e, double t, double *y, int *zero_length) {
     double y_before[PM_NX];
@@ -458,8 +470,7 @@ static int at_event(PamEngine *e, double t, double *y, int *zero_length) {
         return 0;
     }
     *zero_length = 0;
-    e->n_events++;
-    e->stiff = e->n_stiff = e->n_nonstiff = 0; /* a new mode is tested afresh */
+    mode_changed(e);
     if (e->on_event) e->on_event(e->event_env, t, old, e->mode, fired, y_before, y);
     return 0;
 }
@@ -477,10 +488,7 @@ static void recheck_held(PamEngine *e, double t, const double *y) {
     int old = e->mode;
     if (!held(e) || holding(e, t)) return;
     e->mode = rest_mode(e, e->mode, y);
-    if (e->mode != old) {
-        e->n_events++;
-        e->stiff = e->n_stiff = e->n_nonstiff = 0;
-    }
+    if (e->mode != old) mode_changed(e);
 }
 
 static int at_breakpoint(const PamEngine *e, double t_s) {
@@ -503,7 +511,7 @@ int pam_engine_do_step(PamEngine *e, double t_end) {
     t_piece = next_piece_end(e, t, t_end);
     /* A remainder below the time resolution (left by an event located just before t_end) is not a step. */
     while (t_end - t > 1e-13 * fmax(1.0, fabs(t_end))) {
-        double h, err, factor, grow, lo = 0.0, hi = 1.0;
+        double h, err, factor, grow, cap, lo = 0.0, hi = 1.0;
         unsigned crossed;
         int last, at_rest = held(e), rosenbrock, stiff_able;
         if (t_piece - t <= 1e-13 * fmax(1.0, fabs(t_piece))) {
@@ -549,11 +557,12 @@ int pam_engine_do_step(PamEngine *e, double t_end) {
         err = rosenbrock ? ros_step(e, &RODAS4, y, h, &s, y1) : dp_step(e, t, y, h, &s, y1, y6);
         /* the step grows by err^(-1/(q+1)), q the order of the error estimate, at most 10 times (6 for Rodas4) */
         grow = rosenbrock ? -1.0 / RODAS4.elo : -0.2;
+        cap = rosenbrock ? 6.0 : 10.0;
         if (!(err <= 1.0)) {
             e->h_s = h * (isfinite(err) ? fmax(0.2, 0.9 * pow(err, grow)) : 0.1);
             continue;
         }
-        factor = err == 0.0 ? (rosenbrock ? 6.0 : 10.0) : fmin(rosenbrock ? 6.0 : 10.0, fmax(0.2, 0.9 * pow(err, grow)));
+        factor = err == 0.0 ? cap : fmin(cap, fmax(0.2, 0.9 * pow(err, grow)));
         if (rosenbrock) note_rosenbrock_step(e, h);
         else if (stiff_able) test_stiffness(e, &s, y1, y6, h);
         e->n_steps++;

@@ -12,8 +12,8 @@ from ..components.stick_slip import BodyMode, event_name
 from ..errors import InputError
 from ..assemblies.one_muscle import RUN_FUNCTIONS
 from ..modeling.pygen import compiled_by_mode
-from ..native.backend import (method_label, stiff_switch, SCENARIO_CACHE_SIZE, KeptByObject, check_status, event_capacity,
-                              exact_segments, native_rtol)
+from ..native.backend import (SCENARIO_CACHE_SIZE, KeptByObject, check_status, engine_stats, event_capacity,
+                              exact_segments, native_rtol, stiff_switch)
 from ..native.engine import EngineCase, engine_library
 from .result import JointEvent, JointResult
 from .scenario import JointScenario
@@ -96,8 +96,6 @@ def _result(scenario: JointScenario, assembly, muscles, names: dict, out: dict, 
         if before[ke] != after[ke]:
             losses.append(before[ke] - after[ke])
     high, low = out["extremes"][0][:ny], out["extremes"][0][ny:]
-    stats = {"rhs_evaluations": int(out["stats"][0][0]), "events": len(events), "segments": int(out["stats"][0][2]),
-             "jacobians": int(out["stats"][0][3]), "method": method_label(scenario.solver),
-             "rtol": native_rtol(scenario.solver)}
+    stats = engine_stats(out, 0, scenario.solver, len(events))
     return JointResult(scenario.name, t, signals, modes, events, losses, stats, wall_s, tuple(m.name for m in muscles),
                        {body.position: float(high[theta]), body.min_key: float(low[theta])}, body)

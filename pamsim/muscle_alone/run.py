@@ -158,7 +158,7 @@ def _python(drive: LengthDrive, backend: str) -> LengthDrivenResult:
 
 def _native(drive: LengthDrive, backend: str) -> LengthDrivenResult:
     """The generic C engine compiled with the assembly's generated C, its inputs cut into exact segments."""
-    from ..native.backend import method_label, stiff_switch, check_status, event_capacity, exact_segments, native_rtol
+    from ..native.backend import check_status, engine_stats, event_capacity, exact_segments, native_rtol, stiff_switch
     from ..native.engine import EngineCase, engine_library
 
     sc, opts = drive.scenario, drive.scenario.solver
@@ -185,8 +185,7 @@ def _native(drive: LengthDrive, backend: str) -> LengthDrivenResult:
     # e[3] is the bit mask of the indicators that fired: one event each, as the python loop reports them
     events = [(float(e[0]), name) for e in out["events"][:int(out["n_events"][0])].tolist()
               for k, name in enumerate(names) if int(e[3]) >> k & 1]
-    stats = {"rhs_evaluations": int(out["stats"][0][0]), "events": len(events), "segments": int(out["stats"][0][2]),
-             "jacobians": int(out["stats"][0][3]), "method": method_label(opts), "rtol": native_rtol(opts)}
+    stats = engine_stats(out, 0, opts, len(events))
     return drive.result(backend, np.linspace(0.0, sc.duration_s, n), Y, events, stats, wall)
 
 

@@ -68,6 +68,8 @@ def stiff_switch(opts) -> bool:
     """Whether the engine steps a held model whose Dormand-Prince steps are bound by stability with Rodas4:
     for ``solver.method = "LSODA"`` (the default, the automatic choice), not for ``RK45`` or ``DOPRI5``."""
     return opts.method == "LSODA"
+
+
 BATCH_EVENT_CAPACITY = 1024
 """Events kept per case in a batch; a case with more is run again alone, with room for ``max_events``."""
 
@@ -91,6 +93,7 @@ def outgrew_batch(status: int, max_events: int) -> bool:
     and so is to be run again alone with room for ``max_events + 1`` events."""
     return status == 3 and max_events + 1 > BATCH_EVENT_CAPACITY
 
+
 HOLD_STEPS_PER_TAU = 10
 """A first-order lag is held over at most tau / 10 (and never longer than one output sample)."""
 METHOD_LABEL = "native DOPRI5(4)"
@@ -101,6 +104,16 @@ def method_label(opts) -> str:
     """``Result.stats["method"]`` of a native run with solver options ``opts``: :data:`METHOD_LABEL`, and the
     stiff method it may switch to (:func:`stiff_switch`)."""
     return METHOD_LABEL + ", Rodas4 where stiff" if stiff_switch(opts) else METHOD_LABEL
+
+
+def engine_stats(out: dict, i: int, opts, n_events: int) -> dict:
+    """``Result.stats`` of case ``i`` of an engine batch's output ``out`` run with solver options ``opts``,
+    with ``n_events`` events, in the python backend's order of keys."""
+    counts = out["stats"][i]
+    return {"rhs_evaluations": int(counts[0]), "events": n_events, "segments": int(counts[2]),
+            "jacobians": int(counts[3]), "method": method_label(opts), "rtol": native_rtol(opts)}
+
+
 _EXACT = (Constant, Step, PiecewiseConstant)  # constant between breakpoints: held exactly
 _DEFAULT_MAX_STEP_S = float(lib.REAL_DEFAULTS[lib.REAL_INDEX["cs_max_step_s"]])
 
@@ -502,9 +515,7 @@ def _result(scenario: Scenario, case: CaseInputs, out: dict, i: int, wall_time_s
         raise too_many_events(case.max_events)
     if t is None:
         t = np.linspace(0.0, case.duration_s, case.n_samples)
-    stats = {"rhs_evaluations": int(out["stats"][i][0]), "segments": int(out["stats"][i][2]),
-             "jacobians": int(out["stats"][i][3]), "method": method_label(scenario.solver),
-             "rtol": native_rtol(scenario.solver)}
+    stats = engine_stats(out, i, scenario.solver, 0)  # its events counted from the transitions
     return _engine_result(scenario, case, out, i, wall_time_s, t, stats)
 
 

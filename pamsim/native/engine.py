@@ -34,7 +34,8 @@ from ..fmu.generate import c_source_dir
 from ..modeling import code_cache
 from .build import FLAGS, cache_root, compile_library, compiler
 
-ENGINE_SOURCES = ("pam_engine_batch.c", "pam_engine_session.c", "pam_engine.c", "pam_engine.h", "pam_dopri.h", "pam_rosenbrock.h", "pam_gauss.h")
+ENGINE_SOURCES = ("pam_engine_batch.c", "pam_engine_session.c", "pam_engine.c", "pam_engine.h", "pam_dopri.h",
+                  "pam_rosenbrock.h", "pam_gauss.h")
 LAYOUT = ("nx", "nq", "nu", "np", "ny", "nz", "nmodes", "ns", "event_columns", "message_bytes", "batch_bytes")
 """What ``pam_engine_layout(k)`` returns, by k."""
 STATUS = ("ok", "bad input", "solver failed", "event buffer full")
@@ -163,7 +164,8 @@ buffer, which is reused while it is free, they are not new arrays whose first to
 fault per 4 KiB, as a batch's results would be (they are kept, so the heap grows)."""
 _SETTINGS = ("rtol", "max_step_s", "duration_s")
 """The per-case float settings, rows of one block."""
-_COUNTS = ("max_steps", "stiff_switch", "n_samples", "sample_offset", "n_segments", "segment_offset", "event_capacity", "event_offset")
+_COUNTS = ("max_steps", "stiff_switch", "n_samples", "sample_offset", "n_segments", "segment_offset", "event_capacity",
+           "event_offset")
 """The per-case integers, rows of one block."""
 
 
@@ -206,8 +208,8 @@ def _fill_inputs(arrays: dict[str, np.ndarray], cases: Sequence[EngineCase], cou
     arrays["params"][:] = [k.params for k in cases]
     arrays["settings"][:] = [[getattr(k, name) for k in cases] for name in _SETTINGS]
     offsets = {name: [0, *itertools.accumulate(values[:-1])] for name, values in counts.items()}
-    arrays["counts"][:] = [[k.max_steps for k in cases], [int(k.stiff_switch) for k in cases], counts["n_samples"], offsets["n_samples"],
-                           counts["n_segments"], offsets["n_segments"], counts["event_capacity"],
+    arrays["counts"][:] = [[k.max_steps for k in cases], [int(k.stiff_switch) for k in cases], counts["n_samples"],
+                           offsets["n_samples"], counts["n_segments"], offsets["n_segments"], counts["event_capacity"],
                            offsets["event_capacity"]]
     start = 0
     for k in cases:
