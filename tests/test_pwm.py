@@ -97,7 +97,7 @@ def test_the_short_sticks_between_two_pulses_are_found(two_valves_reference, bac
     the next pulse lifting it again: a Dormand-Prince step of that length crossed the stick and came back,
     the velocity positive at both its ends.  Every event of the reference is found, in its order, within
     0.1 ms, and the contraction follows it.  (Before sliding steps were looked into where an indicator may
-    dip, the native engine found 28 of the 36 (5 of the 9 sticks), python's DOPRI5 22 and RK45 fewer than
+    dip, the native engine reported 28 events for the 36 (5 of the 9 sticks), python's DOPRI5 22 and RK45 fewer than
     36; python's LSODA, whose steps there are shorter, found them all, and is kept as a cross-check.)"""
     sc, ref = two_valves_reference
     run = pamsim.simulate(sc.with_changes({"solver": {"method": method}}), backend=backend)
