@@ -32,7 +32,7 @@ from .errors import InputError, SolverFailure
 from .model import STATE_SCALES, Mode, MuscleModel
 from .modeling.pygen import compiled_by_mode
 from .result import Result, TransitionEvent
-from .stepping import integrate_segment
+from .stepping import LsodaRestarts, integrate_segment
 
 
 MIN_RTOL = 1e-13
@@ -233,8 +233,8 @@ class GeneratedCode:
         """The right-hand side ``f(t, y)`` of ``mode``, as ``solve_ivp`` calls it."""
         f, inputs, p = self.code[mode].f, self.inputs, self.p
 
-        def rhs(t, y):
-            return np.array(f(y.tolist(), inputs(min(t, self.t_left)), p, ())[0])
+        def rhs(t, y):  # a list: the integrators make it an array (scipy's as float), once
+            return f(y.tolist(), inputs(min(t, self.t_left)), p, ())[0]
         return rhs
 
     def events(self, mode: Mode) -> list[tuple[str, Callable, int]]:
@@ -431,6 +431,7 @@ class HybridRun:
         self.low_x, self.peak_x = math.inf, -math.inf
         self.calls = 0
         self.h_next = None  # the step DOPRI5 proposed at the last segment's end, to start the next with
+        self.restarts = LsodaRestarts()
         self.reached = 0.0  # reported time: the RHS is also evaluated at trial points, which need not increase
 
     def report(self, t: float) -> None:
@@ -465,7 +466,7 @@ class HybridRun:
         try:
             seg = integrate_segment(rhs, t, t_break, y, opts.method, [_from_start(f, t, y) for _, f, _ in named],
                                     samples, rtol=opts.rtol, atol=self.atol, max_step=max_step, v_row=_V_ROW,
-                                    first_step=self.h_next)
+                                    first_step=self.h_next, restarts=self.restarts)
         except (InputError, SolverFailure):
             raise
         except Exception as exc:

@@ -20,6 +20,7 @@ step, where ``solve_ivp`` went on to its segment's end and was cut afterwards: o
 
 from __future__ import annotations
 
+import math
 from bisect import bisect_left, bisect_right
 from dataclasses import dataclass
 from typing import Callable, Sequence
@@ -179,6 +180,97 @@ class DormandPrince:
         return y_at
 
 
+# The exponents 0..q of LSODA's orders (up to 12, Adams; 5, BDF) as floats: numpy raises a float to an
+# integer array's powers through the same pow() after casting them, so only the cast is saved.
+_POWERS = [np.arange(q + 1, dtype=float) for q in range(13)]
+
+
+class _Nordsieck:
+    """LSODA's dense output over its last step, read from the solver's Nordsieck array as scipy's (1.17)
+    ``LSODA._dense_output_impl`` reads it (ODEPACK's layout: the last step's order ``iwork[13]``, the next
+    step ``rwork[11]``, the array from ``rwork[20]``, its last column rescaled where the order is to fall)
+    and evaluated with the same operations as scipy's ``LsodaDenseOutput``: the same numbers.  Without
+    scipy's generic objects around it, which cost more than the evaluation: a run under PWM reads one at
+    every step (its midpoint, :func:`_may_dip`)."""
+
+    __slots__ = ("t", "h", "yh", "p")
+
+    def __init__(self, solver):
+        integrator = solver._lsoda_solver._integrator
+        iwork, rwork = integrator.iwork, integrator.rwork
+        order, h = iwork[13], rwork[11]
+        yh = rwork[20:20 + (order + 1) * solver.n].reshape((solver.n, order + 1), order="F").copy()
+        if iwork[14] < order:  # the last column, unused at the next order, was not rescaled to its step
+            yh[:, -1] *= (h / rwork[10]) ** order
+        self.t, self.h, self.yh, self.p = solver.t, h, yh, _POWERS[order]
+
+    def __call__(self, t):
+        if t.__class__ is not float and np.ndim(t):
+            return np.dot(self.yh, ((np.asarray(t, dtype=float) - self.t) / self.h) ** self.p[:, None])
+        return np.dot(self.yh, ((t - self.t) / self.h) ** self.p)
+
+
+def _dense_of(solver):
+    """The solver's dense output over its last step (:class:`_Nordsieck` for LSODA's, where the installed
+    scipy keeps LSODA's arrays where scipy 1.17 does)."""
+    if solver.t != solver.t_old and hasattr(solver, "_lsoda_solver"):
+        try:
+            return _Nordsieck(solver)
+        except (AttributeError, IndexError, TypeError):
+            pass
+    return solver.dense_output()
+
+
+class LsodaRestarts:
+    """``scipy.integrate.LSODA`` solvers kept from one segment to the next of a run and restarted at each
+    segment's start, in place of a new solver per segment.
+
+    A valve under PWM cuts a run into hundreds of segments of about ten steps each, and building an LSODA
+    solver (scipy's argument checks, its ``ode`` wrapper looking its integrator up by name) cost a tenth of
+    such a run.  A restart does what the constructor does to the integrator, through the same private
+    attributes scipy's ``LSODA.__init__`` sets (``_lsoda_solver``, its integrator's ``rwork`` and
+    ``call_args``): the initial value set afresh (new work arrays, ``istate = 1``, so nothing of the last
+    segment is kept) and the segment's end written where LSODA's one-step mode reads it.  Its steps are
+    those of a new solver, bit for bit (``tests/test_stepping.py``).  Where the installed scipy lacks those
+    attributes, a new solver is built as before.  One solver per set of options (tolerances and longest
+    step); the right-hand side, which changes with the mode, is looked up at each call."""
+
+    def __init__(self):
+        self._solvers: dict = {}
+        self._fun: Callable | None = None
+
+    def _call(self, t, y):
+        return self._fun(t, y)
+
+    def start(self, fun: Callable, t0: float, y0: np.ndarray, t_bound: float, *, rtol: float, atol,
+              max_step: float):
+        """An LSODA solver of ``fun`` from ``(t0, y0)`` to ``t_bound``, as ``scipy.integrate.LSODA`` builds it."""
+        from scipy.integrate import LSODA
+
+        self._fun = fun
+        key = (rtol, np.asarray(atol, dtype=float).tobytes(), max_step, np.size(y0))
+        solver = self._solvers.get(key)
+        if solver is None:
+            solver = LSODA(self._call, t0, y0, t_bound, rtol=rtol, atol=atol, max_step=max_step)
+            self._solvers[key] = solver
+            return solver
+        try:
+            ode, integrator = solver._lsoda_solver, solver._lsoda_solver._integrator
+            ode.set_initial_value(y0, t0)
+            integrator.rwork[0] = t_bound
+            integrator.call_args[4] = integrator.rwork
+        except (AttributeError, IndexError, TypeError):  # scipy's internals changed: build as before
+            del self._solvers[key]
+            return self.start(fun, t0, y0, t_bound, rtol=rtol, atol=atol, max_step=max_step)
+        solver.y = np.asarray(y0, dtype=float)
+        if not all(map(math.isfinite, solver.y.tolist())):  # scipy's own check, and its words
+            raise ValueError("All components of the initial state `y0` must be finite.")
+        solver.t_old, solver.t, solver.t_bound, solver.status = None, t0, t_bound, "running"
+        solver.direction = np.sign(t_bound - t0) if t_bound != t0 else 1
+        solver.nfev = solver.njev = solver.nlu = 0
+        return solver
+
+
 def missed_crossing(events: Sequence[Callable], directions: Sequence[float], g_old: Sequence[float], dense,
                     t_old: float, t: float, also: Sequence[float] = ()):
     """The first ``(time, index)`` inside the step ``(t_old, t]`` where one of ``events`` crossed zero in its
@@ -211,11 +303,11 @@ def missed_crossing(events: Sequence[Callable], directions: Sequence[float], g_o
     return None
 
 
-def _resolution(fun: Callable, t: float, y: np.ndarray, value: float, atol: np.ndarray) -> float:
+def _resolution(fun: Callable, t: float, y: np.ndarray, value: float, atol) -> float:
     """How far the event function ``fun`` (``value`` at ``(t, y)``) moves when the states move by their
-    absolute tolerances ``atol``, one at a time (the sum of the moves): a value closer to zero than that is
-    below what the integration resolves."""
-    moved = 0.0
+    absolute tolerances ``atol`` (one, or one per state), one at a time (the sum of the moves): a value closer
+    to zero than that is below what the integration resolves."""
+    moved, atol = 0.0, np.broadcast_to(np.asarray(atol, dtype=float), y.shape)
     for n in range(y.size):
         yd = y.copy()
         yd[n] += atol[n]
@@ -224,7 +316,7 @@ def _resolution(fun: Callable, t: float, y: np.ndarray, value: float, atol: np.n
 
 
 def _may_dip(events: Sequence[Callable], directions: Sequence[float], g_old: Sequence[float],
-             g_new: Sequence[float], dense, t_old: float, t: float, atol: np.ndarray) -> list[float] | None:
+             g_new: Sequence[float], dense, t_old: float, t: float, atol) -> list[float] | None:
     """Where to look inside a step, as a time, for an event function on the same side of zero at both ends
     (the side it crosses from) that may cross zero and come back inside it, or None: it is on the far side
     at the step's midpoint (look there), or the parabola through its values at the ends and the midpoint
@@ -284,7 +376,7 @@ def _earliest_event(events, directions, g_old, g_new, dense, t_old: float, t: fl
 def integrate_segment(fun: Callable, t0: float, t_end: float, y0: np.ndarray, method: str,
                       events: Sequence[Callable], samples: np.ndarray, *, rtol: float, atol, max_step: float,
                       v_row: int | None = None, first_step: float | None = None,
-                      long_step_s: float = LONG_STEP_S) -> Segment:
+                      long_step_s: float = LONG_STEP_S, restarts: LsodaRestarts | None = None) -> Segment:
     """Integrate ``fun`` from ``(t0, y0)`` to ``t_end`` or the first of the terminal ``events``.
 
     Parameters
@@ -308,6 +400,8 @@ def integrate_segment(fun: Callable, t0: float, t_end: float, y0: np.ndarray, me
         (:func:`missed_crossing`), as is any step longer than ``long_step_s`` (:data:`LONG_STEP_S`).
     first_step : float, optional
         :data:`DOPRI5`'s first step [s] (None: estimated from the start); the other methods ignore it.
+    restarts : LsodaRestarts, optional
+        Where LSODA's solver is kept between the segments of a run (None: a new solver).
 
     Returns
     -------
@@ -317,12 +411,13 @@ def integrate_segment(fun: Callable, t0: float, t_end: float, y0: np.ndarray, me
 
     if method == DOPRI5:
         solver = DormandPrince(fun, t0, y0, t_end, rtol=rtol, atol=atol, max_step=max_step, first_step=first_step)
+    elif method == "LSODA" and restarts is not None:
+        solver = restarts.start(fun, float(t0), y0, float(t_end), rtol=rtol, atol=atol, max_step=max_step)
     else:
         solver = getattr(scipy.integrate, method)(fun, float(t0), y0, float(t_end), rtol=rtol, atol=atol,
                                                   max_step=max_step)
     from_next = method in _FROM_NEXT_STEP
     v_tol = None if v_row is None else float(atol[v_row] if np.ndim(atol) else atol)
-    atol_all = np.broadcast_to(np.asarray(atol, dtype=float), np.shape(y0))
     grid = samples.tolist()  # bisect on a list: a step's samples are few, and a numpy call costs more
     directions = [getattr(e, "direction", 0.0) for e in events]
     g = [e(solver.t, solver.y) for e in events]
@@ -340,22 +435,22 @@ def integrate_segment(fun: Callable, t0: float, t_end: float, y0: np.ndarray, me
         dense = None  # built only where something is read from it
         g_new = [e(t, y) for e in events]
         if events and any(map(_crossed, g, g_new, directions)):
-            dense = solver.dense_output()
+            dense = _dense_of(solver)
             t, event = _earliest_event(events, directions, g, g_new, dense, t_old, t)
             y, status = dense(t), 1
         turned, dips = False, None
-        if v_row is not None and abs(y[v_row]) > v_tol:
-            v_old = ys[-1][v_row]
+        v_old, v_new = (0.0, 0.0) if v_row is None else (float(ys[-1][v_row]), float(y[v_row]))
+        if v_row is not None and abs(v_new) > v_tol:
             if v_old == 0.0:  # a slide from rest: turned if it ends moving against its motion early in the step
-                dense = solver.dense_output() if dense is None else dense
-                turned = float(dense(t_old + (t - t_old) / LONG_STEP_CHECKS)[v_row]) * y[v_row] < 0.0
+                dense = _dense_of(solver) if dense is None else dense
+                turned = float(dense(t_old + (t - t_old) / LONG_STEP_CHECKS)[v_row]) * v_new < 0.0
             else:
-                turned = _turned(v_old, y[v_row], v_tol)
-        if events and status != 1 and not turned and v_row is not None and ys[-1][v_row] * y[v_row] > 0.0:
-            dense = solver.dense_output() if dense is None else dense
-            dips = _may_dip(events, directions, g, g_new, dense, t_old, t, atol_all)
+                turned = _turned(v_old, v_new, v_tol)
+        if events and status != 1 and not turned and v_old * v_new > 0.0:
+            dense = _dense_of(solver) if dense is None else dense
+            dips = _may_dip(events, directions, g, g_new, dense, t_old, t, atol)
         if events and (t - t_old > long_step_s or turned or dips):
-            dense = solver.dense_output() if dense is None else dense
+            dense = _dense_of(solver) if dense is None else dense
             missed = missed_crossing(events, directions, g, dense, t_old, t, dips or ())
             if missed is not None:
                 t, event = missed
@@ -367,11 +462,11 @@ def integrate_segment(fun: Callable, t0: float, t_end: float, y0: np.ndarray, me
         # for LSODA and BDF the one that starts there, unless that one is the last and has no time.
         n_step = (bisect_left if from_next and status is None else bisect_right)(grid, t)
         if n_step > n_taken:
-            dense = solver.dense_output() if dense is None else dense
+            dense = _dense_of(solver) if dense is None else dense
             sample_ys.append(dense(samples[n_taken:n_step]))
             n_taken = n_step
         on_end = status is None and n_step < len(grid) and grid[n_step] == t
-        kept = None if not on_end else solver.dense_output() if dense is None else dense
+        kept = None if not on_end else _dense_of(solver) if dense is None else dense
         ts.append(t)
         ys.append(y)
     if status is not None and status >= 0 and kept is not None:
@@ -388,4 +483,4 @@ def integrate_segment(fun: Callable, t0: float, t_end: float, y0: np.ndarray, me
                    njev=getattr(solver, "njev", 0))
 
 
-__all__ = ["DOPRI5", "DormandPrince", "Segment", "integrate_segment", "missed_crossing", "LONG_STEP_S", "LONG_STEP_CHECKS"]
+__all__ = ["DOPRI5", "DormandPrince", "LsodaRestarts", "Segment", "integrate_segment", "missed_crossing", "LONG_STEP_S", "LONG_STEP_CHECKS"]

@@ -253,3 +253,84 @@ def test_a_rising_event_that_dips_from_below_fires(direction):
     minus_speed.direction = direction
     seg = _one_step(f, [minus_speed], y0, "DOPRI5")
     assert seg.status == 1 and abs(seg.t_event - 0.2) < 1e-9
+
+
+def switched(sign: float):
+    """The oscillator under a force of ``sign``: a run switches it at its breakpoints."""
+    def f(t, y):
+        return np.array([y[1], -40.0 * y[0] - 0.3 * y[1] + sign * 2.0])
+    return f
+
+
+@pytest.mark.parametrize("events", [[], [below(-0.05), speed_zero]], ids=["breakpoints", "breakpoints and events"])
+def test_lsoda_restarted_at_each_segment_takes_a_new_solvers_steps(events):
+    """A run of segments (the force switching at each breakpoint, two longest steps, one segment of no time)
+    with LSODA kept and restarted (:class:`LsodaRestarts`) against a new solver per segment: the same steps,
+    samples, events and counts, bit for bit."""
+    from pamsim.stepping import LsodaRestarts
+
+    breaks = [0.0, 0.13, 0.4, 0.4, 0.71, 1.2, 1.25, 2.0]
+    grid = np.linspace(0.0, 2.0, 2001)
+
+    def run(restarts):
+        t, y, out = 0.0, Y0.copy(), []
+        for k, t_break in enumerate(breaks[1:]):
+            while True:
+                seg = integrate_segment(switched((-1.0) ** k), t, t_break, y, "LSODA", events,
+                                        grid[(grid >= t) & (grid <= t_break)], rtol=1e-7, atol=1e-9,
+                                        max_step=0.05 if k % 2 else np.inf, restarts=restarts)
+                out.append(seg)
+                t, y = (seg.t_event, seg.y_event + [0.0, 1e-3]) if seg.status == 1 else (t_break, seg.y[:, -1])
+                if seg.status != 1:
+                    break
+        return out
+
+    fresh, kept = run(None), run(LsodaRestarts())
+    assert len(fresh) == len(kept) >= len(breaks) - 1
+    for a, b in zip(fresh, kept):
+        assert np.array_equal(a.t, b.t) and np.array_equal(a.y, b.y)
+        assert np.array_equal(a.samples_t, b.samples_t) and np.array_equal(a.samples_y, b.samples_y)
+        assert (a.status, a.event, a.t_event, a.nfev, a.njev) == (b.status, b.event, b.t_event, b.nfev, b.njev)
+    assert sum(s.status == 1 for s in kept) >= (2 if events else 0)
+
+
+def test_a_restarted_lsoda_refuses_a_state_that_is_not_finite_as_scipys_does():
+    from pamsim.stepping import LsodaRestarts
+
+    restarts = LsodaRestarts()
+    integrate_segment(oscillator, 0.0, 0.1, Y0, "LSODA", [], np.empty(0), rtol=1e-7, atol=1e-9, max_step=np.inf,
+                      restarts=restarts)
+    for kept in (None, restarts):
+        with pytest.raises(ValueError, match="must be finite"):
+            integrate_segment(oscillator, 0.1, 0.2, np.array([np.nan, 0.0]), "LSODA", [], np.empty(0), rtol=1e-7,
+                              atol=1e-9, max_step=np.inf, restarts=kept)
+
+
+def robertson(t, y):
+    """Robertson's stiff kinetics: LSODA switches to BDF and changes its order both ways."""
+    return np.array([-0.04 * y[0] + 1e4 * y[1] * y[2], 0.04 * y[0] - 1e4 * y[1] * y[2] - 3e7 * y[1] ** 2,
+                     3e7 * y[1] ** 2])
+
+
+@pytest.mark.parametrize("fun, y0, t_end", [(oscillator, Y0, 3.0), (robertson, np.array([1.0, 0.0, 0.0]), 1e3)],
+                         ids=["oscillator (Adams)", "Robertson (BDF)"])
+def test_lsodas_dense_output_read_from_its_nordsieck_array_is_scipys(fun, y0, t_end):
+    """The segment loop reads LSODA's dense output itself (:class:`_Nordsieck`): at every step, at its ends and
+    at random times inside it, one at a time and as an array, the numbers of scipy's own, bit for bit; over
+    orders rising and falling, which rescales the array's last column."""
+    from scipy.integrate import LSODA
+
+    from pamsim.stepping import _Nordsieck
+
+    rng = np.random.default_rng(7)
+    solver = LSODA(fun, 0.0, y0, t_end, rtol=1e-7, atol=1e-10)
+    falling = 0
+    while solver.status == "running":
+        solver.step()
+        iwork = solver._lsoda_solver._integrator.iwork
+        falling += int(iwork[14] < iwork[13])
+        ref, mine = solver.dense_output(), _Nordsieck(solver)
+        times = np.concatenate([[solver.t_old, solver.t], rng.uniform(solver.t_old, solver.t, 4)])
+        assert np.array_equal(mine(times), ref(times))
+        assert all(np.array_equal(mine(float(t)), ref(t)) for t in times)
+    assert falling > 0

@@ -21,7 +21,7 @@ from ..assemblies.one_muscle import RUN_FUNCTIONS, input_signals, source_parts
 from ..errors import InputError, SolverFailure
 from ..modeling.pygen import compiled_by_mode, outputs_by_mode
 from ..simulator import _distinct_breaks, _event, _from_start, fired_together, n_samples, too_many_events
-from ..stepping import integrate_segment
+from ..stepping import LsodaRestarts, integrate_segment
 from .motion import Motion, motion_of
 from .result import LengthDrivenResult
 
@@ -97,10 +97,11 @@ def simulate_length_drive(scenario, backend: str = "python") -> LengthDrivenResu
     return run(drive, backend)
 
 
-def _segment(drive: LengthDrive, gen, p, t: float, y: np.ndarray, t_break: float, atol: np.ndarray, samples):
+def _segment(drive: LengthDrive, gen, p, t: float, y: np.ndarray, t_break: float, atol: np.ndarray, samples,
+             restarts: LsodaRestarts):
     """The generated model integrated from ``t`` to ``t_break`` or its first indicator's crossing
-    (:func:`pamsim.stepping.integrate_segment`), read at ``samples`` on the way, its inputs at their left
-    limit at ``t_break`` (a jump there belongs to the next segment)."""
+    (:func:`pamsim.stepping.integrate_segment`, its LSODA kept in ``restarts``), read at ``samples`` on the
+    way, its inputs at their left limit at ``t_break`` (a jump there belongs to the next segment)."""
     opts = drive.scenario.solver
     t_left = float(np.nextafter(t_break, -math.inf))
 
@@ -114,7 +115,8 @@ def _segment(drive: LengthDrive, gen, p, t: float, y: np.ndarray, t_break: float
     try:
         # No step is looked into between its ends: the muscle's length is driven, and nothing turns inside one.
         seg = integrate_segment(rhs, t, t_break, y, opts.method, [_from_start(indicator(k), t, y) for k in range(n)],
-                                samples, rtol=opts.rtol, atol=atol, max_step=opts.max_step_s, long_step_s=math.inf)
+                                samples, rtol=opts.rtol, atol=atol, max_step=opts.max_step_s, long_step_s=math.inf,
+                                restarts=restarts)
     except Exception as exc:  # numerical trouble comes as plain exceptions: a solver failure (exit 3)
         raise SolverFailure(f"the integrator raised {type(exc).__name__} at t = {t:.6g} s: {exc}") from exc
     if seg.status == -1:
@@ -132,10 +134,11 @@ def _python(drive: LengthDrive, backend: str) -> LengthDrivenResult:
     grid = np.linspace(0.0, sc.duration_s, n_samples(sc.duration_s, opts.sample_rate_Hz))
     t, y = 0.0, np.array(gen.x0(drive.inputs(0.0), p)[0], dtype=float)
     ys, events, nfev, njev, segments, next_sample = [], [], 0, 0, 0, 0
+    restarts = LsodaRestarts()
     for t_break in _distinct_breaks(drive.breakpoints, sc.duration_s):
         while t < t_break:
             samples = grid[next_sample:np.searchsorted(grid, t_break, side="right")]
-            seg = _segment(drive, gen, p, t, y, t_break, atol, samples)
+            seg = _segment(drive, gen, p, t, y, t_break, atol, samples, restarts)
             nfev, njev, segments = nfev + seg.nfev, njev + seg.njev, segments + 1
             if seg.samples_t.size:  # slips closer together than the samples leave pieces without one
                 ys.append(seg.samples_y)
