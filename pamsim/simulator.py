@@ -233,8 +233,8 @@ class GeneratedCode:
         """The right-hand side ``f(t, y)`` of ``mode``, as ``solve_ivp`` calls it."""
         f, inputs, p = self.code[mode].f, self.inputs, self.p
 
-        def rhs(t, y):  # a list: the integrators make it an array (scipy's as float), once
-            return f(y.tolist(), inputs(min(t, self.t_left)), p, ())[0]
+        def rhs(t, y):
+            return np.array(f(y.tolist(), inputs(min(t, self.t_left)), p, ())[0])
         return rhs
 
     def events(self, mode: Mode) -> list[tuple[str, Callable, int]]:
