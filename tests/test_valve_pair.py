@@ -261,6 +261,8 @@ def test_switching_pairs_mean_pressure_tends_to_the_averaged_pairs():
     assert averaged == pytest.approx(balance, abs=1.0)
     gaps = [abs(_mean_gauge_Pa(_balanced_pair(f, "switching", weight_N=HELD_N), f) - averaged)
             for f in (50.0, 200.0, 1000.0)]
+    print(f"different valves: |switching - averaged| mean pressure {gaps[0]:.0f}, {gaps[1]:.1f}, {gaps[2]:.2f} Pa at "
+          f"50, 200, 1000 Hz ({gaps[1] / gaps[2]:.1f} times from 200 to 1000 Hz)")
     assert gaps[0] > gaps[1] > gaps[2], gaps
     assert gaps[1] / gaps[2] >= 0.8 * 5.0 ** 2, gaps
     assert gaps[2] < 1.0, gaps
