@@ -20,6 +20,7 @@ from types import SimpleNamespace
 import control as ct
 import numpy as np
 
+from ..elements.chamber import MuscleChamber
 from ..elements.pressure_source import LineValveSource, ValveChamberSource
 from ..errors import InputError
 from ..modeling import PNEUMATIC
@@ -32,17 +33,25 @@ from .system import FrictionTreatment
 
 def needs_reduction(model, added: tuple) -> bool:
     """Whether ``model`` (with the components ``added`` to its rig) has states beyond the design model's
-    contraction, velocity and chamber pressure: a spool's, or a line's."""
-    return len(model.source.state_names) > 2 or any(a.component.states for a in added)
+    contraction, velocity and chamber pressure: a spool's, a line's, or the thermal law's gas temperature
+    (its air mass and pressure independent)."""
+    return (len(model.source.state_names) > 2 or any(a.component.states for a in added)
+            or getattr(model.source.chamber, "law", "") == "thermal")
 
 
 def reduced_model(model):
     """``model`` with its valve source reduced to the proportional valve feeding the chamber: a spool valve's
     full opening taken as instant (:class:`~pamsim.elements.spool.SpoolValve33`'s ``valve``), the line's
-    wiring dropped."""
+    wiring dropped, and a thermal chamber's gas taken as adiabatic (the polytropic law with the gas's
+    ``heat_capacity_ratio``: the thermal law with ``h = 0``; its wall's heat acts over a second or so, far
+    slower than the loop)."""
     src = model.source
     valve = getattr(src.valve, "valve", src.valve)
-    plain = ValveChamberSource(valve, src.chamber, src.supply_gauge_Pa, src.command, src.T_supply_K, src.p_atm_Pa)
+    chamber = src.chamber
+    if getattr(chamber, "law", "") == "thermal":
+        chamber = MuscleChamber(chamber.L0_m, chamber.thread_length_m, chamber.turns, chamber.dead_volume_m3,
+                                chamber.heat_capacity_ratio, chamber.R_J_per_kg_K)
+    plain = ValveChamberSource(valve, chamber, src.supply_gauge_Pa, src.command, src.T_supply_K, src.p_atm_Pa)
     return dataclasses.replace(model, source=plain)
 
 
