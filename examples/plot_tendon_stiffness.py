@@ -5,8 +5,9 @@ A stiff tendon tends to the rigid one
 ``scenarios/antagonistic_elastic.toml`` is the antagonistic pair on tendons of 2 kN/m.  This runs it with
 tendons of 2, 10, 100 and 1000 kN/m and with rigid ones (python backend), and prints the largest gap of
 the link's angle from the rigid pair's: it falls as 1/k, with the tendon's stretch T/k.  It also prints
-what each costs, in right-hand-side evaluations on python (LSODA, stiff when it must) and native (an
-explicit method, whose steps the muscle end's time constant c/k bounds).  The figure shows the angles.
+what each costs, in right-hand-side evaluations on python (LSODA, stiff when it must) and native
+(Dormand-Prince while the link moves, whose steps the muscle end's time constant c/k bounds, and Rodas4
+where a held link's steps are bound by their stability).  The figure shows the angles.
 """
 
 import copy

@@ -186,8 +186,8 @@ _POWERS = [np.arange(q + 1, dtype=float) for q in range(13)]
 
 
 class _Nordsieck:
-    """LSODA's dense output over its last step, read from the solver's Nordsieck array as scipy's (1.17)
-    ``LSODA._dense_output_impl`` reads it (ODEPACK's layout: the last step's order ``iwork[13]``, the next
+    """LSODA's dense output over its last step, read from the solver's Nordsieck array as scipy's (1.12 and
+    later: pamsim's floor) ``LSODA._dense_output_impl`` reads it (ODEPACK's layout: the last step's order ``iwork[13]``, the next
     step ``rwork[11]``, the array from ``rwork[20]``, its last column rescaled where the order is to fall)
     and evaluated with the same operations as scipy's ``LsodaDenseOutput``: the same numbers.  Without
     scipy's generic objects around it, which cost more than the evaluation: a run under PWM reads one at
@@ -212,7 +212,7 @@ class _Nordsieck:
 
 def _dense_of(solver):
     """The solver's dense output over its last step (:class:`_Nordsieck` for LSODA's, where the installed
-    scipy keeps LSODA's arrays where scipy 1.17 does)."""
+    scipy keeps LSODA's arrays where scipy 1.12 to 1.17 do)."""
     if solver.t != solver.t_old and hasattr(solver, "_lsoda_solver"):
         try:
             return _Nordsieck(solver)

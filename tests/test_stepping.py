@@ -334,3 +334,23 @@ def test_lsodas_dense_output_read_from_its_nordsieck_array_is_scipys(fun, y0, t_
         assert np.array_equal(mine(times), ref(times))
         assert all(np.array_equal(mine(float(t)), ref(t)) for t in times)
     assert falling > 0
+
+
+def test_a_restarted_lsoda_counts_its_own_segments_jacobians_only():
+    """A stiff segment (Robertson's, where LSODA forms Jacobians), then one of no time, then another: each
+    restarted solver reports the evaluations and Jacobians of its own segment, as a new solver does (a
+    segment of no time after a stiff one reported the stiff one's Jacobians when they were not reset)."""
+    from pamsim.stepping import LsodaRestarts
+
+    def run(restarts):
+        t, y, counts = 0.0, np.array([1.0, 0.0, 0.0]), []
+        for t_break in (1.0, 1.0, 10.0):
+            seg = integrate_segment(robertson, t, t_break, y, "LSODA", [], np.empty(0), rtol=1e-6, atol=1e-10,
+                                    max_step=np.inf, restarts=restarts)
+            counts.append((seg.nfev, seg.njev))
+            t, y = t_break, seg.y[:, -1]
+        return counts
+
+    fresh = run(None)
+    assert run(LsodaRestarts()) == fresh
+    assert fresh[0][1] > 0 and fresh[1] == (0, 0)
