@@ -251,6 +251,23 @@ def check_wiring(scenario: Any, error: type[Exception]) -> None:
         if key not in _CHECKED:
             assembly.flatten()
             _CHECKED.add(key)
+        _refuse_isolated(scenario, assembly)
     except (AssemblyError, KeyError, ValueError) as exc:
         text = exc.args[0] if isinstance(exc, KeyError) and exc.args else exc
         raise error(f"{scenario.origin}: [[component]]: {text}") from None
+
+
+def _refuse_isolated(scenario: Any, assembly: Any) -> None:
+    """Refuse an added component with ports that no connection reaches (its own ``connect`` table, another
+    component's, or the valve's ``pressure.supply_port`` and ``outlet_port``): a chain that is not connected.
+    A lone node port is valid inside the assembly (a volume a branch may join), so the assembly's own check
+    lets such a component through, and it would be integrated beside the rig, doing nothing."""
+    named = {ref.split(".", 1)[0] for pair in assembly.connections for ref in pair}
+    named |= {ref.split(".", 1)[0] for refs in assembly.inputs.values() for ref in refs}
+    tables = [e.get("name") if isinstance(e, dict) else None for e in scenario.spec.get("component", [])]
+    for added in scenario.added_components:
+        c = added.component
+        if c.ports and c.name not in named and c.name in tables:
+            raise AssemblyError(f"component[{tables.index(c.name)}] ({c.name!r}, {type(c).__name__}) is connected "
+                                "to nothing: connect one of its ports (its [component.connect] table, another "
+                                "component's, or pressure.supply_port / pressure.outlet_port)")

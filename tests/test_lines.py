@@ -378,3 +378,17 @@ def test_linearize_takes_a_lines_states_from_its_run():
     assert line["reservoir.p_abs_Pa"] > line["tube.p_abs_Pa"] + 1e5  # the valve still filling the tube at 0.7 s
     assert "tube.p_abs_Pa" in out["states"]
     # a held contraction: tests/test_tube_flow.py
+
+
+def test_a_component_connected_to_nothing_is_refused_by_its_index(tmp_path, cli):
+    """A reservoir in no connection (its port a lone node, which the assembly allows inside a line) would be
+    integrated beside the rig and change nothing: refused, naming its table, with exit 2 and nothing written."""
+    with pytest.raises(InputError, match=r"component\[1\] \('tank', Reservoir\) is connected to nothing"):
+        _scenario([_component("reservoir", "reservoir", volume_m3=2e-5),
+                   _component("tank", "reservoir", volume_m3=1e-4)], pressure={"supply_port": "reservoir.port"})
+    path = tmp_path / "isolated.toml"
+    path.write_text((SCENARIOS / "acra2012_fig4.toml").read_text()
+                    + '\n[[component]]\nname = "tank"\ntype = "reservoir"\nvolume_m3 = 1e-4\n')
+    proc = cli("run", path, "-o", tmp_path / "out")
+    assert proc.returncode == 2 and "component[0] ('tank', Reservoir) is connected to nothing" in proc.stderr
+    assert "Traceback" not in proc.stderr and not (tmp_path / "out").exists()
