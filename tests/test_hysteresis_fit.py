@@ -226,3 +226,25 @@ def test_the_api_refuses_bad_options_before_fitting(kwargs, message):
     with pytest.raises(InputError) as info:
         fit_hysteresis(loop("maxwell_slip_2"), **kwargs)
     assert message in str(info.value)
+
+
+def test_a_loop_with_more_than_one_force_column_is_refused_until_one_is_named(synthetic_csv, tmp_path):
+    """A rig run's CSV has several force columns (``F_static_N``, ``F_friction_N``, ...): the reader took the
+    first without a word.  Two candidates are refused, naming both (exit 2, nothing written); ``--columns
+    force=NAME`` picks one, and the fit reads that column's values."""
+    import csv
+
+    from pamsim.hysteresis.loop_data import read_loop
+
+    rows = list(csv.reader(synthetic_csv.open()))
+    path = tmp_path / "two_forces.csv"
+    with path.open("w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["t_s", "p_gauge_Pa", "x_m", "F_static_N", "force_N"])
+        w.writerows([r[:3] + [str(2.0 * float(r[3])), r[3]] for r in rows[1:]])
+    proc = run_main("fit", "hysteresis", path, "--max-elements", "2", "-o", tmp_path / "out")
+    assert proc.returncode == 2 and "2 columns could be the force (F_static_N, force_N)" in proc.stderr
+    assert "Traceback" not in proc.stderr and not (tmp_path / "out").exists()
+    picked = read_loop(path, {"force": "force_N"})
+    assert np.array_equal(picked.force_N, read_loop(synthetic_csv).force_N)
+    assert np.array_equal(read_loop(path, {"force": "F_static_N"}).force_N, 2.0 * picked.force_N)

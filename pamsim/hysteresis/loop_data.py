@@ -17,6 +17,7 @@ import numpy as np
 
 from ..identification.columns import (LENGTH_UNITS_M, PRESSURE_UNITS_PA, DataError, _check_columns_map, _finite,
                                       _table, _unit_column)
+from ..table_checks import unit_suffix
 from .play import reversals
 
 MIN_ROWS = 20
@@ -70,12 +71,15 @@ def read_loop(path: str | Path, columns: Mapping[str, str] | None = None) -> Loo
     columns = dict(columns or {})
     _check_columns_map(columns, path)
     header, rows, digest = _table(path)
-    found = {
-        "time": _unit_column(path, header, "time", {"_s": 1.0}, ("t_", "time"), columns),
-        "pressure": _unit_column(path, header, "pressure", PRESSURE_UNITS_PA, ("p_", "pressure"), columns),
-        "contraction": _unit_column(path, header, "contraction", LENGTH_UNITS_M, ("x_", "contraction"), columns),
-        "force": _unit_column(path, header, "force", {"_N": 1.0}, ("force", "F_"), columns),
-    }
+    rules = {"time": ({"_s": 1.0}, ("t_", "time")), "pressure": (PRESSURE_UNITS_PA, ("p_", "pressure")),
+             "contraction": (LENGTH_UNITS_M, ("x_", "contraction")), "force": ({"_N": 1.0}, ("force", "F_"))}
+    for quantity, (units, stems) in rules.items():
+        candidates = [h for h in header if h.startswith(stems) and unit_suffix(h, units)]
+        if quantity not in columns and len(candidates) > 1:
+            # a rig's CSV has F_static_N, F_friction_N, ...: the first would be fitted without a word
+            raise DataError(f"{path}: {len(candidates)} columns could be the {quantity} ({', '.join(candidates)}): "
+                            f"say which with --columns {quantity}=NAME")
+    found = {q: _unit_column(path, header, q, units, stems, columns) for q, (units, stems) in rules.items()}
     values = {q: _finite(path, name, rows[:, header.index(name)] * k) for q, (name, k) in found.items()}
     t = values["time"]
     bad = np.flatnonzero(np.diff(t) <= 0)
