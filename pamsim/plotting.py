@@ -79,15 +79,42 @@ def result_figure(result: "Result", title: str | None = None, compare: "list[Res
     all the paper gives of it as numbers.
     """
     thermal = "wall_heat_W" in result.signals  # the thermal chamber's: its temperature gets a panel
-    fig = Figure(figsize=(9, 11 if thermal else 9), constrained_layout=True)
-    axes = fig.subplots(4 if thermal else 3, 1, sharex=True)
+    loops = LOOP_FORCE in result.signals  # hysteresis elements: their loops get a row of their own
+    rows, height = (4, 11) if thermal else (3, 9)
+    fig = Figure(figsize=(9, height + (4 if loops else 0)), constrained_layout=True)
+    in_time, loop_row = fig.subfigures(2, 1, height_ratios=[height, 4]) if loops else (fig, None)
+    axes = in_time.subplots(rows, 1, sharex=True)
     _contraction_panel(axes[0], result, compare or [], measured)
     _pressure_panel(axes[1], result, measured)
     if thermal:
         _temperature_panel(axes[2], result)
     _force_panel(axes[-1], result)
+    if loops:
+        _loop_panels(loop_row.subplots(1, 2), result)
     fig.suptitle(_result_title(result, title, backend, measured))
     return fig
+
+
+LOOP_FORCE = "hysteresis.F_N"
+"""The hysteresis elements' force on the load (Maxwell-slip, Prandtl-Ishlinskii, Bouc-Wen): a run that has it
+gets :func:`_loop_panels`."""
+
+
+def _loop_panels(axes, result: "Result") -> None:
+    """The hysteresis loops: the contraction against the pressure, and the elements' force against the
+    contraction (with their minor loops, where the input turns inside a cycle)."""
+    ax_p, ax_f = axes
+    x_mm = result.x_m * 1e3
+    ax_p.plot(result.p_gauge_Pa / PA_PER_BAR, x_mm, **series(0, "k"))
+    ax_p.set_xlabel("gauge pressure [bar]")
+    ax_p.set_ylabel(X_LABEL)
+    ax_p.set_title("contraction against pressure", fontsize=9)
+    ax_f.plot(x_mm, result.signals[LOOP_FORCE], **series(0, "C1"))
+    ax_f.set_xlabel(X_LABEL)
+    ax_f.set_ylabel("hysteresis elements' force [N]")
+    ax_f.set_title("the elements' force against contraction", fontsize=9)
+    for ax in axes:
+        ax.grid(alpha=0.3)
 
 
 def _contraction_panel(ax, result: "Result", compare: "list[Result]", measured) -> None:

@@ -287,3 +287,17 @@ def test_a_sweep_without_time_responses_draws_a_figure_that_says_so():
     fig = time_responses_figure(_fake_sweep({}))
     assert [t.get_text() for t in fig.axes[0].texts] == ["no [time_responses] in the sweep file"]
     assert not fig.axes[0].axison and fig._suptitle is None
+
+
+def test_a_run_with_hysteresis_elements_draws_its_loops():
+    """Under the time panels, a run with hysteresis elements gets the contraction against the pressure and the
+    elements' force against the contraction, drawn from the run's own columns; a run without has no such row."""
+    sc = pamsim.load_scenario(SCENARIOS / "hysteresis_loops.toml").with_changes({"simulation": {"duration_s": 15.0}})
+    res = pamsim.simulate(sc)
+    axes = result_figure(res).axes
+    assert len(axes) == 5
+    (p_line,), (f_line,) = axes[3].get_lines(), axes[4].get_lines()
+    assert np.array_equal(p_line.get_xdata(), res.p_gauge_Pa / 1e5) and np.array_equal(p_line.get_ydata(), res.x_m * 1e3)
+    assert np.array_equal(f_line.get_xdata(), res.x_m * 1e3)
+    assert np.array_equal(f_line.get_ydata(), res.signals["hysteresis.F_N"])
+    assert len(result_figure(pamsim.simulate(SCENARIOS / "acra2012_fig4.toml")).axes) == 3
