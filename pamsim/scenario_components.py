@@ -258,16 +258,26 @@ def check_wiring(scenario: Any, error: type[Exception]) -> None:
 
 
 def _refuse_isolated(scenario: Any, assembly: Any) -> None:
-    """Refuse an added component with ports that no connection reaches (its own ``connect`` table, another
-    component's, or the valve's ``pressure.supply_port`` and ``outlet_port``): a chain that is not connected.
-    A lone node port is valid inside the assembly (a volume a branch may join), so the assembly's own check
-    lets such a component through, and it would be integrated beside the rig, doing nothing."""
-    named = {ref.split(".", 1)[0] for pair in assembly.connections for ref in pair}
-    named |= {ref.split(".", 1)[0] for refs in assembly.inputs.values() for ref in refs}
+    """Refuse added components that no chain of connections joins to the rig or to its inputs (their own
+    ``connect`` tables, another component's, or the valve's ``pressure.supply_port`` and ``outlet_port``): a
+    chain that is not connected.  A lone node port is valid inside the assembly (a volume a branch may join), so the assembly's
+    own check lets such a component through, alone or with others joined only to each other, and they would
+    be integrated beside the rig, doing nothing."""
+    parent: dict[str, str] = {}
+
+    def root(name: str) -> str:
+        while parent.setdefault(name, name) != name:
+            name = parent[name]
+        return name
+    for a_ref, b_ref in assembly.connections:
+        parent[root(a_ref.split(".", 1)[0])] = root(b_ref.split(".", 1)[0])
+    # the rig, and what reads the rig's own inputs (a supply set to the scenario's supply pressure)
+    joined = {root(name) for name in RIG_COMPONENTS}
+    joined |= {root(ref.split(".", 1)[0]) for refs in assembly.inputs.values() for ref in refs}
     tables = [e.get("name") if isinstance(e, dict) else None for e in scenario.spec.get("component", [])]
     for added in scenario.added_components:
         c = added.component
-        if c.ports and c.name not in named and c.name in tables:
+        if c.ports and c.name in tables and root(c.name) not in joined:
             raise AssemblyError(f"component[{tables.index(c.name)}] ({c.name!r}, {type(c).__name__}) is connected "
-                                "to nothing: connect one of its ports (its [component.connect] table, another "
-                                "component's, or pressure.supply_port / pressure.outlet_port)")
+                                "to nothing that reaches the rig: connect one of its ports (its [component.connect] "
+                                "table, another component's, or pressure.supply_port / pressure.outlet_port)")

@@ -470,3 +470,23 @@ def test_bode_phase_is_unwrapped():
         assert phase[0] == pytest.approx(0.0, abs=5.0)
         assert phase[np.searchsorted(lin.frequency_grid_rad_s(), 1.5 * lin.mechanical_mode().omega_n_rad_s)] \
             == pytest.approx(-180.0, abs=20.0)
+
+
+@pytest.mark.parametrize("name, chamber", [("proportional_valve", None), ("closed_loop_position", "thermal")])
+def test_loop_margins_are_those_of_the_loop_around_the_full_linearisation(name, chamber):
+    """Where the controller is designed on a reduced model (a spool and a line; a thermal gas taken adiabatic),
+    the margins' loop is broken around the full linearisation: closed with unity feedback its poles are the
+    design's full-loop poles.  (Before, a scenario with a line raised a traceback and a thermal one gave the
+    reduced model's margins.)"""
+    import control as ct
+
+    from pamsim.control.closed_loop import design_closed_loop
+    from pamsim.control.margins import loop_margins, loop_transfer
+
+    sc = pamsim.load_scenario(ROOT / "scenarios" / f"{name}.toml")
+    if chamber:
+        sc = sc.with_changes({"chamber": {"law": chamber}})
+    closed = np.sort_complex(np.linalg.eigvals(ct.feedback(loop_transfer(sc), 1).A))
+    full = np.sort_complex(design_closed_loop(sc).design.full_loop_poles)
+    np.testing.assert_allclose(closed, full, rtol=1e-9)
+    assert loop_margins(sc).phase_margin_deg > 30.0

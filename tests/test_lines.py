@@ -381,11 +381,18 @@ def test_linearize_takes_a_lines_states_from_its_run():
 
 
 def test_a_component_connected_to_nothing_is_refused_by_its_index(tmp_path, cli):
-    """A reservoir in no connection (its port a lone node, which the assembly allows inside a line) would be
-    integrated beside the rig and change nothing: refused, naming its table, with exit 2 and nothing written."""
+    """A reservoir in no connection (its port a lone node, which the assembly allows inside a line), or a
+    group of components joined only to each other, would be integrated beside the rig and change nothing:
+    refused, naming the table, with exit 2 and nothing written."""
     with pytest.raises(InputError, match=r"component\[1\] \('tank', Reservoir\) is connected to nothing"):
         _scenario([_component("reservoir", "reservoir", volume_m3=2e-5),
                    _component("tank", "reservoir", volume_m3=1e-4)], pressure={"supply_port": "reservoir.port"})
+    # two volumes and the tube between them, joined to each other but not to the rig
+    with pytest.raises(InputError, match=r"component\[0\] \('tank', Reservoir\) is connected to nothing that "
+                                         r"reaches the rig"):
+        _scenario([_component("tank", "reservoir", volume_m3=1e-4), _component("tank2", "reservoir", volume_m3=1e-4),
+                   _component("pipe", "tube", {"inlet": "tank.port", "outlet": "tank2.port"}, length_m=1.0,
+                              diameter_m=0.004)])
     path = tmp_path / "isolated.toml"
     path.write_text((SCENARIOS / "acra2012_fig4.toml").read_text()
                     + '\n[[component]]\nname = "tank"\ntype = "reservoir"\nvolume_m3 = 1e-4\n')

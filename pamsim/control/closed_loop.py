@@ -232,9 +232,9 @@ def _checked_on_full(design: LqrDesign, config: ControllerConfig, op, added: tup
     poles = loop_poles(full, controller_system(design, config))
     if np.max(poles.real) >= 0.0:
         worst = poles[np.argmax(poles.real)]
-        raise InputError(f"the controller designed on the reduced model (spool instant, no line) does not stabilise "
-                         f"the full linearisation: pole {worst:.4g} 1/s (a spool or a line slower than the loop: "
-                         "raise pressure.spool.natural_frequency_Hz or slow the loop down)")
+        raise InputError(f"the controller designed on the reduced model (spool instant, no line, the gas adiabatic) "
+                         f"does not stabilise the full linearisation: pole {worst:.4g} 1/s (a spool or a line slower "
+                         "than the loop: raise pressure.spool.natural_frequency_Hz or slow the loop down)")
     return dataclasses.replace(design, full_linear=full, full_loop_poles=poles)
 
 

@@ -5,8 +5,10 @@
 prints the gain crossover (``|L| = 1``) with its phase margin, the phase crossover
 (phase -180 deg) with its gain margin, and the phase a pure delay costs at the
 gain crossover.  The loop is the linear design loop: the held plant
-linearisation at the design contraction (Coulomb friction dropped) and the
-LQR controller with its velocity filter, no saturation and no deadband.
+linearisation at the design contraction (Coulomb friction dropped; the full one,
+spool, line and thermal gas included, where the controller was designed on a
+reduced model) and the LQR controller with its velocity filter, no saturation
+and no deadband.
 """
 
 from __future__ import annotations
@@ -23,6 +25,7 @@ import numpy as np
 from ..errors import InputError
 from ..scenario import Scenario, load_scenario
 from .closed_loop import ControllerConfig, controller_system, design_lqr
+from .reduced import line_components
 
 
 @dataclass(frozen=True)
@@ -47,10 +50,12 @@ class LoopMargins:
 
 
 def loop_transfer(scenario: Scenario) -> ct.StateSpace:
-    """The loop broken at the valve command: command in, minus the controller's command out."""
+    """The loop broken at the valve command: command in, minus the controller's command out; around the full
+    linearisation where the controller was designed on a reduced model (a spool, a line, a thermal gas)."""
     config = ControllerConfig.from_scenario(scenario)
-    design = design_lqr(scenario.build_model(), config, scenario.final_pressure_gauge_Pa)
-    plant = design.linear.sys[["contraction_m", "p_gauge_Pa"], "valve_command"]
+    design = design_lqr(scenario.build_model(), config, scenario.final_pressure_gauge_Pa, line_components(scenario))
+    held = design.full_linear or design.linear
+    plant = held.sys[["contraction_m", "p_gauge_Pa"], "valve_command"]
     ctrl = controller_system(design, config)[:, ["contraction_m", "p_gauge_Pa"]]
     return -ct.series(plant, ctrl)
 
