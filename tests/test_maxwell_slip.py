@@ -383,3 +383,15 @@ def test_linearize_refuses_a_prescribed_pressure_with_added_components():
     done = subprocess.run([sys.executable, "-m", "pamsim", "linearize", str(ROOT / "scenarios" / "hysteresis_loops.toml")],
                           capture_output=True, text=True)
     assert done.returncode == 2 and "valve source" in done.stderr and "Traceback" not in done.stderr
+
+
+def test_the_elements_friction_law_parameters_say_what_they_are():
+    """The friction law's numbers reach the assembly (and its FMU's parameters) through the elements: each
+    carries the description the muscle's parameter schema gives its name, where it had none."""
+    from pamsim.assemblies.one_muscle import scenario_assembly
+    from pamsim.parameter_schema import KNOWN
+
+    flat = scenario_assembly(pamsim.load_scenario(ROOT / "scenarios" / "hysteresis_loops.toml")).flatten()
+    described = {v.name: v.description for v in flat.parameters}
+    for name in ("N0_N_per_bar", "N1_N_per_bar_m", "N2_N_per_bar_m2", "phi_bar_per_kg"):
+        assert described[f"hysteresis.{name}"] == KNOWN[name].description != ""

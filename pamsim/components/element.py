@@ -29,7 +29,7 @@ import numpy as np
 
 from ..modeling import Var, code_cache
 from ..modeling.component import quiet_numpy_on_symbols
-from ..parameter_schema import unit_of
+from ..parameter_schema import KNOWN, unit_of
 
 STRUCTURAL = ("name", "negative_level")
 """Fields that are choices or metadata, never parameters."""
@@ -276,8 +276,11 @@ def parameter_vars(values: Mapping[str, float], descriptions: Mapping[str, str] 
 
 @functools.lru_cache(maxsize=256)
 def _declared(names: tuple[str, ...], descriptions: tuple[tuple[str, str], ...]) -> tuple[Var, ...]:
+    # A name the muscle's parameter schema knows (N0_N_per_bar, D1_N_s_per_m, ...) says what it is there:
+    # an element's numbers reach an FMU's parameters, which would otherwise carry no description.
     text = dict(descriptions)
-    return tuple(Var(name, unit_of(name), text.get(name, "")) for name in names)
+    return tuple(Var(name, unit_of(name), text.get(name) or getattr(KNOWN.get(name), "description", ""))
+                 for name in names)
 
 
 _TRACES: dict = {}
