@@ -247,4 +247,9 @@ def test_a_loop_with_more_than_one_force_column_is_refused_until_one_is_named(sy
     assert "Traceback" not in proc.stderr and not (tmp_path / "out").exists()
     picked = read_loop(path, {"force": "force_N"})
     assert np.array_equal(picked.force_N, read_loop(synthetic_csv).force_N)
+    proc = run_main("fit", "hysteresis", path, "--max-elements", "2", "--columns", "force=F_static_N", "--json",
+                    "-o", tmp_path / "named")
+    assert proc.returncode == 0, proc.stderr
+    assert json.loads(proc.stdout)["data"]["columns"] == {"time": "t_s", "pressure": "p_gauge_Pa",
+                                                          "contraction": "x_m", "force": "F_static_N"}
     assert np.array_equal(read_loop(path, {"force": "F_static_N"}).force_N, 2.0 * picked.force_N)

@@ -122,7 +122,8 @@ class HysteresisFit:
     def to_json(self) -> dict:
         """The chosen fit, each model's best fit, the comparison and the data's provenance."""
         return {"data": {"file": self.data.origin, "sha256": self.data.sha256, "samples": len(self.data),
-                         "mean_pressure_Pa": float(np.mean(self.data.p_gauge_Pa))},
+                         "mean_pressure_Pa": float(np.mean(self.data.p_gauge_Pa)),
+                         "columns": dict(self.data.columns)},
                 "input": "contraction x_m", "output": "force_N", "fit": self.chosen.to_json(),
                 "elements": "given" if self.elements_given else "chosen by BIC",
                 "models": {name: f.to_json() for name, f in self.models.items()},

@@ -38,6 +38,8 @@ class LoopData:
     force_N: np.ndarray
     origin: str = "<arrays>"
     sha256: str = ""
+    columns: tuple[tuple[str, str], ...] = ()
+    """``(quantity, column)`` pairs: the file's column each quantity was read from (none for arrays)."""
 
     def __post_init__(self):
         check_loop(self)
@@ -86,7 +88,8 @@ def read_loop(path: str | Path, columns: Mapping[str, str] | None = None) -> Loo
     if bad.size:
         raise DataError(f"{path}: column {found['time'][0]}, data row {int(bad[0]) + 2}: time {t[bad[0] + 1]:g} "
                         f"does not increase (previous {t[bad[0]]:g})")
-    return LoopData(t, values["pressure"], values["contraction"], values["force"], str(path), digest)
+    return LoopData(t, values["pressure"], values["contraction"], values["force"], str(path), digest,
+                    tuple((q, name) for q, (name, _) in found.items()))
 
 
 def write_loop_csv(data: LoopData, path: str | Path) -> None:
