@@ -109,7 +109,8 @@ def _loop_panels(axes, result: "Result") -> None:
     ax_p.set_xlabel("gauge pressure [bar]")
     ax_p.set_ylabel(X_LABEL)
     ax_p.set_title("contraction against pressure", fontsize=9)
-    ax_f.plot(x_mm, result.signals[LOOP_FORCE], **series(0, "C1"))
+    k = len(FORCE_STYLE) + _added_forces(result.signals).index(LOOP_FORCE)  # the force panel's colour for it
+    ax_f.plot(x_mm, result.signals[LOOP_FORCE], **series(0, f"C{k % 10}"))
     ax_f.set_xlabel(X_LABEL)
     ax_f.set_ylabel("hysteresis elements' force [N]")
     ax_f.set_title("the elements' force against contraction", fontsize=9)
