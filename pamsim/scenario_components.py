@@ -260,9 +260,9 @@ def check_wiring(scenario: Any, error: type[Exception]) -> None:
 def _refuse_isolated(scenario: Any, assembly: Any) -> None:
     """Refuse added components that no chain of connections joins to the rig or to its inputs (their own
     ``connect`` tables, another component's, or the valve's ``pressure.supply_port`` and ``outlet_port``): a
-    chain that is not connected.  A lone node port is valid inside the assembly (a volume a branch may join), so the assembly's
-    own check lets such a component through, alone or with others joined only to each other, and they would
-    be integrated beside the rig, doing nothing."""
+    chain that is not connected.  A lone node port is valid inside the assembly (a volume a branch may join),
+    so the assembly's own check lets such a component through, alone or with others joined only to each
+    other, and they would be integrated beside the rig, doing nothing."""
     parent: dict[str, str] = {}
 
     def root(name: str) -> str:

@@ -187,11 +187,11 @@ _POWERS = [np.arange(q + 1, dtype=float) for q in range(13)]
 
 class _Nordsieck:
     """LSODA's dense output over its last step, read from the solver's Nordsieck array as scipy's (1.12 and
-    later: pamsim's floor) ``LSODA._dense_output_impl`` reads it (ODEPACK's layout: the last step's order ``iwork[13]``, the next
-    step ``rwork[11]``, the array from ``rwork[20]``, its last column rescaled where the order is to fall)
-    and evaluated with the same operations as scipy's ``LsodaDenseOutput``: the same numbers.  Without
-    scipy's generic objects around it, which cost more than the evaluation: a run under PWM reads one at
-    every step (its midpoint, :func:`_may_dip`)."""
+    later: pamsim's floor) ``LSODA._dense_output_impl`` reads it (ODEPACK's layout: the last step's order
+    ``iwork[13]``, the next step ``rwork[11]``, the array from ``rwork[20]``, its last column rescaled where
+    the order is to fall) and evaluated with the same operations as scipy's ``LsodaDenseOutput``: the same
+    numbers.  Without scipy's generic objects around it, which cost more than the evaluation: a run under PWM
+    reads one at every step (its midpoint, :func:`_may_dip`)."""
 
     __slots__ = ("t", "h", "yh", "p")
 
@@ -483,4 +483,5 @@ def integrate_segment(fun: Callable, t0: float, t_end: float, y0: np.ndarray, me
                    njev=getattr(solver, "njev", 0))
 
 
-__all__ = ["DOPRI5", "DormandPrince", "LsodaRestarts", "Segment", "integrate_segment", "missed_crossing", "LONG_STEP_S", "LONG_STEP_CHECKS"]
+__all__ = ["DOPRI5", "DormandPrince", "LsodaRestarts", "Segment", "integrate_segment", "missed_crossing", "LONG_STEP_S",
+           "LONG_STEP_CHECKS"]

@@ -117,13 +117,15 @@ def unit_suffix(name: str, units: Mapping[str, float]) -> str | None:
     return next((s for s in sorted(units, key=len, reverse=True) if name.endswith(s)), None)
 
 
+def unit_columns(header, stems: tuple[str, ...], units: Mapping[str, float]) -> list[str]:
+    """Every column of ``header`` whose name starts with one of ``stems`` and ends in a unit of ``units``, in
+    order.  Measurement files name their columns so (``pressure_bar``, ``contraction_mm``, ``weight_N``): the
+    readers of fits and of a muscle's measured points find them by this one rule."""
+    return [name for name in header if name.startswith(stems) and unit_suffix(name, units) is not None]
+
+
 def unit_column(header, stems: tuple[str, ...], units: Mapping[str, float]) -> tuple[str, float] | None:
-    """The first column of ``header`` whose name starts with one of ``stems`` and ends in a unit of ``units``,
-    with that unit's factor to SI; None if there is none.  Measurement files name their columns so
-    (``pressure_bar``, ``contraction_mm``, ``weight_N``): the readers of fits and of a muscle's measured
-    points find them by this one rule."""
-    for name in header:
-        suffix = unit_suffix(name, units) if name.startswith(stems) else None
-        if suffix is not None:
-            return name, units[suffix]
+    """The first of :func:`unit_columns`, with its unit's factor to SI; None if there is none."""
+    for name in unit_columns(header, stems, units)[:1]:
+        return name, units[unit_suffix(name, units)]
     return None

@@ -17,7 +17,7 @@ import numpy as np
 
 from ..identification.columns import (LENGTH_UNITS_M, PRESSURE_UNITS_PA, DataError, _check_columns_map, _finite,
                                       _table, _unit_column)
-from ..table_checks import unit_suffix
+from ..table_checks import unit_columns
 from .play import reversals
 
 MIN_ROWS = 20
@@ -76,7 +76,7 @@ def read_loop(path: str | Path, columns: Mapping[str, str] | None = None) -> Loo
     rules = {"time": ({"_s": 1.0}, ("t_", "time")), "pressure": (PRESSURE_UNITS_PA, ("p_", "pressure")),
              "contraction": (LENGTH_UNITS_M, ("x_", "contraction")), "force": ({"_N": 1.0}, ("force", "F_"))}
     for quantity, (units, stems) in rules.items():
-        candidates = [h for h in header if h.startswith(stems) and unit_suffix(h, units)]
+        candidates = unit_columns(header, stems, units)
         if quantity not in columns and len(candidates) > 1:
             # a rig's CSV has F_static_N, F_friction_N, ...: the first would be fitted without a word
             raise DataError(f"{path}: {len(candidates)} columns could be the {quantity} ({', '.join(candidates)}): "
