@@ -294,12 +294,15 @@ def register_hysteresis(fsub) -> None:
 
     h = fsub.add_parser("hysteresis", help="fit a hysteresis model to a force-contraction loop",
                         description="Fit Maxwell-slip, Prandtl-Ishlinskii and Bouc-Wen models to a loop (contraction "
-                                    "in, force out), report the chosen one's parameters with confidence intervals "
+                                    "in, force out; with --scenario, a pressure-contraction loop at a hanging "
+                                    "load, whose force is the weight minus the muscle's static force), report the chosen one's parameters with confidence intervals "
                                     "and AIC/BIC across the models and across N, and write fit.json, report.md, "
                                     "compare.csv and figures (docs/hysteresis.md).  With --write-synthetic, write "
                                     "a synthetic loop to DATA instead.")
     h.add_argument("data", help="loop CSV: t_s, a pressure (p_*_Pa, _kPa, _bar), a contraction (x_m or x_mm) and "
-                                "force_N")
+                                "force_N (no force with --scenario)")
+    h.add_argument("--scenario", help="the loop was measured at this scenario's hanging load: its force is the "
+                                      "weight minus the muscle's static force at the file's contraction and pressure")
     h.add_argument("--model", choices=MODELS, default="maxwell_slip", help="the model reported (default maxwell_slip)")
     h.add_argument("--elements", type=int, help="Maxwell-slip elements N, 1 to 100 (default: chosen by BIC)")
     h.add_argument("--max-elements", type=int, default=6, help="largest N tried for the BIC (default 6)")
@@ -310,6 +313,11 @@ def register_hysteresis(fsub) -> None:
     h.add_argument("--exponent", type=finite_float, help="Bouc-Wen exponent n, fixed (default: fitted)")
     h.add_argument("--columns", type=_columns, default={},
                    help="map quantities to other column names: time=NAME,pressure=NAME,contraction=NAME,force=NAME")
+    h.add_argument("--residual", choices=("correlated", "white"), default="correlated",
+                   help="the residual in the intervals and AIC/BIC: correlated (default) counts its effective "
+                        "samples when its lag-1 autocorrelation is significant; white takes it as independent noise")
+    h.add_argument("--window", type=_window,
+                   help="fit the samples of the time window T0:T1 [s] only (default: the whole file)")
     h.add_argument("-o", "--output", help="output directory (required to fit)")
     h.add_argument("--json", action="store_true", help="print fit.json to stdout")
     h.add_argument("--write-synthetic", action="store_true",
@@ -329,6 +337,9 @@ def run_hysteresis(args: argparse.Namespace) -> int:
     _check_hysteresis_options(args)
     thresholds_m = None if args.thresholds_mm is None else [v * 1e-3 for v in args.thresholds_mm]
     if args.write_synthetic:
+        for key in ("scenario", "window"):
+            if getattr(args, key) is not None:
+                raise InputError(f"--{key} = {getattr(args, key)!r}: only to fit a loop, not with --write-synthetic")
         return _write_synthetic(args, thresholds_m)
     if args.output is None:
         raise InputError("-o/--output: required to fit (the folder for fit.json, report.md and the figures)")
@@ -337,9 +348,16 @@ def run_hysteresis(args: argparse.Namespace) -> int:
 
     figures = figure_args.options(args)
     check_output_dir(args.output)
-    data = read_loop(args.data, args.columns)
+    hanging_load = None
+    if args.scenario is not None:
+        from ..hysteresis.hanging_load import HangingLoad
+
+        hanging_load = HangingLoad.from_scenario(args.scenario)
+    data = read_loop(args.data, args.columns, hanging_load)
+    if args.window is not None:
+        data = data.window(*args.window)
     fit = fit_hysteresis(data, args.model, elements=args.elements, max_elements=args.max_elements,
-                         plays=args.plays, thresholds_m=thresholds_m, exponent=args.exponent)
+                         plays=args.plays, thresholds_m=thresholds_m, exponent=args.exponent, residual=args.residual)
     names = write_hysteresis_fit(fit, args.output, *figures)
     if args.json:
         from ..identification.report import json_text

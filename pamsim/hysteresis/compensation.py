@@ -44,6 +44,7 @@ from ..scenario import Scenario
 from ..table_checks import TableChecker
 from . import MODELS
 from .fit import HysteresisFit, ModelFit, fit_hysteresis
+from .hanging_load import hysteresis_pull_N
 from .loop_data import LoopData
 
 SETTLE_S = 1.0
@@ -216,7 +217,7 @@ def identify(scenario: Scenario, config: CompensationConfig, backend: str = "pyt
     x = result.x_m[keep] + rng.normal(0.0, ident.noise_contraction_m, int(keep.sum()))
     p = result.p_gauge_Pa[keep] + rng.normal(0.0, ident.noise_pressure_Pa, int(keep.sum()))
     model = plant.build_model()
-    force = model.load.weight_N - np.asarray(model.static_force.force_N(x, p), dtype=float)
+    force = hysteresis_pull_N(model.static_force, model.load.weight_N, x, p)
     loop = LoopData(result.t_s[keep], p, x, force, f"{scenario.origin} (identification, seed {ident.seed})")
     return Identification(result, loop, fit_hysteresis(loop, config.model, config.elements))
 

@@ -19,7 +19,7 @@ Maxwell-slip elements, all on the same residual (the force, in N).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Callable
 
 import numpy as np
@@ -45,6 +45,69 @@ ENVELOPE_SCALE_BOUNDS = (0.2, 1000.0)
 identity to 4e-7 of the span ((u/s)^2/3), so a fit that ends there says the classical operator is enough."""
 BOUC_WEN_EXPONENT_BOUNDS = (0.3, 10.0)
 """Search range of the Bouc-Wen exponent n."""
+RESIDUAL_MODELS = ("correlated", "white")
+"""How the intervals and the information criteria take the residual: ``correlated`` (the default) as
+independent noise unless its lag-1 autocorrelation is significant, and then with the effective samples of its
+autocorrelation (:class:`ResidualCorrelation`); ``white`` as independent noise always."""
+
+
+@dataclass(frozen=True)
+class ResidualCorrelation:
+    """How correlated a fit's residual is along the loop, and what that does to the intervals.
+
+    A loop's residual is rarely white: model error (a structure the model lacks, the load's dynamics in a
+    quasi-static loop) runs along the loop for many samples.  Taken as white, the intervals are too narrow by
+    the square root of the residual's integrated autocorrelation time ``tau = 1 + 2 sum_k rho_k`` (in samples)
+    and the information criteria count ``n`` independent samples where there are about ``n / tau``.  ``tau``
+    is summed over Geyer's initial positive sequence (the sums of pairs of neighbouring lags, up to the first
+    that is negative; C. J. Geyer, "Practical Markov chain Monte Carlo", Statistical Science, 1992), so that a
+    correlation that lasts longer than one lag is counted, as a first-order autoregressive model of the lag-1
+    correlation would not.  The residual counts as correlated when its lag-1 autocorrelation is positive
+    beyond the 95 % bound of white noise, ``1.96 / sqrt(n)``: the intervals are then widened by
+    ``sqrt(tau)``, their Student-t takes the effective samples' degrees of freedom, and AIC and BIC count the
+    effective samples."""
+
+    lag1: float
+    integrated_time: float
+    """``tau`` [samples], at least 1."""
+    samples: int
+    residual_model: str = "correlated"
+
+    @property
+    def significant(self) -> bool:
+        """Whether the residual is correlated beyond what white noise shows (and is treated as such)."""
+        return self.residual_model == "correlated" and self.lag1 > 1.96 / math.sqrt(self.samples)
+
+    @property
+    def effective_samples(self) -> float:
+        """``n / tau`` when :attr:`significant`, else ``n``."""
+        return self.samples / self.integrated_time if self.significant else float(self.samples)
+
+    @property
+    def widening(self) -> float:
+        """The factor on the white-noise standard errors: ``sqrt(n / n_eff)``."""
+        return math.sqrt(self.samples / self.effective_samples)
+
+    @classmethod
+    def of(cls, residual: np.ndarray, residual_model: str = "correlated") -> "ResidualCorrelation":
+        """The correlation of ``residual`` (time order)."""
+        r = np.asarray(residual, dtype=float) - np.mean(residual)
+        n = r.size
+        spectrum = np.fft.rfft(r, 2 * n)
+        acov = np.fft.irfft(spectrum * np.conj(spectrum), 2 * n)[:n]
+        if not acov[0] > 0:
+            return cls(0.0, 1.0, n, residual_model)
+        rho = acov / acov[0]
+        pairs = rho[:n - n % 2].reshape(-1, 2).sum(axis=1)  # Gamma_m = rho_2m + rho_2m+1
+        negative = np.flatnonzero(pairs < 0)
+        tau = -1.0 + 2.0 * float(np.sum(pairs[:negative[0] if negative.size else pairs.size]))
+        return cls(float(rho[1]), max(tau, 1.0), n, residual_model)
+
+    def to_json(self) -> dict:
+        """The correlation as JSON-ready values: what ``fit.json`` gives under each fit's ``residual``."""
+        return {"lag1_autocorrelation": self.lag1, "integrated_time_samples": self.integrated_time,
+                "treated_as": "correlated" if self.significant else "white",
+                "effective_samples": self.effective_samples, "interval_widening": self.widening}
 
 
 @dataclass(frozen=True)
@@ -68,12 +131,17 @@ class ModelFit:
     """The fitted :class:`MaxwellSlip`, :class:`PrandtlIshlinskii` or :class:`BoucWen` (its own sign
     convention: :meth:`predict_N` gives the fitted pull)."""
     predictor: Callable[[np.ndarray], np.ndarray] = field(repr=False)
+    correlation: ResidualCorrelation
+    """The residual's lag-1 autocorrelation and the widening of the intervals it asks for."""
     fixed: dict = field(default_factory=dict)
     """Values that were set, not fitted (the Prandtl-Ishlinskii thresholds, a given Bouc-Wen exponent)."""
 
-    def predict_N(self, x_m) -> np.ndarray:
-        """The fitted model's pull [N] for the contraction ``x_m`` [m], relaxed at its first sample."""
-        return self.predictor(np.asarray(x_m, dtype=float))
+    def predict_N(self, x_m, level_N=None) -> np.ndarray:
+        """The fitted model's pull [N] for the contraction ``x_m`` [m], relaxed at its first sample; a
+        Maxwell-slip fit whose elements share the friction law's level needs that level [N] at each sample."""
+        if level_N is None:
+            return self.predictor(np.asarray(x_m, dtype=float))
+        return self.predictor(np.asarray(x_m, dtype=float), level_N)
 
     @property
     def rms_N(self) -> float:
@@ -86,8 +154,9 @@ class ModelFit:
         return len(self.names)
 
     def intervals(self) -> dict[str, tuple[float, float] | None]:
-        """``{name: (low, high)}`` at :data:`CONFIDENCE`; None for a parameter that is not identified."""
-        t = _t_quantile(self.residual_N.size - self.n_parameters)
+        """``{name: (low, high)}`` at :data:`CONFIDENCE`; None for a parameter that is not identified.  The
+        standard errors are already widened for a correlated residual (:class:`ResidualCorrelation`)."""
+        t = _t_quantile(_dof(self.correlation, self.n_parameters))
         return {n: ((v - t * s, v + t * s) if ok else None)
                 for n, v, s, ok in zip(self.names, self.values, self.standard_errors, self.identified)}
 
@@ -95,7 +164,7 @@ class ModelFit:
         """The fit as JSON-ready values; an interval that is not identified is the text ``not identified``."""
         intervals = self.intervals()
         return {"model": self.model, "label": self.label, "rms_N": self.rms_N, "aic": self.aic, "bic": self.bic,
-                "n_parameters": self.n_parameters,
+                "n_parameters": self.n_parameters, "residual": self.correlation.to_json(),
                 "parameters": {n: {"value": float(v), "interval": "not identified" if intervals[n] is None
                                    else [float(intervals[n][0]), float(intervals[n][1])]}
                                for n, v in zip(self.names, self.values)},
@@ -112,6 +181,9 @@ class HysteresisFit:
     models: dict[str, ModelFit]
     elements_scan: list[ModelFit]
     elements_given: bool
+    effective_samples: float
+    """The samples AIC and BIC count, for every model alike: the effective samples of the residual of the
+    fit with the least RMS (all of them when its residual is white or taken as such)."""
 
     def comparison_rows(self) -> list[dict]:
         """One row per model and per Maxwell-slip N: label, parameters, RMS, AIC, BIC."""
@@ -123,8 +195,9 @@ class HysteresisFit:
         """The chosen fit, each model's best fit, the comparison and the data's provenance."""
         return {"data": {"file": self.data.origin, "sha256": self.data.sha256, "samples": len(self.data),
                          "mean_pressure_Pa": float(np.mean(self.data.p_gauge_Pa)),
-                         "columns": dict(self.data.columns)},
+                         "columns": dict(self.data.columns), "window_s": self.data.window_s},
                 "input": "contraction x_m", "output": "force_N", "fit": self.chosen.to_json(),
+                "information_criteria_samples": self.effective_samples,
                 "elements": "given" if self.elements_given else "chosen by BIC",
                 "models": {name: f.to_json() for name, f in self.models.items()},
                 "comparison": self.comparison_rows()}
@@ -132,7 +205,7 @@ class HysteresisFit:
 
 def fit_hysteresis(data: LoopData, model: str = "maxwell_slip", elements: int | None = None,
                    max_elements: int = DEFAULT_MAX_ELEMENTS, plays: int = DEFAULT_PLAYS,
-                   thresholds_m=None, exponent: float | None = None) -> HysteresisFit:
+                   thresholds_m=None, exponent: float | None = None, residual: str = "correlated") -> HysteresisFit:
     """Fit the three models to ``data`` and return the one asked for with the comparison.
 
     Parameters
@@ -152,6 +225,8 @@ def fit_hysteresis(data: LoopData, model: str = "maxwell_slip", elements: int | 
         default: the grid of ``plays``.
     exponent : float, optional
         Bouc-Wen exponent n (above 0), fixed; default: fitted.
+    residual : str
+        ``correlated`` (default) or ``white``: :data:`RESIDUAL_MODELS`.
 
     Returns
     -------
@@ -159,6 +234,8 @@ def fit_hysteresis(data: LoopData, model: str = "maxwell_slip", elements: int | 
     """
     if model not in MODELS:
         raise checks.InputError(f"model = {model!r}: choose from {', '.join(MODELS)}")
+    if residual not in RESIDUAL_MODELS:
+        raise checks.InputError(f"residual = {residual!r}: choose from {', '.join(RESIDUAL_MODELS)}")
     counts = [checks.count("elements", elements)] if elements is not None else \
         range(1, checks.count("max_elements", max_elements) + 1)
     plays = checks.count("plays", plays)
@@ -166,10 +243,15 @@ def fit_hysteresis(data: LoopData, model: str = "maxwell_slip", elements: int | 
         thresholds_m = PrandtlIshlinskii(thresholds_m, np.zeros(np.size(thresholds_m))).thresholds
     if exponent is not None:
         exponent = checks.number("exponent", exponent, 0.0, strict=True)
-    scan = [fit_maxwell_slip(data, n) for n in counts]
-    models = {"maxwell_slip": min(scan, key=lambda f: f.bic), "pi": fit_pi(data, plays, thresholds_m),
-              "bouc_wen": fit_bouc_wen(data, exponent)}
-    return HysteresisFit(data, models[model], models, scan, elements is not None)
+    scan = [fit_maxwell_slip(data, n, residual) for n in counts]
+    others = [fit_pi(data, plays, thresholds_m, residual), fit_bouc_wen(data, exponent, residual)]
+    # One count of samples for all, so that the criteria compare the models on the same footing.
+    samples = min([*scan, *others], key=lambda f: f.rms_N).correlation.effective_samples
+    scan, others = ([replace(f, **dict(zip(("aic", "bic"), information_criteria(
+        float(f.residual_N @ f.residual_N), f.residual_N.size, f.n_parameters, samples)))) for f in fits]
+        for fits in (scan, others))
+    models = {"maxwell_slip": min(scan, key=lambda f: f.bic), "pi": others[0], "bouc_wen": others[1]}
+    return HysteresisFit(data, models[model], models, scan, elements is not None, samples)
 
 
 # ------------------------------------------------------------------ the shared steps
@@ -185,16 +267,22 @@ def _linear(columns: np.ndarray, y: np.ndarray, lower: np.ndarray) -> tuple[np.n
     return c, y - columns @ c
 
 
-def _t_quantile(dof: int) -> float:
+def _t_quantile(dof: float) -> float:
     """Student's t at :data:`CONFIDENCE` (two-sided) for ``dof`` degrees of freedom (at least 1)."""
     return float(stats.t.ppf(0.5 + CONFIDENCE / 2, max(dof, 1)))
 
 
+def _dof(correlation: ResidualCorrelation, k: int) -> float:
+    """The residual's degrees of freedom: its effective samples less the ``k`` fitted parameters."""
+    return correlation.effective_samples - k
+
+
 def _finish(model: str, label: str, data: LoopData, names, theta: np.ndarray, predict, at_bound, positive,
-            operator, predictor, fixed=None) -> ModelFit:
+            operator, predictor, fixed=None, residual_model: str = "correlated") -> ModelFit:
     """The :class:`ModelFit` at ``theta``: ``predict(theta)`` the force, its Jacobian by central differences,
-    the intervals.  Not identified: a parameter the Jacobian does not see, one on a bound of its search
-    (``at_bound``), and one that must be above 0 (``positive``) whose interval reaches 0."""
+    the intervals (widened for a correlated residual).  Not identified: a parameter the Jacobian does not see,
+    one on a bound of its search (``at_bound``), one that must be above 0 (``positive``) whose interval reaches
+    0, and every one when the residual's effective samples do not outnumber the parameters."""
     force = predict(theta)
     residual = data.force_N - force
     jac = np.empty((force.size, theta.size))
@@ -204,45 +292,49 @@ def _finish(model: str, label: str, data: LoopData, names, theta: np.ndarray, pr
         up[i], down[i] = v + h, v - h
         jac[:, i] = (predict(up) - predict(down)) / (2 * h)
     unc = linearised_uncertainty(names, jac, residual)
-    se = unc.standard_errors
-    identified = unc.identified & np.isfinite(se) & (se > 0) & ~at_bound
+    correlation = ResidualCorrelation.of(residual, residual_model)
+    se = unc.standard_errors * correlation.widening
+    dof = _dof(correlation, theta.size)
+    identified = unc.identified & np.isfinite(se) & (se > 0) & ~at_bound & (dof >= 1)
     # A stiffness, slip force or scale whose interval reaches 0 is one the data cannot tell from none.
-    reaches_zero = positive & (theta - _t_quantile(residual.size - theta.size) * np.nan_to_num(se, nan=np.inf) <= 0)
+    reaches_zero = positive & (theta - _t_quantile(dof) * np.nan_to_num(se, nan=np.inf) <= 0)
     identified &= ~reaches_zero
-    aic, bic = information_criteria(float(residual @ residual), residual.size, theta.size)
-    return ModelFit(model, label, tuple(names), theta, np.where(identified, unc.standard_errors, np.nan),
-                    identified, force, residual, aic, bic, operator, predictor, fixed or {})
+    aic, bic = information_criteria(float(residual @ residual), residual.size, theta.size,
+                                    correlation.effective_samples if correlation.significant else None)
+    return ModelFit(model, label, tuple(names), theta, np.where(identified, se, np.nan),
+                    identified, force, residual, aic, bic, operator, predictor, correlation, fixed or {})
 
 
 # ------------------------------------------------------------------ Maxwell-slip
-def _ms_columns(x: np.ndarray, deflections: np.ndarray) -> np.ndarray:
-    """Columns of ``F0, k0, k_1..k_N`` for the slip deflections ``deflections``: ``1, x, -d_i``."""
+def _ms_columns(x: np.ndarray, deflections: np.ndarray, level: np.ndarray | None = None) -> np.ndarray:
+    """Columns of ``F0, k0, k_1..k_N`` for the slip deflections ``deflections``: ``1, x, -d_i``; with the
+    friction law's ``level``, of ``F0, k0, share_1..share_N``: ``1, x, -level d_i / delta_i``."""
     ms = MaxwellSlip(np.ones(deflections.size), deflections)  # unit stiffness: d_i is the force per N/m
-    return np.column_stack([np.ones_like(x), x, -ms.run(x).deflection_m])
+    d = ms.run(x).deflection_m
+    if level is not None:
+        d = d * (level[:, None] / deflections)
+    return np.column_stack([np.ones_like(x), x, -d])
 
 
 def _ms_lower(n: int) -> np.ndarray:
     return np.concatenate([[-np.inf, -np.inf], np.zeros(n)])
 
 
-def fit_maxwell_slip(data: LoopData, n: int) -> ModelFit:
-    """Fit ``n`` Maxwell-slip elements (with ``F0`` and ``k0``) to ``data``."""
+def fit_maxwell_slip(data: LoopData, n: int, residual: str = "correlated") -> ModelFit:
+    """Fit ``n`` Maxwell-slip elements (with ``F0`` and ``k0``) to ``data``.
+
+    Where the data carry the rig's friction level (a loop at a hanging load), the elements are the rig's:
+    element i slips at ``share_i`` times the level, ``delta_i`` its slip displacement, and the fit reports
+    ``share<i>`` and ``delta<i>_m`` (:func:`_fit_shared_level`); otherwise constant ``k<i>_N_per_m`` and
+    ``F<i>_N``."""
+    if data.level_N is not None:
+        return _fit_shared_level(data, n, residual)
     x, y = data.x_m, data.force_N
-    span = float(np.ptp(x))
-
-    def residual(log_d):
-        return _linear(_ms_columns(x, np.exp(log_d)), y, _ms_lower(n))[1]
-
-    best = None
-    for low, high in ((0.01, 0.3), (0.003, 0.1), (0.03, 0.5)):
-        start = np.log(span * np.geomspace(low, high, n))
-        res = optimize.least_squares(residual, start, bounds=(np.log(1e-6 * span), np.log(2 * span)), x_scale=1.0,
-                                     diff_step=1e-4)
-        if best is None or res.cost < best.cost:
-            best = res
+    best = _ms_search(x, y, n, None)
     deflections = np.exp(best.x)
     order = np.argsort(deflections)
     deflections = deflections[order]
+
     c, _ = _linear(_ms_columns(x, deflections), y, _ms_lower(n))
     k = c[2:]
     theta = np.concatenate([c[:2], k, k * deflections])
@@ -257,7 +349,51 @@ def fit_maxwell_slip(data: LoopData, n: int) -> ModelFit:
 
     operator = MaxwellSlip(np.maximum(k, 1e-300), k * deflections)
     return _finish("maxwell_slip", f"maxwell_slip N={n}", data, names, theta, predict, at_bound, positive, operator,
-                   lambda u: theta[0] + theta[1] * u - operator.run(u).force_N)
+                   lambda u: theta[0] + theta[1] * u - operator.run(u).force_N, residual_model=residual)
+
+
+def _ms_search(x: np.ndarray, y: np.ndarray, n: int, level: np.ndarray | None):
+    """The best of three local searches of the log slip deflections (log-spaced starts over the input's span)."""
+    span = float(np.ptp(x))
+
+    def residual(log_d):
+        return _linear(_ms_columns(x, np.exp(log_d), level), y, _ms_lower(n))[1]
+
+    best = None
+    for low, high in ((0.01, 0.3), (0.003, 0.1), (0.03, 0.5)):
+        start = np.log(span * np.geomspace(low, high, n))
+        res = optimize.least_squares(residual, start, bounds=(np.log(1e-6 * span), np.log(2 * span)), x_scale=1.0,
+                                     diff_step=1e-4)
+        if best is None or res.cost < best.cost:
+            best = res
+    return best
+
+
+def _fit_shared_level(data: LoopData, n: int, residual: str) -> ModelFit:
+    """The rig's elements (:mod:`pamsim.components.maxwell_slip_friction`): element i's spring has the stiffness
+    ``share_i level / delta_i`` and slips at ``share_i level``, so its pull is ``share_i level d_i / delta_i``
+    with ``d_i`` the deflection of an element of slip displacement ``delta_i``: linear in the shares."""
+    x, y, level = data.x_m, data.force_N, data.level_N
+    deltas = np.sort(np.exp(_ms_search(x, y, n, level).x))
+    c, _ = _linear(_ms_columns(x, deltas, level), y, _ms_lower(n))
+    theta = np.concatenate([c, deltas])
+    names = ["F0_N", "k0_N_per_m", *(f"share{i + 1}" for i in range(n)), *(f"delta{i + 1}_m" for i in range(n))]
+    shares = c[2:]
+    at_bound = np.concatenate([[False, False], shares <= 0, shares <= 0])
+    positive = np.concatenate([[False, False], np.ones(2 * n, dtype=bool)])
+
+    def predict(th):
+        return _ms_columns(x, np.maximum(th[2 + n:], 1e-300), level) @ th[:2 + n]
+
+    def predictor(u, level_N=None):
+        if level_N is None:
+            raise checks.InputError("this fit's elements share the friction law's level: give level_N, the level "
+                                    "at each sample of the input")
+        return _ms_columns(u, deltas, np.asarray(level_N, dtype=float)) @ c
+
+    operator = MaxwellSlip(np.maximum(shares, 1e-300) / deltas, shares)  # at a level of 1 N
+    return _finish("maxwell_slip", f"maxwell_slip N={n}", data, names, theta, predict, at_bound, positive, operator,
+                   predictor, {"level": "shared: element i slips at share_i times the friction law's level"}, residual)
 
 
 # ------------------------------------------------------------------ Prandtl-Ishlinskii
@@ -273,7 +409,7 @@ def _pi_columns(x: np.ndarray, thresholds: np.ndarray, scale: float) -> np.ndarr
     return np.column_stack([np.ones_like(x), pi.run(x, start).states])
 
 
-def fit_pi(data: LoopData, plays: int = DEFAULT_PLAYS, thresholds_m=None) -> ModelFit:
+def fit_pi(data: LoopData, plays: int = DEFAULT_PLAYS, thresholds_m=None, residual: str = "correlated") -> ModelFit:
     """Fit a generalized Prandtl-Ishlinskii operator (offset, weights, envelope scale) to ``data``."""
     x, y = data.x_m, data.force_N
     span = float(np.ptp(x))
@@ -305,7 +441,7 @@ def fit_pi(data: LoopData, plays: int = DEFAULT_PLAYS, thresholds_m=None) -> Mod
     positive[-1] = True
     return _finish("pi", f"pi m={thresholds.size}", data, names, theta, predict, at_bound, positive, operator,
                    lambda u: operator.run(u, np.full(thresholds.size, float(operator.envelope(u[0])))).output,
-                   {"thresholds_m": thresholds})
+                   {"thresholds_m": thresholds}, residual)
 
 
 # ------------------------------------------------------------------ Bouc-Wen
@@ -342,7 +478,7 @@ def _bw_search(x: np.ndarray, y: np.ndarray, exponent: float | None):
     return best.x, np.isclose(best.x, lower, atol=1e-6) | np.isclose(best.x, upper, atol=1e-6)
 
 
-def fit_bouc_wen(data: LoopData, exponent: float | None = None) -> ModelFit:
+def fit_bouc_wen(data: LoopData, exponent: float | None = None, residual: str = "correlated") -> ModelFit:
     """Fit Bouc-Wen (``F0, k_e, alpha, beta, gamma`` and, unless ``exponent`` is given, ``n``) to ``data``."""
     x, y = data.x_m, data.force_N
     fitted_n = exponent is None
@@ -359,4 +495,5 @@ def fit_bouc_wen(data: LoopData, exponent: float | None = None) -> ModelFit:
     positive = np.array([False] * 5 + [True] * fitted_n)
     operator = BoucWen(-c[2], beta, gamma, n, c[1], c[0])  # its law is F0 + k_e x + alpha z
     return _finish("bouc_wen", "bouc_wen" + ("" if fitted_n else f" n={n:g}"), data, names, theta, predict,
-                   at_bound, positive, operator, lambda u: operator.run(u).force_N, {} if fitted_n else {"n": n})
+                   at_bound, positive, operator, lambda u: operator.run(u).force_N, {} if fitted_n else {"n": n},
+                   residual)

@@ -47,12 +47,25 @@ def comparison_lines(fit: "HysteresisFit") -> list[str]:
     return out
 
 
+def correlation_lines(fit: "HysteresisFit") -> list[str]:
+    """A warning when the reported fit's residual is correlated (model error along the loop), and what that does
+    to the intervals and the comparison; nothing when it is white."""
+    r = fit.chosen.correlation
+    if not r.significant:
+        return []
+    return [f"warning: the residual is correlated along the loop (lag-1 autocorrelation {r.lag1:.4g}; white noise "
+            f"stays below {1.96 / math.sqrt(r.samples):.2g}): model error, or noise that is not white; its "
+            f"autocorrelation lasts {r.integrated_time:.4g} samples, so about {r.effective_samples:.4g} of the "
+            f"{r.samples} are independent: the intervals are widened {r.widening:.3g} times and AIC and BIC count "
+            f"{fit.effective_samples:.4g} samples (--residual white takes the residual as white noise)"]
+
+
 def summary_lines(fit: "HysteresisFit") -> list[str]:
     """What ``pamsim fit hysteresis`` prints: the reported fit, its parameters and the comparison."""
     c = fit.chosen
     how = "" if c.model != "maxwell_slip" else (" (N given)" if fit.elements_given else " (N chosen by BIC)")
     return [f"{c.label}{how} on {fit.data.origin}: RMS {c.rms_N:.4g} N over {len(fit.data)} samples, "
-            f"AIC {c.aic:.2f}, BIC {c.bic:.2f}",
+            f"AIC {c.aic:.2f}, BIC {c.bic:.2f}", *correlation_lines(fit),
             f"parameters ({100 * CONFIDENCE:g} % intervals from the Jacobian):",
             *("  " + line for line in parameter_lines(c)), "comparison:", *("  " + line for line in comparison_lines(fit))]
 
@@ -60,8 +73,11 @@ def summary_lines(fit: "HysteresisFit") -> list[str]:
 def report_md(fit: "HysteresisFit", ext: str) -> str:
     """``report.md``: provenance, the summary and the figures."""
     d = fit.data
-    lines = ["# Hysteresis fit", "", f"- data: `{Path(d.origin).name}` (sha256 `{d.sha256}`), {len(d)} samples",
-             "- input: contraction (m); output: force (N); models start relaxed at the first sample", "",
+    window = "" if d.window_s is None else f" from {d.window_s[0]:g} s to {d.window_s[1]:g} s"
+    force = dict(d.columns).get("force", "")
+    derived = f" (at a hanging load: {force}, quasi-static)" if force.startswith("W - ") else ""
+    lines = ["# Hysteresis fit", "", f"- data: `{Path(d.origin).name}` (sha256 `{d.sha256}`), {len(d)} samples{window}",
+             f"- input: contraction (m); output: force (N){derived}; models start relaxed at the first sample", "",
              "```", *summary_lines(fit), "```", "", f"![loop](fit.{ext})", "", f"![residuals](residuals.{ext})", ""]
     return "\n".join(lines)
 

@@ -132,12 +132,16 @@ def linearised_uncertainty(names, jacobian: np.ndarray, residuals: np.ndarray) -
                        np.clip(corr, -1.0, 1.0), math.sqrt(sigma2) if dof > 0 else math.nan, identified, dof)
 
 
-def information_criteria(ssr: float, n: int, k: int) -> tuple[float, float]:
-    """(AIC, BIC) of a least-squares fit with Gaussian residuals: ``n ln(SSR/n) + 2k`` and ``+ k ln n``."""
+def information_criteria(ssr: float, n: int, k: int, n_effective: float | None = None) -> tuple[float, float]:
+    """(AIC, BIC) of a least-squares fit with Gaussian residuals: ``n ln(SSR/n) + 2k`` and ``+ k ln n``.
+
+    With ``n_effective`` (the independent samples of a correlated residual), the likelihood and the BIC's
+    penalty count those: ``n_eff ln(SSR/n) + 2k`` and ``+ k ln n_eff``."""
     if n == 0 or ssr <= 0.0:
         return -math.inf, -math.inf
-    base = n * math.log(ssr / n)
-    return base + 2 * k, base + k * math.log(n)
+    m = n if n_effective is None else n_effective
+    base = m * math.log(ssr / n)
+    return base + 2 * k, base + k * math.log(m)
 
 
 def _num(v: float):

@@ -1,0 +1,68 @@
+"""A loop measured at a hanging load: the pressure is cycled, the contraction measured, and the force the
+muscle's hysteresis carries is what its static force misses of the weight (docs/hysteresis.md,
+"A loop at a hanging load").
+
+At rest, or slowly enough that the load's inertia and damping are negligible, the load's balance is
+``F_static(x, p) - W + F_h = 0`` with ``F_h`` the hysteresis elements' force on it, so the pull that the
+contraction-to-force models of :mod:`.fit` describe (the elements resisting the contraction) is
+``W - F_static(x, p)``.  The static force and the weight come from a scenario's muscle and load; whatever the
+static model misses goes into the fitted offset and slope (``F0``, ``k0``) or, if it is not linear in the
+contraction, into the residual.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..elements.friction import FRICTION_MODELS
+
+
+def hysteresis_pull_N(static_force, weight_N: float, x_m, p_gauge_Pa) -> np.ndarray:
+    """``W - F_static(x, p)`` [N]: what the static force ``static_force`` misses of the weight ``weight_N`` at
+    each sample of ``x_m`` [m] and ``p_gauge_Pa`` [Pa], the hysteresis' pull in the sign of :mod:`.fit`."""
+    return weight_N - np.asarray(static_force.force_N(x_m, p_gauge_Pa), dtype=float)
+
+
+@dataclass(frozen=True)
+class HangingLoad:
+    """The muscle's static force and the hung weight that turn a pressure-contraction loop into the force the
+    hysteresis carries."""
+
+    static_force: object
+    """An element with ``force_N(x_m, p_gauge_Pa)`` (the scenario's static force model)."""
+    weight_N: float
+    label: str
+    """Where the two come from, for the fit's report: ``W - F_static(x, p)`` with the scenario's names."""
+    friction: object
+    """The scenario's friction law (``level_N(x_m, p_gauge_Pa, mass_kg)``), whose level the rig's Maxwell-slip
+    elements share."""
+    mass_kg: float
+    level_label: str
+
+    @classmethod
+    def from_scenario(cls, path) -> "HangingLoad":
+        """The static force and weight of the one-muscle rig of the scenario file ``path``; a scenario whose
+        muscle is driven by its length (``[motion]``) has no hung weight and is refused, naming the key."""
+        from ..scenario import ScenarioError, load_scenario
+
+        scenario = load_scenario(path)
+        if "motion" in scenario.spec:
+            raise ScenarioError(f"{path}: [motion]: the muscle is driven by its length; a loop at a hanging "
+                                "load needs a scenario with a [load]")
+        model = scenario.build_model()
+        m = scenario.spec["model"]
+        label = f"W - F_static(x, p): weight {model.load.weight_N:g} N, static force of {m['muscle']} ({path})"
+        law = FRICTION_MODELS[m["friction"]](scenario.parameters, m)
+        return cls(model.static_force, float(model.load.weight_N), label, law, float(model.load.mass_kg),
+                   f"the {m['friction']} friction law's level F_c(x, p, m) ({path})")
+
+    def pull_N(self, x_m, p_gauge_Pa) -> np.ndarray:
+        """``W - F_static(x, p)`` [N] at each sample: the hysteresis' pull, in the sign of :mod:`.fit`."""
+        return hysteresis_pull_N(self.static_force, self.weight_N, x_m, p_gauge_Pa)
+
+    def level_N(self, x_m, p_gauge_Pa) -> np.ndarray:
+        """The friction law's level [N] at each sample: the sum of the rig's elements' slip forces over shares."""
+        x = np.asarray(x_m, dtype=float)
+        return np.asarray(self.friction.level_N(x, p_gauge_Pa, self.mass_kg), dtype=float) + 0.0 * x
