@@ -383,13 +383,14 @@ def test_the_one_muscle_fmu_refuses_another_law_by_name():
     assert start_values(sc.with_changes({"chamber": {"law": "polytropic"}}))["polytropic_index"] == 1.0
 
 
-def test_the_slider_form_of_a_rig_refuses_another_law_rather_than_drop_it():
+def test_the_slider_form_of_a_rig_carries_its_chamber_law():
+    # Its traces are the rig's: tests/test_joint_pneumatics.py.
     from pamsim.joints.scenario import slider_of_rig
 
     sc = pamsim.load_scenario(SCENARIOS / "thermal_drift.toml")
-    with pytest.raises(InputError, match=r"chamber.law = 'thermal': a slider's muscles have the polytropic chamber"):
-        slider_of_rig(sc)
-    assert slider_of_rig(sc.with_changes({"chamber": {"law": "polytropic"}})).muscles
+    assert [m.chamber_law for _, m in slider_of_rig(sc).muscles] == ["thermal"]
+    assert [m.chamber_law for _, m in slider_of_rig(sc.with_changes({"chamber": {"law": "isothermal"}})).muscles] == \
+        ["isothermal"]
 
 
 @pytest.mark.parametrize("kind", ["CoSimulation", "ModelExchange"])

@@ -15,7 +15,7 @@ rig's: a valve and chamber, a prescribed pressure), its components named after i
 from __future__ import annotations
 
 import copy
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 from ..components import CoulombFriction, MuscleStaticForce, ViscousDamping
@@ -23,8 +23,10 @@ from ..components.linear_slider import LinearSlider
 from ..components.pulley import LeverAttachment, Pulley, SliderTendon
 from ..components.rotary_joint import RotaryJoint
 from ..components.series_tendon import MuscleEndDamping, SeriesTendon
+from ..elements.pressure_source import PrescribedPressure
 from ..modeling import Assembly
-from .one_muscle import rewired, source_parts
+from ..signals import Constant
+from .one_muscle import AddedComponent, drive_input, rewired, source_parts, unsettled
 
 @dataclass(frozen=True)
 class JointMuscle:
@@ -52,6 +54,30 @@ class JointMuscle:
     added: tuple = ()
     """Components on the muscle, wired as on the one-muscle rig's load (:class:`pamsim.assemblies.one_muscle.AddedComponent`
     s: its ``[hysteresis]``), renamed ``<muscle>_<name>``."""
+
+
+def at_prescribed_pressure(m: JointMuscle) -> JointMuscle:
+    """Muscle ``m`` with its pressure a model input (a prescribed pressure, as the statics, the linearisation
+    and the stiffness controller take it).  A component of the muscle's that reads its source's pressure reads
+    the prescribed one; one wired into the source otherwise (a tube, a reservoir, a supply: the pneumatics the
+    prescribed pressure replaces) is left out, with whatever is wired to it in turn."""
+    old = source_parts(m.source, None)
+    prescribed = PrescribedPressure(Constant(0.0))
+    new = source_parts(prescribed, None)
+    own, pressure = {c.name for c in old.parts}, f"{old.pressure}.p_gauge_Pa"
+    kept, dropped = list(m.added), set()
+
+    def pneumatic(target: str) -> bool:
+        owner, dot, _ = target.partition(".")
+        return (owner in own and target != pressure) or owner in dropped or (not dot and target not in new.inputs)
+
+    while any(pneumatic(t) for a in kept for t in a.connect.values()):
+        for a in [a for a in kept if any(pneumatic(t) for t in a.connect.values())]:
+            kept.remove(a)
+            dropped.add(a.component.name)
+    added = tuple(AddedComponent(a.component, {k: f"{new.pressure}.p_gauge_Pa" if t == pressure else t
+                                               for k, t in a.connect.items()}) for a in kept)
+    return replace(m, source=prescribed, added=added)
 
 
 def attachment_name(m: JointMuscle, body: str = "joint") -> str:
@@ -130,7 +156,7 @@ def _muscle_parts(m: JointMuscle, attach, body, friction_load: str | None) -> tu
     is, the attachment's flange carries the spring's pull, and the friction reads the muscle's own motion.
     """
     pulley, elastic = attach.name, m.tendon_stiffness_N_per_m is not None
-    source = rewired(source_parts(m.source, m.p0_gauge_Pa), pulley, m.name)
+    source = rewired(source_parts(m.source, m.p0_gauge_Pa), pulley, m.name, tuple(a.component.name for a in m.added))
     damping = (MuscleEndDamping if elastic else ViscousDamping)(f"{m.name}_damping", m.damping)
     parts = [*source.parts, MuscleStaticForce(f"{m.name}_muscle", m.static_force),
              CoulombFriction(f"{m.name}_friction", m.friction), damping, attach]
@@ -157,30 +183,39 @@ def _muscle_parts(m: JointMuscle, attach, body, friction_load: str | None) -> tu
                (moves, f"{m.name}_friction.direction"),
                (f"{m.name}_muscle.F_static_N", f"{pulley}.F_static_N"),
                (f"{body.name}.slip_direction", f"{pulley}.joint_direction")]
-    extra, extra_wiring = _added_parts(m, source, node, friction_load or f"{pulley}.load_mass_kg")
     inputs = {f"{m.name}.{k}": v for k, v in source.inputs.items()}
+    extra, extra_wiring = _added_parts(m, source, node, friction_load or f"{pulley}.load_mass_kg", inputs)
+    if any(target == "chamber.port" for a in m.added for target in a.connect.values()):
+        wiring = unsettled(wiring, f"{m.name}_chamber")
     return parts + extra, wiring + extra_wiring, inputs
 
 
-def _added_parts(m: JointMuscle, source, node: str, mass: str) -> tuple[list, list]:
-    """The components on muscle ``m``, renamed after it, what they read of the rig's load read of the muscle's
-    flange node ``node`` and the friction's load ``mass``, and of its pressure source of the muscle's own."""
-    own = {c.name.removeprefix(f"{m.name}_"): c.name for c in source.parts}  # "chamber" -> "<muscle>_chamber"
+def _added_parts(m: JointMuscle, source, node: str, mass: str, inputs: dict) -> tuple[list, list]:
+    """The components on muscle ``m`` (its ``[hysteresis]``, its lines and reservoirs), renamed after it, wired
+    as on the one-muscle rig: what they read of the rig's load read of the muscle's flange node ``node`` and the
+    friction's load ``mass``; a reference to the rig's muscle, friction, damping, pressure source or another of
+    the muscle's components, of the muscle's own; a model input (a supply's set pressure), the muscle's own
+    input of that name in ``inputs``, which then drives them too."""
+    prefix = f"{m.name}_"
+    names = {c.name.removeprefix(prefix): c.name for c in source.parts}  # "chamber" -> "<muscle>_chamber"
+    names.update({k: prefix + k for k in ("muscle", "friction", "damping")})
+    names.update({a.component.name: prefix + a.component.name for a in m.added})
     load = {"load.flange": f"{node}.flange", "load.x_m": f"{node}.x_m", "load.v_m_s": f"{node}.v_m_s",
             "load.mass_kg": mass}
     parts, wiring = [], []
     for a in m.added:
         c = copy.copy(a.component)
-        c.name = f"{m.name}_{a.component.name}"
+        c.name = names[a.component.name]
         parts.append(c)
         for port, target in a.connect.items():
-            owner, _, rest = target.partition(".")
+            owner, dot, rest = target.partition(".")
             if target in load:
-                target = load[target]
-            elif owner in own:
-                target = f"{own[owner]}.{rest}"
+                wiring.append((load[target], f"{c.name}.{port}"))
+            elif dot and owner in names:
+                wiring.append((f"{names[owner]}.{rest}", f"{c.name}.{port}"))
+            elif not dot:
+                drive_input(inputs, f"{m.name}.{target}", f"{c.name}.{port}")
             else:
                 raise ValueError(f"muscle {m.name!r}: component {a.component.name!r}: {port} = {target!r}: on a joint "
-                                 f"it reads {', '.join(load)} and its pressure source")
-            wiring.append((target, f"{c.name}.{port}"))
+                                 f"it reads {', '.join(load)}, the muscle's own components and its model inputs")
     return parts, wiring

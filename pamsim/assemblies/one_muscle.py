@@ -97,26 +97,26 @@ def rig_assembly(load: HangingLoad, source: "SourceParts", forces: tuple, added:
                ("load.v_m_s", "external.v_m_s")]
     inputs["external_force_N"] = "external.F_N"
     if any(target == "chamber.port" for extra in added for target in extra.connect.values()):
-        wiring = _unsettled(wiring)
+        wiring = unsettled(wiring)
     for extra in added:
         parts.append(extra.component)
         for own, target in extra.connect.items():
             if "." in target:
                 wiring.append((target, f"{extra.component.name}.{own}"))
             else:
-                _drive(inputs, target, f"{extra.component.name}.{own}")
+                drive_input(inputs, target, f"{extra.component.name}.{own}")
     return Assembly(parts, wiring, inputs, name=name)
 
 
-def _unsettled(wiring: list) -> list:
-    """``wiring`` with the chamber settling onto its own pressure (not at all) instead of its valve's: an
-    added component feeds it too (a tube from a reservoir), so the pressure it approaches is not the
-    valve's supply pressure, and settling onto that would make air."""
-    own = ("chamber.p_abs_Pa", "chamber.p_settle_abs_Pa")
-    return [own if b == "chamber.p_settle_abs_Pa" else (a, b) for a, b in wiring]
+def unsettled(wiring: list, chamber: str = "chamber") -> list:
+    """``wiring`` with the chamber (the component ``chamber``) settling onto its own pressure (not at all)
+    instead of its valve's: an added component feeds it too (a tube from a reservoir), so the pressure it
+    approaches is not the valve's supply pressure, and settling onto that would make air."""
+    own = (f"{chamber}.p_abs_Pa", f"{chamber}.p_settle_abs_Pa")
+    return [own if b == own[1] else (a, b) for a, b in wiring]
 
 
-def _drive(inputs: dict, model_input: str, ref: str) -> None:
+def drive_input(inputs: dict, model_input: str, ref: str) -> None:
     """Let the model input ``model_input`` drive the component input ``ref`` too (a connection's target
     without a component: one of the rig's model inputs, such as a supply's set pressure)."""
     if model_input not in inputs:
@@ -219,11 +219,12 @@ def source_parts(src, p0_gauge_Pa: float | None) -> SourceParts:
                     f"(pamsim.assemblies.one_muscle.register_source names them)")
 
 
-def rewired(source: SourceParts, node: str, prefix: str = "") -> SourceParts:
+def rewired(source: SourceParts, node: str, prefix: str = "", others: tuple[str, ...] = ()) -> SourceParts:
     """``source``'s parts reading from component ``node`` what they read from the rig's load (its
     ``x_m`` and ``v_m_s``), renamed ``<prefix>_<name>`` if ``prefix`` is given, with their wiring and
-    inputs."""
-    names = {c.name: f"{prefix}_{c.name}" if prefix else c.name for c in source.parts}
+    inputs; a reference to one of the components ``others`` (a line the valve feeds) is renamed alike."""
+    names = {c: f"{prefix}_{c}" if prefix else c for c in others}
+    names.update({c.name: f"{prefix}_{c.name}" if prefix else c.name for c in source.parts})
     parts = []
     for c in source.parts:
         renamed = copy.copy(c)

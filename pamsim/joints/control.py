@@ -17,14 +17,13 @@ exact stick/slip integration, advanced sample by sample (:class:`pamsim.simulato
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
-from ..assemblies.joint import joint_assembly
-from ..elements.pressure_source import PrescribedPressure
+from ..assemblies.joint import at_prescribed_pressure, joint_assembly
 from ..errors import InputError
-from ..signals import Constant, PiecewiseConstant
+from ..signals import PiecewiseConstant
 from ..simulator import GeneratedCode, HybridRun, SteppedRun
 from .scenario import JointScenario
 from .simulate import ENERGY_SCALE_J
@@ -286,7 +285,7 @@ def _torque_slopes(statics: JointStatics, theta: float, p) -> np.ndarray:
 
 def _pressure_assembly(scenario: JointScenario):
     """The joint with each muscle's pressure a model input."""
-    muscles = tuple(replace(m, source=PrescribedPressure(Constant(0.0))) for m in scenario.joint_muscles())
+    muscles = tuple(at_prescribed_pressure(m) for m in scenario.joint_muscles())
     return joint_assembly(scenario.joint_values(), muscles, scenario.joint["g_m_s2"], name=scenario.name)
 
 

@@ -13,15 +13,14 @@ derivative (a pressure ratio of 1).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
-from ..assemblies.joint import joint_assembly
+from ..assemblies.joint import at_prescribed_pressure, joint_assembly
 from ..components.stick_slip import BodyMode
 from ..elements.pressure_source import PrescribedPressure
 from ..errors import InputError
-from ..signals import Constant
 from .scenario import JointScenario
 from .static import JointStatics
 
@@ -67,7 +66,7 @@ def _prescribed(scenario: JointScenario):
             raise InputError(f"{scenario.origin}: muscle {m.name!r}: pressure.source = {m.source.name!r}: a joint is "
                              "linearised with each muscle's pressure prescribed (a valve's flow has no derivative "
                              "at rest); give it a prescribed pressure")
-    return tuple(replace(m, source=PrescribedPressure(Constant(0.0))) for m in muscles)
+    return tuple(at_prescribed_pressure(m) for m in muscles)
 
 
 def linearize_joint(scenario: JointScenario, p_gauge_Pa) -> JointLinearModel:

@@ -21,11 +21,12 @@ DISPLAY = {"joint": ("joint angle [deg]", np.degrees, "deg", "torque on the link
 def joint_figure(result) -> Figure:
     """Three panels over time: the joint angle (shaded where the link is held), each muscle's gauge
     pressure, and each muscle's torque with gravity's and the external torque (a slider's: its position
-    and the forces on the carriage)."""
+    and the forces on the carriage); a fourth, the gas temperature, when a muscle's chamber is thermal."""
     body = result.body
     label, convert, unit, effort_label = DISPLAY[body.name]
-    fig = Figure(figsize=(7.5, 8.0), layout="constrained")
-    ax_theta, ax_p, ax_tau = fig.subplots(3, 1, sharex=True)
+    thermal = result.thermal_muscles()
+    fig = Figure(figsize=(7.5, 10.0 if thermal else 8.0), layout="constrained")
+    ax_theta, ax_p, ax_tau, *ax_gas = fig.subplots(4 if thermal else 3, 1, sharex=True)
     t = result.t_s
     shade_held(ax_theta, t, result.mode)
     ax_theta.plot(t, convert(result.position), color="k", label=body.noun)
@@ -42,8 +43,14 @@ def joint_figure(result) -> Figure:
     ax_p.set_ylabel("gauge pressure [bar]")
     ax_p.legend(loc="best", fontsize="small")
     ax_tau.set_ylabel(effort_label)
-    ax_tau.set_xlabel("time [s]")
     ax_tau.legend(loc="best", fontsize="small")
+    for ax in ax_gas:  # a thermal chamber's gas temperature (its own state)
+        for k, m in enumerate(result.muscles):
+            if m in thermal:
+                ax.plot(t, result.muscle(m, "gas_temperature_K") - 273.15, label=m, **series(k))
+        ax.set_ylabel("gas temperature [degC]")
+        ax.legend(loc="best", fontsize="small")
+    (ax_gas or [ax_tau])[-1].set_xlabel("time [s]")
     final = convert(result.position[-1])
     n = len(result.muscles)
     fig.suptitle(f"{result.name}: {n} muscle{'s' if n > 1 else ''} on a {body.name}, final {body.noun} {final:.2f} {unit} "

@@ -15,6 +15,8 @@ from .body import JOINT, Body
 MUSCLE_COLUMNS = ("p_gauge_Pa", "x_m", "F_tendon_N", "tau_Nm")
 """Per muscle, the columns of a joint run's CSV (``<muscle>.<quantity>``); on a slider ``F_N`` in place of
 ``tau_Nm`` (the force of its tendon on the carriage)."""
+THERMAL_COLUMNS = ("gas_temperature_K",)
+"""Per muscle whose chamber has the thermal law, the columns that follow :data:`MUSCLE_COLUMNS`."""
 ATTACHMENTS = ("pulley", "lever", "tendon")
 """The suffixes of a muscle's attachment's name: a joint's pulley or lever, a slider's tendon."""
 
@@ -98,18 +100,29 @@ class JointResult:
     def muscle(self, name: str, quantity: str) -> np.ndarray:
         """A muscle's signal: ``p_gauge_Pa`` (its pressure), ``x_m`` (contraction), ``F_tendon_N``,
         ``tau_Nm`` (its torque on the joint; on a slider ``F_N``, its force on the carriage), ``taut``,
-        ``moment_arm_m``, ``F_static_N``, and on an elastic tendon ``stretch_m``; ``KeyError`` for an
-        unknown one."""
+        ``moment_arm_m``, ``F_static_N``, on an elastic tendon ``stretch_m``, and with a thermal chamber
+        ``gas_temperature_K``; ``KeyError`` for an unknown one."""
         attach = next(a for a in ATTACHMENTS if f"{name}_{a}.x_m" in self.signals)
         # On an elastic tendon the muscle's own end is the spring's node; its attachment's x_m is the path's.
         end = "series_spring" if f"{name}_series_spring.x_m" in self.signals else attach
         where = {"p_gauge_Pa": "pressure", "x_m": end, "F_tendon_N": attach, "tau_Nm": attach, "F_N": attach,
-                 "taut": attach, "moment_arm_m": attach, "F_static_N": "muscle", "stretch_m": "series_spring"}
+                 "taut": attach, "moment_arm_m": attach, "F_static_N": "muscle", "stretch_m": "series_spring",
+                 "gas_temperature_K": "chamber"}
         if quantity == "p_gauge_Pa":
             found = [k for k in self.signals if k.startswith(f"{name}_") and k.endswith(".p_gauge_Pa")
                      and k.split(".")[0] in (f"{name}_chamber", f"{name}_pressure")]
             return self.signals[found[0]]
         return self.signals[f"{name}_{where[quantity]}.{quantity}"]
+
+    def thermal_muscles(self) -> tuple[str, ...]:
+        """The muscles whose chamber has the thermal law (a gas temperature of its own, and the wall's heat)."""
+        return tuple(m for m in self.muscles if f"{m}_chamber.wall_heat_W" in self.signals)
+
+    def _quantities(self, muscle: str) -> tuple[str, ...]:
+        """A muscle's columns: :data:`MUSCLE_COLUMNS` (the body's effort last), then :data:`THERMAL_COLUMNS` for a
+        thermal chamber."""
+        own = (*MUSCLE_COLUMNS[:-1], self.body.attach_effort)
+        return own + THERMAL_COLUMNS if muscle in self.thermal_muscles() else own
 
     def signals_key(self, muscle: str, name: str) -> str:
         """The name in :attr:`signals` of the variable ``name`` of ``muscle``'s pulley, lever or tendon."""
@@ -142,13 +155,13 @@ class JointResult:
         return {**terms, **slack, "residual_J": float(residual), "relative": float(abs(residual) / scale)}
 
     def columns(self) -> dict[str, np.ndarray]:
-        """``t_s``, ``theta_rad``, ``omega_rad_s``, ``mode``, then per muscle :data:`MUSCLE_COLUMNS`, then the
-        joint's gravity, muscle, external and net torques (a slider's: ``x_m``, ``v_m_s``, forces)."""
+        """``t_s``, ``theta_rad``, ``omega_rad_s``, ``mode``, then per muscle :data:`MUSCLE_COLUMNS` (and
+        :data:`THERMAL_COLUMNS` with a thermal chamber), then the joint's gravity, muscle, external and net
+        torques (a slider's: ``x_m``, ``v_m_s``, forces)."""
         body = self.body
         cols = {"t_s": self.t_s, body.position: self.position, body.velocity: self.velocity, "mode": self.mode}
-        quantities = (*MUSCLE_COLUMNS[:-1], body.attach_effort)
         for m in self.muscles:
-            cols.update({f"{m}.{q}": self.muscle(m, q) for q in quantities})
+            cols.update({f"{m}.{q}": self.muscle(m, q) for q in self._quantities(m)})
         cols.update({k: self.body_signal(k) for k in map(body.effort_name, ("gravity", "muscles", "applied", "net"))})
         return cols
 
@@ -160,12 +173,11 @@ class JointResult:
         """The run in numbers: final and extreme angles, final mode, each muscle's final pressure, tendon
         force and torque, the events, the solver's statistics and the energy balance."""
         pos, q = self.body.position, self.position
-        quantities = (*MUSCLE_COLUMNS[:-1], self.body.attach_effort)
         return {"name": self.name, f"final_{pos}": float(q[-1]),
                 f"peak_{pos}": float(self.peaks.get(pos, np.max(q))),
                 f"min_{pos}": float(self.peaks.get(self.body.min_key, np.min(q))),
                 "final_mode": self.final_mode.label,
-                "muscles": {m: {k: float(self.muscle(m, k)[-1]) for k in quantities} for m in self.muscles},
+                "muscles": {m: {k: float(self.muscle(m, k)[-1]) for k in self._quantities(m)} for m in self.muscles},
                 "events": [{"t_s": e.t_s, "kind": e.kind, "from": e.from_mode, "to": e.to_mode, pos: e.coordinate}
                            for e in self.transitions],
                 "stats": {**self.stats, "wall_time_s": self.wall_time_s}, "energy_balance": self.energy_balance()}

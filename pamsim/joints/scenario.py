@@ -17,9 +17,10 @@
     source = "prescribed"
     ...
 
-Each muscle's ``model``, ``parameters`` and ``pressure`` tables are read as a one-muscle scenario's
-(:class:`pamsim.scenario.Scenario`), so every static force model, friction and damping law and
-pressure source a one-muscle scenario offers works per muscle, with the same checks and messages.
+Each muscle's ``model``, ``parameters``, ``pressure``, ``chamber``, ``hysteresis`` and ``component`` tables are
+read as a one-muscle scenario's (:class:`pamsim.scenario.Scenario`), so every static force model, friction and
+damping law, pressure source, valve, chamber law and line a one-muscle scenario offers works per muscle, with
+the same checks and messages; a component's ``load.*`` is the muscle's end.
 """
 
 from __future__ import annotations
@@ -53,7 +54,7 @@ JOINT_KEYS: dict[str, tuple[float | None, str]] = {
 moves the link by less than any angle a figure resolves)."""
 MUSCLE_KEYS = {"name", "side", "radius_m", "x_at_zero_m", "model", "parameters", "pressure", "attachment",
                "link_attach_m", "base_attach_m", "angle_at_zero_rad", "tendon_length_m", "tendon_stiffness_N_per_m",
-               "hysteresis"}
+               "hysteresis", "chamber", "component"}
 LEVER_KEYS = {"link_attach_m": "positive", "base_attach_m": "positive", "angle_at_zero_rad": "positive",
               "tendon_length_m": "non_negative"}
 """A lever attachment's keys in a ``[[muscle]]`` table (``attachment = "lever"``) and their ranges."""
@@ -68,7 +69,7 @@ carriage by less than a figure resolves).  Besides these, ``weight_N`` in place 
 then ``weight_N / g_m_s2``, as a one-muscle scenario's ``[load]``), ``friction_load`` (:data:`SLIDER_FRICTION_LOADS`,
 default ``"static_force"``) and an ``external_force`` signal table."""
 SLIDER_MUSCLE_KEYS = {"name", "side", "x_at_zero_m", "model", "parameters", "pressure", "tendon_stiffness_N_per_m",
-                      "hysteresis"}
+                      "hysteresis", "chamber", "component"}
 TOP_KEYS = {"name", "description", "joint", "slider", "muscle", "simulation", "solver", "controller"}
 CONTROLLER_KEYS: dict[str, tuple[object, str]] = {
     "kind": (None, "text"), "sample_rate_Hz": (1000.0, "positive"), "stiffness_Nm_per_rad": (None, "positive"),
@@ -321,6 +322,10 @@ def _muscle(origin: str, where: str, table: dict, shared: dict, base_dir: Path, 
            "load": PLACEHOLDER_LOAD, **shared}
     if "hysteresis" in table:  # read as a one-muscle scenario's: its elements take the muscle's friction's place
         one["hysteresis"] = _table(origin, f"{where}.hysteresis", table["hysteresis"])
+    if "chamber" in table:  # the chamber's law, as a one-muscle scenario's [chamber]
+        one["chamber"] = _table(origin, f"{where}.chamber", table["chamber"])
+    if "component" in table:  # its line, reservoir, ...: as a one-muscle scenario's [[component]] tables
+        one["component"] = table["component"]
     scenario = Scenario.from_dict(one, name=table["name"], base_dir=base_dir, origin=f"{origin}: {where}")
     values["tendon_stiffness_N_per_m"] = _tendon_stiffness(origin, where, table, scenario)
     return values, scenario
@@ -437,17 +442,16 @@ def slider_of_rig(scenario: Scenario) -> JointScenario:
     would push (a tendon goes slack) and in the slider's energy states, which the integrator's error
     control also weighs.
 
+    The rig's ``[chamber]``, ``[hysteresis]`` and ``[[component]]`` tables become the muscle's (a component's
+    ``load.*`` is then the muscle's end on the carriage).
+
     Raises
     ------
     ScenarioError
-        For a rig with added components, a controller or a chamber law other than the polytropic, which a
-        slider scenario does not carry.
+        For a rig with a controller, which a slider scenario does not carry.
     """
-    for key in ("component", "controller"):
-        if key in scenario.spec:
-            _fail(scenario.origin, key, "...", "a rig with it has no slider form")
-    if scenario.chamber_law != "polytropic":  # a joint's muscle has the polytropic chamber: refused, not dropped
-        _fail(scenario.origin, "chamber.law", scenario.chamber_law, "a slider's muscles have the polytropic chamber")
+    if "controller" in scenario.spec:
+        _fail(scenario.origin, "controller", "...", "a rig with it has no slider form")
     stops, spec = scenario.build_model().stops, scenario.spec
     sim = dict(spec.get("simulation", {}))
     x0 = float(sim.pop("initial_contraction_m", 0.0))
@@ -458,7 +462,8 @@ def slider_of_rig(scenario: Scenario) -> JointScenario:
     if "external_force" in spec["load"]:
         slider["external_force"] = spec["load"]["external_force"]
     muscle = {"name": "muscle", "side": 1, "x_at_zero_m": 0.0, "model": spec.get("model", {}),
-              "parameters": spec.get("parameters", {}), "pressure": spec["pressure"]}
+              "parameters": spec.get("parameters", {}), "pressure": spec["pressure"],
+              **{key: spec[key] for key in ("chamber", "hysteresis", "component") if key in spec}}
     name = re.sub(r"\W", "_", f"{scenario.name}_slider")
     out = {"name": name if name.isidentifier() else f"rig_{name}", "slider": slider, "muscle": [muscle], "simulation": sim,
            "solver": {k: v for k, v in spec.get("solver", {}).items() if k in SOLVER_KEYS}}

@@ -14,16 +14,14 @@ in): at each angle its contraction is that root, and the stiffness is the total 
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
-from ..assemblies.joint import attachment_name, joint_assembly
+from ..assemblies.joint import at_prescribed_pressure, attachment_name, joint_assembly
 from ..components.stick_slip import BodyMode
-from ..elements.pressure_source import PrescribedPressure
 from ..errors import InputError
 from ..modeling.pygen import compiled_by_mode
-from ..signals import Constant
 from .scenario import JointScenario
 
 
@@ -52,7 +50,7 @@ class JointStatics:
             raise InputError(f"{scenario.origin}: the statics, stiffness and linearisation of muscles are for a joint; "
                              f"this scenario's muscles move a {scenario.body.name}")
         self.scenario = scenario
-        muscles = tuple(replace(m, source=PrescribedPressure(Constant(0.0))) for m in scenario.joint_muscles())
+        muscles = tuple(at_prescribed_pressure(m) for m in scenario.joint_muscles())
         assembly = joint_assembly(scenario.joint_values(), muscles, scenario.joint["g_m_s2"], name=scenario.name)
         self.names = [m.name for m in muscles]
         self.code = compiled_by_mode(assembly, "joint", ("y", "jacobian"))[int(BodyMode.STICK)]
