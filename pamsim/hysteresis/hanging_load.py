@@ -4,9 +4,9 @@ muscle's hysteresis carries is what its static force misses of the weight (docs/
 
 At rest, or slowly enough that the load's inertia and damping are negligible, the load's balance is
 ``F_static(x, p) - W + F_h = 0`` with ``F_h`` the hysteresis elements' force on it, so the pull that the
-contraction-to-force models of :mod:`.fit` describe (the elements resisting the contraction) is
-``W - F_static(x, p)``.  The static force and the weight come from a scenario's muscle and load; whatever the
-static model misses goes into the fitted offset and slope (``F0``, ``k0``) or, if it is not linear in the
+contraction-to-force models of :mod:`pamsim.hysteresis.fit` describe (the elements resisting the contraction)
+is ``W - F_static(x, p)``. The static force and the weight come from a scenario's muscle and load; whatever
+the static model misses goes into the fitted offset and slope (``F0``, ``k0``) or, if it is not linear in the
 contraction, into the residual.
 """
 
@@ -21,7 +21,8 @@ from ..elements.friction import FRICTION_MODELS
 
 def hysteresis_pull_N(static_force, weight_N: float, x_m, p_gauge_Pa) -> np.ndarray:
     """``W - F_static(x, p)`` [N]: what the static force ``static_force`` misses of the weight ``weight_N`` at
-    each sample of ``x_m`` [m] and ``p_gauge_Pa`` [Pa], the hysteresis' pull in the sign of :mod:`.fit`."""
+    each sample of ``x_m`` [m] and ``p_gauge_Pa`` [Pa], the hysteresis' pull in the sign of
+    :mod:`pamsim.hysteresis.fit`."""
     return weight_N - np.asarray(static_force.force_N(x_m, p_gauge_Pa), dtype=float)
 
 
@@ -59,7 +60,8 @@ class HangingLoad:
                    f"the {m['friction']} friction law's level F_c(x, p, m) ({path})")
 
     def pull_N(self, x_m, p_gauge_Pa) -> np.ndarray:
-        """``W - F_static(x, p)`` [N] at each sample: the hysteresis' pull, in the sign of :mod:`.fit`."""
+        """``W - F_static(x, p)`` [N] at each sample: the hysteresis' pull, in the sign of
+        :mod:`pamsim.hysteresis.fit`."""
         return hysteresis_pull_N(self.static_force, self.weight_N, x_m, p_gauge_Pa)
 
     def level_N(self, x_m, p_gauge_Pa) -> np.ndarray:

@@ -1,11 +1,12 @@
 """A measured hysteresis loop: a CSV with time, pressure, contraction and force columns, read into SI units.
 
 The loop is a prescribed-length cycle at one pressure: the contraction is the models' input (the test drives
-it) and the force their output (the test measures it).  Or it was measured at a hanging load, the pressure
-cycled and the contraction measured: then the force is derived (:mod:`.hanging_load`).  The column names carry their units as the other
-measurement files do (:mod:`pamsim.identification.columns`): ``t_s``, a pressure (``p_*`` or ``pressure*``
-ending in ``_Pa``, ``_kPa``, ``_bar`` or ``_psi``), a contraction (``x_*`` or ``contraction*`` ending in
-``_m`` or ``_mm``) and ``force_N`` (not read at a hanging load).
+it) and the force their output (the test measures it). Or it was measured at a hanging load, the pressure
+cycled and the contraction measured: then the force is derived (:mod:`pamsim.hysteresis.hanging_load`). The
+column names carry their units as the other measurement files do (:mod:`pamsim.identification.columns`):
+``t_s``, a pressure (``p_*`` or ``pressure*`` ending in ``_Pa``, ``_kPa``, ``_bar`` or ``_psi``), a
+contraction (``x_*`` or ``contraction*`` ending in ``_m`` or ``_mm``) and ``force_N`` (not read at a hanging
+load).
 """
 
 from __future__ import annotations
@@ -45,7 +46,8 @@ class LoopData:
     """The time window the samples were taken from (:meth:`window`); None: the whole file."""
     level_N: np.ndarray | None = None
     """At a hanging load, the rig's friction law's level at each sample [N]: Maxwell-slip elements are then
-    fitted as the rig's are, their slip forces shares of it (:func:`.fit.fit_maxwell_slip`); None: constant."""
+    fitted as the rig's are, their slip forces shares of it (:func:`pamsim.hysteresis.fit.fit_maxwell_slip`);
+    None: constant."""
 
     def __post_init__(self):
         check_loop(self)
@@ -87,8 +89,9 @@ def read_loop(path: str | Path, columns: Mapping[str, str] | None = None, hangin
     """Read a loop CSV (see the module's docstring); ``columns`` maps ``time``, ``pressure``, ``contraction``
     or ``force`` to other column names (which must still end in a unit).
 
-    With ``hanging_load`` (a :class:`~.hanging_load.HangingLoad`) the loop was measured at a hanging load:
-    no force column is read, and the force is its ``pull_N`` of the file's contraction and pressure."""
+    With ``hanging_load`` (a :class:`~pamsim.hysteresis.hanging_load.HangingLoad`) the loop was measured at a
+    hanging load: no force column is read, and the force is its ``pull_N`` of the file's contraction and
+    pressure."""
     path = Path(path)
     columns = dict(columns or {})
     _check_columns_map(columns, path)
