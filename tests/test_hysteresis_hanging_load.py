@@ -18,7 +18,7 @@ import pytest
 import pamsim
 from pamsim.hysteresis import fit_hysteresis
 from pamsim.hysteresis.fit import ResidualCorrelation, fit_maxwell_slip
-from pamsim.hysteresis.hanging_load import HangingLoad
+from pamsim.hysteresis.hanging_load import HangingWeight
 from pamsim.hysteresis.loop_data import LoopData
 from pamsim.hysteresis.synthetic import contraction_path, maxwell_slip_pull
 
@@ -69,14 +69,14 @@ def test_the_derived_force_is_the_elements_force_wherever_the_load_rests(runs):
     cols = result.columns()
     rest = cols["mode"] == 0
     assert rest.sum() > 50  # the final hold at 4 bar
-    pull = HangingLoad.from_scenario(path).pull_N(result.x_m, result.p_gauge_Pa)
+    pull = HangingWeight.from_scenario(path).pull_N(result.x_m, result.p_gauge_Pa)
     # What holds the load at rest beside the elements is the stick's hold force (F_friction_N, within the
     # load's stick margin): F_static - W + F_h + F_hold = 0.
     hold = cols["F_friction_N"][rest]
     assert np.max(np.abs(hold)) < 1e-5
     assert np.max(np.abs(pull[rest] - cols["hysteresis.F_N"][rest] - hold)) < 1e-9
     # ... and the level is the one the elements share.
-    level = HangingLoad.from_scenario(path).level_N(result.x_m, result.p_gauge_Pa)
+    level = HangingWeight.from_scenario(path).level_N(result.x_m, result.p_gauge_Pa)
     assert np.allclose(level, cols["hysteresis.level_N"], rtol=1e-12, atol=0)
 
 
@@ -112,9 +112,9 @@ def test_the_rigs_elements_are_recovered_from_its_pressure_contraction_loop(runs
 
 def test_elements_with_constant_slip_forces_miss_a_level_that_follows_the_pressure(runs):
     # The same loop, the elements' slip forces constant (the fit without the scenario's level): the
-    # load-dependent level runs from 1.2 to 4.4 N over the cycle and constant elements cannot follow it.
+    # load-dependent level runs from 0.95 to 4.40 N over the window and constant elements cannot follow it.
     path, csv, _ = runs["shipped"]
-    hanging = HangingLoad.from_scenario(path)
+    hanging = HangingWeight.from_scenario(path)
     shared = pamsim.hysteresis.read_loop(csv, None, hanging).window(1.0, 50.0)
     constant = LoopData(shared.t_s, shared.p_gauge_Pa, shared.x_m, shared.force_N)
     assert fit_maxwell_slip(constant, 3).rms_N > 4 * fit_maxwell_slip(shared, 3).rms_N
@@ -131,6 +131,14 @@ def test_a_scenario_without_a_hanging_load_or_a_force_column_with_one_is_refused
                    "none.toml", out)
     assert_refused(run_main("fit", "hysteresis", csv, "--scenario", path, "--window", "49.9:50", "-o", out),
                    "--window 49.9:50", out)
+    assert_refused(run_main("fit", "hysteresis", csv, "--scenario", path, "--window", "1:5", "-o", out),
+                   "--window 1:5", out)  # no reversal inside it
+    assert_refused(run_main("fit", "hysteresis", csv, "--scenario", ROOT / "scenarios" / "parallel_spring.toml",
+                            "-o", out), "component 'spring'", out)
+    no_friction = tmp_path / "none.toml"
+    no_friction.write_text(LOOPS.read_text().replace('friction = "load_dependent"', 'friction = "none"'))
+    assert_refused(run_main("fit", "hysteresis", csv, "--scenario", no_friction, "-o", out),
+                   "model.friction = 'none'", out)
     assert_refused(run_main("fit", "hysteresis", tmp_path / "w.csv", "--write-synthetic", "--scenario", path,
                             "--parameters", "F0_N=1,k0_N_per_m=1,k1_N_per_m=1,F1_N=1"), "--scenario",
                    tmp_path / "w.csv")
@@ -153,6 +161,29 @@ def test_the_lag1_autocorrelation_of_an_ar1_sequence_and_of_white_noise():
     assert not ResidualCorrelation.of(ar, "white").significant
     # The integrated time of an AR(1) sequence is (1 + rho) / (1 - rho): 19 at rho = 0.9.
     assert r.integrated_time == pytest.approx(19.0, rel=0.15)
+
+
+def test_the_integrated_time_counts_what_one_lag_does_not():
+    """A moving average ``e_t + e_t-1`` has rho_1 = 0.5 and no later correlation: its integrated time is
+    1 + 2 rho_1 = 2, where the AR(1) formula (1 + rho_1) / (1 - rho_1) of the lag-1 value alone says 3.  A
+    negative correlation (``e_t - 0.5 e_t-1``) is not counted: it does not narrow the intervals."""
+    e = np.random.default_rng(5).normal(size=40001)
+    ma = ResidualCorrelation.of(e[1:] + e[:-1])
+    assert abs(ma.lag1 - 0.5) < 0.02 and ma.integrated_time == pytest.approx(2.0, rel=0.05)
+    negative = ResidualCorrelation.of(e[1:] - 0.5 * e[:-1])
+    assert negative.lag1 < -0.3 and not negative.significant and negative.widening == 1.0
+
+
+def test_the_intervals_take_the_effective_samples_degrees_of_freedom():
+    from scipy import stats
+
+    fit = fit_maxwell_slip(_ar1_loop(0), 3)
+    dof = fit.correlation.effective_samples - fit.n_parameters
+    assert fit.correlation.significant and dof < 100
+    t = stats.t.ppf(0.975, dof)
+    for name, value, se in zip(fit.names, fit.values, fit.standard_errors):
+        low, high = fit.intervals()[name]
+        assert (high - value) == pytest.approx(t * se, rel=1e-12)
 
 
 def _ar1_loop(seed, rho=0.95, sigma_N=0.2):

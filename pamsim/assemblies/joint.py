@@ -53,7 +53,7 @@ class JointMuscle:
     None: a rigid tendon."""
     added: tuple = ()
     """Components on the muscle, wired as on the one-muscle rig's load (:class:`pamsim.assemblies.one_muscle.AddedComponent`
-    s: its ``[hysteresis]``), renamed ``<muscle>_<name>``."""
+    s: its ``[hysteresis]`` and ``[[component]]`` tables), renamed ``<muscle>_<name>``."""
 
 
 def at_prescribed_pressure(m: JointMuscle) -> JointMuscle:
@@ -65,14 +65,21 @@ def at_prescribed_pressure(m: JointMuscle) -> JointMuscle:
     prescribed = PrescribedPressure(Constant(0.0))
     new = source_parts(prescribed, None)
     own, pressure = {c.name for c in old.parts}, f"{old.pressure}.p_gauge_Pa"
-    kept, dropped = list(m.added), set()
+    kept = list(m.added)
+    # What the source's own wiring reaches besides itself (the reservoir a valve draws from, the tube it feeds).
+    dropped = {ref.partition(".")[0] for pair in old.wiring for ref in pair} - own - {"load"}
 
-    def pneumatic(target: str) -> bool:
-        owner, dot, _ = target.partition(".")
-        return (owner in own and target != pressure) or owner in dropped or (not dot and target not in new.inputs)
+    def pneumatic(a) -> bool:
+        if a.component.name in dropped:
+            return True
+        for target in a.connect.values():
+            owner, dot, _ = target.partition(".")
+            if (owner in own and target != pressure) or owner in dropped or (not dot and target not in new.inputs):
+                return True
+        return False
 
-    while any(pneumatic(t) for a in kept for t in a.connect.values()):
-        for a in [a for a in kept if any(pneumatic(t) for t in a.connect.values())]:
+    while any(pneumatic(a) for a in kept):
+        for a in [a for a in kept if pneumatic(a)]:
             kept.remove(a)
             dropped.add(a.component.name)
     added = tuple(AddedComponent(a.component, {k: f"{new.pressure}.p_gauge_Pa" if t == pressure else t

@@ -350,9 +350,9 @@ def run_hysteresis(args: argparse.Namespace) -> int:
     check_output_dir(args.output)
     hanging_load = None
     if args.scenario is not None:
-        from ..hysteresis.hanging_load import HangingLoad
+        from ..hysteresis.hanging_load import HangingWeight
 
-        hanging_load = HangingLoad.from_scenario(args.scenario)
+        hanging_load = HangingWeight.from_scenario(args.scenario)
     data = read_loop(args.data, args.columns, hanging_load)
     if args.window is not None:
         data = data.window(*args.window)

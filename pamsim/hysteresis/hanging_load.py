@@ -27,7 +27,7 @@ def hysteresis_pull_N(static_force, weight_N: float, x_m, p_gauge_Pa) -> np.ndar
 
 
 @dataclass(frozen=True)
-class HangingLoad:
+class HangingWeight:
     """The muscle's static force and the hung weight that turn a pressure-contraction loop into the force the
     hysteresis carries."""
 
@@ -43,15 +43,28 @@ class HangingLoad:
     level_label: str
 
     @classmethod
-    def from_scenario(cls, path) -> "HangingLoad":
-        """The static force and weight of the one-muscle rig of the scenario file ``path``; a scenario whose
-        muscle is driven by its length (``[motion]``) has no hung weight and is refused, naming the key."""
+    def from_scenario(cls, path) -> "HangingWeight":
+        """The static force and weight of the one-muscle rig of the scenario file ``path``.  Refused, naming the
+        key: a muscle driven by its length (``[motion]``: no hung weight), a force on the load the derivation
+        would leave out (``[load] external_force``, a ``[[component]]`` on the load), and ``friction =
+        "none"`` (no level for the elements to share)."""
         from ..scenario import ScenarioError, load_scenario
 
         scenario = load_scenario(path)
         if "motion" in scenario.spec:
             raise ScenarioError(f"{path}: [motion]: the muscle is driven by its length; a loop at a hanging "
                                 "load needs a scenario with a [load]")
+        if "external_force" in scenario.spec.get("load", {}):
+            raise ScenarioError(f"{path}: load.external_force: a loop at a hanging load is derived from the weight "
+                                "and the static force alone; this force would be left out")
+        on_load = [a.component.name for a in scenario.added_components
+                   if any(t.startswith("load.") for t in a.connect.values()) and a.component.name != "hysteresis"]
+        if on_load:
+            raise ScenarioError(f"{path}: component {on_load[0]!r}: it acts on the load, and a loop at a hanging "
+                                "load is derived from the weight and the static force alone")
+        if scenario.spec["model"]["friction"] == "none":
+            raise ScenarioError(f"{path}: model.friction = 'none': its level is 0, so elements that share it "
+                                "have no slip force; give the friction law the rig's elements share")
         model = scenario.build_model()
         m = scenario.spec["model"]
         label = f"W - F_static(x, p): weight {model.load.weight_N:g} N, static force of {m['muscle']} ({path})"

@@ -62,9 +62,12 @@ class LoopData:
         if keep.sum() < MIN_ROWS:
             raise DataError(f"{self.origin}: --window {t0_s:g}:{t1_s:g}: {int(keep.sum())} samples in it (times "
                             f"{self.t_s[0]:g} to {self.t_s[-1]:g} s): a loop needs at least {MIN_ROWS}")
-        return LoopData(self.t_s[keep], self.p_gauge_Pa[keep], self.x_m[keep], self.force_N[keep], self.origin,
-                        self.sha256, self.columns, (float(t0_s), float(t1_s)),
-                        None if self.level_N is None else self.level_N[keep])
+        try:
+            return LoopData(self.t_s[keep], self.p_gauge_Pa[keep], self.x_m[keep], self.force_N[keep], self.origin,
+                            self.sha256, self.columns, (float(t0_s), float(t1_s)),
+                            None if self.level_N is None else self.level_N[keep])
+        except DataError as exc:  # say which window the samples were cut to
+            raise DataError(f"--window {t0_s:g}:{t1_s:g}: {exc}") from None
 
 
 def check_loop(data: LoopData) -> None:
@@ -89,7 +92,7 @@ def read_loop(path: str | Path, columns: Mapping[str, str] | None = None, hangin
     """Read a loop CSV (see the module's docstring); ``columns`` maps ``time``, ``pressure``, ``contraction``
     or ``force`` to other column names (which must still end in a unit).
 
-    With ``hanging_load`` (a :class:`~pamsim.hysteresis.hanging_load.HangingLoad`) the loop was measured at a
+    With ``hanging_load`` (a :class:`~pamsim.hysteresis.hanging_load.HangingWeight`) the loop was measured at a
     hanging load: no force column is read, and the force is its ``pull_N`` of the file's contraction and
     pressure."""
     path = Path(path)
