@@ -179,3 +179,17 @@ def test_the_command_refuses_a_joint_muscles_unknown_law_with_exit_2(tmp_path):
                                  'supply_gauge_bar = 2.2', 1))
     assert_refused(run_main("run", path, "-o", tmp_path / "out"), "muscle 'flexor': chamber.law = 'bogus'",
                    tmp_path / "out")
+
+
+def test_on_an_elastic_tendon_the_chamber_follows_the_muscles_own_end():
+    """The chamber's volume is the braid's at the muscle's own contraction (the series spring's node), not at
+    its tendon path's, which the spring's stretch (about 10 mm here) keeps apart from it."""
+    scenario = load_joint_scenario(SCENARIOS / "antagonistic_elastic.toml")
+    run = simulate_joint(scenario)
+    for m in scenario.joint_muscles():
+        own = run.signals[f"{m.name}_series_spring.x_m"]
+        path = run.signals[f"{m.name}_pulley.x_m"]
+        assert np.max(np.abs(own - path)) > 5e-3
+        volume = run.signals[f"{m.name}_chamber.volume_m3"]
+        assert np.array_equal(volume, m.source.chamber.volume_m3(own)) or \
+            np.max(np.abs(volume - m.source.chamber.volume_m3(own))) < 1e-15

@@ -163,7 +163,9 @@ def _muscle_parts(m: JointMuscle, attach, body, friction_load: str | None) -> tu
     is, the attachment's flange carries the spring's pull, and the friction reads the muscle's own motion.
     """
     pulley, elastic = attach.name, m.tendon_stiffness_N_per_m is not None
-    source = rewired(source_parts(m.source, m.p0_gauge_Pa), pulley, m.name, tuple(a.component.name for a in m.added))
+    # The chamber's volume follows the muscle's own end: on an elastic tendon the spring's node, not the path.
+    end = series_spring_name(m) if elastic else pulley
+    source = rewired(source_parts(m.source, m.p0_gauge_Pa), end, m.name, tuple(a.component.name for a in m.added))
     damping = (MuscleEndDamping if elastic else ViscousDamping)(f"{m.name}_damping", m.damping)
     parts = [*source.parts, MuscleStaticForce(f"{m.name}_muscle", m.static_force),
              CoulombFriction(f"{m.name}_friction", m.friction), damping, attach]
