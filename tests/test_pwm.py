@@ -51,12 +51,19 @@ def _pwm_scenario(backend_rate_Hz: float = 1000.0) -> dict:
             "simulation": {"duration_s": 1.6, "sample_rate_Hz": backend_rate_Hz}, "solver": {"rtol": 1e-8}}
 
 
-@pytest.mark.parametrize("backend", ["python", "native"])
-def test_the_valve_closes_exactly_at_each_switch(backend):
+@pytest.mark.parametrize("backend, bound_s", [("python", 1e-9), ("native", 1e-9), ("fmu-cs", 1e-9),
+                                               ("fmu-me", 1e-7)])
+def test_the_valve_closes_exactly_at_each_switch(backend, bound_s):
     """Between pulses the inlet valve is closed and the chamber's air mass stays what it was at the
-    switch: an integrator that stepped past a switch by dt would go on filling, by the inflow times dt.
-    The change over each closed interval, divided by the inflow just before it closed, bounds how late
-    the switch was taken: below 1e-9 s at all 50 switches.  Within each pulse the mass grows."""
+    switch: an integrator that stepped past a closing switch by dt would go on filling, by the inflow times
+    dt, and one that took the next opening switch early by dt would fill before it.  The change over each
+    closed interval, its two ends included (the mass at the opening instant is still the closed one's),
+    divided by the inflow just before it closed, bounds both: below 1e-9 s at all 50 pulses (3e-16 s
+    measured on python and native, 0 on fmu-cs).  The model-exchange FMU's switches are fmpy's: its CVode
+    steps to each time event within 3.7e-8 s (measured), so its bound is 1e-7 s.  A closing switch taken
+    early, or an opening one late, would shorten the pulse instead, which this does not see; both kinds are
+    breakpoints of the one PWM signal, taken by the same segment boundaries.  Within each pulse the mass
+    grows."""
     res = pamsim.simulate(pamsim.Scenario.from_dict(_pwm_scenario(10000.0)), backend=backend)
     cols = res.columns()
     m, mdot = cols["air_mass_kg"], cols["valve_mass_flow_kg_s"]
@@ -64,8 +71,9 @@ def test_the_valve_closes_exactly_at_each_switch(backend):
         on, off = 0.5 + 0.02 * k, 0.5 + 0.02 * k + 0.008
         i_on, i_off, i_next = (int(round(x * 10000)) for x in (on, off, on + 0.02))
         assert m[i_off] > m[i_on] and mdot[i_off - 1] > 0.0
-        late_s = np.max(np.abs(m[i_off:i_next] - m[i_off])) / mdot[i_off - 1]
-        assert late_s < 1e-9, (k, late_s)
+        closed = m[i_off:i_next + 1] if k < 49 else m[i_off:i_next]  # after the last pulse nothing opens
+        off_s = np.max(np.abs(closed - m[i_off])) / mdot[i_off - 1]
+        assert off_s < bound_s, (k, off_s)
         assert np.all(mdot[i_off + 1:i_next] == 0.0)  # the sample at the switch shows the flow up to it
 
 
