@@ -283,6 +283,20 @@ def test_cli_linearize_uses_the_averaged_model(tmp_path, cli):
     assert "DC gain pwm_duty -> contraction" in text.stdout
 
 
+@pytest.mark.parametrize("law", ["isothermal", "polytropic", "thermal"])
+def test_every_chamber_law_linearises_under_averaged_pwm_without_a_pole_at_zero(law):
+    """At the averaged model's balance both paths flow.  Under the isothermal law ``p V = m R T_wall`` fixes
+    the air mass by the pressure: its outflow once carried ``p V / (m R)``, so the pressure's rate read the
+    air mass and the linearisation kept it, with a pole at -2e-16 (a mode no input moves).  Now the
+    isothermal air mass is dropped as decoupled and every pole is a physical one; the polytropic and thermal
+    gases keep theirs (their temperature is a state of its own)."""
+    model = AVERAGED.with_changes({"chamber": {"law": law}}).build_model()
+    lin = linearize(model, averaged_pwm_equilibrium(model, 0.5))
+    poles = np.linalg.eigvals(lin.sys.A)
+    assert np.min(np.abs(poles)) > 0.1, poles
+    assert ("air_mass_kg" in lin.dropped_states) == (law == "isothermal"), lin.dropped_states
+
+
 # ---------------------------------------------------------------- bad input
 
 

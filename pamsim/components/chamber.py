@@ -41,7 +41,7 @@ class Chamber(ElementParameters, Component):
     inputs = (Var("x_m", "m", "contraction"), Var("v_m_s", "m/s", "contraction velocity"),
               Var("p_settle_abs_Pa", "Pa", "pressure the source holds the port at (its own pressure when none)"))
     states = (Var("p_abs_Pa", "Pa", "absolute chamber pressure", 1e5),
-              Var("air_mass_kg", "kg", "air mass in the chamber", 1e-5))
+              Var("air_mass_kg", "kg", "air mass in the chamber", 1e-5, conserved=True))
     outputs = OUTPUTS
     extra_parameters = (positive("p_atm_Pa", "Pa", "ambient pressure"),
                         non_negative("initial_pressure_gauge_Pa", "Pa", "chamber gauge pressure at the start"),

@@ -16,7 +16,8 @@ VOLUME_OUTPUTS = (Var("p_gauge_Pa", "Pa", "gauge pressure"), Var("p_abs_Pa", "Pa
                   Var("gas_temperature_K", "K", "gas temperature p V / (m R)"))
 """The outputs of every rigid volume."""
 
-VOLUME_STATES = (Var("p_abs_Pa", "Pa", "absolute pressure", 1e5), Var("air_mass_kg", "kg", "air mass", 1e-5))
+VOLUME_STATES = (Var("p_abs_Pa", "Pa", "absolute pressure", 1e5),
+                 Var("air_mass_kg", "kg", "air mass", 1e-5, conserved=True))
 """The states of every rigid volume: the chamber's."""
 
 

@@ -150,6 +150,13 @@ class IsothermalLaw:
         """Gas temperature [K] at the start: the wall's."""
         return self.T_wall_K
 
+    def gas_temperature_K(self, p_abs_Pa, volume_m3, air_mass_kg):
+        """Gas temperature [K]: the wall's, as the law has it (``p V / (m R)`` equals it along a run to the
+        integrator's tolerance).  An outflow carries it; taken as ``p V / (m R)`` it tied the pressure's rate to
+        the air mass, which the law's ``p V = m R T_wall`` already fixes, and a linearisation kept the air mass
+        as a state with a pole at 0."""
+        return self.T_wall_K + 0.0 * p_abs_Pa
+
     def pressure_rate_of_flows_Pa_s(self, p_abs_Pa, volume_m3, dvolume_dt_m3_s, inflow_kg_s, flow_work_W,
                                     air_mass_kg=None, x_m=None):
         """``(R T_wall mdot - p dV/dt) / V`` [Pa/s]: every flow at the wall temperature, whatever it brings."""

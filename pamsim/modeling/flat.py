@@ -191,7 +191,9 @@ class FlatModel:
     def quadratures(self) -> list[int]:
         """The states that only accumulate (a work integral): nothing reads them but the outputs, no
         event resets them, and no other derivative, indicator or mode depends on them.  An integrator
-        may compute them by quadrature of its solution rather than carry them in its error control."""
+        may compute them by quadrature of its solution rather than carry them in its error control.  Not a
+        conserved state (:attr:`pamsim.modeling.variables.Var.conserved`: an isothermal volume's air mass,
+        which nothing reads), which must be integrated by the rule of those it exchanges with."""
         import casadi as ca
 
         def reads(exprs, sym):
@@ -205,7 +207,7 @@ class FlatModel:
             others += [e for j, e in enumerate(self.settle_x) if j != i]
             others += [a for ext in self.externals for a in ext.args]
             own = [self.transition_x[i], *(self.settle_x[i:i + 1] or [xi])]
-            if not reads(others, xi) and all(ca.is_equal(ca.SX(e), xi) for e in own):
+            if not self.states[i].conserved and not reads(others, xi) and all(ca.is_equal(ca.SX(e), xi) for e in own):
                 out.append(i)
         return out
 

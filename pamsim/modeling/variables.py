@@ -18,7 +18,13 @@ from dataclasses import dataclass
 class Var:
     """A named variable with its unit, meaning and nominal scale (the integrator's absolute scale), and
     for a parameter the range its value must lie in (``lower``/``upper``; ``*_open``: the bound excluded),
-    which a scenario and an FMU check."""
+    which a scenario and an FMU check.
+
+    ``conserved`` marks a state that connections move to and from other states (a volume's air mass): an
+    integrator carries it with the states it exchanges with, under one rule, even where nothing reads it,
+    so that their sum holds to rounding: it is never a quadrature
+    (:meth:`pamsim.modeling.flat.FlatModel.quadratures`), which the native engine takes from its dense
+    output by a rule that is not its steps'."""
 
     name: str
     unit: str
@@ -28,6 +34,7 @@ class Var:
     upper: float = math.inf
     lower_open: bool = False
     upper_open: bool = False
+    conserved: bool = False
 
     def violation(self, value: float) -> str | None:
         """Why ``value`` is outside the range, or None."""
