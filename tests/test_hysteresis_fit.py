@@ -92,6 +92,7 @@ def test_fit_hysteresis_writes_its_outputs(synthetic_csv, tmp_path):
     assert sorted(p.name for p in out.iterdir()) == ["compare.csv", "fit.json", "fit.png", "report.md",
                                                     "residuals.png"]
     assert json.loads((out / "fit.json").read_text()) == body
+    assert "hanging load" not in (out / "report.md").read_text()  # a measured force: nothing derived
     truth = HIDDEN["maxwell_slip_2"][1]
     for name, entry in body["fit"]["parameters"].items():
         low, high = entry["interval"]

@@ -92,6 +92,7 @@ def test_the_rigs_elements_are_recovered_from_its_pressure_contraction_loop(runs
     report = json.loads(proc.stdout)
     assert report["data"]["columns"]["force"].startswith("W - F_static(x, p)")
     assert report["data"]["window_s"] == [1.0, 50.0]
+    assert "(at a hanging load: W - F_static(x, p)" in (out / "report.md").read_text()
     params = report["fit"]["parameters"]
     truth = {**{f"share{i + 1}": w for i, w in enumerate(shares)},
              **{f"delta{i + 1}_m": d for i, d in enumerate(deltas)}}
@@ -154,13 +155,13 @@ def test_the_lag1_autocorrelation_of_an_ar1_sequence_and_of_white_noise():
         ar[i] = 0.9 * ar[i - 1] + e[i]
     r = ResidualCorrelation.of(ar)
     assert abs(r.lag1 - 0.9) < 0.01 and r.significant
-    assert r.widening == pytest.approx(math.sqrt(r.integrated_time), rel=1e-12)
-    assert r.effective_samples == pytest.approx(20000 / r.integrated_time, rel=1e-12)
+    assert r.widening == pytest.approx(math.sqrt(r.integrated_time_samples), rel=1e-12)
+    assert r.effective_samples == pytest.approx(20000 / r.integrated_time_samples, rel=1e-12)
     white = ResidualCorrelation.of(e)
     assert not white.significant and white.widening == 1.0 and white.effective_samples == 20000
     assert not ResidualCorrelation.of(ar, "white").significant
     # The integrated time of an AR(1) sequence is (1 + rho) / (1 - rho): 19 at rho = 0.9.
-    assert r.integrated_time == pytest.approx(19.0, rel=0.15)
+    assert r.integrated_time_samples == pytest.approx(19.0, rel=0.15)
 
 
 def test_the_integrated_time_counts_what_one_lag_does_not():
@@ -169,7 +170,7 @@ def test_the_integrated_time_counts_what_one_lag_does_not():
     negative correlation (``e_t - 0.5 e_t-1``) is not counted: it does not narrow the intervals."""
     e = np.random.default_rng(5).normal(size=40001)
     ma = ResidualCorrelation.of(e[1:] + e[:-1])
-    assert abs(ma.lag1 - 0.5) < 0.02 and ma.integrated_time == pytest.approx(2.0, rel=0.05)
+    assert abs(ma.lag1 - 0.5) < 0.02 and ma.integrated_time_samples == pytest.approx(2.0, rel=0.05)
     negative = ResidualCorrelation.of(e[1:] - 0.5 * e[:-1])
     assert negative.lag1 < -0.3 and not negative.significant and negative.widening == 1.0
 

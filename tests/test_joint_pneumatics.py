@@ -114,13 +114,19 @@ def test_a_joint_muscle_with_a_thermal_chamber_behind_a_tube_runs_alike_on_every
     assert "flexor_tube.air_mass_kg" in variables and "flexor_tube.p_gauge_Pa" in variables
 
 
-def test_the_run_writes_the_gas_temperature_of_a_thermal_muscle(tmp_path):
-    path = tmp_path / "pair.toml"
+def _pair_file_with_law(folder, law: str):
+    """The shipped pair's file with a ``[muscle.chamber]`` of ``law`` on its first muscle (the flexor),
+    written into ``folder``: the file a user edits, not a dict."""
     text = (SCENARIOS / "antagonistic_pair.toml").read_text()
-    path.write_text(text.replace('[muscle.pressure]\nsource = "valve"\nsupply_gauge_bar = 2.2',
-                                 '[muscle.chamber]\nlaw = "thermal"\n[muscle.pressure]\nsource = "valve"\n'
-                                 'supply_gauge_bar = 2.2', 1))
-    proc = run_main("run", path, "-o", tmp_path / "out")
+    marker = '[muscle.pressure]\nsource = "valve"\nsupply_gauge_bar = 2.2'
+    assert marker in text
+    path = folder / "pair.toml"
+    path.write_text(text.replace(marker, f'[muscle.chamber]\nlaw = "{law}"\n' + marker, 1))
+    return path
+
+
+def test_the_run_writes_the_gas_temperature_of_a_thermal_muscle(tmp_path):
+    proc = run_main("run", _pair_file_with_law(tmp_path, "thermal"), "-o", tmp_path / "out")
     assert proc.returncode == 0, proc.stderr
     header = (tmp_path / "out" / "antagonistic_pair.csv").read_text().splitlines()[0].split(",")
     assert "flexor.gas_temperature_K" in header and "extensor.gas_temperature_K" not in header
@@ -172,12 +178,7 @@ def test_a_bad_pneumatic_table_of_a_joint_muscle_is_refused_by_key(change, key):
 
 
 def test_the_command_refuses_a_joint_muscles_unknown_law_with_exit_2(tmp_path):
-    path = tmp_path / "bad.toml"
-    text = (SCENARIOS / "antagonistic_pair.toml").read_text()
-    path.write_text(text.replace('[muscle.pressure]\nsource = "valve"\nsupply_gauge_bar = 2.2',
-                                 '[muscle.chamber]\nlaw = "bogus"\n[muscle.pressure]\nsource = "valve"\n'
-                                 'supply_gauge_bar = 2.2', 1))
-    assert_refused(run_main("run", path, "-o", tmp_path / "out"), "muscle 'flexor': chamber.law = 'bogus'",
+    assert_refused(run_main("run", _pair_file_with_law(tmp_path, "bogus"), "-o", tmp_path / "out"), "muscle 'flexor': chamber.law = 'bogus'",
                    tmp_path / "out")
 
 

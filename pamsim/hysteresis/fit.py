@@ -68,7 +68,7 @@ class ResidualCorrelation:
     effective samples."""
 
     lag1: float
-    integrated_time: float
+    integrated_time_samples: float
     """``tau`` [samples], at least 1."""
     samples: int
     residual_model: str = "correlated"
@@ -81,7 +81,7 @@ class ResidualCorrelation:
     @property
     def effective_samples(self) -> float:
         """``n / tau`` when :attr:`significant`, else ``n``."""
-        return self.samples / self.integrated_time if self.significant else float(self.samples)
+        return self.samples / self.integrated_time_samples if self.significant else float(self.samples)
 
     @property
     def widening(self) -> float:
@@ -105,7 +105,7 @@ class ResidualCorrelation:
 
     def to_json(self) -> dict:
         """The correlation as JSON-ready values: what ``fit.json`` gives under each fit's ``residual``."""
-        return {"lag1_autocorrelation": self.lag1, "integrated_time_samples": self.integrated_time,
+        return {"lag1_autocorrelation": self.lag1, "integrated_time_samples": self.integrated_time_samples,
                 "treated_as": "correlated" if self.significant else "white",
                 "effective_samples": self.effective_samples, "interval_widening": self.widening}
 

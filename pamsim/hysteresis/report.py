@@ -55,7 +55,7 @@ def correlation_lines(fit: "HysteresisFit") -> list[str]:
         return []
     return [f"warning: the residual is correlated along the loop (lag-1 autocorrelation {r.lag1:.4g}; white noise "
             f"stays below {1.96 / math.sqrt(r.samples):.2g}): model error, or noise that is not white; its "
-            f"autocorrelation lasts {r.integrated_time:.4g} samples, so about {r.effective_samples:.4g} of the "
+            f"autocorrelation lasts {r.integrated_time_samples:.4g} samples, so about {r.effective_samples:.4g} of the "
             f"{r.samples} are independent: the intervals are widened {r.widening:.3g} times and AIC and BIC count "
             f"{fit.effective_samples:.4g} samples (--residual white takes the residual as white noise)"]
 
@@ -75,7 +75,7 @@ def report_md(fit: "HysteresisFit", ext: str) -> str:
     d = fit.data
     window = "" if d.window_s is None else f" from {d.window_s[0]:g} s to {d.window_s[1]:g} s"
     force = dict(d.columns).get("force", "")
-    derived = f" (at a hanging load: {force}, quasi-static)" if force.startswith("W - ") else ""
+    derived = f" (at a hanging load: {force}, quasi-static)" if d.level_N is not None else ""
     lines = ["# Hysteresis fit", "", f"- data: `{Path(d.origin).name}` (sha256 `{d.sha256}`), {len(d)} samples{window}",
              f"- input: contraction (m); output: force (N){derived}; models start relaxed at the first sample", "",
              "```", *summary_lines(fit), "```", "", f"![loop](fit.{ext})", "", f"![residuals](residuals.{ext})", ""]
