@@ -431,6 +431,11 @@ class HybridRun:
         self.low_x, self.peak_x = math.inf, -math.inf
         self.calls = 0
         self.h_next = None  # the step DOPRI5 proposed at the last segment's end, to start the next with
+        # LSODA restarts with its non-stiff method.  After a jump that kept a held body's mode (an element
+        # reaching its limit) the next segment is BDF's: what moves while the body is held is a massless
+        # muscle end, a stiff node, where an element at rest on its limit, restarted non-stiff, crossed it
+        # again at every few steps of noise (more than 20000 events in a second).
+        self.stiff_restart = False
         self.restarts = LsodaRestarts()
         self.reached = 0.0  # reported time: the RHS is also evaluated at trial points, which need not increase
 
@@ -462,9 +467,10 @@ class HybridRun:
         self.t_left = self.gen.t_left = float(np.nextafter(t_break, -math.inf))
         max_step = opts.max_step_s if mode.is_slip else min(opts.max_step_s, self.held_max_step)
         rhs = self.gen.rhs(mode) if self.progress is None else self._reporting(self.gen.rhs(mode))
+        method = "BDF" if self.stiff_restart and opts.method == "LSODA" else opts.method
         samples = self.grid[self.next_sample:np.searchsorted(self.grid, t_break, side="right") if sampled else 0]
         try:
-            seg = integrate_segment(rhs, t, t_break, y, opts.method, [_from_start(f, t, y) for _, f, _ in named],
+            seg = integrate_segment(rhs, t, t_break, y, method, [_from_start(f, t, y) for _, f, _ in named],
                                     samples, rtol=opts.rtol, atol=self.atol, max_step=max_step, v_row=_V_ROW,
                                     first_step=self.h_next, restarts=self.restarts)
         except (InputError, SolverFailure):
@@ -513,6 +519,7 @@ class HybridRun:
         if kind == "velocity_zero" and zero_length and self.mode.is_slip:
             self.mode = Mode.STICK
             self.hold_until = t_event + _HOLD_S * 2.0 ** (min(self.n_zero, _MAX_ZERO_LENGTH) - 1)
+        self.stiff_restart = self.mode == old and not old.is_slip
         self.transitions.append(TransitionEvent(t_event, kind, old.label, self.mode.label, float(self.y[0])))
         self.transitions.extend(TransitionEvent(t_event, name, self.mode.label, self.mode.label, float(self.y[0]))
                                 for name, _ in also)
@@ -524,6 +531,7 @@ class HybridRun:
         """The segment reached an input breakpoint: a held load's mode is decided again there."""
         self.t = t_break
         self.hold_until = math.inf
+        self.stiff_restart = False
         self.n_stuck = 0
         self.y = seg.y[:, -1].copy()
         if self.mode in _REST:

@@ -198,3 +198,59 @@ def test_linearize_and_the_mujoco_coupling_refuse_elastic_tendons():
     for call in (lambda: linearize_joint(scenario, [2e5, 2e5]), lambda: joint_muscles(scenario)):
         with pytest.raises(InputError, match="muscle 'flexor'.tendon_stiffness_N_per_m = 2000"):
             call()
+
+
+# ---------------------------------------------------------------- hysteresis elements on the muscle's end
+ELEMENTS = {"model": "maxwell_slip", "slip_displacement_m": [2e-4, 1e-3, 4e-3], "share": [1.0, 1.0, 1.0]}
+
+
+def _with_elements(pressures_bar=(None, None), duration_s=1.5, **table) -> JointScenario:
+    spec = copy.deepcopy(SPEC)
+    spec["muscle"][0]["hysteresis"] = {**ELEMENTS, **table}
+    for m, p in zip(spec["muscle"], pressures_bar):
+        if p is not None:
+            m["pressure"]["supply_gauge_bar"] = p
+    spec["simulation"]["duration_s"] = duration_s
+    return JointScenario.from_dict(spec, origin="elastic.toml", base_dir=ELASTIC.parent)
+
+
+@pytest.mark.parametrize("backend", ["python", "native"])
+def test_maxwell_slip_elements_on_the_muscles_end_join_its_balance(backend):
+    """The flexor's elements act on its massless end: where the end rests, its static force and the elements'
+    force together equal the tendon's pull (by hand from the signals; their force is 0.68 N of a 21 N pull,
+    which a balance that left them out missed), and the link rests elsewhere than with elements too weak to
+    matter."""
+    sc = _with_elements()
+    run = simulate_joint(sc, backend)
+    one = sc.muscles[0][1]
+    x, p = run.muscle("flexor", "x_m")[-1], run.muscle("flexor", "p_gauge_Pa")[-1]
+    F_static = one.build_model().static_force.force_N(x, p)
+    F_elements = run.signals["flexor_hysteresis.F_N"][-1]
+    T = run.muscle("flexor", "F_tendon_N")[-1]
+    assert abs(F_elements) > 0.5 and T > 15.0
+    assert abs(run.signals["flexor_series_spring.v_m_s"][-1]) < 1e-6  # at rest: the damping takes < 1e-6 N
+    assert F_static + F_elements == pytest.approx(T, abs=1e-5)
+    weak = simulate_joint(_with_elements(share=[0.01] * 3), backend)
+    assert abs(weak.theta_rad[-1] - run.theta_rad[-1]) > 0.02
+
+
+def test_elements_resting_on_their_limit_on_a_held_link_take_few_events():
+    """The flexor at 4 bar against an empty extensor drives the link onto its stop; the flexor's end then
+    comes to rest with its first element on its slip displacement, a stiff node (the element's spring over the
+    end's 1 N s/m).  Both backends keep integrating it as stiff across the element's switches (native: its
+    Rodas4; python: BDF after such a switch): 29 and 6 events, where each once restarted non-stiff and
+    crossed the limit again at every few steps (more than 20000 events by 0.9 s), and the end rests at the
+    same place on both."""
+    sc = _with_elements(pressures_bar=(4.0, 0.0), duration_s=3.0)
+    runs = {b: simulate_joint(sc, b) for b in ("python", "native")}
+    for run in runs.values():
+        assert run.theta_rad[-1] == pytest.approx(SPEC["joint"]["theta_max_rad"], abs=1e-9)
+        assert len(run.transitions) < 100
+    for name in ("x_m", "F_tendon_N"):
+        assert runs["native"].muscle("flexor", name)[-1] == pytest.approx(runs["python"].muscle("flexor", name)[-1],
+                                                                          rel=1e-5)
+
+
+def test_presliding_damping_on_an_elastic_tendon_is_refused_by_key():
+    with pytest.raises(ScenarioError, match="muscle 'flexor'.hysteresis.damping_N_s_per_m = 100"):
+        _with_elements(damping_N_s_per_m=100.0)

@@ -193,27 +193,32 @@ def _muscle_parts(m: JointMuscle, attach, body, friction_load: str | None) -> tu
                (f"{m.name}_muscle.F_static_N", f"{pulley}.F_static_N"),
                (f"{body.name}.slip_direction", f"{pulley}.joint_direction")]
     inputs = {f"{m.name}.{k}": v for k, v in source.inputs.items()}
-    extra, extra_wiring = _added_parts(m, source, node, friction_load or f"{pulley}.load_mass_kg", inputs)
+    # On an elastic tendon what is added on the muscle's end joins the spring node's balance (its port others).
+    extra, extra_wiring = _added_parts(m, source, node, f"{node}.others" if elastic else f"{node}.flange",
+                                       friction_load or f"{pulley}.load_mass_kg", inputs)
     if any(target == "chamber.port" for a in m.added for target in a.connect.values()):
         wiring = unsettled(wiring, f"{m.name}_chamber")
     return parts + extra, wiring + extra_wiring, inputs
 
 
-def _added_parts(m: JointMuscle, source, node: str, mass: str, inputs: dict) -> tuple[list, list]:
+def _added_parts(m: JointMuscle, source, node: str, flange: str, mass: str, inputs: dict) -> tuple[list, list]:
     """The components on muscle ``m`` (its ``[hysteresis]``, its lines and reservoirs), renamed after it, wired
-    as on the one-muscle rig: what they read of the rig's load read of the muscle's flange node ``node`` and the
-    friction's load ``mass``; a reference to the rig's muscle, friction, damping, pressure source or another of
+    as on the one-muscle rig: what they read of the rig's load read of the muscle's flange node ``node`` (its
+    flange port ``flange``) and the friction's load ``mass``; a reference to the rig's muscle, friction, damping, pressure source or another of
     the muscle's components, of the muscle's own; a model input (a supply's set pressure), the muscle's own
     input of that name in ``inputs``, which then drives them too."""
     prefix = f"{m.name}_"
     names = {c.name.removeprefix(prefix): c.name for c in source.parts}  # "chamber" -> "<muscle>_chamber"
     names.update({k: prefix + k for k in ("muscle", "friction", "damping")})
     names.update({a.component.name: prefix + a.component.name for a in m.added})
-    load = {"load.flange": f"{node}.flange", "load.x_m": f"{node}.x_m", "load.v_m_s": f"{node}.v_m_s",
+    load = {"load.flange": flange, "load.x_m": f"{node}.x_m", "load.v_m_s": f"{node}.v_m_s",
             "load.mass_kg": mass}
     parts, wiring = [], []
+    massless = flange != f"{node}.flange"
     for a in m.added:
-        c = copy.copy(a.component)
+        # on the massless end of an elastic tendon, without forces that read its velocity (MaxwellSlip's damping)
+        c = a.component.on_massless_end() if massless and hasattr(a.component, "on_massless_end") else a.component
+        c = copy.copy(c)
         c.name = names[a.component.name]
         parts.append(c)
         for port, target in a.connect.items():

@@ -39,14 +39,15 @@ def _branches(branches, n: int) -> tuple[int, ...] | None:
     return out
 
 
-def _parameters(n: int, envelope: bool) -> tuple:
-    """The declared parameters of ``n`` elements, and the envelope's scale if they deflect on one."""
+def _parameters(n: int, envelope: bool, damped: bool) -> tuple:
+    """The declared parameters of ``n`` elements, their presliding damping if ``damped``, and the envelope's
+    scale if they deflect on one."""
     idx = range(1, n + 1)
     scale = (positive("envelope_scale_m", "m", "scale s of the envelope s tanh(x / s) the elements deflect on"),)
+    damping = (non_negative("damping_N_s_per_m", "N s/m", "presliding damping, shared as the level"),)
     return (*(positive(f"delta{i}_m", "m", f"slip displacement of element {i}") for i in idx),
             *(non_negative(f"share{i}", "1", f"element {i}'s share of the friction level") for i in idx),
-            non_negative("damping_N_s_per_m", "N s/m", "presliding damping, shared as the level"),
-            *(scale if envelope else ()))
+            *(damping if damped else ()), *(scale if envelope else ()))
 
 
 class MaxwellSlip(ElementParameters, Component):
@@ -58,6 +59,7 @@ class MaxwellSlip(ElementParameters, Component):
     losses).  Outputs: the total force ``F_N``, the level ``level_N``, each element's force and whether it
     slips.
 
+    ``damping_N_s_per_m``: the presliding damping, a parameter; None, no such term (:meth:`on_massless_end`).
     ``branches`` (:meth:`held`): each element held in one stick state, for a linearisation: 0 sticking,
     +1 or -1 slipping that way, its deflection then the constant ``+-delta<i>_m`` and no state; no events.
     """
@@ -78,7 +80,7 @@ class MaxwellSlip(ElementParameters, Component):
         idx = range(1, n + 1)
         self.branches = _branches(branches, n)
         self.envelope_scale_m = envelope_scale_m
-        self.extra_parameters = _parameters(n, envelope_scale_m is not None)
+        self.extra_parameters = _parameters(n, envelope_scale_m is not None, damping_N_s_per_m is not None)
         # Held slipping, an element's deflection is a constant: it is no state (a linearisation drops it).
         self.states = (*(Var(f"z{i}_m", "m", f"deflection of element {i}'s spring", 1e-3) for i in idx
                          if not self._held_slipping(i)),
@@ -92,14 +94,16 @@ class MaxwellSlip(ElementParameters, Component):
         values = self.wrap(element, _level_N, PROBE_POINTS)
         values.update({f"delta{i}_m": float(d) for i, d in zip(idx, deltas_m)})
         values.update({f"share{i}": float(w) for i, w in zip(idx, shares)})
-        values["damping_N_s_per_m"] = float(damping_N_s_per_m)
+        if damping_N_s_per_m is not None:
+            values["damping_N_s_per_m"] = float(damping_N_s_per_m)
         if envelope_scale_m is not None:
             values["envelope_scale_m"] = float(envelope_scale_m)
         super().__init__(name, values)
 
     def structure_key(self) -> tuple:
         """The key of :class:`ElementParameters`, with the number of elements: it shapes the code."""
-        return super().structure_key() + (self.n_elements, self.branches, self.envelope_scale_m is None)
+        return super().structure_key() + (self.n_elements, self.branches, self.envelope_scale_m is None,
+                                           "damping_N_s_per_m" in self.values)
 
     def _held_slipping(self, i: int) -> bool:
         """Whether element ``i`` (from 1) is held slipping (``branches``)."""
@@ -111,10 +115,24 @@ class MaxwellSlip(ElementParameters, Component):
         linearisation within one stick state differentiates."""
         n = self.n_elements
         held = MaxwellSlip(self.name, self.element, [self.values[f"delta{i}_m"] for i in range(1, n + 1)],
-                           [self.values[f"share{i}"] for i in range(1, n + 1)], self.values["damping_N_s_per_m"],
+                           [self.values[f"share{i}"] for i in range(1, n + 1)], self.values.get("damping_N_s_per_m"),
                            branches, self.values.get("envelope_scale_m"))
         held.model_name = self.model_name
         return held
+
+    def on_massless_end(self) -> "MaxwellSlip":
+        """These elements without the presliding damping term (and its parameter), for a node whose velocity
+        its balance of forces gives (:class:`pamsim.components.series_tendon.SeriesTendon`'s muscle end):
+        there a force that depends on the velocity is an algebraic loop.  Their damping must be 0."""
+        if self.values.get("damping_N_s_per_m", 0.0) != 0.0:
+            raise ValueError(f"{self.name}: presliding damping {self.values['damping_N_s_per_m']:g} N s/m on a "
+                             "massless node")
+        n = self.n_elements
+        out = MaxwellSlip(self.name, self.element, [self.values[f"delta{i}_m"] for i in range(1, n + 1)],
+                          [self.values[f"share{i}"] for i in range(1, n + 1)], None, self.branches,
+                          self.values.get("envelope_scale_m"))
+        out.model_name = self.model_name
+        return out
 
     def held_state(self, p_abs_Pa: float) -> dict[str, float]:
         """The states at rest, relaxed (every deflection 0), whatever the pressure ``p_abs_Pa``."""
@@ -136,8 +154,9 @@ class MaxwellSlip(ElementParameters, Component):
             share = s.p[f"share{i}"]
             branch = None if self.branches is None else self.branches[i - 1]
             z = branch * delta if self._held_slipping(i) else s.x[f"z{i}_m"]
+            c = share * s.p["damping_N_s_per_m"] if "damping_N_s_per_m" in self.values else 0.0
             e = element(z, v_elements, share * level / delta, delta, s.fired[i - 1] if branch is None else 0.0,
-                        share * s.p["damping_N_s_per_m"], None if branch is None else branch == 0)
+                        c, None if branch is None else branch == 0)
             if not self._held_slipping(i):
                 der[f"z{i}_m"] = e.rate
             der[f"E_element{i}_J"] = -e.force * v

@@ -13,7 +13,11 @@ docs/joints.md).  Its forces then balance at every instant::
 
 which gives its velocity without a mode: held (``v = 0`` exactly) while ``|F_static - T| <= F_c``,
 else the velocity at which the damping takes what friction leaves,
-``v = F_damp^-1(F_static - T -+ F_c)``.  The velocity is continuous in the state (a dead zone, not a
+``v = F_damp^-1(F_static - T -+ F_c)``.  Components added on the muscle's end (Maxwell-slip, Bouc-Wen or
+Prandtl-Ishlinskii elements in the friction's place, a spring) act on the node's port ``others``, and their
+summed force ``F_others`` joins the static force: ``F_static + F_others - T``.  None of them may pull with
+a force that depends on the end's velocity (a damper, an element's presliding damping): the velocity is
+what the balance gives, and such a force would be an algebraic loop.  The velocity is continuous in the state (a dead zone, not a
 switch), so the muscle's stick and slip need no event; its kinks at ``|F_static - T| = F_c`` are left
 to the integrator's step control, as a tendon's slack is.  It needs a damping law whose force grows
 strictly with speed (:func:`pamsim.elements.damping.increasing`); the paper's, with ``D1 < 0``, does not.
@@ -46,14 +50,17 @@ class SeriesTendon(Component):
     (which then carries the tendon's pull ``T`` to the body).
 
     Inputs: the muscle's static force, its Coulomb level, and the velocity its damping gives for the
-    force left after friction (``F_free_N`` out, ``v_free_m_s`` in: :class:`MuscleEndDamping`).
+    force left after friction (``F_free_N`` out, ``v_free_m_s`` in: :class:`MuscleEndDamping`).  The node
+    ``others`` (optional) carries the components added on the muscle's end; their force joins the static
+    force in the balance.
     State ``x_m``: the muscle's contraction; it starts at the path's (the tendon unstretched).
     Output ``level_on_body_N`` is zero: the muscle's friction acts at its end and reaches the body
     only through the tendon's force.
     """
 
     parameters = (positive("k_N_per_m", "N/m", "stiffness of the tendon in series with the muscle"),)
-    ports = (Port("flange", TRANSLATIONAL, "node"), Port("path", TRANSLATIONAL, "branch"))
+    ports = (Port("flange", TRANSLATIONAL, "node"), Port("path", TRANSLATIONAL, "branch"),
+             Port("others", TRANSLATIONAL, "node", optional=True))
     inputs = (Var("F_static_N", "N", "the muscle's static force"),
               Var("friction_level_N", "N", "the muscle's Coulomb friction level"),
               Var("v_free_m_s", "m/s", "velocity at which the muscle's damping takes F_free_N"))
@@ -73,7 +80,7 @@ class SeriesTendon(Component):
         x, level = s.x["x_m"], s.u["friction_level_N"]
         stretch = x - path["x_m"]
         T = k * fmax(stretch, 0.0)
-        drive = s.u["F_static_N"] - T
+        drive = s.u["F_static_N"] + s.port["others"]["F_N"] - T
         free = if_else(drive > level, drive - level, if_else(drive < -level, drive + level, 0.0))
         v = s.u["v_free_m_s"]  # exactly zero at free == 0: every law's inverse is
         taut_stretch = fmax(stretch, 0.0)
@@ -82,5 +89,5 @@ class SeriesTendon(Component):
             outputs={"x_m": x, "v_m_s": v, "stretch_m": stretch, "F_tendon_N": T, "F_free_N": free,
                      "direction": if_else(free > 0.0, 1.0, if_else(free < 0.0, -1.0, 0.0)),
                      "E_elastic_J": 0.5 * k * taut_stretch * taut_stretch, "level_on_body_N": 0.0},
-            port={"flange": {"x_m": x, "v_m_s": v}, "path": {"F_N": T}},
+            port={"flange": {"x_m": x, "v_m_s": v}, "others": {"x_m": x, "v_m_s": v}, "path": {"F_N": T}},
             initial={"x_m": path["x_m"]})

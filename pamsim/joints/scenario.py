@@ -369,6 +369,12 @@ def _tendon_stiffness(origin: str, where: str, table: dict, scenario: Scenario) 
               f"a muscle on an elastic tendon ({key} = {k:g}) needs damping that grows with speed through zero "
               "(its end is massless and moves at the speed its damping allows): use damping = 'linear', or "
               "'paper' with D1_N_s_per_m > 0")
+    c = table.get("hysteresis", {}).get("damping_N_s_per_m", 0.0)
+    if c != 0.0:
+        _fail(origin, f"{where}.hysteresis.damping_N_s_per_m", c,
+              f"presliding damping cannot act on the end of a muscle on an elastic tendon ({key} = {k:g}): the end "
+              "is massless and moves at the speed the balance of its forces gives, which a force that depends on "
+              "that speed would make a loop; leave it out (0), or make the tendon rigid")
     return k
 
 
