@@ -417,6 +417,58 @@ def test_a_joint_on_valves_or_on_a_limit_is_not_linearised():
         linearize_joint(prescribed_pair(), [4e5, 1e5])
 
 
+def test_a_joints_hysteresis_elements_are_linearised_relaxed_and_sticking_as_springs(tmp_path):
+    """At the equilibrium each muscle's elements are taken relaxed, Maxwell-slip's sticking and Bouc-Wen on its
+    loading branch, and the model says so: springs of ``w F_c / delta`` (Maxwell-slip) and ``F_c / z_u``
+    (Bouc-Wen at z = 0) on the muscles' flanges.  The joint's oscillation is then the plain pair's with the
+    springs' ``r^2 sum k`` added to its stiffness over the inertia, by hand; the static stiffness output is the
+    plain pair's (the springs act through their deflections, states).  ``pamsim linearize`` prints it."""
+    import json
+
+    from pamsim.joints.linear import linearize_joint
+
+    spec = copy.deepcopy(PAIR)
+    for table in spec["muscle"]:
+        table["pressure"] = {"source": "prescribed", "prescribed": {"kind": "constant", "value_gauge_bar": 2.0}}
+        table["model"]["friction"] = "constant"  # 2.5 N: the paper's level is zero at this link's load
+    plain = linearize_joint(JointScenario.from_dict(copy.deepcopy(spec)), [2.2e5, 2.0e5])
+    spec["muscle"][0]["hysteresis"] = {"model": "maxwell_slip", "slip_displacement_m": [1e-3, 4e-3], "share": [0.5, 0.5]}
+    spec["muscle"][1]["hysteresis"] = {"model": "bouc_wen", "beta_per_m_n": 200.0, "gamma_per_m_n": 200.0,
+                                       "exponent": 1.0}
+    lm = linearize_joint(JointScenario.from_dict(spec), [2.2e5, 2.0e5])
+    loops = dict(lm.hysteresis)
+    assert [e["state"] for e in loops["flexor"].elements] == ["stick", "stick"]
+    assert [e["k_N_per_m"] for e in loops["flexor"].elements] == pytest.approx([0.5 * 2.5 / 1e-3, 0.5 * 2.5 / 4e-3])
+    assert loops["extensor"].elements[0]["k_N_per_m"] == pytest.approx(2.5 * (200.0 + 200.0))  # F_c / z_u
+    assert {loop.branch for loop in loops.values()} == {"at rest"}
+    springs = sum(t["radius_m"] ** 2 * e["k_N_per_m"] for t, (_, loop) in zip(spec["muscle"], lm.hysteresis)
+                  for e in loop.elements)
+    by_hand = plain.A.copy()
+    by_hand[1, 0] -= springs / spec["joint"]["inertia_kg_m2"]
+    moving = np.sort_complex([z for z in lm.poles() if abs(z) > 1.0])
+    np.testing.assert_allclose(moving, np.sort_complex(np.linalg.eigvals(by_hand)), rtol=1e-9)
+    assert abs(moving[0].imag) > 1.5 * abs(np.linalg.eigvals(plain.A)[0].imag)
+    assert lm.k0_Nm_per_rad == plain.k0_Nm_per_rad
+    text = PAIR_FILE.read_text().replace('friction = "load_dependent"', 'friction = "constant"')
+    for name, (bar, table) in {"2.2": ("2.2", 'model = "maxwell_slip"\nslip_displacement_m = [1e-3, 4e-3]\n'
+                                              'share = [0.5, 0.5]'),
+                               "2.0": ("2.0", 'model = "bouc_wen"\nbeta_per_m_n = 200.0\ngamma_per_m_n = 200.0\n'
+                                              'exponent = 1.0')}.items():
+        valve = f'[muscle.pressure]\nsource = "valve"\nsupply_gauge_bar = {name}\nvalve_open_time_s = 0.5'
+        assert valve in text
+        text = text.replace(valve, f'[muscle.hysteresis]\n{table}\n[muscle.pressure]\nsource = "prescribed"\n'
+                                   f'[muscle.pressure.prescribed]\nkind = "constant"\nvalue_gauge_bar = {bar}')
+    path = tmp_path / "pair.toml"
+    path.write_text(text)
+    done = subprocess.run([sys.executable, "-m", "pamsim", "linearize", str(path), "--json"], capture_output=True,
+                          text=True)
+    assert done.returncode == 0, done.stderr
+    rep = json.loads(done.stdout)["hysteresis"]
+    assert rep["flexor"]["branch"] == "at rest" and [e["state"] for e in rep["flexor"]["elements"]] == ["stick"] * 2
+    text = subprocess.run([sys.executable, "-m", "pamsim", "linearize", str(path)], capture_output=True, text=True)
+    assert "flexor: hysteresis: maxwell_slip, branch at rest" in text.stdout, text.stdout
+
+
 def test_pamsim_linearize_a_joint_prints_the_mimo_model():
     """``pamsim linearize`` on a joint scenario with prescribed pressures: the model about the equilibrium at
     the final pressures (pair_cocontraction: 4 bar on both, the link at zero), as JSON; the stiffness is the

@@ -148,6 +148,8 @@ def _linearize_joint(scenario, args: argparse.Namespace) -> int:
            "inputs": list(lm.inputs), "outputs": list(lm.outputs), "poles": [_complex(z) for z in lm.poles()],
            "theta0_rad": lm.theta0_rad, "p0_gauge_Pa": list(lm.p0_gauge_Pa), "k0_Nm_per_rad": lm.k0_Nm_per_rad,
            "friction": "Coulomb friction dropped (the bearing's and the muscles': no linearisation at rest)"}
+    if lm.hysteresis:
+        rep["hysteresis"] = {name: loop.as_dict() for name, loop in lm.hysteresis}
     if args.json:
         print(json.dumps(rep, indent=2))
         return 0
@@ -155,6 +157,8 @@ def _linearize_joint(scenario, args: argparse.Namespace) -> int:
     print(f"operating point: the joint at rest at {lm.theta0_rad:.6g} rad, muscles at "
           + ", ".join(f"{p / 1e5:g} bar" for p in lm.p0_gauge_Pa) + f"; stiffness {lm.k0_Nm_per_rad:.6g} N m/rad")
     print(f"friction: {rep['friction']}")
+    for name, loop in lm.hysteresis:
+        print(f"{name}: " + "\n".join(loop.lines()))
     for key in ("states", "inputs", "outputs"):
         print(f"{key + ':':8} {', '.join(rep[key])}")
     for key in ("A", "B", "C", "D"):

@@ -37,12 +37,13 @@ from dataclasses import dataclass, replace
 import control as ct
 import numpy as np
 
+from ..assemblies.stick_state import LoopPoint
 from ..errors import InputError
 from ..model import MuscleModel
 from .choices import VALVE_SLOPES
 from .exact import control_functions, exact_jacobians, held_line_states, line_states
 from .line_rest import held_line_pressures
-from .loop_point import LoopPoint, hold_hysteresis
+from .loop_point import hold_hysteresis
 from .operating_point import OperatingPoint
 from .system import INPUT_SCALES, INPUTS, OUTPUTS, STATE_SCALES, STATES, FrictionTreatment, MusclePlant, input_names
 

@@ -28,45 +28,13 @@ the switch fixed, differentiated exactly with the rig.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 from ..assemblies.one_muscle import AddedComponent
+from ..assemblies.stick_state import BRANCHES, LoopPoint, held_bouc_wen, held_maxwell_slip
 from ..components.bouc_wen_friction import BoucWenFriction
-from ..components.elasto_slide import element
 from ..components.maxwell_slip_friction import MaxwellSlip
 from .operating_point import OperatingPoint
-
-BRANCHES = {1: "loading", -1: "unloading", 0: "at rest"}
-"""The branch's name by the sign of the motion."""
-
-
-@dataclass(frozen=True)
-class LoopPoint:
-    """Where on its loop the hysteresis was linearised: the branch, how it was found, and per element its
-    stick state (Maxwell-slip) or its tangent (Bouc-Wen); ``dropped``: the slipping elements' deflections,
-    left out of the linear model."""
-
-    model: str
-    branch: str
-    branch_from: str
-    elements: tuple[dict, ...]
-    dropped: tuple[str, ...] = ()
-
-    def as_dict(self) -> dict:
-        """JSON-ready: ``{"model", "branch", "branch_from", "elements": [...]}``."""
-        return {"model": self.model, "branch": self.branch, "branch_from": self.branch_from,
-                "elements": [dict(e) for e in self.elements]}
-
-    def lines(self) -> list[str]:
-        """The text the command line prints."""
-        out = [f"hysteresis: {self.model}, branch {self.branch} ({self.branch_from})"]
-        for e in self.elements:
-            out.append("  " + ", ".join(f"{k} {_text(v)}" for k, v in e.items()))
-        return out
-
-
-def _text(value) -> str:
-    return f"{value:.6g}" if isinstance(value, float) else str(value)
 
 
 def _motion(op: OperatingPoint) -> tuple[int, str]:
@@ -92,9 +60,9 @@ def hold_hysteresis(model, op: OperatingPoint, added: tuple) -> tuple[tuple, Ope
     state.update({k: v for k, v in op.line_states.items() if k in state})
     level = _level_N(model, a.component, op)
     if isinstance(a.component, MaxwellSlip):
-        held, loop = _maxwell_slip(a.component, state, sign, level)
+        held, loop = held_maxwell_slip(a.component, state, sign, level)
     else:
-        held, loop = _bouc_wen(a.component, state, sign, level)
+        held, loop = held_bouc_wen(a.component, state, sign, level)
     loop = replace(loop, branch=BRANCHES[sign], branch_from=source)
     out = added[:index] + (AddedComponent(held, a.connect),) + added[index + 1:]
     return out, replace(op, line_states={**state, **op.line_states}), loop
@@ -104,39 +72,3 @@ def _level_N(model, component, op: OperatingPoint) -> float:
     """The friction law's level at ``op`` [N], as the component reads it."""
     p_gauge = float(op.states[2]) - model.source.p_atm_Pa
     return float(component.element.level_N(float(op.states[0]), p_gauge, model.load.mass_kg))
-
-
-def _maxwell_slip(component: MaxwellSlip, state: dict, sign: int, level: float):
-    """The model held in each element's stick state, and the elements' report."""
-    branches, elements, dropped = [], [], []
-    c = component.values["damping_N_s_per_m"]
-    for i in range(1, component.n_elements + 1):
-        delta, share = component.values[f"delta{i}_m"], component.values[f"share{i}"]
-        name = f"{component.name}.z{i}_m"
-        z = state[name]
-        slips = bool(element(z, float(sign), 1.0, delta, 0.0).slipping)
-        branches.append(int(math.copysign(1.0, z)) if slips else 0)
-        entry = {"name": f"{component.name}.element{i}", "state": "slip" if slips else "stick",
-                 "k_N_per_m": share * level / delta, "slip_force_N": share * level, "deflection_m": z,
-                 "slip_limit_m": delta}
-        if slips:
-            entry["force_N"] = -branches[-1] * share * level
-            dropped.append(name)
-        else:
-            entry.update(damping_N_s_per_m=share * c, margin_m=delta - abs(z))
-        elements.append(entry)
-    return component.held(branches), LoopPoint(component.model_name, "", "", tuple(elements), tuple(dropped))
-
-
-def _bouc_wen(component: BoucWenFriction, state: dict, sign: int, level: float):
-    """The model on the branch ``sign`` (+1 at rest), and its tangent there: ``dz/dx`` along the branch and
-    the force's slope against the contraction at a constant level, ``-F_c / z_u dz/dx``."""
-    P = component.values
-    s = sign or 1
-    z = state[f"{component.name}.z_m"]
-    n = P["exponent"]
-    z_u = (1.0 / (P["beta_per_m_n"] + P["gamma_per_m_n"])) ** (1.0 / n)
-    slope = 1.0 - P["beta_per_m_n"] * s * math.copysign(1.0, z) * abs(z) ** n - P["gamma_per_m_n"] * abs(z) ** n
-    entry = {"name": component.name, "z_m": z, "z_saturation_m": z_u, "dz_dx": slope,
-             "k_N_per_m": level / z_u * slope, "level_N": level}
-    return component.held(s), LoopPoint("bouc_wen", "", "", (entry,))

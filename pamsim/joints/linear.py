@@ -9,15 +9,24 @@ prescribed gauge pressure and the external torque; the outputs the angle and the
 ``k = -d tau_net / d theta`` at rest, whose own derivatives are CasADi's second derivatives of the net
 torque.  A muscle fed by a valve is refused: its chamber at rest sits where the valve's flow has no
 derivative (a pressure ratio of 1).
+
+A muscle's hysteresis elements (``[muscle.hysteresis]``) are taken at the equilibrium as the one-muscle
+``linearize`` takes them at rest (:mod:`pamsim.control.loop_point`): relaxed, every Maxwell-slip element
+sticking (a spring on the muscle's flange, its deflection a state), Bouc-Wen on its loading branch; the model
+says so (``hysteresis``).  The stiffness output is the static one, ``-d tau_net / d theta`` with the
+elements' deflections held: their springs act through their states.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from ..assemblies.joint import at_prescribed_pressure, joint_assembly
+from ..assemblies.stick_state import BRANCHES, LoopPoint, held_bouc_wen, held_maxwell_slip
+from ..components.bouc_wen_friction import BoucWenFriction
+from ..components.maxwell_slip_friction import MaxwellSlip
 from ..components.stick_slip import BodyMode
 from ..elements.pressure_source import PrescribedPressure
 from ..errors import InputError
@@ -30,7 +39,8 @@ class JointLinearModel:
     """``dx/dt = A dx + B du``, ``dy = C dx + D du`` about ``theta0_rad`` at pressures ``p0_gauge_Pa``.
 
     ``states``, ``inputs`` and ``outputs`` name the rows and columns (outputs: ``joint.theta_rad`` and
-    ``joint.k_Nm_per_rad``); ``k0_Nm_per_rad`` is the stiffness at the operating point.
+    ``joint.k_Nm_per_rad``); ``k0_Nm_per_rad`` is the stiffness at the operating point; ``hysteresis``:
+    ``(muscle, LoopPoint)`` for each muscle with hysteresis elements, the stick state they were taken in.
     """
 
     A: np.ndarray
@@ -43,6 +53,7 @@ class JointLinearModel:
     theta0_rad: float
     p0_gauge_Pa: tuple[float, ...]
     k0_Nm_per_rad: float
+    hysteresis: tuple[tuple[str, LoopPoint], ...] = ()
 
     def poles(self) -> np.ndarray:
         """The eigenvalues of ``A`` [1/s]."""
@@ -91,17 +102,59 @@ def linearize_joint(scenario: JointScenario, p_gauge_Pa) -> JointLinearModel:
     if eq.on_limit:
         raise InputError(f"{scenario.origin}: at {[p / 1e5 for p in p_gauge_Pa]} bar the link rests on its "
                          f"{eq.on_limit} limit: there is no equilibrium to linearise about")
+    u0 = [float(v) for v in p_gauge_Pa] + [0.0]
+    muscles, loops = _relaxed_hysteresis(scenario, muscles, eq.theta_rad, u0)
     assembly = joint_assembly(scenario.joint_values(), muscles, scenario.joint["g_m_s2"], name=scenario.name)
     moving, held = (assembly.flatten({"joint": int(m)}) for m in (BodyMode.SLIP_UP, BodyMode.STICK))
     if moving.externals:
         raise InputError(f"{scenario.origin}: a static force without a symbolic form cannot be linearised exactly")
     keep = [i for i in range(len(moving.states)) if i not in moving.quadratures()]
     x0 = _operating_state(moving, eq.theta_rad)
-    u0 = [float(v) for v in p_gauge_Pa] + [0.0]
     A, B, C, D, k0 = (np.array(m, dtype=float) for m in _jacobians(moving, held, keep)(x0, u0, _without_coulomb(moving)))
     return JointLinearModel(A, B, C, D, tuple(moving.states[i].name for i in keep), tuple(v.name for v in moving.inputs),
                             ("joint.theta_rad", "joint.k_Nm_per_rad"), eq.theta_rad,
-                            tuple(float(v) for v in p_gauge_Pa), float(k0.item()))
+                            tuple(float(v) for v in p_gauge_Pa), float(k0.item()), loops)
+
+
+def _relaxed_hysteresis(scenario: JointScenario, muscles: tuple, theta_rad: float, u0: list) -> tuple[tuple, tuple]:
+    """``(muscles, loops)``: each muscle's hysteresis elements held relaxed at the equilibrium ``theta_rad``
+    (:mod:`pamsim.control.loop_point`'s rule at rest: Maxwell-slip elements sticking, Bouc-Wen on its
+    loading branch) at their friction level there, and what was held, per muscle."""
+    has = [any(isinstance(a.component, (MaxwellSlip, BoucWenFriction)) for a in m.added) for m in muscles]
+    if not any(has):
+        return muscles, ()
+    flat = joint_assembly(scenario.joint_values(), muscles, scenario.joint["g_m_s2"]).flatten(
+        {"joint": int(BodyMode.STICK)})
+    levels = _outputs_at(flat, _operating_state(flat, theta_rad), u0,
+                         [f"{m.name}_{a.component.name}.level_N" for m, h in zip(muscles, has) if h
+                          for a in m.added if isinstance(a.component, (MaxwellSlip, BoucWenFriction))])
+    out, loops = [], []
+    for m in muscles:
+        added = []
+        for a in m.added:
+            if not isinstance(a.component, (MaxwellSlip, BoucWenFriction)):
+                added.append(a)
+                continue
+            c = a.component
+            state = {f"{c.name}.{k}": v for k, v in c.held_state(0.0).items()}
+            hold = held_maxwell_slip if isinstance(c, MaxwellSlip) else held_bouc_wen
+            component, loop = hold(c, state, 0, levels[f"{m.name}_{c.name}.level_N"])
+            added.append(replace(a, component=component))
+            loops.append((m.name, replace(loop, branch=BRANCHES[0], branch_from="an equilibrium: the elements relaxed",
+                                          elements=tuple({**e, "name": f"{m.name}_{e['name']}"} for e in loop.elements))))
+        out.append(replace(m, added=tuple(added)))
+    return tuple(out), tuple(loops)
+
+
+def _outputs_at(flat, x0: list, u0: list, names: list[str]) -> dict[str, float]:
+    """The values of ``flat``'s outputs ``names`` at states ``x0`` and inputs ``u0`` (its own parameters)."""
+    import casadi as ca
+
+    index = [v.name for v in flat.outputs]
+    f = ca.Function("outputs_at", [ca.vertcat(*flat.x), ca.vertcat(*flat.u), ca.vertcat(*flat.p)],
+                    [ca.vertcat(*[flat.y[index.index(n)] for n in names])])
+    values = np.array(f(x0, u0, flat.parameter_values), dtype=float).ravel()
+    return dict(zip(names, (float(v) for v in values)))
 
 
 def _without_coulomb(flat) -> np.ndarray:
