@@ -524,7 +524,7 @@ class HybridRun:
         self.transitions.extend(TransitionEvent(t_event, name, self.mode.label, self.mode.label, float(self.y[0]))
                                 for name, _ in also)
         if len(self.transitions) > self.opts.max_events:
-            raise too_many_events(self.opts.max_events, f" by t = {t_event:.6g} s")
+            raise too_many_events(self.opts.max_events, f" by t = {t_event:.6g} s{_in_place(self.transitions)}")
         self.t = t_event
 
     def at_breakpoint(self, seg, t_break: float) -> None:
@@ -581,6 +581,18 @@ class _Run(HybridRun):
                                  wall_time_s, peaks={"x_m": self.peak_x, "p_gauge_Pa": self.peak_p,
                                                      "x_min_m": self.low_x},
                                  outputs=RigOutputs(self.gen.assembly, self.model, t, Y, modes))
+
+
+def _in_place(transitions: list) -> str:
+    """What the last hundred events were, where each left the mode as it was (an element reaching its limit
+    again and again): "" otherwise."""
+    last = transitions[-100:]
+    if not last or any(e.from_mode != e.to_mode for e in last):
+        return ""
+    return (f"; the last {len(last)} are {', '.join(sorted({e.kind for e in last}))} in mode {last[-1].to_mode}: "
+            "an element resting on its limit at a stiff node (a massless muscle end on an elastic tendon), which "
+            "this integrator's restarts switch again and again; the native backend integrates it as stiff across "
+            "those switches (docs/joints.md)")
 
 
 def too_many_events(max_events: int, when: str = "") -> SolverFailure:

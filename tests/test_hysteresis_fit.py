@@ -81,6 +81,21 @@ def synthetic_csv(tmp_path_factory):
     return path
 
 
+def test_a_measured_force_named_like_a_derived_one_is_not_reported_as_derived(synthetic_csv, tmp_path):
+    """The report calls a force derived at a hanging load only where it was (``--scenario``): a measured
+    column that happens to be named ``W - ...`` is reported as read."""
+    lines = synthetic_csv.read_text().splitlines()
+    header = lines[0].split(",")
+    i = next(k for k, name in enumerate(header) if name.startswith(("force", "F_")) and name.endswith("_N"))
+    header[i] = "W - pull_N"
+    path = tmp_path / "loop.csv"
+    path.write_text("\n".join([",".join(header), *lines[1:]]) + "\n")
+    out = tmp_path / "fit"
+    proc = run_main("fit", "hysteresis", path, "--columns", "force=W - pull_N", "--elements", "2", "-o", out)
+    assert proc.returncode == 0, proc.stderr
+    assert "hanging load" not in (out / "report.md").read_text()
+
+
 def test_fit_hysteresis_writes_its_outputs(synthetic_csv, tmp_path):
     out = tmp_path / "fit"
     proc = run_main("fit", "hysteresis", synthetic_csv, "--max-elements", "3", "-o", out, "--json")

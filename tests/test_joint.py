@@ -432,7 +432,8 @@ def test_a_joints_hysteresis_elements_are_linearised_relaxed_and_sticking_as_spr
         table["pressure"] = {"source": "prescribed", "prescribed": {"kind": "constant", "value_gauge_bar": 2.0}}
         table["model"]["friction"] = "constant"  # 2.5 N: the paper's level is zero at this link's load
     plain = linearize_joint(JointScenario.from_dict(copy.deepcopy(spec)), [2.2e5, 2.0e5])
-    spec["muscle"][0]["hysteresis"] = {"model": "maxwell_slip", "slip_displacement_m": [1e-3, 4e-3], "share": [0.5, 0.5]}
+    spec["muscle"][0]["hysteresis"] = {"model": "maxwell_slip", "slip_displacement_m": [1e-3, 4e-3],
+                                       "share": [0.5, 0.5]}
     spec["muscle"][1]["hysteresis"] = {"model": "bouc_wen", "beta_per_m_n": 200.0, "gamma_per_m_n": 200.0,
                                        "exponent": 1.0}
     lm = linearize_joint(JointScenario.from_dict(spec), [2.2e5, 2.0e5])

@@ -178,8 +178,8 @@ def test_a_bad_pneumatic_table_of_a_joint_muscle_is_refused_by_key(change, key):
 
 
 def test_the_command_refuses_a_joint_muscles_unknown_law_with_exit_2(tmp_path):
-    assert_refused(run_main("run", _pair_file_with_law(tmp_path, "bogus"), "-o", tmp_path / "out"), "muscle 'flexor': chamber.law = 'bogus'",
-                   tmp_path / "out")
+    assert_refused(run_main("run", _pair_file_with_law(tmp_path, "bogus"), "-o", tmp_path / "out"),
+                   "muscle 'flexor': chamber.law = 'bogus'", tmp_path / "out")
 
 
 def test_on_an_elastic_tendon_the_chamber_follows_the_muscles_own_end():

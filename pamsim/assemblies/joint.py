@@ -204,9 +204,9 @@ def _muscle_parts(m: JointMuscle, attach, body, friction_load: str | None) -> tu
 def _added_parts(m: JointMuscle, source, node: str, flange: str, mass: str, inputs: dict) -> tuple[list, list]:
     """The components on muscle ``m`` (its ``[hysteresis]``, its lines and reservoirs), renamed after it, wired
     as on the one-muscle rig: what they read of the rig's load read of the muscle's flange node ``node`` (its
-    flange port ``flange``) and the friction's load ``mass``; a reference to the rig's muscle, friction, damping, pressure source or another of
-    the muscle's components, of the muscle's own; a model input (a supply's set pressure), the muscle's own
-    input of that name in ``inputs``, which then drives them too."""
+    flange port ``flange``) and the friction's load ``mass``; a reference to the rig's muscle, friction,
+    damping, pressure source or another of the muscle's components, of the muscle's own; a model input (a
+    supply's set pressure), the muscle's own input of that name in ``inputs``, which then drives them too."""
     prefix = f"{m.name}_"
     names = {c.name.removeprefix(prefix): c.name for c in source.parts}  # "chamber" -> "<muscle>_chamber"
     names.update({k: prefix + k for k in ("muscle", "friction", "damping")})

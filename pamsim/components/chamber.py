@@ -10,7 +10,7 @@ from .element import ElementParameters
 PROBE_POINTS = tuple((x,) for x in (0.0, 0.01, 0.04))
 
 OUTPUTS = (Var("p_gauge_Pa", "Pa", "chamber gauge pressure"), Var("p_abs_Pa", "Pa", "absolute chamber pressure"),
-           Var("gas_temperature_K", "K", "chamber gas temperature p V / (m R)"),
+           Var("gas_temperature_K", "K", "chamber gas temperature p V / (m R) (the wall's, isothermal)"),
            Var("volume_m3", "m^3", "chamber volume"))
 THERMAL_OUTPUTS = (Var("wall_heat_W", "W", "heat the wall gives the gas, h A(x) (T_wall - T)"),
                    Var("wall_area_m2", "m^2", "inner surface of the muscle's cylinder"))

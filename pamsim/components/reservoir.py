@@ -13,7 +13,7 @@ from . import gas_volume
 from .element import ElementParameters
 
 VOLUME_OUTPUTS = (Var("p_gauge_Pa", "Pa", "gauge pressure"), Var("p_abs_Pa", "Pa", "absolute pressure"),
-                  Var("gas_temperature_K", "K", "gas temperature p V / (m R)"))
+                  Var("gas_temperature_K", "K", "gas temperature p V / (m R) (the wall's, isothermal)"))
 """The outputs of every rigid volume."""
 
 VOLUME_STATES = (Var("p_abs_Pa", "Pa", "absolute pressure", 1e5),

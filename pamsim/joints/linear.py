@@ -140,8 +140,9 @@ def _relaxed_hysteresis(scenario: JointScenario, muscles: tuple, theta_rad: floa
             hold = held_maxwell_slip if isinstance(c, MaxwellSlip) else held_bouc_wen
             component, loop = hold(c, state, 0, levels[f"{m.name}_{c.name}.level_N"])
             added.append(replace(a, component=component))
+            named = tuple({**e, "name": f"{m.name}_{e['name']}"} for e in loop.elements)
             loops.append((m.name, replace(loop, branch=BRANCHES[0], branch_from="an equilibrium: the elements relaxed",
-                                          elements=tuple({**e, "name": f"{m.name}_{e['name']}"} for e in loop.elements))))
+                                          elements=named)))
         out.append(replace(m, added=tuple(added)))
     return tuple(out), tuple(loops)
 

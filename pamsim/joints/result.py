@@ -134,7 +134,8 @@ class JointResult:
         ``residual_J`` = work in - (kinetic + potential gain + bearing friction + impacts); ``relative``
         divides it by the largest term.  Per muscle, ``<name>.slack_J`` is the work of its forces that
         no tendon passed on (nonzero only where it went slack): static work - damping - friction - tendon,
-        less what an elastic tendon stored and what the muscle's hysteresis took.
+        less what an elastic tendon stored, plus what the components added on the muscle's end gave it
+        (their ``W_`` terms, the rig's convention) less what they took (``E_``: the hysteresis').
         """
         s = self.signals
         d = lambda key: float(s[key][-1] - s[key][0])  # noqa: E731
@@ -149,10 +150,23 @@ class JointResult:
         slack = {f"{m}.slack_J": float(s[f"{m}_muscle.W_muscle_J"][-1] - s[f"{m}_damping.E_damping_J"][-1]
                                        - s[f"{m}_friction.E_friction_J"][-1] - s[tendon[m]][-1]
                                        - (d(k) if (k := f"{m}_series_spring.E_elastic_J") in s else 0.0)
-                                       - sum(float(s[k][-1]) for k in s if k.startswith(f"{m}_hysteresis.E_")))
+                                       + sum(self._added_work_J(m)))
                  for m in self.muscles}
         scale = max(abs(v) for v in terms.values()) or 1.0
         return {**terms, **slack, "residual_J": float(residual), "relative": float(abs(residual) / scale)}
+
+    def _added_work_J(self, muscle: str) -> list[float]:
+        """The work [J] each component added on ``muscle``'s end gave it (``W_`` states) or took (``E_``,
+        negative): every ``<muscle>_<component>.W_*`` or ``.E_*`` but the muscle's own forces' and tendon's."""
+        own = {f"{muscle}_muscle", f"{muscle}_damping", f"{muscle}_friction", f"{muscle}_series_spring",
+               self.signals_key(muscle, "W_tendon_J").split(".")[0]}
+        out = []
+        for key, values in self.signals.items():
+            owner, _, var = key.partition(".")
+            other = any(owner.startswith(f"{o}_") for o in self.muscles if len(o) > len(muscle))  # "a_b" vs "a"
+            if owner.startswith(f"{muscle}_") and not other and owner not in own and var[:2] in ("W_", "E_"):
+                out.append(float(values[-1]) if var.startswith("W_") else -float(values[-1]))
+        return out
 
     def columns(self) -> dict[str, np.ndarray]:
         """``t_s``, ``theta_rad``, ``omega_rad_s``, ``mode``, then per muscle :data:`MUSCLE_COLUMNS` (and
