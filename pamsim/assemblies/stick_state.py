@@ -15,6 +15,9 @@ from ..components.bouc_wen_friction import BoucWenFriction
 from ..components.elasto_slide import element
 from ..components.maxwell_slip_friction import MaxwellSlip
 
+HYSTERESIS = (MaxwellSlip, BoucWenFriction)
+"""The components a linearisation holds in a stick state."""
+
 BRANCHES = {1: "loading", -1: "unloading", 0: "at rest"}
 """The branch's name by the sign of the motion."""
 
@@ -84,3 +87,10 @@ def held_bouc_wen(component: BoucWenFriction, state: dict, sign: int, level: flo
     entry = {"name": component.name, "z_m": z, "z_saturation_m": z_u, "dz_dx": slope,
              "k_N_per_m": level / z_u * slope, "level_N": level}
     return component.held(s), LoopPoint("bouc_wen", "", "", (entry,))
+
+
+def held(component, state: dict, sign: int, level: float):
+    """``(held model, LoopPoint)`` of a :data:`HYSTERESIS` component: :func:`held_maxwell_slip` or
+    :func:`held_bouc_wen`."""
+    hold = held_maxwell_slip if isinstance(component, MaxwellSlip) else held_bouc_wen
+    return hold(component, state, sign, level)

@@ -113,12 +113,7 @@ class MaxwellSlip(ElementParameters, Component):
         """This model with each element held in a stick state (``branches``: per element 0 sticking, +1 or -1
         slipping that way, at its slip displacement), its equations otherwise the same, and no events: what a
         linearisation within one stick state differentiates."""
-        n = self.n_elements
-        held = MaxwellSlip(self.name, self.element, [self.values[f"delta{i}_m"] for i in range(1, n + 1)],
-                           [self.values[f"share{i}"] for i in range(1, n + 1)], self.values.get("damping_N_s_per_m"),
-                           branches, self.values.get("envelope_scale_m"))
-        held.model_name = self.model_name
-        return held
+        return self._copy(self.values.get("damping_N_s_per_m"), branches)
 
     def on_massless_end(self) -> "MaxwellSlip":
         """These elements without the presliding damping term (and its parameter), for a node whose velocity
@@ -127,9 +122,14 @@ class MaxwellSlip(ElementParameters, Component):
         if self.values.get("damping_N_s_per_m", 0.0) != 0.0:
             raise ValueError(f"{self.name}: presliding damping {self.values['damping_N_s_per_m']:g} N s/m on a "
                              "massless node")
+        return self._copy(None, self.branches)
+
+    def _copy(self, damping_N_s_per_m: float | None, branches) -> "MaxwellSlip":
+        """These elements with the presliding damping ``damping_N_s_per_m`` (None: no such term) and the stick
+        states ``branches``, the rest as they are."""
         n = self.n_elements
         out = MaxwellSlip(self.name, self.element, [self.values[f"delta{i}_m"] for i in range(1, n + 1)],
-                          [self.values[f"share{i}"] for i in range(1, n + 1)], None, self.branches,
+                          [self.values[f"share{i}"] for i in range(1, n + 1)], damping_N_s_per_m, branches,
                           self.values.get("envelope_scale_m"))
         out.model_name = self.model_name
         return out

@@ -31,9 +31,7 @@ import math
 from dataclasses import replace
 
 from ..assemblies.one_muscle import AddedComponent
-from ..assemblies.stick_state import BRANCHES, LoopPoint, held_bouc_wen, held_maxwell_slip
-from ..components.bouc_wen_friction import BoucWenFriction
-from ..components.maxwell_slip_friction import MaxwellSlip
+from ..assemblies.stick_state import BRANCHES, HYSTERESIS, LoopPoint, held
 from .operating_point import OperatingPoint
 
 
@@ -51,7 +49,7 @@ def hold_hysteresis(model, op: OperatingPoint, added: tuple) -> tuple[tuple, Ope
     """``(added, op, loop)``: the ``[hysteresis]`` component among ``added`` replaced by its model held in
     the stick state of ``op``, ``op`` with its deflections (0, relaxed, where it has none: an equilibrium),
     and what was held; ``added`` and ``op`` unchanged and None without one."""
-    index = next((i for i, a in enumerate(added) if isinstance(a.component, (MaxwellSlip, BoucWenFriction))), None)
+    index = next((i for i, a in enumerate(added) if isinstance(a.component, HYSTERESIS)), None)
     if index is None:
         return added, op, None
     a = added[index]
@@ -59,12 +57,9 @@ def hold_hysteresis(model, op: OperatingPoint, added: tuple) -> tuple[tuple, Ope
     state = {f"{a.component.name}.{k}": v for k, v in a.component.held_state(0.0).items()}
     state.update({k: v for k, v in op.line_states.items() if k in state})
     level = _level_N(model, a.component, op)
-    if isinstance(a.component, MaxwellSlip):
-        held, loop = held_maxwell_slip(a.component, state, sign, level)
-    else:
-        held, loop = held_bouc_wen(a.component, state, sign, level)
+    component, loop = held(a.component, state, sign, level)
     loop = replace(loop, branch=BRANCHES[sign], branch_from=source)
-    out = added[:index] + (AddedComponent(held, a.connect),) + added[index + 1:]
+    out = added[:index] + (AddedComponent(component, a.connect),) + added[index + 1:]
     return out, replace(op, line_states={**state, **op.line_states}), loop
 
 

@@ -24,9 +24,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..assemblies.joint import at_prescribed_pressure, joint_assembly
-from ..assemblies.stick_state import BRANCHES, LoopPoint, held_bouc_wen, held_maxwell_slip
-from ..components.bouc_wen_friction import BoucWenFriction
-from ..components.maxwell_slip_friction import MaxwellSlip
+from ..assemblies.stick_state import BRANCHES, HYSTERESIS, LoopPoint, held
 from ..components.stick_slip import BodyMode
 from ..elements.pressure_source import PrescribedPressure
 from ..errors import InputError
@@ -120,25 +118,23 @@ def _relaxed_hysteresis(scenario: JointScenario, muscles: tuple, theta_rad: floa
     """``(muscles, loops)``: each muscle's hysteresis elements held relaxed at the equilibrium ``theta_rad``
     (:mod:`pamsim.control.loop_point`'s rule at rest: Maxwell-slip elements sticking, Bouc-Wen on its
     loading branch) at their friction level there, and what was held, per muscle."""
-    has = [any(isinstance(a.component, (MaxwellSlip, BoucWenFriction)) for a in m.added) for m in muscles]
-    if not any(has):
+    names = [f"{m.name}_{a.component.name}.level_N" for m in muscles for a in m.added
+             if isinstance(a.component, HYSTERESIS)]
+    if not names:
         return muscles, ()
     flat = joint_assembly(scenario.joint_values(), muscles, scenario.joint["g_m_s2"]).flatten(
         {"joint": int(BodyMode.STICK)})
-    levels = _outputs_at(flat, _operating_state(flat, theta_rad), u0,
-                         [f"{m.name}_{a.component.name}.level_N" for m, h in zip(muscles, has) if h
-                          for a in m.added if isinstance(a.component, (MaxwellSlip, BoucWenFriction))])
+    levels = _outputs_at(flat, _operating_state(flat, theta_rad), u0, names)
     out, loops = [], []
     for m in muscles:
         added = []
         for a in m.added:
-            if not isinstance(a.component, (MaxwellSlip, BoucWenFriction)):
+            if not isinstance(a.component, HYSTERESIS):
                 added.append(a)
                 continue
             c = a.component
             state = {f"{c.name}.{k}": v for k, v in c.held_state(0.0).items()}
-            hold = held_maxwell_slip if isinstance(c, MaxwellSlip) else held_bouc_wen
-            component, loop = hold(c, state, 0, levels[f"{m.name}_{c.name}.level_N"])
+            component, loop = held(c, state, 0, levels[f"{m.name}_{c.name}.level_N"])
             added.append(replace(a, component=component))
             named = tuple({**e, "name": f"{m.name}_{e['name']}"} for e in loop.elements)
             loops.append((m.name, replace(loop, branch=BRANCHES[0], branch_from="an equilibrium: the elements relaxed",
