@@ -32,7 +32,7 @@ from .errors import InputError, SolverFailure
 from .model import STATE_SCALES, Mode, MuscleModel
 from .modeling.pygen import compiled_by_mode
 from .result import Result, TransitionEvent
-from .stepping import LsodaRestarts, integrate_segment
+from .stepping import DOPRI5, LsodaRestarts, integrate_segment
 
 
 MIN_RTOL = 1e-13
@@ -430,12 +430,18 @@ class HybridRun:
         # Over every integrator step and event, not the samples.
         self.low_x, self.peak_x = math.inf, -math.inf
         self.calls = 0
-        self.h_next = None  # the step DOPRI5 proposed at the last segment's end, to start the next with
+        # The step DOPRI5 proposed at the last segment's end (scipy's methods: the last step taken), to start
+        # the next segment with (DOPRI5's, and a stiff restart's after another, see below), and its method.
+        self.h_next = None
         # LSODA restarts with its non-stiff method.  After a jump that kept a held body's mode (an element
         # reaching its limit) the next segment is BDF's: what moves while the body is held is a massless
         # muscle end, a stiff node, where an element at rest on its limit, restarted non-stiff, crossed it
-        # again at every few steps of noise (more than 20000 events in a second).
+        # again at every few steps of noise (more than 20000 events in a second).  Where the last segment was
+        # such a restart too, BDF starts with its last step, as the native engine's Rodas4 carries on:
+        # estimated afresh, its first steps were fractions of a microsecond whose noise crossed the limit
+        # again at once (elements on both muscles of an elastic pair: more than 5000 events by 0.82 s).
         self.stiff_restart = False
+        self.last_method: str | None = None
         self.restarts = LsodaRestarts()
         self.reached = 0.0  # reported time: the RHS is also evaluated at trial points, which need not increase
 
@@ -467,12 +473,15 @@ class HybridRun:
         self.t_left = self.gen.t_left = float(np.nextafter(t_break, -math.inf))
         max_step = opts.max_step_s if mode.is_slip else min(opts.max_step_s, self.held_max_step)
         rhs = self.gen.rhs(mode) if self.progress is None else self._reporting(self.gen.rhs(mode))
-        method = "BDF" if self.stiff_restart and opts.method == "LSODA" else opts.method
+        stiff = self.stiff_restart and opts.method == "LSODA"
+        method = "BDF" if stiff else opts.method
+        first_step = self.h_next if method == DOPRI5 or (stiff and self.last_method == "BDF") else None
+        self.last_method = method
         samples = self.grid[self.next_sample:np.searchsorted(self.grid, t_break, side="right") if sampled else 0]
         try:
             seg = integrate_segment(rhs, t, t_break, y, method, [_from_start(f, t, y) for _, f, _ in named],
                                     samples, rtol=opts.rtol, atol=self.atol, max_step=max_step, v_row=_V_ROW,
-                                    first_step=self.h_next, restarts=self.restarts)
+                                    first_step=first_step, restarts=self.restarts)
         except (InputError, SolverFailure):
             raise
         except Exception as exc:

@@ -51,7 +51,8 @@ class Segment:
     (``message`` says why).  ``event``: the index of the event function that fired, at ``t_event`` [s]
     with the states ``y_event``; ``nfev``: right-hand-side evaluations; ``njev``: Jacobians the method formed
     (scipy's count; LSODA's by finite differences, whose evaluations are among ``nfev``); ``h_next``:
-    :data:`DOPRI5`'s proposal for the next step [s] (None for scipy's methods)."""
+    :data:`DOPRI5`'s proposal for the next step [s]; for scipy's methods the last step taken (to the
+    segment's end or its event; None if it took none)."""
 
     t: np.ndarray
     y: np.ndarray
@@ -399,7 +400,8 @@ def integrate_segment(fun: Callable, t0: float, t_end: float, y0: np.ndarray, me
         The row of the load's velocity: a step in which it changes sign (:func:`_turned`) is checked inside
         (:func:`missed_crossing`), as is any step longer than ``long_step_s`` (:data:`LONG_STEP_S`).
     first_step : float, optional
-        :data:`DOPRI5`'s first step [s] (None: estimated from the start); the other methods ignore it.
+        The first step [s] of :data:`DOPRI5` and of ``"BDF"`` (None: estimated from the start); the other
+        methods ignore it.
     restarts : LsodaRestarts, optional
         Where LSODA's solver is kept between the segments of a run (None: a new solver).
 
@@ -414,8 +416,9 @@ def integrate_segment(fun: Callable, t0: float, t_end: float, y0: np.ndarray, me
     elif method == "LSODA" and restarts is not None:
         solver = restarts.start(fun, float(t0), y0, float(t_end), rtol=rtol, atol=atol, max_step=max_step)
     else:
+        first = {"first_step": min(first_step, t_end - t0)} if method == "BDF" and first_step else {}
         solver = getattr(scipy.integrate, method)(fun, float(t0), y0, float(t_end), rtol=rtol, atol=atol,
-                                                  max_step=max_step)
+                                                  max_step=max_step, **first)
     from_next = method in _FROM_NEXT_STEP
     v_tol = None if v_row is None else float(atol[v_row] if np.ndim(atol) else atol)
     grid = samples.tolist()  # bisect on a list: a step's samples are few, and a numpy call costs more
@@ -479,7 +482,8 @@ def integrate_segment(fun: Callable, t0: float, t_end: float, y0: np.ndarray, me
                    samples_y=np.hstack(sample_ys) if sample_ys else np.empty((n, 0)),
                    status=status, event=event, t_event=float(t) if status == 1 else None,
                    y_event=np.array(y, dtype=float) if status == 1 else None,
-                   nfev=solver.nfev, message=message or "", h_next=getattr(solver, "h_next", None),
+                   nfev=solver.nfev, message=message or "", h_next=getattr(solver, "h_next", None) if method == DOPRI5
+                   else ts[-1] - ts[-2] if len(ts) > 1 else None,
                    njev=getattr(solver, "njev", 0))
 
 
