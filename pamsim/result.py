@@ -242,6 +242,8 @@ class Result:
             "events": int(self.stats["events"]),
             "rhs_evaluations": int(self.stats["rhs_evaluations"]),
             "segments": int(self.stats["segments"]),
+            # what the backend counts: an FMU's runs count no Jacobians
+            **{k: self.stats[k] for k in ("jacobians", "method", "rtol") if k in self.stats},
             "wall_time_s": float(self.wall_time_s),
             "out_of_fit_range": self.out_of_fit_range,
             "fit_range_violations": list(self.fit_range_violations),

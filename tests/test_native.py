@@ -64,6 +64,9 @@ def test_result_has_the_python_backends_columns_summary_and_event_records(paper_
     assert set(nat.summary()) == set(py.summary())
     assert set(nat.stats) == set(py.stats) and nat.stats["method"] == "native DOPRI5(4), Rodas4 where stiff"
     assert nat.summary()["events"] == len(nat.transitions) == len(py.transitions) > 20
+    for res in (py, nat):  # the solver's counts and settings, as the joint's and the muscle's summaries give them
+        assert {k: res.summary()[k] for k in ("rhs_evaluations", "segments", "jacobians", "method", "rtol")} == \
+            {k: res.stats[k] for k in ("rhs_evaluations", "segments", "jacobians", "method", "rtol")}
     # The modes on the sample grid are those of the Python run, except within a sample of an event.
     differ = np.flatnonzero(nat.mode != py.mode)
     times = np.array([e.t_s for e in py.transitions])
