@@ -431,17 +431,18 @@ class HybridRun:
         self.low_x, self.peak_x = math.inf, -math.inf
         self.calls = 0
         # The step DOPRI5 proposed at the last segment's end (scipy's methods: the last step taken), to start
-        # the next segment with (DOPRI5's, and a stiff restart's after another, see below), and its method.
+        # the next segment with: DOPRI5's, and a stiff restart's that follows another (see below).
         self.h_next = None
         # LSODA restarts with its non-stiff method.  After a jump that kept a held body's mode (an element
         # reaching its limit) the next segment is BDF's: what moves while the body is held is a massless
         # muscle end, a stiff node, where an element at rest on its limit, restarted non-stiff, crossed it
         # again at every few steps of noise (more than 20000 events in a second).  Where the last segment was
-        # such a restart too, BDF starts with its last step, as the native engine's Rodas4 carries on:
-        # estimated afresh, its first steps were fractions of a microsecond whose noise crossed the limit
-        # again at once (elements on both muscles of an elastic pair: more than 5000 events by 0.82 s).
+        # such a restart too, BDF starts with its last step (cut at its event), as the native engine's Rodas4
+        # carries on: estimated afresh, its first steps were fractions of a microsecond whose noise crossed
+        # the limit again at once (elements on both muscles of an elastic pair: more than 5000 events by
+        # 0.82 s).  Not floored at 1 us as the native engine's is: floored, that pair took 517 events, not 220.
         self.stiff_restart = False
-        self.last_method: str | None = None
+        self.stiff_before = False  # whether the last segment was such a stiff restart
         self.restarts = LsodaRestarts()
         self.reached = 0.0  # reported time: the RHS is also evaluated at trial points, which need not increase
 
@@ -475,8 +476,8 @@ class HybridRun:
         rhs = self.gen.rhs(mode) if self.progress is None else self._reporting(self.gen.rhs(mode))
         stiff = self.stiff_restart and opts.method == "LSODA"
         method = "BDF" if stiff else opts.method
-        first_step = self.h_next if method == DOPRI5 or (stiff and self.last_method == "BDF") else None
-        self.last_method = method
+        first_step = self.h_next if method == DOPRI5 or (stiff and self.stiff_before) else None
+        self.stiff_before = stiff
         samples = self.grid[self.next_sample:np.searchsorted(self.grid, t_break, side="right") if sampled else 0]
         try:
             seg = integrate_segment(rhs, t, t_break, y, method, [_from_start(f, t, y) for _, f, _ in named],

@@ -477,13 +477,13 @@ def integrate_segment(fun: Callable, t0: float, t_end: float, y0: np.ndarray, me
         sample_ys.append(kept(samples[n_taken:n_end]))
         n_taken = n_end
     n = len(y0)
+    last_step = ts[-1] - ts[-2] if len(ts) > 1 else None
     return Segment(t=np.array(ts, dtype=float), y=np.array(ys, dtype=float).T,
                    samples_t=samples[:n_taken],
                    samples_y=np.hstack(sample_ys) if sample_ys else np.empty((n, 0)),
                    status=status, event=event, t_event=float(t) if status == 1 else None,
                    y_event=np.array(y, dtype=float) if status == 1 else None,
-                   nfev=solver.nfev, message=message or "", h_next=getattr(solver, "h_next", None) if method == DOPRI5
-                   else ts[-1] - ts[-2] if len(ts) > 1 else None,
+                   nfev=solver.nfev, message=message or "", h_next=solver.h_next if method == DOPRI5 else last_step,
                    njev=getattr(solver, "njev", 0))
 
 

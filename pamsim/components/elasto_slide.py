@@ -43,11 +43,13 @@ def element(z, v, k, delta, fired, c=0.0, stuck=None) -> Element:
     the generalized Maxwell-slip model): ``-c dz/dt``, zero while it slips.  ``stuck``: None, the element
     switches as above; True or False, it is held sticking or slipping whatever its state (a linearisation
     within one stick state: the same equations, the switch left out)."""
-    # On the limit means there, where the event's jump put it, to the last bits either way: an integrator's
-    # dense output can round a held deflection a few ulps outward, and an implicit one's (BDF's) a few ulps
-    # inward, which counted as having left the limit, and the next outward step crossed it again (an element
-    # at rest on its limit at a massless muscle end switched every few microseconds).  A state further past
-    # it inside a step keeps the indicator below zero, so that the crossing is found.
+    # On the limit means there, where the event's jump put it, within 5e-13 of delta either way (1e-12 on
+    # z^2): an integrator's dense output can round a held deflection a few ulps outward, and an implicit
+    # one's (BDF's) a few ulps inward, which counted as having left the limit, and the next outward step
+    # crossed it again (an element at rest on its limit at a massless muscle end switched every few
+    # microseconds).  A deflection that reaches the band from inside slips there without an event, its force
+    # the limit's to 5e-13.  A state further past it inside a step keeps the indicator below zero, so that
+    # the crossing is found.
     at_limit = (z * z >= delta * delta * (1.0 - 1e-12)) * (z * z <= delta * delta * (1.0 + 1e-12))
     slipping = at_limit * (v * z > 0.0) if stuck is None else (not stuck)
     rate = if_else(slipping, 0.0, v)
