@@ -20,7 +20,8 @@ a force that depends on the end's velocity (a damper, an element's presliding da
 what the balance gives, and such a force would be an algebraic loop.  The velocity is continuous in the
 state (a dead zone, not a switch), so the muscle's stick and slip need no event; its kinks at
 ``|F_static - T| = F_c`` are left to the integrator's step control, as a tendon's slack is.  It needs a
-damping law whose force grows strictly with speed (:func:`pamsim.elements.damping.increasing`); the paper's, with ``D1 < 0``, does not.
+damping law whose force grows strictly with speed (:func:`pamsim.elements.damping.increasing`); the
+paper's, with ``D1 < 0``, does not.
 """
 
 from __future__ import annotations
