@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import copy
 import math
+import re
 import subprocess
 import sys
 import tomllib
@@ -184,20 +185,113 @@ def test_bad_tendons_are_refused_by_key(tmp_path, change, key):
         assert not (tmp_path / "out").exists()
 
 
-def test_linearize_and_the_mujoco_coupling_refuse_elastic_tendons():
-    """Neither writes a muscle's end as a state of its own yet: both name the muscle and the key rather
-    than drop the spring."""
+def _prescribed_spec(pressures_bar=(2.0, 2.0)) -> dict:
+    spec = copy.deepcopy(SPEC)
+    for m, p in zip(spec["muscle"], pressures_bar):
+        m["pressure"] = {"source": "prescribed", "prescribed": {"kind": "constant", "value_gauge_bar": p}}
+    return spec
+
+
+def test_the_mujoco_coupling_refuses_elastic_tendons():
+    """It drives a tendon's length from MuJoCo's side and has no state for the muscle's end: it names the
+    muscle and the key rather than drop the spring."""
     from pamsim.coupling.mujoco import joint_muscles
     from pamsim.errors import InputError
+
+    with pytest.raises(InputError, match="muscle 'flexor'.tendon_stiffness_N_per_m = 2000"):
+        joint_muscles(JointScenario.from_dict(_prescribed_spec(), origin="elastic.toml"))
+
+
+@pytest.mark.parametrize("p_bar", [(2.2, 2.0), (2.5, 2.0), (4.0, 4.2)])
+def test_the_linear_model_on_elastic_tendons_has_the_series_stiffness_and_the_statics_gains(p_bar):
+    """Each muscle's end is a state, at its own rest; the stiffness output is the statics' series one (the
+    chain rule there against CasADi's here, and a central difference of the net torque at rest), and the
+    model's gain from each pressure to the angle, ``D - C A^-1 B``, is the slope of the statics'
+    equilibrium angle against that pressure (central differences of 100 Pa)."""
     from pamsim.joints.linear import linearize_joint
 
-    spec = copy.deepcopy(SPEC)
+    scenario = JointScenario.from_dict(_prescribed_spec())
+    p = [v * 1e5 for v in p_bar]
+    lm = linearize_joint(scenario, p)
+    assert lm.states == ("joint.theta_rad", "joint.omega_rad_s", "flexor_series_spring.x_m",
+                         "extensor_series_spring.x_m")
+    statics = JointStatics(scenario)
+    eq = statics.equilibrium(p)
+    assert lm.theta0_rad == eq.theta_rad
+    assert lm.k0_Nm_per_rad == pytest.approx(eq.k_Nm_per_rad, rel=1e-12)
+    h = 1e-6
+    k_fd = -(statics.net_torque_Nm(eq.theta_rad + h, p) - statics.net_torque_Nm(eq.theta_rad - h, p)) / (2 * h)
+    assert lm.k0_Nm_per_rad == pytest.approx(k_fd, rel=1e-7)
+    rigid_spec = _prescribed_spec()
+    for m in rigid_spec["muscle"]:
+        del m["tendon_stiffness_N_per_m"]
+    rigid = linearize_joint(JointScenario.from_dict(rigid_spec), p)
+    assert lm.k0_Nm_per_rad < 0.8 * rigid.k0_Nm_per_rad  # the tendons in series soften the joint
+    gain = lm.D - lm.C @ np.linalg.solve(lm.A, lm.B)
+    for j in range(2):
+        dp = np.zeros(2)
+        dp[j] = 100.0
+        slope = (statics.equilibrium(list(p + dp)).theta_rad - statics.equilibrium(list(p - dp)).theta_rad) / 200.0
+        assert gain[0, j] == pytest.approx(slope, rel=1e-6)
+    assert np.all(lm.poles().real < 0.0)  # the ends' own poles fast and real, the link's ringing slow
+
+
+def _step_gap(dp_bar: float) -> tuple[float, float]:
+    """The frictionless elastic pair at rest at 2.2 and 2 bar, the flexor's pressure stepped by ``dp_bar``
+    at 2 s: the largest angle change after the step on the python backend, and its largest gap to the
+    linear model's step response over 1.5 s (scipy's ``lsim``)."""
+    from scipy.signal import StateSpace, lsim
+
+    from pamsim.joints.linear import linearize_joint
+
+    spec = _prescribed_spec((2.2, 2.0))
     for m in spec["muscle"]:
-        m["pressure"] = {"source": "prescribed", "prescribed": {"kind": "constant", "value_gauge_bar": 2.0}}
-    scenario = JointScenario.from_dict(spec, origin="elastic.toml")
-    for call in (lambda: linearize_joint(scenario, [2e5, 2e5]), lambda: joint_muscles(scenario)):
-        with pytest.raises(InputError, match="muscle 'flexor'.tendon_stiffness_N_per_m = 2000"):
-            call()
+        m["model"]["friction"] = "none"
+    spec["joint"]["tau_coulomb_Nm"] = 0.0
+    lm = linearize_joint(JointScenario.from_dict(copy.deepcopy(spec)), [2.2e5, 2.0e5])
+    spec["joint"]["initial_angle_rad"] = lm.theta0_rad
+    spec["muscle"][0]["pressure"]["prescribed"] = {"kind": "steps", "times_s": [0.0, 2.0],
+                                                   "values_gauge_bar": [2.2, 2.2 + dp_bar]}
+    spec["simulation"]["duration_s"] = 3.5
+    spec["solver"]["rtol"] = 1e-8
+    run = simulate_joint(JointScenario.from_dict(spec), "python")
+    after = run.t_s >= 2.0
+    u = np.zeros((int(after.sum()), 3))
+    u[:, 0] = dp_bar * 1e5
+    _, y, _ = lsim(StateSpace(lm.A, lm.B, lm.C, lm.D), u, run.t_s[after] - 2.0)
+    moved = run.theta_rad[after] - lm.theta0_rad
+    return float(np.abs(moved).max()), float(np.abs(moved - y[:, 0]).max())
+
+
+def test_the_linear_model_on_elastic_tendons_follows_a_small_pressure_step():
+    """The nonlinear joint, friction dropped as the linearisation drops it, after a pressure step of 2 mbar
+    and of 4 mbar from its equilibrium: its angle follows the linear model's step response (ringing at the
+    series stiffness) within 1e-3 of the response, and the gap is the nonlinearity's, growing as the step
+    squared (4.0 times for twice the step, within 10 %)."""
+    peak, gap = _step_gap(0.002)
+    peak2, gap2 = _step_gap(0.004)
+    assert peak > 4e-3 and gap < 1e-3 * peak
+    assert gap2 / gap == pytest.approx(4.0, rel=0.1)
+
+
+def test_pamsim_linearize_prints_an_elastic_joints_model(tmp_path):
+    """The command linearises a joint on elastic tendons whose pressures are prescribed, its ends' states
+    among the model's, as JSON."""
+    import json
+
+    path = tmp_path / "elastic_prescribed.toml"
+    text = ELASTIC.read_text()
+    for p in ("2.2", "2.0"):
+        text = text.replace(f'source = "valve"\nsupply_gauge_bar = {p}\nvalve_open_time_s = 0.5',
+                            f'source = "prescribed"\nprescribed = {{ kind = "constant", value_gauge_bar = {p} }}')
+    path.write_text(text)
+    done = subprocess.run([sys.executable, "-m", "pamsim", "linearize", str(path), "--json"],
+                          capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    rep = json.loads(done.stdout)
+    assert rep["states"][2:] == ["flexor_series_spring.x_m", "extensor_series_spring.x_m"]
+    statics = JointStatics(JointScenario.from_dict(_prescribed_spec((2.2, 2.0))))
+    assert rep["k0_Nm_per_rad"] == pytest.approx(statics.equilibrium([2.2e5, 2.0e5]).k_Nm_per_rad, rel=1e-12)
 
 
 # ---------------------------------------------------------------- hysteresis elements on the muscle's end
@@ -310,3 +404,69 @@ def test_where_python_switches_an_element_again_and_again_it_says_so():
     with pytest.raises(SolverFailure, match=r"more than 150 events .*hysteresis.slip1.* in mode stick: .*native "
                                             r"backend integrates it as stiff"):
         simulate_joint(_both_with_elements((0.3, 0.3, 0.4), max_events=150), "python")
+
+
+# ---------------------------------------------------------------- the angle-stiffness controller on elastic tendons
+CONTROLLED = ROOT / "scenarios" / "pair_angle_stiffness.toml"
+
+
+def _controlled_on_tendons(stiffness_Nm_per_rad: float) -> dict:
+    """The controlled pair on 2 kN/m tendons (linear damping, as a massless end needs) at a commanded stiffness."""
+    spec = tomllib.loads(CONTROLLED.read_text())
+    for m in spec["muscle"]:
+        m["tendon_stiffness_N_per_m"] = 2000.0
+        m["model"]["damping"] = "linear"
+    spec["controller"]["stiffness_Nm_per_rad"] = stiffness_Nm_per_rad
+    return spec
+
+
+def test_the_controller_on_elastic_tendons_rests_the_link_with_the_series_stiffness_and_meets_its_spec():
+    """The feedforward's pressures hold the link at each angle of its table with the commanded series
+    stiffness (the statics'); the PID is designed on that stiffness (the ends at rest: their poles, near
+    -2600 1/s, lie 30 times beyond the 80 rad/s bandwidth), so the full linear loop, ends included, is stable
+    with its three slow poles within a factor 1.6 of the designed -80 1/s; and the native run meets the
+    scenario's spec.  Designed on the angle row of A (the ends held, 0.40 N m/rad), the gains were refused."""
+    from pamsim.joints.control import controller_of, metrics, spec_failures
+    from pamsim.joints.linear import linearize_joint
+
+    scenario = JointScenario.from_dict(_controlled_on_tendons(0.1))
+    controller = controller_of(scenario)
+    statics = JointStatics(scenario)
+    for theta, p in zip(controller.feedforward.grid_rad, controller.feedforward.p_Pa):
+        assert abs(statics.net_torque_Nm(theta, p)) < 1e-11
+        assert statics.stiffness_Nm_per_rad(theta, p) == pytest.approx(0.1, rel=1e-9)
+    g, w = controller.gains, scenario.controller["bandwidth_rad_s"]
+    lm = linearize_joint(scenario, list(controller.feedforward(0.0)))
+    # the table's pressures interpolated between its angles: the stiffness to 1e-5
+    assert lm.k0_Nm_per_rad == pytest.approx(0.1, rel=1e-5) and -lm.A[1, 0] * scenario.joint["inertia_kg_m2"] > 0.3
+    n, b = lm.A.shape[0], lm.B[:, 2]
+    closed = np.zeros((n + 1, n + 1))
+    closed[:n, :n] = lm.A
+    closed[:n, 0] -= b * g.Kp
+    closed[:n, 1] -= b * g.Kd
+    closed[:n, n] = b * g.Ki
+    closed[n, 0] = -1.0
+    poles = sorted(np.linalg.eigvals(closed), key=abs)
+    assert all(-1.6 * w < z.real < -w / 1.6 for z in poles[:3]) and all(z.real < -20 * w for z in poles[3:])
+    run = controller.run("native")
+    measured = metrics(run, controller.reference, scenario.controller["settle_s"], scenario.duration_s)
+    assert spec_failures(measured, scenario.controller["spec"]) == []
+    assert np.max(run.theta_rad) > 0.29 and np.min(run.theta_rad) < -0.39
+
+
+def test_a_stiffness_the_elastic_pair_cannot_reach_is_refused_by_key(tmp_path):
+    """0.05 N m/rad is below what the pair on its tendons can hold at -0.44 rad with the torques balanced
+    (the least, over pressures in [0, 4.5] bar, leaves 0.007 N m/rad): exit code 2, the key named, no
+    traceback, nothing written.  Newton's pressures there clip one muscle to 0 bar, where its tendon hangs
+    slack and the Jacobian is singular: that raised numpy's LinAlgError."""
+    text = CONTROLLED.read_text().replace("[[muscle]]\n", "[[muscle]]\ntendon_stiffness_N_per_m = 2000.0\n")
+    text = re.sub(r'damping = "\w+"', 'damping = "linear"', text)
+    text = re.sub(r"\nstiffness_Nm_per_rad = [0-9.e-]+", "\nstiffness_Nm_per_rad = 0.05", text)
+    assert tomllib.loads(text) == _controlled_on_tendons(0.05)
+    path = tmp_path / "soft.toml"
+    path.write_text(text)
+    done = subprocess.run([sys.executable, "-m", "pamsim", "run", str(path), "-o", str(tmp_path / "out")],
+                          capture_output=True, text=True)
+    assert done.returncode == 2 and "Traceback" not in done.stderr
+    assert "controller.stiffness_Nm_per_rad = 0.05: no pressures within [0, 4.5] bar" in done.stderr
+    assert not (tmp_path / "out").exists()

@@ -82,7 +82,10 @@ class SeriesTendon(Component):
         stretch = x - path["x_m"]
         T = k * fmax(stretch, 0.0)
         drive = s.u["F_static_N"] + s.port["others"]["F_N"] - T
-        free = if_else(drive > level, drive - level, if_else(drive < -level, drive + level, 0.0))
+        # ">=": the same value at the band's edge (0), and there the slope of the side outside it, so that a
+        # muscle end at rest without friction (level 0, drive 0: the linearisation's operating point) has
+        # the derivative d free / d drive = 1 its neighbours have, not the band's 0.
+        free = if_else(drive >= level, drive - level, if_else(drive <= -level, drive + level, 0.0))
         v = s.u["v_free_m_s"]  # exactly zero at free == 0: every law's inverse is
         taut_stretch = fmax(stretch, 0.0)
         return Equations(

@@ -96,7 +96,13 @@ def _solve(statics: JointStatics, theta: float, k: float, p0, p_max_Pa: float) -
         if abs(r[0]) < 1e-12 and abs(r[1]) < 1e-10 * max(k, 1e-9):
             return p
         J = np.column_stack([(_residual(statics, theta, k, p + d) - r) / 10.0 for d in np.eye(2) * 10.0])
-        p = np.clip(p - np.linalg.solve(J, r), 0.0, p_max_Pa)
+        try:
+            step = np.linalg.solve(J, r)
+        except np.linalg.LinAlgError:
+            # A muscle's pressure clipped at zero on an elastic tendon: its tendon hangs slack and neither
+            # residual moves with that pressure.  The least-squares step moves the other pressure.
+            step = np.linalg.lstsq(J, r, rcond=None)[0]
+        p = np.clip(p - step, 0.0, p_max_Pa)
     raise InputError(f"no pressures within [0, {p_max_Pa / BAR:g}] bar hold the link at {theta:.4g} rad with "
                      f"that stiffness")
 
@@ -113,12 +119,15 @@ class Gains:
 def design_gains(scenario: JointScenario, p_Pa, bandwidth_rad_s: float) -> Gains:
     """PID gains that put the three closed-loop poles of the linear model about the equilibrium at the
     pressures ``p_Pa`` at ``-bandwidth_rad_s``: ``J s^3 + (Kd - c) s^2 + (k + Kp) s + Ki = J (s + w)^3``,
-    with ``J`` the inertia, ``k`` the stiffness and ``c`` the linear model's own damping term (A[1, 1] J)."""
+    with ``J`` the inertia, ``k`` the static stiffness and ``c`` the linear model's own damping term (A[1, 1] J).
+    On rigid tendons ``k`` is ``-A[1, 0] J``; on elastic ones it takes the muscles' ends at rest, whose poles
+    (thousands of 1/s) lie far beyond any bandwidth the link's can be given, where ``-A[1, 0] J`` would hold
+    them still."""
     from .linear import linearize_joint
 
     lm = linearize_joint(scenario, list(p_Pa))
     J, w = scenario.joint["inertia_kg_m2"], bandwidth_rad_s
-    k, c = -lm.A[1, 0] * J, lm.A[1, 1] * J
+    k, c = lm.k0_Nm_per_rad, float(lm.A[1, 1] * J)
     if 3 * J * w * w < k:  # the poles would need a negative Kp: the muscles alone are stiffer than that
         raise InputError(f"{scenario.origin}: controller.bandwidth_rad_s = {w:g}: the joint's own stiffness, "
                          f"{k:.4g} N m/rad, puts its poles beyond it; give at least {np.sqrt(k / (3 * J)):.4g} rad/s")

@@ -15,6 +15,15 @@ A muscle's hysteresis elements (``[muscle.hysteresis]``) are taken at the equili
 sticking (a spring on the muscle's flange, its deflection a state), Bouc-Wen on its loading branch; the model
 says so (``hysteresis``).  The stiffness output is the static one, ``-d tau_net / d theta`` with the
 elements' deflections held: their springs act through their states.
+
+A muscle on an elastic tendon (:class:`pamsim.components.series_tendon.SeriesTendon`) adds its end's
+contraction as a state, taken at its own rest (:class:`pamsim.joints.static.JointStatics` finds it: its
+static force equals its tendon's pull).  Its friction dropped, the massless end's velocity is the damping
+law's inverse of the force left to it, differentiable there.  The stiffness output is then the muscle and
+its tendon in series: ``-d tau_net / d theta`` with each end following the link so that its forces stay
+balanced (``dx/dtheta = -g_theta / g_x``, ``g`` the force left to its damping), written in the state, so
+that its own derivatives are again CasADi's.  Against the link, an end's spring acts through its state:
+the angle's row of ``A`` is the stiffness with the ends held, the static ``k`` the ends' rest included.
 """
 
 from __future__ import annotations
@@ -85,18 +94,12 @@ def linearize_joint(scenario: JointScenario, p_gauge_Pa) -> JointLinearModel:
     Raises
     ------
     InputError
-        A muscle fed by a valve or on an elastic tendon, pressures that push the link onto a limit (no
-        equilibrium inside), or a static force without a symbolic form.
+        A muscle fed by a valve, pressures that push the link onto a limit (no equilibrium inside), or a
+        static force without a symbolic form.
     """
     muscles = _prescribed(scenario)
-    for m in muscles:
-        if m.tendon_stiffness_N_per_m is not None:
-            # Its state and the stiffness output would need the muscle's end at its own rest (JointStatics
-            # finds it) and the stiffness through it as a function of the state: not written yet.
-            raise InputError(f"{scenario.origin}: muscle {m.name!r}.tendon_stiffness_N_per_m = "
-                             f"{m.tendon_stiffness_N_per_m:g}: a joint on elastic tendons is not linearised yet "
-                             "(its statics and stiffness are: pamsim joint-map)")
-    eq = JointStatics(scenario).equilibrium(p_gauge_Pa)
+    statics = JointStatics(scenario)
+    eq = statics.equilibrium(p_gauge_Pa)
     if eq.on_limit:
         raise InputError(f"{scenario.origin}: at {[p / 1e5 for p in p_gauge_Pa]} bar the link rests on its "
                          f"{eq.on_limit} limit: there is no equilibrium to linearise about")
@@ -107,8 +110,10 @@ def linearize_joint(scenario: JointScenario, p_gauge_Pa) -> JointLinearModel:
     if moving.externals:
         raise InputError(f"{scenario.origin}: a static force without a symbolic form cannot be linearised exactly")
     keep = [i for i in range(len(moving.states)) if i not in moving.quadratures()]
-    x0 = _operating_state(moving, eq.theta_rad)
-    A, B, C, D, k0 = (np.array(m, dtype=float) for m in _jacobians(moving, held, keep)(x0, u0, _without_coulomb(moving)))
+    x0 = _operating_state(moving, eq.theta_rad, statics.rest_state(eq.theta_rad, p_gauge_Pa))
+    ends = [m.name for m in muscles if m.tendon_stiffness_N_per_m is not None]
+    A, B, C, D, k0 = (np.array(m, dtype=float)
+                      for m in _jacobians(moving, held, keep, ends)(x0, u0, _without_coulomb(moving)))
     return JointLinearModel(A, B, C, D, tuple(moving.states[i].name for i in keep), tuple(v.name for v in moving.inputs),
                             ("joint.theta_rad", "joint.k_Nm_per_rad"), eq.theta_rad,
                             tuple(float(v) for v in p_gauge_Pa), float(k0.item()), loops)
@@ -163,24 +168,39 @@ def _without_coulomb(flat) -> np.ndarray:
     return p
 
 
-def _jacobians(moving, held, keep: list[int]):
+def _jacobians(moving, held, keep: list[int], ends: list[str]):
     """CasADi function of (x, u, p): df/dx and df/du of the moving link's states ``keep``, d/dx and d/du of
-    the outputs (angle, stiffness at rest), and the stiffness itself."""
+    the outputs (angle, stiffness at rest), and the stiffness itself.  ``ends``: the muscles on elastic
+    tendons, whose ends follow the link in the stiffness (see the module's docstring)."""
     import casadi as ca
 
     x, u, p = ca.vertcat(*moving.x), ca.vertcat(*moving.u), ca.vertcat(*moving.p)
     xs, f = ca.vertcat(*[moving.x[i] for i in keep]), ca.vertcat(*[moving.f[i] for i in keep])
-    theta = moving.x[[v.name for v in moving.states].index("joint.theta_rad")]
-    tau = held.y[[v.name for v in held.outputs].index("joint.tau_net_Nm")]
-    tau = ca.substitute(tau, ca.vertcat(*held.x, *held.u, *held.p), ca.vertcat(x, u, p))  # one set of symbols
+    names = [v.name for v in moving.states]
+    theta = moving.x[names.index("joint.theta_rad")]
+    outputs = [v.name for v in held.outputs]
+
+    def held_output(name: str):  # in the moving model's symbols: one set of symbols
+        return ca.substitute(held.y[outputs.index(name)], ca.vertcat(*held.x, *held.u, *held.p), ca.vertcat(x, u, p))
+
+    tau = held_output("joint.tau_net_Nm")
     k = -ca.jacobian(tau, theta)
+    if ends:
+        x_end = ca.vertcat(*[moving.x[names.index(f"{m}_series_spring.x_m")] for m in ends])
+        g = ca.vertcat(*[held_output(f"{m}_series_spring.F_free_N") for m in ends])
+        follow = -ca.solve(ca.jacobian(g, x_end), ca.jacobian(g, theta))  # dx_end / dtheta at the ends' rest
+        k = k - ca.mtimes(ca.jacobian(tau, x_end), follow)
     y = ca.vertcat(theta, k)
     return ca.Function("joint_linear", [x, u, p],
                        [ca.jacobian(f, xs), ca.jacobian(f, u), ca.jacobian(y, xs), ca.jacobian(y, u), k])
 
 
-def _operating_state(flat, theta_rad: float) -> list[float]:
-    """Every state at the operating point: the link at ``theta_rad`` at rest, the work integrals zero."""
-    x0 = [0.0] * len(flat.states)
-    x0[[v.name for v in flat.states].index("joint.theta_rad")] = theta_rad
+def _operating_state(flat, theta_rad: float, rest: dict | None = None) -> list[float]:
+    """Every state at the operating point: the link at ``theta_rad`` at rest, the states ``rest`` gives
+    (``{name: value}``: a muscle's end on an elastic tendon), the others (work integrals) zero."""
+    names = [v.name for v in flat.states]
+    x0 = [0.0] * len(names)
+    x0[names.index("joint.theta_rad")] = theta_rad
+    for name, value in (rest or {}).items():
+        x0[names.index(name)] = value
     return x0

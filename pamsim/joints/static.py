@@ -103,6 +103,13 @@ class JointStatics:
                 raise InputError(f"muscle {name!r}: no contraction within 1 m at which it pulls what its tendon does")
         return low if gap(low) == 0.0 else brentq(gap, low, high, xtol=1e-15, rtol=4 * np.finfo(float).eps)
 
+    def rest_state(self, theta_rad: float, p_gauge_Pa) -> dict[str, float]:
+        """``{state name: contraction [m]}`` of each muscle's end on an elastic tendon at rest, the link at
+        ``theta_rad`` and the muscles at ``p_gauge_Pa`` (empty with rigid tendons)."""
+        x, _ = self._point(theta_rad, p_gauge_Pa)
+        states = self.code.names["states"]
+        return {states[spring[0]]: x[spring[0]] for spring in self._springs}
+
     def net_torque_Nm(self, theta_rad: float, p_gauge_Pa) -> float:
         """Net torque on the link at rest at ``theta_rad`` with the muscles at ``p_gauge_Pa`` (in the
         scenario's muscle order): the muscles' and gravity's."""
