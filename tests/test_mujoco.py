@@ -77,12 +77,25 @@ def frictionless_slider() -> JointScenario:
     return JointScenario.from_dict(spec)
 
 
+def frictionless_elastic() -> JointScenario:
+    """The shipped pair on 2 kN/m tendons (``antagonistic_elastic.toml``, its damping linear), without Coulomb
+    friction on the bearing or the muscles: the spring in series and the massless muscle end are pamsim's,
+    integrated over each MuJoCo step with the tendon's path held."""
+    spec = tomllib.loads((ROOT / "scenarios" / "antagonistic_elastic.toml").read_text())
+    spec["joint"]["tau_coulomb_Nm"] = 0.0
+    for table in spec["muscle"]:
+        table["model"] = dict(table["model"], friction="none")
+    return JointScenario.from_dict(spec)
+
+
 @pytest.mark.parametrize("make, bound", [(frictionless_pair, 0.01), (frictionless_levers, 0.01),
-                                         (frictionless_slider, 1e-3)], ids=["pulleys", "levers", "slider"])
+                                         (frictionless_slider, 1e-3), (frictionless_elastic, 0.01)],
+                         ids=["pulleys", "levers", "slider", "elastic tendons"])
 def test_the_coupling_converges_to_pamsims_joint_at_first_order(make, bound):
-    """For pulleys, levers (spatial tendons) and a slider (a slide joint): the error against pamsim's own
-    run is within 1.5 Richardson estimates, halves with the step, and is below ``bound`` (rad, or m) at
-    dt = 0.25 ms."""
+    """For pulleys, levers (spatial tendons), a slider (a slide joint) and elastic tendons: the error against
+    pamsim's own run is within 1.5 Richardson estimates, halves with the step, and is below ``bound`` (rad,
+    or m) at dt = 0.25 ms; at rest the tensions, pressures and (on elastic tendons) the muscles' own
+    contractions are pamsim's."""
     scenario = make()
     dt = 2.5e-4
     # The reference sampled at MuJoCo's finer step: a 1 kHz trace interpolated across a fast swing would
@@ -103,6 +116,8 @@ def test_the_coupling_converges_to_pamsims_joint_at_first_order(make, bound):
     for m in reference.muscles:
         assert coupled.tension_N(m) == pytest.approx(reference.muscle(m, "F_tendon_N")[-1], rel=1e-6)
         assert coupled.outputs(m)["chamber.p_gauge_Pa"] == pytest.approx(reference.muscle(m, "p_gauge_Pa")[-1], rel=1e-6)
+        if "spring.x_m" in coupled.outputs(m):
+            assert coupled.outputs(m)["spring.x_m"] == pytest.approx(reference.muscle(m, "x_m")[-1], rel=1e-6)
 
 
 def test_a_missing_actuator_or_one_not_on_a_tendon_is_refused_by_name():

@@ -192,16 +192,6 @@ def _prescribed_spec(pressures_bar=(2.0, 2.0)) -> dict:
     return spec
 
 
-def test_the_mujoco_coupling_refuses_elastic_tendons():
-    """It drives a tendon's length from MuJoCo's side and has no state for the muscle's end: it names the
-    muscle and the key rather than drop the spring."""
-    from pamsim.coupling.mujoco import joint_muscles
-    from pamsim.errors import InputError
-
-    with pytest.raises(InputError, match="muscle 'flexor'.tendon_stiffness_N_per_m = 2000"):
-        joint_muscles(JointScenario.from_dict(_prescribed_spec(), origin="elastic.toml"))
-
-
 @pytest.mark.parametrize("p_bar", [(2.2, 2.0), (2.5, 2.0), (4.0, 4.2)])
 def test_the_linear_model_on_elastic_tendons_has_the_series_stiffness_and_the_statics_gains(p_bar):
     """Each muscle's end is a state, at its own rest; the stiffness output is the statics' series one (the

@@ -22,7 +22,7 @@ from ..components import CoulombFriction, MuscleStaticForce, ViscousDamping
 from ..components.linear_slider import LinearSlider
 from ..components.pulley import LeverAttachment, Pulley, SliderTendon
 from ..components.rotary_joint import RotaryJoint
-from ..components.series_tendon import MuscleEndDamping, SeriesTendon
+from ..components.series_tendon import MuscleEndDamping, SeriesTendon, end_wiring
 from ..elements.pressure_source import PrescribedPressure
 from ..modeling import Assembly
 from ..signals import Constant
@@ -178,10 +178,7 @@ def _muscle_parts(m: JointMuscle, attach, body, friction_load: str | None) -> tu
         parts.append(SeriesTendon(spring, {"k_N_per_m": m.tendon_stiffness_N_per_m}))
         moves = f"{spring}.direction"
         wiring += [(f"{spring}.path", f"{pulley}.flange"), (f"{spring}.level_on_body_N", f"{pulley}.friction_level_N"),
-                   (f"{m.name}_friction.level_N", f"{spring}.friction_level_N"),
-                   (f"{m.name}_muscle.F_static_N", f"{spring}.F_static_N"),
-                   (f"{spring}.F_free_N", f"{m.name}_damping.F_free_N"),
-                   (f"{m.name}_damping.v_free_m_s", f"{spring}.v_free_m_s")]
+                   *end_wiring(spring, f"{m.name}_muscle", f"{m.name}_friction", f"{m.name}_damping")]
     else:
         wiring.append((f"{m.name}_friction.level_N", f"{pulley}.friction_level_N"))
     # The flange adds the forces in the one-muscle rig's order: static, damping, friction.

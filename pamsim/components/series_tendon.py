@@ -95,3 +95,11 @@ class SeriesTendon(Component):
                      "E_elastic_J": 0.5 * k * taut_stretch * taut_stretch, "level_on_body_N": 0.0},
             port={"flange": {"x_m": x, "v_m_s": v}, "others": {"x_m": x, "v_m_s": v}, "path": {"F_N": T}},
             initial={"x_m": path["x_m"]})
+
+
+def end_wiring(spring: str, muscle: str, friction: str, damping: str) -> list[tuple[str, str]]:
+    """How a muscle's static force (``muscle``), Coulomb friction (``friction``) and damping (``damping``, a
+    :class:`MuscleEndDamping`) feed the balance of its end on the :class:`SeriesTendon` ``spring``: the
+    force the spring's node balances, the friction's level, and the damping's force out and velocity back."""
+    return [(f"{friction}.level_N", f"{spring}.friction_level_N"), (f"{muscle}.F_static_N", f"{spring}.F_static_N"),
+            (f"{spring}.F_free_N", f"{damping}.F_free_N"), (f"{damping}.v_free_m_s", f"{spring}.v_free_m_s")]

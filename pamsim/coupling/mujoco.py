@@ -37,7 +37,10 @@ class CoupledMuscle:
     used); ``actuator``: the name of the MuJoCo ``general`` actuator (gain 1) on its tendon;
     ``length_offset_m``: the muscle's length minus the tendon's (MuJoCo's fixed tendon length is its
     coefficients times the joint angles); ``pressure_inputs``: the pressure source's inputs at a time
-    (default: the scenario's signals), replaceable by a controller's.
+    (default: the scenario's signals), replaceable by a controller's; ``tendon_stiffness_N_per_m``: a spring
+    in series between the muscle and MuJoCo's tendon (None: rigid), whose massless muscle end is a state of
+    pamsim's (:func:`pamsim.assemblies.muscle_only.muscle_only_assembly`): the length MuJoCo gives is then
+    the spring's far end, and the force it gets back the spring's pull.
     """
 
     name: str
@@ -45,6 +48,7 @@ class CoupledMuscle:
     actuator: str
     length_offset_m: float
     pressure_inputs: Callable[[float], Sequence[float]] | None = None
+    tendon_stiffness_N_per_m: float | None = None
     _session: Any = field(default=None, repr=False)
     _inputs: np.ndarray = field(default=None, repr=False)
     _force_at: int = field(default=0, repr=False)
@@ -93,7 +97,8 @@ class MujocoMuscles:
         model = sc.build_model()
         try:
             assembly = muscle_only_assembly(model, sc.parameters["L0_m"], sc.parameters["g_m_s2"],
-                                            sc.initial_pressure_gauge_Pa, sc.added_components)
+                                            sc.initial_pressure_gauge_Pa, sc.added_components,
+                                            m.tendon_stiffness_N_per_m)
         except ValueError as exc:
             raise InputError(f"muscle {m.name!r}: {exc}") from None
         library = engine_library(assembly)
@@ -251,12 +256,9 @@ def _slide_body(j: dict) -> str:
 def joint_muscles(scenario) -> list[CoupledMuscle]:
     """The muscles of a joint (slider) scenario on the actuators of :func:`joint_mjcf`: each muscle's length
     is its tendon's MuJoCo length plus an offset, its rest length less its contraction at angle (position)
-    zero on a fixed tendon, less the tendon's own length on a lever's spatial one.  A muscle on an elastic
-    tendon is refused: MuJoCo's tendon is the rigid path, and a spring in series would need the muscle's end
-    as a state of pamsim's, between two MuJoCo steps."""
-    for t, _ in scenario.muscles:
-        if t.get("tendon_stiffness_N_per_m") is not None:
-            raise InputError(f"{scenario.origin}: muscle {t['name']!r}.tendon_stiffness_N_per_m = "
-                             f"{t['tendon_stiffness_N_per_m']:g}: the MuJoCo coupling drives rigid tendons only")
+    zero on a fixed tendon, less the tendon's own length on a lever's spatial one.  On an elastic tendon
+    MuJoCo's tendon is its rigid path, and the spring in series and the muscle's end are pamsim's
+    (``CoupledMuscle.tendon_stiffness_N_per_m``)."""
     return [CoupledMuscle(t["name"], sc, t["name"], sc.parameters["L0_m"] - t["x_at_zero_m"] if t["lever"] is None
-                          else -t["lever"]["tendon_length_m"]) for t, sc in scenario.muscles]
+                          else -t["lever"]["tendon_length_m"], tendon_stiffness_N_per_m=t.get("tendon_stiffness_N_per_m"))
+            for t, sc in scenario.muscles]
