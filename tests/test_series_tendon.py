@@ -481,3 +481,68 @@ def test_python_restarts_where_a_muscle_end_with_elements_turns():
     python = run("python", 1e-6)
     assert np.abs(python.theta_rad - reference.theta_rad).max() < 2e-5 and len(python.transitions) < 200
     assert np.abs(run("python", 1e-10).theta_rad - reference.theta_rad).max() < 1e-8
+
+
+def test_the_elastic_linear_models_stiffness_row_is_the_statics_slope_along_the_rest():
+    """The stiffness output's derivatives (C's and D's second row): along the ends' rest, ``dk/dtheta`` is
+    ``C[1, theta] + C[1, ends] dx_rest/dtheta`` and ``dk/dp`` is ``D[1, p] + C[1, ends] dx_rest/dp``, each against
+    central differences of the statics' stiffness and of its rest state (1e-6)."""
+    from pamsim.joints.linear import linearize_joint
+
+    scenario = JointScenario.from_dict(_prescribed_spec())
+    p = np.array([2.5e5, 2.0e5])
+    lm = linearize_joint(scenario, list(p))
+    statics = JointStatics(scenario)
+    ends = list(lm.states[2:])
+
+    def rest(theta, pressures):
+        state = statics.rest_state(theta, list(pressures))
+        return np.array([state[n] for n in ends])
+
+    h, th = 1e-5, lm.theta0_rad
+    slope = (statics.stiffness_Nm_per_rad(th + h, list(p)) - statics.stiffness_Nm_per_rad(th - h, list(p))) / (2 * h)
+    follow = (rest(th + h, p) - rest(th - h, p)) / (2 * h)
+    assert lm.C[1, 0] + lm.C[1, 2:] @ follow == pytest.approx(slope, rel=1e-6)
+    for j in range(2):
+        dp = np.zeros(2)
+        dp[j] = 10.0
+        slope = (statics.stiffness_Nm_per_rad(th, list(p + dp)) - statics.stiffness_Nm_per_rad(th, list(p - dp))) / 20.0
+        follow = (rest(th, p + dp) - rest(th, p - dp)) / 20.0
+        assert lm.D[1, j] + lm.C[1, 2:] @ follow == pytest.approx(slope, rel=1e-6)
+
+
+def test_a_spring_on_an_elastic_muscles_end_enters_the_statics_and_the_linear_model():
+    """A 1 kN/m spring (free at 20 mm) on the flexor's end: the statics rest the link where the frictionless
+    joint comes to rest on native (they took the end's balance without the spring: 0.309 rad against the run's
+    -0.252), and the linear model's stiffness is the statics' there."""
+    from pamsim.joints.linear import linearize_joint
+
+    spec = _prescribed_spec((2.2, 2.0))
+    spec["muscle"][0]["component"] = [{"type": "linear_spring", "name": "spring", "k_N_per_m": 1000.0,
+                                       "x_free_m": 0.02, "connect": {"flange": "load.flange"}}]
+    statics = JointStatics(JointScenario.from_dict(copy.deepcopy(spec)))
+    eq = statics.equilibrium([2.2e5, 2.0e5])
+    lm = linearize_joint(JointScenario.from_dict(copy.deepcopy(spec)), [2.2e5, 2.0e5])
+    assert lm.k0_Nm_per_rad == pytest.approx(eq.k_Nm_per_rad, rel=1e-12)
+    for m in spec["muscle"]:
+        m["model"]["friction"] = "none"
+    spec["joint"]["tau_coulomb_Nm"] = 0.0
+    spec["simulation"]["duration_s"] = 4.0
+    run = simulate_joint(JointScenario.from_dict(spec), "native")
+    assert abs(run.theta_rad[-1] - eq.theta_rad) < 1e-6
+
+
+def test_an_elastic_linearisation_reports_its_elements_at_the_ends_rest():
+    """Maxwell-slip elements on the flexor's end: the stick state reported gives each element the stiffness
+    ``w F_c / delta`` that the model's own row of the end holds (``dv/dz_i = -k_i / c``, c = 1.01 N s/m, the
+    linear damping), at the friction level of the end at its rest (not at contraction 0, where it is 0)."""
+    from pamsim.joints.linear import linearize_joint
+
+    spec = _prescribed_spec((2.2, 2.0))
+    spec["muscle"][0]["hysteresis"] = {"model": "maxwell_slip", "slip_displacement_m": [1e-3, 4e-3], "share": [0.5, 0.5]}
+    lm = linearize_joint(JointScenario.from_dict(spec), [2.2e5, 2.0e5])
+    elements = dict(lm.hysteresis)["flexor"].elements
+    row = lm.states.index("flexor_series_spring.x_m")
+    for i, e in enumerate(elements, start=1):
+        assert e["state"] == "stick" and e["k_N_per_m"] > 10.0
+        assert e["k_N_per_m"] == pytest.approx(-lm.A[row, lm.states.index(f"flexor_hysteresis.z{i}_m")] * 1.01, rel=1e-9)

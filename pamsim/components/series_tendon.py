@@ -82,9 +82,9 @@ class SeriesTendon(Component):
         stretch = x - path["x_m"]
         T = k * fmax(stretch, 0.0)
         drive = s.u["F_static_N"] + s.port["others"]["F_N"] - T
-        # ">=": the same value at the band's edge (0), and there the slope of the side outside it, so that a
-        # muscle end at rest without friction (level 0, drive 0: the linearisation's operating point) has
-        # the derivative d free / d drive = 1 its neighbours have, not the band's 0.
+        # ">=": the same value at the band's edge (0), and there the slope of the side outside it.  Without
+        # friction (level 0, as the statics and the linearisation read an end's balance) a root found exactly
+        # at drive = 0 then has d free / d drive = 1, as its neighbours do, not the band's 0 (a stiffness of NaN).
         free = if_else(drive >= level, drive - level, if_else(drive <= -level, drive + level, 0.0))
         v = s.u["v_free_m_s"]  # exactly zero at free == 0: every law's inverse is
         taut_stretch = fmax(stretch, 0.0)

@@ -120,9 +120,9 @@ def design_gains(scenario: JointScenario, p_Pa, bandwidth_rad_s: float) -> Gains
     """PID gains that put the three closed-loop poles of the linear model about the equilibrium at the
     pressures ``p_Pa`` at ``-bandwidth_rad_s``: ``J s^3 + (Kd - c) s^2 + (k + Kp) s + Ki = J (s + w)^3``,
     with ``J`` the inertia, ``k`` the static stiffness and ``c`` the linear model's own damping term (A[1, 1] J).
-    On rigid tendons ``k`` is ``-A[1, 0] J``; on elastic ones it takes the muscles' ends at rest, whose poles
-    (thousands of 1/s) lie far beyond any bandwidth the link's can be given, where ``-A[1, 0] J`` would hold
-    them still."""
+    On rigid tendons ``k`` is ``-A[1, 0] J``; on elastic ones it takes the muscles' ends at rest, as their
+    poles (thousands of 1/s) lie far beyond any bandwidth asked of the link; ``-A[1, 0] J`` would hold them
+    still."""
     from .linear import linearize_joint
 
     lm = linearize_joint(scenario, list(p_Pa))

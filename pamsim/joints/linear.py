@@ -32,13 +32,13 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..assemblies.joint import at_prescribed_pressure, joint_assembly
+from ..assemblies.joint import at_prescribed_pressure, joint_assembly, series_spring_name
 from ..assemblies.stick_state import BRANCHES, HYSTERESIS, LoopPoint, held
 from ..components.stick_slip import BodyMode
 from ..elements.pressure_source import PrescribedPressure
 from ..errors import InputError
 from .scenario import JointScenario
-from .static import JointStatics
+from .static import JointStatics, without_coulomb
 
 
 @dataclass(frozen=True)
@@ -104,14 +104,15 @@ def linearize_joint(scenario: JointScenario, p_gauge_Pa) -> JointLinearModel:
         raise InputError(f"{scenario.origin}: at {[p / 1e5 for p in p_gauge_Pa]} bar the link rests on its "
                          f"{eq.on_limit} limit: there is no equilibrium to linearise about")
     u0 = [float(v) for v in p_gauge_Pa] + [0.0]
-    muscles, loops = _relaxed_hysteresis(scenario, muscles, eq.theta_rad, u0)
+    rest = statics.rest_state(eq.theta_rad, p_gauge_Pa)
+    muscles, loops = _relaxed_hysteresis(scenario, muscles, eq.theta_rad, u0, rest)
     assembly = joint_assembly(scenario.joint_values(), muscles, scenario.joint["g_m_s2"], name=scenario.name)
     moving, held = (assembly.flatten({"joint": int(m)}) for m in (BodyMode.SLIP_UP, BodyMode.STICK))
     if moving.externals:
         raise InputError(f"{scenario.origin}: a static force without a symbolic form cannot be linearised exactly")
     keep = [i for i in range(len(moving.states)) if i not in moving.quadratures()]
-    x0 = _operating_state(moving, eq.theta_rad, statics.rest_state(eq.theta_rad, p_gauge_Pa))
-    ends = [m.name for m in muscles if m.tendon_stiffness_N_per_m is not None]
+    x0 = _operating_state(moving, eq.theta_rad, rest)
+    ends = [series_spring_name(m) for m in muscles if m.tendon_stiffness_N_per_m is not None]
     A, B, C, D, k0 = (np.array(m, dtype=float)
                       for m in _jacobians(moving, held, keep, ends)(x0, u0, _without_coulomb(moving)))
     return JointLinearModel(A, B, C, D, tuple(moving.states[i].name for i in keep), tuple(v.name for v in moving.inputs),
@@ -119,8 +120,10 @@ def linearize_joint(scenario: JointScenario, p_gauge_Pa) -> JointLinearModel:
                             tuple(float(v) for v in p_gauge_Pa), float(k0.item()), loops)
 
 
-def _relaxed_hysteresis(scenario: JointScenario, muscles: tuple, theta_rad: float, u0: list) -> tuple[tuple, tuple]:
+def _relaxed_hysteresis(scenario: JointScenario, muscles: tuple, theta_rad: float, u0: list,
+                        rest: dict) -> tuple[tuple, tuple]:
     """``(muscles, loops)``: each muscle's hysteresis elements held relaxed at the equilibrium ``theta_rad``
+    (the muscles' ends on elastic tendons at their ``rest``)
     (:mod:`pamsim.control.loop_point`'s rule at rest: Maxwell-slip elements sticking, Bouc-Wen on its
     loading branch) at their friction level there, and what was held, per muscle."""
     names = [f"{m.name}_{a.component.name}.level_N" for m in muscles for a in m.added
@@ -129,7 +132,7 @@ def _relaxed_hysteresis(scenario: JointScenario, muscles: tuple, theta_rad: floa
         return muscles, ()
     flat = joint_assembly(scenario.joint_values(), muscles, scenario.joint["g_m_s2"]).flatten(
         {"joint": int(BodyMode.STICK)})
-    levels = _outputs_at(flat, _operating_state(flat, theta_rad), u0, names)
+    levels = _outputs_at(flat, _operating_state(flat, theta_rad, rest), u0, names)
     out, loops = [], []
     for m in muscles:
         added = []
@@ -160,18 +163,14 @@ def _outputs_at(flat, x0: list, u0: list, names: list[str]) -> dict[str, float]:
 
 
 def _without_coulomb(flat) -> np.ndarray:
-    """``flat``'s parameter values with the Coulomb terms zero: the bearing's and every muscle's friction."""
-    p = np.array(flat.parameter_values, dtype=float)
-    for k, v in enumerate(flat.parameters):
-        if v.name == "joint.tau_coulomb_Nm" or v.name.split(".")[0].endswith("_friction"):
-            p[k] = 0.0
-    return p
+    """``flat``'s parameter values with the Coulomb terms zero (:func:`pamsim.joints.static.without_coulomb`)."""
+    return without_coulomb([v.name for v in flat.parameters], flat.parameter_values)
 
 
 def _jacobians(moving, held, keep: list[int], ends: list[str]):
     """CasADi function of (x, u, p): df/dx and df/du of the moving link's states ``keep``, d/dx and d/du of
     the outputs (angle, stiffness at rest), and the stiffness itself.  ``ends``: the muscles on elastic
-    tendons, whose ends follow the link in the stiffness (see the module's docstring)."""
+    tendons' springs, whose ends follow the link in the stiffness (see the module's docstring)."""
     import casadi as ca
 
     x, u, p = ca.vertcat(*moving.x), ca.vertcat(*moving.u), ca.vertcat(*moving.p)
@@ -186,8 +185,8 @@ def _jacobians(moving, held, keep: list[int], ends: list[str]):
     tau = held_output("joint.tau_net_Nm")
     k = -ca.jacobian(tau, theta)
     if ends:
-        x_end = ca.vertcat(*[moving.x[names.index(f"{m}_series_spring.x_m")] for m in ends])
-        g = ca.vertcat(*[held_output(f"{m}_series_spring.F_free_N") for m in ends])
+        x_end = ca.vertcat(*[moving.x[names.index(f"{spring}.x_m")] for spring in ends])
+        g = ca.vertcat(*[held_output(f"{spring}.F_free_N") for spring in ends])
         follow = -ca.solve(ca.jacobian(g, x_end), ca.jacobian(g, theta))  # dx_end / dtheta at the ends' rest
         k = k - ca.mtimes(ca.jacobian(tau, x_end), follow)
     y = ca.vertcat(theta, k)

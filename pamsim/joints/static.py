@@ -7,7 +7,7 @@ of the same output).  At an equilibrium ``k`` is the joint's stiffness against a
 slope of the muscles' torques and of gravity; co-contraction raises it without moving the angle.
 
 A muscle on an elastic tendon (:class:`pamsim.components.series_tendon.SeriesTendon`) rests where its
-static force equals its tendon's pull, without friction (the middle of the band its friction holds it
+static force, with what is added on its end (a spring), equals its tendon's pull, without friction (the middle of the band its friction holds it
 in): at each angle its contraction is that root, and the stiffness is the total derivative through it
 (the muscle and its tendon in series).
 """
@@ -18,11 +18,21 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..assemblies.joint import at_prescribed_pressure, attachment_name, joint_assembly
+from ..assemblies.joint import at_prescribed_pressure, attachment_name, joint_assembly, series_spring_name
 from ..components.stick_slip import BodyMode
 from ..errors import InputError
 from ..modeling.pygen import compiled_by_mode
 from .scenario import JointScenario
+
+
+def without_coulomb(names, values) -> np.ndarray:
+    """The parameter ``values`` (named ``names``) with the Coulomb terms zero: the bearing's and every muscle's
+    friction."""
+    p = np.array(values, dtype=float)
+    for k, name in enumerate(names):
+        if name == "joint.tau_coulomb_Nm" or name.split(".")[0].endswith("_friction"):
+            p[k] = 0.0
+    return p
 
 
 @dataclass(frozen=True)
@@ -61,9 +71,11 @@ class JointStatics:
         self._n_states = len(states)
         self._limits = (scenario.joint["theta_min_rad"], scenario.joint["theta_max_rad"])
         outputs = self.code.names["outputs"]
-        self._springs = [(states.index(f"{m.name}_series_spring.x_m"), outputs.index(f"{m.name}_muscle.F_static_N"),
-                          outputs.index(f"{m.name}_series_spring.F_tendon_N"), outputs.index(f"{attachment_name(m)}.x_m"),
-                          m.name)
+        # A muscle end's balance is read with the Coulomb terms zero: the force left to its damping is then
+        # its static force, what is added on it (a spring) and its tendon's pull together.
+        self._frictionless = without_coulomb(self.code.names["parameters"], self.p)
+        self._springs = [(states.index(f"{series_spring_name(m)}.x_m"), outputs.index(f"{series_spring_name(m)}.F_free_N"),
+                          outputs.index(f"{attachment_name(m)}.x_m"), m.name)
                          for m in muscles if m.tendon_stiffness_N_per_m is not None]
 
     def _point(self, theta_rad: float, p_gauge_Pa) -> tuple[list, list]:
@@ -78,17 +90,17 @@ class JointStatics:
 
     def _muscle_at_rest(self, x: list, u: list, spring: tuple) -> float:
         """The contraction at which a muscle on an elastic tendon pulls what its tendon does, the link at
-        ``x``: the root of ``F_static - T``, which falls as the muscle contracts (its force drops, its
-        tendon stretches).  Bracketed from the tendon's unstretched length outward."""
+        ``x``: the root of ``F_static + F_others - T`` (what is added on its end among ``F_others``), which
+        falls as the muscle contracts (its force drops, its tendon stretches).  Bracketed from the tendon's
+        unstretched length outward."""
         from scipy.optimize import brentq
 
-        index, static, tendon, path_x, name = spring
+        index, free, path_x, name = spring
 
         def gap(x_m: float) -> float:
             y = list(x)
             y[index] = x_m
-            out = self.code.y(y, u, self.p, (float(BodyMode.STICK),))[0]
-            return float(out[static] - out[tendon])
+            return float(self.code.y(y, u, self._frictionless, (float(BodyMode.STICK),))[0][free])
 
         path = self.code.y(x, u, self.p, (float(BodyMode.STICK),))[0][path_x]
         step = 1e-3
@@ -121,10 +133,11 @@ class JointStatics:
         x, u = self._point(theta_rad, p_gauge_Pa)
         C = self.code.jacobian(x, u, self.p, (float(BodyMode.STICK),))[2]
         k = -C[self._net, self._theta]
-        for index, static, tendon, _, _ in self._springs:
-            # The muscle follows the link so that F_static - T stays zero: dx/dtheta = -g_theta / g_x.
-            g_theta, g_x = C[static, self._theta] - C[tendon, self._theta], C[static, index] - C[tendon, index]
-            k -= C[self._net, index] * (-g_theta / g_x)
+        if self._springs:
+            G = self.code.jacobian(x, u, self._frictionless, (float(BodyMode.STICK),))[2]
+        for index, free, _, _ in self._springs:
+            # The muscle follows the link so that its balance g stays zero: dx/dtheta = -g_theta / g_x.
+            k -= C[self._net, index] * (-G[free, self._theta] / G[free, index])
         return float(k)
 
     def equilibrium(self, p_gauge_Pa) -> Equilibrium:
