@@ -28,7 +28,6 @@ import numpy as np
 from .assemblies import one_muscle_assembly
 from .assemblies.one_muscle import RUN_FUNCTIONS, RigOutputs
 from .components.hanging_load import EVENT_NAMES
-from .components.series_tendon import SeriesTendon
 from .errors import InputError, SolverFailure
 from .model import STATE_SCALES, Mode, MuscleModel
 from .modeling.pygen import compiled_by_mode
@@ -147,16 +146,6 @@ def _from_start(fun, t0: float, y0: np.ndarray):
     return _event(guarded, fun.direction)
 
 
-def _slip_flags_on(assembly, spring: str, outputs: list[str]) -> list[str]:
-    """The slip flags (``<component>.slipping<i>`` outputs) of the components with event indicators (hysteresis
-    elements) wired to the massless end of the series spring ``spring`` (its node ``others``)."""
-    eventful = {c for c, _ in assembly.indicator_names()}
-    end = f"{spring}.others"
-    on_end = {other.partition(".")[0] for a, b in assembly.connections if end in (a, b) for other in (a, b)
-              if other != end and other.partition(".")[0] in eventful}
-    return [n for n in outputs if n.partition(".")[0] in on_end and n.partition(".")[2].startswith("slipping")]
-
-
 def fired_together(z, k_fired: int, candidates) -> list[int]:
     """``k_fired`` and every indicator of ``candidates`` at or below zero in ``z``, the indicators where
     ``solve_ivp`` reported ``k_fired``'s crossing: they crossed at the same instant (two elements of equal slip
@@ -209,11 +198,6 @@ class GeneratedCode:
         self.kinetic = self.code[Mode.STICK].names["outputs"].index(f"{hybrid}.kinetic_energy_J")
         self.t_left = math.inf  # inputs are read at min(t, t_left): the left limit at a segment's end
         self.inputs = inputs
-        outputs = self.code[Mode.STICK].names["outputs"]
-        # Per massless end that carries elements: the row of its velocity and the rows of its elements' slip flags.
-        self.turning = [(outputs.index(f"{c.name}.v_m_s"), [outputs.index(n) for n in slip_flags])
-                        for c in assembly.components if isinstance(c, SeriesTendon)
-                        for slip_flags in [_slip_flags_on(assembly, c.name, outputs)] if slip_flags]
 
     @classmethod
     def of_model(cls, model: MuscleModel, opts: SolverOptions, x0_m: float, p0_gauge_Pa: float | None,
@@ -252,25 +236,6 @@ class GeneratedCode:
         def rhs(t, y):
             return np.array(f(y.tolist(), inputs(min(t, self.t_left)), p, ())[0])
         return rhs
-
-    def turns(self, mode: Mode) -> Callable | None:
-        """``w(t, y)``: for each massless muscle end that carries hysteresis elements (None if there are none),
-        its velocity and whether one of its elements slips on its limit.  Such an element lets go where its
-        end turns back, with no event (the end's velocity is no state): the equations change without a jump,
-        and LSODA, stiff there, stepped over that change with an error estimate that missed it (5.3e-4 rad off
-        on a pair whose native run was within 1.4e-7).  A segment ends before the step in which an end turns
-        with an element slipping, and a later one restarts just short of the turn (:func:`integrate_segment`);
-        an end that turns with its elements sticking changes no equation, and is left alone, and so is one
-        while the body is held (a massless end settling on a held link: restarted, its elements resting on
-        their limits switched again and again)."""
-        if not self.turning:
-            return None
-        y_of, inputs, p, rows = self.code[mode].y, self.inputs, self.p, self.turning
-
-        def w(t, y):
-            out = y_of(list(y), inputs(min(t, self.t_left)), p, ())[0]
-            return [(out[v], any(out[k] > 0.5 for k in flags)) for v, flags in rows]
-        return w
 
     def events(self, mode: Mode) -> list[tuple[str, Callable, int]]:
         """The mode's event functions: its indicators that can cross there, each positive inside it,
@@ -430,15 +395,10 @@ class SteppedRun:
         elif run.mode in _REST:
             run.mode = run.gen.rest_mode(run.mode, run.t, run.y)
         while run.t < t_end_s:
-            t_input = min(t_end_s, run.hold_until)
-            t_break = min(t_input, run.turn_at)
+            t_break = min(t_end_s, run.hold_until)
             seg, named = run.segment(t_break, sampled=False)
             if seg.status == 1:
                 run.at_event(seg, named)
-            elif seg.status == 2:
-                run.at_turn(seg)
-            elif t_break < t_input:
-                run.past_turn(seg, t_break)
             elif t_break < t_end_s:
                 run.at_breakpoint(seg, t_break)
             else:  # the mode is decided at the next advance, with the inputs it brings
@@ -485,8 +445,6 @@ class HybridRun:
         self.stiff_before = False  # whether the last segment was such a stiff restart
         self.restarts = LsodaRestarts()
         self.reached = 0.0  # reported time: the RHS is also evaluated at trial points, which need not increase
-        self.turn_at = math.inf  # where a muscle end turns inside the next segment (see at_turn)
-        self.passing: dict = {}  # the muscle ends being taken through a turn (integrate_segment's passing)
 
     def report(self, t: float) -> None:
         """Tell the progress callback, if any, the simulated time reached (never less than before)."""
@@ -524,9 +482,7 @@ class HybridRun:
         try:
             seg = integrate_segment(rhs, t, t_break, y, method, [_from_start(f, t, y) for _, f, _ in named],
                                     samples, rtol=opts.rtol, atol=self.atol, max_step=max_step, v_row=_V_ROW,
-                                    first_step=first_step, restarts=self.restarts,
-                                    turns=self.gen.turns(mode) if mode.is_slip else None,
-                                    turn_tol=opts.rtol * STATE_SCALES["v_m_s"], passing=self.passing)
+                                    first_step=first_step, restarts=self.restarts)
         except (InputError, SolverFailure):
             raise
         except Exception as exc:
@@ -534,7 +490,6 @@ class HybridRun:
             # from brentq, ZeroDivisionError, LinAlgError...); to the caller it is a solver failure (exit 3).
             raise SolverFailure(f"the integrator raised {type(exc).__name__} at t = {t:.6g} s in mode "
                                 f"{mode.label}: {exc}") from exc
-        self.passing = seg.passing or {}
         self.nfev += seg.nfev
         self.njev += seg.njev
         self.n_segments += 1
@@ -582,19 +537,8 @@ class HybridRun:
             raise too_many_events(self.opts.max_events, f" by t = {t_event:.6g} s{_in_place(self.transitions)}")
         self.t = t_event
 
-    def at_turn(self, seg) -> None:
-        """The segment stopped at the start of a step in which a muscle end turned (:meth:`GeneratedCode.turns`):
-        the next integrates to the turn's approach (:func:`pamsim.stepping._first_turn`), and the one after
-        restarts there and takes the end through its turn in its own steps; nothing else changes."""
-        self.t, self.y, self.turn_at = float(seg.t[-1]), seg.y[:, -1].copy(), seg.t_turn
-
-    def past_turn(self, seg, t_turn: float) -> None:
-        """The segment reached the turn's approach :meth:`at_turn` found: the next starts there afresh."""
-        self.t, self.y, self.turn_at = t_turn, seg.y[:, -1].copy(), math.inf
-
     def at_breakpoint(self, seg, t_break: float) -> None:
         """The segment reached an input breakpoint: a held load's mode is decided again there."""
-        self.turn_at = math.inf
         self.t = t_break
         self.hold_until = math.inf
         self.stiff_restart = False
@@ -607,16 +551,11 @@ class HybridRun:
         """Integrate from where the run is to ``duration_s``, segment by segment, sampling each."""
         while self.t < duration_s:
             self.report(self.t)
-            t_input = min(self.breaks[bisect.bisect_right(self.breaks, self.t)], self.hold_until)
-            t_break = min(t_input, self.turn_at)
+            t_break = min(self.breaks[bisect.bisect_right(self.breaks, self.t)], self.hold_until)
             seg, named = self.segment(t_break)
             self.record(seg)
             if seg.status == 1:
                 self.at_event(seg, named)
-            elif seg.status == 2:
-                self.at_turn(seg)
-            elif t_break < t_input:
-                self.past_turn(seg, t_break)
             else:
                 self.at_breakpoint(seg, t_break)
 

@@ -16,9 +16,6 @@ A step that is long, in which the load's velocity changes sign, or in which a sl
 dip to zero and back (:func:`_may_dip`), is also checked inside for an indicator that went below zero and
 back between its ends (:func:`missed_crossing`), and the segment then ends there.  The run stops at that
 step, where ``solve_ivp`` went on to its segment's end and was cut afterwards: only the count of right-hand-side evaluations differs.
-
-Given velocities to watch (``turns``), a step in which one of them turns is not kept: the segment ends at
-its start, and says where the turn's approach is, for the caller to integrate to it and restart there.
 """
 
 from __future__ import annotations
@@ -50,9 +47,7 @@ class Segment:
 
     ``t``, ``y``: the start, every step's end and the segment's end (its event's time, if any), and the
     states there (one column per time).  ``samples_t``, ``samples_y``: the samples asked for, up to the
-    segment's end, from the dense output.  ``status``: 0 at the breakpoint, 1 at an event, 2 before a step
-    in which a watched velocity turned (approached at ``t_turn`` [s], inside the step, which is not kept;
-    ``passing``: that velocity's index and the sign it had before, with those still being passed), -1 failed
+    segment's end, from the dense output.  ``status``: 0 at the breakpoint, 1 at an event, -1 failed
     (``message`` says why).  ``event``: the index of the event function that fired, at ``t_event`` [s]
     with the states ``y_event``; ``nfev``: right-hand-side evaluations; ``njev``: Jacobians the method formed
     (scipy's count; LSODA's by finite differences, whose evaluations are among ``nfev``); ``h_next``:
@@ -71,8 +66,6 @@ class Segment:
     message: str
     h_next: float | None = None
     njev: int = 0
-    t_turn: float | None = None
-    passing: dict | None = None
 
 
 DOPRI5 = "DOPRI5"
@@ -368,30 +361,6 @@ def _crossed(g_old, g_new, direction) -> bool:
     return (up and direction > 0) or (down and direction < 0) or ((up or down) and direction == 0)
 
 
-TURN_MARGIN = 10.0
-"""How many of its tolerances short of zero a turning velocity is taken at: the segment that restarts there
-crosses the turn inside its own steps.  At the zero itself, the elements on a massless end that a
-velocity within its noise of zero holds switched from slipping to sticking and back, an event every
-fraction of a microsecond (50 events in 3 us on one pair)."""
-
-
-def _first_turn(turns: Callable, w_old, w_new, tol: float, dense, t_old: float, t: float):
-    """``(time, index, sign)`` of the first velocity ``turns(t, y)`` gives (``w_old`` at the step's start,
-    ``w_new`` at its end: ``(velocity, armed)`` pairs), armed at the start, that changes sign inside the step
-    ``(t_old, t]`` beyond ``tol`` on both sides (:func:`_turned`), at its approach: where it is still
-    :data:`TURN_MARGIN` tolerances (at most half its start value) short of zero on its own side, from the
-    step's dense output; or None."""
-    from scipy.optimize import brentq
-
-    found = []
-    for k, ((a, armed), (b, _)) in enumerate(zip(w_old, w_new)):
-        if armed and _turned(a, b, tol):
-            short = math.copysign(min(TURN_MARGIN * tol, 0.5 * abs(a)), a)
-            found.append((brentq(lambda tau: turns(tau, dense(tau))[k][0] - short, t_old, t, xtol=4 * EPS,
-                                 rtol=4 * EPS), k, math.copysign(1.0, a)))
-    return min(found) if found else None
-
-
 def _earliest_event(events, directions, g_old, g_new, dense, t_old: float, t: float) -> tuple[float, int]:
     """``solve_ivp``'s terminal event of the step ``(t_old, t]``: ``(time, index)`` of the earliest root of
     the events that crossed in it, and of equal times the first event (as its stable sort orders them)."""
@@ -408,8 +377,7 @@ def _earliest_event(events, directions, g_old, g_new, dense, t_old: float, t: fl
 def integrate_segment(fun: Callable, t0: float, t_end: float, y0: np.ndarray, method: str,
                       events: Sequence[Callable], samples: np.ndarray, *, rtol: float, atol, max_step: float,
                       v_row: int | None = None, first_step: float | None = None,
-                      long_step_s: float = LONG_STEP_S, restarts: LsodaRestarts | None = None,
-                      turns: Callable | None = None, turn_tol: float = 0.0, passing: dict | None = None) -> Segment:
+                      long_step_s: float = LONG_STEP_S, restarts: LsodaRestarts | None = None) -> Segment:
     """Integrate ``fun`` from ``(t0, y0)`` to ``t_end`` or the first of the terminal ``events``.
 
     Parameters
@@ -436,17 +404,6 @@ def integrate_segment(fun: Callable, t0: float, t_end: float, y0: np.ndarray, me
         methods ignore it.
     restarts : LsodaRestarts, optional
         Where LSODA's solver is kept between the segments of a run (None: a new solver).
-    turns : callable, optional
-        ``w(t, y)``, a list of ``(velocity, armed)`` pairs: velocities whose equations change where they turn,
-        with no event, while armed (a massless muscle end with an element slipping on its limit).  The segment
-        ends at the start of a step in which one armed at its start changes sign beyond ``turn_tol`` on both
-        sides (status 2), with the turn's approach located on the step's dense output (``t_turn``:
-        :func:`_first_turn`), so that the caller integrates to it and restarts there.
-    turn_tol : float
-        The velocities' tolerance of zero (a velocity hovering within it at rest is no turn).
-    passing : dict, optional
-        ``{index: sign}``: velocities being taken through a turn found before, not armed until their sign
-        has changed from ``sign``; the segment returns those still being passed.
 
     Returns
     -------
@@ -467,18 +424,8 @@ def integrate_segment(fun: Callable, t0: float, t_end: float, y0: np.ndarray, me
     grid = samples.tolist()  # bisect on a list: a step's samples are few, and a numpy call costs more
     directions = [getattr(e, "direction", 0.0) for e in events]
     g = [e(solver.t, solver.y) for e in events]
-    passing = dict(passing or {})
-
-    def watched(t, y):
-        out = turns(t, y)
-        for k, sign in list(passing.items()):
-            if out[k][0] * sign < 0.0:
-                del passing[k]  # through its turn: armed again
-        return [(v, armed and k not in passing) for k, (v, armed) in enumerate(out)]
-
-    w = watched(solver.t, solver.y) if turns is not None else None
     ts, ys = [solver.t], [solver.y]
-    sample_ys, n_taken, status, event, message, t_turn = [], 0, None, None, "", None
+    sample_ys, n_taken, status, event, message = [], 0, None, None, ""
     kept = None  # the last kept step's dense output, where a sample sits on its end (see below)
     while status is None:
         message = solver.step()
@@ -512,14 +459,6 @@ def integrate_segment(fun: Callable, t0: float, t_end: float, y0: np.ndarray, me
                 t, event = missed
                 y, status = dense(t), 1
         g = g_new
-        if turns is not None and status != 1:
-            w_new = watched(t, y)
-            turn = _first_turn(turns, w, w_new, turn_tol, _dense_of(solver) if dense is None else dense, t_old, t)
-            if turn is not None:
-                status, (t_turn, k, sign) = 2, turn
-                passing[k] = sign
-                break
-            w = w_new
         if t == ts[-1] and len(ts) > 1:
             continue  # no time passed: solve_ivp keeps neither the point nor its dense output
         # A sample on a step boundary is read from the step solve_ivp's piecewise solution reads it from:
@@ -545,7 +484,7 @@ def integrate_segment(fun: Callable, t0: float, t_end: float, y0: np.ndarray, me
                    status=status, event=event, t_event=float(t) if status == 1 else None,
                    y_event=np.array(y, dtype=float) if status == 1 else None,
                    nfev=solver.nfev, message=message or "", h_next=solver.h_next if method == DOPRI5 else last_step,
-                   njev=getattr(solver, "njev", 0), t_turn=t_turn if status == 2 else None, passing=passing)
+                   njev=getattr(solver, "njev", 0))
 
 
 __all__ = ["DOPRI5", "DormandPrince", "LsodaRestarts", "Segment", "integrate_segment", "missed_crossing", "LONG_STEP_S",

@@ -462,27 +462,6 @@ def test_a_stiffness_the_elastic_pair_cannot_reach_is_refused_by_key(tmp_path):
     assert not (tmp_path / "out").exists()
 
 
-def test_python_restarts_where_a_muscle_end_with_elements_turns():
-    """Prandtl-Ishlinskii operators on both muscles at 3.5 and 1.5 bar: at 0.580 s the extensor's end turns
-    back while its smallest operator slips on its limit, which lets go with no event.  LSODA stepped over it
-    (983 events, the angle 5.3e-4 rad off native's at rtol 1e-10); restarted at the turn, python at rtol 1e-6
-    is within 2e-5 rad of it in fewer than 200 events, and at 1e-10 within 1e-8 rad."""
-    spec = copy.deepcopy(SPEC)
-    for m, p in zip(spec["muscle"], (3.5, 1.5)):
-        m["pressure"]["supply_gauge_bar"] = p
-        m["hysteresis"] = {"model": "pi", "thresholds_m": [2e-4, 1e-3, 4e-3], "weights_N_per_m": [3750, 750, 250]}
-
-    def run(backend, rtol):
-        s = copy.deepcopy(spec)
-        s["solver"].update(rtol=rtol, max_events=5000)
-        return simulate_joint(JointScenario.from_dict(s, origin="pair", base_dir=ELASTIC.parent), backend)
-
-    reference = run("native", 1e-10)
-    python = run("python", 1e-6)
-    assert np.abs(python.theta_rad - reference.theta_rad).max() < 2e-5 and len(python.transitions) < 200
-    assert np.abs(run("python", 1e-10).theta_rad - reference.theta_rad).max() < 1e-8
-
-
 def test_the_elastic_linear_models_stiffness_row_is_the_statics_slope_along_the_rest():
     """The stiffness output's derivatives (C's and D's second row): along the ends' rest, ``dk/dtheta`` is
     ``C[1, theta] + C[1, ends] dx_rest/dtheta`` and ``dk/dp`` is ``D[1, p] + C[1, ends] dx_rest/dp``, each against

@@ -354,35 +354,3 @@ def test_a_restarted_lsoda_counts_its_own_segments_jacobians_only():
     fresh = run(None)
     assert run(LsodaRestarts()) == fresh
     assert fresh[0][1] > 0 and fresh[1] == (0, 0)
-
-
-@pytest.mark.parametrize("method", ["LSODA", "RK45", "DOPRI5"])
-def test_a_segment_stops_before_the_step_in_which_a_watched_velocity_turns(method):
-    """``y'' = -y`` from ``y = 0, y' = 1``: the watched velocity ``y'`` = cos t turns at pi/2.  The segment
-    ends at the start of the step that crosses it (status 2, nothing of that step kept: its samples neither)
-    and gives the turn's approach, where ``y'`` is still TURN_MARGIN tolerances above zero, to 1e-9 s
-    (``arccos(1e-5)``), and the velocity as being passed.  A segment from there, passing it, crosses the turn
-    and is armed again past it: it stops before the next turn, at 3 pi / 2.  A velocity that stays within its
-    tolerance of zero, a segment that ends before the turn, or a velocity not armed, is no turn."""
-    from pamsim.stepping import TURN_MARGIN
-
-    def f(t, y):
-        return np.array([y[1], -y[0]])
-
-    def run(t0, t1, y0, armed=True, passing=None):
-        grid = np.linspace(0.0, 6.0, 601)
-        grid = grid[(grid >= t0) & (grid <= t1)]
-        return integrate_segment(f, t0, t1, np.array(y0), method, [], grid, rtol=1e-10, atol=1e-12, max_step=np.inf,
-                                 turns=lambda t, y: [(y[1], armed)], turn_tol=1e-6, passing=passing)
-
-    seg = run(0.0, 3.0, [0.0, 1.0])
-    assert seg.status == 2 and seg.passing == {0: 1.0}
-    assert seg.t_turn == pytest.approx(np.arccos(TURN_MARGIN * 1e-6), abs=1e-9)
-    assert seg.t[-1] < seg.t_turn and seg.samples_t[-1] <= seg.t[-1]
-    np.testing.assert_allclose(seg.samples_y[1], np.cos(seg.samples_t), atol=1e-7)
-    t_a = seg.t_turn
-    on = run(t_a, 6.0, [np.sin(t_a), np.cos(t_a)], passing=seg.passing)
-    assert on.status == 2 and on.passing == {0: -1.0}
-    assert on.t_turn == pytest.approx(2 * np.pi - np.arccos(-TURN_MARGIN * 1e-6), abs=1e-8)
-    assert run(0.0, 1.5, [0.0, 1.0]).status == 0
-    assert run(0.0, 3.0, [0.0, 1e-8]).status == 0 and run(0.0, 3.0, [0.0, 1.0], armed=False).status == 0
