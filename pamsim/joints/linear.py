@@ -18,7 +18,7 @@ elements' deflections held: their springs act through their states.
 
 A muscle on an elastic tendon (:class:`pamsim.components.series_tendon.SeriesTendon`) adds its end's
 contraction as a state, taken at its own rest (:class:`pamsim.joints.static.JointStatics` finds it: its
-static force equals its tendon's pull).  Its friction dropped, the massless end's velocity is the damping
+static force, with what is added on its end, equals its tendon's pull).  Its friction dropped, the massless end's velocity is the damping
 law's inverse of the force left to it, differentiable there.  The stiffness output is then the muscle and
 its tendon in series: ``-d tau_net / d theta`` with each end following the link so that its forces stay
 balanced (``dx/dtheta = -g_theta / g_x``, ``g`` the force left to its damping), written in the state, so
