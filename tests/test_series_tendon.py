@@ -340,6 +340,26 @@ def test_presliding_damping_on_an_elastic_tendon_is_refused_by_key():
         _with_elements(damping_N_s_per_m=100.0)
 
 
+@pytest.mark.parametrize("damping", ["paper", "none", "linear"])
+def test_the_assembly_itself_refuses_a_damping_a_massless_end_cannot_move_under(damping):
+    """Built from Python (as the MuJoCo coupling does), not from a joint scenario: on an elastic tendon the
+    paper's D1 < 0 and no damping are refused where the muscle is assembled, naming the law; on a rigid
+    tendon, and with linear damping on an elastic one, the muscle is built."""
+    from pamsim.assemblies.muscle_only import muscle_only_assembly
+    from pamsim.scenario import Scenario
+
+    spec = tomllib.loads((ROOT / "scenarios" / "acra2012_fig4.toml").read_text())
+    spec.setdefault("model", {})["damping"] = damping
+    model = Scenario.from_dict(spec, base_dir=ROOT / "scenarios").build_model()
+    assert isinstance(model.damping, PaperDamping) == (damping == "paper")
+    muscle_only_assembly(model, 0.3, 9.81)  # rigid: the muscle's end moves with the load, any law will do
+    if damping == "linear":
+        muscle_only_assembly(model, 0.3, 9.81, tendon_stiffness_N_per_m=2000.0)
+        return
+    with pytest.raises(ValueError, match=f"damping '{damping}' on a massless muscle end.*'linear'"):
+        muscle_only_assembly(model, 0.3, 9.81, tendon_stiffness_N_per_m=2000.0)
+
+
 @pytest.mark.parametrize("elastic", [True, False])
 def test_a_spring_on_the_muscles_end_enters_its_balance_and_its_energy(elastic):
     """A ``linear_spring`` added on the flexor's end (1000 N/m, free at 20 mm): its work is counted in the

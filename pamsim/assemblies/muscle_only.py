@@ -53,7 +53,8 @@ def muscle_only_assembly(model, L0_m: float, g_m_s2: float, p0_gauge_Pa: float |
     ------
     ValueError
         For an added component wired to a part of the load a muscle alone does not have, or one that cannot
-        act on a massless end (a Maxwell-slip element's presliding damping).
+        act on a massless end (a Maxwell-slip element's presliding damping); on an elastic tendon, for a
+        damping law whose force does not grow with speed through zero (the paper's ``D1 < 0``, or none).
     """
     elastic = tendon_stiffness_N_per_m is not None
     end, load = ("spring", LOAD_TO_SPRING) if elastic else ("motion", LOAD_TO_MOTION)

@@ -26,6 +26,7 @@ paper's, with ``D1 < 0``, does not.
 
 from __future__ import annotations
 
+from ..elements.damping import increasing
 from ..modeling import TRANSLATIONAL, Component, Equations, Port, Symbols, Var, positive
 from ..modeling.smath import fmax, if_else
 from .damping import ViscousDamping
@@ -37,6 +38,15 @@ class MuscleEndDamping(ViscousDamping):
 
     inputs = (Var("F_free_N", "N", "force left to the damping at the muscle's end"),)
     outputs = ViscousDamping.outputs + (Var("v_free_m_s", "m/s", "velocity at which the damping force is F_free_N"),)
+
+    def __init__(self, name: str, element):
+        # Without a law that grows through zero the massless end has no velocity, or several, for a force: the
+        # integrator would fail far from here ("step size underflow"), so the law is refused where it is given.
+        if not increasing(element):
+            raise ValueError(f"damping {getattr(element, 'name', type(element).__name__)!r} on a massless muscle "
+                             "end (a muscle on an elastic tendon): its force must grow with speed through zero; "
+                             "use damping = 'linear', or 'paper' with D1_N_s_per_m > 0")
+        super().__init__(name, element)
 
     def equations(self, s: Symbols) -> Equations:
         """The damping's equations, and the inverse of its law at ``F_free_N``."""
