@@ -21,6 +21,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from .assemblies.muscle_only import MUSCLE_ONLY_COMPONENTS
 from .assemblies.one_muscle import RIG_COMPONENTS, AddedComponent, scenario_assembly
 from .components.catalogue import COMPONENT_TYPES
 from .components.bouc_wen_friction import BoucWenFriction
@@ -79,12 +80,14 @@ def _component_options(v, where: str, cls, entry: dict) -> dict[str, str]:
 
 
 def _component_name(v, where: str, entry: dict, taken: set) -> str:
-    """The entry's name: an identifier, not the rig's own components' nor an earlier entry's."""
+    """The entry's name: an identifier, not the rig's own components' (a muscle alone's among them) nor an
+    earlier entry's."""
     name = entry.get("name")
     if not isinstance(name, str) or not name.isidentifier():
         v.fail(f"{where}.name", name, "must be a name made of letters, digits and underscores")
-    if name in RIG_COMPONENTS or name in taken:
-        v.fail(f"{where}.name", name, "is taken (by the rig's own components or an earlier [[component]])")
+    if name in RIG_COMPONENTS or name in MUSCLE_ONLY_COMPONENTS or name in taken:
+        v.fail(f"{where}.name", name, "is taken (by the rig's own components, a muscle alone's ("
+               f"{', '.join(sorted(MUSCLE_ONLY_COMPONENTS))}) or an earlier [[component]])")
     return name
 
 

@@ -116,8 +116,28 @@ def test_the_coupling_converges_to_pamsims_joint_at_first_order(make, bound):
     for m in reference.muscles:
         assert coupled.tension_N(m) == pytest.approx(reference.muscle(m, "F_tendon_N")[-1], rel=1e-6)
         assert coupled.outputs(m)["chamber.p_gauge_Pa"] == pytest.approx(reference.muscle(m, "p_gauge_Pa")[-1], rel=1e-6)
-        if "spring.x_m" in coupled.outputs(m):
-            assert coupled.outputs(m)["spring.x_m"] == pytest.approx(reference.muscle(m, "x_m")[-1], rel=1e-6)
+        if any("tendon_stiffness_N_per_m" in table for table in scenario.spec["muscle"]):
+            assert coupled.outputs(m)["series_spring.x_m"] == pytest.approx(reference.muscle(m, "x_m")[-1], rel=1e-6)
+
+
+def test_a_component_on_an_elastic_muscles_end_acts_there_in_mujoco():
+    """A ``linear_spring`` named ``spring`` (the name the scenario docs use) on the flexor's end of the
+    frictionless elastic pair: it acts on the massless end, not on MuJoCo's tendon, so MuJoCo comes to rest
+    where pamsim's joint does (-0.252 rad, where the pair alone rests at +0.309), with the same tensions,
+    contractions and spring force."""
+    spec = copy.deepcopy(frictionless_elastic().spec)
+    spec["muscle"][0]["component"] = [{"name": "spring", "type": "linear_spring", "k_N_per_m": 1000.0,
+                                       "x_free_m": 0.02, "connect": {"flange": "load.flange"}}]
+    reference = simulate_joint(JointScenario.from_dict({**copy.deepcopy(spec), "solver": {"rtol": 1e-9}}), "native")
+    _, theta, coupled = mujoco_run(JointScenario.from_dict(spec), 2.5e-4)
+    assert reference.position[-1] < -0.2
+    assert theta[-1] == pytest.approx(reference.position[-1], abs=1e-7)
+    for m in reference.muscles:
+        assert coupled.tension_N(m) == pytest.approx(reference.muscle(m, "F_tendon_N")[-1], rel=1e-6)
+        assert coupled.outputs(m)["series_spring.x_m"] == pytest.approx(reference.muscle(m, "x_m")[-1], rel=1e-6)
+    F_spring_N = reference.signals["flexor_spring.F_spring_N"][-1]
+    assert abs(F_spring_N) > 1.0
+    assert coupled.outputs("flexor")["spring.F_spring_N"] == pytest.approx(F_spring_N, rel=1e-6)
 
 
 def test_a_missing_actuator_or_one_not_on_a_tendon_is_refused_by_name():

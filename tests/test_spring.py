@@ -86,6 +86,8 @@ BAD = [
     ({"k_N_per_mm": 2.0}, "component[0].k_N_per_mm", "not a parameter of linear_spring"),
     ({"k_N_per_m": "stiff"}, "component[0].k_N_per_m", "must be a finite number"),
     ({"name": "load"}, "component[0].name", "is taken"),
+    ({"name": "motion"}, "component[0].name", "is taken"),  # a muscle alone's: run on a length, or in MuJoCo
+    ({"name": "series_spring"}, "component[0].name", "is taken"),
     ({"connect": {}}, "[[component]]", "spring.flange"),
     ({"connect": {"flange": "chamber.port"}}, "[[component]]", "spring.flange"),
     ({"connect": {"flange": "load.flang"}}, "[[component]]", "load.flang"),

@@ -12,9 +12,9 @@ Model inputs: the pressure source's (``valve_command`` and ``supply_pressure_gau
 output ``motion.F_N``.
 
 On an elastic tendon (``tendon_stiffness_N_per_m``) the length given is the tendon's path, and a
-:class:`~pamsim.components.series_tendon.SeriesTendon` named ``spring`` sits between it and the muscle, whose
-end (its contraction the state ``spring.x_m``) is massless: the muscle's static force, damping and friction,
-and whatever is added on the load, act there, and ``motion.F_N`` is the tendon's pull.
+:class:`~pamsim.components.series_tendon.SeriesTendon` named ``series_spring`` sits between it and the muscle,
+whose end (its contraction the state ``series_spring.x_m``) is massless: the muscle's static force, damping
+and friction, and whatever is added on the load, act there, and ``motion.F_N`` is the tendon's pull.
 """
 
 from __future__ import annotations
@@ -29,13 +29,20 @@ MOTION_INPUTS = {"length_m": "motion.length_m", "lengthening_velocity_m_s": "mot
 """The model inputs that move the muscle, and the component inputs they drive."""
 
 
+MUSCLE_ONLY_COMPONENTS = frozenset({"motion", "series_spring"})
+"""The names of this assembly's own components beyond the one-muscle rig's
+(:data:`pamsim.assemblies.one_muscle.RIG_COMPONENTS`): a component added to a muscle cannot take them,
+since a scenario's muscle may be run alone on a length, or coupled to another tool through this assembly."""
+
+
 LOAD_TO_MOTION = {"load.flange": "motion.flange", "load.x_m": "motion.x_m", "load.v_m_s": "motion.v_m_s",
                   "load.mass_kg": "motion.load_mass_kg"}
 """What a component added to the rig reads of its load, on a muscle alone (the load's mass: the one the
 friction law reads there, the static force over g)."""
 
 
-LOAD_TO_SPRING = {"load.flange": "spring.others", "load.x_m": "spring.x_m", "load.v_m_s": "spring.v_m_s",
+LOAD_TO_SPRING = {"load.flange": "series_spring.others", "load.x_m": "series_spring.x_m",
+                  "load.v_m_s": "series_spring.v_m_s",
                   "load.mass_kg": "motion.load_mass_kg"}
 """The same on an elastic tendon: what is added on the load acts on the muscle's end, the spring's node."""
 
@@ -57,7 +64,7 @@ def muscle_only_assembly(model, L0_m: float, g_m_s2: float, p0_gauge_Pa: float |
         damping law whose force does not grow with speed through zero (the paper's ``D1 < 0``, or none).
     """
     elastic = tendon_stiffness_N_per_m is not None
-    end, load = ("spring", LOAD_TO_SPRING) if elastic else ("motion", LOAD_TO_MOTION)
+    end, load = ("series_spring", LOAD_TO_SPRING) if elastic else ("motion", LOAD_TO_MOTION)
     source = rewired(source_parts(model.source, p0_gauge_Pa), end)
     parts = [PrescribedMotion("motion", {"L0_m": L0_m, "g_m_s2": g_m_s2}), *source.parts,
              MuscleStaticForce("muscle", model.static_force), CoulombFriction("friction", model.friction),
@@ -65,8 +72,8 @@ def muscle_only_assembly(model, L0_m: float, g_m_s2: float, p0_gauge_Pa: float |
     p = f"{source.pressure}.p_gauge_Pa"
     wiring = list(source.wiring)
     if elastic:
-        parts.append(SeriesTendon("spring", {"k_N_per_m": tendon_stiffness_N_per_m}))
-        wiring += [("spring.path", "motion.flange"), *end_wiring("spring", "muscle", "friction", "damping")]
+        parts.append(SeriesTendon(end, {"k_N_per_m": tendon_stiffness_N_per_m}))
+        wiring += [(f"{end}.path", "motion.flange"), *end_wiring(end, "muscle", "friction", "damping")]
     # The flange adds the forces in the one-muscle rig's order: static, damping, friction.
     wiring += [(f"{end}.flange", "muscle.flange"), (f"{end}.flange", "damping.flange"),
                (f"{end}.flange", "friction.flange"), (p, "muscle.p_gauge_Pa"), (p, "friction.p_gauge_Pa"),
