@@ -173,6 +173,9 @@ class DormandPrince:
         t_old, y_old, h = self.t_old, self.y_old, self.t - self.t_old
 
         def y_at(t):
+            if t.__class__ is float:  # the root finders' and event checks' many scalar reads: no array made
+                x = (t - t_old) / h
+                return y_old + x * (q1 + x * (q2 + x * (q3 + x * q4)))
             x = (np.asarray(t, dtype=float) - t_old) / h
             if x.ndim:
                 x = x[None, :]
@@ -284,9 +287,10 @@ def missed_crossing(events: Sequence[Callable], directions: Sequence[float], g_o
     (RK45 at rtol 1e-10 took 0.17 s and carried the load 24 mm through its upper stop)."""
     from scipy.optimize import brentq
 
-    taus = np.linspace(t_old, t, LONG_STEP_CHECKS + 1)
+    # Floats, not numpy scalars: the dense output reads a float without making an array (same values)
+    taus = np.linspace(t_old, t, LONG_STEP_CHECKS + 1).tolist()
     if len(also):
-        taus = np.unique(np.concatenate([taus, [a for a in also if t_old < a < t]]))
+        taus = sorted(set(taus).union(a for a in also if t_old < a < t))
     g_lo = list(g_old)
     for lo, hi in zip(taus[:-2], taus[1:-1]):  # the step's end is what the event rule checked
         y_hi = dense(hi)
