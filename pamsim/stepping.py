@@ -175,11 +175,11 @@ class DormandPrince:
         def y_at(t):
             if t.__class__ is float:  # the root finders' and event checks' many scalar reads: no array made
                 x = (t - t_old) / h
-                return y_old + x * (q1 + x * (q2 + x * (q3 + x * q4)))
-            x = (np.asarray(t, dtype=float) - t_old) / h
-            if x.ndim:
-                x = x[None, :]
-                return y_old[:, None] + x * (q1[:, None] + x * (q2[:, None] + x * (q3[:, None] + x * q4[:, None])))
+            else:
+                x = (np.asarray(t, dtype=float) - t_old) / h
+                if x.ndim:
+                    x = x[None, :]
+                    return y_old[:, None] + x * (q1[:, None] + x * (q2[:, None] + x * (q3[:, None] + x * q4[:, None])))
             return y_old + x * (q1 + x * (q2 + x * (q3 + x * q4)))
         return y_at
 
