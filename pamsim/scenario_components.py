@@ -121,6 +121,10 @@ HYSTERESIS_KEYS = {"maxwell_slip": ("slip_displacement_m", "share", "damping_N_s
 """The hysteresis models a ``[hysteresis]`` table puts in the muscle's force balance, and their keys."""
 
 
+LEVEL_SHARING = ("maxwell_slip", "bouc_wen")
+"""The ``[hysteresis]`` models whose forces are parts of the ``[model] friction`` law's level."""
+
+
 def hysteresis_component(v, table: dict, law, pressure: str, added: tuple) -> AddedComponent:
     """The ``[hysteresis]`` table's model in place of the rig's Coulomb friction, reading the level of its law
     ``law`` (the ``[model] friction`` one) from the muscle's pressure (``<pressure>.p_gauge_Pa``) and the
@@ -153,6 +157,11 @@ def hysteresis_component(v, table: dict, law, pressure: str, added: tuple) -> Ad
         v.fail(f"hysteresis.{key}", table[key], f"unknown key for model = {model!r}", choices=keys)
     if any(a.component.name == "hysteresis" for a in added):
         v.fail("component", "hysteresis", "the name is taken by the [hysteresis] table's model")
+    if model in LEVEL_SHARING and getattr(law, "name", None) == "none":
+        # Their forces are parts of the law's level; at a level of 0 only the presliding damping would act.
+        v.fail("model.friction", "none", f"its level is 0, so the [hysteresis] {model} model that shares it has "
+               "no slip force; give the friction law it shares ('load_dependent' or 'constant'), or use "
+               "hysteresis.model = 'pi', whose forces are its own weights")
     component = {"maxwell_slip": _maxwell_slip, "bouc_wen": _bouc_wen, "pi": _prandtl_ishlinskii}[model](v, table, law)
     return AddedComponent(component, {"flange": "load.flange", "p_gauge_Pa": f"{pressure}.p_gauge_Pa",
                                       "mass_kg": "load.mass_kg"})

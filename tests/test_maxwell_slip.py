@@ -136,6 +136,34 @@ def test_bad_hysteresis_tables_are_refused_by_key(fig4, change, key):
         Scenario.from_dict(spec, name="bad", base_dir=fig4.base_dir)
 
 
+@pytest.mark.parametrize("table", [
+    {"model": "maxwell_slip", "slip_displacement_m": [1e-4], "share": [1.0], "damping_N_s_per_m": 100.0},
+    {"model": "bouc_wen", "beta_per_m_n": 10.0, "gamma_per_m_n": 10.0, "exponent": 1.0},
+])
+def test_elements_that_share_a_level_of_zero_are_refused_by_key(fig4, table, tmp_path):
+    """``friction = "none"`` has a level of 0: Maxwell-slip or Bouc-Wen elements sharing it would have no slip
+    force (only the presliding damping would act), so the scenario is refused naming ``model.friction``, from
+    Python and from ``pamsim run`` (exit 2, nothing written).  PI's forces are its own: it is accepted, and
+    its elements pull where the load moves."""
+    spec = copy.deepcopy(dict(fig4.spec))
+    spec["model"]["friction"] = "none"
+    spec["hysteresis"] = table
+    with pytest.raises(ScenarioError, match=r"model\.friction = 'none'"):
+        Scenario.from_dict(spec, name="bad", base_dir=fig4.base_dir)
+    lines = "".join(f"{k} = {v!r}\n".replace("'", '"') for k, v in table.items())
+    path = tmp_path / "bad.toml"
+    path.write_text(FIG4.read_text().replace('friction = "load_dependent"', 'friction = "none"', 1)
+                    + "\n[hysteresis]\n" + lines)
+    assert 'friction = "none"' in path.read_text()
+    done = subprocess.run([sys.executable, "-m", "pamsim", "run", str(path), "-o", str(tmp_path / "out")],
+                          capture_output=True, text=True, cwd=ROOT / "scenarios")
+    assert done.returncode == 2 and "model.friction = 'none'" in done.stderr, done.stderr
+    assert "Traceback" not in done.stderr and not (tmp_path / "out").exists()
+    spec["hysteresis"] = {"model": "pi", "thresholds_m": [2e-4, 1e-3], "weights_N_per_m": [3000.0, 500.0]}
+    res = simulate(Scenario.from_dict(spec, name="pi", base_dir=fig4.base_dir), backend="python")
+    assert np.max(np.abs(res.signals["hysteresis.F_N"])) > 0.1
+
+
 # ---------------------------------------------------------------- where the load rests
 TEN_DELTAS = list(np.geomspace(1e-4, 5e-3, 10))
 
