@@ -51,6 +51,28 @@ def test_the_bic_picks_the_true_number_of_elements_on_a_clean_loop(name, true_n)
     assert {r["label"] for r in fit.comparison_rows()} >= {"pi m=8", "bouc_wen"}
 
 
+def test_plays_the_loop_never_moves_are_neither_placed_nor_counted():
+    """A loop that swings +-10 mm about its start: the default grid's thresholds stay below the largest
+    excursion from the start (10 mm), so every play moves; a given threshold past it (15 mm) is a play that
+    never moves, reported not identified at weight 0, and the fit (offset, RMS, AIC, BIC, k) is the fit
+    without that threshold."""
+    params = dict(F0_N=10.0, w0_N_per_m=400.0, w1_N_per_m=300.0, envelope_scale_m=0.05)
+    pull = pull_from_parameters("pi", params, [0.0, 0.003])
+    data = synthetic_loop(pull, 0.05, 4, points_m=(0.015, 0.025, 0.005, 0.025, 0.005, 0.015))
+    grid = fit_pi(data)
+    assert grid.fixed["thresholds_m"][-1] < 0.010 and grid.n_parameters == len(grid.names) == 10
+    beyond = fit_pi(data, thresholds_m=[0.0, 0.003, 0.015])
+    without = fit_pi(data, thresholds_m=[0.0, 0.003])
+    assert beyond.n_parameters == without.n_parameters == 4 and len(beyond.names) == 5
+    values = dict(zip(beyond.names, beyond.values))
+    assert values["w2_N_per_m"] == 0.0 and beyond.intervals()["w2_N_per_m"] is None
+    assert beyond.to_json()["parameters"]["w2_N_per_m"]["interval"] == "not identified"
+    assert beyond.identified[:3].all() and beyond.identified[4] == without.identified[3]
+    assert values["F0_N"] == pytest.approx(dict(zip(without.names, without.values))["F0_N"], rel=1e-6)
+    for attribute in ("rms_N", "aic", "bic"):
+        assert getattr(beyond, attribute) == pytest.approx(getattr(without, attribute), rel=1e-6), attribute
+
+
 def test_what_the_data_cannot_show_is_not_identified():
     # A classical operator's loop (no envelope) does not set the envelope's scale: the search ends on its
     # upper bound.  Two elements more than the truth: their stiffness and slip force intervals reach 0.

@@ -309,7 +309,7 @@ def register_hysteresis(fsub) -> None:
     h.add_argument("--plays", type=int, default=8,
                    help="Prandtl-Ishlinskii play operators on the default threshold grid (default 8)")
     h.add_argument("--thresholds-mm", type=_numbers,
-                   help="Prandtl-Ishlinskii thresholds [mm], strictly increasing from 0 (default: a grid of --plays)")
+                   help="Prandtl-Ishlinskii thresholds [mm], at least 0 and strictly increasing (default: a grid of --plays)")
     h.add_argument("--exponent", type=finite_float, help="Bouc-Wen exponent n, fixed (default: fitted)")
     h.add_argument("--columns", type=_columns, default={},
                    help="map quantities to other column names: time=NAME,pressure=NAME,contraction=NAME,force=NAME")

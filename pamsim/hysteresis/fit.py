@@ -35,7 +35,8 @@ from .prandtl_ishlinskii import PrandtlIshlinskii
 DEFAULT_MAX_ELEMENTS = 6
 """Maxwell-slip fits tried for the BIC's choice: N = 1 to this."""
 DEFAULT_PLAYS = 8
-"""Play operators of a Prandtl-Ishlinskii fit: thresholds ``j / m`` of the envelope's span, ``j = 0..m-1``."""
+"""Play operators of a Prandtl-Ishlinskii fit: thresholds ``j / m`` of the envelope's largest excursion from its
+first sample, ``j = 0..m-1`` (a play of threshold at least that never moves from its relaxed start)."""
 CONFIDENCE = 0.95
 """Level of the reported intervals (Student's t on the residual's degrees of freedom)."""
 FD_RELATIVE_STEP = 1e-6
@@ -135,6 +136,9 @@ class ModelFit:
     """The residual's lag-1 autocorrelation and the widening of the intervals it asks for."""
     fixed: dict = field(default_factory=dict)
     """Values that were set, not fitted (the Prandtl-Ishlinskii thresholds, a given Bouc-Wen exponent)."""
+    not_counted: int = 0
+    """Parameters the data never reach (the weights of plays the loop never moves: their columns are the
+    offset's), reported as not identified and left out of the AIC and BIC's count."""
 
     def predict_N(self, x_m, level_N=None) -> np.ndarray:
         """The fitted model's pull [N] for the contraction ``x_m`` [m], relaxed at its first sample; a
@@ -150,8 +154,8 @@ class ModelFit:
 
     @property
     def n_parameters(self) -> int:
-        """Fitted parameters: what the AIC and BIC count."""
-        return len(self.names)
+        """Fitted parameters the data reach: what the AIC and BIC count."""
+        return len(self.names) - self.not_counted
 
     def intervals(self) -> dict[str, tuple[float, float] | None]:
         """``{name: (low, high)}`` at :data:`CONFIDENCE`; None for a parameter that is not identified.  The
@@ -221,7 +225,7 @@ def fit_hysteresis(data: LoopData, model: str = "maxwell_slip", elements: int | 
     plays : int
         Play operators of the Prandtl-Ishlinskii fit on the default threshold grid.
     thresholds_m : array_like, optional
-        Prandtl-Ishlinskii thresholds in the envelope's input unit (m), strictly increasing from 0;
+        Prandtl-Ishlinskii thresholds in the envelope's input unit (m), at least 0 and strictly increasing;
         default: the grid of ``plays``.
     exponent : float, optional
         Bouc-Wen exponent n (above 0), fixed; default: fitted.
@@ -278,11 +282,14 @@ def _dof(correlation: ResidualCorrelation, k: int) -> float:
 
 
 def _finish(model: str, label: str, data: LoopData, names, theta: np.ndarray, predict, at_bound, positive,
-            operator, predictor, fixed=None, residual_model: str = "correlated") -> ModelFit:
+            operator, predictor, fixed=None, residual_model: str = "correlated", unreached=None) -> ModelFit:
     """The :class:`ModelFit` at ``theta``: ``predict(theta)`` the force, its Jacobian by central differences,
     the intervals (widened for a correlated residual).  Not identified: a parameter the Jacobian does not see,
     one on a bound of its search (``at_bound``), one that must be above 0 (``positive``) whose interval reaches
-    0, and every one when the residual's effective samples do not outnumber the parameters."""
+    0, one the data never reach (``unreached``: not counted in the AIC and BIC either), and every one when
+    the residual's effective samples do not outnumber the parameters."""
+    unreached = np.zeros(theta.size, dtype=bool) if unreached is None else unreached
+    k = theta.size - int(np.sum(unreached))
     force = predict(theta)
     residual = data.force_N - force
     jac = np.empty((force.size, theta.size))
@@ -294,15 +301,16 @@ def _finish(model: str, label: str, data: LoopData, names, theta: np.ndarray, pr
     unc = linearised_uncertainty(names, jac, residual)
     correlation = ResidualCorrelation.of(residual, residual_model)
     se = unc.standard_errors * correlation.widening
-    dof = _dof(correlation, theta.size)
-    identified = unc.identified & np.isfinite(se) & (se > 0) & ~at_bound & (dof >= 1)
+    dof = _dof(correlation, k)
+    identified = unc.identified & np.isfinite(se) & (se > 0) & ~at_bound & ~unreached & (dof >= 1)
     # A stiffness, slip force or scale whose interval reaches 0 is one the data cannot tell from none.
     reaches_zero = positive & (theta - _t_quantile(dof) * np.nan_to_num(se, nan=np.inf) <= 0)
     identified &= ~reaches_zero
-    aic, bic = information_criteria(float(residual @ residual), residual.size, theta.size,
+    aic, bic = information_criteria(float(residual @ residual), residual.size, k,
                                     correlation.effective_samples if correlation.significant else None)
     return ModelFit(model, label, tuple(names), theta, np.where(identified, se, np.nan),
-                    identified, force, residual, aic, bic, operator, predictor, correlation, fixed or {})
+                    identified, force, residual, aic, bic, operator, predictor, correlation, fixed or {},
+                    int(np.sum(unreached)))
 
 
 # ------------------------------------------------------------------ Maxwell-slip
@@ -397,16 +405,25 @@ def _fit_shared_level(data: LoopData, n: int, residual: str) -> ModelFit:
 
 
 # ------------------------------------------------------------------ Prandtl-Ishlinskii
-def _pi_thresholds(x: np.ndarray, scale: float, plays: int) -> np.ndarray:
+def _pi_excursion(x: np.ndarray, scale: float) -> float:
+    """The envelope's largest excursion from its first sample: plays of threshold at least this never move
+    from their relaxed start (the envelope is monotone)."""
     g = PrandtlIshlinskii([0.0], [1.0], 0.0, scale).envelope(x)
-    return np.arange(plays) * float(np.ptp(g)) / plays
+    return float(np.max(np.abs(g - g[0])))
+
+
+def _pi_thresholds(x: np.ndarray, scale: float, plays: int) -> np.ndarray:
+    return np.arange(plays) * _pi_excursion(x, scale) / plays
 
 
 def _pi_columns(x: np.ndarray, thresholds: np.ndarray, scale: float) -> np.ndarray:
-    """Columns of ``F0, w_0..w_m-1``: ``1`` and the plays of ``g(x)``, relaxed at the first sample."""
+    """Columns of ``F0, w_0..w_m-1``: ``1`` and the plays of ``g(x)``, relaxed at the first sample.  A play
+    that never moves has a column of 0: its constant would be the offset's, which alone carries it."""
     pi = PrandtlIshlinskii(thresholds, np.ones(thresholds.size), 0.0, scale)
     start = np.full(thresholds.size, float(pi.envelope(x[0])))
-    return np.column_stack([np.ones_like(x), pi.run(x, start).states])
+    states = pi.run(x, start).states
+    states[:, np.ptp(states, axis=0) == 0.0] = 0.0
+    return np.column_stack([np.ones_like(x), states])
 
 
 def fit_pi(data: LoopData, plays: int = DEFAULT_PLAYS, thresholds_m=None, residual: str = "correlated") -> ModelFit:
@@ -439,9 +456,10 @@ def fit_pi(data: LoopData, plays: int = DEFAULT_PLAYS, thresholds_m=None, residu
     operator = PrandtlIshlinskii(thresholds, c[1:], c[0], scale)
     positive = np.zeros(theta.size, dtype=bool)
     positive[-1] = True
+    unreached = np.concatenate([[False], thresholds >= _pi_excursion(x, scale), [False]])
     return _finish("pi", f"pi m={thresholds.size}", data, names, theta, predict, at_bound, positive, operator,
                    lambda u: operator.run(u, np.full(thresholds.size, float(operator.envelope(u[0])))).output,
-                   {"thresholds_m": thresholds}, residual)
+                   {"thresholds_m": thresholds}, residual, unreached)
 
 
 # ------------------------------------------------------------------ Bouc-Wen
