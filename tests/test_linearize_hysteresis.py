@@ -287,6 +287,9 @@ def test_the_command_line_reports_the_branch_and_stick_states(loop, tmp_path):
     text = _cli(LOOP, "--at-time", 7, "-o", tmp_path / "out")
     assert text.returncode == 0, text.stderr
     assert "branch unloading" in text.stdout and "state slip" in text.stdout and "state stick" in text.stdout
+    # The rig has no Coulomb friction of its own to drop: the elements are its friction.
+    assert rep["friction"].startswith("no Coulomb friction: the [hysteresis] elements")
+    assert "friction: no Coulomb friction" in text.stdout and "Coulomb friction dropped" not in text.stdout
 
 
 @pytest.mark.parametrize("args, key", [(["--at-time", 20], "--at-time 20"), (["--at-time", 0], "--at-time 0"),

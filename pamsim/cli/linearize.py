@@ -21,6 +21,8 @@ from . import figure_args, finite_float
 
 DEFAULT_OUTPUT = "out"
 
+HYSTERESIS_FRICTION = "no Coulomb friction: the [hysteresis] elements take its place (below)"
+
 
 def register(sub) -> None:
     """Add ``pamsim linearize`` and its options to ``sub``, the subparsers of :func:`pamsim.cli.build_parser`."""
@@ -85,7 +87,7 @@ def report(lin) -> dict:
         "bode_valve_to_contraction": lin.bode(sys.input_labels[0], "contraction_m", omega),
         "operating_point": lin.op.as_dict(),
         "residual_f_x0_u0": [float(v) for v in lin.residual],
-        "friction": lin.friction.describe(),
+        "friction": (HYSTERESIS_FRICTION if lin.hysteresis else lin.friction.describe()),
         "valve_slope": lin.valve_slope,
         "jacobians": lin.jacobian_method,
         "dropped_states": list(lin.dropped_states),
@@ -147,7 +149,10 @@ def _linearize_joint(scenario, args: argparse.Namespace) -> int:
     rep = {"A": _matrix(lm.A), "B": _matrix(lm.B), "C": _matrix(lm.C), "D": _matrix(lm.D), "states": list(lm.states),
            "inputs": list(lm.inputs), "outputs": list(lm.outputs), "poles": [_complex(z) for z in lm.poles()],
            "theta0_rad": lm.theta0_rad, "p0_gauge_Pa": list(lm.p0_gauge_Pa), "k0_Nm_per_rad": lm.k0_Nm_per_rad,
-           "friction": "Coulomb friction dropped (the bearing's and the muscles': no linearisation at rest)"}
+           "friction": ("Coulomb friction dropped (the bearing's and the muscles': no linearisation at rest)"
+                        if not lm.hysteresis else "Coulomb friction dropped (the bearing's and that of muscles "
+                        "without [hysteresis]: no linearisation at rest); a muscle's [hysteresis] elements take "
+                        "its friction's place (below)")}
     if lm.hysteresis:
         rep["hysteresis"] = {name: loop.as_dict() for name, loop in lm.hysteresis}
     if args.json:
