@@ -36,7 +36,7 @@ from .muscle_setup import applicable_model, model_inputs, with_overrides
 from .muscles import Muscle, load_muscle, shipped_names
 from .paperdata import STEADY_STATE_SETS, SteadyState, steady_state
 from .parameters import CHAMBER_DEFAULTS, CHAMBER_LAW_KEYS, LOAD_MASS, ParameterSet, dynamics_parameters
-from .scenario_components import added_components, check_wiring, hysteresis_component
+from .scenario_components import added_components, check_pressure_ports, check_wiring, hysteresis_component
 from .static_models import REGISTRY
 from .signal_tables import VALVE_TIMING, on_off_command, signal_from_table, signal_range
 from .signals import Constant, Step
@@ -212,6 +212,7 @@ class Scenario:
             added += (hysteresis_component(v, self.spec["hysteresis"], FRICTION_MODELS[m["friction"]](self.parameters, m),
                                            source_parts(self._source, None).pressure, added),)
             object.__setattr__(self, "solver", self._margins_without_coulomb())
+        check_pressure_ports(v, self.spec.get("pressure", {}), added)
         object.__setattr__(self, "_added", added)
         if self._added or isinstance(self._source, LineValveSource):
             check_wiring(self, ScenarioError)

@@ -248,6 +248,28 @@ def refuse_added(scenario: Any, what: str, error: type[Exception], hysteresis: b
                     f"({names}); run the scenario with `pamsim run` (python or native backend)")
 
 
+def check_pressure_ports(v, pressure: dict, added: tuple) -> None:
+    """``pressure.supply_port`` and ``pressure.outlet_port`` must each name a pneumatic port of a
+    ``[[component]]`` (the rig's own chamber is the valve's outlet when ``outlet_port`` is left out): refused
+    naming the key, with the closest name."""
+    components = {a.component.name: a.component for a in added}
+    for key in ("supply_port", "outlet_port"):
+        if key not in pressure:
+            continue
+        name, _, port = pressure[key].partition(".")
+        if name not in components:
+            where = (f"{name!r} is the rig's own component, not a [[component]]" if name in RIG_COMPONENTS
+                     else f"no [[component]] is named {name!r}" if components
+                     else "the scenario has no [[component]] for the valve to be wired to")
+            v.fail(f"pressure.{key}", pressure[key], f"{where}; the key names a port of one as \"name.port\"",
+                   choices=[f"{n}.{p.name}" for n, c in components.items() for p in c.ports if p.kind is PNEUMATIC]
+                   or None)
+        ports = [p.name for p in components[name].ports if p.kind is PNEUMATIC]
+        if port not in ports:
+            v.fail(f"pressure.{key}", pressure[key], f"component {name!r} ({type(components[name]).__name__}) has "
+                   "no pneumatic port so named", choices=[f"{name}.{p}" for p in ports] or None)
+
+
 def is_line_component(component: Any) -> bool:
     """Whether every port of ``component`` is pneumatic (a supply, a reservoir, a tube): it adds no force
     to the load and changes no static equilibrium."""
@@ -265,8 +287,18 @@ def check_wiring(scenario: Any, error: type[Exception]) -> None:
             _CHECKED.add(key)
         _refuse_isolated(scenario, assembly)
     except (AssemblyError, KeyError, ValueError) as exc:
-        text = exc.args[0] if isinstance(exc, KeyError) and exc.args else exc
-        raise error(f"{scenario.origin}: [[component]]: {text}") from None
+        text = str(exc.args[0] if isinstance(exc, KeyError) and exc.args else exc)
+        raise error(f"{scenario.origin}: [[component]]: {text}{_valve_port_hint(scenario, text)}") from None
+
+
+def _valve_port_hint(scenario: Any, text: str) -> str:
+    """Where a wiring error names a port of the component the valve is wired to (``pressure.supply_port``,
+    ``pressure.outlet_port``), which of those keys wired it: the likely cause (the valve on the tube's outlet
+    leaves its inlet unconnected)."""
+    pressure = scenario.spec.get("pressure", {})
+    keys = [f"pressure.{k} = {pressure[k]!r}" for k in ("supply_port", "outlet_port")
+            if isinstance(pressure.get(k), str) and f" {pressure[k].partition('.')[0]}." in f" {text}"]
+    return f" (the valve is wired by {' and '.join(keys)})" if keys else ""
 
 
 def _refuse_isolated(scenario: Any, assembly: Any) -> None:

@@ -293,13 +293,29 @@ def test_the_cli_refuses_a_bad_line_with_exit_2_and_writes_nothing(tmp_path, key
 
 
 @pytest.mark.parametrize("pressure, match", [
-    ({"supply_port": "nowhere.port"}, r"nowhere"),
+    ({"supply_port": "nowhere.port"}, r"pressure\.supply_port = 'nowhere\.port': no \[\[component\]\] is named "
+                                      r"'nowhere'.*\(choose from reservoir\.port\)"),
     ({"supply_port": "reservoir"}, r"pressure\.supply_port"),
-    ({"outlet_port": "reservoir.inlet"}, r"reservoir.*inlet"),
+    ({"outlet_port": "reservoir.inlet"}, r"pressure\.outlet_port = 'reservoir\.inlet': component 'reservoir' "
+                                         r"\(Reservoir\) has no pneumatic port so named \(did you mean 'reservoir\.port'\?\)"),
+    ({"supply_port": "resrvoir.port"}, r"pressure\.supply_port = 'resrvoir\.port'.*did you mean 'reservoir\.port'"),
+    ({"outlet_port": "chamber.port"}, r"pressure\.outlet_port = 'chamber\.port': 'chamber' is the rig's own"),
 ])
 def test_a_line_that_is_not_connected_is_refused_by_name(pressure, match):
+    """A valve port that names no [[component]], a port it does not have, or the rig's own: refused naming the
+    key, with the closest port or the ports there are."""
     with pytest.raises(InputError, match=match):
         _scenario([_component("reservoir", "reservoir", volume_m3=2e-5)], pressure=pressure)
+
+
+def test_an_unconnected_port_says_which_valve_key_wired_its_component():
+    """The valve on the tube's outlet (which the tube already joins to the chamber) leaves the tube's inlet
+    unconnected: the assembly's error names that port and the key that put the valve there."""
+    tube = _component("tube", "tube", {"outlet": "chamber.port"}, length_m=1.0, diameter_m=0.004, inlet="volume")
+    with pytest.raises(InputError, match=r"port tube\.inlet .*is not connected \(the valve is wired by "
+                                         r"pressure\.outlet_port = 'tube\.outlet'\)"):
+        _scenario([tube], pressure={"outlet_port": "tube.outlet"})
+    assert _scenario([tube], pressure={"outlet_port": "tube.inlet"}).added_components
 
 
 def test_an_unknown_law_or_inlet_is_refused_with_the_choices():
