@@ -19,7 +19,7 @@ from .muscles import Muscle, load_muscle
 from .parameter_schema import KNOWN, ParameterSet, known_parameter
 from .parameters import dynamics_parameters
 from .static_models import REGISTRY, StaticModelSpec
-from .table_checks import did_you_mean, option_error
+from .table_checks import did_you_mean, number_problem, option_error
 
 Fail = Callable[..., None]
 Key = Callable[[str, str], str]
@@ -37,7 +37,7 @@ def with_overrides(params: ParameterSet, overrides: Mapping[str, Any], fail: Fai
         if name not in params and name not in KNOWN:
             fail(key("parameter", name), value, "unknown parameter" + _suggest(name, sorted(set(params) | set(KNOWN))))
         if isinstance(value, bool) or not isinstance(value, (int, float)):
-            fail(key("parameter", name), value, f"must be a number, not {type(value).__name__}")
+            fail(key("parameter", name), value, number_problem(value))
         (values if name in params else added)[name] = float(value)
     params = params.with_overrides(values, source=source)
     if added:

@@ -41,7 +41,7 @@ from .static_models import REGISTRY
 from .signal_tables import VALVE_TIMING, on_off_command, signal_from_table, signal_range
 from .signals import Constant, Step
 from .simulator import MIN_MAX_STEP_S, MIN_RTOL, NATIVE_RTOL_FACTOR, SolverOptions
-from .table_checks import TableChecker, choices_hint, did_you_mean
+from .table_checks import TableChecker, choices_hint, did_you_mean, value_phrase
 
 
 # Schema: section -> {key: (type, required)}; a nested dict is a sub-table.
@@ -703,7 +703,7 @@ class _Validator(TableChecker):
         if not ok:
             names = {float: "a number", int: "an integer", str: "a string", dict: "a table",
                      list: "an array of tables ([[...]])"}
-            self.fail(key, value, f"must be {names[expected]}, not {type(value).__name__}")
+            self.fail(key, value, f"must be {names[expected]}, not {value_phrase(value)}")
         if expected is float and not math.isfinite(value):
             self.fail(key, value, "must be a finite number")
 

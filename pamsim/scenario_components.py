@@ -18,7 +18,6 @@ assembly once per structure.
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 from .assemblies.muscle_only import MUSCLE_ONLY_COMPONENTS
@@ -27,7 +26,7 @@ from .components.catalogue import COMPONENT_TYPES
 from .components.bouc_wen_friction import BoucWenFriction
 from .components.maxwell_slip_friction import MAX_ELEMENTS, MaxwellSlip, prandtl_ishlinskii
 from .modeling import PNEUMATIC, AssemblyError
-from .table_checks import did_you_mean
+from .table_checks import did_you_mean, number_problem
 
 RESERVED_KEYS = ("name", "type", "connect")
 
@@ -102,8 +101,9 @@ def _component_values(v, where: str, kind: str, parameters, entry: dict, default
         if key not in declared:
             v.fail(f"{where}.{key}", value, f"not a parameter of {kind}" + did_you_mean(key, list(declared)),
                    choices=list(declared))
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-            v.fail(f"{where}.{key}", value, "must be a finite number")
+        why = number_problem(value)
+        if why:
+            v.fail(f"{where}.{key}", value, why)
         why = declared[key].violation(float(value))
         if why:
             v.fail(f"{where}.{key}", value, why)

@@ -185,10 +185,13 @@ def _on_off_kind(v, where: str, spec: Any, exhaust: bool) -> str:
     if not isinstance(kind, str) or kind not in allowed:
         v.fail(f"{where}.kind", kind, "unknown command of an on/off valve", choices=allowed)
     for key in spec:
-        if key in VALVE_TIMING or key in ("low", "high"):
-            what = "timing is a key" if key in VALVE_TIMING else "levels are no keys"
-            v.fail(f"{where}.{key}", spec[key], f"an on/off valve opens (1) and closes (0); its {what} of its own "
-                   f"table ({where.rsplit('.', 1)[0]}), not of its command")
+        table = where.rsplit(".", 1)[0]
+        if key in VALVE_TIMING:
+            v.fail(f"{where}.{key}", spec[key], f"the valve's timing is a key of its own table ({table}), not of "
+                   "its command")
+        if key in ("low", "high"):
+            v.fail(f"{where}.{key}", spec[key], "an on/off valve's command has no levels: it opens the valve "
+                   "(1) or closes it (0); leave the key out")
     return kind
 
 

@@ -41,6 +41,24 @@ def type_phrase(kind: type) -> str:
     return _TYPE_PHRASES.get(kind, f"an {name}" if name[:1].lower() in "aeiou" else f"a {name}")
 
 
+def value_phrase(value: Any) -> str:
+    """How a message names the type of a value that is not the one expected: ``a string``, ``a boolean``."""
+    return "a boolean" if isinstance(value, bool) else type_phrase(type(value))
+
+
+def number_problem(value: Any) -> str | None:
+    """Why ``value`` read from a file is not a finite number, or None: a boolean or any other type is named
+    as the file writes it (``not a string``), NaN and the infinities are not finite."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return f"must be a number, not {value_phrase(value)}"
+    return None if math.isfinite(value) else "must be a finite number"
+
+
+def shown(value: Any) -> str:
+    """``value`` as a message shows it: a boolean as the file writes it (``true``), anything else by its repr."""
+    return ("true" if value else "false") if isinstance(value, bool) else repr(value)
+
+
 class TableChecker:
     """The checks of the tables of one file: a mistake raises ``error`` naming ``origin``, the key and the value.
 
@@ -56,7 +74,7 @@ class TableChecker:
 
     def fail(self, key: str, value: Any, why: str, choices=None) -> NoReturn:
         """Raise ``ORIGIN: KEY = VALUE: WHY``, with the closest of ``choices`` or all of them."""
-        msg = f"{self.origin}: {key} = {value!r}: {why}"
+        msg = f"{self.origin}: {key} = {shown(value)}: {why}"
         if choices is not None:
             msg += choices_hint(value, choices)
         raise self.error(msg)
@@ -81,13 +99,14 @@ class TableChecker:
         if kind is float:
             return self.number(key, value)
         if not isinstance(value, kind):
-            self.fail(key, value, f"must be {type_phrase(kind)}, not {type_phrase(type(value))}")
+            self.fail(key, value, f"must be {type_phrase(kind)}, not {value_phrase(value)}")
         return value
 
     def number(self, key: str, value: Any) -> float:
         """``value`` as a float; a boolean, a non-number or a non-finite number is an error."""
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-            self.fail(key, value, "must be a finite number")
+        why = number_problem(value)
+        if why:
+            self.fail(key, value, why)
         return float(value)
 
     def positive(self, key: str, value: float) -> float:

@@ -84,7 +84,9 @@ def test_the_native_backend_agrees_with_python():
 BAD = [
     ({"type": "lineer_spring"}, "component[0].type", "did you mean 'linear_spring'"),
     ({"k_N_per_mm": 2.0}, "component[0].k_N_per_mm", "not a parameter of linear_spring"),
-    ({"k_N_per_m": "stiff"}, "component[0].k_N_per_m", "must be a finite number"),
+    ({"k_N_per_m": "stiff"}, "component[0].k_N_per_m", "must be a number, not a string"),
+    ({"k_N_per_m": True}, "component[0].k_N_per_m = true", "must be a number, not a boolean"),
+    ({"k_N_per_m": float("nan")}, "component[0].k_N_per_m = nan", "must be a finite number"),
     ({"name": "load"}, "component[0].name", "is taken"),
     ({"name": "motion"}, "component[0].name", "is taken"),  # a muscle alone's: run on a length, or in MuJoCo
     ({"name": "series_spring"}, "component[0].name", "is taken"),

@@ -38,6 +38,7 @@ from ..assemblies.one_muscle import SourceParts, register_source, source_parts
 from ..constants import PA_PER_BAR
 from ..elements.pressure_source import ValveChamberSource
 from ..errors import InputError
+from ..table_checks import number_problem, shown
 from ..model import MuscleModel
 from ..modeling import Component, Equations, Symbols, Var, smath
 from ..result import Result
@@ -147,8 +148,9 @@ def _controller_number(table: Mapping[str, Any], key: str, where: str) -> float:
     if key not in table and default is None:
         raise InputError(f"{where}: missing key controller.{key}")
     raw = table.get(key, default)
-    if isinstance(raw, bool) or not isinstance(raw, (int, float)) or not math.isfinite(raw):
-        raise InputError(f"{where}: controller.{key} = {raw!r}: must be a finite number")
+    why = number_problem(raw)
+    if why:
+        raise InputError(f"{where}: controller.{key} = {shown(raw)}: {why}")
     if raw < 0 or (raw == 0 and key != "integrator_deadband_mm"):
         raise InputError(f"{where}: controller.{key} = {raw!r}: must be positive")
     return float(raw)
