@@ -12,7 +12,7 @@ from .atomic import atomic_path
 from .constants import PA_PER_BAR
 from .elements.pressure_source import PrescribedPressure, ValveChamberSource
 from .model import N_WORK, Mode
-from .signals import Constant, PiecewiseConstant, Step
+from .signals import Constant, PiecewiseConstant, Pwm, Step
 
 if TYPE_CHECKING:
     from .model import MuscleModel
@@ -306,6 +306,25 @@ def running_losses(t_s: np.ndarray, loss_t_s, loss_J: np.ndarray) -> np.ndarray:
     return out
 
 
+def _closed_valve_warning(command, t_end: float) -> str:
+    """Why a valve whose command never rises above 0 (closed, or a 3/2 valve's exhaust side) kept the muscle
+    from its supply: a step after the run's end, PWM pulses too short for the valve's delays and switching
+    times (the command is the opening the valve reaches), or a command that never opens it."""
+    if isinstance(command, Pwm) and command.duty > 0.0 and command.start_s < t_end:
+        period_ms = 1e3 / command.frequency_Hz
+        on_ms, off_ms = (1e3 * (command.delay_on_s + command.rise_s), 1e3 * (command.delay_off_s + command.fall_s))
+        side = "toward the supply past its middle (it only vents)" if command.low < 0.0 else "at all"
+        return (f"the valve never opens {side}: its PWM pulses, {command.duty * period_ms:.4g} ms of each "
+                f"{period_ms:.4g} ms period at {command.frequency_Hz:g} Hz, are too short for its delay and "
+                f"opening time ({on_ms:.4g} ms; closing: {off_ms:.4g} ms), so the muscle never sees the supply "
+                "(lower pressure.command.frequency_Hz or raise its duty)")
+    opens = getattr(command, "time_s", None)  # a step's opening time
+    when = f"opens at {opens:g} s, after the run ends at {t_end:g} s" if opens is not None else \
+        f"stays closed (command <= 0) until the run ends at {t_end:g} s"
+    return (f"the valve {when}: the muscle never sees the supply "
+            "(raise simulation.duration_s or open the valve earlier)")
+
+
 def pointless_run_warnings(model, t_s: np.ndarray, at_rest_at_end: bool, v_end_m_s: float) -> list[str]:
     """The valve never opens, the load is beyond the blocked force, or the load still moves at the end."""
     t_end = float(t_s[-1])
@@ -313,11 +332,7 @@ def pointless_run_warnings(model, t_s: np.ndarray, at_rest_at_end: bool, v_end_m
     src = model.source
     # ndarray methods, not np.any and np.max: the same reductions without numpy's dispatch, run after run
     if isinstance(src, ValveChamberSource) and not (np.asarray(at_samples(src.command, t_s)) > 0.0).any():
-        opens = getattr(src.command, "time_s", None)  # a step's opening time
-        when = f"opens at {opens:g} s, after the run ends at {t_end:g} s" if opens is not None else \
-            f"stays closed (command <= 0) until the run ends at {t_end:g} s"
-        out.append(f"the valve {when}: the muscle never sees the supply "
-                   "(raise simulation.duration_s or open the valve earlier)")
+        out.append(_closed_valve_warning(src.command, t_end))
     supply = _largest_supply_Pa(src, t_s)
     if supply is not None:
         blocked = float(model.static_force.force_N(0.0, supply))

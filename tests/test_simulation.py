@@ -368,6 +368,24 @@ POINTLESS = {
 }
 
 
+def test_pwm_pulses_too_short_for_the_valve_say_so_not_that_it_opens_too_late():
+    """The 3/2 valve of pwm_3_2.toml (2 ms delays and switching times) at 1 kHz, duty 0.5: 0.5 ms pulses
+    against 4 ms to open, its opening (by hand: 0.5 ms of a 2 ms rise) never past a quarter, so it only
+    vents.  The warning names the pulses, the period and the valve's times; at 50 Hz there is none."""
+    sc = pamsim.load_scenario(SCENARIOS / "pwm_3_2.toml")
+
+    def shortened(**command):
+        return sc.with_changes({"pressure": {"command": {**sc.spec["pressure"]["command"], "end_s": 1.0, **command}},
+                                "simulation": {"duration_s": 1.0}})
+    res = pamsim.simulate(shortened(frequency_Hz=1000.0))
+    assert float(np.max(res.p_gauge_Pa)) < 1e3
+    hits = [w for w in res.warnings if "PWM pulses" in w]
+    assert len(hits) == 1 and "0.5 ms of each 1 ms period at 1000 Hz" in hits[0] and "(4 ms;" in hits[0], hits
+    assert "only vents" in hits[0] and "after the run ends" not in hits[0]
+    slow = pamsim.simulate(shortened())
+    assert not [w for w in slow.warnings if "valve" in w], slow.warnings
+
+
 @pytest.mark.parametrize("what", POINTLESS)
 def test_pointless_run_warns_once_in_the_result_the_summary_and_on_stderr(tmp_path, what):
     from conftest import run_main
