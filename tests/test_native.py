@@ -230,7 +230,8 @@ def test_a_case_that_outgrows_the_batch_event_room_runs_again_alone(monkeypatch)
     assert len(reference[0].transitions) > 3
     calls = []
     run = backend._run
-    monkeypatch.setattr(backend, "_run", lambda cases, capacity: calls.append(list(capacity)) or run(cases, capacity))
+    monkeypatch.setattr(backend, "_run", lambda cases, capacity, engines=None:
+                        calls.append(list(capacity)) or run(cases, capacity, engines))
     monkeypatch.setattr(backend, "BATCH_EVENT_CAPACITY", 3)
     again = simulate_batch([fig6b, fig4, few], return_exceptions=True)
     # fig6b (34 events) and fig4 (4) outgrow the room; `few` stops on its own limit of 2, not run again
