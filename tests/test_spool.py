@@ -143,7 +143,7 @@ def test_the_linear_model_is_the_valves_times_the_spools_lag():
     plain_model, spool_model = BASE.build_model(), spool.build_model()
     plain = linearize(plain_model, held_equilibrium(plain_model, 0.030, 3.6e5))
     lin = linearize(spool_model, held_equilibrium(spool_model, 0.030, 3.6e5))
-    assert list(lin.sys.state_labels)[-2:] == ["valve.spool_position", "valve.spool_velocity"]
+    assert list(lin.sys.state_labels)[-2:] == ["valve.spool_position", "valve.spool_velocity_per_s"]
     w = np.logspace(0, 4, 41)
     g_plain = plain.sys["contraction_m", "valve_command"](1j * w)
     g_spool = lin.sys["contraction_m", "valve_command"](1j * w)
@@ -258,7 +258,8 @@ def test_the_design_is_checked_on_the_full_linearisation(loops):
 
     design = loops["python"].design
     assert list(design.linear.sys.state_labels) == ["x_m", "v_m_s", "p_abs_Pa"]
-    assert {"valve.spool_position", "valve.spool_velocity", "tube.p_abs_Pa"} <= set(design.full_linear.sys.state_labels)
+    assert {"valve.spool_position", "valve.spool_velocity_per_s", "tube.p_abs_Pa"} \
+        <= set(design.full_linear.sys.state_labels)
     assert np.max(design.full_loop_poles.real) < 0.0
     assert np.any(np.abs(np.abs(design.full_loop_poles) - 2 * math.pi * 125.0) < 0.5 * 2 * math.pi * 125.0)
     slow = pamsim.load_scenario(PROPORTIONAL).with_changes({"pressure": {"spool": {"natural_frequency_Hz": 20.0}}})

@@ -298,7 +298,7 @@ def test_linearize_holds_a_line_behind_a_spool_valve():
     out = json.loads(proc.stdout)
     op = out["operating_point"]
     assert op["line_states"]["tube.p_abs_Pa"] == op["states"][2]
-    assert op["line_states"]["valve.spool_position"] == 0.0 == op["line_states"]["valve.spool_velocity"]
+    assert op["line_states"]["valve.spool_position"] == 0.0 == op["line_states"]["valve.spool_velocity_per_s"]
     assert np.max(np.abs(out["residual_f_x0_u0"])) < 1e-9
 
 

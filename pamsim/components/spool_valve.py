@@ -17,13 +17,13 @@ class SpoolValve(ProportionalValve):
     """
 
     states = (Var("spool_position", "1", "spool position as a fraction of its stroke (+1 open to supply)", 0.1),
-              Var("spool_velocity", "1/s", "spool velocity in strokes per second", 100.0))
+              Var("spool_velocity_per_s", "1/s", "spool velocity in strokes per second", 100.0))
 
     def equations(self, s: Symbols) -> Equations:
         """The spool's second-order lag behind the command, and the two paths' flows at its position."""
         valve = self.symbolic_element(s.p)
-        position, velocity = s.x["spool_position"], s.x["spool_velocity"]
+        position, velocity = s.x["spool_position"], s.x["spool_velocity_per_s"]
         outputs, port = two_path_flows(self, s, position)
         return Equations(der={"spool_position": velocity,
-                              "spool_velocity": valve.spool_acceleration(position, velocity, s.u["command"])},
-                         initial={"spool_position": 0.0, "spool_velocity": 0.0}, outputs=outputs, port=port)
+                              "spool_velocity_per_s": valve.spool_acceleration(position, velocity, s.u["command"])},
+                         initial={"spool_position": 0.0, "spool_velocity_per_s": 0.0}, outputs=outputs, port=port)

@@ -99,7 +99,7 @@ class SpoolValveSource(ValveChamberSource):
     ``outlet_port``: where the valve discharges (a tube's inlet), empty for the chamber."""
 
     outlet_port: str = ""
-    state_names: tuple[str, ...] = ("p_abs_Pa", "air_mass_kg", "spool_position", "spool_velocity")
+    state_names: tuple[str, ...] = ("p_abs_Pa", "air_mass_kg", "spool_position", "spool_velocity_per_s")
 
     def initial_state(self, x_m: float, p_gauge_Pa: float = 0.0) -> list[float]:
         """The chamber's start (:meth:`ValveChamberSource.initial_state`), the spool at rest in its centre."""
@@ -107,7 +107,7 @@ class SpoolValveSource(ValveChamberSource):
 
     def held_spool(self, command: float) -> dict[str, float]:
         """The spool at rest under a held ``command``: at the command (clipped to the stroke), not moving."""
-        return {"spool_position": float(np.clip(command, -1.0, 1.0)), "spool_velocity": 0.0}
+        return {"spool_position": float(np.clip(command, -1.0, 1.0)), "spool_velocity_per_s": 0.0}
 
     def inflow_kg_s(self, s, V, inputs):
         """Net mass flow into the chamber [kg/s] at the spool's position ``s[2]``, and the gas temperature [K]."""
@@ -125,7 +125,7 @@ class SpoolValveSource(ValveChamberSource):
         """:meth:`ValveChamberSource.outputs` (the flow at the spool's position) and the spool's position and
         velocity."""
         out = super().outputs(t_s, S, x_m)
-        out.update(spool_position=np.asarray(S[2], dtype=float), spool_velocity=np.asarray(S[3], dtype=float))
+        out.update(spool_position=np.asarray(S[2], dtype=float), spool_velocity_per_s=np.asarray(S[3], dtype=float))
         return out
 
 
