@@ -149,7 +149,7 @@ def hysteresis_component(v, table: dict, law, pressure: str, added: tuple) -> Ad
         weights_N_per_m = [3750, 750, 250]   # w_j >= 0
         envelope_scale_m = 0.05              # optional: s of g(x) = s tanh(x / s); none, g(x) = x
     """
-    model = table.get("model")
+    model = v.required(table, "model", prefix="hysteresis.")
     if not isinstance(model, str) or model not in HYSTERESIS_KEYS:
         v.fail("hysteresis.model", model, "unknown hysteresis model", choices=list(HYSTERESIS_KEYS))
     keys = ["model", *HYSTERESIS_KEYS[model]]

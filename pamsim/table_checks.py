@@ -54,9 +54,18 @@ def number_problem(value: Any) -> str | None:
     return None if math.isfinite(value) else "must be a finite number"
 
 
+SHOWN_ITEMS = 6
+"""Items of a list a message shows before it says how many more there are."""
+
+
 def shown(value: Any) -> str:
-    """``value`` as a message shows it: a boolean as the file writes it (``true``), anything else by its repr."""
-    return ("true" if value else "false") if isinstance(value, bool) else repr(value)
+    """``value`` as a message shows it: a boolean as the file writes it (``true``), a long list by its first
+    :data:`SHOWN_ITEMS` and its length, anything else by its repr."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, list) and len(value) > SHOWN_ITEMS:
+        return f"[{', '.join(shown(x) for x in value[:SHOWN_ITEMS])}, ... ({len(value)} values)]"
+    return repr(value)
 
 
 class TableChecker:
@@ -121,7 +130,7 @@ class TableChecker:
             self.fail(key, value, "must be a list of numbers")
         if not value:
             self.fail(key, value, "is empty: give at least one value")
-        return [self.number(key, v) for v in value]
+        return [self.number(f"{key}[{i}]", v) for i, v in enumerate(value)]
 
 
 PRESSURE_UNITS_PA = {"_gauge_Pa": 1.0, "_Pa": 1.0, "_kPa": 1e3, "_gauge_bar": 1e5, "_bar": 1e5, "_psi": 6894.757293168}

@@ -169,7 +169,7 @@ BAD = [
     ("compensation.elements", lambda s: s["compensation"].update(elements=0)),
     ("compensation.model", lambda s: s["compensation"].update(model="preisach")),
     ("compensation.feedforward", lambda s: s["compensation"].update(feedforward=["static"])),
-    ("compensation.frequencies_Hz", lambda s: s["compensation"].update(frequencies_Hz=[0.2, -1.0])),
+    ("compensation.frequencies_Hz[1]", lambda s: s["compensation"].update(frequencies_Hz=[0.2, -1.0])),
     ("compensation.wobble", lambda s: s["compensation"].update(wobble=1.0)),
     ("compensation.identification.pressures_bar", lambda s: s["compensation"]["identification"].update(
         pressures_bar=[1.7, 2.9, 1.7])),

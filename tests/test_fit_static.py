@@ -217,7 +217,7 @@ def test_readers_convert_units_and_map_columns(tmp_path):
 
 @pytest.mark.parametrize("text, match", [
     ("pressure_bar,contraction_mm\n1,2\n", "need exactly one of a force_N"),
-    ("pressure_bar,contraction_mm,weight_N\n1,abc,3\n", "line 2: value 'abc' is not a number"),
+    ("pressure_bar,contraction_mm,weight_N\n1,abc,3\n", "line 2, column 'contraction_mm': value 'abc' is not a number"),
     ("pressure_bar,contraction_mm,weight_N\n1,2\n", "line 2 has 2 fields"),
     ("pressure_bar,contraction_mm,weight_N\n1,2,-3\n", "weight_N, data row 1: value -3"),
     ("pressure_atm,contraction_mm,weight_N\n1,2,3\n", "no pressure column"),

@@ -193,6 +193,18 @@ def test_bad_synthetic_parameters_are_refused(tmp_path, model, params, message):
     assert not path.exists()
 
 
+@pytest.mark.parametrize("options, message", [
+    ([], "--parameters: required with --write-synthetic: the maxwell_slip model's values"),
+    (["--parameters", ""], "'': write NAME=VALUE"),
+    (["--parameters", "F0_N"], "'F0_N': write NAME=VALUE"),
+])
+def test_synthetic_parameters_that_are_not_given_say_what_to_write(tmp_path, options, message):
+    path = tmp_path / "loop.csv"
+    proc = run_main("fit", "hysteresis", path, "--write-synthetic", *options)
+    assert proc.returncode == 2 and message in proc.stderr and "Traceback" not in proc.stderr, proc.stderr
+    assert not path.exists()
+
+
 def bad_loop_files(tmp_path):
     good = "t_s,p_gauge_Pa,x_m,force_N"
     rows = [(i * 0.1, 3e5, x, 100 - 1000 * x) for i, x in enumerate(np.abs(np.sin(np.linspace(0, 6, 60))) * 0.03)]
@@ -209,6 +221,8 @@ def bad_loop_files(tmp_path):
         "too few rows": (write(tmp_path / "f.csv", good, rows[:12]), "12 rows: a loop needs at least 20"),
         "time back": (write(tmp_path / "g.csv", good, rows[:5] + [(0.1,) + rows[5][1:]] + rows[6:]),
                       "column t_s, data row 6: time 0.1 does not increase"),
+        "text": (write(tmp_path / "h.csv", good, rows[:5] + [(0.55, 3e5, 0.01, "heavy")] + rows[6:]),
+                 "line 7, column 'force_N': value 'heavy' is not a number"),
     }
 
 

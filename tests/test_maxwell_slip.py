@@ -136,6 +136,20 @@ def test_bad_hysteresis_tables_are_refused_by_key(fig4, change, key):
         Scenario.from_dict(spec, name="bad", base_dir=fig4.base_dir)
 
 
+def test_a_long_list_or_a_missing_model_reads_plainly(fig4):
+    """101 elements: the message shows the list's first values and its length, not all 101; no model: the key
+    is missing (not 'None: unknown')."""
+    spec = copy.deepcopy(dict(fig4.spec))
+    spec["hysteresis"] = {"model": "maxwell_slip", "slip_displacement_m": [1e-3] * 101, "share": [0.01] * 101}
+    with pytest.raises(ScenarioError) as info:
+        Scenario.from_dict(spec, name="bad", base_dir=fig4.base_dir)
+    assert "hysteresis.slip_displacement_m = [0.001, 0.001, 0.001, 0.001, 0.001, 0.001, ... (101 values)]: " \
+        "must be an array of 1 to 100 numbers" in str(info.value) and len(str(info.value)) < 300
+    del spec["hysteresis"]["model"]
+    with pytest.raises(ScenarioError, match=r"missing key hysteresis\.model$"):
+        Scenario.from_dict(spec, name="bad", base_dir=fig4.base_dir)
+
+
 @pytest.mark.parametrize("table", [
     {"model": "maxwell_slip", "slip_displacement_m": [1e-4], "share": [1.0], "damping_N_s_per_m": 100.0},
     {"model": "bouc_wen", "beta_per_m_n": 10.0, "gamma_per_m_n": 10.0, "exponent": 1.0},

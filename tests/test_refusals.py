@@ -516,8 +516,8 @@ def test_fmu_build_options_that_do_not_go_together_are_refused_with_the_first_na
     ("p_bar,x_mm,weight_N\n# no rows\n\n", "no data rows below the header"),
     ("p_bar,x_mm,weight_N\n1,2,3\n# c\n4,5\n", "line 4 has 2 fields, the header has 3"),
     ("p_bar,x_mm,weight_N\n1,2,3,4\n", "line 2 has 4 fields, the header has 3"),
-    ("p_bar,x_mm,weight_N\n1,2,3\n4, five ,6\n", "line 3: value 'five' is not a number"),
-    ("p_bar,x_mm,weight_N\n1,,3\n", "line 2: value '' is not a number"),
+    ("p_bar,x_mm,weight_N\n1,2,3\n4, five ,6\n", "line 3, column 'x_mm': value 'five' is not a number"),
+    ("p_bar,x_mm,weight_N\n1,,3\n", "line 2, column 'x_mm': value '' is not a number"),
     ("p_bar,x_mm,weight_N\n1,x,3,4\n", "line 2 has 4 fields, the header has 3"),  # the count is checked first
 ])
 def test_a_measurement_file_that_is_not_a_numeric_csv_is_refused_naming_file_and_line(tmp_path, content, message):

@@ -24,12 +24,12 @@ def _names(text: str) -> list[str]:
     return names
 
 
-def _columns(text: str) -> dict[str, str]:
+def _columns(text: str, form: str = "QUANTITY=COLUMN, e.g. pressure=p_meas_kPa") -> dict[str, str]:
     out = {}
     for item in text.split(","):
         key, sep, value = item.partition("=")
         if not sep or not key.strip() or not value.strip():
-            raise argparse.ArgumentTypeError(f"{item!r}: write QUANTITY=COLUMN, e.g. pressure=p_meas_kPa")
+            raise argparse.ArgumentTypeError(f"{item!r}: write {form}")
         out[key.strip()] = value.strip()
     return out
 
@@ -280,7 +280,7 @@ def _check_hysteresis_options(args: argparse.Namespace) -> None:
 
 def _parameters(text: str) -> dict[str, float]:
     out = {}
-    for key, value in _columns(text).items():
+    for key, value in _columns(text, "NAME=VALUE,..., e.g. F0_N=150,k0_N_per_m=-3000").items():
         try:
             out[key] = float(value)
         except ValueError:
@@ -340,6 +340,9 @@ def run_hysteresis(args: argparse.Namespace) -> int:
         for key in ("scenario", "window"):
             if getattr(args, key) is not None:
                 raise InputError(f"--{key} = {getattr(args, key)!r}: only to fit a loop, not with --write-synthetic")
+        if not args.parameters:
+            raise InputError(f"--parameters: required with --write-synthetic: the {args.model} model's values, named "
+                             "as the fit reports them (NAME=VALUE,...: docs/hysteresis.md, 'An example')")
         return _write_synthetic(args, thresholds_m)
     if args.output is None:
         raise InputError("-o/--output: required to fit (the folder for fit.json, report.md and the figures)")

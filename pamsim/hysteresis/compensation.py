@@ -140,8 +140,8 @@ def _elements(v: TableChecker, table: dict) -> int | None:
 
 def _frequencies(v: TableChecker, table: dict) -> tuple[float, ...]:
     values = v.number_list("compensation.frequencies_Hz", v.required(table, "frequencies_Hz", prefix="compensation."))
-    for f in values:
-        v.positive("compensation.frequencies_Hz", f)
+    for i, f in enumerate(values):
+        v.positive(f"compensation.frequencies_Hz[{i}]", f)
     return tuple(values)
 
 

@@ -14,7 +14,7 @@ import hashlib
 import io
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Mapping
+from typing import Mapping, Sequence
 
 import numpy as np
 
@@ -85,7 +85,7 @@ def _table(path: Path) -> tuple[list[str], np.ndarray, str]:
     raw, text = _file_text(path)
     lines = _content_lines(path, text)
     header = [h.strip() for h in lines[0][1].split(",")]
-    rows = [_numbers(path, n, line, len(header)) for n, line in lines[1:]]
+    rows = [_numbers(path, n, line, header) for n, line in lines[1:]]
     if not rows:
         raise DataError(f"{path}: no data rows below the header")
     return header, np.array(rows, dtype=float), hashlib.sha256(raw).hexdigest()
@@ -111,16 +111,16 @@ def _content_lines(path: Path, text: str) -> list[tuple[int, str]]:
     return lines
 
 
-def _numbers(path: Path, n: int, line: str, width: int) -> list[float]:
-    """Data line ``n``'s values: as many fields as the header has (``width``), each a number."""
+def _numbers(path: Path, n: int, line: str, header: Sequence[str]) -> list[float]:
+    """Data line ``n``'s values: as many fields as the ``header`` has, each a number."""
     cells = line.split(",")
-    if len(cells) != width:
-        raise DataError(f"{path}: line {n} has {len(cells)} fields, the header has {width}")
+    if len(cells) != len(header):
+        raise DataError(f"{path}: line {n} has {len(cells)} fields, the header has {len(header)}")
     try:
         return [float(c) for c in cells]
     except ValueError:
-        bad = next(c for c in cells if not _is_number(c))
-        raise DataError(f"{path}: line {n}: value {bad.strip()!r} is not a number") from None
+        column, bad = next((h, c) for h, c in zip(header, cells) if not _is_number(c))
+        raise DataError(f"{path}: line {n}, column {column.strip()!r}: value {bad.strip()!r} is not a number") from None
 
 
 def _is_number(text: str) -> bool:
