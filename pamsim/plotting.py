@@ -6,7 +6,9 @@ imports this module, and one direction of dependency is enough.
 
 from __future__ import annotations
 
+import itertools
 import textwrap
+from typing import TYPE_CHECKING
 
 import numpy as np
 from matplotlib.figure import Figure
@@ -14,6 +16,9 @@ from matplotlib.figure import Figure
 from .atomic import atomic_path
 from .constants import PA_PER_BAR
 from .figure_style import format_of, save, series
+
+if TYPE_CHECKING:  # for the annotations only: at run time Result imports this module, not the other way
+    from .result import Result
 
 FORCE_STYLE: dict[str, tuple[str, dict]] = {key: (label, series(k, colour)) for k, (key, label, colour) in enumerate((
     ("F_static_N", "static", "C0"),
@@ -69,7 +74,8 @@ def draw_measured(ax, measured, value: float, label: str) -> None:
 
 def result_figure(result: "Result", title: str | None = None, compare: "list[Result] | None" = None,
                   backend: str = "python", measured=None) -> Figure:
-    """Contraction, pressure, the gas temperature (a thermal chamber's) and force components against time.
+    """Contraction, pressure (the muscle's, the supply's and those of the line's components), a PWM or spool
+    valve's opening, the gas temperature (a thermal chamber's) and force components against time.
 
     ``compare`` overlays the contraction of other results (for example the
     constant-friction model).  A ``backend`` other than ``"python"`` is named
@@ -80,14 +86,21 @@ def result_figure(result: "Result", title: str | None = None, compare: "list[Res
     """
     thermal = "wall_heat_W" in result.signals  # the thermal chamber's: its temperature gets a panel
     loops = LOOP_FORCE in result.signals  # hysteresis elements: their loops get a row of their own
+    valve = valve_lines(result)  # a PWM or spool valve's: a small panel under the pressure it drives
     rows, height = (4, 11) if thermal else (3, 9)
+    ratios = None
+    if valve is not None:
+        ratios = [1.0, 1.0, VALVE_PANEL_RATIO] + [1.0] * (rows - 2)
+        rows, height = rows + 1, height + VALVE_PANEL_HEIGHT_IN
     fig = Figure(figsize=(9, height + (4 if loops else 0)), constrained_layout=True)
     in_time, loop_row = fig.subfigures(2, 1, height_ratios=[height, 4]) if loops else (fig, None)
-    axes = in_time.subplots(rows, 1, sharex=True)
+    axes = in_time.subplots(rows, 1, sharex=True, height_ratios=ratios)
     _contraction_panel(axes[0], result, compare or [], measured)
     _pressure_panel(axes[1], result, measured)
+    if valve is not None:
+        _valve_panel(axes[2], result, *valve)
     if thermal:
-        _temperature_panel(axes[2], result)
+        _temperature_panel(axes[-2], result)
     _force_panel(axes[-1], result)
     if loops:
         _loop_panels(loop_row.subplots(1, 2), result)
@@ -132,15 +145,102 @@ def _contraction_panel(ax, result: "Result", compare: "list[Result]", measured) 
 
 
 def _pressure_panel(ax, result: "Result", measured) -> None:
-    """The muscle's pressure, the supply's where the run has one, and the measured stable pressure, if any."""
+    """The muscle's pressure, the supply's where the run has one, those of the components added to the rig
+    (:func:`line_pressures`), one line each under its name, and the measured stable pressure, if any."""
     t = result.t_s
     ax.plot(t, result.p_gauge_Pa / PA_PER_BAR, **series(0, "C3"), label="muscle")
+    labels = ["muscle"]
     if "supply_gauge_Pa" in result.signals:
         ax.plot(t, result.signals["supply_gauge_Pa"] / PA_PER_BAR, **series(3, "k"), label="supply")
+        labels.append("supply")
+    line = line_pressures(result)
+    # Style 0 is the muscle's and 3 the supply's: every other k differs from both in line style or marker.
+    styles = (k for k in itertools.count(1) if k != 3)
+    for (name, p_gauge_Pa), k in zip(line.items(), styles):
+        # A component may share a name with a line above ("supply": the regulator beside the rig's set pressure).
+        label = f"{name} (component)" if name in labels else name
+        ax.plot(t, p_gauge_Pa / PA_PER_BAR, **series(k), label=label)
     if measured is not None:
         draw_measured(ax, measured, measured.pressure_stable_bar, measured_labels(measured)[1])
     ax.set_ylabel("gauge pressure [bar]")
-    ax.legend(loc="lower right", fontsize=8)
+    ax.legend(loc="lower right", fontsize=8, **({"ncol": 2} if line else {}))
+    ax.grid(alpha=0.3)
+
+
+def line_pressures(result: "Result") -> dict[str, np.ndarray]:
+    """Component name -> gauge pressure [Pa] of each component added to the rig that has one (a supply, a
+    reservoir, a tube): its ``NAME.p_gauge_Pa``, or else its ``NAME.p_abs_Pa`` less the run's atmosphere."""
+    found: dict[str, np.ndarray] = {}
+    for key in result.signals:
+        name, _, quantity = key.partition(".")
+        if quantity == "p_gauge_Pa":
+            found[name] = np.asarray(result.signals[key], dtype=float)
+        elif quantity == "p_abs_Pa" and f"{name}.p_gauge_Pa" not in result.signals:
+            found[name] = np.asarray(result.signals[key], dtype=float) - _atmosphere_Pa(result)
+    return found
+
+
+def _atmosphere_Pa(result: "Result") -> float:
+    """The ambient pressure [Pa] of the run's valve source, or the package's default where it has none."""
+    from .parameters import DYNAMICS_DEFAULTS
+
+    p_atm = getattr(getattr(result.model, "source", None), "p_atm_Pa", None)
+    return float(DYNAMICS_DEFAULTS["p_atm_Pa"][0] if p_atm is None else p_atm)
+
+
+VALVE_PANEL_RATIO = 0.5
+VALVE_PANEL_HEIGHT_IN = 1.8
+"""The valve panel's height beside a full panel's, and the inches it adds to the figure."""
+
+VALVE_COLOURS = ("C2", "C9")
+"""The valve panel's lines: the inlet (or the spool's command), then the exhaust (or the spool's position)."""
+
+
+def valve_lines(result: "Result") -> "tuple[str, list[tuple[str, str]]] | None":
+    """The valve panel's y label and its ``(signal, legend label)`` lines, for a run whose valve follows a
+    PWM command (its opening, each valve's of a pair, or the averaged valve's duty) or is a spool valve (its
+    command and position); None for any other run, whose valve command is a plain step or steps."""
+    from .elements.pwm_average import AveragedPwmSource
+    from .signals import Pwm
+
+    signals = result.signals
+    if "spool_position" in signals:
+        return ("spool / stroke [-]\n(+1 supply, -1 exhaust)",
+                [("valve_command", "command"), ("spool_position", "position")])
+    source = getattr(result.model, "source", None)
+    if source is None or "valve_command" not in signals:
+        return None
+    if isinstance(source, AveragedPwmSource):
+        return "PWM duty [-]", [("valve_command", "duty (averaged valve)")]
+    inlet, exhaust = getattr(source, "command", None), getattr(source, "exhaust_command", None)
+    averaged_inlet = getattr(source, "averaged_inlet", None)  # a pair's inlet run by its mean opening
+    if not any(isinstance(c, Pwm) for c in (inlet, exhaust, averaged_inlet)):
+        return None
+    if "exhaust_command" in signals:
+        what = (_pwm_text(averaged_inlet, ", mean over a period") if isinstance(averaged_inlet, Pwm)
+                else _pwm_text(inlet))
+        return ("valve opening [-]\n(0 shut, 1 open)",
+                [("valve_command", f"inlet{what}"), ("exhaust_command", f"exhaust{_pwm_text(exhaust)}")])
+    return "valve opening [-]\n(+1 supply, -1 exhaust)", [("valve_command", f"valve{_pwm_text(inlet)}")]
+
+
+def _pwm_text(command, note: str = "") -> str:
+    """A PWM command's frequency and duty in brackets after a space, with whether it is inverted (a
+    complementary exhaust's: at its high level, shut, for the duty) and ``note``; empty for any other command."""
+    from .signals import Pwm
+
+    if not isinstance(command, Pwm):
+        return ""
+    inverted = ", inverted" if command.high < command.low else ""
+    return f" (PWM {command.frequency_Hz:g} Hz, duty {command.duty:g}{inverted}{note})"
+
+
+def _valve_panel(ax, result: "Result", ylabel: str, lines: "list[tuple[str, str]]") -> None:
+    """The valve's command or opening, or a spool's command and position (:func:`valve_lines`)."""
+    for k, (key, label) in enumerate(lines):
+        ax.plot(result.t_s, result.signals[key], lw=1, label=label, **series(k, VALVE_COLOURS[k]))
+    ax.set_ylabel(ylabel, fontsize=8)
+    ax.legend(loc="upper right", fontsize=8, ncol=len(lines))
     ax.grid(alpha=0.3)
 
 
@@ -157,12 +257,15 @@ def _temperature_panel(ax, result: "Result") -> None:
 
 
 def _force_panel(ax, result: "Result") -> None:
-    """The forces on the load: each of the rig's that is ever nonzero in its own style, then those of the
-    components added to the rig."""
+    """The forces on the load: each of the rig's that is ever nonzero in its own style (the friction not for a
+    run with hysteresis elements), then those of the components added to the rig."""
     t = result.t_s
+    # Hysteresis elements replace the Coulomb friction: its level is then zero, and F_friction_N is zero but
+    # where the load sticks, where it holds the micronewtons or less that the integration leaves unbalanced.
+    hidden = {"F_friction_N"} if LOOP_FORCE in result.signals else set()
     for key, (label, style) in FORCE_STYLE.items():
         values = result.signals[key]
-        if np.any(values != 0.0):
+        if key not in hidden and np.any(values != 0.0):
             ax.plot(t, values, label=label, lw=1, **style)
     for k, key in enumerate(_added_forces(result.signals), start=len(FORCE_STYLE)):
         ax.plot(t, result.signals[key], label=key.split(".", 1)[0], lw=1, **series(k, f"C{k % 10}"))

@@ -6,7 +6,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from ..figure_style import series
-from ..plotting import X_LABEL, shade_held
+from ..plotting import X_LABEL, line_pressures, shade_held
 from .linear import LinearModel
 
 _BODE_CHANNELS = ((None, "contraction_m"), (None, "p_gauge_Pa"),
@@ -74,7 +74,8 @@ def pole_zero_figure(lin: LinearModel) -> Figure:
 
 
 def closed_loop_figure(run) -> Figure:
-    """Contraction against reference and linear prediction, pressure, and valve command of a closed-loop run."""
+    """Contraction against reference and linear prediction, pressure (the chamber's and those of the line's
+    components, a tube's), and valve command (with a spool valve's position) of a closed-loop run."""
     res = run.result
     fig = Figure(figsize=(9, 8.5), constrained_layout=True)
     ax_x, ax_p, ax_u = fig.subplots(3, 1, sharex=True)
@@ -87,9 +88,15 @@ def closed_loop_figure(run) -> Figure:
     ax_p.plot(res.t_s, res.p_gauge_Pa / 1e5, label="chamber", **series(0, "C3"))
     ax_p.plot(res.t_s, res.signals["feedforward_gauge_Pa"] / 1e5, label="holding pressure (feedforward)",
               **series(3, "k"))
+    # Styles 0 and 3 are taken above: the line's components get the others.
+    for (name, p_gauge_Pa), k in zip(line_pressures(res).items(), (k for k in range(1, 20) if k != 3)):
+        ax_p.plot(res.t_s, p_gauge_Pa / 1e5, lw=1, label=name, **series(k))
     ax_p.set_ylabel("gauge pressure [bar]")
     ax_p.legend(loc="lower right", fontsize=8)
-    ax_u.plot(res.t_s, res.signals["valve_command"], color="C2")
+    ax_u.plot(res.t_s, res.signals["valve_command"], label="command", **series(0, "C2"))
+    if "spool_position" in res.signals:
+        ax_u.plot(res.t_s, res.signals["spool_position"], lw=1, label="spool position", **series(1, "C9"))
+        ax_u.legend(loc="upper right", fontsize=8)
     ax_u.set_ylabel("valve command [-]")
     ax_u.set_xlabel("time [s]")
     for ax in (ax_x, ax_p, ax_u):
