@@ -225,6 +225,14 @@ def _dense_of(solver):
     return solver.dense_output()
 
 
+def _failure_message(solver, message: str | None) -> str:
+    """Why ``solver`` failed: for LSODA, ODEPACK's own words for its state (scipy says only "Unexpected
+    istate in LSODA." and puts the reason in a warning), else the solver's message."""
+    integrator = getattr(getattr(solver, "_lsoda_solver", None), "_integrator", None)
+    words = getattr(integrator, "messages", {}).get(getattr(integrator, "istate", None))
+    return f"LSODA: {words}" if words else (message or "")
+
+
 class LsodaRestarts:
     """``scipy.integrate.LSODA`` solvers kept from one segment to the next of a run and restarted at each
     segment's start, in place of a new solver per segment.
@@ -434,7 +442,13 @@ def integrate_segment(fun: Callable, t0: float, t_end: float, y0: np.ndarray, me
     while status is None:
         message = solver.step()
         if solver.status == "failed":
-            status = -1
+            status, message = -1, _failure_message(solver, message)
+            break
+        if not all(map(math.isfinite, solver.y.tolist())):
+            # LSODA takes a step whose right-hand side was NaN and calls it a success: the run would go on,
+            # or end, with NaN states.
+            status, message = -1, (f"the state is not finite after the step from t = {solver.t_old:.9g} s to "
+                                   f"{solver.t:.9g} s (the right-hand side returned NaN or overflowed)")
             break
         if solver.status == "finished":
             status = 0

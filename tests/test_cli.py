@@ -187,6 +187,30 @@ def test_solver_failure_exits_3_and_leaves_nothing(tmp_path, cli):
     assert not (tmp_path / "new").exists()  # neither the folder nor the parent the command created
 
 
+def test_an_lsoda_failure_is_reported_once_with_its_reason(tmp_path, cli, monkeypatch):
+    """scipy warns of an LSODA failure before pamsim reports it: the command prints pamsim's line only,
+    which carries ODEPACK's reason (here zero absolute tolerances on a state at zero: illegal input)."""
+    import warnings
+
+    import pamsim.simulator
+
+    segment = pamsim.simulator.integrate_segment
+
+    def without_atol(*args, **kwargs):
+        return segment(*args, **{**kwargs, "atol": 0.0 * np.asarray(kwargs["atol"])})
+
+    monkeypatch.setattr(pamsim.simulator, "integrate_segment", without_atol)
+    sc = tmp_path / "s.toml"
+    sc.write_text(BASE)
+    with warnings.catch_warnings(record=True) as shown:
+        warnings.simplefilter("always")
+        code, err = _code_err(cli, "run", sc, "-o", tmp_path / "out")
+    assert code == 3 and "Traceback" not in err
+    assert "pamsim: solver failure:" in err and "LSODA: Illegal input detected" in err
+    assert not [w for w in shown if "lsoda" in str(w.message)], [str(w.message) for w in shown]
+    assert not (tmp_path / "out").exists()
+
+
 def test_late_write_error_and_interrupt_leave_no_folder(tmp_path, cli, monkeypatch):
     import os
 

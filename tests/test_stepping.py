@@ -306,6 +306,31 @@ def test_a_restarted_lsoda_refuses_a_state_that_is_not_finite_as_scipys_does():
                               atol=1e-9, max_step=np.inf, restarts=kept)
 
 
+@pytest.mark.parametrize("restarted", [False, True], ids=["new solver", "restarted"])
+def test_lsoda_fed_nan_fails_the_segment_where_scipy_carries_on(restarted):
+    """scipy's LSODA takes a step whose right-hand side is NaN as a success; the segment fails there."""
+    from pamsim.stepping import LsodaRestarts
+
+    def nan_after(t, y):
+        return oscillator(t, y) * (np.nan if t > 0.05 else 1.0)
+
+    plain = solve_ivp(nan_after, (0.0, 0.1), Y0, method="LSODA", rtol=1e-7, atol=1e-9)
+    assert plain.status == 0 and np.isnan(plain.y[:, -1]).all()  # what the check is for
+    seg = integrate_segment(nan_after, 0.0, 0.1, Y0, "LSODA", [], np.linspace(0.0, 0.1, 11), rtol=1e-7, atol=1e-9,
+                            max_step=np.inf, restarts=LsodaRestarts() if restarted else None)
+    assert seg.status == -1 and "not finite" in seg.message
+    assert np.isfinite(seg.y).all() and np.isfinite(seg.samples_y).all() and seg.t[-1] <= 0.05 + 1e-3
+
+
+def test_an_lsoda_failure_says_odepacks_reason():
+    """scipy says "Unexpected istate in LSODA." and warns the reason; the segment's message carries it."""
+    with pytest.warns(UserWarning, match="lsoda: Excess accuracy"):
+        seg = integrate_segment(lambda t, y: -1e3 * y, 0.0, 1e4, np.array([1.0]), "LSODA", [], np.empty(0),
+                                rtol=1e-6, atol=np.array([0.0]), max_step=np.inf)
+    assert seg.status == -1
+    assert seg.message == "LSODA: Excess accuracy requested (tolerances too small)."
+
+
 def robertson(t, y):
     """Robertson's stiff kinetics: LSODA switches to BDF and changes its order both ways."""
     return np.array([-0.04 * y[0] + 1e4 * y[1] * y[2], 0.04 * y[0] - 1e4 * y[1] * y[2] - 3e7 * y[1] ** 2,

@@ -14,6 +14,7 @@ import os
 import signal
 import sys
 import threading
+import warnings
 
 from ..errors import InputError, RunFailure, SolverFailure
 
@@ -56,7 +57,9 @@ def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
-        with _sigterm_as_interrupt():
+        with _sigterm_as_interrupt(), warnings.catch_warnings():
+            # scipy warns of an LSODA failure before pamsim reports it (its reason in the solver failure)
+            warnings.filterwarnings("ignore", message="lsoda: ", category=UserWarning)
             return int(args.func(args) or 0)
     except InputError as exc:
         print(f"pamsim: error: {exc}", file=sys.stderr)
