@@ -171,7 +171,7 @@ def _muscle(upper_stop):
 
 @pytest.mark.parametrize("table, why", [
     ({"at": "lock"}, "m.toml: upper_stop.at = 'lock': must be one of auto, jam, domain_end, braid_lock"),
-    ({"at": "jam"}, "m.toml: upper_stop.source = None: required"),
+    ({"at": "jam"}, "m.toml: missing key upper_stop.source: required"),
     ({"at": "jam", "source": "x", "why": "y"}, "m.toml: upper_stop.why = 'y': unknown key"),
     ("jam", "m.toml: upper_stop = 'jam': must be a table"),
 ])

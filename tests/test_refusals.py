@@ -79,9 +79,9 @@ def _controller(changes=None, drop=(), spec=None, table=None, top=None) -> Contr
     ({"changes": {"integrator_deadband_mm": -1.0}}, "controller.integrator_deadband_mm = -1.0: must be positive"),
     ({"spec": 3}, f"controller.spec must be a table with keys from {_CONTROL_SPEC}"),
     ({"spec": {"rise_time_s": 1.0}}, f"controller.spec must be a table with keys from {_CONTROL_SPEC}"),
-    ({"spec": {"rise_time_max_s": True}}, "controller.spec.rise_time_max_s = True: must be a positive number"),
-    ({"spec": {"settling_band_mm": "x"}}, "controller.spec.settling_band_mm = 'x': must be a positive number"),
-    ({"spec": {"rise_time_max_s": 0}}, "controller.spec.rise_time_max_s = 0: must be a positive number"),
+    ({"spec": {"rise_time_max_s": True}}, "controller.spec.rise_time_max_s = true: must be a number, not a boolean"),
+    ({"spec": {"settling_band_mm": "x"}}, "controller.spec.settling_band_mm = 'x': must be a number, not a string"),
+    ({"spec": {"rise_time_max_s": 0}}, "controller.spec.rise_time_max_s = 0: must be positive"),
     ({"changes": {"step_time_s": 3.0}}, "controller.step_time_s = 3: must lie inside the simulation (0, 3) s"),
     # the spec is checked before the step time
     ({"changes": {"step_time_s": 5}, "spec": {"x": 1}}, f"controller.spec must be a table with keys from {_CONTROL_SPEC}"),
@@ -269,7 +269,7 @@ def _muscle(**changes) -> pamsim.muscles.Muscle:
 @pytest.mark.parametrize("changes, message", [
     ({"nmae": "x"}, "nmae = 'x': unknown key (did you mean 'name'?)"),
     ({"zzz": 1, "name": ""}, "zzz = 1: unknown key"),
-    ({"name": None}, "name = None: required, a non-empty string"),
+    ({"name": None}, "missing key name: required, a non-empty string"),
     ({"description": "  ", "citation": 3}, "description = '  ': required, a non-empty string"),
     ({"default_static_force": 3}, "default_static_force = 3: required, a non-empty string"),
     ({"gaps": ["a", 1]}, "gaps = ['a', 1]: must be a list of strings"),
@@ -288,7 +288,7 @@ def _muscle(**changes) -> pamsim.muscles.Muscle:
     ({"upper_stop": {"at": "nowhere", "source": "x"}},
      "upper_stop.at = 'nowhere': must be one of auto, jam, domain_end, braid_lock"),
     ({"upper_stop": {"at": "braid_lock"}},
-     "upper_stop.source = None: required: why the stop stands there (or \"assumed: <reason>\")"),
+     "missing key upper_stop.source: required: why the stop stands there (or \"assumed: <reason>\")"),
 ])
 def test_a_bad_muscle_file_is_refused_with_its_first_mistake(changes, message):
     with pytest.raises(MuscleError) as err:

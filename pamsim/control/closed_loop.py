@@ -172,8 +172,9 @@ def _controller_spec(spec: Any, where: str) -> dict[str, float]:
     if not isinstance(spec, dict) or any(k not in _SPEC_KEYS for k in spec):
         raise InputError(f"{where}: controller.spec must be a table with keys from {', '.join(_SPEC_KEYS)}")
     for key, raw in spec.items():
-        if isinstance(raw, bool) or not isinstance(raw, (int, float)) or raw <= 0:
-            raise InputError(f"{where}: controller.spec.{key} = {raw!r}: must be a positive number")
+        why = number_problem(raw) or (None if raw > 0 else "must be positive")
+        if why:
+            raise InputError(f"{where}: controller.spec.{key} = {shown(raw)}: {why}")
     return {k: float(v) for k, v in spec.items()}
 
 

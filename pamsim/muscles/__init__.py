@@ -7,7 +7,6 @@
 
 from __future__ import annotations
 
-import math
 import tomllib
 from dataclasses import dataclass, field
 from functools import lru_cache
@@ -19,7 +18,7 @@ from ..errors import InputError
 from ..parameter_schema import KNOWN, LOCK_DEG, UPPER_STOP_DEFAULT, UPPER_STOPS, Parameter, ParameterSet, unit_of
 from ..static_models import REGISTRY, StaticForce
 from ..static_models import get as get_model
-from ..table_checks import did_you_mean
+from ..table_checks import did_you_mean, number_problem, shown
 
 
 class MuscleError(InputError):
@@ -152,7 +151,7 @@ def muscle_from_dict(raw: Mapping[str, Any], origin: str | Path = "<dict>") -> M
     origin = Path(origin)
 
     def fail(key: str, value: Any, why: str) -> MuscleError:
-        return MuscleError(f"{origin}: {key} = {value!r}: {why}")
+        return MuscleError(f"{origin}: {_key_value(key, value)}: {why}")
 
     for key in raw:
         if key not in TOP_KEYS:
@@ -308,15 +307,21 @@ def _check_entry_table(fail, origin: Path, name: str, table: Any) -> None:
             raise fail(f"{key}.{k}", table[k], "unknown key" + did_you_mean(k, ENTRY_KEYS))
 
 
+def _key_value(key: str, value: Any) -> str:
+    """``key = value`` as a message shows it, or ``missing key KEY`` for None (TOML has no null: a key the
+    file leaves out)."""
+    return f"missing key {key}" if value is None else f"{key} = {shown(value)}"
+
+
 def _entry_value(fail, key: str, table: Mapping[str, Any]) -> float:
     """The entry's ``value``, a finite number (a bool is not one)."""
-    value = table.get("value")
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise fail(f"{key}.value", value, "required, a number")
-    value = float(value)
-    if not math.isfinite(value):
-        raise fail(f"{key}.value", value, "must be a finite number")
-    return value
+    if "value" not in table:
+        raise fail(f"{key}.value", None, "required, a number")
+    value = table["value"]
+    why = number_problem(value)
+    if why:
+        raise fail(f"{key}.value", value, why)
+    return float(value)
 
 
 def _entry_description(fail, key: str, name: str, table: Mapping[str, Any]):
@@ -377,7 +382,7 @@ def rederive(entries: Mapping[str, Parameter]) -> dict[str, Parameter]:
     out = {k: p for k, p in entries.items() if not p.source.startswith(DERIVED)}
 
     def fail(key, value, why):
-        return MuscleError(f"{key} = {value!r}: {why}")
+        return MuscleError(f"{_key_value(key, value)}: {why}")
 
     _complete_wall(fail, out)
     return {k: out[k] for k in entries if k in out} | {k: p for k, p in out.items() if k not in entries}
