@@ -36,8 +36,9 @@ def with_overrides(params: ParameterSet, overrides: Mapping[str, Any], fail: Fai
     for name, value in overrides.items():
         if name not in params and name not in KNOWN:
             fail(key("parameter", name), value, "unknown parameter" + _suggest(name, sorted(set(params) | set(KNOWN))))
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            fail(key("parameter", name), value, number_problem(value))
+        why = number_problem(value)
+        if why:
+            fail(key("parameter", name), value, why)
         (values if name in params else added)[name] = float(value)
     params = params.with_overrides(values, source=source)
     if added:

@@ -308,21 +308,52 @@ def running_losses(t_s: np.ndarray, loss_t_s, loss_J: np.ndarray) -> np.ndarray:
 
 def _closed_valve_warning(command, t_end: float) -> str:
     """Why a valve whose command never rises above 0 (closed, or a 3/2 valve's exhaust side) kept the muscle
-    from its supply: a step after the run's end, PWM pulses too short for the valve's delays and switching
-    times (the command is the opening the valve reaches), or a command that never opens it."""
+    from its supply: a step or a first opening after the run's end, a PWM whose high level does not open it,
+    or PWM pulses too short for the valve's delays and opening time (the command is the opening the valve
+    reaches, :class:`~pamsim.signals.Pwm`)."""
     if isinstance(command, Pwm) and command.duty > 0.0 and command.start_s < t_end:
-        period_ms = 1e3 / command.frequency_Hz
-        on_ms, off_ms = (1e3 * (command.delay_on_s + command.rise_s), 1e3 * (command.delay_off_s + command.fall_s))
-        side = "toward the supply past its middle (it only vents)" if command.low < 0.0 else "at all"
-        return (f"the valve never opens {side}: its PWM pulses, {command.duty * period_ms:.4g} ms of each "
-                f"{period_ms:.4g} ms period at {command.frequency_Hz:g} Hz, are too short for its delay and "
-                f"opening time ({on_ms:.4g} ms; closing: {off_ms:.4g} ms), so the muscle never sees the supply "
-                "(lower pressure.command.frequency_Hz or raise its duty)")
+        if command.high <= 0.0:
+            return (f"the valve never opens toward the supply: its PWM command's high level, "
+                    f"pressure.command.high = {command.high:g}, is at or below 0 (1 opens it to the supply)")
+        opens_s = _first_opening_s(command)
+        if opens_s is None:
+            return _short_pulses_warning(command)
+        return (f"the valve first opens at {opens_s:.4g} s (its PWM starts at {command.start_s:g} s, its opening "
+                f"delay is {command.delay_on_s * 1e3:.4g} ms), not before the run ends at {t_end:g} s: the muscle "
+                "never sees the supply (raise simulation.duration_s or start the PWM earlier)")
     opens = getattr(command, "time_s", None)  # a step's opening time
     when = f"opens at {opens:g} s, after the run ends at {t_end:g} s" if opens is not None else \
         f"stays closed (command <= 0) until the run ends at {t_end:g} s"
     return (f"the valve {when}: the muscle never sees the supply "
             "(raise simulation.duration_s or open the valve earlier)")
+
+
+def _first_opening_s(command: Pwm) -> float | None:
+    """When the PWM's whole trace (to its ``end_s``, whatever the run's end) first rises above 0, or None."""
+    t, level = command.knots_t_s, command.knots
+    for k in range(1, len(level)):
+        if level[k] > 0.0 >= level[k - 1]:
+            return t[k - 1] + (t[k] - t[k - 1]) * (0.0 - level[k - 1]) / (level[k] - level[k - 1])
+    return None
+
+
+def _short_pulses_warning(command: Pwm) -> str:
+    """A PWM whose pulses never move the valve past closed: each moves it toward the supply for the pulse less
+    the opening delay plus the closing delay, too short for its opening to get past its middle (a 3/2 valve,
+    ``low`` < 0) or closed."""
+    period_ms = 1e3 / command.frequency_Hz
+    pulse_ms = command.duty * period_ms
+    moving_ms = pulse_ms + 1e3 * (command.delay_off_s - command.delay_on_s)
+    vents = command.low < 0.0
+    need_ms = 1e3 * command.rise_s * (-command.low / (command.high - command.low) if vents else 0.0)
+    side, past = (("toward the supply past its middle (it only vents)", "from exhaust to its middle") if vents
+                  else ("at all", "to open"))
+    return (f"the valve never opens {side}: each PWM pulse, {pulse_ms:.4g} ms of a {period_ms:.4g} ms period at "
+            f"{command.frequency_Hz:g} Hz, moves it toward the supply for {max(moving_ms, 0.0):.4g} ms (the pulse, "
+            f"less its {command.delay_on_s * 1e3:.4g} ms opening delay, plus its {command.delay_off_s * 1e3:.4g} "
+            f"ms closing delay), too short for the {need_ms:.4g} ms its {command.rise_s * 1e3:.4g} ms opening "
+            f"takes {past}: the muscle never sees the supply (lower pressure.command.frequency_Hz or raise "
+            "its duty)")
 
 
 def pointless_run_warnings(model, t_s: np.ndarray, at_rest_at_end: bool, v_end_m_s: float) -> list[str]:

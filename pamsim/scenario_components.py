@@ -157,14 +157,28 @@ def hysteresis_component(v, table: dict, law, pressure: str, added: tuple) -> Ad
         v.fail(f"hysteresis.{key}", table[key], f"unknown key for model = {model!r}", choices=keys)
     if any(a.component.name == "hysteresis" for a in added):
         v.fail("component", "hysteresis", "the name is taken by the [hysteresis] table's model")
-    if model in LEVEL_SHARING and getattr(law, "name", None) == "none":
+    zero = _zero_level(law) if model in LEVEL_SHARING else None
+    if zero is not None:
         # Their forces are parts of the law's level; at a level of 0 only the presliding damping would act.
-        v.fail("model.friction", "none", f"its level is 0, so the [hysteresis] {model} model that shares it has "
-               "no slip force; give the friction law it shares ('load_dependent' or 'constant'), or use "
-               "hysteresis.model = 'pi', whose forces are its own weights")
+        v.fail(*zero, f"the friction law's level is 0 at every point, so the [hysteresis] {model} model that "
+               "shares it has no slip force; give the law it shares a level ('load_dependent' or 'constant' with "
+               "a nonzero coefficient), or use hysteresis.model = 'pi', whose forces are its own weights")
     component = {"maxwell_slip": _maxwell_slip, "bouc_wen": _bouc_wen, "pi": _prandtl_ishlinskii}[model](v, table, law)
     return AddedComponent(component, {"flange": "load.flange", "p_gauge_Pa": f"{pressure}.p_gauge_Pa",
                                       "mass_kg": "load.mass_kg"})
+
+
+def _zero_level(law) -> tuple[str, Any] | None:
+    """``(key, value)`` that makes the ``[model] friction`` law's level 0 at every contraction, pressure and
+    load (no law, a constant law of 0 N, the paper's law with its three coefficients 0), or None."""
+    name = getattr(law, "name", None)
+    if name == "none":
+        return "model.friction", "none"
+    if name == "constant" and law.level_constant_N == 0.0:
+        return "parameters.coulomb_constant_N", law.level_constant_N
+    if name == "load_dependent" and law.N2_N_per_bar_m2 == law.N1_N_per_bar_m == law.N0_N_per_bar == 0.0:
+        return "parameters.N0_N_per_bar", law.N0_N_per_bar
+    return None
 
 
 def _maxwell_slip(v, table: dict, law) -> MaxwellSlip:
@@ -250,8 +264,8 @@ def refuse_added(scenario: Any, what: str, error: type[Exception], hysteresis: b
 
 def check_pressure_ports(v, pressure: dict, added: tuple) -> None:
     """``pressure.supply_port`` and ``pressure.outlet_port`` must each name a pneumatic port of a
-    ``[[component]]`` (the rig's own chamber is the valve's outlet when ``outlet_port`` is left out): refused
-    naming the key, with the closest name."""
+    ``[[component]]`` (the rig's own chamber is the valve's outlet when ``outlet_port`` is left out), not
+    both the same: refused naming the key, with the closest name."""
     components = {a.component.name: a.component for a in added}
     for key in ("supply_port", "outlet_port"):
         if key not in pressure:
@@ -268,6 +282,10 @@ def check_pressure_ports(v, pressure: dict, added: tuple) -> None:
         if port not in ports:
             v.fail(f"pressure.{key}", pressure[key], f"component {name!r} ({type(components[name]).__name__}) has "
                    "no pneumatic port so named", choices=[f"{name}.{p}" for p in ports] or None)
+    if "supply_port" in pressure and pressure.get("outlet_port") == pressure["supply_port"]:
+        # The valve's two sides on one volume: it passes nothing, and the muscle never sees the supply.
+        v.fail("pressure.outlet_port", pressure["outlet_port"], "is the valve's supply side too (pressure.supply_port): "
+               "the valve would join a volume to itself; its outlet is the port toward the muscle")
 
 
 def is_line_component(component: Any) -> bool:
@@ -292,12 +310,20 @@ def check_wiring(scenario: Any, error: type[Exception]) -> None:
 
 
 def _valve_port_hint(scenario: Any, text: str) -> str:
-    """Where a wiring error names a port of the component the valve is wired to (``pressure.supply_port``,
-    ``pressure.outlet_port``), which of those keys wired it: the likely cause (the valve on the tube's outlet
-    leaves its inlet unconnected)."""
+    """Where a wiring error names a port of a component the valve is wired to (``pressure.supply_port``,
+    ``pressure.outlet_port``) on a port a ``connect`` table joins too, which of those keys wired it: the
+    likely cause (the valve on the tube's outlet, which the tube joins to the chamber, leaves its inlet
+    unconnected).  A valve alone on its port is wired as it should be: the error is elsewhere."""
     pressure = scenario.spec.get("pressure", {})
+    joined = set()
+    for table in scenario.spec.get("component", []):
+        connect = table.get("connect") if isinstance(table, dict) else None
+        if isinstance(connect, dict):
+            joined |= {f"{table.get('name')}.{port}" for port in connect} | {v for v in connect.values()
+                                                                            if isinstance(v, str)}
     keys = [f"pressure.{k} = {pressure[k]!r}" for k in ("supply_port", "outlet_port")
-            if isinstance(pressure.get(k), str) and f" {pressure[k].partition('.')[0]}." in f" {text}"]
+            if isinstance(pressure.get(k), str) and pressure[k] in joined
+            and f" {pressure[k].partition('.')[0]}." in f" {text}"]
     return f" (the valve is wired by {' and '.join(keys)})" if keys else ""
 
 

@@ -468,6 +468,8 @@ def test_a_joints_hysteresis_elements_are_linearised_relaxed_and_sticking_as_spr
     assert rep["flexor"]["branch"] == "at rest" and [e["state"] for e in rep["flexor"]["elements"]] == ["stick"] * 2
     text = subprocess.run([sys.executable, "-m", "pamsim", "linearize", str(path)], capture_output=True, text=True)
     assert "flexor: hysteresis: maxwell_slip, branch at rest" in text.stdout, text.stdout
+    assert ("friction: Coulomb friction dropped (the bearing's: no linearisation at rest); the [hysteresis] "
+            "elements of muscles flexor and extensor take their Coulomb friction's place (below)") in text.stdout, text.stdout
 
 
 def test_pamsim_linearize_a_joint_prints_the_mimo_model():

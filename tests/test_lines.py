@@ -300,6 +300,8 @@ def test_the_cli_refuses_a_bad_line_with_exit_2_and_writes_nothing(tmp_path, key
                                          r"\(Reservoir\) has no pneumatic port so named \(did you mean 'reservoir\.port'\?\)"),
     ({"supply_port": "resrvoir.port"}, r"pressure\.supply_port = 'resrvoir\.port'.*did you mean 'reservoir\.port'"),
     ({"outlet_port": "chamber.port"}, r"pressure\.outlet_port = 'chamber\.port': 'chamber' is the rig's own"),
+    ({"supply_port": "reservoir.port", "outlet_port": "reservoir.port"},
+     r"pressure\.outlet_port = 'reservoir\.port': is the valve's supply side too"),
 ])
 def test_a_line_that_is_not_connected_is_refused_by_name(pressure, match):
     """A valve port that names no [[component]], a port it does not have, or the rig's own: refused naming the
@@ -316,6 +318,11 @@ def test_an_unconnected_port_says_which_valve_key_wired_its_component():
                                          r"pressure\.outlet_port = 'tube\.outlet'\)"):
         _scenario([tube], pressure={"outlet_port": "tube.outlet"})
     assert _scenario([tube], pressure={"outlet_port": "tube.inlet"}).added_components
+    # The valve where it belongs and the tube's own connect left out: the error is the tube's, not the key's.
+    loose = _component("tube", "tube", {}, length_m=1.0, diameter_m=0.004, inlet="volume")
+    with pytest.raises(InputError, match=r"port tube\.outlet .*is not connected") as refused:
+        _scenario([loose], pressure={"outlet_port": "tube.inlet"})
+    assert "wired by" not in str(refused.value)
 
 
 def test_an_unknown_law_or_inlet_is_refused_with_the_choices():

@@ -178,6 +178,24 @@ def test_elements_that_share_a_level_of_zero_are_refused_by_key(fig4, table, tmp
     assert np.max(np.abs(res.signals["hysteresis.F_N"])) > 0.1
 
 
+@pytest.mark.parametrize("friction, parameters, key", [
+    ("constant", {"coulomb_constant_N": 0.0}, r"parameters\.coulomb_constant_N = 0\.0"),
+    ("load_dependent", {"N2_N_per_bar_m2": 0.0, "N1_N_per_bar_m": 0.0, "N0_N_per_bar": 0.0},
+     r"parameters\.N0_N_per_bar = 0\.0"),
+])
+def test_a_friction_law_whose_coefficients_make_its_level_zero_is_refused_as_none_is(fig4, friction, parameters, key):
+    """A law named with a level but whose coefficients are 0 is the same mistake as ``friction = "none"``; a
+    nonzero coefficient is accepted."""
+    spec = copy.deepcopy(dict(fig4.spec))
+    spec["model"]["friction"] = friction
+    spec["parameters"] = {**spec.get("parameters", {}), **parameters}
+    spec["hysteresis"] = {"model": "maxwell_slip", "slip_displacement_m": [1e-4], "share": [1.0]}
+    with pytest.raises(ScenarioError, match=key + r": the friction law's level is 0"):
+        Scenario.from_dict(spec, name="bad", base_dir=fig4.base_dir)
+    spec["parameters"][key.split(r"\.")[1].split(" ")[0]] = 0.5
+    assert Scenario.from_dict(spec, name="ok", base_dir=fig4.base_dir).build_model() is not None
+
+
 # ---------------------------------------------------------------- where the load rests
 TEN_DELTAS = list(np.geomspace(1e-4, 5e-3, 10))
 

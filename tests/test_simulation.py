@@ -379,11 +379,28 @@ def test_pwm_pulses_too_short_for_the_valve_say_so_not_that_it_opens_too_late():
                                 "simulation": {"duration_s": 1.0}})
     res = pamsim.simulate(shortened(frequency_Hz=1000.0))
     assert float(np.max(res.p_gauge_Pa)) < 1e3
-    hits = [w for w in res.warnings if "PWM pulses" in w]
-    assert len(hits) == 1 and "0.5 ms of each 1 ms period at 1000 Hz" in hits[0] and "(4 ms;" in hits[0], hits
-    assert "only vents" in hits[0] and "after the run ends" not in hits[0]
+    hits = [w for w in res.warnings if "PWM pulse" in w]
+    assert len(hits) == 1 and "0.5 ms of a 1 ms period at 1000 Hz" in hits[0], hits
+    # By hand: 0.5 ms pulse - 2 ms opening delay + 2 ms closing delay; half of the 2 ms opening reaches the middle.
+    assert "toward the supply for 0.5 ms" in hits[0] and "the 1 ms its 2 ms opening takes" in hits[0], hits
+    assert "only vents" in hits[0] and "run ends" not in hits[0]
     slow = pamsim.simulate(shortened())
     assert not [w for w in slow.warnings if "valve" in w], slow.warnings
+
+
+@pytest.mark.parametrize("changes, words, not_words", [
+    # The run ends as the first pulse opens it: by hand 0.5 s + 2 ms delay + half the 2 ms rise = 0.503 s.
+    ({"simulation": {"duration_s": 0.503}}, ["first opens at 0.503 s", "raise simulation.duration_s"], ["PWM pulse,"]),
+    ({"pressure": {"command": {"high": 0.0}}}, ["pressure.command.high = 0", "at or below 0"], ["PWM pulse,", "run ends"]),
+], ids=["run ends before the first opening", "high level shut"])
+def test_a_pwm_valve_that_never_opens_is_blamed_on_its_real_cause(changes, words, not_words):
+    sc = pamsim.load_scenario(SCENARIOS / "pwm_3_2.toml")
+    if "pressure" in changes:
+        changes = {"pressure": {"command": {**sc.spec["pressure"]["command"], **changes["pressure"]["command"]}}}
+    res = pamsim.simulate(sc.with_changes(changes))
+    hits = [w for w in res.warnings if "valve" in w]
+    assert len(hits) == 1, res.warnings
+    assert all(w in hits[0] for w in words) and not any(w in hits[0] for w in not_words), hits[0]
 
 
 @pytest.mark.parametrize("what", POINTLESS)

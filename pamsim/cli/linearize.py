@@ -48,6 +48,20 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
+def _joint_friction_line(muscles: list[str], with_hysteresis: list[str]) -> str:
+    """What a joint's linearisation did with friction: the bearing's and the Coulomb friction of the muscles
+    without ``[hysteresis]`` dropped, each named; the elements of the others in its place."""
+    dropped = [m for m in muscles if m not in with_hysteresis]
+    whose = "the bearing's" + (f" and that of muscle{'s' * (len(dropped) > 1)} {' and '.join(dropped)}"
+                               if dropped else "")
+    line = f"Coulomb friction dropped ({whose}: no linearisation at rest)"
+    if with_hysteresis:
+        line += (f"; the [hysteresis] elements of muscle{'s' * (len(with_hysteresis) > 1)} "
+                 f"{' and '.join(with_hysteresis)} take "
+                 f"{'its' if len(with_hysteresis) == 1 else 'their'} Coulomb friction's place (below)")
+    return line
+
+
 def _matrix(a) -> list[list[float]]:
     import numpy as np  # the CLI's modules import nothing heavy at the top: `pamsim --help` stays fast
 
@@ -149,10 +163,8 @@ def _linearize_joint(scenario, args: argparse.Namespace) -> int:
     rep = {"A": _matrix(lm.A), "B": _matrix(lm.B), "C": _matrix(lm.C), "D": _matrix(lm.D), "states": list(lm.states),
            "inputs": list(lm.inputs), "outputs": list(lm.outputs), "poles": [_complex(z) for z in lm.poles()],
            "theta0_rad": lm.theta0_rad, "p0_gauge_Pa": list(lm.p0_gauge_Pa), "k0_Nm_per_rad": lm.k0_Nm_per_rad,
-           "friction": ("Coulomb friction dropped (the bearing's and the muscles': no linearisation at rest)"
-                        if not lm.hysteresis else "Coulomb friction dropped (the bearing's and that of muscles "
-                        "without [hysteresis]: no linearisation at rest); a muscle's [hysteresis] elements take "
-                        "its friction's place (below)")}
+           "friction": _joint_friction_line([m.name for m in scenario.joint_muscles()],
+                                            [name for name, _ in lm.hysteresis])}
     if lm.hysteresis:
         rep["hysteresis"] = {name: loop.as_dict() for name, loop in lm.hysteresis}
     if args.json:
