@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import itertools
 import textwrap
-from typing import TYPE_CHECKING
 
 import numpy as np
 from matplotlib.figure import Figure
@@ -16,9 +15,6 @@ from matplotlib.figure import Figure
 from .atomic import atomic_path
 from .constants import PA_PER_BAR
 from .figure_style import format_of, save, series
-
-if TYPE_CHECKING:  # for the annotations only: at run time Result imports this module, not the other way
-    from .result import Result
 
 FORCE_STYLE: dict[str, tuple[str, dict]] = {key: (label, series(k, colour)) for k, (key, label, colour) in enumerate((
     ("F_static_N", "static", "C0"),
@@ -86,7 +82,7 @@ def result_figure(result: "Result", title: str | None = None, compare: "list[Res
     """
     thermal = "wall_heat_W" in result.signals  # the thermal chamber's: its temperature gets a panel
     loops = LOOP_FORCE in result.signals  # hysteresis elements: their loops get a row of their own
-    valve = valve_lines(result)  # a PWM or spool valve's: a small panel under the pressure it drives
+    valve = result.valve_panel()  # a PWM or spool valve's: a small panel under the pressure it drives
     rows, height = (4, 11) if thermal else (3, 9)
     ratios = None
     if valve is not None:
@@ -169,23 +165,9 @@ def _pressure_panel(ax, result: "Result", measured) -> None:
 
 def line_pressures(result: "Result") -> dict[str, np.ndarray]:
     """Component name -> gauge pressure [Pa] of each component added to the rig that has one (a supply, a
-    reservoir, a tube): its ``NAME.p_gauge_Pa``, or else its ``NAME.p_abs_Pa`` less the run's atmosphere."""
-    found: dict[str, np.ndarray] = {}
-    for key in result.signals:
-        name, _, quantity = key.partition(".")
-        if quantity == "p_gauge_Pa":
-            found[name] = np.asarray(result.signals[key], dtype=float)
-        elif quantity == "p_abs_Pa" and f"{name}.p_gauge_Pa" not in result.signals:
-            found[name] = np.asarray(result.signals[key], dtype=float) - _atmosphere_Pa(result)
-    return found
-
-
-def _atmosphere_Pa(result: "Result") -> float:
-    """The ambient pressure [Pa] of the run's valve source, or the package's default where it has none."""
-    from .parameters import DYNAMICS_DEFAULTS
-
-    p_atm = getattr(getattr(result.model, "source", None), "p_atm_Pa", None)
-    return float(DYNAMICS_DEFAULTS["p_atm_Pa"][0] if p_atm is None else p_atm)
+    reservoir, a tube): its ``NAME.p_gauge_Pa``."""
+    return {key.partition(".")[0]: np.asarray(values, dtype=float) for key, values in result.signals.items()
+            if key.partition(".")[2] == "p_gauge_Pa"}
 
 
 VALVE_PANEL_RATIO = 0.5
@@ -196,47 +178,8 @@ VALVE_COLOURS = ("C2", "C9")
 """The valve panel's lines: the inlet (or the spool's command), then the exhaust (or the spool's position)."""
 
 
-def valve_lines(result: "Result") -> "tuple[str, list[tuple[str, str]]] | None":
-    """The valve panel's y label and its ``(signal, legend label)`` lines, for a run whose valve follows a
-    PWM command (its opening, each valve's of a pair, or the averaged valve's duty) or is a spool valve (its
-    command and position); None for any other run, whose valve command is a plain step or steps."""
-    from .elements.pwm_average import AveragedPwmSource
-    from .signals import Pwm
-
-    signals = result.signals
-    if "spool_position" in signals:
-        return ("spool / stroke [-]\n(+1 supply, -1 exhaust)",
-                [("valve_command", "command"), ("spool_position", "position")])
-    source = getattr(result.model, "source", None)
-    if source is None or "valve_command" not in signals:
-        return None
-    if isinstance(source, AveragedPwmSource):
-        return "PWM duty [-]", [("valve_command", "duty (averaged valve)")]
-    inlet, exhaust = getattr(source, "command", None), getattr(source, "exhaust_command", None)
-    averaged_inlet = getattr(source, "averaged_inlet", None)  # a pair's inlet run by its mean opening
-    if not any(isinstance(c, Pwm) for c in (inlet, exhaust, averaged_inlet)):
-        return None
-    if "exhaust_command" in signals:
-        what = (_pwm_text(averaged_inlet, ", mean over a period") if isinstance(averaged_inlet, Pwm)
-                else _pwm_text(inlet))
-        return ("valve opening [-]\n(0 shut, 1 open)",
-                [("valve_command", f"inlet{what}"), ("exhaust_command", f"exhaust{_pwm_text(exhaust)}")])
-    return "valve opening [-]\n(+1 supply, -1 exhaust)", [("valve_command", f"valve{_pwm_text(inlet)}")]
-
-
-def _pwm_text(command, note: str = "") -> str:
-    """A PWM command's frequency and duty in brackets after a space, with whether it is inverted (a
-    complementary exhaust's: at its high level, shut, for the duty) and ``note``; empty for any other command."""
-    from .signals import Pwm
-
-    if not isinstance(command, Pwm):
-        return ""
-    inverted = ", inverted" if command.high < command.low else ""
-    return f" (PWM {command.frequency_Hz:g} Hz, duty {command.duty:g}{inverted}{note})"
-
-
 def _valve_panel(ax, result: "Result", ylabel: str, lines: "list[tuple[str, str]]") -> None:
-    """The valve's command or opening, or a spool's command and position (:func:`valve_lines`)."""
+    """The valve's command or opening, or a spool's command and position (``Result.valve_panel``)."""
     for k, (key, label) in enumerate(lines):
         ax.plot(result.t_s, result.signals[key], lw=1, label=label, **series(k, VALVE_COLOURS[k]))
     ax.set_ylabel(ylabel, fontsize=8)

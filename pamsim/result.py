@@ -11,6 +11,7 @@ import numpy as np
 from .atomic import atomic_path
 from .constants import PA_PER_BAR
 from .elements.pressure_source import PrescribedPressure, ValveChamberSource
+from .elements.pwm_average import AveragedPwmSource
 from .model import N_WORK, Mode
 from .signals import Constant, PiecewiseConstant, Pwm, Step
 
@@ -279,12 +280,45 @@ class Result:
         """Write the trace; the first columns are ``t_s,x_m,v_m_s,p_gauge_Pa``. Atomic."""
         write_columns(path, self.columns())
 
+    def valve_panel(self) -> "tuple[str, list[tuple[str, str]]] | None":
+        """The run figure's valve panel, for a run whose valve follows a PWM command (its opening, each
+        valve's of a pair, or the averaged valve's duty) or is a spool valve (its command and position): its
+        y label and its ``(signal, legend label)`` lines; None for any other run (a plain step or steps)."""
+        signals = self.signals
+        if "spool_position" in signals:
+            return ("spool / stroke [-]\n(+1 supply, -1 exhaust)",
+                    [("valve_command", "command"), ("spool_position", "position")])
+        source = getattr(self.model, "source", None)
+        if source is None or "valve_command" not in signals:
+            return None
+        if isinstance(source, AveragedPwmSource):
+            return "PWM duty [-]", [("valve_command", "duty (averaged valve)")]
+        inlet, exhaust = getattr(source, "command", None), getattr(source, "exhaust_command", None)
+        averaged_inlet = getattr(source, "averaged_inlet", None)  # a pair's inlet run by its mean opening
+        if not any(isinstance(c, Pwm) for c in (inlet, exhaust, averaged_inlet)):
+            return None
+        if "exhaust_command" in signals:
+            what = (_pwm_text(averaged_inlet, ", mean over a period") if isinstance(averaged_inlet, Pwm)
+                    else _pwm_text(inlet))
+            return ("valve opening [-]\n(0 shut, 1 open)",
+                    [("valve_command", f"inlet{what}"), ("exhaust_command", f"exhaust{_pwm_text(exhaust)}")])
+        return "valve opening [-]\n(+1 supply, -1 exhaust)", [("valve_command", f"valve{_pwm_text(inlet)}")]
+
     def plot(self, path=None, dpi: int | None = None, **kwargs):
         """Plot contraction, pressure and forces; write them to ``path`` if given, as PNG, PDF or SVG by its
         suffix, at ``dpi`` dots per inch (default 110).  See :func:`pamsim.plotting.plot_result`."""
         from .plotting import plot_result
 
         return plot_result(self, path, dpi=dpi, **kwargs)
+
+
+def _pwm_text(command, note: str = "") -> str:
+    """A PWM command's frequency and duty in brackets after a space, with whether it is inverted (a
+    complementary exhaust's: at its high level, shut, for the duty) and ``note``; empty for any other command."""
+    if not isinstance(command, Pwm):
+        return ""
+    inverted = ", inverted" if command.high < command.low else ""
+    return f" (PWM {command.frequency_Hz:g} Hz, duty {command.duty:g}{inverted}{note})"
 
 
 def write_columns(path, cols: dict) -> None:

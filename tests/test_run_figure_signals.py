@@ -113,19 +113,14 @@ def test_each_line_components_pressure_is_drawn_in_bar_gauge_under_its_name():
     assert len(set(styles)) == len(styles)  # told apart in grey too
 
 
-def test_an_absolute_line_pressure_is_made_gauge_with_the_runs_atmosphere():
-    p_abs = np.array([150e3, 250e3])
-    signals = {"vessel.p_abs_Pa": p_abs, "tube.p_gauge_Pa": np.array([1.0, 2.0]), "tube.p_abs_Pa": np.zeros(2),
-               "tube.outlet_p_gauge_Pa": np.zeros(2), "p_gauge_Pa": np.zeros(2)}
-    run = SimpleNamespace(signals=signals, model=SimpleNamespace(source=SimpleNamespace(p_atm_Pa=95e3)))
-    found = plotting.line_pressures(run)
-    assert list(found) == ["vessel", "tube"]
-    assert np.array_equal(found["vessel"], p_abs - 95e3)
+def test_only_a_components_own_gauge_pressure_is_a_line_pressure():
+    """``NAME.p_gauge_Pa`` of each component, not the muscle's own column, another quantity of the component
+    (``tube.outlet_p_gauge_Pa``) or its absolute pressure."""
+    signals = {"vessel.p_abs_Pa": np.array([150e3, 250e3]), "tube.p_gauge_Pa": np.array([1.0, 2.0]),
+               "tube.p_abs_Pa": np.zeros(2), "tube.outlet_p_gauge_Pa": np.zeros(2), "p_gauge_Pa": np.zeros(2)}
+    found = plotting.line_pressures(SimpleNamespace(signals=signals))
+    assert list(found) == ["tube"]
     assert np.array_equal(found["tube"], signals["tube.p_gauge_Pa"])
-    from pamsim.parameters import DYNAMICS_DEFAULTS
-
-    no_source = SimpleNamespace(signals=signals, model=None)
-    assert np.array_equal(plotting.line_pressures(no_source)["vessel"], p_abs - DYNAMICS_DEFAULTS["p_atm_Pa"][0])
 
 
 EXPECTED_PLAIN = {  # counted on the figures before the valve panel and the line pressures were added
