@@ -55,8 +55,24 @@ def added_components(v, entries: list) -> tuple[AddedComponent, ...]:
         connect = entry.get("connect", {})
         if not isinstance(connect, dict) or not all(isinstance(t, str) for t in connect.values()):
             v.fail(f"{where}.connect", connect, 'must be a table of its ports and inputs, e.g. {flange = "load.flange"}')
-        out.append(AddedComponent(cls(name, values, **options), dict(connect)))
+        component = cls(name, values, **options)
+        _refuse_self_joined(v, where, component, connect)
+        out.append(AddedComponent(component, dict(connect)))
     return tuple(out)
+
+
+def _refuse_self_joined(v, where: str, component: Any, connect: dict) -> None:
+    """Two ports of one component wired to one port: it would act between a volume (or a flange) and itself,
+    passing nothing (a tube whose ends are on one volume).  Two inputs may read one output."""
+    seen: dict[str, str] = {}
+    for port in (p.name for p in component.ports):
+        target = connect.get(port)
+        if target is None:
+            continue
+        if target in seen:
+            v.fail(f"{where}.connect.{port}", target, f"is where its {seen[target]} is connected too: the component "
+                   "would join a port to itself and pass nothing")
+        seen[target] = port
 
 
 def _component_options(v, where: str, cls, entry: dict) -> dict[str, str]:
@@ -111,7 +127,7 @@ def _component_values(v, where: str, kind: str, parameters, entry: dict, default
     needed = [key for key in declared if key not in (defaults or {})]
     for key in needed:
         if key not in values:
-            v.fail(f"{where}.{key}", None, f"missing: {kind} needs {', '.join(needed)}")
+            raise v.error(f"{v.origin}: missing key {where}.{key}: {kind} needs {', '.join(needed)}")
     return values
 
 

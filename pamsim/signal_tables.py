@@ -119,8 +119,9 @@ def _pwm(e: _Entries) -> Pwm:
     end = e.after("end_s", "start_s", start)
     f = e.v.number(f"{e.where}.frequency_Hz", e.v.required(e.spec, "frequency_Hz", prefix=f"{e.where}."))
     if not 0.0 < f <= MAX_PWM_FREQUENCY_HZ:
-        e.v.fail(f"{e.where}.frequency_Hz", f, f"must lie in (0, {MAX_PWM_FREQUENCY_HZ:g}] Hz (above it, use "
-                 "the valve's averaged command: the duty)")
+        e.v.fail(f"{e.where}.frequency_Hz", f, f"must lie in (0, {MAX_PWM_FREQUENCY_HZ:g}] Hz" + (
+            "" if f <= 0.0 else " (solenoid valves switch in 1 to 3 ms: faster PWM than that is a valve's "
+            "proportional opening, not its switching)"))
     if (end - start) * f * 2 > MAX_PWM_SWITCHES:
         e.v.fail(f"{e.where}.frequency_Hz", f, f"{(end - start) * f * 2:.0f} switches from start_s to end_s, "
                  f"more than {MAX_PWM_SWITCHES}")
@@ -169,7 +170,7 @@ def on_off_command(v, where: str, spec: Any, timing: Mapping[str, float], inlet=
     signal = signal_from_table(v, where, table, "", 1.0, Path("."))
     if isinstance(signal, Pwm):
         return dataclasses.replace(signal, **timing)
-    states = _boolean_states(v, where, signal)
+    states = _boolean_states(v, where, signal, table)
     commands = tuple(zip(signal.times_s, states)) if isinstance(signal, PiecewiseConstant) else (
         ((signal.time_s, states[-1]),) if isinstance(signal, Step) else ())
     return OnOff(commands, float(states[0]), **timing)
@@ -195,15 +196,29 @@ def _on_off_kind(v, where: str, spec: Any, exhaust: bool) -> str:
     return kind
 
 
-def _boolean_states(v, where: str, signal) -> list[int]:
-    """The states (0 or 1) a boolean ``constant``, ``step`` or ``steps`` signal takes, in order; any other
-    value is refused naming ``where``."""
+def _boolean_states(v, where: str, signal, spec: Mapping) -> list[int]:
+    """The states (0 or 1) a boolean ``constant``, ``step`` or ``steps`` signal (of the table ``spec``) takes,
+    in order; any other value is refused naming its key."""
     values = (signal.values if isinstance(signal, PiecewiseConstant)
               else (signal.initial, signal.final) if isinstance(signal, Step) else (signal.value,))
     for value in values:
         if value not in (0.0, 1.0):
-            v.fail(where, value, "an on/off valve's command is 0 (closed) or 1 (open)")
+            v.fail(_boolean_key(where, spec, value), value, "an on/off valve's command is 0 (closed) or 1 (open)")
     return [int(x) for x in values]
+
+
+def _boolean_key(where: str, spec: Mapping, value: float) -> str:
+    """The key of ``spec`` (a command table) that holds ``value``: ``value``, ``initial``, ``final`` or
+    ``values[i]``; ``where`` itself if none does."""
+    for key in ("value", "initial", "final"):
+        if spec.get(key) == value:
+            return f"{where}.{key}"
+    listed = spec.get("values")
+    if isinstance(listed, list):
+        for i, x in enumerate(listed):
+            if x == value:
+                return f"{where}.values[{i}]"
+    return where
 
 
 def _numbers(v, key: str, value: Any) -> list[float]:

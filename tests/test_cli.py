@@ -177,6 +177,20 @@ def test_bad_arguments_exit_2(args, word, tmp_path, cli, monkeypatch):
     assert "Traceback" not in r.stderr and word in r.stderr
 
 
+@pytest.mark.parametrize("args, words", [
+    (["fit", "hysteresis", "loop.csv", "--model", "foo"], ["pamsim fit hysteresis: error: argument --model",
+                                                           "'foo'", "see pamsim fit hysteresis --help"]),
+    (["fit", "hysteresis", "loop.csv", "--thresholds-mm", "-1,2"], ["--thresholds-mm", "goes after '='"]),
+    (["run"], ["pamsim run: error:", "scenario"]),
+    (["bogus"], ["pamsim: error:", "'bogus'"]),
+], ids=["invalid choice", "value like an option", "missing argument", "unknown command"])
+def test_a_mistake_in_the_arguments_is_one_line(args, words):
+    """argparse's mistakes print one line naming the argument (not the usage block first), exit code 2."""
+    r = pamsim(*args)
+    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1, r.stderr
+    assert all(w in r.stderr for w in words), r.stderr
+
+
 def test_solver_failure_exits_3_and_leaves_nothing(tmp_path, cli):
     sc = tmp_path / "few.toml"
     sc.write_text(BASE + "\n[solver]\nmax_events = 1\n")

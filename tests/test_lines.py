@@ -310,6 +310,23 @@ def test_a_line_that_is_not_connected_is_refused_by_name(pressure, match):
         _scenario([_component("reservoir", "reservoir", volume_m3=2e-5)], pressure=pressure)
 
 
+def test_a_required_parameter_left_out_is_a_missing_key():
+    """A first-order supply without its time constant: the key is named as missing, not shown as a value."""
+    with pytest.raises(InputError, match=r"missing key component\[0\]\.tau_s: supply needs tau_s") as refused:
+        _scenario([_component("supply", "supply", SUPPLY_SET, response="first_order")])
+    assert "None" not in str(refused.value)
+
+
+def test_a_tube_with_both_ends_on_one_volume_is_refused_by_key():
+    """A hose whose inlet and outlet are on one port joins the volume to itself: refused naming the second end."""
+    hose = _component("hose", "tube", {"inlet": "reservoir.port", "outlet": "reservoir.port"}, length_m=1.0,
+                      diameter_m=0.004)
+    with pytest.raises(InputError, match=r"component\[1\]\.connect\.outlet = 'reservoir\.port': is where its inlet "
+                                         r"is connected too"):
+        _scenario([_component("reservoir", "reservoir", volume_m3=2e-5), hose],
+                  pressure={"supply_port": "reservoir.port"})
+
+
 def test_an_unconnected_port_says_which_valve_key_wired_its_component():
     """The valve on the tube's outlet (which the tube already joins to the chamber) leaves the tube's inlet
     unconnected: the assembly's error names that port and the key that put the valve there."""

@@ -34,11 +34,21 @@ COMMANDS = (
 )
 
 
+class _Parser(argparse.ArgumentParser):
+    """An argument parser whose mistakes are one line, as every other user mistake of ``pamsim`` is: the
+    command, the argument and why, and where the help is (exit code 2); not the usage block first."""
+
+    def error(self, message: str):
+        if message.endswith("expected one argument"):  # or its value begins with '-' and reads as an option
+            message += " (a value that begins with '-' goes after '=': --option=-1)"
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The ``pamsim`` parser: ``--version`` and one subcommand per module of :data:`COMMANDS`, each added by
-    its ``register``.
+    its ``register`` (its subparsers are of the same one-line-error class).
     """
-    parser = argparse.ArgumentParser(prog="pamsim", description="McKibben muscle simulator")
+    parser = _Parser(prog="pamsim", description="McKibben muscle simulator")
     parser.add_argument("--version", action="version", version="pamsim " + __import__("pamsim").__version__)
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for name in COMMANDS:

@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 
 from ..errors import InputError
-from .outputs import wall_time_text, write_run_files
+from .outputs import rhs_text, wall_time_text, write_run_files
 
 
 def is_length_driven(scenario) -> bool:
@@ -51,6 +51,7 @@ def run_length_drive(scenario, args: argparse.Namespace, out: Path) -> list[str]
     print(f"{scenario.name} ({args.backend}): {summary['motion']} motion over {x0 * 1e3:.2f} to {x1 * 1e3:.2f} mm, "
           f"force {lo:.3f} to {hi:.3f} N, final {summary['final_force_N']:.3f} N; work done on the muscle "
           f"{summary['work_on_muscle_J'] * 1e3:.4f} mJ; {len(summary['events'])} events, "
-          f"{summary['stats']['rhs_evaluations']} RHS evaluations, {wall_time_text(summary['stats']['wall_time_s'])}")
+          f"{rhs_text(summary['stats']['rhs_evaluations'], args.backend)}, "
+          f"{wall_time_text(summary['stats']['wall_time_s'])}")
     print(f"wrote {', '.join(str(out / n) for n in names)}")
     return []

@@ -195,8 +195,11 @@ def _linearize(scenario, args: argparse.Namespace):
     pwm = scenario.pwm_model is not None
     if "inlet" in scenario.spec["pressure"] and not pwm:
         kind = scenario.spec["pressure"]["inlet"]["command"].get("kind")
-        raise InputError(f"{scenario.origin}: pressure.inlet.command.kind = {kind!r}: pamsim linearize takes two 2/2 "
-                         "valves through their averaged model, under a pwm inlet command and a complementary exhaust")
+        raise InputError(f"{scenario.origin}: pressure.inlet.command.kind = {kind!r}: two on/off 2/2 valves under "
+                         "boolean commands have no continuous input to linearise in (each is open or shut); pamsim "
+                         "linearize takes the pair through its averaged model, whose input is the inlet's duty: give "
+                         "the inlet a 'pwm' command at the duty to linearise at (the exhaust complementary, or held "
+                         "open or shut by a command of its own)")
     if pwm:
         if args.valve_slope != "mean":
             raise InputError(f"--valve-slope {args.valve_slope}: a PWM valve is linearised through its averaged "

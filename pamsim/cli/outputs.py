@@ -26,6 +26,13 @@ def write_run_files(out: Path, name: str, args: argparse.Namespace, to_csv: Call
     return names
 
 
+def rhs_text(rhs_evaluations: int, backend: str) -> str:
+    """A run's right-hand-side evaluations for its summary line; an FMU's solver does not report its own."""
+    if backend.startswith("fmu"):
+        return "RHS evaluations not counted (the FMU's own solver)"
+    return f"{rhs_evaluations} RHS evaluations"
+
+
 def wall_time_text(wall_time_s: float) -> str:
     """A run's wall time for its summary line, to three figures: a native run takes a fraction of a
     millisecond, which whole milliseconds printed as 0 ms."""

@@ -18,7 +18,7 @@ from ..backends import BACKENDS, DESCRIPTIONS, check_backend
 from ..errors import InputError
 from . import figure_args, finite_float
 from .length_run import check_length_drive, is_length_driven, run_length_drive
-from .outputs import wall_time_text, write_run_files
+from .outputs import rhs_text, wall_time_text, write_run_files
 
 MAX_CSV_MB = 200.0
 """Default limit of ``pamsim run --max-csv-MB``: a CSV beyond it is refused before the run."""
@@ -43,7 +43,7 @@ def register(sub) -> None:
     p.add_argument("--max-csv-MB", type=finite_float, default=MAX_CSV_MB, metavar="MB",
                    help=f"refuse a run whose CSV could exceed this size (default {MAX_CSV_MB:g} MB; "
                         "the estimate is an upper bound, about twice the usual size)")
-    p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr (shown after 1 s)")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr (shown after 1 s on a terminal)")
     p.set_defaults(func=run)
 
 
@@ -184,7 +184,7 @@ def _run_joint(scenario, args: argparse.Namespace, out: Path) -> list[str]:
     pos = scenario.body.position
     final = f"final angle {summary[f'final_{pos}']:.4f} rad" if joint else f"final position {summary[f'final_{pos}'] * 1e3:.3f} mm"
     print(f"{scenario.name}: {final} ({summary['final_mode']}), {muscles}; "
-          f"{len(summary['events'])} events, {result.stats['rhs_evaluations']} RHS evaluations, "
+          f"{len(summary['events'])} events, {rhs_text(result.stats['rhs_evaluations'], args.backend)}, "
           f"{wall_time_text(result.wall_time_s)}")
     if joint:
         print(f"  at rest at these pressures the joint balances at {eq.theta_rad:.4f} rad"
@@ -260,9 +260,9 @@ def _run_one(scenario, args: argparse.Namespace, out: Path) -> list[str]:
 
     from ..api import run as run_scenario
 
-    # Shown only for runs that last over a second; cleared when done.
+    # Shown only for runs that last over a second, on a terminal (a log keeps every redraw); cleared when done.
     with tqdm(total=scenario.duration_s, desc=scenario.name, unit="s simulated", delay=1.0, leave=False,
-              file=sys.stderr, disable=args.no_progress, bar_format="{l_bar}{bar}| {n:.3g}/{total:g} s "
+              file=sys.stderr, disable=args.no_progress or not sys.stderr.isatty(), bar_format="{l_bar}{bar}| {n:.3g}/{total:g} s "
               "[{elapsed}<{remaining}]") as bar:
         outcome = run_scenario(scenario, args.backend, progress=lambda t: bar.update(t - bar.n))
     result = outcome.result
@@ -275,7 +275,7 @@ def _run_one(scenario, args: argparse.Namespace, out: Path) -> list[str]:
     print(f"{scenario.name}: final contraction {s['final_contraction_m'] * 1e3:.2f} mm "
           f"(peak {s['peak_contraction_m'] * 1e3:.2f} mm), final pressure {s['final_pressure_gauge_Pa'] / 1e5:.3f} bar, "
           f"{'at rest' if s['at_rest_at_end'] else 'still moving'} ({s['final_mode']}), {s['events']} events, "
-          f"{s['rhs_evaluations']} RHS evaluations, {wall_time_text(s['wall_time_s'])}")
+          f"{rhs_text(s['rhs_evaluations'], args.backend)}, {wall_time_text(s['wall_time_s'])}")
     if outcome.closed_loop is not None:
         c = s["controller"]
         m = c["metrics"]

@@ -94,8 +94,8 @@ def require_valve_source(model: MuscleModel) -> None:
     """Raise :class:`InputError` for a ``model`` whose pressure is not fed by a valve: a control model's input
     is the valve's command."""
     if not isinstance(model.source, ValveChamberSource):
-        raise InputError(f"control models need a valve source (source = 'valve'); this model uses "
-                         f"{getattr(model.source, 'name', type(model.source).__name__)!r}")
+        raise InputError(f"pressure.source = {getattr(model.source, 'name', type(model.source).__name__)!r}: control "
+                         "models need a valve source (pressure.source = 'valve'): their input is the valve's command")
 
 
 class MusclePlant:
