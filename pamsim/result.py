@@ -340,7 +340,17 @@ def running_losses(t_s: np.ndarray, loss_t_s, loss_J: np.ndarray) -> np.ndarray:
     return out
 
 
-def _closed_valve_warning(command, t_end: float) -> str:
+def _opens_in_run(command, t_s: np.ndarray) -> bool:
+    """Whether ``command`` rises above 0 (opens the valve to the supply) before the run's end: at a sample,
+    or for a PWM anywhere in its trace (a pulse may open it between two samples)."""
+    if isinstance(command, Pwm):
+        opens_s = _first_opening_s(command)
+        return opens_s is not None and opens_s < float(t_s[-1])
+    # ndarray methods, not np.any: the same reduction without numpy's dispatch, run after run
+    return bool((np.asarray(at_samples(command, t_s)) > 0.0).any())
+
+
+def _closed_valve_warning(command, t_end: float, key: str = "pressure.command") -> str:
     """Why a valve whose command never rises above 0 (closed, or a 3/2 valve's exhaust side) kept the muscle
     from its supply: a step or a first opening after the run's end, a PWM whose high level does not open it,
     or PWM pulses too short for the valve's delays and opening time (the command is the opening the valve
@@ -348,10 +358,10 @@ def _closed_valve_warning(command, t_end: float) -> str:
     if isinstance(command, Pwm) and command.duty > 0.0 and command.start_s < t_end:
         if command.high <= 0.0:
             return (f"the valve never opens toward the supply: its PWM command's high level, "
-                    f"pressure.command.high = {command.high:g}, is at or below 0 (1 opens it to the supply)")
+                    f"{key}.high = {command.high:g}, is at or below 0 (1 opens it to the supply)")
         opens_s = _first_opening_s(command)
         if opens_s is None:
-            return _short_pulses_warning(command)
+            return _short_pulses_warning(command, key)
         return (f"the valve first opens at {opens_s:.4g} s (its PWM starts at {command.start_s:g} s, its opening "
                 f"delay is {command.delay_on_s * 1e3:.4g} ms), not before the run ends at {t_end:g} s: the muscle "
                 "never sees the supply (raise simulation.duration_s or start the PWM earlier)")
@@ -371,23 +381,25 @@ def _first_opening_s(command: Pwm) -> float | None:
     return None
 
 
-def _short_pulses_warning(command: Pwm) -> str:
+def _short_pulses_warning(command: Pwm, key: str) -> str:
     """A PWM whose pulses never move the valve past closed: each moves it toward the supply for the pulse less
     the opening delay plus the closing delay, too short for its opening to get past its middle (a 3/2 valve,
-    ``low`` < 0) or closed."""
+    ``low`` < 0), or no time at all (a 2/2 valve: the opening delay outlasts the pulse and the closing delay)."""
     period_ms = 1e3 / command.frequency_Hz
     pulse_ms = command.duty * period_ms
-    moving_ms = pulse_ms + 1e3 * (command.delay_off_s - command.delay_on_s)
-    vents = command.low < 0.0
-    need_ms = 1e3 * command.rise_s * (-command.low / (command.high - command.low) if vents else 0.0)
-    side, past = (("toward the supply past its middle (it only vents)", "from exhaust to its middle") if vents
-                  else ("at all", "to open"))
+    moving_ms = max(pulse_ms + 1e3 * (command.delay_off_s - command.delay_on_s), 0.0)
+    timing = (f"the pulse, less its {command.delay_on_s * 1e3:.4g} ms opening delay, plus its "
+              f"{command.delay_off_s * 1e3:.4g} ms closing delay")
+    if command.low < 0.0:
+        need_ms = 1e3 * command.rise_s * -command.low / (command.high - command.low)
+        side = "toward the supply past its middle (it only vents)"
+        why = (f"for {moving_ms:.4g} ms ({timing}), too short for the {need_ms:.4g} ms its "
+               f"{command.rise_s * 1e3:.4g} ms opening takes from exhaust to its middle")
+    else:
+        side, why = "at all", f"for no time ({timing}): it never starts to open"
     return (f"the valve never opens {side}: each PWM pulse, {pulse_ms:.4g} ms of a {period_ms:.4g} ms period at "
-            f"{command.frequency_Hz:g} Hz, moves it toward the supply for {max(moving_ms, 0.0):.4g} ms (the pulse, "
-            f"less its {command.delay_on_s * 1e3:.4g} ms opening delay, plus its {command.delay_off_s * 1e3:.4g} "
-            f"ms closing delay), too short for the {need_ms:.4g} ms its {command.rise_s * 1e3:.4g} ms opening "
-            f"takes {past}: the muscle never sees the supply (lower pressure.command.frequency_Hz or raise "
-            "its duty)")
+            f"{command.frequency_Hz:g} Hz, moves it toward the supply {why}; the muscle never sees the supply "
+            f"(lower {key}.frequency_Hz or raise its duty)")
 
 
 def pointless_run_warnings(model, t_s: np.ndarray, at_rest_at_end: bool, v_end_m_s: float) -> list[str]:
@@ -396,8 +408,10 @@ def pointless_run_warnings(model, t_s: np.ndarray, at_rest_at_end: bool, v_end_m
     out = []
     src = model.source
     # ndarray methods, not np.any and np.max: the same reductions without numpy's dispatch, run after run
-    if isinstance(src, ValveChamberSource) and not (np.asarray(at_samples(src.command, t_s)) > 0.0).any():
-        out.append(_closed_valve_warning(src.command, t_end))
+    if isinstance(src, ValveChamberSource) and not _opens_in_run(src.command, t_s):
+        # A pair's inlet is the valve that opens to the supply: its command is pressure.inlet's.
+        key = "pressure.inlet.command" if hasattr(src, "exhaust_command") else "pressure.command"
+        out.append(_closed_valve_warning(src.command, t_end, key))
     supply = _largest_supply_Pa(src, t_s)
     if supply is not None:
         blocked = float(model.static_force.force_N(0.0, supply))

@@ -261,7 +261,11 @@ def switching_levels(commands, initial: float, timing) -> tuple[list[float], lis
     states ``commands`` (``[(t_s, 1 on or 0 off), ...]``) with the delays and opening and closing times of
     ``timing`` (``delay_on_s``, ``delay_off_s``, ``rise_s``, ``fall_s``), as knots ``(times, levels)``
     (see :func:`pwm_levels`)."""
-    events = sorted((t + (timing.delay_on_s if on else timing.delay_off_s), on) for t, on in commands)
+    delayed = [(t + (timing.delay_on_s if on else timing.delay_off_s), on) for t, on in commands]
+    # A command that the next one overtakes never takes effect: a pulse shorter than the opening delay less
+    # the closing delay does not open the valve (nor does a gap that short close it), rather than the
+    # overtaken command's delayed switch landing after the next one's and holding the valve the wrong way.
+    events = sorted(e for k, e in enumerate(delayed) if k + 1 == len(delayed) or e[0] < delayed[k + 1][0])
     times, levels = [0.0], [initial]
     level, target, now = initial, initial, 0.0
     for t_event, on in events:

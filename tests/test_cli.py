@@ -180,10 +180,12 @@ def test_bad_arguments_exit_2(args, word, tmp_path, cli, monkeypatch):
 @pytest.mark.parametrize("args, words", [
     (["fit", "hysteresis", "loop.csv", "--model", "foo"], ["pamsim fit hysteresis: error: argument --model",
                                                            "'foo'", "see pamsim fit hysteresis --help"]),
-    (["fit", "hysteresis", "loop.csv", "--thresholds-mm", "-1,2"], ["--thresholds-mm", "goes after '='"]),
+    (["fit", "hysteresis", "loop.csv", "--thresholds-mm", "-1,2"], ["is written --thresholds-mm=VALUE"]),
     (["run"], ["pamsim run: error:", "scenario"]),
+    (["run", "x.toml", "--no-figure"], ["pamsim run: error: unrecognized arguments: --no-figure",
+                                        "see pamsim run --help"]),
     (["bogus"], ["pamsim: error:", "'bogus'"]),
-], ids=["invalid choice", "value like an option", "missing argument", "unknown command"])
+], ids=["invalid choice", "value like an option", "missing argument", "unknown option", "unknown command"])
 def test_a_mistake_in_the_arguments_is_one_line(args, words):
     """argparse's mistakes print one line naming the argument (not the usage block first), exit code 2."""
     r = pamsim(*args)

@@ -388,6 +388,32 @@ def test_pwm_pulses_too_short_for_the_valve_say_so_not_that_it_opens_too_late():
     assert not [w for w in slow.warnings if "valve" in w], slow.warnings
 
 
+def _pwm_3_2(duration_s: float, **command):
+    sc = pamsim.load_scenario(SCENARIOS / "pwm_3_2.toml")
+    return sc.with_changes({"pressure": {"command": {**sc.spec["pressure"]["command"], **command}},
+                            "simulation": {"duration_s": duration_s}})
+
+
+def test_a_pulse_whose_closing_overtakes_its_opening_does_not_open_the_valve():
+    """A 2 ms pulse against a 5 ms opening delay and a 1 ms closing delay: the delayed 'off' comes 2 ms
+    before the delayed 'on', so the valve never moves toward the supply (it held the supply open 16 ms of
+    each 20 before: the 'on' landed after the 'off').  By hand, each pulse moves it 2 - 5 + 1 < 0 ms."""
+    res = pamsim.simulate(_pwm_3_2(1.5, duty=0.1, delay_on_s=0.005, delay_off_s=0.001))
+    assert float(np.max(res.signals["valve_command"])) == -1.0  # at the exhaust throughout
+    assert float(np.max(res.p_gauge_Pa)) < 1.0
+    hits = [w for w in res.warnings if "valve" in w]
+    assert len(hits) == 1 and "toward the supply for 0 ms" in hits[0], hits
+
+
+def test_a_valve_that_opens_between_two_samples_gets_no_warning():
+    """A 1.1 ms pulse at 50 Hz sampled at 1 kHz, its opening between samples: the valve opens in the run, so
+    neither 'never opens' nor 'opens after the run ends' is said."""
+    sc = _pwm_3_2(1.0, duty=0.055, start_s=0.5004).with_changes({"simulation": {"sample_rate_Hz": 1000.0}})
+    res = pamsim.simulate(sc)
+    assert not (res.signals["valve_command"] > 0.0).any()  # no sample sees the opening
+    assert not [w for w in res.warnings if "valve" in w], res.warnings
+
+
 @pytest.mark.parametrize("changes, words, not_words", [
     # The run ends as the first pulse opens it: by hand 0.5 s + 2 ms delay + half the 2 ms rise = 0.503 s.
     ({"simulation": {"duration_s": 0.503}}, ["first opens at 0.503 s", "raise simulation.duration_s"], ["PWM pulse,"]),

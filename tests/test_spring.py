@@ -113,7 +113,7 @@ def test_a_parameter_outside_its_range_is_refused():
 def test_a_missing_parameter_is_refused():
     spec = copy.deepcopy(SPEC)
     del spec["component"][0]["x_free_m"]
-    with pytest.raises(InputError, match=r"component\[0\]\.x_free_m.*missing"):
+    with pytest.raises(InputError, match=r"missing key component\[0\]\.x_free_m: linear_spring needs"):
         pamsim.Scenario.from_dict(spec)
 
 

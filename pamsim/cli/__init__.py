@@ -39,9 +39,21 @@ class _Parser(argparse.ArgumentParser):
     command, the argument and why, and where the help is (exit code 2); not the usage block first."""
 
     def error(self, message: str):
-        if message.endswith("expected one argument"):  # or its value begins with '-' and reads as an option
-            message += " (a value that begins with '-' goes after '=': --option=-1)"
+        if message.endswith("expected one argument"):  # left out, or it begins with '-' and reads as an option
+            option = message.removeprefix("argument ").partition(":")[0].split("/")[-1]
+            message += f" (a value that begins with '-' is written {option}=VALUE)"
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
+def _command_parser(parser: argparse.ArgumentParser, argv: list[str]) -> argparse.ArgumentParser:
+    """The (sub)command's own parser that ``argv`` reaches (``pamsim fit hysteresis``'s for its arguments):
+    the one whose help lists the options a mistake is about."""
+    for token in argv:
+        commands = next((a.choices for a in parser._actions if isinstance(a, argparse._SubParsersAction)), None)
+        if commands is None:
+            break
+        parser = commands.get(token, parser)
+    return parser
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -65,7 +77,10 @@ def main(argv: list[str] | None = None) -> int:
     an interrupt 130, SIGTERM (handled as an interrupt) 143.
     """
     parser = build_parser()
-    args = parser.parse_args(argv)
+    argv = sys.argv[1:] if argv is None else list(argv)
+    args, unknown = parser.parse_known_args(argv)
+    if unknown:  # told by the command they were given to, whose --help lists its options
+        _command_parser(parser, argv).error(f"unrecognized arguments: {' '.join(unknown)}")
     try:
         with _sigterm_as_interrupt(), warnings.catch_warnings():
             # scipy warns of an LSODA failure before pamsim reports it (its reason in the solver failure)

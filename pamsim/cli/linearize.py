@@ -48,16 +48,21 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
+def _listed(names: list[str]) -> str:
+    """``a``, ``a and b``, ``a, b and c``."""
+    return " and ".join(names) if len(names) < 3 else f"{', '.join(names[:-1])} and {names[-1]}"
+
+
 def _joint_friction_line(muscles: list[str], with_hysteresis: list[str]) -> str:
     """What a joint's linearisation did with friction: the bearing's and the Coulomb friction of the muscles
     without ``[hysteresis]`` dropped, each named; the elements of the others in its place."""
     dropped = [m for m in muscles if m not in with_hysteresis]
-    whose = "the bearing's" + (f" and that of muscle{'s' * (len(dropped) > 1)} {' and '.join(dropped)}"
+    whose = "the bearing's" + (f" and that of muscle{'s' * (len(dropped) > 1)} {_listed(dropped)}"
                                if dropped else "")
     line = f"Coulomb friction dropped ({whose}: no linearisation at rest)"
     if with_hysteresis:
         line += (f"; the [hysteresis] elements of muscle{'s' * (len(with_hysteresis) > 1)} "
-                 f"{' and '.join(with_hysteresis)} take "
+                 f"{_listed(with_hysteresis)} take "
                  f"{'its' if len(with_hysteresis) == 1 else 'their'} Coulomb friction's place (below)")
     return line
 
