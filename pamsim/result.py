@@ -241,7 +241,9 @@ class Result:
             "final_net_force_N": float(self.final_rest_forces_N[0]),
             "final_coulomb_level_N": float(self.final_rest_forces_N[1]),
             "events": int(self.stats["events"]),
-            "rhs_evaluations": int(self.stats["rhs_evaluations"]),
+            # an FMU's own solver does not report its evaluations: not counted (null), rather than 0
+            "rhs_evaluations": (None if str(self.stats.get("method", "")).startswith("fmu")
+                                else int(self.stats["rhs_evaluations"])),
             "segments": int(self.stats["segments"]),
             # what the backend counts: an FMU's runs count no Jacobians
             **{k: self.stats[k] for k in ("jacobians", "method", "rtol") if k in self.stats},

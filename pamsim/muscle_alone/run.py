@@ -210,6 +210,6 @@ def _fmu(drive: LengthDrive, backend: str) -> LengthDrivenResult:
     events = [(float(t[j + 1]), name.replace("slipping", "slip")) for name in slipping
               for j in np.flatnonzero(np.diff(result.signals[name]) > 0.5)]
     result.events = sorted(events)
-    result.stats = {"rhs_evaluations": 0, "events": len(events), "segments": 0, "jacobians": 0, "method": backend,
+    result.stats = {"rhs_evaluations": None, "events": len(events), "segments": 0, "jacobians": 0, "method": backend,
                     "rtol": sc.solver.rtol}
     return result
