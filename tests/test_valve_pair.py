@@ -446,15 +446,35 @@ def test_bad_3_2_path_keys_exit_2_naming_the_key(tmp_path, cli, key, value, mess
     assert_refused(cli("run", path, "-o", tmp_path / "out"), message, tmp_path / "out")
 
 
-def test_linearize_refuses_a_pair_without_pwm(tmp_path, cli):
-    """Two valves under boolean commands have no averaged model to linearise: refused naming the inlet's kind
-    (at the default operating point and at a run's time alike)."""
+@pytest.mark.parametrize("at_time, side", [(None, -1.0), (0.3, 1.0)], ids=["inlet open (the end)", "inlet shut (0.3 s)"])
+def test_linearize_takes_a_boolean_pair_in_the_inlets_opening(tmp_path, cli, at_time, side):
+    """Two valves under boolean commands (the inlet a step open at 0.5 s, the exhaust complementary) are
+    linearised in the inlet's opening: its B column and the pressure's own A entry are the switching pair's
+    flow law differentiated by hand (one-sided into the openings' range: from below where the inlet is open,
+    from above where it is shut), at the operating point the command prints."""
+    import json
+
     path = _bad(tmp_path, ('kind = "pwm"\nstart_s = 0.5\nend_s = 4.5\n', 'kind = "step"\ntime_s = 0.5\nfinal = 1.0\n'),
                 ("frequency_Hz = 50.0", "#"), ("duty = 0.5\n", "\n"))
     assert cli("run", path, "-o", tmp_path / "ok").returncode == 0
-    for extra in ((), ("--at-time", "1.0")):
-        assert_refused(cli("linearize", path, *extra, "-o", tmp_path / "out"), "pressure.inlet.command.kind",
-                       tmp_path / "out")
+    extra = () if at_time is None else ("--at-time", str(at_time))
+    done = cli("linearize", path, *extra, "--json")
+    assert done.returncode == 0, done.stderr
+    rep = json.loads(done.stdout)
+    assert "under boolean commands" in rep["valve_model"] and rep["inputs"][0] == "pwm_duty"
+    x, v, p, m = rep["operating_point"]["states"]
+    supply = rep["operating_point"]["inputs"][1]
+    src = pamsim.load_scenario(path).build_model().source  # the switching pair's own flow law
+
+    def dp_dt(inlet: float, p_abs: float = p) -> float:
+        return src.derivatives(np.array([p_abs, m]), x, v, (inlet, 1.0 - inlet, supply))[0]
+    u0 = 1.0 if side < 0 else 0.0
+    assert rep["operating_point"]["inputs"][0] == u0
+    h = 1e-7
+    row = rep["states"].index("p_abs_Pa")
+    assert rep["B"][row][0] == pytest.approx((dp_dt(u0 + side * h) - dp_dt(u0)) / (side * h), rel=1e-6)
+    dp = 0.05  # Pa: the flow law curves near the ambient, and a central difference of 1 Pa is off by 2.5e-6
+    assert rep["A"][row][row] == pytest.approx((dp_dt(u0, p + dp) - dp_dt(u0, p - dp)) / (2.0 * dp), rel=1e-6)
 
 
 def test_a_closed_loop_on_two_valves_is_refused(tmp_path, cli):

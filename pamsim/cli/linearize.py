@@ -191,31 +191,35 @@ def _linearize_joint(scenario, args: argparse.Namespace) -> int:
 
 def _linearize(scenario, args: argparse.Namespace):
     """Linearise at the operating point the arguments choose: (model, report).  A scenario whose valve is
-    driven by PWM is linearised through its averaged valve, its input the duty."""
+    driven by PWM is linearised through its averaged valve, its input the duty; two 2/2 valves under boolean
+    commands through the same model without the PWM, its input the inlet's opening
+    (:func:`_boolean_pair_as_openings`)."""
     from ..control.exact import rest_pull
     from ..control.linear import linearize
     from ..control.system import FrictionTreatment
     from ..errors import InputError
 
     pwm = scenario.pwm_model is not None
-    if "inlet" in scenario.spec["pressure"] and not pwm:
-        kind = scenario.spec["pressure"]["inlet"]["command"].get("kind")
-        raise InputError(f"{scenario.origin}: pressure.inlet.command.kind = {kind!r}: two on/off 2/2 valves under "
-                         "boolean commands have no continuous input to linearise in (each is open or shut); pamsim "
-                         "linearize takes the pair through its averaged model, whose input is the inlet's duty: give "
-                         "the inlet a 'pwm' command at the duty to linearise at (the exhaust complementary, or held "
-                         "open or shut by a command of its own)")
-    if pwm:
+    boolean_pair = "inlet" in scenario.spec["pressure"] and not pwm
+    # The run an --at-time operating point is taken from: a PWM's averaged run, a boolean pair's own switching
+    trajectory = scenario
+    if boolean_pair:
+        if args.valve_slope != "mean":
+            raise InputError(f"--valve-slope {args.valve_slope}: two 2/2 valves are linearised in the inlet's "
+                             "opening, which has no command kink to choose a slope at")
+        scenario = _boolean_pair_as_openings(scenario, args.at_time or scenario.duration_s)
+        pwm = True
+    elif pwm:
         if args.valve_slope != "mean":
             raise InputError(f"--valve-slope {args.valve_slope}: a PWM valve is linearised through its averaged "
                              "model, whose input is the duty; it has no command kink to choose a slope at")
-        scenario = scenario.with_pwm_averaged()
+        scenario = trajectory = scenario.with_pwm_averaged()
     model = _at_inlet_duty(scenario, scenario.build_model())
     added = scenario.added_components
     if "hysteresis" in scenario.spec and args.friction != "dropped":
         raise InputError(f"--friction {args.friction}: the scenario's [hysteresis] elements take the Coulomb "
                          "friction's place; they are linearised in their stick state at the operating point")
-    op = _operating_point(scenario, model, rest_pull(model, added), args)
+    op = _operating_point(trajectory, model, rest_pull(model, added), args, pwm)
     friction = FrictionTreatment(args.friction, args.friction_velocity_mm_s * 1e-3)
     lin = linearize(model, op, friction, args.valve_slope, added=added)
     rep = report(lin)
@@ -223,11 +227,42 @@ def _linearize(scenario, args: argparse.Namespace):
     valves = ("the on/off valve" if "inlet" not in scenario.spec["pressure"]
               else "the inlet and exhaust 2/2 valves (the exhaust complementary)" if exhaust is None
               else f"the inlet and exhaust 2/2 valves (the exhaust open {exhaust:.4g} of the time, by its own command)")
-    rep["valve_model"] = (f"the averaged model of {valves} under {model.source.valve.frequency_Hz:g} Hz PWM "
-                          "(the mean of its supply and exhaust paths' flows over a period), input pwm_duty [1]; "
-                          "pamsim run runs its switching" if pwm
-                          else f"proportional 3/3 valve, slope at command 0: {lin.valve_slope}")
+    if boolean_pair:
+        rep["valve_model"] = (f"{valves} under boolean commands, each valve's flow its opening times its orifice's "
+                              "(the inlet's opening the input pwm_duty [1], the exhaust's "
+                              + ("1 - pwm_duty" if exhaust is None else "held") + "); pamsim run runs their switching")
+    else:
+        rep["valve_model"] = (f"the averaged model of {valves} under {model.source.valve.frequency_Hz:g} Hz PWM "
+                              "(the mean of its supply and exhaust paths' flows over a period), input pwm_duty [1]; "
+                              "pamsim run runs its switching" if pwm
+                              else f"proportional 3/3 valve, slope at command 0: {lin.valve_slope}")
     return lin, rep
+
+
+def _boolean_pair_as_openings(scenario, time_s: float):
+    """``scenario``'s two 2/2 valves under boolean commands as the pair whose inlet opens by its input, the
+    model of the averaged PWM pair without its PWM: the inlet's command a duty equal to its opening at
+    ``time_s`` from the run's start to its end, with no delays or switching times (the mean opening is then
+    the duty, :meth:`pamsim.elements.pwm_average.PwmShare.share`); an exhaust with a command of its own held
+    at its opening then, a complementary one still complementary (``1 - duty``)."""
+    from ..errors import InputError
+
+    model = scenario.build_model()
+    if not 0.0 < time_s <= scenario.duration_s:
+        raise InputError(f"--at-time {time_s:g} s: must lie in (0, {scenario.duration_s:g}] s, the scenario's "
+                         "duration")
+    inlet_opening, exhaust_opening, _ = (float(u) for u in model.source.inputs(float(time_s)))
+    pressure = scenario.spec["pressure"]
+    untimed = {k: 0.0 for k in ("delay_on_s", "delay_off_s", "rise_s", "fall_s")}
+    inlet = {**pressure["inlet"], **untimed, "command": {
+        "kind": "pwm", "start_s": 0.0, "end_s": scenario.duration_s, "frequency_Hz": 50.0,
+        "duty": inlet_opening, "model": "averaged"}}
+    exhaust = dict(pressure["exhaust"])
+    if exhaust["command"].get("kind") == "complementary":
+        exhaust.update(untimed)
+    else:
+        exhaust["command"] = {"kind": "constant", "value": exhaust_opening}
+    return scenario.with_changes({"pressure": {"inlet": inlet, "exhaust": exhaust}})
 
 
 def _at_inlet_duty(scenario, model):
@@ -248,13 +283,12 @@ def _at_inlet_duty(scenario, model):
                          f"pair averaged at the inlet's duty, the exhaust at a fixed share: {exc}") from None
 
 
-def _operating_point(scenario, model, pull, args: argparse.Namespace):
-    """The operating point the arguments choose, the averaged PWM valve's for a model that has one."""
+def _operating_point(scenario, model, pull, args: argparse.Namespace, pwm: bool):
+    """The operating point the arguments choose, the averaged PWM valve's for a model that has one (``pwm``)."""
     from ..control.operating_point import (averaged_pwm_equilibrium, averaged_pwm_held, held_equilibrium,
                                            open_valve_equilibrium, trajectory_point)
 
     supply = scenario.final_pressure_gauge_Pa
-    pwm = scenario.pwm_model is not None
     if args.at_time is not None:
         return trajectory_point(scenario, args.at_time)
     if args.contraction_mm is not None:

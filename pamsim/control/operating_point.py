@@ -196,7 +196,9 @@ def trajectory_point(scenario, time_s: float) -> OperatingPoint:
     result = simulate(scenario.with_changes({"simulation": {"duration_s": float(time_s)}}))
     p_abs = result.p_gauge_Pa[-1] + model.source.p_atm_Pa
     states = np.array([result.x_m[-1], result.v_m_s[-1], p_abs, result.signals["air_mass_kg"][-1]], dtype=float)
-    command, supply = model.source.inputs(float(time_s))
+    # A valve pair's inputs are (inlet, exhaust, supply): the inlet's opening is the averaged model's duty
+    inputs = model.source.inputs(float(time_s))
+    command, supply = inputs[0], inputs[-1]
     mode = result.final_mode
     added = {f"{a.component.name}.{v.name}" for a in scenario.added_components for v in a.component.states}
     line = {name: float(values[-1]) for name, values in result.signals.items() if name in added}
