@@ -149,18 +149,24 @@ def _pressure_panel(ax, result: "Result", measured) -> None:
     if "supply_gauge_Pa" in result.signals:
         ax.plot(t, result.signals["supply_gauge_Pa"] / PA_PER_BAR, **series(3, "k"), label="supply")
         labels.append("supply")
-    line = line_pressures(result)
-    # Style 0 is the muscle's and 3 the supply's: every other k differs from both in line style or marker.
-    styles = (k for k in itertools.count(1) if k != 3)
-    for (name, p_gauge_Pa), k in zip(line.items(), styles):
-        # A component may share a name with a line above ("supply": the regulator beside the rig's set pressure).
-        label = f"{name} (component)" if name in labels else name
-        ax.plot(t, p_gauge_Pa / PA_PER_BAR, **series(k), label=label)
+    line = draw_line_pressures(ax, result, tuple(labels))
     if measured is not None:
         draw_measured(ax, measured, measured.pressure_stable_bar, measured_labels(measured)[1])
     ax.set_ylabel("gauge pressure [bar]")
     ax.legend(loc="lower right", fontsize=8, **({"ncol": 2} if line else {}))
     ax.grid(alpha=0.3)
+
+
+def draw_line_pressures(ax, result: "Result", taken: tuple[str, ...] = (), **line) -> bool:
+    """Each line component's gauge pressure [bar] on ``ax`` (:func:`line_pressures`) with ``line``'s keywords,
+    in the styles that differ from series 0 and 3 (the muscle's and the supply's or the feedforward's), under
+    its name, or ``NAME (component)`` where the name is one of ``taken`` (the regulator "supply" beside the rig's
+    set pressure); whether there was any."""
+    pressures = line_pressures(result)
+    for (name, p_gauge_Pa), k in zip(pressures.items(), (k for k in itertools.count(1) if k != 3)):
+        ax.plot(result.t_s, p_gauge_Pa / PA_PER_BAR, label=f"{name} (component)" if name in taken else name,
+                **line, **series(k))
+    return bool(pressures)
 
 
 def line_pressures(result: "Result") -> dict[str, np.ndarray]:

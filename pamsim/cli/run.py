@@ -43,7 +43,8 @@ def register(sub) -> None:
     p.add_argument("--max-csv-MB", type=finite_float, default=MAX_CSV_MB, metavar="MB",
                    help=f"refuse a run whose CSV could exceed this size (default {MAX_CSV_MB:g} MB; "
                         "the estimate is an upper bound, about twice the usual size)")
-    p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr (shown after 1 s on a terminal)")
+    p.add_argument("--no-progress", action="store_true",
+                   help="no progress bar on stderr (shown after 1 s on a terminal)")
     p.set_defaults(func=run)
 
 
@@ -262,8 +263,8 @@ def _run_one(scenario, args: argparse.Namespace, out: Path) -> list[str]:
 
     # Shown only for runs that last over a second, on a terminal (a log keeps every redraw); cleared when done.
     with tqdm(total=scenario.duration_s, desc=scenario.name, unit="s simulated", delay=1.0, leave=False,
-              file=sys.stderr, disable=args.no_progress or not sys.stderr.isatty(), bar_format="{l_bar}{bar}| {n:.3g}/{total:g} s "
-              "[{elapsed}<{remaining}]") as bar:
+              file=sys.stderr, disable=args.no_progress or not sys.stderr.isatty(),
+              bar_format="{l_bar}{bar}| {n:.3g}/{total:g} s [{elapsed}<{remaining}]") as bar:
         outcome = run_scenario(scenario, args.backend, progress=lambda t: bar.update(t - bar.n))
     result = outcome.result
     summary = outcome.summary()

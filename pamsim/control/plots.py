@@ -6,7 +6,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from ..figure_style import series
-from ..plotting import X_LABEL, line_pressures, shade_held
+from ..plotting import X_LABEL, draw_line_pressures, shade_held
 from .linear import LinearModel
 
 _BODE_CHANNELS = ((None, "contraction_m"), (None, "p_gauge_Pa"),
@@ -88,9 +88,7 @@ def closed_loop_figure(run) -> Figure:
     ax_p.plot(res.t_s, res.p_gauge_Pa / 1e5, label="chamber", **series(0, "C3"))
     ax_p.plot(res.t_s, res.signals["feedforward_gauge_Pa"] / 1e5, label="holding pressure (feedforward)",
               **series(3, "k"))
-    # Styles 0 and 3 are taken above: the line's components get the others.
-    for (name, p_gauge_Pa), k in zip(line_pressures(res).items(), (k for k in range(1, 20) if k != 3)):
-        ax_p.plot(res.t_s, p_gauge_Pa / 1e5, lw=1, label=name, **series(k))
+    draw_line_pressures(ax_p, res, lw=1)
     ax_p.set_ylabel("gauge pressure [bar]")
     ax_p.legend(loc="lower right", fontsize=8)
     ax_u.plot(res.t_s, res.signals["valve_command"], label="command", **series(0, "C2"))
